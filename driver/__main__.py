@@ -1,0 +1,6 @@
+"""``python -m driver DECK ...``"""
+import sys
+
+from driver.cli import main
+
+sys.exit(main())

@@ -1,0 +1,175 @@
+"""Command line: ``python -m driver DECK [DECK ...] [-o OUTDIR] [--csv|--format F] [--plot]``.
+
+Each deck runs on its own; the exit status is 0 when every deck succeeded,
+2 when any deck had bad input (nothing written for that deck), 1 when a run
+failed otherwise (e.g. an optimiser did not converge; its outputs say so).
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import pkgutil
+import sys
+import traceback
+from pathlib import Path
+from types import ModuleType
+
+import driver
+from driver.atomic import write_text
+from driver.deck import Deck, DeckError, Params, read_deck, validate
+from driver.export import FORMATS, write_tidy
+from driver.study import Result, load_study
+
+__all__ = ["main", "study_of", "write_outputs", "run_deck", "EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT"]
+
+EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+
+#: groups handled by the driver itself rather than by a study module
+CONTROL_GROUPS = ("sweep",)
+
+
+def available_studies() -> dict[str, ModuleType]:
+    """Every study module in the package, by group name."""
+    found = {}
+    for info in pkgutil.iter_modules(driver.__path__):
+        module = load_study(info.name)
+        if module is not None:
+            found[info.name] = module
+    return found
+
+
+def study_of(deck: Deck) -> tuple[ModuleType, Params]:
+    """The single study group of a deck, validated; DeckError otherwise."""
+    studies = []
+    for name, raw in deck.groups.items():
+        if name in CONTROL_GROUPS:
+            continue
+        module = load_study(name)
+        if module is None:
+            known = ", ".join(f"&{g}" for g in sorted(available_studies()) + list(CONTROL_GROUPS))
+            raise DeckError(deck.path, raw.line, None, f"unknown group &{name} (known groups: {known})")
+        studies.append((module, raw))
+    if not studies:
+        raise DeckError(deck.path, None, None, "deck has no study group")
+    if len(studies) > 1:
+        names = ", ".join(f"&{raw.name} (line {raw.line})" for _, raw in studies)
+        raise DeckError(deck.path, studies[1][1].line, None,
+                        f"a deck describes one study; found {names}")
+    module, raw = studies[0]
+    return module, validate(raw, module.SPEC, deck.path)
+
+
+def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool) -> list[Path]:
+    """Write the .out file, extra files, tidy tables and figures for one case (all atomic)."""
+    written = [write_text(stem.with_name(stem.name + ".out"), result.text)]
+    for suffix, text in result.extra.items():
+        written.append(write_text(stem.with_name(stem.name + suffix), text))
+    for fmt in formats:
+        written.append(write_tidy(result.tidy, stem, fmt))
+    if plot and result.figures:
+        from driver.plotting import save_figure
+        for fig in result.figures:
+            written.append(save_figure(fig.draw(), stem.with_name(f"{stem.name}_{fig.name}.png")))
+    return written
+
+
+def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool, progress: bool,
+             quiet: bool = False, sweep_options: dict | None = None) -> int:
+    """Run one deck; returns its exit status. Errors are printed, never raised.
+
+    ``sweep_options`` (jobs, scheduler, resume) apply when the deck has a &sweep group.
+    """
+    try:
+        deck = read_deck(path)
+        if "sweep" in deck.groups:
+            from driver import sweep
+            return sweep.run_sweep_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))
+        module, params = study_of(deck)
+        result = module.run(params, progress=progress)
+    except DeckError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        raise
+    except Exception as exc:  # a bug or an unexpected numerical failure: say so plainly
+        print(f"error: {path}: run failed: {exc.__class__.__name__}: {exc}", file=sys.stderr)
+        if os.environ.get("DRIVER_DEBUG"):
+            traceback.print_exc()
+        return EXIT_FAILED
+    for w in result.warnings:
+        print(f"warning: {path}: {w}", file=sys.stderr)
+    written = write_outputs(result, outdir / Path(path).stem, formats, plot)
+    if not quiet:
+        for p in written:
+            print(f"wrote {p}")
+    if result.failure:
+        print(f"error: {path}: {result.failure}", file=sys.stderr)
+        return EXIT_FAILED
+    return EXIT_OK
+
+
+def _keys_help(group: str) -> str:
+    module = load_study(group)
+    if module is None:
+        return f"no study group &{group}"
+    spec = module.SPEC
+    lines = [f"&{spec.name}: {spec.doc}".rstrip(": "), ""]
+    for name, key in spec.keys.items():
+        req = "required" if key.required else f"default {key.default!r}"
+        choices = f"; one of {', '.join(map(repr, key.choices))}" if key.choices else ""
+        units = f" [{key.units}]" if key.units else ""
+        lines.append(f"  {name:<22} {key.kind:<7}{units} ({req}{choices})")
+        if key.doc:
+            lines.append(f"  {'':<22} {key.doc}")
+    return "\n".join(lines)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    studies = ", ".join(f"&{g}" for g in sorted(available_studies()))
+    parser = argparse.ArgumentParser(
+        prog="python -m driver",
+        description="Run mechanism-analysis decks (Fortran namelist files) and write "
+                    "fixed-format tables to OUTDIR/<deck stem>.out.",
+        epilog=f"Study groups: {studies}; a &sweep group turns a deck into a study over "
+               "several cases. 'python -m driver --keys GROUP' lists a group's keys. "
+               "Exit status: 0 all decks succeeded, 1 a run failed, 2 bad input.",
+    )
+    parser.add_argument("decks", nargs="*", type=Path, metavar="DECK", help="input deck(s), e.g. inputs/crank5.dat")
+    parser.add_argument("-o", "--outdir", type=Path, default=Path("outputs"),
+                        help="output folder (default: outputs/, created when missing)")
+    parser.add_argument("--csv", action="store_true", help="also write the tidy table as <stem>.csv")
+    parser.add_argument("--format", dest="formats", action="append", choices=FORMATS, default=[],
+                        help="also write the tidy table in this format (repeatable)")
+    parser.add_argument("--plot", action="store_true", help="write PNG figures <stem>_<name>.png")
+    parser.add_argument("-q", "--quiet", action="store_true", help="print only warnings and errors")
+    parser.add_argument("--keys", metavar="GROUP", help="list the keys of a namelist group and exit")
+    parser.add_argument("-j", "--jobs", type=int, default=None,
+                        help="sweeps: worker processes (default: all cores)")
+    parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                        help="sweeps: run cases on this Dask distributed scheduler")
+    parser.add_argument("--resume", action="store_true",
+                        help="sweeps: skip cases whose outputs are already complete")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {driver.__version__}")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.keys:
+        print(_keys_help(args.keys.lstrip("&").lower()))
+        return EXIT_OK
+    if not args.decks:
+        parser.error("no deck given")
+    formats = list(dict.fromkeys((["csv"] if args.csv else []) + args.formats))
+    progress = sys.stderr.isatty() and not args.quiet and not os.environ.get("CI")
+    sweep_options = {"jobs": args.jobs, "scheduler": args.scheduler, "resume": args.resume}
+    status = EXIT_OK
+    try:
+        for deck in args.decks:
+            status = max(status, run_deck(deck, args.outdir, formats, args.plot, progress, args.quiet,
+                                         sweep_options))
+    except KeyboardInterrupt:
+        print("interrupted: finished outputs are complete; no partial file was left", file=sys.stderr)
+        return 130
+    return status

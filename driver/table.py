@@ -1,0 +1,118 @@
+"""The one fixed-format table writer: Fortran F/I editing in Python.
+
+Two number styles:
+
+* ``modern``: what gfortran writes (``0.5``, ``-0.0`` avoided: a value that
+  rounds to zero never carries a minus sign).
+* ``legacy``: the style of the old compiler that printed the published tables:
+  no optional leading zero (``.5``, ``-.8094``) and no sign on a value that
+  rounds to zero (``.0``).
+
+A value that does not fit its field is never written as ``****``: the writer
+widens the whole column instead and records a note, and a NaN or infinity
+raises :class:`TableValueError` (a kernel must mark such rows in words).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from decimal import ROUND_HALF_UP, Decimal
+from typing import Iterable, Sequence
+
+__all__ = ["TableValueError", "Column", "fortran_f", "fortran_i", "render_table"]
+
+
+class TableValueError(ValueError):
+    """A NaN or infinite number was about to reach a table."""
+
+
+def _round_half_up(value: float, decimals: int) -> str:
+    """Decimal text of ``value`` rounded half away from zero (Fortran's RN-compatible)."""
+    q = Decimal(1).scaleb(-decimals)
+    return str(Decimal(value).quantize(q, rounding=ROUND_HALF_UP))
+
+
+def fortran_f(value: float, w: int | None, d: int, style: str = "modern") -> str:
+    """Fortran ``Fw.d`` editing of ``value``; ``w=None`` gives the minimal width.
+
+    Raises TableValueError for NaN/inf.  The result may be longer than ``w``
+    when the value does not fit (callers widen the column; never ``****``).
+    """
+    x = float(value)
+    if not math.isfinite(x):
+        raise TableValueError(f"non-finite value {x!r} cannot be written in F{w}.{d}")
+    text = _round_half_up(x, d)
+    if text.startswith("-") and float(text) == 0.0:
+        text = text[1:]  # no sign on a value that rounds to zero
+    if style == "legacy":
+        if text.startswith("0."):
+            text = text[1:]
+        elif text.startswith("-0."):
+            text = "-" + text[2:]
+    elif style != "modern":
+        raise ValueError(f"unknown number style {style!r}")
+    if d == 0:
+        text = text + "."
+    return text if w is None else text.rjust(w)
+
+
+def fortran_i(value: int, w: int | None) -> str:
+    """Fortran ``Iw`` editing; may exceed ``w`` (callers widen, never ``***``)."""
+    text = str(int(value))
+    return text if w is None else text.rjust(w)
+
+
+@dataclass
+class Column:
+    """One table column: header text, Fortran edit (``f``/``i``/``s``), field width, decimals.
+
+    ``sep`` is the number of blanks written before the field (the ``nx`` of a format).
+    """
+
+    header: str
+    kind: str = "f"
+    width: int = 10
+    decimals: int = 4
+    sep: int = 2
+    style: str = "modern"
+    widened: bool = field(default=False, init=False)
+
+    def cell(self, value: object) -> str:
+        """Format one value without padding to the width."""
+        if value is None:
+            return ""
+        if isinstance(value, str):
+            return value
+        if self.kind == "f":
+            return fortran_f(float(value), None, self.decimals, self.style)
+        if self.kind == "i":
+            return fortran_i(int(value), None)
+        return str(value)
+
+
+def render_table(columns: Sequence[Column], rows: Iterable[Sequence[object]],
+                 trailers: Sequence[str] | None = None, header: bool = True) -> list[str]:
+    """Render rows into fixed-format lines.
+
+    Each row holds one value per column (a number, a preformatted string, or
+    ``None`` for a blank cell).  ``trailers[k]`` (optional) is free text appended
+    to row k, e.g. a status in words.  Columns whose values do not fit are
+    widened for every row (the column stays aligned) and flagged ``widened``.
+    """
+    rows = [list(r) for r in rows]
+    cells = [[col.cell(v) for col, v in zip(columns, row)] for row in rows]
+    widths = []
+    for j, col in enumerate(columns):
+        need = max([len(r[j]) for r in cells] + [len(col.header) if header else 0, 0])
+        if need > col.width:
+            col.widened = True
+        widths.append(max(col.width, need))
+    lines = []
+    if header:
+        lines.append("".join(" " * c.sep + c.header.rjust(w) for c, w in zip(columns, widths)).rstrip())
+    for k, r in enumerate(cells):
+        line = "".join(" " * c.sep + v.rjust(w) for c, v, w in zip(columns, r, widths))
+        if trailers is not None and trailers[k]:
+            line += "   " + trailers[k]
+        lines.append(line.rstrip())
+    return lines
