@@ -54,3 +54,55 @@ def line_panels(x: np.ndarray, panels: Sequence[tuple[str, dict[str, np.ndarray]
     if title:
         fig.suptitle(title)
     return fig
+
+
+# ----------------------------------------------------------------------------- fourbar
+
+def fourbar_curves(exact, listing, title: str) -> Figure:
+    """Angles, angular velocities and transmission angle against crank angle.
+
+    ``exact`` and ``listing`` are tidy frames from driver.fourbar; listing rows are
+    drawn as markers over the exact curves so the listing's defect is visible.
+    """
+    panels = [("coupler, rocker [deg]", ["coupler_deg", "rocker_deg"]),
+              ("transmission [deg]", ["transmission_deg"]),
+              ("angular velocity [rad/s]", ["omega2_rad_s", "omega3_rad_s"])]
+    fig, axes = new_figure(3, 1, sharex=True, figsize=(7.0, 7.4))
+    colors = {"coupler_deg": "C0", "rocker_deg": "C1", "transmission_deg": "C2",
+              "omega2_rad_s": "C0", "omega3_rad_s": "C1"}
+    for ax, (label, keys) in zip(axes, panels):
+        for k in keys:
+            ax.plot(exact["theta_deg"], exact[k], color=colors[k], label=f"{k.split('_')[0]} (exact)")
+            if listing is not None:
+                ax.plot(listing["theta_deg"], listing[k], "o", ms=4, mfc="none", color=colors[k],
+                        label=f"{k.split('_')[0]} (listing)")
+        ax.set_ylabel(label)
+        ax.legend(fontsize=7, ncol=2)
+    axes[1].axhspan(40, 120, color="C2", alpha=0.08, label="40-120 deg")
+    axes[-1].set_xlabel("crank angle [deg]")
+    fig.suptitle(f"{title}: four-bar kinematics")
+    return fig
+
+
+def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.ndarray,
+                    listing, title: str, n_poses: int = 6) -> Figure:
+    """The linkage drawn at a few crank angles with the paths of A and B (exact)."""
+    fig, (ax,) = new_figure(1, 1, figsize=(7.0, 5.0))
+    ax.plot(out[:, 3], out[:, 4], color="0.6", lw=0.8, label="path of A")
+    bx = np.where(ok, out[:, 5], np.nan)
+    by = np.where(ok, out[:, 6], np.nan)
+    ax.plot(bx, by, color="C3", lw=1.2, label="path of B (exact)")
+    if listing is not None:
+        ax.plot(listing["xb"], listing["yb"], "x", color="k", ms=5, label="B (listing)")
+    idx = np.flatnonzero(ok)
+    for j, k in enumerate(idx[np.linspace(0, len(idx) - 1, n_poses, endpoint=False).astype(int)] if len(idx) else []):
+        xs = [0.0, out[k, 3], out[k, 5], ground]
+        ys = [0.0, out[k, 4], out[k, 6], 0.0]
+        ax.plot(xs, ys, "-o", color=plt.cm.viridis(j / max(1, n_poses - 1)), ms=3, lw=1.4,
+                label=f"theta = {theta[k]:.0f} deg")
+    ax.plot([0.0, ground], [0.0, 0.0], color="k", lw=2.5)
+    ax.plot([0.0, ground], [0.0, 0.0], "^", color="k", ms=9)
+    ax.set_aspect("equal")
+    ax.legend(fontsize=7, loc="best")
+    ax.set_title(f"{title}: linkage positions")
+    return fig

@@ -1,0 +1,431 @@
+"""Four-bar linkage study (seed 001, Soegihardjo 2003): the ``&fourbar`` group.
+
+``method = 'listing'`` runs the published Fortran 77 program (Lampiran 1), kept
+cell-for-cell, and audits it against the closed loop; ``method = 'exact'``
+(default) solves the loop on the requested branch in double precision and adds
+accelerations, Grashof class, limit and toggle positions and a summary.
+
+Lengths in any consistent unit; angles in degrees in decks and tables; crank
+speed in rad/s, accelerations in rad/s^2.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+from scipy.optimize import brentq
+
+from driver import kernels
+from driver.deck import GroupSpec, Key, Params, positive
+from driver.study import Figure, Result
+from driver.table import Column, fortran_f, render_table
+
+__all__ = ["SPEC", "run", "grashof", "limit_angles", "exact_grid", "listing_grid"]
+
+ST = kernels.FOURBAR_STATUS
+BAND = (40.0, 120.0)  # transmission-angle band recommended by the paper [deg]
+
+
+def _check(p: Params) -> None:
+    """Cross-key checks: step, range, and what the listing method can do."""
+    if p.step_deg == 0:
+        raise p.error("step_deg", "must not be 0 (the crank angle would never advance)")
+    span = p.stop_deg - p.start_deg
+    if span * p.step_deg < 0:
+        raise p.error("step_deg", f"steps away from stop_deg ({p.start_deg:g} -> {p.stop_deg:g} "
+                                  f"with step {p.step_deg:g})")
+    if abs(span / p.step_deg) > 5_000_000:
+        raise p.error("step_deg", "more than 5e6 crank positions; use a coarser step")
+    if p.method == "listing":
+        for key in ("start_deg", "stop_deg", "step_deg"):
+            if not float(p[key]).is_integer():
+                raise p.error(key, "method='listing' steps in whole degrees like the published program "
+                                   f"(got {p[key]:g}); use method='exact' for fractional angles")
+        if "branch" in p.given and p.branch != "open":
+            raise p.error("branch", "the listing computes one assembly only; branch applies to method='exact'")
+
+
+SPEC = GroupSpec(
+    name="fourbar",
+    doc="planar four-bar linkage driven by its crank at constant speed",
+    keys={
+        "fixed_link": Key("float", required=True, check=positive, units="length", doc="ground link O_A-O_B"),
+        "crank": Key("float", required=True, check=positive, units="length", doc="input link O_A-A"),
+        "coupler": Key("float", required=True, check=positive, units="length", doc="coupler A-B"),
+        "rocker": Key("float", required=True, check=positive, units="length", doc="output link O_B-B"),
+        "omega": Key("float", default=1.0, units="rad/s", doc="crank angular velocity (ccw positive)"),
+        "alpha": Key("float", default=0.0, units="rad/s^2", doc="crank angular acceleration (exact method)"),
+        "step_deg": Key("float", required=True, units="deg", doc="crank-angle step"),
+        "start_deg": Key("float", default=0.0, units="deg", doc="first crank angle"),
+        "stop_deg": Key("float", default=360.0, units="deg", doc="last crank angle (inclusive)"),
+        "method": Key("str", default="exact", choices=("exact", "listing"),
+                      doc="'listing' = published program cell for cell; 'exact' = closed loop"),
+        "branch": Key("str", default="open", choices=("open", "crossed"),
+                      doc="'open': B left of the line A->O_B; 'crossed': mirror assembly"),
+        "title": Key("str", default="", doc="free text echoed in the output"),
+    },
+    check=_check,
+)
+
+
+# ----------------------------------------------------------------------------- analysis
+
+@dataclass
+class Grashof:
+    """Grashof classification of a four-bar (Norton's classes)."""
+
+    name: str
+    condition: str
+    full_crank_rotation: bool
+
+
+def grashof(p: float, q: float, r: float, s: float) -> Grashof:
+    """Class from link lengths (p ground, q crank, r coupler, s rocker)."""
+    links = {"ground": p, "crank": q, "coupler": r, "rocker": s}
+    srt = sorted(links.values())
+    short, long_ = srt[0], srt[-1]
+    lhs, rhs = short + long_, srt[1] + srt[2]
+    tol = 1e-12 * rhs
+    cond = f"S + L = {short:g} + {long_:g} = {lhs:g} {'<' if lhs < rhs - tol else ('=' if abs(lhs - rhs) <= tol else '>')} P + Q = {rhs:g}"
+    if lhs > rhs + tol:
+        return Grashof("non-Grashof triple-rocker", cond, False)
+    if abs(lhs - rhs) <= tol:
+        return Grashof("change-point (special Grashof)", cond, True)
+    shortest = min(links, key=lambda k: (links[k], ["ground", "crank", "rocker", "coupler"].index(k)))
+    names = {"ground": ("double-crank (drag link)", True), "crank": ("crank-rocker", True),
+             "rocker": ("rocker-crank", False), "coupler": ("Grashof double-rocker", False)}
+    name, full = names[shortest]
+    return Grashof(name, cond, full)
+
+
+def limit_angles(p: float, q: float, r: float, s: float) -> list[float]:
+    """Crank angles [deg, 0..360) where |A O_B| = r + s or |r - s| (toggle / assembly limits)."""
+    out = []
+    for d in (r + s, abs(r - s)):
+        c = (p * p + q * q - d * d) / (2 * p * q)
+        if -1.0 <= c <= 1.0:
+            a = math.degrees(math.acos(c))
+            out += [a, (360.0 - a) % 360.0]
+    return sorted(set(round(a, 10) for a in out))
+
+
+def crank_angles(p: Params) -> np.ndarray:
+    """The requested crank angles [deg] (Fortran DO semantics: start, start+step, ... <= stop)."""
+    n = int(math.floor((p.stop_deg - p.start_deg) / p.step_deg + 1e-9)) + 1
+    return p.start_deg + p.step_deg * np.arange(n)
+
+
+def exact_grid(p: Params, theta_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Closed-loop states at ``theta_deg`` (kernel columns, see kernels.fourbar_exact)."""
+    return kernels.fourbar_exact(np.radians(theta_deg), p.fixed_link, p.crank, p.coupler, p.rocker,
+                                 p.omega, p.alpha, 1 if p.branch == "open" else -1)
+
+
+def listing_grid(p: Params) -> tuple[np.ndarray, np.ndarray]:
+    """The published program's rows for the deck's crank angles."""
+    start, step = int(p.start_deg), int(p.step_deg)
+    n = len(crank_angles(p))
+    return kernels.fourbar_listing(p.fixed_link, p.crank, p.coupler, p.rocker, p.omega, start, step, n)
+
+
+def _deg360(rad: np.ndarray) -> np.ndarray:
+    """Radians -> degrees in [0, 360), with values that round to 360.0 folded to 0."""
+    d = np.mod(np.degrees(rad), 360.0)
+    return np.where(d >= 359.95, d - 360.0, d)
+
+
+@dataclass
+class Extremes:
+    """Headline figures over the analysed crank range (exact solution)."""
+
+    mu_min: float
+    mu_min_at: float
+    mu_max: float
+    mu_max_at: float
+    rocker_min: float
+    rocker_min_at: float
+    rocker_max: float
+    rocker_max_at: float
+    w3_peak: float
+    w3_peak_at: float
+    w2_peak: float
+    w2_peak_at: float
+    assembled_fraction: float
+    rocker_turns: bool = False
+    toggles: tuple[float, ...] = ()
+
+
+def extremes(p: Params) -> Extremes | None:
+    """Transmission-angle, rocker-position and speed extremes on a dense grid over the deck's range.
+
+    Rocker extremes (omega3 = 0) are refined with brentq on the kernel; the
+    transmission angle depends on |A O_B| only, whose extremes sit at 0 and 180 deg,
+    which are inserted into the grid when in range.
+    """
+    lo, hi = sorted((p.start_deg, p.stop_deg))
+    grid = np.linspace(lo, hi, max(2, int((hi - lo) / 0.01) + 1))
+    special = [a for a in (0.0, 180.0, 360.0) if lo <= a <= hi] + [a for a in limit_angles(
+        p.fixed_link, p.crank, p.coupler, p.rocker) if lo <= a <= hi]
+    grid = np.unique(np.concatenate([grid, special]))
+    out, st = exact_grid(p, grid)
+    ok = st == ST["ok"]
+    if not ok.any():
+        return None
+    mu = np.round(np.degrees(out[:, 2]), 9)
+    rocker = np.degrees(out[:, 1])
+    w2, w3 = out[:, 7], out[:, 8]
+
+    def at(values: np.ndarray, pick) -> tuple[float, float]:
+        idx = np.flatnonzero(ok)[pick(values[ok])]
+        return float(values[idx]), float(grid[idx])
+
+    # rocker angle unwrapped about its mean direction, extremes where omega3 changes sign
+    ref = np.degrees(np.angle(np.mean(np.exp(1j * out[ok, 1]))))
+    rel = (rocker - ref + 180.0) % 360.0 - 180.0
+    cands = [(rel[i], grid[i]) for i in np.flatnonzero(ok)[[0, -1]]]
+    for i in np.flatnonzero(ok[:-1] & ok[1:] & (np.sign(w3[:-1]) != np.sign(w3[1:]))):
+        f = lambda t: float(exact_grid(p, np.array([t]))[0][0, 8])
+        try:
+            t = brentq(f, grid[i], grid[i + 1], xtol=1e-10)
+        except ValueError:
+            t = grid[i]
+        a = math.degrees(float(exact_grid(p, np.array([t]))[0][0, 1]))
+        cands.append(((a - ref + 180.0) % 360.0 - 180.0, t))
+    rmin = min(cands, key=lambda c: c[0])
+    rmax = max(cands, key=lambda c: c[0])
+    mu_min, mu_min_at = at(mu, np.argmin)
+    mu_max, mu_max_at = at(mu, np.argmax)
+    w3v, w3a = at(w3, lambda v: np.argmax(np.abs(v)))
+    w2v, w2a = at(w2, lambda v: np.argmax(np.abs(v)))
+    turns = bool(ok.all() and np.ptp(np.unwrap(out[:, 1])) >= 2 * np.pi - 1e-6)
+    toggles = tuple(a for a in limit_angles(p.fixed_link, p.crank, p.coupler, p.rocker) if lo <= a <= hi)
+    return Extremes(mu_min, mu_min_at, mu_max, mu_max_at,
+                    (rmin[0] + ref) % 360.0, float(rmin[1]), (rmax[0] + ref) % 360.0, float(rmax[1]),
+                    w3v, w3a, w2v, w2a, float(ok.mean()), turns, toggles)
+
+
+# ----------------------------------------------------------------------------- tables
+
+def _echo(p: Params) -> list[str]:
+    """Deck inputs echoed in the English header of exact runs."""
+    rows = [("fixed link O_A-O_B", p.fixed_link, ""), ("crank (driver) O_A-A", p.crank, ""),
+            ("coupler A-B", p.coupler, ""), ("rocker (output) O_B-B", p.rocker, ""),
+            ("crank speed", p.omega, "rad/s"), ("crank acceleration", p.alpha, "rad/s^2")]
+    return [f"  {name:<24}{fortran_f(v, 12, 4)} {u}".rstrip() for name, v, u in rows]
+
+
+def listing_text(p: Params, table: np.ndarray, status: np.ndarray) -> list[str]:
+    """The listing's output file: its header (format 15), column line and rows (format 25)."""
+    head = ["", "", "",
+            f"  panjang OA-OB (fixed link):  {fortran_f(p.fixed_link, 5, 2, 'legacy')}",
+            f"  panjang poros engkol (crank/driver):  {fortran_f(p.crank, 5, 2, 'legacy')}",
+            f"  panjang batang penghubung (coupler):  {fortran_f(p.coupler, 5, 2, 'legacy')}",
+            f"  panjang batang ayun (rocker/output link):  {fortran_f(p.rocker, 5, 2, 'legacy')}",
+            f"  kecepatan sudut poros engkol (rad/detik):  {fortran_f(p.omega, 5, 2, 'legacy')}",
+            ""]
+    # format 25: (2x,i3,2x,7(f5.1,2x),3x,2(f7.4,3x))
+    cols = ([Column("i", "i", 3, 0, 2)] + [Column(h, "f", 5, 1, 2, "legacy") for h in ("epsl", "phi", "beta", "xa", "ya", "xb")]
+            + [Column("yb", "f", 5, 1, 2, "legacy"), Column("omr", "f", 7, 4, 5, "legacy"), Column("oms", "f", 7, 4, 3, "legacy")])
+    rows, trailers = [], []
+    for row, st in zip(table, status):
+        if st == ST["no_assembly"]:
+            rows.append([int(row[0])] + [None] * 9)
+            trailers.append("cannot be assembled (the listing would print NaN)")
+        elif st == ST["toggle"]:
+            rows.append([int(row[0])] + list(row[1:8]) + [None, None])
+            trailers.append("toggle: sin(phi - epsl) = 0, velocities unbounded")
+        else:
+            rows.append([int(row[0])] + list(row[1:]))
+            trailers.append("")
+    lines = render_table(cols, rows, trailers)
+    return head + [lines[0], ""] + lines[1:], cols
+
+
+def exact_table(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarray) -> list[str]:
+    """Fixed-format exact table: the listing's ten columns (angles rounded) plus accelerations."""
+    whole = np.all(np.isclose(theta, np.round(theta)))
+    tcol = Column("theta", "i", 5, 0, 2) if whole else Column("theta", "f", 8, 3, 2)
+    cols = [tcol, Column("coupler", "f", 7, 1), Column("rocker", "f", 7, 1), Column("transm", "f", 7, 1)]
+    cols += [Column(h, "f", 9, 4) for h in ("xa", "ya", "xb", "yb")]
+    cols += [Column(h, "f", 10, 4) for h in ("omega2", "omega3")] + [Column(h, "f", 11, 4) for h in ("alpha2", "alpha3")]
+    units = ["[deg]", "[deg]", "[deg]", "[deg]", "", "", "", "", "[rad/s]", "[rad/s]", "[rad/s2]", "[rad/s2]"]
+    ang = np.column_stack([_deg360(out[:, 0]), _deg360(out[:, 1]), np.degrees(out[:, 2])])
+    rows, trailers = [], []
+    d = np.hypot(p.fixed_link - out[:, 3], out[:, 4])
+    for k in range(len(theta)):
+        t = int(round(theta[k])) if whole else theta[k]
+        if status[k] == ST["no_assembly"]:
+            rows.append([t, None, None, None, out[k, 3], out[k, 4]] + [None] * 6)
+            trailers.append(f"cannot be assembled: |A O_B| = {d[k]:.4f} outside "
+                            f"[{abs(p.coupler - p.rocker):g}, {p.coupler + p.rocker:g}]")
+        elif status[k] == ST["toggle"]:
+            rows.append([t, *ang[k], *out[k, 3:7]] + [None] * 4)
+            trailers.append("toggle: coupler and rocker collinear, velocity unbounded")
+        else:
+            rows.append([t, *ang[k], *out[k, 3:11]])
+            trailers.append("")
+    lines = render_table(cols, rows, trailers)
+    unit_line = "".join(" " * c.sep + u.rjust(max(c.width, len(c.header))) for c, u in zip(cols, units)).rstrip()
+    return [lines[0], unit_line] + lines[1:]
+
+
+def summary_lines(p: Params, g: Grashof, ex: Extremes | None) -> list[str]:
+    """Words and numbers after an exact table."""
+    lim = limit_angles(p.fixed_link, p.crank, p.coupler, p.rocker)
+    out = ["", "  Summary (closed-loop solution, branch = " + p.branch + ")",
+           f"    Grashof class ........ {g.name}  ({g.condition})",
+           "    crank rotation ....... " + ("full turn" if not lim else
+                                           "limited: limit (toggle) crank angles " +
+                                           ", ".join(f"{a:.3f}" for a in lim) + " deg")]
+    if ex is None:
+        out.append("    the linkage cannot be assembled anywhere in the requested range")
+        return out
+    lo, hi = BAND
+    meets = lo <= ex.mu_min and ex.mu_max <= hi
+    out += [f"    transmission angle ... min {ex.mu_min:.2f} deg at theta = {ex.mu_min_at:.2f}, "
+            f"max {ex.mu_max:.2f} deg at theta = {ex.mu_max_at:.2f}",
+            f"    {lo:g}-{hi:g} deg band ...... " + ("met" if meets else "NOT met"),
+            ("    rocker ............... turns fully (no extreme positions)" if ex.rocker_turns else
+             f"    rocker positions ..... {ex.rocker_min:.3f} deg (theta = {ex.rocker_min_at:.3f}) to "
+             f"{ex.rocker_max:.3f} deg (theta = {ex.rocker_max_at:.3f}); swing "
+             f"{(ex.rocker_max - ex.rocker_min) % 360.0:.3f} deg")]
+    if ex.toggles:
+        out.append("    peak speeds .......... unbounded at the toggle positions (theta = "
+                   + ", ".join(f"{a:.3f}" for a in ex.toggles) + " deg)")
+    else:
+        out += [f"    peak rocker speed .... {ex.w3_peak:.4f} rad/s at theta = {ex.w3_peak_at:.2f} deg",
+                f"    peak coupler speed ... {ex.w2_peak:.4f} rad/s at theta = {ex.w2_peak_at:.2f} deg"]
+    if ex.assembled_fraction < 1.0:
+        out.append(f"    assemblable ..........  {100 * ex.assembled_fraction:.1f} % of the requested range")
+    return out
+
+
+def audit(p: Params, theta: np.ndarray, table: np.ndarray, lst_status: np.ndarray,
+          out: np.ndarray, status: np.ndarray) -> tuple[list[str], str | None, pd.DataFrame]:
+    """Rows of the listing that violate loop closure, compared with the exact solution."""
+    ab = np.hypot(table[:, 6] - table[:, 4], table[:, 7] - table[:, 5])
+    dev = ab - p.coupler
+    good = (lst_status == ST["ok"]) & (status == ST["ok"])
+    bad = good & (np.abs(dev) > 1e-4 * p.coupler)
+    lines = ["", "  Audit of the listing against the closed loop (method = 'exact', branch = 'open')"]
+    frame = pd.DataFrame({"theta_deg": theta, "ab_length": ab, "ab_deviation": dev})
+    if not bad.any():
+        lines.append(f"    every row closes the loop: |AB| = coupler within {np.max(np.abs(dev[good]), initial=0):.2e}")
+        return lines, None, frame
+    worst = int(np.argmax(np.where(bad, np.abs(dev), -1)))
+    cols = [Column("i", "i", 5, 0), Column("|AB|", "f", 9, 4), Column("dev", "f", 9, 4),
+            Column("xb lst", "f", 8, 3), Column("yb lst", "f", 8, 3), Column("xb", "f", 8, 3),
+            Column("yb", "f", 8, 3), Column("oms lst", "f", 9, 4), Column("omega3", "f", 9, 4)]
+    rows = [[int(theta[k]), ab[k], dev[k], table[k, 6], table[k, 7], out[k, 5], out[k, 6], table[k, 9], out[k, 8]]
+            for k in np.flatnonzero(bad)]
+    lines += [f"    {int(bad.sum())} of {len(theta)} rows have a coupler length |AB| different from "
+              f"the deck's {p.coupler:g}; largest deviation {dev[worst]:+.4f} at i = {int(theta[worst])}:"]
+    lines += ["  " + l for l in render_table(cols, rows)]
+    lines += ["    Why: for crank angles in (180, 360) deg the listing's quadrant test sends",
+              "    sigy > 0, sigx > 0 to 'sigma = 2 pi - |atan|' (meant: |atan|), so those rows",
+              "    repeat the positions of 360 - i (mirror image) and their velocities are",
+              "    wrong; the transmission angle column is still right (it depends on |A O_B| only).",
+              "    Use method = 'exact' for correct values (columns 'xb', 'yb', 'omega3' above)."]
+    warn = (f"listing rows violate loop closure at {int(bad.sum())} crank angles "
+            f"(largest |AB| deviation {dev[worst]:+.4f} at {int(theta[worst])} deg); see the audit in the .out")
+    return lines, warn, frame
+
+
+# ----------------------------------------------------------------------------- tidy + figures
+
+def tidy_frame(method: str, theta: np.ndarray, cols: dict[str, np.ndarray], status: np.ndarray) -> pd.DataFrame:
+    """One row per crank angle; status in words; unassemblable cells left empty (NaN in the frame)."""
+    words = np.array(["ok", "cannot_assemble", "toggle"])[status]
+    frame = pd.DataFrame({"method": method, "theta_deg": theta, **cols, "status": words})
+    return frame
+
+
+def _exact_columns(out: np.ndarray, status: np.ndarray) -> dict[str, np.ndarray]:
+    vals = {"coupler_deg": _deg360(out[:, 0]), "rocker_deg": _deg360(out[:, 1]),
+            "transmission_deg": np.degrees(out[:, 2]), "xa": out[:, 3], "ya": out[:, 4],
+            "xb": out[:, 5], "yb": out[:, 6], "omega2_rad_s": out[:, 7], "omega3_rad_s": out[:, 8],
+            "alpha2_rad_s2": out[:, 9], "alpha3_rad_s2": out[:, 10]}
+    nope = status == ST["no_assembly"]
+    tog = status == ST["toggle"]
+    for k, v in vals.items():
+        v = v.copy()
+        if k not in ("xa", "ya"):
+            v[nope] = np.nan
+        if k.startswith(("omega", "alpha")):
+            v[tog] = np.nan
+        vals[k] = v
+    return vals
+
+
+def _figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> list[Figure]:
+    from driver import plotting
+
+    def curves():
+        theta = np.linspace(p.start_deg, p.stop_deg, 721)
+        out, st = exact_grid(p, theta)
+        exact = tidy_frame("exact", theta, _exact_columns(out, st), st)
+        return plotting.fourbar_curves(exact, listing, stem_title)
+
+    def linkage():
+        theta = np.linspace(0.0, 360.0, 721)
+        out, st = exact_grid(p, theta)
+        return plotting.fourbar_linkage(p.fixed_link, theta, out, st == ST["ok"], listing, stem_title)
+
+    return [Figure("curves", curves), Figure("linkage", linkage)]
+
+
+# ----------------------------------------------------------------------------- run
+
+def run(params: Params, progress: bool = False) -> Result:
+    """Analyse one four-bar deck (see module docstring)."""
+    p = params
+    theta = crank_angles(p)
+    g = grashof(p.fixed_link, p.crank, p.coupler, p.rocker)
+    out, status = exact_grid(p, theta)
+    ex = extremes(p)
+    exact_frame = tidy_frame("exact", theta, _exact_columns(out, status), status)
+    warnings: list[str] = []
+    title = p.title or f"{p.path.stem}"
+    if p.method == "listing":
+        table, lst_status = listing_grid(p)
+        lines, _ = listing_text(p, table, lst_status)
+        alines, warn, _ = audit(p, theta, table, lst_status, out, status)
+        lines += alines + summary_lines(p, g, ex)
+        if warn:
+            warnings.append(warn)
+        lst_cols = dict(zip(["coupler_deg", "rocker_deg", "transmission_deg", "xa", "ya", "xb", "yb",
+                             "omega2_rad_s", "omega3_rad_s"], table[:, 1:].T))
+        listing_frame = tidy_frame("listing", theta, lst_cols, lst_status)
+        tidy = pd.concat([listing_frame, exact_frame], ignore_index=True)
+    else:
+        listing_frame = None
+        lines = [f"  four-bar linkage: closed-loop analysis (method = exact, branch = {p.branch})",
+                 f"  deck: {p.path}" + (f" -- {p.title}" if p.title else ""), ""] + _echo(p) + [""]
+        lines += exact_table(p, theta, out, status) + summary_lines(p, g, ex)
+        for k in np.flatnonzero(status == ST["no_assembly"])[:1]:
+            warnings.append(f"the linkage cannot be assembled at {int((status == ST['no_assembly']).sum())} "
+                            f"of {len(theta)} crank angles (first at {theta[k]:g} deg)")
+        tidy = exact_frame
+    summary = _summary(p, g, ex)
+    return Result(text="\n".join(lines) + "\n", tidy=tidy, summary=summary, warnings=warnings,
+                  figures=_figures(p, title, listing_frame))
+
+
+def _summary(p: Params, g: Grashof, ex: Extremes | None) -> dict:
+    """Headline figures for sweeps (exact solution over the deck's range)."""
+    s = {"grashof_class": g.name, "full_crank_rotation": g.full_crank_rotation}
+    if ex is None:
+        return s | {"assemblable": False}
+    lo, hi = BAND
+    return s | {
+        "assemblable": True, "mu_min_deg": ex.mu_min, "mu_max_deg": ex.mu_max,
+        "meets_band_40_120": bool(lo <= ex.mu_min and ex.mu_max <= hi),
+        "rocker_turns_fully": ex.rocker_turns,
+        "rocker_swing_deg": 360.0 if ex.rocker_turns else (ex.rocker_max - ex.rocker_min) % 360.0,
+        "toggle_in_range": bool(ex.toggles),
+        "omega3_peak_rad_s": None if ex.toggles else ex.w3_peak,
+        "omega2_peak_rad_s": None if ex.toggles else ex.w2_peak,
+        "assembled_fraction": ex.assembled_fraction,
+    }
