@@ -256,7 +256,10 @@ def exact_table(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarra
     d = np.hypot(p.fixed_link - out[:, 3], out[:, 4])
     for k in range(len(theta)):
         t = int(round(theta[k])) if whole else theta[k]
-        if status[k] == ST["no_assembly"]:
+        if status[k] == ST["indeterminate"]:
+            rows.append([t, None, None, None, out[k, 3], out[k, 4]] + [None] * 6)
+            trailers.append("indeterminate: crank pin A on the rocker pivot O_B, B free on a circle")
+        elif status[k] == ST["no_assembly"]:
             rows.append([t, None, None, None, out[k, 3], out[k, 4]] + [None] * 6)
             trailers.append(f"cannot be assembled: |A O_B| = {d[k]:.4f} outside "
                             f"[{abs(p.coupler - p.rocker):g}, {p.coupler + p.rocker:g}]")
@@ -337,7 +340,7 @@ def audit(p: Params, theta: np.ndarray, table: np.ndarray, lst_status: np.ndarra
 
 def tidy_frame(method: str, theta: np.ndarray, cols: dict[str, np.ndarray], status: np.ndarray) -> pd.DataFrame:
     """One row per crank angle; status in words; unassemblable cells left empty (NaN in the frame)."""
-    words = np.array(["ok", "cannot_assemble", "toggle"])[status]
+    words = np.array(["ok", "cannot_assemble", "toggle", "indeterminate"])[status]
     frame = pd.DataFrame({"method": method, "theta_deg": theta, **cols, "status": words})
     return frame
 
@@ -347,7 +350,7 @@ def _exact_columns(out: np.ndarray, status: np.ndarray) -> dict[str, np.ndarray]
             "transmission_deg": np.degrees(out[:, 2]), "xa": out[:, 3], "ya": out[:, 4],
             "xb": out[:, 5], "yb": out[:, 6], "omega2_rad_s": out[:, 7], "omega3_rad_s": out[:, 8],
             "alpha2_rad_s2": out[:, 9], "alpha3_rad_s2": out[:, 10]}
-    nope = status == ST["no_assembly"]
+    nope = (status == ST["no_assembly"]) | (status == ST["indeterminate"])
     tog = status == ST["toggle"]
     for k, v in vals.items():
         v = v.copy()

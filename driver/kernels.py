@@ -26,7 +26,8 @@ def farray(x, ndim: int | None = None) -> np.ndarray:
 
 #: status codes of the four-bar kernels (fortran/fourbar.f90)
 FOURBAR_STATUS = {"ok": int(_kernels.fourbar.st_ok), "no_assembly": int(_kernels.fourbar.st_no_assembly),
-                  "toggle": int(_kernels.fourbar.st_toggle)}
+                  "toggle": int(_kernels.fourbar.st_toggle),
+                  "indeterminate": int(_kernels.fourbar.st_indeterminate)}
 
 
 def fourbar_listing(p: float, q: float, r: float, s: float, omega: float,
@@ -47,7 +48,7 @@ def fourbar_exact(theta: np.ndarray, p: float, q: float, r: float, s: float, ome
     Columns: coupler angle, rocker angle, transmission angle [rad]; xa, ya, xb, yb [length];
     coupler and rocker angular velocity [rad/s]; coupler and rocker angular acceleration
     [rad/s^2].  ``branch`` +1 open, -1 crossed.  Status: 0 ok, 1 cannot be assembled,
-    2 toggle (velocities unbounded, returned as 0).
+    2 toggle (velocities unbounded, returned as 0), 3 indeterminate (A on O_B).
     """
     theta = farray(np.atleast_1d(theta), 1)
     return _kernels.fourbar.exact_states(theta, p, q, r, s, omega, alpha, int(branch))

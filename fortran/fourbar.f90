@@ -18,7 +18,7 @@ module fourbar
   public :: listing_table, exact_states
 
   !> status codes shared with driver/fourbar.py
-  integer, parameter, public :: st_ok = 0, st_no_assembly = 1, st_toggle = 2
+  integer, parameter, public :: st_ok = 0, st_no_assembly = 1, st_toggle = 2, st_indeterminate = 3
 
 contains
 
@@ -117,6 +117,8 @@ contains
   !> out(:, 10:11) coupler and rocker angular acceleration [rad/s^2]
   !> status(k)  0 ok, 1 cannot be assembled (row zeroed except xa, ya),
   !>            2 toggle: coupler and rocker collinear, velocities unbounded (set to 0)
+  !>            3 indeterminate: crank pin A on the rocker pivot O_B with r = s (B free on a circle);
+  !>              zeroed like status 1
   subroutine exact_states(n, theta, p, q, r, s, omega, alpha1, branch, out, status)
     !f2py threadsafe
     integer, intent(in) :: n
@@ -127,7 +129,7 @@ contains
     integer, intent(out) :: status(n)
     real(dp), parameter :: tol = 1.0e-13_dp
     real(dp) :: sgn, r2, s2, c, sn, ax, ay, dx, dy, d2, a, h2, h, bx, by
-    real(dp) :: e2x, e2y, e3x, e3y, s23, c23, w2, w3, den2, den3, sinv, ok
+    real(dp) :: e2x, e2y, e3x, e3y, s23, c23, w2, w3, den2, den3, sinv, ok, placed
     integer :: k, st
 
     sgn = merge(1.0_dp, -1.0_dp, branch >= 0)
@@ -144,6 +146,10 @@ contains
       a = (d2 + r2 - s2)/(2*d2)
       h2 = r2/d2 - a*a
       st = merge(st_no_assembly, merge(st_toggle, st_ok, h2 <= tol), h2 < -tol)
+      if (d2 <= (tol*(p + q))**2) then   ! A on O_B: B free on a circle if r = s, else impossible
+        st = merge(st_indeterminate, st_no_assembly, abs(r - s) <= tol*(r + s))
+      end if
+      h2 = merge(0.0_dp, h2, st == st_indeterminate)
       h = sqrt(max(h2, 0.0_dp))
       bx = ax + a*dx - sgn*h*dy
       by = ay + a*dy + sgn*h*dx
@@ -159,13 +165,14 @@ contains
       w3 = omega*q*(sn*e2x - c*e2y)/s*sinv
       den2 = -r*s23
       den3 = s*s23
-      out(k, 1) = atan2(e2y, e2x)*merge(1.0_dp, 0.0_dp, st /= st_no_assembly)
-      out(k, 2) = atan2(e3y, e3x)*merge(1.0_dp, 0.0_dp, st /= st_no_assembly)
-      out(k, 3) = atan2(abs(s23), c23)*merge(1.0_dp, 0.0_dp, st /= st_no_assembly)
+      placed = merge(1.0_dp, 0.0_dp, st == st_ok .or. st == st_toggle)
+      out(k, 1) = atan2(e2y, e2x)*placed
+      out(k, 2) = atan2(e3y, e3x)*placed
+      out(k, 3) = atan2(abs(s23), c23)*placed
       out(k, 4) = ax
       out(k, 5) = ay
-      out(k, 6) = bx*merge(1.0_dp, 0.0_dp, st /= st_no_assembly)
-      out(k, 7) = by*merge(1.0_dp, 0.0_dp, st /= st_no_assembly)
+      out(k, 6) = bx*placed
+      out(k, 7) = by*placed
       out(k, 8) = w2
       out(k, 9) = w3
       out(k, 10) = ok*(-q*alpha1*(sn*e3x - c*e3y) - q*omega*omega*(c*e3x + sn*e3y) &
