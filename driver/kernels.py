@@ -42,13 +42,21 @@ def fourbar_listing(p: float, q: float, r: float, s: float, omega: float,
 
 
 def fourbar_exact(theta: np.ndarray, p: float, q: float, r: float, s: float, omega: float,
-                  alpha: float = 0.0, branch: int = 1) -> tuple[np.ndarray, np.ndarray]:
+                  alpha: float = 0.0, branch: int = 1, out: np.ndarray | None = None,
+                  status: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Closed-loop states at crank angles ``theta`` [rad]: (n, 11) array and status (n,).
 
     Columns: coupler angle, rocker angle, transmission angle [rad]; xa, ya, xb, yb [length];
     coupler and rocker angular velocity [rad/s]; coupler and rocker angular acceleration
     [rad/s^2].  ``branch`` +1 open, -1 crossed.  Status: 0 ok, 1 cannot be assembled,
     2 toggle (velocities unbounded, returned as 0), 3 indeterminate (A on O_B).
+    ``out`` (Fortran-ordered float64, (n, 11)) and ``status`` (int32, (n,)) may be passed
+    to reuse buffers across calls; they are overwritten.
     """
     theta = farray(np.atleast_1d(theta), 1)
-    return _kernels.fourbar.exact_states(theta, p, q, r, s, omega, alpha, int(branch))
+    n = theta.shape[0]
+    if out is None:
+        out = np.empty((n, 11), dtype=np.float64, order="F")
+    if status is None:
+        status = np.empty(n, dtype=np.int32)
+    return _kernels.fourbar.exact_states(theta, p, q, r, s, omega, alpha, int(branch), out, status)

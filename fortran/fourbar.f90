@@ -115,6 +115,7 @@ contains
   !> out(:, 4:7) xa, ya, xb, yb [length]
   !> out(:, 8:9) coupler and rocker angular velocity [rad/s]
   !> out(:, 10:11) coupler and rocker angular acceleration [rad/s^2]
+  !> out and status are overwritten (intent inout so callers can reuse buffers).
   !> status(k)  0 ok, 1 cannot be assembled (row zeroed except xa, ya),
   !>            2 toggle: coupler and rocker collinear, velocities unbounded (set to 0)
   !>            3 indeterminate: crank pin A on the rocker pivot O_B with r = s (B free on a circle);
@@ -125,19 +126,44 @@ contains
     real(dp), intent(in) :: theta(n)
     real(dp), intent(in) :: p, q, r, s, omega, alpha1
     integer, intent(in) :: branch
-    real(dp), intent(out) :: out(n, 11)
-    integer, intent(out) :: status(n)
-    real(dp), parameter :: tol = 1.0e-13_dp
-    real(dp) :: sgn, r2, s2, c, sn, ax, ay, dx, dy, d2, a, h2, h, bx, by
-    real(dp) :: e2x, e2y, e3x, e3y, s23, c23, w2, w3, den2, den3, sinv, ok, placed
-    integer :: k, st
+    real(dp), intent(inout) :: out(n, 11)
+    !f2py intent(in,out) :: out
+    integer, intent(inout) :: status(n)
+    !f2py intent(in,out) :: status
+    integer, parameter :: nb = 256
+    real(dp) :: sgn, blk(nb, 11), sblk(nb)
+    integer :: k0, m
 
     sgn = merge(1.0_dp, -1.0_dp, branch >= 0)
+    ! Work in blocks of nb positions held in fixed-size local arrays, so the
+    ! compiler can prove the eleven output columns independent and vectorise.
+    do k0 = 1, n, nb
+      m = min(nb, n - k0 + 1)
+      call exact_block(m, theta(k0:k0 + m - 1), p, q, r, s, omega, alpha1, sgn, blk, sblk)
+      out(k0:k0 + m - 1, :) = blk(1:m, :)
+      status(k0:k0 + m - 1) = nint(sblk(1:m))
+    end do
+  end subroutine exact_states
+
+  !> One block of exact_states (see there); m <= size of the local arrays of the caller.
+  subroutine exact_block(m, theta, p, q, r, s, omega, alpha1, sgn, out, status)
+    integer, intent(in) :: m
+    real(dp), intent(in) :: theta(m), p, q, r, s, omega, alpha1, sgn
+    real(dp), intent(inout) :: out(256, 11)
+    real(dp), intent(inout) :: status(256)   ! status code as a real: keeps the loop in one vector width
+    real(dp), parameter :: tol = 1.0e-13_dp
+    real(dp) :: r2, s2, c, sn, ax, ay, dx, dy, d2, a, h2, h, bx, by
+    real(dp) :: e2x, e2y, e3x, e3y, s23, c23, w2, w3, den2, den3, sinv, ok, placed
+    real(dp) :: st, isno, istog, isdeg, degst, dmin2, ys(256, 3), xs(256, 3)
+    real(dp), parameter :: ok_ = st_ok, none_ = st_no_assembly, tog_ = st_toggle, ind_ = st_indeterminate
+    integer :: k, j
     r2 = r*r
     s2 = s*s
-    do k = 1, n
-      c = cos(theta(k))
-      sn = sin(theta(k))
+    dmin2 = (tol*(p + q))**2
+    ! A on O_B: B free on a circle if r = s (indeterminate), else impossible
+    degst = merge(ind_, none_, abs(r - s) <= tol*(r + s))
+    do k = 1, m
+      call vsincos(theta(k), sn, c)
       ax = q*c
       ay = q*sn
       dx = p - ax
@@ -145,11 +171,12 @@ contains
       d2 = max(dx*dx + dy*dy, tiny(1.0_dp))
       a = (d2 + r2 - s2)/(2*d2)
       h2 = r2/d2 - a*a
-      st = merge(st_no_assembly, merge(st_toggle, st_ok, h2 <= tol), h2 < -tol)
-      if (d2 <= (tol*(p + q))**2) then   ! A on O_B: B free on a circle if r = s, else impossible
-        st = merge(st_indeterminate, st_no_assembly, abs(r - s) <= tol*(r + s))
-      end if
-      h2 = merge(0.0_dp, h2, st == st_indeterminate)
+      ! status flags as 0/1 reals (single comparisons keep the loop vectorisable)
+      isno = merge(1.0_dp, 0.0_dp, h2 < -tol)                   ! cannot be assembled
+      istog = merge(1.0_dp, 0.0_dp, h2 <= tol)*(1.0_dp - isno)  ! coupler and rocker collinear
+      isdeg = merge(1.0_dp, 0.0_dp, d2 <= dmin2)                ! A on O_B
+      st = (1.0_dp - isdeg)*(none_*isno + tog_*istog) + isdeg*degst
+      h2 = h2*(1.0_dp - isdeg)
       h = sqrt(max(h2, 0.0_dp))
       bx = ax + a*dx - sgn*h*dy
       by = ay + a*dy + sgn*h*dx
@@ -159,16 +186,19 @@ contains
       e3y = by/s
       s23 = e2x*e3y - e2y*e3x            ! sin(theta3 - theta2)
       c23 = e2x*e3x + e2y*e3y            ! cos(theta3 - theta2)
-      ok = merge(1.0_dp, 0.0_dp, st == st_ok)
-      sinv = ok/merge(s23, 1.0_dp, st == st_ok)
+      ok = (1.0_dp - isno)*(1.0_dp - istog)*(1.0_dp - isdeg)
+      sinv = ok/(ok*s23 + (1.0_dp - ok))
       w2 = omega*q*(sn*e3x - c*e3y)/r*sinv
       w3 = omega*q*(sn*e2x - c*e2y)/s*sinv
       den2 = -r*s23
       den3 = s*s23
-      placed = merge(1.0_dp, 0.0_dp, st == st_ok .or. st == st_toggle)
-      out(k, 1) = atan2(e2y, e2x)*placed
-      out(k, 2) = atan2(e3y, e3x)*placed
-      out(k, 3) = atan2(abs(s23), c23)*placed
+      placed = (1.0_dp - isno)*(1.0_dp - isdeg)
+      ys(k, 1) = e2y*placed
+      xs(k, 1) = e2x
+      ys(k, 2) = e3y*placed
+      xs(k, 2) = e3x
+      ys(k, 3) = abs(s23)*placed
+      xs(k, 3) = c23
       out(k, 4) = ax
       out(k, 5) = ay
       out(k, 6) = bx*placed
@@ -176,11 +206,74 @@ contains
       out(k, 8) = w2
       out(k, 9) = w3
       out(k, 10) = ok*(-q*alpha1*(sn*e3x - c*e3y) - q*omega*omega*(c*e3x + sn*e3y) &
-                   - r*w2*w2*c23 + s*w3*w3)/merge(den2, 1.0_dp, st == st_ok)
+                   - r*w2*w2*c23 + s*w3*w3)/(ok*den2 + (1.0_dp - ok))
       out(k, 11) = ok*(q*alpha1*(sn*e2x - c*e2y) + q*omega*omega*(c*e2x + sn*e2y) &
-                   + r*w2*w2 - s*w3*w3*c23)/merge(den3, 1.0_dp, st == st_ok)
+                   + r*w2*w2 - s*w3*w3*c23)/(ok*den3 + (1.0_dp - ok))
       status(k) = st
     end do
-  end subroutine exact_states
+    ! angles in a second pass: one call site, so vatan2 is inlined and vectorised
+    ! (an unplaced row has y = 0 and x = 0 or a unit vector; its angle is then zeroed)
+    do j = 1, 3
+      do k = 1, m
+        out(k, j) = vatan2(ys(k, j), xs(k, j))*merge(0.0_dp, 1.0_dp, status(k) == none_ .or. status(k) == ind_)
+      end do
+    end do
+  end subroutine exact_block
+
+  !> sin and cos of x [rad], branch-free so that loops calling it vectorise.
+  !> Cody-Waite reduction by pi/2 in three parts (fdlibm constants), then the
+  !> fdlibm kernel polynomials on |r| <= pi/4.  Accurate to ~1 ulp for |x| < 1e5.
+  elemental subroutine vsincos(x, s, c)
+    real(dp), intent(in) :: x
+    real(dp), intent(out) :: s, c
+    real(dp), parameter :: twoopi = 6.36619772367581382433e-01_dp
+    real(dp), parameter :: pio2_1 = 1.57079632673412561417e+00_dp, pio2_2 = 6.07710050630396597660e-11_dp, &
+                           pio2_2t = 2.02226624879595063154e-21_dp
+    real(dp), parameter :: magic = 6755399441055744.0_dp   ! 1.5 * 2**52: adding/subtracting rounds to nearest
+    real(dp), parameter :: s1 = -1.66666666666666324348e-01_dp, s2 = 8.33333333332248946124e-03_dp, &
+      s3 = -1.98412698298579493134e-04_dp, s4 = 2.75573137070700676789e-06_dp, &
+      s5 = -2.50507602534068634195e-08_dp, s6 = 1.58969099521155010221e-10_dp
+    real(dp), parameter :: c1 = 4.16666666666666019037e-02_dp, c2 = -1.38888888888741095749e-03_dp, &
+      c3 = 2.48015872894767294178e-05_dp, c4 = -2.75573143513906633035e-07_dp, &
+      c5 = 2.08757232129817482790e-09_dp, c6 = -1.13596475577881948265e-11_dp
+    real(dp) :: kf, m, r, z, sr, cr
+    kf = (x*twoopi + magic) - magic                     ! nearest integer k
+    r = ((x - kf*pio2_1) - kf*pio2_2) - kf*pio2_2t
+    m = kf - 4.0_dp*(((kf*0.25_dp - 0.375_dp) + magic) - magic)   ! k mod 4 in {0,1,2,3}
+    z = r*r
+    sr = r + r*z*(s1 + z*(s2 + z*(s3 + z*(s4 + z*(s5 + z*s6)))))
+    cr = 1.0_dp - 0.5_dp*z + z*z*(c1 + z*(c2 + z*(c3 + z*(c4 + z*(c5 + z*c6)))))
+    s = merge(cr, sr, m == 1.0_dp .or. m == 3.0_dp)*merge(-1.0_dp, 1.0_dp, m >= 2.0_dp)
+    c = merge(sr, cr, m == 1.0_dp .or. m == 3.0_dp)*merge(-1.0_dp, 1.0_dp, m == 1.0_dp .or. m == 2.0_dp)
+  end subroutine vsincos
+
+  !> atan2(y, x) [rad] in (-pi, pi], branch-free (Cephes atan rational on [0, 1]).
+  elemental function vatan2(y, x) result(t)
+    real(dp), intent(in) :: y, x
+    real(dp) :: t
+    real(dp), parameter :: pio2 = 1.57079632679489661923_dp, pio4 = 0.78539816339744830962_dp, &
+                           pi = 3.14159265358979323846_dp, morebits = 6.123233995736765886130e-17_dp
+    real(dp), parameter :: p0 = -8.750608600031904122785e-01_dp, p1 = -1.615753718733365076637e+01_dp, &
+      p2 = -7.500855792314704667340e+01_dp, p3 = -1.228866684490136173410e+02_dp, &
+      p4 = -6.485021904942025371773e+01_dp
+    real(dp), parameter :: q0 = 2.485846490142306297962e+01_dp, q1 = 1.650270098316988542046e+02_dp, &
+      q2 = 4.328810604912902668951e+02_dp, q3 = 4.853903996359136964868e+02_dp, &
+      q4 = 1.945506571482613964425e+02_dp
+    real(dp) :: ax, ay, mn, mx, u, v, z, base, big   ! big: 1 or 0 (a real keeps one vector width)
+    ax = abs(x)
+    ay = abs(y)
+    mx = max(ax, ay)
+    mn = min(ax, ay)
+    u = mn/max(mx, tiny(1.0_dp))                      ! in [0, 1]
+    big = merge(1.0_dp, 0.0_dp, u > 0.66_dp)
+    v = big*((u - 1.0_dp)/(u + 1.0_dp)) + (1.0_dp - big)*u
+    base = big*pio4
+    z = v*v
+    z = z*((((p0*z + p1)*z + p2)*z + p3)*z + p4)/(((((z + q0)*z + q1)*z + q2)*z + q3)*z + q4)
+    t = base + (v*z + v + big*(0.5_dp*morebits))
+    t = merge(pio2 - t, t, ay > ax)
+    t = merge(pi - t, t, x < 0.0_dp)
+    t = sign(t, y)
+  end function vatan2
 
 end module fourbar

@@ -135,3 +135,17 @@ def test_branches_are_mirror_images_about_line_A_OB():
     foot = mid_o / 2 - o[:, 3:5]
     d = np.column_stack([12 - o[:, 3], -o[:, 4]])
     assert np.allclose(foot[:, 0] * d[:, 1] - foot[:, 1] * d[:, 0], 0, atol=1e-9)
+
+
+def test_vectorised_trig_matches_libm():
+    """The kernel's branch-free sincos/atan2 against numpy (libm) over a wide angle range."""
+    rng = np.random.default_rng(1)
+    theta = np.concatenate([rng.uniform(-2e4, 2e4, 20000), np.linspace(-10, 10, 20001),
+                            np.arange(-8, 9) * np.pi / 4])
+    out, st_ = states(theta, 12.0, 5.0, 15.0, 9.0)
+    assert np.all(st_ == OK)
+    assert np.max(np.abs(out[:, 3] - 5.0 * np.cos(theta))) < 5.0 * 4e-16 * (1 + np.abs(theta).max() / 1e3)
+    assert np.max(np.abs(out[:, 4] - 5.0 * np.sin(theta))) < 5.0 * 4e-16 * (1 + np.abs(theta).max() / 1e3)
+    e2 = (out[:, 5] - out[:, 3], out[:, 6] - out[:, 4])
+    assert np.max(np.abs(np.angle(np.exp(1j * (out[:, 0] - np.arctan2(e2[1], e2[0])))))) < 1e-15
+    assert np.max(np.abs(np.angle(np.exp(1j * (out[:, 1] - np.arctan2(out[:, 6], out[:, 5] - 12.0)))))) < 1e-15
