@@ -26,7 +26,7 @@ import f90nml
 
 __all__ = ["DeckError", "Key", "GroupSpec", "Params", "RawGroup", "Deck", "read_deck", "validate"]
 
-KINDS = ("float", "int", "str", "bool", "floats", "ints", "strs")
+KINDS = ("float", "int", "str", "bool", "floats", "ints", "strs", "list")
 
 
 class DeckError(Exception):
@@ -47,7 +47,8 @@ class Key:
     """Declaration of one deck key.
 
     kind      one of float, int, str, bool (scalars) or floats, ints, strs (lists;
-              a single value is accepted as a list of one)
+              a single value is accepted as a list of one); ``list`` is a list of
+              scalars of any one type, left uncoerced (sweep values)
     required  the deck must give it; otherwise ``default`` is used
     choices   allowed values (strings compared case-insensitively, stored lower-case)
     check     extra test: returns an error message or None
@@ -279,6 +280,13 @@ def _as_float(v: Any) -> float | None:
 
 def _coerce(kind: str, v: Any) -> tuple[Any, str | None]:
     """Convert a raw value to ``kind``; returns (value, error message)."""
+    if kind == "list":
+        items = v if isinstance(v, list) else [v]
+        if any(x is None for x in items):
+            return None, "list has an empty entry"
+        if len({str if isinstance(x, str) else (bool if isinstance(x, bool) else float) for x in items}) > 1:
+            return None, "list mixes numbers, strings and logicals"
+        return items, None
     if kind in ("floats", "ints", "strs"):
         items = v if isinstance(v, list) else [v]
         if any(x is None for x in items):

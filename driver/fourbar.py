@@ -15,14 +15,14 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
-from scipy.optimize import brentq
+from scipy.optimize import brentq, minimize_scalar
 
 from driver import kernels
 from driver.deck import GroupSpec, Key, Params, positive
 from driver.study import Figure, Result
 from driver.table import Column, fortran_f, render_table
 
-__all__ = ["SPEC", "run", "grashof", "limit_angles", "exact_grid", "listing_grid"]
+__all__ = ["SPEC", "run", "summarise", "grashof", "limit_angles", "exact_grid", "listing_grid"]
 
 ST = kernels.FOURBAR_STATUS
 BAND = (40.0, 120.0)  # transmission-angle band recommended by the paper [deg]
@@ -157,50 +157,81 @@ class Extremes:
     toggles: tuple[float, ...] = ()
 
 
-def extremes(p: Params) -> Extremes | None:
-    """Transmission-angle, rocker-position and speed extremes on a dense grid over the deck's range.
+def transmission_extremes(p: Params, lo: float, hi: float, lims: list[float]) -> tuple[float, float, float, float]:
+    """Closed form: mu grows with d = |A O_B|, and d is monotonic between 0 and 180 deg.
 
-    Rocker extremes (omega3 = 0) are refined with brentq on the kernel; the
-    transmission angle depends on |A O_B| only, whose extremes sit at 0 and 180 deg,
-    which are inserted into the grid when in range.
+    Over [lo, hi] d takes its extremes at the range ends or at 0/180 (+360k); the
+    assemblable part is d in [|r - s|, r + s], whose ends are the limit angles.
+    Returns (mu_min, theta, mu_max, theta) in degrees.
+    """
+    P, q, r, s = p.fixed_link, p.crank, p.coupler, p.rocker
+    d = lambda t: math.hypot(P - q * math.cos(math.radians(t)), q * math.sin(math.radians(t)))
+    mu = lambda x: math.degrees(math.acos(max(-1.0, min(1.0, (r * r + s * s - x * x) / (2 * r * s)))))
+    cands = [lo, hi] + [a + 360.0 * k for a in (0.0, 180.0) for k in range(-3, 4) if lo <= a + 360.0 * k <= hi]
+    lim_in = [a + 360.0 * k for a in lims for k in range(-3, 4) if lo <= a + 360.0 * k <= hi]
+    tmin = min(cands, key=d)
+    tmax = max(cands, key=d)
+    near = lambda target: min(lim_in, key=lambda t: abs(d(t) - target))
+    t_lo = tmin if d(tmin) >= abs(r - s) else near(abs(r - s))
+    t_hi = tmax if d(tmax) <= r + s else near(r + s)
+    d_lo = max(d(tmin), abs(r - s))
+    d_hi = min(d(tmax), r + s)
+    return mu(d_lo), t_lo, mu(d_hi), t_hi
+
+
+def extremes(p: Params) -> Extremes | None:
+    """Transmission-angle, rocker-position and speed extremes over the deck's crank range.
+
+    The transmission angle depends on |A O_B| only, which is monotonic in the crank
+    angle on [0, 180] and [180, 360], so its extremes sit at 0, 180, the range ends or
+    the limit angles, all inserted into a 0.5 deg grid (exact).  Rocker extremes
+    (omega3 = 0) are refined with brentq and speed peaks with a bounded search, both
+    on the kernel itself.
     """
     lo, hi = sorted((p.start_deg, p.stop_deg))
-    grid = np.linspace(lo, hi, max(2, int((hi - lo) / 0.01) + 1))
-    special = [a for a in (0.0, 180.0, 360.0) if lo <= a <= hi] + [a for a in limit_angles(
-        p.fixed_link, p.crank, p.coupler, p.rocker) if lo <= a <= hi]
-    grid = np.unique(np.concatenate([grid, special]))
+    grid = np.linspace(lo, hi, max(2, int(math.ceil((hi - lo) / 0.5)) + 1))
+    lims = limit_angles(p.fixed_link, p.crank, p.coupler, p.rocker)
+    special = [a + 360.0 * k for a in [0.0, 180.0] + lims for k in range(-3, 4)]
+    grid = np.unique(np.concatenate([grid, [a for a in special if lo <= a <= hi]]))
     out, st = exact_grid(p, grid)
     ok = st == ST["ok"]
     if not ok.any():
         return None
-    mu = np.round(np.degrees(out[:, 2]), 9)
-    rocker = np.degrees(out[:, 1])
     w2, w3 = out[:, 7], out[:, 8]
+    one = lambda t, col: float(exact_grid(p, np.array([t]))[0][0, col])
 
     def at(values: np.ndarray, pick) -> tuple[float, float]:
         idx = np.flatnonzero(ok)[pick(values[ok])]
         return float(values[idx]), float(grid[idx])
 
-    # rocker angle unwrapped about its mean direction, extremes where omega3 changes sign
+    # rocker angle relative to its mean direction; extremes where omega3 changes sign
     ref = np.degrees(np.angle(np.mean(np.exp(1j * out[ok, 1]))))
-    rel = (rocker - ref + 180.0) % 360.0 - 180.0
+    rel = (np.degrees(out[:, 1]) - ref + 180.0) % 360.0 - 180.0
     cands = [(rel[i], grid[i]) for i in np.flatnonzero(ok)[[0, -1]]]
     for i in np.flatnonzero(ok[:-1] & ok[1:] & (np.sign(w3[:-1]) != np.sign(w3[1:]))):
-        f = lambda t: float(exact_grid(p, np.array([t]))[0][0, 8])
         try:
-            t = brentq(f, grid[i], grid[i + 1], xtol=1e-10)
+            t = brentq(lambda x: one(x, 8), grid[i], grid[i + 1], xtol=1e-10)
         except ValueError:
             t = grid[i]
-        a = math.degrees(float(exact_grid(p, np.array([t]))[0][0, 1]))
-        cands.append(((a - ref + 180.0) % 360.0 - 180.0, t))
+        cands.append(((math.degrees(one(t, 1)) - ref + 180.0) % 360.0 - 180.0, t))
     rmin = min(cands, key=lambda c: c[0])
     rmax = max(cands, key=lambda c: c[0])
-    mu_min, mu_min_at = at(mu, np.argmin)
-    mu_max, mu_max_at = at(mu, np.argmax)
-    w3v, w3a = at(w3, lambda v: np.argmax(np.abs(v)))
-    w2v, w2a = at(w2, lambda v: np.argmax(np.abs(v)))
+
+    def peak(col: int, values: np.ndarray) -> tuple[float, float]:
+        v, t = at(values, lambda x: np.argmax(np.abs(x)))
+        a, b = max(lo, t - 0.5), min(hi, t + 0.5)
+        if b > a:
+            res = minimize_scalar(lambda x: -abs(one(x, col)), bounds=(a, b), method="bounded",
+                                  options={"xatol": 1e-7})
+            if res.success and abs(one(res.x, col)) > abs(v):
+                return one(res.x, col), float(res.x)
+        return v, t
+
+    mu_min, mu_min_at, mu_max, mu_max_at = transmission_extremes(p, lo, hi, lims)
+    toggles = tuple(a for a in lims if lo <= a <= hi)
+    w3v, w3a = peak(8, w3) if not toggles else at(w3, lambda x: np.argmax(np.abs(x)))
+    w2v, w2a = peak(7, w2) if not toggles else at(w2, lambda x: np.argmax(np.abs(x)))
     turns = bool(ok.all() and np.ptp(np.unwrap(out[:, 1])) >= 2 * np.pi - 1e-6)
-    toggles = tuple(a for a in limit_angles(p.fixed_link, p.crank, p.coupler, p.rocker) if lo <= a <= hi)
     return Extremes(mu_min, mu_min_at, mu_max, mu_max_at,
                     (rmin[0] + ref) % 360.0, float(rmin[1]), (rmax[0] + ref) % 360.0, float(rmax[1]),
                     w3v, w3a, w2v, w2a, float(ok.mean()), turns, toggles)
@@ -301,7 +332,7 @@ def summary_lines(p: Params, g: Grashof, ex: Extremes | None) -> list[str]:
         out += [f"    peak rocker speed .... {ex.w3_peak:.4f} rad/s at theta = {ex.w3_peak_at:.2f} deg",
                 f"    peak coupler speed ... {ex.w2_peak:.4f} rad/s at theta = {ex.w2_peak_at:.2f} deg"]
     if ex.assembled_fraction < 1.0:
-        out.append(f"    assemblable ..........  {100 * ex.assembled_fraction:.1f} % of the requested range")
+        out.append(f"    assemblable .......... about {100 * ex.assembled_fraction:.1f} % of the requested range")
     return out
 
 
@@ -414,6 +445,12 @@ def run(params: Params, progress: bool = False) -> Result:
     summary = _summary(p, g, ex)
     return Result(text="\n".join(lines) + "\n", tidy=tidy, summary=summary, warnings=warnings,
                   figures=_figures(p, title, listing_frame))
+
+
+def summarise(params: Params) -> dict:
+    """Headline figures only (what a sweep needs when it writes no per-case files)."""
+    p = params
+    return _summary(p, grashof(p.fixed_link, p.crank, p.coupler, p.rocker), extremes(p))
 
 
 def _summary(p: Params, g: Grashof, ex: Extremes | None) -> dict:
