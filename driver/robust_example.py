@@ -239,6 +239,8 @@ def run(params: Params, progress: bool = False) -> Result:
             recs.append({"item": key, "index": i, "value": float(v)})
     for key in ("eq22_tmin", "eq29", "eq213", "eq215", "eq22_quartic", "eq214_quartic"):
         recs.append({"item": key, "index": 0, "value": float(r[key])})
+    recs.append({"item": "eq22_slope", "index": 0, "value": float(r["eq22_slope"][0])})
+    recs.append({"item": "eq22_slope", "index": 1, "value": float(r["eq22_slope"][1])})
     recs.append({"item": "eq214_slope", "index": 0, "value": float(r["eq214_slope"][0])})
     recs.append({"item": "eq214_slope", "index": 1, "value": float(r["eq214_slope"][1])})
     for key in ("mean22", "std22", "mean25", "std25"):
