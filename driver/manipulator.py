@@ -604,6 +604,7 @@ def _tidy(tables: list[Table], tol: list[dict], sweep: dict, used: dict) -> pd.D
                         "th2'": "theta2_rate_rad_s", "th1''": "theta1_acc_rad_s2",
                         "th2''": "theta2_acc_rad_s2"}.get(col.header.strip(), col.header.strip())
                 rec[name] = np.nan if v is None else v
+            rec["note"] = t.trailers[i] if t.trailers else ""
             recs.append(rec)
     for rec in tol:
         recs.append({"table": "tolerance", "row": 0, "label": rec["name"], "l1_m": rec["l1"], "l2_m": rec["l2"],

@@ -162,9 +162,10 @@ def _compare(name: str, printed: list[float] | None, computed: np.ndarray,
         exp = -decimals if decimals is not None else Decimal(repr(float(a))).as_tuple().exponent
         half = 0.5 * 10.0 ** exp
         ok = abs(a - c) <= half + 1e-12
-        lines.append(f"  {name}[{i}]  printed {a!r:>12}  computed {c:.10g}  {'reproduced' if ok else 'NOT REPRODUCED'}")
+        text = f"{a:.{decimals}f}" if decimals is not None else repr(float(a))
+        lines.append(f"  {name}[{i}]  printed {text:>12}  computed {c:.10g}  {'reproduced' if ok else 'NOT REPRODUCED'}")
         if not ok:
-            flags.append(f"{name}[{i}]: printed {a!r}, computed {c:.10g}")
+            flags.append(f"{name}[{i}]: printed {text}, computed {c:.10g}")
     return lines, flags
 
 
