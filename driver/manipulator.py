@@ -521,7 +521,7 @@ def _tolerance(p: Params, ws: Workspace, names: list[str], l1: np.ndarray, l2: n
 # ----------------------------------------------------------------------------- differences between modes
 
 REASONS = {
-    ("4.2", "l2"): "report uses C = 6.874^2-style rounded radius squared instead of mean d^2",
+    ("4.2", "l2"): "report uses C = (radius rounded to 3 dp)^2 instead of mean d^2",
     ("4.2", "RI2"): "follows from l2",
     ("4.4", "l1opt"): "report prints 2 dp and uses the rounded radius",
     ("4.4", "l2opt"): "report prints 2 dp and uses the rounded radius",

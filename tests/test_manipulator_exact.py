@@ -110,8 +110,10 @@ def test_jacobian_manipulability_condition(l1, l2, t1, t2):
                    (fk(l1, l2, t1, t2 + h)[i] - fk(l1, l2, t1, t2 - h)[i]) / (2 * h)] for i in range(2)])
     np.testing.assert_allclose(jac[0].reshape(2, 2), J, atol=1e-6 * max(l1, l2))
     assert w[0] == pytest.approx(l1 * l2 * abs(math.sin(t2)), rel=1e-9, abs=1e-12)
+    Ja = np.array([[-l1 * math.sin(t1) - l2 * math.sin(t1 + t2), -l2 * math.sin(t1 + t2)],
+                   [l1 * math.cos(t1) + l2 * math.cos(t1 + t2), l2 * math.cos(t1 + t2)]])   # eq. 4.18
     if abs(math.sin(t2)) > 1e-3:
-        assert kappa[0] == pytest.approx(np.linalg.cond(J), rel=1e-5)
+        assert kappa[0] == pytest.approx(np.linalg.cond(Ja), rel=1e-7)
 
 
 @settings(max_examples=60, deadline=None)
