@@ -420,12 +420,44 @@ def _torque_tables(p: Params, conv: Conv) -> tuple[Table, Table, Table, dict[str
     if conv.report:
         src = "printed_angles_deg of the deck" if p.printed_angles_deg is not None else "Table 4.5 rounded to 2 dp"
         n47.append(f"joint angles fed in as printed ({src}), the interior angle used as theta2")
-    used = {"names": names, "l1": l1, "l2": l2, "m1": m1, "m2": m2, "tau": tau, "ok": ok,
+    rad1, rad2 = np.radians(ang["used1"]), np.radians(ang["used2"])
+    fx = l1 * np.cos(rad1) + l2 * np.cos(rad1 + rad2)
+    fy = l1 * np.sin(rad1) + l2 * np.sin(rad1 + rad2)
+    miss = np.hypot(fx - tx, fy - ty)
+    for i, name in enumerate(names):
+        if ok[i] and miss[i] > 1e-6:
+            n47.append(f"{name}: the joint angles used put the end effector at ({fx[i]:.3f}, {fy[i]:.3f}), "
+                       f"{miss[i]:.3f} m from the target")
+    used = {"names": names, "l1": l1, "l2": l2, "m1": m1, "m2": m2, "tau": tau, "ok": ok, "fk_miss": miss,
             "used1": ang["used1"], "used2": ang["used2"], "shown1": ang["shown1"], "shown2": ang["shown2"]}
     return (Table("4.5", "Table 4.5  Torque parameters", cols45, r45, tr, n45),
             Table("4.6", "Table 4.6  Torque parameters (continued): rates [rad/s], accelerations [rad/s^2]",
                   cols46, r46, tr),
             Table("4.7", "Table 4.7  Motor torques", cols47, r47, tr, n47), used)
+
+
+def _designs_table(p: Params, conv: Conv) -> Table:
+    """Robustness indices of the designs and their manipulability/condition number at the target."""
+    names, l1, l2 = _design_list(p, conv)
+    ri, sumc2, reach = kernels.manipulator_design_indices(conv.ws.x, conv.ws.y, l1, l2)
+    tx, ty = _target(p, conv.ws)
+    th1, th2, st = kernels.manipulator_ik(l1, l2, tx, ty, p.elbow)
+    _, w, kappa, _ = kernels.manipulator_arm_states(l1, l2, th1, th2)
+    rows, trailers = [], []
+    for i, name in enumerate(names):
+        ok = st[i] == STATUS["ok"]
+        rows.append([name, l1[i], l2[i], float(ri[i, 0]) if ri[i, 0] > 0 else None, float(ri[i, 1]),
+                     float(ri[i, 2]), float(w[i]) if ok else None, float(kappa[i]) if ok and kappa[i] > 0 else None,
+                     "yes" if reach[i] else "no"])
+        trailers.append("" if ok else "target out of reach of this design")
+    cols = [Column("Design", "s", 10), Column("l1", "f", 8, 4), Column("l2", "f", 8, 4), Column("RI1", "f", 9, 3),
+            Column("RI2", "f", 8, 5), Column("RI3", "f", 8, 5), Column("w", "f", 9, 4), Column("kappa", "f", 8, 4),
+            Column("reach", "s", 6)]
+    notes = ["RI1 = sigma_max/sigma_min (blank where sigma_min = 0), "
+             "RI2 = sigma_max (2.25), RI3 = sigma_max + ||J_x||_F (2.26)",
+             f"w = |det J| [m^2] and kappa = cond(J) of the arm Jacobian (4.18) at the target ({tx:g}, {ty:g}), "
+             "IK joint angles"]
+    return Table("designs", "Designs: robustness indices and dexterity measures", cols, rows, trailers, notes)
 
 
 def _sweep_l1(p: Params, conv: Conv) -> np.ndarray:
@@ -479,6 +511,11 @@ def _t48(p: Params, conv: Conv) -> tuple[Table, dict[str, Any]]:
     if conv.report:
         notes.append(f"report convention: theta2 = +acos(c2), theta1 = "
                      f"{round_half_up(math.degrees(math.atan2(ty, tx)), 2):.2f} - theta2 (does not reach P)")
+    r1, r2 = np.radians(t1), np.radians(t2)
+    miss = np.hypot(safe1 * np.cos(r1) + safe2 * np.cos(r1 + r2) - tx, safe1 * np.sin(r1) + safe2 * np.sin(r1 + r2) - ty)
+    good = (st == STATUS["ok"]) & inside
+    if good.any() and miss[good].max() > 1e-6:
+        notes.append(f"the tabulated angles miss the target by {miss[good].min():.3f} to {miss[good].max():.3f} m (FK)")
     data = {"l1": l1, "l2": l2, "m1": m1, "m2": m2, "t1": t1, "t2": t2, "tau": tau, "ok": (st == STATUS["ok"]) & inside,
             "reach_all": ri[2].astype(bool) & inside}
     return Table("4.8", "Table 4.8  Torques for other arm lengths along C_rob", cols, rows, trailers, notes), data
@@ -559,7 +596,7 @@ def _differences(report: list[Table], exact: list[Table]) -> list[str]:
 def _tables(p: Params, conv: Conv) -> tuple[list[Table], dict[str, Any], dict[str, Any]]:
     t45, t46, t47, used = _torque_tables(p, conv)
     t48, sweep = _t48(p, conv)
-    return [_t41(p, conv), _t42(p, conv), _t44(p, conv), t45, t46, t47, t48], used, sweep
+    return [_t41(p, conv), _t42(p, conv), _t44(p, conv), _designs_table(p, conv), t45, t46, t47, t48], used, sweep
 
 
 def _header(p: Params, ws: Workspace, conv: Conv) -> list[str]:
@@ -602,7 +639,8 @@ def _tidy(tables: list[Table], tol: list[dict], sweep: dict, used: dict) -> pd.D
                         "l1opt": "l1_m", "l2opt": "l2_m", "RI2": "ri2", "n": "n", "a1": "a1", "b2": "b2",
                         "a2": "a2", "b1": "b1", "reach": "reach", "th1'": "theta1_rate_rad_s",
                         "th2'": "theta2_rate_rad_s", "th1''": "theta1_acc_rad_s2",
-                        "th2''": "theta2_acc_rad_s2"}.get(col.header.strip(), col.header.strip())
+                        "th2''": "theta2_acc_rad_s2", "RI1": "ri1", "RI3": "ri3",
+                        "w": "manipulability_m2", "kappa": "condition_number"}.get(col.header.strip(), col.header.strip())
                 rec[name] = np.nan if v is None else v
             rec["note"] = t.trailers[i] if t.trailers else ""
             recs.append(rec)
@@ -688,6 +726,9 @@ def _claims(used: dict, sweep: dict) -> list[str]:
     for i, name in enumerate(used["names"]):
         if used["ok"][i]:
             lines.append(f"  {name:<10} total torque tau1 + tau2 = {fortran_f(tot[i], None, 3)} N m")
+    if used["ok"].sum() > 1:
+        k = int(np.argmin(np.where(used["ok"], tot, np.inf)))
+        lines.append(f"  lowest total torque among the designs: {used['names'][k]}")
     t = np.where(sweep["ok"], sweep["tau"].sum(1), np.inf)
     if np.isfinite(t).any():
         k = int(np.argmin(t))
