@@ -465,7 +465,10 @@ def _sweep_l1(p: Params, conv: Conv) -> np.ndarray:
         return p.sweep_l1_start + p.sweep_l1_step * np.arange(p.sweep_count)
     top = math.sqrt(conv.c_sweep)
     n = int(math.floor((top - p.sweep_l1_start) / p.sweep_l1_step + 1e-9)) + 1
-    return p.sweep_l1_start + p.sweep_l1_step * np.arange(max(n, 0))
+    if n < 1:
+        raise p.error("sweep_l1_start", f"{p.sweep_l1_start:g} m is beyond the C_rob radius {top:.4f} m: the sweep "
+                                        "along C_rob would be empty (give a smaller start or a sweep_count)")
+    return p.sweep_l1_start + p.sweep_l1_step * np.arange(n)
 
 
 def _t48(p: Params, conv: Conv) -> tuple[Table, dict[str, Any]]:

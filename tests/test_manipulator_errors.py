@@ -48,6 +48,9 @@ CASES = [
     ("printed_angles_deg", dict(printed_angles_deg="34.81, 61.53"), "needs theta1, theta2"),
     ("tolerance_bound", dict(tolerance_bound="0"), "must be positive"),
     ("mc_samples", dict(mc_samples="0"), "at least 1"),
+    ("sweep_l1_start", dict(sweep_l1_start="10"), "beyond the C_rob radius"),
+    ("sweep_count", dict(sweep_count="-1"), "must not be negative"),
+    ("target_y", dict(target_x="1"), "must be given together"),
 ]
 
 
