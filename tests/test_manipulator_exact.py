@@ -183,3 +183,44 @@ def test_study_tolerance_rows(exact_runs):
         assert (t["mc_max_m"] <= p.tolerance_bound).all()
         assert (t["mc_p99_m"] < t["mc_max_m"]).all()
         np.testing.assert_allclose(t["dl1_m"], p.tolerance_bound / (math.sqrt(2) * t["ri2"]), rtol=1e-12)
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.lists(st.tuples(st.floats(-8, 8), st.floats(-8, 8)), min_size=1, max_size=6),
+       st.floats(0.5, 6.0), st.floats(0.5, 6.0), st.sampled_from(["global", "per_point"]))
+def test_tolerance_box_property(points, l1, l2, measure):
+    """Random workspaces and designs: SLSQP over all corners equals the l = 2 closed form, and the
+    worst corner (computed here in numpy) sits on the bound."""
+    x = np.array([p[0] for p in points])
+    y = np.array([p[1] for p in points])
+    d = np.hypot(x, y)
+    if (d < abs(l1 - l2) + 1e-3).any() or (d > l1 + l2 - 1e-3).any() or (d < 1e-3).any():
+        return
+    th1, th2, status = kernels.manipulator_ik(l1, l2, x, y, 1)
+    assert (status == 0).all()
+    blocks = _sensitivity_blocks(th1, th2)
+    box = tolerance_box(blocks, 0.02, measure)
+    assert box["converged"]
+    np.testing.assert_allclose(box["u"], box["closed"], rtol=1e-5)
+    corners = np.array([[1, 1], [1, -1]]) * box["closed"]
+    e = np.einsum("kij,nj->nki", blocks, corners)
+    worst = np.sqrt((e ** 2).sum((1, 2))).max() if measure == "global" else np.sqrt((e ** 2).sum(2)).max()
+    assert worst == pytest.approx(0.02, rel=1e-10)
+
+
+def test_tolerance_box_three_variables():
+    """General l: all 2^(l-1) corner patterns constrained; the box is on the bound and maximal."""
+    rng = np.random.default_rng(3)
+    blocks = rng.normal(size=(4, 2, 3))
+    eps = 0.05
+    box = tolerance_box(blocks, eps, "global")
+    assert box["closed"] is None and box["converged"]
+    u = box["u"]
+    J = blocks.reshape(-1, 3)
+    signs = np.array([[a, b, c] for a in (1, -1) for b in (1, -1) for c in (1, -1)])
+    err = np.linalg.norm((signs * u) @ J.T, axis=1)
+    assert err.max() == pytest.approx(eps, rel=1e-6)
+    for i in range(3):   # growing any half-width breaks the bound
+        v = u.copy()
+        v[i] *= 1.01
+        assert np.linalg.norm((signs * v) @ J.T, axis=1).max() > eps
