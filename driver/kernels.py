@@ -11,7 +11,9 @@ import numpy as np
 
 from driver import _kernels
 
-__all__ = ["farray", "fourbar_listing", "fourbar_exact", "FOURBAR_STATUS"]
+__all__ = ["farray", "fourbar_listing", "fourbar_exact", "FOURBAR_STATUS",
+           "MANIPULATOR_STATUS", "manipulator_arm_states", "manipulator_torques", "manipulator_ik",
+           "manipulator_design_indices", "manipulator_position_errors"]
 
 
 def farray(x, ndim: int | None = None) -> np.ndarray:
@@ -60,3 +62,87 @@ def fourbar_exact(theta: np.ndarray, p: float, q: float, r: float, s: float, ome
     if status is None:
         status = np.empty(n, dtype=np.int32)
     return _kernels.fourbar.exact_states(theta, p, q, r, s, omega, alpha, int(branch), out, status)
+
+
+# ----------------------------------------------------------------------------- manipulator
+
+#: status codes of the 2R manipulator kernels (fortran/manipulator.f90)
+MANIPULATOR_STATUS = {"ok": int(_kernels.manipulator.st_ok),
+                      "unreachable": int(_kernels.manipulator.st_unreachable),
+                      "degenerate": int(_kernels.manipulator.st_degenerate)}
+
+
+def _col(x, n: int) -> np.ndarray:
+    """``x`` (scalar or length-n) broadcast to a contiguous float64 vector of length n."""
+    return farray(np.broadcast_to(np.asarray(x, dtype=np.float64), (n,)), 1)
+
+
+def _pair(x, n: int) -> np.ndarray:
+    """``x`` (pair or (n, 2)) broadcast to a Fortran-ordered (n, 2) float64 array."""
+    return farray(np.broadcast_to(np.asarray(x, dtype=np.float64), (n, 2)), 2)
+
+
+def manipulator_arm_states(l1, l2, th1, th2, qd=(1.0, 1.0), qdd=(1.0, 1.0), m1=None, m2=None,
+                           g: float = 9.8, mass_per_length: float = 10.0):
+    """Jacobian, manipulability, condition number and torques of 2R configurations.
+
+    Inputs broadcast to n rows: lengths l1, l2 [m], joint angles th1, th2 [rad] (th2 relative),
+    joint rates ``qd`` [rad/s] and accelerations ``qdd`` [rad/s^2] as pairs or (n, 2), link
+    masses m1, m2 [kg] (default ``mass_per_length`` [kg/m] times the length), g [m/s^2] along -y.
+    Returns (jac (n, 4) = J11, J12, J21, J22 [m] of eq. 4.18, w = |det J| [m^2],
+    kappa = sigma_max/sigma_min (0 where J is singular), tau (n, 2) [N m]).
+    """
+    n = max(np.size(l1), np.size(l2), np.size(th1), np.size(th2))
+    l1v, l2v = _col(l1, n), _col(l2, n)
+    m1v = _col(mass_per_length * l1v if m1 is None else m1, n)
+    m2v = _col(mass_per_length * l2v if m2 is None else m2, n)
+    return _kernels.manipulator.arm_states(l1v, l2v, _col(th1, n), _col(th2, n), _pair(qd, n),
+                                           _pair(qdd, n), m1v, m2v, float(g))
+
+
+def manipulator_torques(l1, l2, th1, th2, qd=(1.0, 1.0), qdd=(1.0, 1.0), m1=None, m2=None,
+                        g: float = 9.8, mass_per_length: float = 10.0) -> np.ndarray:
+    """Joint torques (n, 2) [N m] of Craig's point-mass 2R arm (report eqs 2.52/2.53).
+
+    Same inputs and units as :func:`manipulator_arm_states`.
+    """
+    n = max(np.size(l1), np.size(l2), np.size(th1), np.size(th2))
+    l1v, l2v = _col(l1, n), _col(l2, n)
+    m1v = _col(mass_per_length * l1v if m1 is None else m1, n)
+    m2v = _col(mass_per_length * l2v if m2 is None else m2, n)
+    return _kernels.manipulator.craig_torques(l1v, l2v, _col(th1, n), _col(th2, n), _pair(qd, n),
+                                              _pair(qdd, n), m1v, m2v, float(g))
+
+
+def manipulator_ik(l1, l2, x, y, branch: int = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Inverse kinematics of targets (x, y) [m] for arms (l1, l2) [m] on elbow ``branch``.
+
+    +1 gives th2 >= 0, -1 gives th2 <= 0.  Returns th1, th2 [rad] and status per row
+    (0 ok, 1 out of reach, 2 degenerate: zero link or target at the base; angles 0 there).
+    """
+    n = max(np.size(l1), np.size(l2), np.size(x), np.size(y))
+    return _kernels.manipulator.inverse_kin(_col(l1, n), _col(l2, n), _col(x, n), _col(y, n),
+                                            int(branch))
+
+
+def manipulator_design_indices(x, y, l1, l2) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Robustness indices of designs (l1, l2) [m] for workspace points (x, y) [m].
+
+    Returns ri (nd, 3) = RI1 (sigma_max/sigma_min, 0 when sigma_min = 0), RI2 = sigma_max
+    (eq. 2.25), RI3 = sigma_max + ||J_x||_F (dimensionless); sum of cos(th2_i); and reach
+    (1 when the design reaches every point).
+    """
+    x, y = farray(np.atleast_1d(x), 1), farray(np.atleast_1d(y), 1)
+    nd = max(np.size(l1), np.size(l2))
+    return _kernels.manipulator.design_indices(x, y, _col(l1, nd), _col(l2, nd))
+
+
+def manipulator_position_errors(th1, th2, dl) -> np.ndarray:
+    """Positioning errors [m] of an arm held at joint angles (th1, th2) [rad] of the workspace
+    points, for link-length errors ``dl`` (ns, 2) [m].
+
+    Returns (ns, 2): column 0 the global norm over all points stacked (Caro), column 1 the
+    largest error at a single point.
+    """
+    th1, th2 = farray(np.atleast_1d(th1), 1), farray(np.atleast_1d(th2), 1)
+    return _kernels.manipulator.position_errors(th1, th2, farray(dl, 2))

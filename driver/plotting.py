@@ -106,3 +106,66 @@ def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.nd
     ax.legend(fontsize=7, loc="best")
     ax.set_title(f"{title}: linkage positions")
     return fig
+
+
+# ----------------------------------------------------------------------------- manipulator
+
+def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, L2: np.ndarray,
+                             ri2: np.ndarray, sum_d2: float, n: int, levels: Sequence[float],
+                             optima: dict, names: Sequence[str], l1: np.ndarray, l2: np.ndarray,
+                             title: str = "") -> Figure:
+    """Design space (l1, l2) [m] of a 2R arm, like the report's Figures 4.2-4.11.
+
+    Left: reach region |l1 - l2| <= r, l1 + l2 >= R (shaded), C_rob circle, iso-RI2 ellipses
+    (eqs 4.14-4.17, c = sum d^2), dexterity line l2 = l1 sqrt(2)/2, manipulability line l1 = l2,
+    optima and chosen designs.  Right: RI2 contours over the design plane with the same lines.
+    """
+    fig, axes = new_figure(1, 2, figsize=(11.0, 5.0))
+    top = float(L1.max())
+    g = np.linspace(0, top, 400)
+    G1, G2 = np.meshgrid(g, g)
+    ok = (np.abs(G1 - G2) <= r) & (G1 + G2 >= R)
+    t = np.linspace(0, np.pi / 2, 200)
+    for k, ax in enumerate(axes):
+        if k == 0:
+            ax.contourf(G1, G2, ok.astype(float), levels=[0.5, 1.5], colors=["#cfe3f7"])
+            ax.plot(g, g - r, "b-", lw=0.8, label="|l1 - l2| = r")
+            ax.plot(g, g + r, "b-", lw=0.8)
+            ax.plot(g, R - g, "g-", lw=0.8, label="l1 + l2 = R")
+            for v in levels:  # ellipses in the 45-deg frame; both branches
+                for ca, cb in ((v * v, 2 * n - v * v), (2 * n - v * v, v * v)):
+                    phi = np.linspace(0, 2 * np.pi, 400)
+                    A, B = np.sqrt(sum_d2 / ca), np.sqrt(sum_d2 / cb)
+                    P, Q = A * np.cos(phi), B * np.sin(phi)
+                    keep = np.abs(P) >= np.abs(Q)
+                    x, y = (P + Q) / np.sqrt(2), (P - Q) / np.sqrt(2)
+                    ax.plot(np.where(keep, x, np.nan), np.where(keep, y, np.nan), ":", lw=0.8, color="gray")
+        else:
+            cs = ax.contour(L1, L2, ri2, levels=np.sqrt(n) + np.array([0.001, 0.01, 0.05, 0.1, 0.2, 0.4, 0.8]),
+                            linewidths=0.7, cmap="viridis")
+            ax.clabel(cs, fontsize=6, fmt="%.3f")
+        ax.plot(radius * np.cos(t), radius * np.sin(t), "r-", lw=1.2, label=f"C_rob (radius {radius:.3f})")
+        ax.plot(g, g * np.sqrt(2) / 2, "m--", lw=0.8, label="dexterity l2 = l1 sqrt2/2")
+        ax.plot(g, g, "k--", lw=0.8, label="manipulability l1 = l2")
+        for key, mk in (("dexterity", "ms"), ("manipulability", "ko")):
+            ax.plot(*optima[key], mk, ms=5, mfc="none")
+        ax.plot(l1, l2, "r*", ms=9, label="chosen designs")
+        for name, a, b in zip(names, l1, l2):
+            ax.annotate(name, (a, b), textcoords="offset points", xytext=(4, 4), fontsize=7)
+        ax.set_xlim(0, top)
+        ax.set_ylim(0, top)
+        ax.set_aspect("equal")
+        ax.set_xlabel("l1 [m]")
+        ax.set_ylabel("l2 [m]")
+    axes[0].set_title("reach region, C_rob, iso-RI2 ellipses")
+    axes[1].set_title("RI2 over the design plane")
+    axes[0].legend(fontsize=7, loc="upper right")
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+def manipulator_torque_crob(l1: np.ndarray, tau1: np.ndarray, tau2: np.ndarray, c: float) -> Figure:
+    """Motor torques tau1, tau2 and their sum [N m] against l1 [m] along C_rob (Table 4.8)."""
+    return line_panels(l1, [("torque [N m]", {"tau1": tau1, "tau2": tau2, "tau1 + tau2": tau1 + tau2})],
+                       xlabel="l1 [m] (l2 = sqrt(%g - l1^2))" % c, title="Motor torques along C_rob")

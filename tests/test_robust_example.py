@@ -1,0 +1,79 @@
+"""Section 2.3 (Taylor's example) against the printed values of seed 004 (tests/data/manipulator/
+section_2_3.csv); the printed results that do not reproduce (flagged.csv) must be flagged."""
+from __future__ import annotations
+
+from decimal import Decimal
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from driver.cli import study_of
+from driver.deck import read_deck
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = ROOT / "tests" / "data" / "manipulator"
+
+
+def assert_printed(computed: float, printed: str, what: str = "") -> None:
+    """|computed - printed| <= half a unit of the printed last digit + 1e-9."""
+    half = 0.5 * 10.0 ** Decimal(printed.strip()).as_tuple().exponent
+    assert abs(float(computed) - float(printed)) <= half + 1e-9, f"{what}: {computed!r} vs printed {printed}"
+
+
+@pytest.fixture(scope="module")
+def report():
+    module, params = study_of(read_deck(ROOT / "inputs" / "robust_example.dat"))
+    return module.run(params)
+
+
+def value(res, item: str, index: int) -> float:
+    t = res.tidy
+    row = t[(t["item"] == item) & (t["index"] == index)]
+    assert len(row) == 1, (item, index)
+    return float(row["value"].iloc[0])
+
+
+def test_safe_printed_values(report):
+    ref = pd.read_csv(DATA / "section_2_3.csv", dtype=str)
+    for _, r in ref.iterrows():
+        assert_printed(value(report, r["item"], int(r["index"])), r["printed"], f"{r['source']} {r['item']}[{r['index']}]")
+
+
+def test_unreproducible_printed_values_are_flagged(report):
+    ref = pd.read_csv(DATA / "flagged.csv", dtype=str)
+    for _, r in ref.iterrows():
+        computed = value(report, r["item"], int(r["index"]))
+        half = 0.5 * 10.0 ** Decimal(r["printed"]).as_tuple().exponent
+        assert abs(computed - float(r["printed"])) > half, f"{r['item']}[{r['index']}] unexpectedly reproduces"
+    text = report.text
+    assert "Flagged: printed results that do not reproduce" in text
+    for tag in ("(2.12)[0]", "(2.12)[1]", "(2.12)[2]", "Table 2.5 std[1]", "Table 2.5 std[2]"):
+        assert f"  {tag}: printed" in text
+    assert report.summary["flagged"] == 5
+
+
+def test_independent_statistics(report):
+    """Table 2.2 from the raw Table 2.1 data with pandas (sample std), fit by numpy.polyfit."""
+    y = np.array([2.34, 2.03, 2.02, 2.21, 2.20, 1.67, 1.99, 2.17, 2.09, 1.87, 2.21, 1.39,
+                  3.00, 3.00, 3.00, 2.97, 2.98, 3.00, 2.99, 3.00, 3.00, 2.99, 3.00, 3.00,
+                  1.72, 2.19, 2.04, 1.93, 2.03, 1.80, 2.13, 1.65, 1.94, 1.87, 1.90, 2.09]).reshape(3, 12)
+    df = pd.DataFrame(y.T)
+    for i in range(3):
+        assert value(report, "mean22", i) == pytest.approx(df[i].mean(), rel=1e-14)
+        assert value(report, "std22", i) == pytest.approx(df[i].std(), rel=1e-13)
+    b = np.polyfit([10, 15, 20], df.mean().to_numpy(), 2)[::-1]
+    for i in range(3):
+        assert value(report, "eq27", i) == pytest.approx(b[i], rel=1e-9)
+    assert value(report, "eq215", 0) == pytest.approx(-b[1] / (2 * b[2]), rel=1e-5)
+
+
+def test_exact_mode_differs_only_in_rounded_inputs(tmp_path):
+    text = (ROOT / "inputs" / "robust_example.dat").read_text().replace("mode = 'report'", "mode = 'exact'")
+    path = tmp_path / "exact.dat"
+    path.write_text(text)
+    module, params = study_of(read_deck(path))
+    res = module.run(params)
+    assert value(res, "eq211", 0) == pytest.approx(-5.66833, abs=5e-6)   # unrounded means
+    assert value(res, "eq213", 0) == pytest.approx(14.997, abs=5e-4)
