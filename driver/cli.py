@@ -157,7 +157,10 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.keys:
-        print(_keys_help(args.keys.lstrip("&").lower()))
+        try:
+            print(_keys_help(args.keys.lstrip("&").lower()))
+        except BrokenPipeError:  # e.g. piped into head
+            sys.stderr.close()
         return EXIT_OK
     if not args.decks:
         parser.error("no deck given")

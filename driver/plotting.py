@@ -169,3 +169,36 @@ def manipulator_torque_crob(l1: np.ndarray, tau1: np.ndarray, tau2: np.ndarray, 
     """Motor torques tau1, tau2 and their sum [N m] against l1 [m] along C_rob (Table 4.8)."""
     return line_panels(l1, [("torque [N m]", {"tau1": tau1, "tau2": tau2, "tau1 + tau2": tau1 + tau2})],
                        xlabel="l1 [m] (l2 = sqrt(%g - l1^2))" % c, title="Motor torques along C_rob")
+
+
+# ----------------------------------------------------------------------------- sweep
+
+def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (), title: str = "") -> Figure:
+    """Summary of a sweep: chosen (or all numeric) headline figures against a swept key.
+
+    With one numeric x the figures are drawn as lines over the cases; a boolean
+    ``kept`` column, when some cases are not kept, is shown as filled vs hollow markers.
+    """
+    import pandas as pd
+    x = x or next((k for k in keys if pd.api.types.is_numeric_dtype(frame[k])), "case")
+    numeric = [c for c in frame.columns if c not in (x, "case") and pd.api.types.is_numeric_dtype(frame[c])
+               and not pd.api.types.is_bool_dtype(frame[c]) and c not in keys]
+    ys = list(ys) or numeric[:6]
+    fig, axes = new_figure(len(ys), 1, sharex=True, figsize=(7.0, 1.9 * len(ys) + 0.8))
+    kept = frame["kept"].astype(bool) if "kept" in frame else pd.Series(True, index=frame.index)
+    others = [k for k in keys if k != x]
+    groups = frame.groupby(others, sort=False) if others else [("", frame)]
+    for ax, y in zip(axes, ys):
+        for label, g in groups:
+            g = g.sort_values(x)
+            style = "-" if len(frame) <= 2000 else ""
+            ax.plot(g[x], g[y], style, marker="o" if len(frame) <= 200 else ".", ms=3, lw=1,
+                    label=", ".join(f"{k}={v}" for k, v in zip(others, label if isinstance(label, tuple) else (label,))) or None)
+        if not kept.all():
+            ax.plot(frame.loc[kept, x], frame.loc[kept, y], "o", ms=4, mfc="none", color="k", label="kept")
+        ax.set_ylabel(y, fontsize=7)
+    if others or not kept.all():
+        axes[0].legend(fontsize=6, ncol=2)
+    axes[-1].set_xlabel(x)
+    fig.suptitle(f"{title}: sweep summary" if title else "sweep summary")
+    return fig

@@ -29,7 +29,7 @@ class TableValueError(ValueError):
 def _round_half_up(value: float, decimals: int) -> str:
     """Decimal text of ``value`` rounded half away from zero (Fortran's RN-compatible)."""
     q = Decimal(1).scaleb(-decimals)
-    return str(Decimal(value).quantize(q, rounding=ROUND_HALF_UP))
+    return format(Decimal(value).quantize(q, rounding=ROUND_HALF_UP), "f")
 
 
 def fortran_f(value: float, w: int | None, d: int, style: str = "modern") -> str:

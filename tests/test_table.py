@@ -15,6 +15,8 @@ from driver.table import Column, TableValueError, fortran_f, render_table
     (2.0, 5, 2, " 2.00", " 2.00"),
     (0.25, 5, 1, "  0.3", "   .3"),            # ties round away from zero
     (-2.5001, 7, 4, "-2.5001", "-2.5001"),
+    (3e-8, 12, 8, "  0.00000003", "   .00000003"),   # never exponent notation
+    (-4e-12, 12, 8, "  0.00000000", "   .00000000"),
 ])
 def test_f_editing(x, w, d, modern, legacy):
     assert fortran_f(x, w, d) == modern

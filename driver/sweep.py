@@ -1,0 +1,492 @@
+"""Sweeps: a ``&sweep`` group turns a deck into a study over many cases.
+
+    &fourbar  fixed_link = 12, crank = 2, coupler = 15, rocker = 9, omega = 5, step_deg = 20 /
+    &sweep
+      key1 = 'fourbar.crank',   values1 = 2, 3, 4, 5          ! a list ...
+      key2 = 'fourbar.coupler', start2 = 14, stop2 = 16, count2 = 3   ! ... or start/stop/count
+      zip  = .false.            ! .false.: full grid; .true.: keys varied together
+      keep = 'meets_band_40_120 and rocker_swing_deg > 60'   ! optional filter on the summary
+      case_outputs = 'all'      ! per-case files for 'all', 'kept' or 'none' of the cases
+    /
+
+Every case is a complete deck (the study group with the swept values), validated
+and run exactly as a single run would be.  Outputs, for a deck ``<stem>.dat``:
+
+* ``<stem>/case_0001.{dat,out,parquet,json}``: the case deck, its ``.out``, its tidy
+  table and its summary (the json is written last and marks the case complete);
+* ``<stem>.out``: a fixed-format summary table (one row per case) and failed cases;
+* ``<stem>_summary.{csv,parquet}``: one row per case (swept keys + headline figures);
+* ``<stem>_cases.{csv,parquet}``: the tidy tables of the written cases, with a
+  column for every swept key.
+
+Cases run in worker processes (``--jobs``, default all cores) or on a Dask
+cluster (``--scheduler ADDRESS`` or ``scheduler = '...'``), in chunks sized so
+that scheduling costs little; results are ordered by case whatever the
+scheduling.  ``--resume`` skips cases whose outputs are complete.
+"""
+from __future__ import annotations
+
+import concurrent.futures as cf
+import hashlib
+import itertools
+import json
+import math
+import os
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Iterable
+
+import f90nml
+import numpy as np
+import pandas as pd
+
+from driver.atomic import write_text
+from driver.deck import Deck, DeckError, GroupSpec, Key, Params, RawGroup, validate
+from driver.export import write_tidy
+from driver.study import load_study
+from driver.table import Column, render_table
+
+__all__ = ["SPEC", "Case", "build_cases", "run_sweep_deck", "run_task", "MAX_KEYS"]
+
+MAX_KEYS = 9
+EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+
+
+def _spec() -> GroupSpec:
+    keys: dict[str, Key] = {}
+    for k in range(1, MAX_KEYS + 1):
+        keys[f"key{k}"] = Key("str", doc=f"deck key to vary, 'group.key' (axis {k})")
+        keys[f"values{k}"] = Key("list", doc="values of that key (numbers or strings)")
+        keys[f"start{k}"] = Key("float", doc="first value (with stop and count)")
+        keys[f"stop{k}"] = Key("float", doc="last value (inclusive)")
+        keys[f"count{k}"] = Key("int", doc="number of values from start to stop")
+    keys.update({
+        "zip": Key("bool", default=False, doc=".true.: vary the keys together instead of a full grid"),
+        "keep": Key("str", default="", doc="pandas query on the summary table (swept keys in backticks)"),
+        "case_outputs": Key("str", default="all", choices=("all", "kept", "none"),
+                            doc="which cases get their own .out/.parquet/.json files"),
+        "scheduler": Key("str", default="", doc="Dask scheduler address (else local worker processes)"),
+        "chunk": Key("int", default=0, check=lambda v: "must not be negative" if v < 0 else None,
+                     doc="cases per task; 0 = chosen from the time of the first case"),
+        "plot_x": Key("str", default="", doc="summary column on the x axis of the summary plot"),
+        "plot_y": Key("strs", default=[], doc="summary columns plotted against plot_x"),
+    })
+    return GroupSpec("sweep", keys, doc="run a study over a grid or list of deck values")
+
+
+SPEC = _spec()
+
+
+@dataclass
+class Case:
+    """One case of a sweep: its number (from 1) and the swept values {'group.key': value}."""
+
+    index: int
+    values: dict[str, Any]
+
+
+@dataclass
+class CaseResult:
+    """What a worker returns for one case."""
+
+    index: int
+    values: dict[str, Any]
+    status: int = EXIT_OK
+    error: str = ""
+    summary: dict[str, Any] = field(default_factory=dict)
+    kept: bool = True
+    written: bool = False
+    warnings: list[str] = field(default_factory=list)
+    tidy: pd.DataFrame | None = None
+    seconds: float = 0.0
+
+
+# ----------------------------------------------------------------------------- cases
+
+def _axes(sw: Params, study_group: str, study_spec: GroupSpec) -> list[tuple[str, list]]:
+    """The swept axes [(‘group.key’, values)], checked against the study's keys."""
+    axes = []
+    for k in range(1, MAX_KEYS + 1):
+        name = sw[f"key{k}"]
+        has_values = sw[f"values{k}"] is not None
+        has_range = any(sw[f"{w}{k}"] is not None for w in ("start", "stop", "count"))
+        if name is None:
+            for w in ("values", "start", "stop", "count"):
+                if sw[f"{w}{k}"] is not None:
+                    raise sw.error(f"{w}{k}", f"given without key{k}")
+            continue
+        group, _, key = name.lower().partition(".")
+        if not key:
+            raise sw.error(f"key{k}", f"write the key as 'group.key' (e.g. '{study_group}.{name}')")
+        if group != study_group:
+            raise sw.error(f"key{k}", f"group '{group}' is not this deck's study group &{study_group}")
+        if key not in study_spec.keys:
+            raise sw.error(f"key{k}", f"&{study_group} has no key '{key}'")
+        if has_values and has_range:
+            raise sw.error(f"values{k}", f"give values{k} or start{k}/stop{k}/count{k}, not both")
+        if has_values:
+            values = list(sw[f"values{k}"])
+        elif has_range:
+            missing = [w for w in ("start", "stop", "count") if sw[f"{w}{k}"] is None]
+            if missing:
+                raise sw.error(f"{missing[0]}{k}", f"start{k}, stop{k} and count{k} go together")
+            if sw[f"count{k}"] < 1:
+                raise sw.error(f"count{k}", "must be at least 1")
+            values = [float(v) for v in np.linspace(sw[f"start{k}"], sw[f"stop{k}"], sw[f"count{k}"])]
+        else:
+            raise sw.error(f"key{k}", f"needs values{k} or start{k}/stop{k}/count{k}")
+        if not values:
+            raise sw.error(f"values{k}", "must list at least one value")
+        axes.append((f"{group}.{key}", values))
+    if not axes:
+        raise sw.error("key1", "a sweep needs at least key1 with its values")
+    names = [a[0] for a in axes]
+    dup = {n for n in names if names.count(n) > 1}
+    if dup:
+        raise sw.error(f"key{names.index(sorted(dup)[0]) + 1}", f"{sorted(dup)[0]} is swept twice")
+    return axes
+
+
+def build_cases(sw: Params, study_group: str, study_spec: GroupSpec) -> list[Case]:
+    """All cases of the sweep, numbered from 1: a full grid, or zipped axes."""
+    axes = _axes(sw, study_group, study_spec)
+    names = [a[0] for a in axes]
+    if sw.zip:
+        n = len(axes[0][1])
+        for k, (name, vals) in enumerate(axes):
+            if len(vals) != n:
+                raise sw.error(f"values{k + 1}" if sw[f"values{k + 1}"] is not None else f"count{k + 1}",
+                               f"zip = .true. needs equally long value lists ({names[0]}: {n}, {name}: {len(vals)})")
+        combos: Iterable = zip(*(v for _, v in axes))
+    else:
+        combos = itertools.product(*(v for _, v in axes))
+    return [Case(i + 1, dict(zip(names, c))) for i, c in enumerate(combos)]
+
+
+def _case_raw(raw: RawGroup, case: Case) -> RawGroup:
+    values = dict(raw.values)
+    for name, v in case.values.items():
+        values[name.partition(".")[2]] = v
+    return RawGroup(raw.name, values, raw.lines, raw.line)
+
+
+def _case_deck_text(study_group: str, params: Params, case: Case, deck_path: Path) -> str:
+    """A complete deck for the case (the validated study group, swept values included)."""
+    nml = f90nml.Namelist({study_group: {k: v for k, v in params.items() if v is not None and v != [] and v != ""}})
+    head = (f"! case {case.index} of sweep deck {deck_path}: "
+            + ", ".join(f"{k} = {v!r}" for k, v in case.values.items()) + "\n")
+    return head + str(nml) + "\n"
+
+
+# ----------------------------------------------------------------------------- worker
+
+@dataclass
+class Task:
+    """A chunk of cases for one worker (picklable: plain data only)."""
+
+    deck_path: str
+    raw: RawGroup
+    cases: list[Case]
+    case_dir: str
+    width: int
+    keep: str
+    case_outputs: str
+    formats: list[str]
+    plot: bool
+    base_hash: str
+
+
+def _case_name(index: int, width: int) -> str:
+    return f"case_{index:0{width}d}"
+
+
+def _kept(keep: str, values: dict, summary: dict) -> bool:
+    if not keep:
+        return True
+    row = pd.DataFrame([{**values, **summary}])
+    return bool(len(row.query(keep)))
+
+
+def _json_default(o: Any) -> Any:
+    if isinstance(o, (np.floating, np.integer)):
+        return o.item()
+    if isinstance(o, np.bool_):
+        return bool(o)
+    return str(o)
+
+
+def run_case(task: Task, case: Case) -> CaseResult:
+    """Run one case in this process; never raises for a case failure."""
+    t0 = time.perf_counter()
+    res = CaseResult(case.index, case.values)
+    module = load_study(task.raw.name)
+    try:
+        params = validate(_case_raw(task.raw, case), module.SPEC, task.deck_path)
+    except DeckError as exc:
+        res.status, res.error, res.kept = EXIT_BAD_INPUT, str(exc), False
+        return res
+    try:
+        want_files = task.case_outputs != "none"
+        result = None
+        if want_files and (task.case_outputs == "all" or not task.keep) or not hasattr(module, "summarise"):
+            result = module.run(params, progress=False)
+            res.summary = dict(result.summary)
+        else:
+            res.summary = dict(module.summarise(params))
+        res.kept = _kept(task.keep, case.values, res.summary)
+        if want_files and (task.case_outputs == "all" or res.kept):
+            if result is None:
+                result = module.run(params, progress=False)
+            res.warnings = list(result.warnings)
+            if result.failure:
+                res.status, res.error = EXIT_FAILED, result.failure
+            from driver.cli import write_outputs
+            stem = Path(task.case_dir) / _case_name(case.index, task.width)
+            write_text(stem.with_suffix(".dat"), _case_deck_text(task.raw.name, params, case, Path(task.deck_path)))
+            tidy = result.tidy.copy()
+            for name, v in case.values.items():
+                tidy.insert(0, name, v)
+            write_outputs(result, stem, sorted(set(task.formats) | {"parquet"}), task.plot)
+            write_tidy(tidy, stem, "parquet")
+            res.tidy = tidy
+            res.written = True
+            record = {"index": case.index, "values": case.values, "base": task.base_hash,
+                      "status": res.status, "error": res.error, "summary": res.summary,
+                      "kept": res.kept, "warnings": res.warnings}
+            write_text(stem.with_suffix(".json"), json.dumps(record, default=_json_default, indent=1))
+        elif result is not None and result.failure:
+            res.status, res.error = EXIT_FAILED, result.failure
+    except DeckError as exc:
+        res.status, res.error, res.kept = EXIT_BAD_INPUT, str(exc), False
+    except Exception as exc:  # a case that fails is reported, the others go on
+        res.status, res.error, res.kept = EXIT_FAILED, f"{exc.__class__.__name__}: {exc}", False
+    res.seconds = time.perf_counter() - t0
+    return res
+
+
+def run_task(task: Task) -> list[CaseResult]:
+    """Run a chunk of cases (the unit of work sent to a process or a Dask worker)."""
+    return [run_case(task, c) for c in task.cases]
+
+
+# ----------------------------------------------------------------------------- execution
+
+def _chunks(cases: list[Case], size: int) -> list[list[Case]]:
+    return [cases[i:i + size] for i in range(0, len(cases), size)]
+
+
+def auto_chunk(seconds_per_case: float, n_cases: int, workers: int, target: float = 0.1) -> int:
+    """Cases per task: enough for ~``target`` s of work, but at least 4 tasks per worker."""
+    by_time = math.ceil(target / max(seconds_per_case, 1e-6))
+    by_balance = math.ceil(n_cases / (4 * max(workers, 1)))
+    return max(1, min(by_time, by_balance))
+
+
+def _execute(tasks: list[Task], jobs: int, scheduler: str, progress: bool, total: int,
+             done0: int) -> list[CaseResult]:
+    """Run tasks locally (process pool) or on Dask; results in any order (sorted later)."""
+    from tqdm import tqdm
+    bar = tqdm(total=total, initial=done0, unit="case", disable=not progress, dynamic_ncols=True)
+    results: list[CaseResult] = []
+    try:
+        if scheduler:
+            from dask.distributed import Client, as_completed
+            client = scheduler if not isinstance(scheduler, str) else Client(scheduler, set_as_default=False)
+            try:
+                futures = client.map(run_task, tasks, pure=False)
+                for fut in as_completed(futures):
+                    part = fut.result()
+                    results += part
+                    bar.update(len(part))
+            finally:
+                if isinstance(scheduler, str):
+                    client.close()
+        elif jobs <= 1 or len(tasks) <= 1:
+            for t in tasks:
+                part = run_task(t)
+                results += part
+                bar.update(len(part))
+        else:
+            with cf.ProcessPoolExecutor(max_workers=jobs) as pool:
+                futures = [pool.submit(run_task, t) for t in tasks]
+                try:
+                    for fut in cf.as_completed(futures):
+                        part = fut.result()
+                        results += part
+                        bar.update(len(part))
+                except KeyboardInterrupt:
+                    pool.shutdown(wait=False, cancel_futures=True)
+                    raise
+    finally:
+        bar.close()
+    return results
+
+
+# ----------------------------------------------------------------------------- driver entry
+
+def _base_hash(raw: RawGroup) -> str:
+    text = json.dumps(raw.values, sort_keys=True, default=str)
+    return hashlib.sha256(f"{raw.name}:{text}".encode()).hexdigest()[:16]
+
+
+def _resumed(case_dir: Path, case: Case, width: int, base: str) -> CaseResult | None:
+    """A complete earlier result for this case (same deck values), or None."""
+    stem = case_dir / _case_name(case.index, width)
+    try:
+        rec = json.loads(stem.with_suffix(".json").read_text())
+    except (OSError, ValueError):
+        return None
+    if rec.get("base") != base or rec.get("values") != json.loads(json.dumps(case.values, default=_json_default)):
+        return None
+    res = CaseResult(case.index, case.values, rec["status"], rec["error"], rec["summary"], rec["kept"], True,
+                     rec.get("warnings", []))
+    try:
+        res.tidy = pd.read_parquet(stem.with_suffix(".parquet"))
+    except Exception:
+        return None
+    return res
+
+
+def summary_frame(results: list[CaseResult], names: list[str]) -> pd.DataFrame:
+    """One row per case: case, swept keys, status, error, kept, headline figures."""
+    rows = []
+    for r in results:
+        row = {"case": r.index, **{n: r.values[n] for n in names},
+               "status": {EXIT_OK: "ok", EXIT_FAILED: "failed", EXIT_BAD_INPUT: "bad input"}[r.status],
+               "kept": bool(r.kept and r.status == EXIT_OK)}
+        row.update(r.summary)
+        row["error"] = r.error
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def _summary_table(frame: pd.DataFrame, limit: int = 2000) -> list[str]:
+    """Fixed-format rendering of the summary frame (kept cases only above ``limit`` rows)."""
+    show = frame if len(frame) <= limit else frame[frame["kept"]]
+    cols, keys = [], []
+    for name in frame.columns:
+        if name in ("error",):
+            continue
+        s = frame[name]
+        if pd.api.types.is_bool_dtype(s) or s.map(lambda v: isinstance(v, (bool, np.bool_))).all():
+            cols.append(Column(name, "s", max(4, len(name)), 0))
+        elif pd.api.types.is_integer_dtype(s):
+            cols.append(Column(name, "i", max(5, len(name)), 0))
+        elif pd.api.types.is_numeric_dtype(s):
+            cols.append(Column(name, "f", max(10, len(name)), 4))
+        else:
+            cols.append(Column(name, "s", max(6, len(name)), 0))
+        keys.append(name)
+    rows = []
+    for _, r in show.iterrows():
+        row = []
+        for c, k in zip(cols, keys):
+            v = r[k]
+            if v is None or (isinstance(v, float) and not math.isfinite(v)):
+                row.append("-")
+            elif isinstance(v, (bool, np.bool_)):
+                row.append("yes" if v else "no")
+            elif c.kind == "s":
+                row.append(str(v))
+            else:
+                row.append(v)
+        rows.append(row)
+    lines = render_table(cols, rows)
+    if len(show) < len(frame):
+        lines.append(f"  ({len(frame) - len(show)} cases not kept are in the _summary table only)")
+    return lines
+
+
+def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool,
+                   quiet: bool = False, jobs: int | None = None, scheduler: Any = None,
+                   resume: bool = False) -> int:
+    """Run a deck with a &sweep group; returns the exit status (see driver.cli)."""
+    from driver.cli import study_of  # the one place that picks and validates the study group
+    sw = validate(deck.groups["sweep"], SPEC, deck.path)
+    study_raw = {n: g for n, g in deck.groups.items() if n != "sweep"}
+    module, base_params = study_of(Deck(deck.path, study_raw))   # the base deck must be valid on its own
+    raw = study_raw[base_params.group]
+    cases = build_cases(sw, base_params.group, module.SPEC)
+    names = list(cases[0].values)
+    if sw.keep:
+        try:
+            pd.DataFrame(columns=[*names, *getattr(module, "SUMMARY_COLUMNS", [])]).query(sw.keep)
+        except Exception as exc:
+            raise sw.error("keep", f"not a valid filter: {exc}") from None
+    stem = Path(deck.path).stem
+    case_dir = outdir / stem
+    width = max(4, len(str(len(cases))))
+    base = _base_hash(raw)
+    scheduler = scheduler or sw.scheduler or ""
+    jobs = jobs or os.cpu_count() or 1
+    task_of = lambda cs: Task(str(deck.path), raw, cs, str(case_dir), width, sw.keep, sw.case_outputs,
+                              formats, plot, base)
+
+    done: list[CaseResult] = []
+    todo = cases
+    if resume:
+        done = [r for r in (_resumed(case_dir, c, width, base) for c in cases) if r is not None]
+        skip = {r.index for r in done}
+        todo = [c for c in cases if c.index not in skip]
+        if not quiet:
+            print(f"resume: {len(skip)} of {len(cases)} cases complete, {len(todo)} to run")
+    t_start = time.perf_counter()
+    chunk = sw.chunk
+    if todo and not chunk:
+        first = run_task(task_of(todo[:1]))        # the first case also times the chunk size
+        done += first
+        todo = todo[1:]
+        chunk = auto_chunk(first[0].seconds, len(todo), 1 if (jobs <= 1 and not scheduler) else jobs)
+    tasks = [task_of(c) for c in _chunks(todo, chunk or 1)]
+    done += _execute(tasks, jobs, scheduler, progress, len(cases), len(cases) - len(todo))
+    elapsed = time.perf_counter() - t_start
+    done.sort(key=lambda r: r.index)
+
+    frame = summary_frame(done, names)
+    for fmt in ("csv", "parquet"):
+        write_tidy(frame, outdir / f"{stem}_summary", fmt)
+    tidies = [r.tidy for r in done if r.tidy is not None]
+    if tidies:
+        allcases = pd.concat(tidies, ignore_index=True)
+        for fmt in ("csv", "parquet"):
+            write_tidy(allcases, outdir / f"{stem}_cases", fmt)
+    failed = [r for r in done if r.status != EXIT_OK]
+    text = _sweep_text(deck, sw, base_params, names, cases, frame, failed, chunk, jobs, scheduler)
+    write_text(outdir / f"{stem}.out", text)
+    if plot:
+        from driver.plotting import save_figure, sweep_summary
+        save_figure(sweep_summary(frame, names, sw.plot_x, sw.plot_y, stem), outdir / f"{stem}_summary.png")
+    for r in done:
+        for w in r.warnings:
+            print(f"warning: {deck.path}: case {r.index}: {w}", file=sys.stderr)
+    for r in failed:
+        vals = ", ".join(f"{k} = {v!r}" for k, v in r.values.items())
+        print(f"error: {deck.path}: case {r.index} ({vals}): {r.error}", file=sys.stderr)
+    if not quiet:
+        n_ok = len(done) - len(failed)
+        print(f"sweep {deck.path}: {n_ok} of {len(cases)} cases ok, {int(frame['kept'].sum())} kept, "
+              f"{elapsed:.2f} s ({'dask ' + str(scheduler) if scheduler else f'{jobs} worker(s)'}, chunk {chunk})")
+        print(f"wrote {outdir / (stem + '.out')} and {outdir / stem}_summary.{{csv,parquet}}")
+    return max([EXIT_OK] + [r.status for r in failed])
+
+
+def _sweep_text(deck: Deck, sw: Params, base: Params, names: list[str], cases: list[Case],
+                frame: pd.DataFrame, failed: list[CaseResult], chunk: int, jobs: int, scheduler: Any) -> str:
+    lines = [f"  sweep over &{base.group} from deck {deck.path}", ""]
+    for k, name in enumerate(names, start=1):
+        vals = sorted({c.values[name] for c in cases}, key=lambda v: (isinstance(v, str), v))
+        shown = ", ".join(map(str, vals[:8])) + (f", ... ({len(vals)} values)" if len(vals) > 8 else "")
+        lines.append(f"    {name:<28} {shown}")
+    lines += [f"    {'cases':<28} {len(cases)} ({'zipped' if sw.zip else 'full grid'})",
+              f"    {'case outputs':<28} {sw.case_outputs}" + (f"   keep: {sw.keep}" if sw.keep else ""),
+              f"    {'kept':<28} {int(frame['kept'].sum())}",
+              f"    {'failed':<28} {len(failed)}", ""]
+    lines += _summary_table(frame)
+    if failed:
+        lines += ["", "  Failed cases"]
+        for r in failed:
+            vals = ", ".join(f"{k} = {v!r}" for k, v in r.values.items())
+            lines.append(f"    case {r.index} ({vals}): {r.error}")
+    return "\n".join(lines) + "\n"
