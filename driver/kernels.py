@@ -11,7 +11,9 @@ import numpy as np
 
 from driver import _kernels
 
-__all__ = ["farray", "fourbar_listing", "fourbar_exact", "FOURBAR_STATUS"]
+__all__ = ["farray", "fourbar_listing", "fourbar_exact", "FOURBAR_STATUS",
+           "UJOINT_MODELS", "UJOINT_OBJECTIVES", "ujoint_speed", "ujoint_objective",
+           "ujoint_equivalent", "ujoint_geometry"]
 
 
 def farray(x, ndim: int | None = None) -> np.ndarray:
@@ -51,3 +53,73 @@ def fourbar_exact(theta: np.ndarray, p: float, q: float, r: float, s: float, ome
     """
     theta = farray(np.atleast_1d(theta), 1)
     return _kernels.fourbar.exact_states(theta, p, q, r, s, omega, alpha, int(branch))
+
+
+# ----------------------------------------------------------------------------- ujoint
+
+#: model codes of fortran/ujoint.f90: the paper's eq. 13 as printed, the paper's text
+#: (cumulative phases), the exact chain
+UJOINT_MODELS = {"eq13": int(_kernels.ujoint.model_eq13), "cumulative": int(_kernels.ujoint.model_cumulative),
+                 "exact": int(_kernels.ujoint.model_exact)}
+#: objective codes of fortran/ujoint.f90
+UJOINT_OBJECTIVES = {"mean_square": int(_kernels.ujoint.obj_mean_square), "rms": int(_kernels.ujoint.obj_rms),
+                     "peak_to_peak": int(_kernels.ujoint.obj_peak_to_peak)}
+
+
+def _ujoint_chain(beta, phi, rho) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """beta (n,), phi and rho (n-1,) [rad] -> the kernel's three length-n arrays."""
+    beta = farray(np.atleast_1d(beta), 1)
+    n = beta.size
+    ph = np.zeros(n, order="F")
+    rh = np.zeros(n, order="F")
+    ph[: n - 1] = np.asarray(phi, dtype=np.float64).reshape(-1)[: n - 1]
+    if rho is not None:
+        rh[: n - 1] = np.asarray(rho, dtype=np.float64).reshape(-1)[: n - 1]
+    return beta, ph, rh
+
+
+def ujoint_speed(model: int, beta, phi, rho, theta) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Chain speed ratio at input angles ``theta`` [rad]: (R, dR/dtheta, output angle).
+
+    beta (n,) joint angles [rad]; phi (n-1,) the paper's phases [rad] (pi/2 = yokes in
+    phase); rho (n-1,) plane angles between successive joints [rad] or None (coplanar).
+    R = omega_out/omega_in [-]; dR/dtheta [1/rad] times omega_in**2 [rad/s]**2 is the
+    output angular acceleration [rad/s**2] at constant input speed; the output shaft angle
+    [rad] is given by the exact model only (zeros for the paper models).
+    """
+    b, ph, rh = _ujoint_chain(beta, phi, rho)
+    return _kernels.ujoint.chain_speed(int(model), b, ph, rh, farray(np.atleast_1d(theta), 1))
+
+
+def ujoint_objective(model: int, kind: int, beta, phi, rho, m: int,
+                     grad: bool = True) -> tuple[float, np.ndarray]:
+    """Objective over ``m`` uniform input angles per revolution and its gradient.
+
+    Returns (f, g): f dimensionless (mean (R-1)**2, its root, or max R - min R);
+    g (2n,) = df/d(beta_1..beta_n [rad], phi_1..phi_n [rad]) with g[2n-1] = 0 (no phase
+    after the last joint); zeros when ``grad`` is False.
+    """
+    b, ph, rh = _ujoint_chain(beta, phi, rho)
+    return _kernels.ujoint.chain_objective(int(model), int(kind), b, ph, rh, int(m), int(bool(grad)))
+
+
+def ujoint_equivalent(model: int, beta, phi, rho, tol: float = 1e-7) -> tuple[float, float | None]:
+    """Closed-form equivalent angles [rad]: (beta_e, beta_res or None).
+
+    beta_e from the first-order phasor sum of the model's phasing; beta_res of the exact
+    chain when every phi_k - rho_k is a multiple of pi/2 within ``tol`` [rad], else None.
+    """
+    b, ph, rh = _ujoint_chain(beta, phi, rho)
+    be, br, st = _kernels.ujoint.chain_equivalent(int(model), b, ph, rh, float(tol))
+    return float(be), (float(br) if st == int(_kernels.ujoint.st_ok) else None)
+
+
+def ujoint_geometry(axes) -> tuple[np.ndarray, np.ndarray, int]:
+    """Joint angles beta (n,) and plane angles rho (n-1,) [rad] of shaft directions ``axes``.
+
+    axes: (n+1, 3) direction vectors, input shaft first (any length unit, nonzero).
+    Status 0 ok, 2 an axis of zero length, 3 a joint angle of 90 deg or more.
+    """
+    a = farray(np.asarray(axes, dtype=np.float64).T, 2)
+    beta, rho, status = _kernels.ujoint.chain_geometry(a)
+    return beta, rho[:-1].copy(), int(status)
