@@ -67,15 +67,16 @@ UJOINT_OBJECTIVES = {"mean_square": int(_kernels.ujoint.obj_mean_square), "rms":
 
 
 def _ujoint_chain(beta, phi, rho) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """beta (n,), phi and rho (n-1,) [rad] -> the kernel's three length-n arrays."""
+    """beta (n,), phi and rho (n-1,) [rad; rho None = coplanar] as float64 arrays."""
     beta = farray(np.atleast_1d(beta), 1)
-    n = beta.size
-    ph = np.zeros(n, order="F")
-    rh = np.zeros(n, order="F")
-    ph[: n - 1] = np.asarray(phi, dtype=np.float64).reshape(-1)[: n - 1]
-    if rho is not None:
-        rh[: n - 1] = np.asarray(rho, dtype=np.float64).reshape(-1)[: n - 1]
+    if beta.size == 1:   # f2py refuses a 0-length input for dimension(n-1); it takes a dummy of 1
+        return beta, _ONE_ZERO, _ONE_ZERO
+    ph = farray(np.atleast_1d(phi), 1)
+    rh = np.zeros(ph.size) if rho is None else farray(np.atleast_1d(rho), 1)
     return beta, ph, rh
+
+
+_ONE_ZERO = np.zeros(1)
 
 
 def ujoint_speed(model: int, beta, phi, rho, theta) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -96,8 +97,8 @@ def ujoint_objective(model: int, kind: int, beta, phi, rho, m: int,
     """Objective over ``m`` uniform input angles per revolution and its gradient.
 
     Returns (f, g): f dimensionless (mean (R-1)**2, its root, or max R - min R);
-    g (2n,) = df/d(beta_1..beta_n [rad], phi_1..phi_n [rad]) with g[2n-1] = 0 (no phase
-    after the last joint); zeros when ``grad`` is False.
+    g (2n-1,) = df/d(beta_1..beta_n [rad], phi_1..phi_(n-1) [rad]); zeros when ``grad``
+    is False.
     """
     b, ph, rh = _ujoint_chain(beta, phi, rho)
     return _kernels.ujoint.chain_objective(int(model), int(kind), b, ph, rh, int(m), int(bool(grad)))
@@ -122,4 +123,4 @@ def ujoint_geometry(axes) -> tuple[np.ndarray, np.ndarray, int]:
     """
     a = farray(np.asarray(axes, dtype=np.float64).T, 2)
     beta, rho, status = _kernels.ujoint.chain_geometry(a)
-    return beta, rho[:-1].copy(), int(status)
+    return beta, rho, int(status)

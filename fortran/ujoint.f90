@@ -13,7 +13,8 @@
 !> Phase convention: phi(k) is the paper's phase of joint k+1 (90 deg = yokes on shaft k
 !> in phase; the yoke phase delta = phi - 90 deg).  rho(k) is the signed angle between the
 !> planes of joints k and k+1 about their shared shaft (0 for coplanar chains).  Arrays
-!> phi and rho have n entries; entry n (no shaft after the last joint) is ignored.
+!> phi and rho have n-1 entries (one per intermediate shaft; empty for a single joint).
+!> Gradients are with respect to (beta(1..n), phi(1..n-1)): 2n-1 entries.
 !>
 !> Models (see ../shared/notes/ujoint.md):
 !>   model_eq13        the paper's eq. 13 as printed: joint k driven at theta + phi(k-1)
@@ -46,7 +47,7 @@ contains
   !> for exact); model_eq13 by phi(k) - phi(k-1) (phi(0) = 0).
   subroutine shifts(model, n, phi, rho, cs, sn)
     integer, intent(in) :: model, n
-    real(dp), intent(in) :: phi(n), rho(n)
+    real(dp), intent(in) :: phi(n - 1), rho(n - 1)
     real(dp), intent(out) :: cs(n), sn(n)
     real(dp) :: s
     integer :: k
@@ -67,14 +68,14 @@ contains
 
   !> Values (and optionally gradients) of ln R at m points given by (c, s) = (cos, sin) of
   !> the input angle.  rat(j) = R, dlth(j) = d ln R / d theta; if want_grad /= 0 also
-  !> dlp(j, :) = d ln R / d(beta(1..n), phi(1..n)) (column 2n, phi(n), is zero).
+  !> dlp(j, :) = d ln R / d(beta(1..n), phi(1..n-1)).
   !> thout(j): output angle of the last joint (exact model only; 0 otherwise) if want_out.
   subroutine propagate(model, n, beta, phi, rho, m, c0, s0, want_grad, want_out, &
                        rat, dlth, dlp, thout)
     integer, intent(in) :: model, n, m, want_grad, want_out
-    real(dp), intent(in) :: beta(n), phi(n), rho(n), c0(m), s0(m)
-    real(dp), intent(out) :: rat(m), dlth(m), dlp(m, 2*n), thout(m)
-    real(dp) :: c(m), s(m), dth(m), dtp(m, 2*n), cn(m), sq(m)
+    real(dp), intent(in) :: beta(n), phi(n - 1), rho(n - 1), c0(m), s0(m)
+    real(dp), intent(out) :: rat(m), dlth(m), dlp(m, 2*n - 1), thout(m)
+    real(dp) :: c(m), s(m), dth(m), dtp(m, 2*n - 1), cn(m), sq(m)
     real(dp) :: cs(n), sn(n), cb, sb, s2, d, r, a, isd, x, y, tanb
     integer :: j, k, p
     logical :: exact
@@ -106,7 +107,7 @@ contains
         cn(j) = r
       end do
       if (want_grad /= 0) then
-        do p = 1, 2*n
+        do p = 1, 2*n - 1
           do j = 1, m
             dlp(j, p) = dlp(j, p) + 2.0_dp*s2*s(j)*c(j)/sq(j)*dtp(j, p)
           end do
@@ -132,7 +133,7 @@ contains
           end do
         end if
         if (want_grad /= 0) then
-          do p = 1, 2*n
+          do p = 1, 2*n - 1
             do j = 1, m
               dtp(j, p) = cn(j)*dtp(j, p)
             end do
@@ -179,9 +180,9 @@ contains
   !> for the paper models, which do not define it) at input angles theta(1..m) [rad].
   subroutine chain_speed(model, n, beta, phi, rho, m, theta, ratio, dratio, thout)
     integer, intent(in) :: model, n, m
-    real(dp), intent(in) :: beta(n), phi(n), rho(n), theta(m)
+    real(dp), intent(in) :: beta(n), phi(n - 1), rho(n - 1), theta(m)
     real(dp), intent(out) :: ratio(m), dratio(m), thout(m)
-    real(dp) :: dlth(m), dlp(m, 2*n)
+    real(dp) :: dlth(m), dlp(m, 2*n - 1)
     !f2py threadsafe
     call propagate(model, n, beta, phi, rho, m, cos(theta), sin(theta), 0, 1, &
                    ratio, dlth, dlp, thout)
@@ -191,15 +192,15 @@ contains
 
   !> Objective over a uniform grid of m input angles theta_j = 2 pi (j-1)/m covering one
   !> revolution, and (want_grad /= 0) its gradient with respect to beta(1..n) and
-  !> phi(1..n) (grad(n+n), the non-existent phase after the last joint, is 0).
+  !> phi(1..n-1); zeros when want_grad = 0.
   !> kind: obj_mean_square f = mean (R-1)**2 (the paper's U per omega_in**2),
   !>       obj_rms f = sqrt of that, obj_peak_to_peak f = max R - min R on the grid.
   !> R has period pi in theta, so for even m only the first m/2 points are evaluated;
   !> the result is identical to the full grid.
   subroutine chain_objective(model, kind, n, beta, phi, rho, m, want_grad, f, grad)
     integer, intent(in) :: model, kind, n, m, want_grad
-    real(dp), intent(in) :: beta(n), phi(n), rho(n)
-    real(dp), intent(out) :: f, grad(2*n)
+    real(dp), intent(in) :: beta(n), phi(n - 1), rho(n - 1)
+    real(dp), intent(out) :: f, grad(2*n - 1)
     real(dp), allocatable :: c(:), s(:), rat(:), dlth(:), dlp(:, :), thout(:)
     real(dp) :: c1, s1, cd, sd, t, e
     integer :: mh, j, jmax, jmin, g
@@ -226,7 +227,7 @@ contains
     g = 0
     if (want_grad /= 0 .and. kind /= obj_peak_to_peak) g = 1
     if (g == 1) then
-      allocate (dlp(mh, 2*n))
+      allocate (dlp(mh, 2*n - 1))
     else
       allocate (dlp(1, 1))
     end if
@@ -245,7 +246,7 @@ contains
     case default
       f = sum((rat - 1.0_dp)**2)/real(mh, dp)
       if (g == 1) then
-        do j = 1, 2*n
+        do j = 1, 2*n - 1
           grad(j) = 2.0_dp*sum((rat - 1.0_dp)*rat*dlp(:, j))/real(mh, dp)
         end do
       end if
@@ -258,15 +259,14 @@ contains
         end if
       end if
     end select
-    grad(2*n) = 0.0_dp
   end subroutine chain_objective
 
   !> Gradient of max R - min R from the two extreme grid points (ca, sa) and (cb, sb).
   subroutine p2p_grad(model, n, beta, phi, rho, ca, sa, cb, sb, grad)
     integer, intent(in) :: model, n
-    real(dp), intent(in) :: beta(n), phi(n), rho(n), ca, sa, cb, sb
-    real(dp), intent(out) :: grad(2*n)
-    real(dp) :: c2(2), s2(2), r2(2), dl2(2), dp2(2, 2*n), th2(2)
+    real(dp), intent(in) :: beta(n), phi(n - 1), rho(n - 1), ca, sa, cb, sb
+    real(dp), intent(out) :: grad(2*n - 1)
+    real(dp) :: c2(2), s2(2), r2(2), dl2(2), dp2(2, 2*n - 1), th2(2)
     c2 = [ca, cb]
     s2 = [sa, sb]
     call propagate(model, n, beta, phi, rho, 2, c2, s2, 1, 0, r2, dl2, dp2, th2)
@@ -276,7 +276,7 @@ contains
   !> Ratio only (the hot path of the optimisers): rat(j) = R at (cos, sin) = (c0, s0).
   subroutine propagate_nograd(model, n, beta, phi, rho, m, c0, s0, rat)
     integer, intent(in) :: model, n, m
-    real(dp), intent(in) :: beta(n), phi(n), rho(n), c0(m), s0(m)
+    real(dp), intent(in) :: beta(n), phi(n - 1), rho(n - 1), c0(m), s0(m)
     real(dp), intent(out) :: rat(m)
     real(dp) :: c(m), s(m), cs(n), sn(n), cb, s2, d, isd, x, y
     integer :: j, k
@@ -322,7 +322,7 @@ contains
   !>   from the tan-law composition.  status = st_res_undefined (beta_res = 0) otherwise.
   subroutine chain_equivalent(model, n, beta, phi, rho, tol, beta_e, beta_res, status)
     integer, intent(in) :: model, n
-    real(dp), intent(in) :: beta(n), phi(n), rho(n), tol
+    real(dp), intent(in) :: beta(n), phi(n - 1), rho(n - 1), tol
     real(dp), intent(out) :: beta_e, beta_res
     integer, intent(out) :: status
     real(dp) :: cs(n), sn(n), gam, re, im, kk, sh, q
@@ -361,13 +361,13 @@ contains
   !> Joint angles and plane angles of a 3-D chain from shaft direction vectors
   !> axes(:, 1..n+1) (input shaft first; any nonzero length).  beta(k) = angle between
   !> shafts k and k+1 [rad, 0..pi]; rho(k) = signed angle from the plane of joint k to that
-  !> of joint k+1, right-handed about shaft k+1 (rho(n) = 0).  A straight joint (beta = 0)
+  !> of joint k+1, right-handed about shaft k+1 (k = 1..n-1).  A straight joint (beta = 0)
   !> has no plane; it takes its neighbour's.  status: st_zero_axis if an axis has zero
   !> length, st_right_angle if a joint angle is 90 deg or more, else st_ok.
   subroutine chain_geometry(n, axes, beta, rho, status)
     integer, intent(in) :: n
     real(dp), intent(in) :: axes(3, n + 1)
-    real(dp), intent(out) :: beta(n), rho(n)
+    real(dp), intent(out) :: beta(n), rho(n - 1)
     integer, intent(out) :: status
     real(dp) :: a(3, n + 1), nrm(3, n), w(3), len
     logical :: has(n)
