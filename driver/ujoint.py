@@ -612,7 +612,7 @@ def _render_speed_table(params: Params, chain: Chain, designs: list[Design], exa
     data = []
     for d in shown:
         w, a, to = _speed(chain, d, th)
-        tag = d.label.split()[0][:5]
+        tag = {"optimum": "opt", "last iterate": "last"}.get(d.label, d.label)
         cols += [Column(f"{tag} w_out", "f", 12, 5), Column(f"{tag} ratio", "f", 11, 7),
                  Column(f"{tag} acc", "f", 11, 6)]
         data += [w, w / params.rpm, a]
@@ -643,7 +643,7 @@ def _summary(trial: Design, best: Design | None, runs: list[StartRun], failure: 
     d = best if best is not None else trial
     s = {"objective": d.objective, "objective_trial": trial.objective, "pp_ratio": d.pp,
          "omega_out_min_rpm": d.w_min, "omega_out_max_rpm": d.w_max, "beta_e_deg": d.beta_e,
-         "beta_res_deg": d.beta_res if d.beta_res is not None else float("nan"),
+         "beta_res_deg": d.beta_res,   # None when the closed form does not apply
          "peak_accel_rad_s2": d.peak_acc, "converged": failure is None,
          "iterations": sum(r.nit for r in runs), "evaluations": sum(r.nfev for r in runs)}
     s.update({f"beta_{k + 1}_deg": float(v) for k, v in enumerate(d.beta)})
@@ -663,6 +663,7 @@ def _result_dat(params: Params, chain: Chain, designs: list[Design], best: Desig
              f"exitflag   = {1 if pick.success else 0}",
              f"iterations = {pick.nit}",
              f"funccount  = {pick.nfev}",
+             *([] if pick.success else ["% NOT CONVERGED: x is the last iterate, not an optimum"]),
              "% theta_in_deg  omega_in_rpm  omega_out_trial_rpm  omega_out_optimum_rpm"]
     th = np.arange(0.0, 360.0 + 1e-9, 1.0)
     w0 = _speed(chain, designs[0], th)[0]
