@@ -529,7 +529,7 @@ def _render(params: Params, chain: Chain, beta, rho, designs: list[Design], runs
         out.append("")
 
     if runs:
-        out += _render_runs(runs, designs[1])
+        out += _render_runs(runs, designs[1], _free_names(option, n))
     out += _render_compare(params, chain, designs)
     out += _render_speed_table(params, chain, designs, exact)
     out.append(" NOTES")
@@ -556,11 +556,29 @@ def _bounds_text(params: Params, base: str, count: int) -> str:
     return "  ".join(f"[{fortran_f(a, None, 4)}, {fortran_f(b, None, 4)}]" for a, b in zip(lo, hi)) + " deg"
 
 
-def _render_runs(runs: list[StartRun], best: Design) -> list[str]:
+def _free_names(option: int, n: int) -> list[str]:
+    names = [f"beta_{k + 1}" for k in range(n)] + [f"phi_{k + 1}" for k in range(n - 1)]
+    return [names[i] for i in _free_index(option, n)]
+
+
+def _family(runs: list[StartRun], pick: StartRun, n_beta: int) -> tuple[int, np.ndarray]:
+    """Converged starts that reach the best objective, and their distinct end points [deg]
+    (rounded to 0.01 deg; phases taken modulo 180 deg)."""
+    tol = 1e-6 * abs(pick.f) + 1e-12
+    good = [r for r in runs if r.success and r.f <= pick.f + tol]
+    x = np.array([r.x for r in good]) / DEG
+    x[:, n_beta:] %= 180.0
+    x = np.round(x, 2)
+    x[np.isclose(x, 180.0)] = 0.0
+    return len(good), np.unique(x, axis=0)
+
+
+def _render_runs(runs: list[StartRun], best: Design, names: list[str]) -> list[str]:
     idx = best.extra["index"]
     pick = best.extra["run"]
     ok = sum(r.success for r in runs)
-    close = sum(r.success and r.f <= pick.f + 1e-9 * max(1.0, abs(pick.f)) + 1e-14 for r in runs)
+    n_beta = sum(name.startswith("beta") for name in names)
+    close, distinct = _family(runs, pick, n_beta) if ok else (0, np.empty((0, len(names))))
     out = [" OPTIMISER (scipy SLSQP per start; objective values unscaled)"]
     cols = [Column("start", "i", 5), Column("objective", "s", 14), Column("iter", "i", 5),
             Column("f-evals", "i", 7), Column("status", "s", 9)]
@@ -571,7 +589,11 @@ def _render_runs(runs: list[StartRun], best: Design) -> list[str]:
             f"({pick.njev} gradient evaluations); all starts: {sum(r.nit for r in runs)} iterations, "
             f"{sum(r.nfev for r in runs)} evaluations",
             f"   {ok} of {len(runs)} start(s) converged; {close} reached the best objective "
-            "(a family of optima when several land at different angles)", ""]
+            f"(within 1e-6 relative) at {len(distinct)} distinct point(s) (0.01 deg; phases mod 180)"]
+    if len(distinct) > 1:
+        out.append("   distinct optima (a family: the objective does not single out one design), first 8 [deg]:")
+        out += render_table([Column(nm, "f", 10, 2) for nm in names], distinct[:8])
+    out.append("")
     return out
 
 

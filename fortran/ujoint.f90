@@ -49,21 +49,23 @@ contains
     integer, intent(in) :: model, n
     real(dp), intent(in) :: phi(n - 1), rho(n - 1)
     real(dp), intent(out) :: cs(n), sn(n)
-    real(dp) :: s
+    real(dp) :: s, prev
     integer :: k
-    do k = 1, n
-      if (k == n) then
-        s = 0.0_dp
-      else if (model == model_exact) then
+    prev = 0.0_dp
+    do k = 1, n - 1
+      if (model == model_exact) then
         s = phi(k) - rho(k)
-      else if (model == model_eq13 .and. k > 1) then
-        s = phi(k) - phi(k - 1)
+      else if (model == model_eq13) then
+        s = phi(k) - prev
+        prev = phi(k)
       else
         s = phi(k)
       end if
       cs(k) = cos(s)
       sn(k) = sin(s)
     end do
+    cs(n) = 1.0_dp
+    sn(n) = 0.0_dp
   end subroutine shifts
 
   !> Values (and optionally gradients) of ln R at m points given by (c, s) = (cos, sin) of
@@ -370,7 +372,7 @@ contains
     real(dp), intent(out) :: beta(n), rho(n - 1)
     integer, intent(out) :: status
     real(dp) :: a(3, n + 1), nrm(3, n), w(3), len
-    logical :: has(n)
+    logical :: has(n), got(n)
     integer :: k, kk
     status = st_ok
     beta = 0.0_dp
@@ -396,25 +398,27 @@ contains
       if (beta(k) >= 0.5_dp*pi) status = st_right_angle
     end do
     ! straight joints borrow the plane of the nearest bent joint (earlier first)
+    got = has
     do k = 1, n
       if (has(k)) cycle
       do kk = k - 1, 1, -1
         if (has(kk)) then
           nrm(:, k) = nrm(:, kk)
+          got(k) = .true.
           exit
         end if
       end do
-      if (all(nrm(:, k) == 0.0_dp)) then
-        do kk = k + 1, n
-          if (has(kk)) then
-            nrm(:, k) = nrm(:, kk)
-            exit
-          end if
-        end do
-      end if
+      if (got(k)) cycle
+      do kk = k + 1, n
+        if (has(kk)) then
+          nrm(:, k) = nrm(:, kk)
+          got(k) = .true.
+          exit
+        end if
+      end do
     end do
     do k = 1, n - 1
-      if (all(nrm(:, k) == 0.0_dp) .or. all(nrm(:, k + 1) == 0.0_dp)) cycle
+      if (.not. (got(k) .and. got(k + 1))) cycle
       w = cross(nrm(:, k), nrm(:, k + 1))
       rho(k) = atan2(dot_product(w, a(:, k + 1)), dot_product(nrm(:, k), nrm(:, k + 1)))
     end do

@@ -92,13 +92,16 @@ def vector_model_ratio(axes: np.ndarray, delta: np.ndarray, theta: np.ndarray) -
     """Independent oracle (numpy): speed ratio of a Cardan chain by 3-D cross-arm geometry.
 
     axes (n+1, 3) shaft directions; delta (n-1,) yoke phases [rad] about each intermediate
-    shaft (0 = in phase); the input yoke at theta = 0 lies along the joint-1 plane normal.
+    shaft (0 = in phase); the input yoke at theta = 0 lies along the joint-1 plane normal
+    (the first bent joint's normal when joint 1 is straight).
     Each joint: the output arm v is perpendicular to the input arm u and to its own shaft;
     omega_k/omega_(k-1) = -[(a_(k-1) x u).v] / [(a_k x v).u].
     """
     a = axes / np.linalg.norm(axes, axis=1)[:, None]
     n = len(a) - 1
-    u0 = [np.cross(a[0], a[1]) / np.linalg.norm(np.cross(a[0], a[1]))]
+    normals = [np.cross(a[k], a[k + 1]) for k in range(n)]
+    first = next(w for w in normals if np.linalg.norm(w) > 1e-12)
+    u0 = [first / np.linalg.norm(first)]
     v0 = []
     for k in range(n):
         v = np.cross(a[k + 1], u0[k])
@@ -261,3 +264,17 @@ def test_gradient_against_finite_differences(model, kind):
         fd.append((fp - fm) / (2 * h))
     assert g.size == 2 * n - 1
     assert np.allclose(g, fd, rtol=1e-6, atol=1e-9 * max(1.0, abs(f)))
+
+
+@pytest.mark.parametrize("straight", [1, 2])
+def test_straight_joint_borrows_a_plane(straight):
+    """A joint with beta = 0 has no plane of its own; the chain still matches the vector model."""
+    rng = np.random.default_rng(11 + straight)
+    axes = _random_chain(rng, 3)
+    axes = np.insert(axes, straight, axes[straight - 1], axis=0)   # repeat a shaft: straight joint
+    delta = rng.uniform(-1.0, 1.0, 3)
+    beta, rho, status = ujoint_geometry(axes)
+    assert status == 0 and beta[straight - 1] == 0.0
+    th = np.linspace(0.0, 2 * math.pi, 37)
+    r, _, _ = ujoint_speed(EXACT, beta, delta + math.pi / 2, rho, th)
+    assert np.max(np.abs(r - vector_model_ratio(axes, delta, th))) < 1e-13
