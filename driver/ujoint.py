@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 from scipy.optimize import minimize
+from tqdm import tqdm
 
 from driver.deck import GroupSpec, Key, Params, non_empty, positive
 from driver.kernels import (UJOINT_MODELS, UJOINT_OBJECTIVES, ujoint_equivalent, ujoint_geometry,
@@ -137,6 +138,7 @@ class Design:
     beta_e: float = 0.0
     beta_res: float | None = None
     peak_acc: float = 0.0
+    mean_ratio: float = 1.0
     extra: dict = field(default_factory=dict)
 
 
@@ -153,7 +155,8 @@ def evaluate(chain: Chain, label: str, beta_deg, phi_deg, model: int | None = No
     return Design(label, np.asarray(beta_deg, float), np.asarray(phi_deg, float), float(f),
                   float(ms * chain.rpm ** 2), float(ratio.max() - ratio.min()),
                   float(chain.rpm * ratio.min()), float(chain.rpm * ratio.max()), be / DEG,
-                  None if br is None else br / DEG, float(chain.omega ** 2 * np.abs(dratio).max()))
+                  None if br is None else br / DEG, float(chain.omega ** 2 * np.abs(dratio).max()),
+                  float(ratio.mean()))
 
 
 @dataclass
@@ -180,7 +183,7 @@ def _symmetric(chain: Chain, phi_rad: np.ndarray) -> bool:
 
 def optimise(chain: Chain, option: int, beta0: np.ndarray, phi0: np.ndarray,
              lb: np.ndarray, ub: np.ndarray, starts: np.ndarray, maxiter: int,
-             ftol: float) -> list[StartRun]:
+             ftol: float, progress: bool = False) -> list[StartRun]:
     """SLSQP from every row of ``starts`` (free variables, rad) with the kernel gradient.
 
     beta0, phi0 [rad] hold the fixed variables; lb/ub the bounds of the free ones [rad].
@@ -205,7 +208,7 @@ def optimise(chain: Chain, option: int, beta0: np.ndarray, phi0: np.ndarray,
 
     bounds = list(zip(lb, ub))
     runs = []
-    for x0 in starts:
+    for x0 in tqdm(starts, desc="multi-start", unit="start", disable=not progress):
         res = minimize(fun, x0, jac=True, method="SLSQP", bounds=bounds,
                        options={"maxiter": maxiter, "ftol": ftol})
         x = np.clip(res.x, lb, ub)
@@ -406,7 +409,8 @@ def run(params: Params, progress: bool = False) -> Result:
         lb, ub = lo[free] * DEG, hi[free] * DEG
         starts, start_notes = _starts(params, option, beta, phi, lb, ub, chain)
         notes += start_notes
-        runs = optimise(chain, option, beta * DEG, phi * DEG, lb, ub, starts, params.maxiter, params.ftol)
+        runs = optimise(chain, option, beta * DEG, phi * DEG, lb, ub, starts, params.maxiter, params.ftol,
+                        progress)
         ok = [r for r in runs if r.success]
         ipick = min((k for k, r in enumerate(runs) if r.success or not ok), key=lambda k: runs[k].f)
         pick = runs[ipick]
@@ -537,6 +541,17 @@ def _render(params: Params, chain: Chain, beta, rho, designs: list[Design], runs
     if n >= 3 and not exact:
         all_notes.append("the paper optimises a phi_3 for three joints; it has no physical meaning (two "
                          "intermediate shafts, two phases) and is not used here")
+    if not exact and len(designs) > 1 and abs(designs[1].mean_ratio - 1.0) > 1e-6:
+        d = designs[1]
+        text = (f"under the paper's model the {d.label}'s mean output speed is "
+                f"{d.mean_ratio * params.rpm:.4f} rpm, not the input {params.rpm:g} rpm: an artefact "
+                "(a real output shaft turns once per input turn)")
+        if params.objective == "mean_square":
+            share = (d.mean_ratio - 1.0) ** 2 / max(d.objective, 1e-300)
+            text += f"; this bias is {share:.0%} of its objective"
+            if option in (2, 3) and share > 0.5:
+                text += ", which is why the search favours the smallest joint angles"
+        all_notes.append(text)
     if not exact:
         all_notes.append("the paper's model drives every joint with the input angle plus a phase; the "
                          "intermediate shafts do not actually turn uniformly, so its residual is 4th "
