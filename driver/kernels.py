@@ -13,7 +13,9 @@ from driver import _kernels
 
 __all__ = ["farray", "fourbar_listing", "fourbar_exact", "FOURBAR_STATUS",
            "MANIPULATOR_STATUS", "manipulator_arm_states", "manipulator_torques", "manipulator_ik",
-           "manipulator_design_indices", "manipulator_position_errors"]
+           "manipulator_design_indices", "manipulator_position_errors",
+           "UJOINT_MODELS", "UJOINT_OBJECTIVES", "ujoint_speed", "ujoint_objective",
+           "ujoint_equivalent", "ujoint_geometry"]
 
 
 def farray(x, ndim: int | None = None) -> np.ndarray:
@@ -146,3 +148,75 @@ def manipulator_position_errors(th1, th2, dl) -> np.ndarray:
     """
     th1, th2 = farray(np.atleast_1d(th1), 1), farray(np.atleast_1d(th2), 1)
     return _kernels.manipulator.position_errors(th1, th2, farray(dl, 2))
+
+
+
+# ----------------------------------------------------------------------------- ujoint
+
+#: model codes of fortran/ujoint.f90: the paper's eq. 13 as printed, the paper's text
+#: (cumulative phases), the exact chain
+UJOINT_MODELS = {"eq13": int(_kernels.ujoint.model_eq13), "cumulative": int(_kernels.ujoint.model_cumulative),
+                 "exact": int(_kernels.ujoint.model_exact)}
+#: objective codes of fortran/ujoint.f90
+UJOINT_OBJECTIVES = {"mean_square": int(_kernels.ujoint.obj_mean_square), "rms": int(_kernels.ujoint.obj_rms),
+                     "peak_to_peak": int(_kernels.ujoint.obj_peak_to_peak)}
+
+
+def _ujoint_chain(beta, phi, rho) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """beta (n,), phi and rho (n-1,) [rad; rho None = coplanar] as float64 arrays."""
+    beta = farray(np.atleast_1d(beta), 1)
+    if beta.size == 1:   # f2py refuses a 0-length input for dimension(n-1); it takes a dummy of 1
+        return beta, _ONE_ZERO, _ONE_ZERO
+    ph = farray(np.atleast_1d(phi), 1)
+    rh = np.zeros(ph.size) if rho is None else farray(np.atleast_1d(rho), 1)
+    return beta, ph, rh
+
+
+_ONE_ZERO = np.zeros(1)
+
+
+def ujoint_speed(model: int, beta, phi, rho, theta) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Chain speed ratio at input angles ``theta`` [rad]: (R, dR/dtheta, output angle).
+
+    beta (n,) joint angles [rad]; phi (n-1,) the paper's phases [rad] (pi/2 = yokes in
+    phase); rho (n-1,) plane angles between successive joints [rad] or None (coplanar).
+    R = omega_out/omega_in [-]; dR/dtheta [1/rad] times omega_in**2 [rad/s]**2 is the
+    output angular acceleration [rad/s**2] at constant input speed; the output shaft angle
+    [rad] is given by the exact model only (zeros for the paper models).
+    """
+    b, ph, rh = _ujoint_chain(beta, phi, rho)
+    return _kernels.ujoint.chain_speed(int(model), b, ph, rh, farray(np.atleast_1d(theta), 1))
+
+
+def ujoint_objective(model: int, kind: int, beta, phi, rho, m: int,
+                     grad: bool = True) -> tuple[float, np.ndarray]:
+    """Objective over ``m`` uniform input angles per revolution and its gradient.
+
+    Returns (f, g): f dimensionless (mean (R-1)**2, its root, or max R - min R);
+    g (2n-1,) = df/d(beta_1..beta_n [rad], phi_1..phi_(n-1) [rad]); zeros when ``grad``
+    is False.
+    """
+    b, ph, rh = _ujoint_chain(beta, phi, rho)
+    return _kernels.ujoint.chain_objective(int(model), int(kind), b, ph, rh, int(m), int(bool(grad)))
+
+
+def ujoint_equivalent(model: int, beta, phi, rho, tol: float = 1e-7) -> tuple[float, float | None]:
+    """Closed-form equivalent angles [rad]: (beta_e, beta_res or None).
+
+    beta_e from the first-order phasor sum of the model's phasing; beta_res of the exact
+    chain when every phi_k - rho_k is a multiple of pi/2 within ``tol`` [rad], else None.
+    """
+    b, ph, rh = _ujoint_chain(beta, phi, rho)
+    be, br, st = _kernels.ujoint.chain_equivalent(int(model), b, ph, rh, float(tol))
+    return float(be), (float(br) if st == int(_kernels.ujoint.st_ok) else None)
+
+
+def ujoint_geometry(axes) -> tuple[np.ndarray, np.ndarray, int]:
+    """Joint angles beta (n,) and plane angles rho (n-1,) [rad] of shaft directions ``axes``.
+
+    axes: (n+1, 3) direction vectors, input shaft first (any length unit, nonzero).
+    Status 0 ok, 2 an axis of zero length, 3 a joint angle of 90 deg or more.
+    """
+    a = farray(np.asarray(axes, dtype=np.float64).T, 2)
+    beta, rho, status = _kernels.ujoint.chain_geometry(a)
+    return beta, rho, int(status)

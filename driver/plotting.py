@@ -202,3 +202,38 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
     axes[-1].set_xlabel(x)
     fig.suptitle(f"{title}: sweep summary" if title else "sweep summary")
     return fig
+
+
+# ---- ujoint
+
+def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.ndarray],
+                        polar: bool = False) -> Figure:
+    """Input and output shaft speed [rpm] against the input angle [deg], one panel per design
+    (the paper's Figures 6-11: trial and optimum), cartesian or polar."""
+    n = len(curves)
+    if polar:
+        fig = Figure(figsize=(3.6 * n, 3.8), layout="constrained")
+        axes = [fig.add_subplot(1, n, k + 1, projection="polar") for k in range(n)]
+    else:
+        fig, axes = new_figure(n, 1, sharex=True, figsize=(7.0, 2.3 * n + 0.6))
+    top = max(float(np.max(w)) for w in curves.values())
+    low = min(float(np.min(w)) for w in curves.values())
+    for ax, (label, w) in zip(axes, curves.items()):
+        x = np.radians(theta_deg) if polar else theta_deg
+        ax.plot(x, np.full_like(theta_deg, rpm), "k--", lw=1.0, label="input shaft")
+        ax.plot(x, w, lw=1.5, label="output shaft")
+        ax.set_title(f"{label}: output {w.min():.2f}-{w.max():.2f} rpm", fontsize=9, pad=14 if polar else 4)
+        if polar:
+            ax.set_ylim(0.0, 1.05 * top)
+        else:
+            pad = 0.05 * max(top - low, 1e-3 * rpm)
+            ax.set_ylim(low - pad, top + pad)
+            ax.set_ylabel("speed [rpm]")
+            ax.legend(fontsize=7, loc="upper right")
+    if not polar:
+        axes[-1].set_xlabel("input angle [deg]")
+        axes[-1].set_xlim(0.0, 360.0)
+    else:
+        axes[0].legend(fontsize=7, loc="lower left", bbox_to_anchor=(-0.1, -0.15))
+    fig.suptitle("Hooke-joint chain: input and output shaft speed")
+    return fig

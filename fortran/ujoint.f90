@@ -1,0 +1,434 @@
+!> Hooke-joint (Cardan / universal-joint) shaft chains (seed 000, Fajar: the "SSO" package).
+!>
+!> A chain of n joints joins n+1 shafts.  Joint k has the operating (bend) angle beta(k).
+!> Angles are in radians throughout; speeds are dimensionless ratios omega_out/omega_in
+!> (multiply by the input speed for rad/s or rpm), accelerations are d(ratio)/d(theta),
+!> i.e. the output angular acceleration per omega_in**2 at constant input speed.
+!>
+!> Input angle convention: theta, the input yoke angle of joint 1, is measured from the
+!> normal to the plane of the two shafts of joint 1 (the paper's eq. 5/8), so a single
+!> joint gives  ratio = cos(beta)/(1 - sin(beta)**2 sin(theta)**2)  and
+!> tan(theta_out) = cos(beta) tan(theta).
+!>
+!> Phase convention: phi(k) is the paper's phase of joint k+1 (90 deg = yokes on shaft k
+!> in phase; the yoke phase delta = phi - 90 deg).  rho(k) is the signed angle between the
+!> planes of joints k and k+1 about their shared shaft (0 for coplanar chains).  Arrays
+!> phi and rho have n-1 entries (one per intermediate shaft; empty for a single joint).
+!> Gradients are with respect to (beta(1..n), phi(1..n-1)): 2n-1 entries.
+!>
+!> Models (see ../shared/notes/ujoint.md):
+!>   model_eq13        the paper's eq. 13 as printed: joint k driven at theta + phi(k-1)
+!>   model_cumulative  the paper's text: joint k driven at theta + phi(1) + ... + phi(k-1)
+!>   model_exact       exact chain: theta(k+1) = theta_out(k) + phi(k) - rho(k), with
+!>                     tan(theta_out(k)) = cos(beta(k)) tan(theta(k)); exact for
+!>                     non-coplanar chains too (agrees with a 3-D vector model).
+!>
+!> Internally the driving angle of each joint is carried as a unit complex number
+!> (cos, sin), so the exact transfer needs one square root and no trigonometric call.
+module ujoint
+  use kinds, only: dp
+  implicit none
+  private
+  public :: chain_speed, chain_objective, chain_equivalent, chain_geometry
+
+  !> model codes
+  integer, parameter, public :: model_eq13 = 0, model_cumulative = 1, model_exact = 2
+  !> objective codes: mean((R-1)**2), sqrt(mean((R-1)**2)), max(R) - min(R)
+  integer, parameter, public :: obj_mean_square = 0, obj_rms = 1, obj_peak_to_peak = 2
+  !> status codes of chain_equivalent (beta_res) and chain_geometry
+  integer, parameter, public :: st_ok = 0, st_res_undefined = 1, st_zero_axis = 2, st_right_angle = 3
+
+  real(dp), parameter :: pi = 3.14159265358979323846264338327950288_dp
+
+contains
+
+  !> Shift applied to the driving angle between joint k and joint k+1 (radians) and its
+  !> derivative pattern: model_exact and model_cumulative shift by phi(k) (minus rho(k)
+  !> for exact); model_eq13 by phi(k) - phi(k-1) (phi(0) = 0).
+  subroutine shifts(model, n, phi, rho, cs, sn)
+    integer, intent(in) :: model, n
+    real(dp), intent(in) :: phi(n - 1), rho(n - 1)
+    real(dp), intent(out) :: cs(n), sn(n)
+    real(dp) :: s, prev
+    integer :: k
+    prev = 0.0_dp
+    do k = 1, n - 1
+      if (model == model_exact) then
+        s = phi(k) - rho(k)
+      else if (model == model_eq13) then
+        s = phi(k) - prev
+        prev = phi(k)
+      else
+        s = phi(k)
+      end if
+      cs(k) = cos(s)
+      sn(k) = sin(s)
+    end do
+    cs(n) = 1.0_dp
+    sn(n) = 0.0_dp
+  end subroutine shifts
+
+  !> Values (and optionally gradients) of ln R at m points given by (c, s) = (cos, sin) of
+  !> the input angle.  rat(j) = R, dlth(j) = d ln R / d theta; if want_grad /= 0 also
+  !> dlp(j, :) = d ln R / d(beta(1..n), phi(1..n-1)).
+  !> thout(j): output angle of the last joint (exact model only; 0 otherwise) if want_out.
+  subroutine propagate(model, n, beta, phi, rho, m, c0, s0, want_grad, want_out, &
+                       rat, dlth, dlp, thout)
+    integer, intent(in) :: model, n, m, want_grad, want_out
+    real(dp), intent(in) :: beta(n), phi(n - 1), rho(n - 1), c0(m), s0(m)
+    real(dp), intent(out) :: rat(m), dlth(m), dlp(m, 2*n - 1), thout(m)
+    real(dp) :: c(m), s(m), dth(m), dtp(m, 2*n - 1), cn(m), sq(m)
+    real(dp) :: cs(n), sn(n), cb, sb, s2, d, r, a, isd, x, y, tanb
+    integer :: j, k, p
+    logical :: exact
+
+    exact = (model == model_exact)
+    call shifts(model, n, phi, rho, cs, sn)
+    c = c0
+    s = s0
+    rat = 1.0_dp
+    dlth = 0.0_dp
+    dth = 1.0_dp
+    if (want_grad /= 0) then
+      dlp = 0.0_dp
+      dtp = 0.0_dp
+    end if
+    thout = 0.0_dp
+    do k = 1, n
+      cb = cos(beta(k))
+      sb = sin(beta(k))
+      s2 = sb*sb
+      tanb = sb/cb
+      do j = 1, m
+        d = 1.0_dp - s2*s(j)*s(j)
+        r = cb/d
+        a = 2.0_dp*s2*s(j)*c(j)/d              ! d ln r / d theta_k
+        rat(j) = rat(j)*r
+        dlth(j) = dlth(j) + a*dth(j)
+        sq(j) = d
+        cn(j) = r
+      end do
+      if (want_grad /= 0) then
+        do p = 1, 2*n - 1
+          do j = 1, m
+            dlp(j, p) = dlp(j, p) + 2.0_dp*s2*s(j)*c(j)/sq(j)*dtp(j, p)
+          end do
+        end do
+        do j = 1, m                               ! d ln r / d beta_k
+          dlp(j, k) = dlp(j, k) - tanb + 2.0_dp*sb*cb*s(j)*s(j)/sq(j)
+        end do
+      end if
+      if (k == n) then
+        if (exact .and. want_out /= 0) then
+          do j = 1, m
+            thout(j) = thout(j) + atan2((cb - 1.0_dp)*s(j)*c(j), c(j)*c(j) + cb*s(j)*s(j))
+          end do
+        end if
+        exit
+      end if
+      ! transfer to joint k+1
+      if (exact) then
+        if (want_out /= 0) then
+          do j = 1, m
+            thout(j) = thout(j) + atan2((cb - 1.0_dp)*s(j)*c(j), c(j)*c(j) + cb*s(j)*s(j)) &
+                       + atan2(sn(k), cs(k))
+          end do
+        end if
+        if (want_grad /= 0) then
+          do p = 1, 2*n - 1
+            do j = 1, m
+              dtp(j, p) = cn(j)*dtp(j, p)
+            end do
+          end do
+          do j = 1, m                             ! d theta_out / d beta_k
+            dtp(j, k) = dtp(j, k) - sb*s(j)*c(j)/sq(j)
+          end do
+          do j = 1, m
+            dtp(j, n + k) = dtp(j, n + k) + 1.0_dp
+          end do
+        end if
+        do j = 1, m
+          dth(j) = cn(j)*dth(j)
+          isd = 1.0_dp/sqrt(sq(j))
+          x = c(j)*isd
+          y = cb*s(j)*isd
+          c(j) = x*cs(k) - y*sn(k)
+          s(j) = x*sn(k) + y*cs(k)
+        end do
+      else
+        if (want_grad /= 0) then
+          do j = 1, m
+            dtp(j, n + k) = dtp(j, n + k) + 1.0_dp
+          end do
+          if (model == model_eq13 .and. k > 1) then
+            do j = 1, m
+              dtp(j, n + k - 1) = dtp(j, n + k - 1) - 1.0_dp
+            end do
+          end if
+        end if
+        do j = 1, m
+          x = c(j)
+          y = s(j)
+          c(j) = x*cs(k) - y*sn(k)
+          s(j) = x*sn(k) + y*cs(k)
+        end do
+      end if
+    end do
+    if (want_grad == 0) dlp = 0.0_dp
+  end subroutine propagate
+
+  !> Speed ratio R = omega_out/omega_in, dR/dtheta (output angular acceleration per
+  !> omega_in**2 at constant input speed) and the output shaft angle (exact model; zero
+  !> for the paper models, which do not define it) at input angles theta(1..m) [rad].
+  subroutine chain_speed(model, n, beta, phi, rho, m, theta, ratio, dratio, thout)
+    integer, intent(in) :: model, n, m
+    real(dp), intent(in) :: beta(n), phi(n - 1), rho(n - 1), theta(m)
+    real(dp), intent(out) :: ratio(m), dratio(m), thout(m)
+    real(dp) :: dlth(m), dlp(m, 2*n - 1)
+    !f2py threadsafe
+    call propagate(model, n, beta, phi, rho, m, cos(theta), sin(theta), 0, 1, &
+                   ratio, dlth, dlp, thout)
+    dratio = ratio*dlth
+    if (model == model_exact) thout = thout + theta
+  end subroutine chain_speed
+
+  !> Objective over a uniform grid of m input angles theta_j = 2 pi (j-1)/m covering one
+  !> revolution, and (want_grad /= 0) its gradient with respect to beta(1..n) and
+  !> phi(1..n-1); zeros when want_grad = 0.
+  !> kind: obj_mean_square f = mean (R-1)**2 (the paper's U per omega_in**2),
+  !>       obj_rms f = sqrt of that, obj_peak_to_peak f = max R - min R on the grid.
+  !> R has period pi in theta, so for even m only the first m/2 points are evaluated;
+  !> the result is identical to the full grid.
+  subroutine chain_objective(model, kind, n, beta, phi, rho, m, want_grad, f, grad)
+    integer, intent(in) :: model, kind, n, m, want_grad
+    real(dp), intent(in) :: beta(n), phi(n - 1), rho(n - 1)
+    real(dp), intent(out) :: f, grad(2*n - 1)
+    real(dp), allocatable :: c(:), s(:), rat(:), dlth(:), dlp(:, :), thout(:)
+    real(dp) :: c1, s1, cd, sd, t, e
+    integer :: mh, j, jmax, jmin, g
+    !f2py threadsafe
+    mh = m
+    if (mod(m, 2) == 0) mh = m/2
+    allocate (c(mh), s(mh), rat(mh), dlth(mh), thout(mh))
+    ! grid by rotation, re-anchored every 32 points to keep rounding at 1e-15
+    cd = cos(2.0_dp*pi/real(m, dp))
+    sd = sin(2.0_dp*pi/real(m, dp))
+    do j = 1, mh
+      if (mod(j - 1, 32) == 0) then
+        t = 2.0_dp*pi*real(j - 1, dp)/real(m, dp)
+        c1 = cos(t)
+        s1 = sin(t)
+      else
+        e = c1*cd - s1*sd
+        s1 = c1*sd + s1*cd
+        c1 = e
+      end if
+      c(j) = c1
+      s(j) = s1
+    end do
+    g = 0
+    if (want_grad /= 0 .and. kind /= obj_peak_to_peak) g = 1
+    if (g == 1) then
+      allocate (dlp(mh, 2*n - 1))
+    else
+      allocate (dlp(1, 1))
+    end if
+    if (g == 1) then
+      call propagate(model, n, beta, phi, rho, mh, c, s, 1, 0, rat, dlth, dlp, thout)
+    else
+      call propagate_nograd(model, n, beta, phi, rho, mh, c, s, rat)
+    end if
+    grad = 0.0_dp
+    select case (kind)
+    case (obj_peak_to_peak)
+      jmax = maxloc(rat, 1)
+      jmin = minloc(rat, 1)
+      f = rat(jmax) - rat(jmin)
+      if (want_grad /= 0) call p2p_grad(model, n, beta, phi, rho, c(jmax), s(jmax), c(jmin), s(jmin), grad)
+    case default
+      f = sum((rat - 1.0_dp)**2)/real(mh, dp)
+      if (g == 1) then
+        do j = 1, 2*n - 1
+          grad(j) = 2.0_dp*sum((rat - 1.0_dp)*rat*dlp(:, j))/real(mh, dp)
+        end do
+      end if
+      if (kind == obj_rms) then
+        f = sqrt(f)
+        if (f > 0.0_dp) then
+          grad = grad/(2.0_dp*f)
+        else
+          grad = 0.0_dp
+        end if
+      end if
+    end select
+  end subroutine chain_objective
+
+  !> Gradient of max R - min R from the two extreme grid points (ca, sa) and (cb, sb).
+  subroutine p2p_grad(model, n, beta, phi, rho, ca, sa, cb, sb, grad)
+    integer, intent(in) :: model, n
+    real(dp), intent(in) :: beta(n), phi(n - 1), rho(n - 1), ca, sa, cb, sb
+    real(dp), intent(out) :: grad(2*n - 1)
+    real(dp) :: c2(2), s2(2), r2(2), dl2(2), dp2(2, 2*n - 1), th2(2)
+    c2 = [ca, cb]
+    s2 = [sa, sb]
+    call propagate(model, n, beta, phi, rho, 2, c2, s2, 1, 0, r2, dl2, dp2, th2)
+    grad = r2(1)*dp2(1, :) - r2(2)*dp2(2, :)
+  end subroutine p2p_grad
+
+  !> Ratio only (the hot path of the optimisers): rat(j) = R at (cos, sin) = (c0, s0).
+  subroutine propagate_nograd(model, n, beta, phi, rho, m, c0, s0, rat)
+    integer, intent(in) :: model, n, m
+    real(dp), intent(in) :: beta(n), phi(n - 1), rho(n - 1), c0(m), s0(m)
+    real(dp), intent(out) :: rat(m)
+    real(dp) :: c(m), s(m), cs(n), sn(n), cb, s2, d, isd, x, y
+    integer :: j, k
+    call shifts(model, n, phi, rho, cs, sn)
+    c = c0
+    s = s0
+    rat = 1.0_dp
+    do k = 1, n
+      cb = cos(beta(k))
+      s2 = sin(beta(k))**2
+      if (k == n) then
+        do j = 1, m
+          rat(j) = rat(j)*cb/(1.0_dp - s2*s(j)*s(j))
+        end do
+      else if (model == model_exact) then
+        do j = 1, m
+          d = 1.0_dp - s2*s(j)*s(j)
+          isd = 1.0_dp/sqrt(d)
+          rat(j) = rat(j)*cb*isd*isd
+          x = c(j)*isd
+          y = cb*s(j)*isd
+          c(j) = x*cs(k) - y*sn(k)
+          s(j) = x*sn(k) + y*cs(k)
+        end do
+      else
+        do j = 1, m
+          rat(j) = rat(j)*cb/(1.0_dp - s2*s(j)*s(j))
+          x = c(j)
+          y = s(j)
+          c(j) = x*cs(k) - y*sn(k)
+          s(j) = x*sn(k) + y*cs(k)
+        end do
+      end if
+    end do
+  end subroutine propagate_nograd
+
+  !> Closed-form equivalent angles [rad].
+  !> beta_e: first-order residual angle, beta_e**2 = |sum_k beta_k**2 exp(2i gamma_k)| with
+  !>   gamma_1 = 0 and gamma_{k+1} = gamma_k + (shift of the model); the ratio's
+  !>   peak-to-peak is about beta_e**2.
+  !> beta_res: the single Hooke joint that the EXACT chain equals when every phi(k) - rho(k)
+  !>   is a multiple of 90 deg (tolerance tol [rad]): cos(beta_res) = min(K, 1/K), K built
+  !>   from the tan-law composition.  status = st_res_undefined (beta_res = 0) otherwise.
+  subroutine chain_equivalent(model, n, beta, phi, rho, tol, beta_e, beta_res, status)
+    integer, intent(in) :: model, n
+    real(dp), intent(in) :: beta(n), phi(n - 1), rho(n - 1), tol
+    real(dp), intent(out) :: beta_e, beta_res
+    integer, intent(out) :: status
+    real(dp) :: cs(n), sn(n), gam, re, im, kk, sh, q
+    integer :: k
+    call shifts(model, n, phi, rho, cs, sn)
+    gam = 0.0_dp
+    re = 0.0_dp
+    im = 0.0_dp
+    do k = 1, n
+      re = re + beta(k)**2*cos(2.0_dp*gam)
+      im = im + beta(k)**2*sin(2.0_dp*gam)
+      gam = gam + atan2(sn(k), cs(k))
+    end do
+    beta_e = sqrt(sqrt(re*re + im*im))
+    ! exact composition: tan t -> cos(beta) tan t, then a quarter-turn shift -> -1/tan
+    status = st_ok
+    kk = 1.0_dp
+    do k = 1, n
+      kk = kk*cos(beta(k))
+      if (k == n) exit
+      sh = phi(k) - rho(k)
+      q = sh/(0.5_dp*pi)
+      if (abs(q - real(nint(q), dp))*0.5_dp*pi > tol) then
+        status = st_res_undefined
+        exit
+      end if
+      if (mod(abs(nint(q)), 2) == 1) kk = 1.0_dp/kk
+    end do
+    if (status == st_ok) then
+      beta_res = acos(min(kk, 1.0_dp/kk))
+    else
+      beta_res = 0.0_dp
+    end if
+  end subroutine chain_equivalent
+
+  !> Joint angles and plane angles of a 3-D chain from shaft direction vectors
+  !> axes(:, 1..n+1) (input shaft first; any nonzero length).  beta(k) = angle between
+  !> shafts k and k+1 [rad, 0..pi]; rho(k) = signed angle from the plane of joint k to that
+  !> of joint k+1, right-handed about shaft k+1 (k = 1..n-1).  A straight joint (beta = 0)
+  !> has no plane; it takes its neighbour's.  status: st_zero_axis if an axis has zero
+  !> length, st_right_angle if a joint angle is 90 deg or more, else st_ok.
+  subroutine chain_geometry(n, axes, beta, rho, status)
+    integer, intent(in) :: n
+    real(dp), intent(in) :: axes(3, n + 1)
+    real(dp), intent(out) :: beta(n), rho(n - 1)
+    integer, intent(out) :: status
+    real(dp) :: a(3, n + 1), nrm(3, n), w(3), len
+    logical :: has(n), got(n)
+    integer :: k, kk
+    status = st_ok
+    beta = 0.0_dp
+    rho = 0.0_dp
+    do k = 1, n + 1
+      len = sqrt(sum(axes(:, k)**2))
+      if (len <= 0.0_dp) then
+        status = st_zero_axis
+        return
+      end if
+      a(:, k) = axes(:, k)/len
+    end do
+    do k = 1, n
+      w = cross(a(:, k), a(:, k + 1))
+      len = sqrt(sum(w**2))
+      beta(k) = atan2(len, dot_product(a(:, k), a(:, k + 1)))
+      has(k) = len > 1.0e-12_dp
+      if (has(k)) then
+        nrm(:, k) = w/len
+      else
+        nrm(:, k) = 0.0_dp
+      end if
+      if (beta(k) >= 0.5_dp*pi) status = st_right_angle
+    end do
+    ! straight joints borrow the plane of the nearest bent joint (earlier first)
+    got = has
+    do k = 1, n
+      if (has(k)) cycle
+      do kk = k - 1, 1, -1
+        if (has(kk)) then
+          nrm(:, k) = nrm(:, kk)
+          got(k) = .true.
+          exit
+        end if
+      end do
+      if (got(k)) cycle
+      do kk = k + 1, n
+        if (has(kk)) then
+          nrm(:, k) = nrm(:, kk)
+          got(k) = .true.
+          exit
+        end if
+      end do
+    end do
+    do k = 1, n - 1
+      if (.not. (got(k) .and. got(k + 1))) cycle
+      w = cross(nrm(:, k), nrm(:, k + 1))
+      rho(k) = atan2(dot_product(w, a(:, k + 1)), dot_product(nrm(:, k), nrm(:, k + 1)))
+    end do
+  end subroutine chain_geometry
+
+  !> Vector cross product u x v.
+  pure function cross(u, v) result(x)
+    real(dp), intent(in) :: u(3), v(3)
+    real(dp) :: x(3)
+    x = [u(2)*v(3) - u(3)*v(2), u(3)*v(1) - u(1)*v(3), u(1)*v(2) - u(2)*v(1)]
+  end function cross
+
+end module ujoint
