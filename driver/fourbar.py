@@ -456,8 +456,11 @@ def summarise(params: Params) -> dict:
 def _summary(p: Params, g: Grashof, ex: Extremes | None) -> dict:
     """Headline figures for sweeps (exact solution over the deck's range)."""
     s = {"grashof_class": g.name, "full_crank_rotation": g.full_crank_rotation}
-    if ex is None:
-        return s | {"assemblable": False}
+    if ex is None:   # same columns in every case, so sweep tables and filters line up
+        return s | {"assemblable": False, "mu_min_deg": None, "mu_max_deg": None,
+                    "meets_band_40_120": False, "rocker_turns_fully": False, "rocker_swing_deg": None,
+                    "toggle_in_range": False, "omega3_peak_rad_s": None, "omega2_peak_rad_s": None,
+                    "assembled_fraction": 0.0}
     lo, hi = BAND
     return s | {
         "assemblable": True, "mu_min_deg": ex.mu_min, "mu_max_deg": ex.mu_max,

@@ -187,8 +187,17 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
     fig, axes = new_figure(len(ys), 1, sharex=True, figsize=(7.0, 1.9 * len(ys) + 0.8))
     kept = frame["kept"].astype(bool) if "kept" in frame else pd.Series(True, index=frame.index)
     others = [k for k in keys if k != x]
-    groups = frame.groupby(others, sort=False) if others else [("", frame)]
+    many = len(frame) > 2000 or (others and frame.groupby(others).ngroups > 12)
+    groups = [("", frame)] if (many or not others) else frame.groupby(others, sort=False)
+    if many:
+        others = []
     for ax, y in zip(axes, ys):
+        if many:   # a design-space search: every case as a dot, kept cases circled
+            ax.plot(frame[x], frame[y], ".", ms=1, color="0.6", alpha=0.3, rasterized=True)
+            if not kept.all():
+                ax.plot(frame.loc[kept, x], frame.loc[kept, y], "o", ms=3, mfc="none", color="C3", label="kept")
+            ax.set_ylabel(y, fontsize=7)
+            continue
         for label, g in groups:
             g = g.sort_values(x)
             style = "-" if len(frame) <= 2000 else ""

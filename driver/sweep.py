@@ -67,6 +67,8 @@ def _spec() -> GroupSpec:
         "keep": Key("str", default="", doc="pandas query on the summary table (swept keys in backticks)"),
         "case_outputs": Key("str", default="all", choices=("all", "kept", "none"),
                             doc="which cases get their own .out/.parquet/.json files"),
+        "summary_rows": Key("str", default="all", choices=("all", "kept"),
+                            doc="which cases go into the _summary tables (large searches: 'kept')"),
         "scheduler": Key("str", default="", doc="Dask scheduler address (else local worker processes)"),
         "chunk": Key("int", default=0, check=lambda v: "must not be negative" if v < 0 else None,
                      doc="cases per task; 0 = chosen from the time of the first case"),
@@ -202,11 +204,17 @@ def _case_name(index: int, width: int) -> str:
     return f"case_{index:0{width}d}"
 
 
-def _kept(keep: str, values: dict, summary: dict) -> bool:
+def _kept(keep: str, values: dict, summary: dict, strict: bool = False) -> bool:
+    """Whether a case passes the deck's ``keep`` filter (a pandas query on its summary row)."""
     if not keep:
         return True
     row = pd.DataFrame([{**values, **summary}])
-    return bool(len(row.query(keep)))
+    try:
+        return bool(len(row.query(keep)))
+    except (NameError, KeyError, TypeError):   # a figure missing or None for this case: not kept
+        if strict:
+            raise
+        return False
 
 
 def _json_default(o: Any) -> Any:
@@ -293,7 +301,7 @@ def _execute(tasks: list[Task], jobs: int, scheduler: str, progress: bool, total
     try:
         if scheduler:
             from dask.distributed import Client, as_completed
-            client = scheduler if not isinstance(scheduler, str) else Client(scheduler, set_as_default=False)
+            client = scheduler if not isinstance(scheduler, str) else Client(scheduler)
             try:
                 futures = client.map(run_task, tasks, pure=False)
                 for fut in as_completed(futures):
@@ -410,11 +418,14 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
     raw = study_raw[base_params.group]
     cases = build_cases(sw, base_params.group, module.SPEC)
     names = list(cases[0].values)
-    if sw.keep:
+    if sw.keep:   # check the filter on the base deck's summary before running anything
+        probe = (module.summarise(base_params) if hasattr(module, "summarise")
+                 else module.run(base_params).summary)
         try:
-            pd.DataFrame(columns=[*names, *getattr(module, "SUMMARY_COLUMNS", [])]).query(sw.keep)
+            _kept(sw.keep, cases[0].values, probe, strict=True)
         except Exception as exc:
-            raise sw.error("keep", f"not a valid filter: {exc}") from None
+            raise sw.error("keep", f"not a valid filter on the summary columns "
+                                   f"({', '.join([*names, *probe])}): {exc}") from None
     stem = Path(deck.path).stem
     case_dir = outdir / stem
     width = max(4, len(str(len(cases))))
@@ -445,8 +456,9 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
     done.sort(key=lambda r: r.index)
 
     frame = summary_frame(done, names)
+    table = frame if sw.summary_rows == "all" else frame[frame["kept"] | (frame["status"] != "ok")]
     for fmt in ("csv", "parquet"):
-        write_tidy(frame, outdir / f"{stem}_summary", fmt)
+        write_tidy(table, outdir / f"{stem}_summary", fmt)
     tidies = [r.tidy for r in done if r.tidy is not None]
     if tidies:
         allcases = pd.concat(tidies, ignore_index=True)
@@ -477,7 +489,9 @@ def _sweep_text(deck: Deck, sw: Params, base: Params, names: list[str], cases: l
     lines = [f"  sweep over &{base.group} from deck {deck.path}", ""]
     for k, name in enumerate(names, start=1):
         vals = sorted({c.values[name] for c in cases}, key=lambda v: (isinstance(v, str), v))
-        shown = ", ".join(map(str, vals[:8])) + (f", ... ({len(vals)} values)" if len(vals) > 8 else "")
+        fmt = lambda v: v if isinstance(v, str) else f"{v:.6g}"
+        shown = (", ".join(map(fmt, vals[:8])) if len(vals) <= 8 else
+                 f"{fmt(vals[0])}, {fmt(vals[1])}, ..., {fmt(vals[-1])} ({len(vals)} values)")
         lines.append(f"    {name:<28} {shown}")
     lines += [f"    {'cases':<28} {len(cases)} ({'zipped' if sw.zip else 'full grid'})",
               f"    {'case outputs':<28} {sw.case_outputs}" + (f"   keep: {sw.keep}" if sw.keep else ""),
