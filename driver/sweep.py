@@ -225,58 +225,98 @@ def _json_default(o: Any) -> Any:
     return str(o)
 
 
-def run_case(task: Task, case: Case) -> CaseResult:
-    """Run one case in this process; never raises for a case failure."""
+def _compute(task: Task, case: Case, module) -> tuple[CaseResult, Any, Params | None]:
+    """Validate and run (or only summarise) one case; never raises for a case failure."""
     t0 = time.perf_counter()
     res = CaseResult(case.index, case.values)
-    module = load_study(task.raw.name)
+    result, params = None, None
     try:
         params = validate(_case_raw(task.raw, case), module.SPEC, task.deck_path)
-    except DeckError as exc:
-        res.status, res.error, res.kept = EXIT_BAD_INPUT, str(exc), False
-        return res
-    try:
-        want_files = task.case_outputs != "none"
-        result = None
-        if want_files and (task.case_outputs == "all" or not task.keep) or not hasattr(module, "summarise"):
+        full = task.case_outputs == "all" or (task.case_outputs == "kept" and not task.keep)
+        if full or not hasattr(module, "summarise"):
             result = module.run(params, progress=False)
             res.summary = dict(result.summary)
-        else:
-            res.summary = dict(module.summarise(params))
-        res.kept = _kept(task.keep, case.values, res.summary)
-        if want_files and (task.case_outputs == "all" or res.kept):
-            if result is None:
-                result = module.run(params, progress=False)
-            res.warnings = list(result.warnings)
             if result.failure:
                 res.status, res.error = EXIT_FAILED, result.failure
-            from driver.cli import write_outputs
-            stem = Path(task.case_dir) / _case_name(case.index, task.width)
-            write_text(stem.with_suffix(".dat"), _case_deck_text(task.raw.name, params, case, Path(task.deck_path)))
-            tidy = result.tidy.copy()
-            for name, v in case.values.items():
-                tidy.insert(0, name, v)
-            write_outputs(result, stem, sorted(set(task.formats) | {"parquet"}), task.plot)
-            write_tidy(tidy, stem, "parquet")
-            res.tidy = tidy
-            res.written = True
-            record = {"index": case.index, "values": case.values, "base": task.base_hash,
-                      "status": res.status, "error": res.error, "summary": res.summary,
-                      "kept": res.kept, "warnings": res.warnings}
-            write_text(stem.with_suffix(".json"), json.dumps(record, default=_json_default, indent=1))
-        elif result is not None and result.failure:
-            res.status, res.error = EXIT_FAILED, result.failure
+        else:
+            res.summary = dict(module.summarise(params))
     except DeckError as exc:
-        res.status, res.error, res.kept = EXIT_BAD_INPUT, str(exc), False
+        res.status, res.error = EXIT_BAD_INPUT, str(exc)
     except Exception as exc:  # a case that fails is reported, the others go on
-        res.status, res.error, res.kept = EXIT_FAILED, f"{exc.__class__.__name__}: {exc}", False
+        res.status, res.error = EXIT_FAILED, f"{exc.__class__.__name__}: {exc}"
     res.seconds = time.perf_counter() - t0
-    return res
+    return res, result, params
+
+
+def _kept_many(keep: str, results: list[CaseResult]) -> list[bool]:
+    """The keep filter on a chunk of cases at once (one pandas query per chunk, not per case)."""
+    ok = [r.status == EXIT_OK for r in results]
+    if not keep:
+        return ok
+    rows = pd.DataFrame([{**r.values, **r.summary} for r in results])
+    try:
+        hit = set(rows.query(keep).index)
+        return [o and i in hit for i, o in enumerate(ok)]
+    except (NameError, KeyError, TypeError):   # some case lacks a figure: decide one by one
+        return [o and _kept(keep, r.values, r.summary) for o, r in zip(ok, results)]
+
+
+def _write_case(task: Task, case: Case, res: CaseResult, result, params: Params, module) -> None:
+    """Per-case files: deck, .out (+ extras, figures), tidy parquet, json marker last."""
+    t0 = time.perf_counter()
+    try:
+        if result is None:
+            result = module.run(params, progress=False)
+            if result.failure:
+                res.status, res.error = EXIT_FAILED, result.failure
+        res.warnings = list(result.warnings)
+        from driver.cli import write_outputs
+        stem = Path(task.case_dir) / _case_name(case.index, task.width)
+        write_text(stem.with_suffix(".dat"), _case_deck_text(task.raw.name, params, case, Path(task.deck_path)))
+        tidy = result.tidy.copy()
+        for name, v in reversed(case.values.items()):
+            tidy.insert(0, name, v)
+        write_outputs(result, stem, [f for f in task.formats if f != "parquet"], task.plot)
+        write_tidy(tidy, stem, "parquet")
+        res.tidy = tidy
+        res.written = True
+        record = {"index": case.index, "values": case.values, "base": task.base_hash,
+                  "status": res.status, "error": res.error, "summary": res.summary,
+                  "kept": res.kept, "warnings": res.warnings}
+        write_text(stem.with_suffix(".json"), json.dumps(record, default=_json_default, indent=1))
+    except Exception as exc:
+        res.status, res.error, res.kept = EXIT_FAILED, f"{exc.__class__.__name__}: {exc}", False
+    res.seconds += time.perf_counter() - t0
+
+
+def run_case(task: Task, case: Case) -> CaseResult:
+    """Run one case in this process (compute, filter, write); never raises for a case failure."""
+    return run_task(Task(**{**task.__dict__, "cases": [case]}))[0]
 
 
 def run_task(task: Task) -> list[CaseResult]:
     """Run a chunk of cases (the unit of work sent to a process or a Dask worker)."""
-    return [run_case(task, c) for c in task.cases]
+    module = load_study(task.raw.name)
+    writable = lambda res, params: res.status != EXIT_BAD_INPUT and params is not None
+    if task.case_outputs == "all":
+        # write each case as soon as it is computed: an interrupt loses at most one case
+        # ('kept' is decided once, over all cases, by the caller)
+        results = []
+        for c in task.cases:
+            res, result, params = _compute(task, c, module)
+            if writable(res, params):
+                _write_case(task, c, res, result, params, module)
+            results.append(res)
+        return results
+    computed = [_compute(task, c, module) for c in task.cases]
+    results = [r for r, _, _ in computed]
+    for r, k in zip(results, _kept_many(task.keep, results)):
+        r.kept = k
+    if task.case_outputs == "kept":
+        for case, (res, result, params) in zip(task.cases, computed):
+            if res.kept and writable(res, params):
+                _write_case(task, case, res, result, params, module)
+    return results
 
 
 # ----------------------------------------------------------------------------- execution
@@ -454,6 +494,8 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
     done += _execute(tasks, jobs, scheduler, progress, len(cases), len(cases) - len(todo))
     elapsed = time.perf_counter() - t_start
     done.sort(key=lambda r: r.index)
+    for r, k in zip(done, _kept_many(sw.keep, done)):   # one vectorised filter over every case
+        r.kept = k
 
     frame = summary_frame(done, names)
     table = frame if sw.summary_rows == "all" else frame[frame["kept"] | (frame["status"] != "ok")]
