@@ -10,12 +10,11 @@ from __future__ import annotations
 
 import argparse
 import os
-import statistics
-import time
 
 import numpy as np
 
 from driver import kernels
+from timing import median_time
 
 
 def numpy_baseline(theta, p, q, r, s, omega, alpha, branch):
@@ -37,15 +36,6 @@ def numpy_baseline(theta, p, q, r, s, omega, alpha, branch):
     a2 = (-q * alpha * (sn * e3x - c * e3y) - q * omega**2 * (c * e3x + sn * e3y) - r * w2**2 * c23 + s * w3**2) / (-r * s23)
     a3 = (q * alpha * (sn * e2x - c * e2y) + q * omega**2 * (c * e2x + sn * e2y) + r * w2**2 - s * w3**2 * c23) / (s * s23)
     return (np.arctan2(e2y, e2x), np.arctan2(e3y, e3x), np.arctan2(np.abs(s23), c23), ax, ay, bx, by, w2, w3, a2, a3)
-
-
-def median_time(fn, repeat):
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times)
 
 
 def main() -> None:

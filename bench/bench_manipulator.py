@@ -11,12 +11,11 @@ Run: .venv/bin/python bench/bench_manipulator.py [--repeat N]
 from __future__ import annotations
 
 import argparse
-import statistics
-import time
 
 import numpy as np
 
 from driver import kernels
+from timing import median_time as timeit
 
 
 def numpy_arm_states(l1, l2, th1, th2, qd, qdd, m1, m2, g):
@@ -45,16 +44,6 @@ def numpy_position_errors(th1, th2, dl):
     e = dl[:, 0, None, None] * u1[None] + dl[:, 1, None, None] * u2[None]   # (ns, k, 2)
     e2 = (e * e).sum(2)
     return np.stack([np.sqrt(e2.sum(1)), np.sqrt(e2.max(1))], 1)
-
-
-def timeit(fn, repeat: int) -> float:
-    fn()  # warm up
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times)
 
 
 def main() -> None:
