@@ -77,25 +77,35 @@ contains
     kin(7) = -ax*s3 + ay*c3
   end subroutine rigid_kin
 
-  !> Rigid-body axial force N(s) [N] (tension positive) at arc length s [m] from the
-  !> crank pin, from d'Alembert statics of the rod (mass per length rhoa) plus slider msl.
-  pure function axial_force(s, kin, rl, rhoa, msl) result(n)
-    real(dp), intent(in) :: s, kin(7), rl, rhoa, msl
-    real(dp) :: n, s3, c3, fg, acpar, acperp
+  !> Rigid-body axial force N(s) = n0 + n1 s + n2 s^2 [N] (tension positive) at arc length s
+  !> [m] from the crank pin, from d'Alembert statics of the rod (mass per length rhoa) plus
+  !> the slider msl; the guide force F_g follows from moments about the crank pin.
+  pure subroutine axial_coeffs(kin, rl, rhoa, msl, nc)
+    real(dp), intent(in) :: kin(7), rl, rhoa, msl
+    real(dp), intent(out) :: nc(3)
+    real(dp) :: s3, c3, fg, acpar, acperp
     s3 = sin(kin(1))
     c3 = cos(kin(1))
     acpar = kin(5)*c3
     acperp = -kin(5)*s3
     fg = (rhoa*(kin(7)*rl**2/2 + kin(3)*rl**3/3) + rl*msl*acperp)/(rl*c3)
-    n = -(rhoa*(kin(6)*(rl - s) - kin(2)**2*(rl**2 - s**2)/2) + msl*acpar - fg*s3)
+    nc(1) = -(rhoa*(kin(6)*rl - kin(2)**2*rl**2/2) + msl*acpar - fg*s3)
+    nc(2) = rhoa*kin(6)
+    nc(3) = -rhoa*kin(2)**2/2
+  end subroutine axial_coeffs
+
+  !> N(s) from its coefficients.
+  pure function axial_force(s, nc) result(n)
+    real(dp), intent(in) :: s, nc(3)
+    real(dp) :: n
+    n = nc(1) + s*(nc(2) + s*nc(3))
   end function axial_force
 
-  !> Element average of N(s) over [sa, sb] (exact: N is quadratic in s).
-  pure function axial_force_avg(sa, sb, kin, rl, rhoa, msl) result(n)
-    real(dp), intent(in) :: sa, sb, kin(7), rl, rhoa, msl
+  !> Element average of N(s) over [sa, sb] (exact).
+  pure function axial_force_avg(sa, sb, nc) result(n)
+    real(dp), intent(in) :: sa, sb, nc(3)
     real(dp) :: n
-    n = (axial_force(sa, kin, rl, rhoa, msl) + 4*axial_force(0.5_dp*(sa + sb), kin, rl, rhoa, msl) &
-         + axial_force(sb, kin, rl, rhoa, msl))/6
+    n = nc(1) + nc(2)*(sa + sb)/2 + nc(3)*(sa*sa + sa*sb + sb*sb)/3
   end function axial_force_avg
 
   !> Rigid kinematics at n crank angles theta2(n) [rad]; out(k, :) as rigid_kin's kin.
@@ -117,11 +127,12 @@ contains
     real(dp), intent(in) :: theta2(n), s(ns), omega, r2, rl, rhoa, msl
     real(dp), intent(out) :: out(ns, n)
     integer :: k, j
-    real(dp) :: kin(7)
+    real(dp) :: kin(7), nc(3)
     do k = 1, n
       call rigid_kin(theta2(k), omega, r2, rl, kin)
+      call axial_coeffs(kin, rl, rhoa, msl, nc)
       do j = 1, ns
-        out(j, k) = axial_force(s(j), kin, rl, rhoa, msl)
+        out(j, k) = axial_force(s(j), nc)
       end do
     end do
   end subroutine axial_force_at
@@ -251,58 +262,81 @@ contains
 
   !> r = T^T [ Me (T qm - load*ur'') + Ke T qk + Kg(nbar) T qg ] + msl (qm_X - load*A_h) e_X
   !> (the inertia, stiffness and rigid-body load terms of the equation of motion).
+  !> Element by element; the right node's gathered values are reused as the next left node's.
   subroutine apply_ops(nel, nq, qm, qk, qg, use_g, load, kin, le, me, ke, kg1, nbar, msl, r)
     integer, intent(in) :: nel, nq
     real(dp), intent(in) :: qm(nq), qk(nq), qg(nq), load, kin(7), le
     real(dp), intent(in) :: me(6, 6), ke(6, 6), kg1(6, 6), nbar(nel), msl
     logical, intent(in) :: use_g
     real(dp), intent(out) :: r(nq)
-    integer :: e, a, idx(6)
-    real(dp) :: cf(6), xm(6), xk(6), xg(6), f(6), c3, s3, sa, sb, w2, th3dd
+    integer :: e, j
+    real(dp) :: xm(6), xk(6), xg(6), f(6), c3, s3, w2, th3dd, ua, ub, dua
+    real(dp) :: m11, m14, m44, m22, m23, m25, m26, m33, m35, m36, m55, m56, m66
+    real(dp) :: k11, k22, k23, k33, k36
     c3 = cos(kin(1))
     s3 = sin(kin(1))
     w2 = kin(2)**2
     th3dd = kin(3)
+    ! element matrix entries (axial/bending blocks are uncoupled; ke has the beam's symmetries)
+    m11 = me(1, 1); m14 = me(1, 4); m44 = me(4, 4)
+    m22 = me(2, 2); m23 = me(2, 3); m25 = me(2, 5); m26 = me(2, 6); m33 = me(3, 3); m35 = me(3, 5)
+    m36 = me(3, 6); m55 = me(5, 5); m56 = me(5, 6); m66 = me(6, 6)
+    k11 = ke(1, 1); k22 = ke(2, 2); k23 = ke(2, 3); k33 = ke(3, 3); k36 = ke(3, 6)
     r = 0
     xg = 0
+    ! crank-pin node: u = v = 0, theta = q(1); its rigid acceleration (aA_par, aA_perp, th3'')
+    xm(4:6) = [-load*kin(6), -load*kin(7), qm(1) - load*th3dd]
+    xk(4:6) = [0.0_dp, 0.0_dp, qk(1)]
+    if (use_g) xg(4:6) = [0.0_dp, 0.0_dp, qg(1)]
     do e = 1, nel
-      call element_map(e, nel, c3, s3, idx, cf)
-      do a = 1, 6
-        if (idx(a) == 0) then
-          xm(a) = 0
-          xk(a) = 0
-          if (use_g) xg(a) = 0
-        else
-          xm(a) = cf(a)*qm(idx(a))
-          xk(a) = cf(a)*qk(idx(a))
-          if (use_g) xg(a) = cf(a)*qg(idx(a))
-        end if
-      end do
-      if (abs(load) > 0) then
-        sa = (e - 1)*le
-        sb = e*le
-        xm(1) = xm(1) - load*(kin(6) - sa*w2)
-        xm(2) = xm(2) - load*(kin(7) + sa*th3dd)
-        xm(3) = xm(3) - load*th3dd
-        xm(4) = xm(4) - load*(kin(6) - sb*w2)
-        xm(5) = xm(5) - load*(kin(7) + sb*th3dd)
-        xm(6) = xm(6) - load*th3dd
+      xm(1:3) = xm(4:6)
+      xk(1:3) = xk(4:6)
+      if (use_g) xg(1:3) = xg(4:6)
+      ua = load*(kin(6) - e*le*w2)
+      ub = load*(kin(7) + e*le*th3dd)
+      if (e < nel) then
+        j = 3*e - 1
+        xm(4) = qm(j) - ua
+        xm(5) = qm(j + 1) - ub
+        xm(6) = qm(j + 2) - load*th3dd
+        xk(4:6) = qk(j:j + 2)
+        if (use_g) xg(4:6) = qg(j:j + 2)
+      else
+        xm(4) = c3*qm(nq) - ua
+        xm(5) = -s3*qm(nq) - ub
+        xm(6) = qm(nq - 1) - load*th3dd
+        xk(4:6) = [c3*qk(nq), -s3*qk(nq), qk(nq - 1)]
+        if (use_g) xg(4:6) = [c3*qg(nq), -s3*qg(nq), qg(nq - 1)]
       end if
-      ! axial and bending blocks are uncoupled: 40 multiply-adds instead of 72
-      f(1) = me(1, 1)*xm(1) + me(1, 4)*xm(4) + ke(1, 1)*xk(1) + ke(1, 4)*xk(4)
-      f(4) = me(4, 1)*xm(1) + me(4, 4)*xm(4) + ke(4, 1)*xk(1) + ke(4, 4)*xk(4)
-      f(2) = me(2, 2)*xm(2) + me(2, 3)*xm(3) + me(2, 5)*xm(5) + me(2, 6)*xm(6) &
-             + ke(2, 2)*xk(2) + ke(2, 3)*xk(3) + ke(2, 5)*xk(5) + ke(2, 6)*xk(6)
-      f(3) = me(3, 2)*xm(2) + me(3, 3)*xm(3) + me(3, 5)*xm(5) + me(3, 6)*xm(6) &
-             + ke(3, 2)*xk(2) + ke(3, 3)*xk(3) + ke(3, 5)*xk(5) + ke(3, 6)*xk(6)
-      f(5) = me(5, 2)*xm(2) + me(5, 3)*xm(3) + me(5, 5)*xm(5) + me(5, 6)*xm(6) &
-             + ke(5, 2)*xk(2) + ke(5, 3)*xk(3) + ke(5, 5)*xk(5) + ke(5, 6)*xk(6)
-      f(6) = me(6, 2)*xm(2) + me(6, 3)*xm(3) + me(6, 5)*xm(5) + me(6, 6)*xm(6) &
-             + ke(6, 2)*xk(2) + ke(6, 3)*xk(3) + ke(6, 5)*xk(5) + ke(6, 6)*xk(6)
+      dua = xk(4) - xk(1)
+      f(1) = m11*xm(1) + m14*xm(4) - k11*dua
+      f(4) = m14*xm(1) + m44*xm(4) + k11*dua
+      f(2) = m22*xm(2) + m23*xm(3) + m25*xm(5) + m26*xm(6) &
+             + k22*(xk(2) - xk(5)) + k23*(xk(3) + xk(6))
+      f(5) = m25*xm(2) - m26*xm(3) + m55*xm(5) + m56*xm(6) &
+             - k22*(xk(2) - xk(5)) - k23*(xk(3) + xk(6))
+      f(3) = m23*xm(2) + m33*xm(3) + m35*xm(5) + m36*xm(6) &
+             + k23*(xk(2) - xk(5)) + k33*xk(3) + k36*xk(6)
+      f(6) = m26*xm(2) + m36*xm(3) + m56*xm(5) + m66*xm(6) &
+             + k23*(xk(2) - xk(5)) + k36*xk(3) + k33*xk(6)
       if (use_g) f = f + nbar(e)*matmul(kg1, xg)
-      do a = 1, 6
-        if (idx(a) /= 0) r(idx(a)) = r(idx(a)) + cf(a)*f(a)
-      end do
+      if (e == 1) then
+        r(1) = r(1) + f(3)
+      else
+        j = 3*e - 4
+        r(j) = r(j) + f(1)
+        r(j + 1) = r(j + 1) + f(2)
+        r(j + 2) = r(j + 2) + f(3)
+      end if
+      if (e < nel) then
+        j = 3*e - 1
+        r(j) = r(j) + f(4)
+        r(j + 1) = r(j + 1) + f(5)
+        r(j + 2) = r(j + 2) + f(6)
+      else
+        r(nq) = r(nq) + c3*f(4) - s3*f(5)
+        r(nq - 1) = r(nq - 1) + f(6)
+      end if
     end do
     r(nq) = r(nq) + msl*(qm(nq) - load*kin(5))
   end subroutine apply_ops
@@ -310,8 +344,10 @@ contains
   ! ------------------------------------------------------------------ banded Cholesky
 
   !> In-place Cholesky A = L L^T of an SPD band matrix in lower storage
-  !> ab(1 + i - j, j) = A(i, j), j <= i <= min(n, j + kd).  info = 0 on success,
-  !> otherwise the column whose pivot was not positive.
+  !> ab(1 + i - j, j) = A(i, j), j <= i <= min(n, j + kd).  On exit ab(1, j) holds the
+  !> reciprocal 1/L(j, j) (band_solve multiplies: no division in the substitutions) and
+  !> ab(1 + i, j) = L(j + i, j).  info = 0 on success, otherwise the column whose pivot
+  !> was not positive.
   subroutine band_cholesky(n, ab, info)
     integer, intent(in) :: n
     real(dp), intent(inout) :: ab(kd + 1, n)
@@ -325,10 +361,10 @@ contains
         info = j
         return
       end if
-      ajj = sqrt(ajj)
+      ajj = 1/sqrt(ajj)
       ab(1, j) = ajj
       kn = min(kd, n - j)
-      ab(2:kn + 1, j) = ab(2:kn + 1, j)/ajj
+      ab(2:kn + 1, j) = ab(2:kn + 1, j)*ajj
       do i = 1, kn
         do k = i, kn
           ab(1 + k - i, j + i) = ab(1 + k - i, j + i) - ab(1 + k, j)*ab(1 + i, j)
@@ -344,20 +380,105 @@ contains
     real(dp), intent(inout) :: b(n)
     integer :: j, i
     real(dp) :: s
-    do j = 1, n
-      b(j) = b(j)/ab(1, j)
-      do i = 1, min(kd, n - j)
+    do j = 1, n - kd          ! full-width columns: fixed trip count (unrolled by the compiler)
+      b(j) = b(j)*ab(1, j)
+      do i = 1, kd
         b(j + i) = b(j + i) - ab(1 + i, j)*b(j)
       end do
     end do
-    do j = n, 1, -1
+    do j = max(1, n - kd + 1), n
+      b(j) = b(j)*ab(1, j)
+      do i = 1, n - j
+        b(j + i) = b(j + i) - ab(1 + i, j)*b(j)
+      end do
+    end do
+    do j = n, max(1, n - kd + 1), -1
       s = b(j)
-      do i = 1, min(kd, n - j)
+      do i = 1, n - j
         s = s - ab(1 + i, j)*b(j + i)
       end do
-      b(j) = s/ab(1, j)
+      b(j) = s*ab(1, j)
+    end do
+    do j = n - kd, 1, -1
+      s = b(j)
+      do i = 1, kd
+        s = s - ab(1 + i, j)*b(j + i)
+      end do
+      b(j) = s*ab(1, j)
     end do
   end subroutine band_solve
+
+  !> Latency-friendly form of a band_cholesky factor for repeated solves with one matrix:
+  !> d(j) = 1/L(j, j), lf(i, j) = L(j, j - i) d(j) (rows, forward), lb(i, j) = L(j + i, j) d(j)
+  !> (columns, backward); entries outside the matrix are zero.
+  subroutine band_prepare(n, ab, d, lf, lb)
+    integer, intent(in) :: n
+    real(dp), intent(in) :: ab(kd + 1, n)
+    real(dp), intent(out) :: d(n), lf(kd, n), lb(kd, n)
+    integer :: i, j
+    d = ab(1, :)
+    lf = 0
+    lb = 0
+    do j = 1, n
+      do i = 1, kd
+        if (j - i >= 1) lf(i, j) = ab(1 + i, j - i)*d(j)
+        if (j + i <= n) lb(i, j) = ab(1 + i, j)*d(j)
+      end do
+    end do
+  end subroutine band_prepare
+
+  !> Solve L L^T x = b with band_prepare's arrays; b is overwritten by x.  Each unknown
+  !> waits on its neighbour through one multiply-add only (the nearest term is added last).
+  subroutine band_solve_prepared(n, d, lf, lb, b)
+    integer, intent(in) :: n
+    real(dp), intent(in) :: d(n), lf(kd, n), lb(kd, n)
+    real(dp), intent(inout) :: b(n)
+    integer :: j
+    real(dp) :: t
+    if (n <= kd) then
+      do j = 1, n
+        t = d(j)*b(j)
+        if (j > 4) t = t - lf(4, j)*b(j - 4)
+        if (j > 3) t = t - lf(3, j)*b(j - 3)
+        if (j > 2) t = t - lf(2, j)*b(j - 2)
+        if (j > 1) t = t - lf(1, j)*b(j - 1)
+        b(j) = t
+      end do
+      do j = n, 1, -1
+        t = d(j)*b(j)
+        if (j + 4 <= n) t = t - lb(4, j)*b(j + 4)
+        if (j + 3 <= n) t = t - lb(3, j)*b(j + 3)
+        if (j + 2 <= n) t = t - lb(2, j)*b(j + 2)
+        if (j + 1 <= n) t = t - lb(1, j)*b(j + 1)
+        b(j) = t
+      end do
+      return
+    end if
+    do j = 1, kd
+      t = d(j)*b(j)
+      if (j > 4) t = t - lf(4, j)*b(j - 4)
+      if (j > 3) t = t - lf(3, j)*b(j - 3)
+      if (j > 2) t = t - lf(2, j)*b(j - 2)
+      if (j > 1) t = t - lf(1, j)*b(j - 1)
+      b(j) = t
+    end do
+    do j = kd + 1, n
+      b(j) = ((((d(j)*b(j) - lf(5, j)*b(j - 5)) - lf(4, j)*b(j - 4)) - lf(3, j)*b(j - 3)) &
+              - lf(2, j)*b(j - 2)) - lf(1, j)*b(j - 1)
+    end do
+    do j = n, n - kd + 1, -1
+      t = d(j)*b(j)
+      if (j + 4 <= n) t = t - lb(4, j)*b(j + 4)
+      if (j + 3 <= n) t = t - lb(3, j)*b(j + 3)
+      if (j + 2 <= n) t = t - lb(2, j)*b(j + 2)
+      if (j + 1 <= n) t = t - lb(1, j)*b(j + 1)
+      b(j) = t
+    end do
+    do j = n - kd, 1, -1
+      b(j) = ((((d(j)*b(j) - lb(5, j)*b(j + 5)) - lb(4, j)*b(j + 4)) - lb(3, j)*b(j + 3)) &
+              - lb(2, j)*b(j + 2)) - lb(1, j)*b(j + 1)
+    end do
+  end subroutine band_solve_prepared
 
   ! ------------------------------------------------------------------ public assembly
 
@@ -368,7 +489,7 @@ contains
     integer, intent(in) :: nel, nq, geom
     real(dp), intent(in) :: r2, rl, rhoa, ea, ei, msl, theta2, omega
     real(dp), intent(out) :: mb(6, nq), kb(6, nq)   ! 6 = kd + 1 (f2py needs a literal)
-    real(dp) :: me(6, 6), ke(6, 6), kg1(6, 6), kin(7), nbar(nel), le
+    real(dp) :: me(6, 6), ke(6, 6), kg1(6, 6), kin(7), nbar(nel), le, nc(3)
     integer :: e
     mb = 0
     kb = 0
@@ -376,8 +497,9 @@ contains
     le = rl/nel
     call element_matrices(le, rhoa, ea, ei, me, ke, kg1)
     call rigid_kin(theta2, omega, r2, rl, kin)
+    call axial_coeffs(kin, rl, rhoa, msl, nc)
     do e = 1, nel
-      nbar(e) = axial_force_avg((e - 1)*le, e*le, kin, rl, rhoa, msl)
+      nbar(e) = axial_force_avg((e - 1)*le, e*le, nc)
     end do
     call assemble_band(nel, nq, me, kg1, nbar, .false., cos(kin(1)), sin(kin(1)), msl, mb)
     call assemble_band(nel, nq, ke, kg1, nbar, geom /= 0, cos(kin(1)), sin(kin(1)), 0.0_dp, kb)
@@ -417,10 +539,11 @@ contains
 
     real(dp), allocatable :: q(:), qd(:), qdd(:), qn(:), r(:), w1(:), w2(:), zero(:)
     real(dp), allocatable :: ab(:, :), at(:, :), afac(:, :), zu(:), zv(:), eu(:), ev(:), tmp(:)
+    real(dp), allocatable :: fd(:), flf(:, :), flb(:, :)
     real(dp) :: me(6, 6), ke(6, 6), kg1(6, 6), se(6, 6), kin(7), nbar(nel), nzero(nel)
     real(dp) :: le, a0, a1, a2, a3, a4, a5, ck, cm, t, c3, s3, h
     real(dp) :: uu, uv, vv, d44, d45, d55, by, bz, den, ux, limit
-    integer :: k, info, nl, idx(6), a, j0
+    integer :: k, info, nl, idx(6), a, j0, j
     real(dp) :: cf(6)
     logical :: use_g, use_fast, dyn
 
@@ -487,8 +610,11 @@ contains
       end do
       zu = eu
       zv = ev
-      call band_solve(nl, afac(:, 1:nl), zu)
-      call band_solve(nl, afac(:, 1:nl), zv)
+      allocate (fd(nl), flf(kd, nl), flb(kd, nl))
+      call band_prepare(nl, afac(:, 1:nl), fd, flf, flb)
+      deallocate (afac)
+      call band_solve_prepared(nl, fd, flf, flb, zu)
+      call band_solve_prepared(nl, fd, flf, flb, zv)
       uu = dot_product(eu, zu)
       uv = dot_product(eu, zv)
       vv = dot_product(ev, zv)
@@ -564,20 +690,24 @@ contains
         end if
       end if
       if (dyn) then
-        w1 = (a0 + alpha*a1)*q + (a2 + alpha*a4)*qd + (a3 + alpha*a5)*qdd
-        w2 = beta*(a1*q + a4*qd + a5*qdd)
+        do j = 1, nq
+          w1(j) = (a0 + alpha*a1)*q(j) + (a2 + alpha*a4)*qd(j) + (a3 + alpha*a5)*qdd(j)
+          w2(j) = beta*(a1*q(j) + a4*qd(j) + a5*qdd(j))
+        end do
         call apply_ops(nel, nq, w1, w2, zero, .false., 1.0_dp, kin, le, me, ke, kg1, nbar, msl, r)
       else
         call apply_ops(nel, nq, zero, zero, zero, .false., 1.0_dp, kin, le, me, ke, kg1, nbar, msl, r)
       end if
       if (use_fast) then
         qn(1:nl) = r(1:nl)
-        call band_solve(nl, afac(:, 1:nl), qn(1:nl))
+        call band_solve_prepared(nl, fd, flf, flb, qn(1:nl))
         by = c3*dot_product(eu(j0:nl), qn(j0:nl)) - s3*dot_product(ev(j0:nl), qn(j0:nl))
         bz = c3*c3*uu - 2*c3*s3*uv + s3*s3*vv
         den = c3*c3*d44 - 2*c3*s3*d45 + s3*s3*d55 + cm*msl - bz
         ux = (r(nq) - by)/den
-        qn(1:nl) = qn(1:nl) - ux*(c3*zu - s3*zv)
+        do j = 1, nl
+          qn(j) = qn(j) - ux*(c3*zu(j) - s3*zv(j))
+        end do
         qn(nq) = ux
       else
         if (dyn .or. .not. use_g) then
@@ -596,11 +726,15 @@ contains
         end if
       end if
       if (dyn) then
-        tmp = a0*(qn - q) - a2*qd - a3*qdd
-        qd = qd + dt*(0.5_dp*qdd + 0.5_dp*tmp)
-        qdd = tmp
+        do j = 1, nq
+          h = a0*(qn(j) - q(j)) - a2*qd(j) - a3*qdd(j)
+          qd(j) = qd(j) + 0.5_dp*dt*(qdd(j) + h)
+          qdd(j) = h
+          q(j) = qn(j)
+        end do
+      else
+        q = qn
       end if
-      q = qn
       if (.not. small_motion(nq, q, limit)) then
         status = st_diverged
         fail_step = k
@@ -638,8 +772,10 @@ contains
     real(dp), intent(in) :: le, rl, rhoa, msl, kin(7)
     real(dp), intent(out) :: nb(nel)
     integer :: e
+    real(dp) :: nc(3)
+    call axial_coeffs(kin, rl, rhoa, msl, nc)
     do e = 1, nel
-      nb(e) = axial_force_avg((e - 1)*le, e*le, kin, rl, rhoa, msl)
+      nb(e) = axial_force_avg((e - 1)*le, e*le, nc)
     end do
   end subroutine element_nbar
 
@@ -669,16 +805,31 @@ contains
     real(dp), intent(inout) :: eps_ax(nel, nrec), eps_of(nel, nrec), n_avg(nel, nrec)
     real(dp), intent(inout) :: mid(nrec), slider(nrec), elong(nrec)
     integer :: ee, m
-    real(dp) :: ua, ub, ta, tb, ep, ka, vn, va, vb, cc, ss
+    real(dp) :: ua, ub, ta, tb, ep, ka, vn, va, vb, cc, ss, nc(3), inv, c1, c2, third
+    call axial_coeffs(kin, rl, rhoa, msl, nc)
     cc = cos(kin(1))
     ss = sin(kin(1))
+    inv = 1/le
+    third = 1.0_dp/3
+    c1 = nc(2)*le
+    c2 = nc(3)*le*le
     do ee = 1, nel
+      ! element average of N over [(ee-1) le, ee le]: sa^2 + sa sb + sb^2 = le^2 (3 ee^2 - 3 ee + 1)
+      n_avg(ee, j) = nc(1) + c1*(ee - 0.5_dp) + c2*(real(ee, dp)*(ee - 1) + third)
+    end do
+    do ee = 2, nel - 1
+      ep = (q(3*ee - 1) - q(3*ee - 4))*inv
+      ka = (q(3*ee + 1) - q(3*ee - 2))*inv
+      eps_ax(ee, j) = ep
+      eps_of(ee, j) = abs(ep) + half_depth*abs(ka)
+    end do
+    do ee = 1, nel, max(1, nel - 1)      ! the two end elements (one when nel = 1)
       if (ee == 1) then
         ua = 0
         ta = q(1)
       else
-        ua = q(3*(ee - 1) - 1)
-        ta = q(3*(ee - 1) + 1)
+        ua = q(3*ee - 4)
+        ta = q(3*ee - 2)
       end if
       if (ee == nel) then
         ub = cc*q(nq)
@@ -687,11 +838,10 @@ contains
         ub = q(3*ee - 1)
         tb = q(3*ee + 1)
       end if
-      ep = (ub - ua)/le
-      ka = (tb - ta)/le
+      ep = (ub - ua)*inv
+      ka = (tb - ta)*inv
       eps_ax(ee, j) = ep
       eps_of(ee, j) = abs(ep) + half_depth*abs(ka)
-      n_avg(ee, j) = axial_force_avg((ee - 1)*le, ee*le, kin, rl, rhoa, msl)
     end do
     vn = -ss*q(nq)
     if (mod(nel, 2) == 0) then
