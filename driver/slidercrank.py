@@ -264,6 +264,7 @@ class Case:
     omega: float
     n_elements: int
     status: str
+    dt: float = 0.0
     fail_angle_deg: float | None = None
     fail_rev: int | None = None
     angle_deg: np.ndarray | None = None
@@ -315,7 +316,7 @@ def _run_case(model: Model, params: Params, omega: float, n_el: int, alpha: floa
     n_rigid = kernels.slidercrank_axial_force(theta, s, omega, model.r2, model.length, model.rho_a, model.m_s)
     peak_c = max(0.0, float(-n_rigid.min()))
     status = {v: k for k, v in kernels.SLIDERCRANK_STATUS.items()}[res["status"]]
-    case = Case(omega, n_el, status, euler_ratio=peak_c / p_euler, peak_compression=peak_c)
+    case = Case(omega, n_el, status, dt, euler_ratio=peak_c / p_euler, peak_compression=peak_c)
     if status != "ok":
         t_fail = max(res["fail_step"], 0) * dt
         case.fail_angle_deg = math.degrees(omega * t_fail) % 360.0
@@ -567,15 +568,20 @@ def run(params: Params, progress: bool = False) -> Result:
                 failure = f"crank speed {c.omega:g} rad/s, {c.n_elements} elements: {_status_text(c)}"
                 warnings.append(failure)
     le = model.length / max(counts)
-    notes = ["Notes",
-             "  * Strains: element axial strain (u_e - u_e-1)/le (the paper's 'regangan aksial'); tension",
-             "    positive. The peak tensile strain occurs in the crank-end element near theta2 = 0 (rod",
-             "    stretched), the peak compressive strain near theta2 = 180 deg.",
-             "  * The paper publishes figures only; validation is against closed forms (quasi-static",
-             "    limit N(s)/EA, natural frequencies) and the Simeon (1996) benchmark (see tests).",
-             f"  * Time-step criterion: >= {MIN_STEPS_PER_BENDING_PERIOD} steps per period of the first "
-             f"bending mode and >= {MIN_STEPS_PER_REV} per revolution.",
-             "  * Damping is not given in the paper: Rayleigh damping at the first bending and axial modes."]
+    notes = ["Notes"]
+    if params.end_time <= 0:
+        notes += ["  * Strains: element axial strain (u_e - u_e-1)/le (the paper's 'regangan aksial'); tension",
+                  "    positive. The peak tensile strain occurs in the crank-end element near theta2 = 0 (rod",
+                  "    stretched), the peak compressive strain near theta2 = 180 deg.",
+                  "  * The paper publishes figures only; validation is against closed forms (quasi-static",
+                  "    limit N(s)/EA, natural frequencies) and the Simeon (1996) benchmark (see tests).",
+                  "  * Damping is not given in the paper: Rayleigh damping at the first bending and axial modes."]
+    else:
+        notes += [f"  * Benchmark mode: integrated from t = 0 to end_time with the time step {cases[0].dt:.6g} s.",
+                  "  * Midpoint deflection is measured from the chord A-C; elongation is the axial elastic",
+                  "    displacement of the slider end of the rod."]
+    notes.append(f"  * Time-step criterion: >= {MIN_STEPS_PER_BENDING_PERIOD} steps per period of the first "
+                 f"bending mode and >= {MIN_STEPS_PER_REV} per revolution.")
     if le < model.depth:
         notes.append(f"  * Elements ({le * 1e3:.3f} mm) are shorter than the section depth "
                      f"({model.depth * 1e3:g} mm), as in the paper's")

@@ -290,3 +290,20 @@ def test_convergence_monotone_and_below_half_percent_beyond_8(name):
     k8 = counts.index(8)
     assert np.all(np.abs(np.diff(tens) / tens[:-1])[k8:] < 5e-3)
     assert np.all(np.abs(np.diff(comp) / comp[:-1])[k8:] < 5e-3)
+
+
+def test_rest_start_overshoots_then_forgets():
+    """From rest the inertia load is applied suddenly: the crank-end strain overshoots to nearly
+    twice the quasi-static value (step response of a lightly damped oscillator, 1 + exp(-zeta pi)),
+    and after three damped revolutions the last one no longer depends on the start."""
+    rho_a, ea, ei = _rod("aluminium")
+    w, spr, zeta = 29.32, 720, 0.02
+    wb, wa, _ = K.slidercrank_frequencies(rho_a, ea, ei, L, MS)
+    alpha, beta = 2 * zeta * wb * wa / (wb + wa), 2 * zeta / (wb + wa)
+    dt = 2 * math.pi / (w * spr)
+    runs = {st: K.slidercrank_simulate(8, R2, L, rho_a, ea, ei, 1e-3, MS, w, dt, 4 * spr, 0, 4 * spr + 1, alpha, beta,
+                                       start=st)["eps_ax"][0] for st in ("quasistatic", "rest")}
+    qs, rest = runs["quasistatic"], runs["rest"]
+    ratio = rest[:spr].max() / qs[:spr].max()
+    assert 1.8 < ratio <= 1 + math.exp(-zeta * math.pi) + 1e-3
+    assert np.allclose(rest[3 * spr:], qs[3 * spr:], rtol=0, atol=1e-4 * np.abs(qs).max())
