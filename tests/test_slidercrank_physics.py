@@ -169,11 +169,13 @@ def test_quasistatic_limit_of_a_very_stiff_rod():
         assert res["eps_ax"][0, j] == pytest.approx(nbar / (ea * stiff), rel=1e-5)
 
 
-def test_fast_and_general_paths_agree():
+@pytest.mark.parametrize("n", [1, 2, 5, 9])
+def test_fast_and_general_paths_agree(n):
+    """Constant-block Cholesky + Schur complement (fast) vs full banded factorisation every step."""
     rho_a, ea, ei = _rod("medium_carbon_steel")
     w, spr = 25.13, 360
     dt = 2 * math.pi / (w * spr)
-    args = (5, R2, L, rho_a, ea, ei, 1.25e-3, MS, w, dt, 2 * spr, spr, spr + 1, 6.0, 2e-5)
+    args = (n, R2, L, rho_a, ea, ei, 1.25e-3, MS, w, dt, 2 * spr, spr, spr + 1, 6.0, 2e-5)
     a = K.slidercrank_simulate(*args, fast=True)
     b = K.slidercrank_simulate(*args, fast=False)
     for key in ("eps_ax", "eps_of", "mid", "slider"):
@@ -307,3 +309,30 @@ def test_rest_start_overshoots_then_forgets():
     ratio = rest[:spr].max() / qs[:spr].max()
     assert 1.8 < ratio <= 1 + math.exp(-zeta * math.pi) + 1e-3
     assert np.allclose(rest[3 * spr:], qs[3 * spr:], rtol=0, atol=1e-4 * np.abs(qs).max())
+
+
+@pytest.mark.parametrize("name", ["aluminium", "medium_carbon_steel"])
+def test_geometric_stiffness_buckles_at_the_rayleigh_load(name):
+    """At bottom dead centre every acceleration scales with omega^2, so N(s) does too.  The
+    Rayleigh quotient with the pinned-pinned sine mode gives the critical crank speed where the
+    mode-weighted compression 2/L int(-N cos^2(pi s/L)) ds reaches the Euler load; the tangent
+    stiffness K + K_G of the discrete rod must lose definiteness just above it and keep it
+    below (the weighting is nearly exact: N varies by a few per cent along the rod)."""
+    rho_a, ea, ei = _rod(name)
+    w0 = 10.0
+    weighted = 2 / L * quad(lambda s: -axial_force_oracle(s, math.pi, w0, R2, L, rho_a, MS)
+                            * math.cos(math.pi * s / L) ** 2, 0, L)[0]
+    w_crit = w0 * math.sqrt(math.pi ** 2 * ei / L ** 2 / weighted)
+
+    def lowest(w: float) -> float:
+        _, kb = K.slidercrank_matrices(16, R2, L, rho_a, ea, ei, MS, math.pi, w, geometric_stiffness=True)
+        nq = kb.shape[1]
+        k = np.zeros((nq, nq))
+        for d in range(kb.shape[0]):
+            i = np.arange(nq - d)
+            k[i + d, i] = kb[d, : nq - d]
+            k[i, i + d] = kb[d, : nq - d]
+        return float(np.linalg.eigvalsh(k)[0])
+
+    assert lowest(0.99 * w_crit) > 0
+    assert lowest(1.01 * w_crit) < 0
