@@ -262,83 +262,88 @@ contains
 
   !> r = T^T [ Me (T qm - load*ur'') + Ke T qk + Kg(nbar) T qg ] + msl (qm_X - load*A_h) e_X
   !> (the inertia, stiffness and rigid-body load terms of the equation of motion).
-  !> Element by element; the right node's gathered values are reused as the next left node's.
+  !> The mesh is uniform, so the assembled consistent Me and Ke act on interior nodes as
+  !> constant three-node stencils (the sums of the element rows 4-6 of element j and 1-3 of
+  !> element j+1, simplified with the element symmetries); the end nodes take one element.
+  !> The rarely used K_G term is applied element by element.
   subroutine apply_ops(nel, nq, qm, qk, qg, use_g, load, kin, le, me, ke, kg1, nbar, msl, r)
     integer, intent(in) :: nel, nq
     real(dp), intent(in) :: qm(nq), qk(nq), qg(nq), load, kin(7), le
     real(dp), intent(in) :: me(6, 6), ke(6, 6), kg1(6, 6), nbar(nel), msl
     logical, intent(in) :: use_g
     real(dp), intent(out) :: r(nq)
-    integer :: e, j
-    real(dp) :: xm(6), xk(6), xg(6), f(6), c3, s3, w2, th3dd, ua, ub, dua
-    real(dp) :: m11, m14, m44, m22, m23, m25, m26, m33, m35, m36, m55, m56, m66
-    real(dp) :: k11, k22, k23, k33, k36
+    real(dp) :: xu(0:nel), xv(0:nel), xt(0:nel), yu(0:nel), yv(0:nel), yt(0:nel)
+    real(dp) :: xg(6), f(6), c3, s3, w2, th3dd, ru, rv, rt
+    real(dp) :: m11, m14, m22, m23, m25, m26, m33, m35, m36, m56, k11, k22, k23, k33, k36
+    integer :: j, e
     c3 = cos(kin(1))
     s3 = sin(kin(1))
     w2 = kin(2)**2
     th3dd = kin(3)
-    ! element matrix entries (axial/bending blocks are uncoupled; ke has the beam's symmetries)
-    m11 = me(1, 1); m14 = me(1, 4); m44 = me(4, 4)
+    m11 = me(1, 1); m14 = me(1, 4)
     m22 = me(2, 2); m23 = me(2, 3); m25 = me(2, 5); m26 = me(2, 6); m33 = me(3, 3); m35 = me(3, 5)
-    m36 = me(3, 6); m55 = me(5, 5); m56 = me(5, 6); m66 = me(6, 6)
+    m36 = me(3, 6); m56 = me(5, 6)
     k11 = ke(1, 1); k22 = ke(2, 2); k23 = ke(2, 3); k33 = ke(3, 3); k36 = ke(3, 6)
-    r = 0
-    xg = 0
-    ! crank-pin node: u = v = 0, theta = q(1); its rigid acceleration (aA_par, aA_perp, th3'')
-    xm(4:6) = [-load*kin(6), -load*kin(7), qm(1) - load*th3dd]
-    xk(4:6) = [0.0_dp, 0.0_dp, qk(1)]
-    if (use_g) xg(4:6) = [0.0_dp, 0.0_dp, qg(1)]
-    do e = 1, nel
-      xm(1:3) = xm(4:6)
-      xk(1:3) = xk(4:6)
-      if (use_g) xg(1:3) = xg(4:6)
-      ua = load*(kin(6) - e*le*w2)
-      ub = load*(kin(7) + e*le*th3dd)
-      if (e < nel) then
-        j = 3*e - 1
-        xm(4) = qm(j) - ua
-        xm(5) = qm(j + 1) - ub
-        xm(6) = qm(j + 2) - load*th3dd
-        xk(4:6) = qk(j:j + 2)
-        if (use_g) xg(4:6) = qg(j:j + 2)
-      else
-        xm(4) = c3*qm(nq) - ua
-        xm(5) = -s3*qm(nq) - ub
-        xm(6) = qm(nq - 1) - load*th3dd
-        xk(4:6) = [c3*qk(nq), -s3*qk(nq), qk(nq - 1)]
-        if (use_g) xg(4:6) = [c3*qg(nq), -s3*qg(nq), qg(nq - 1)]
-      end if
-      dua = xk(4) - xk(1)
-      f(1) = m11*xm(1) + m14*xm(4) - k11*dua
-      f(4) = m14*xm(1) + m44*xm(4) + k11*dua
-      f(2) = m22*xm(2) + m23*xm(3) + m25*xm(5) + m26*xm(6) &
-             + k22*(xk(2) - xk(5)) + k23*(xk(3) + xk(6))
-      f(5) = m25*xm(2) - m26*xm(3) + m55*xm(5) + m56*xm(6) &
-             - k22*(xk(2) - xk(5)) - k23*(xk(3) + xk(6))
-      f(3) = m23*xm(2) + m33*xm(3) + m35*xm(5) + m36*xm(6) &
-             + k23*(xk(2) - xk(5)) + k33*xk(3) + k36*xk(6)
-      f(6) = m26*xm(2) + m36*xm(3) + m56*xm(5) + m66*xm(6) &
-             + k23*(xk(2) - xk(5)) + k36*xk(3) + k33*xk(6)
-      if (use_g) f = f + nbar(e)*matmul(kg1, xg)
-      if (e == 1) then
-        r(1) = r(1) + f(3)
-      else
-        j = 3*e - 4
-        r(j) = r(j) + f(1)
-        r(j + 1) = r(j + 1) + f(2)
-        r(j + 2) = r(j + 2) + f(3)
-      end if
-      if (e < nel) then
-        j = 3*e - 1
-        r(j) = r(j) + f(4)
-        r(j + 1) = r(j + 1) + f(5)
-        r(j + 2) = r(j + 2) + f(6)
-      else
-        r(nq) = r(nq) + c3*f(4) - s3*f(5)
-        r(nq - 1) = r(nq - 1) + f(6)
-      end if
+    ! nodal values in rod axes; x = T qm - load * rigid acceleration, y = T qk
+    xu(0) = 0; xv(0) = 0; xt(0) = qm(1)
+    yu(0) = 0; yv(0) = 0; yt(0) = qk(1)
+    do j = 1, nel - 1
+      xu(j) = qm(3*j - 1); xv(j) = qm(3*j); xt(j) = qm(3*j + 1)
+      yu(j) = qk(3*j - 1); yv(j) = qk(3*j); yt(j) = qk(3*j + 1)
     end do
-    r(nq) = r(nq) + msl*(qm(nq) - load*kin(5))
+    xu(nel) = c3*qm(nq); xv(nel) = -s3*qm(nq); xt(nel) = qm(nq - 1)
+    yu(nel) = c3*qk(nq); yv(nel) = -s3*qk(nq); yt(nel) = qk(nq - 1)
+    if (abs(load) > 0) then
+      do j = 0, nel
+        xu(j) = xu(j) - load*(kin(6) - j*le*w2)
+        xv(j) = xv(j) - load*(kin(7) + j*le*th3dd)
+        xt(j) = xt(j) - load*th3dd
+      end do
+    end if
+    ! crank-pin node: only its rotation is free (row 3 of element 1)
+    r(1) = m23*xv(0) + m33*xt(0) + m35*xv(1) + m36*xt(1) + k23*(yv(0) - yv(1)) + k33*yt(0) + k36*yt(1)
+    do j = 1, nel - 1
+      r(3*j - 1) = m14*(xu(j - 1) + xu(j + 1)) + 2*m11*xu(j) + k11*(2*yu(j) - yu(j - 1) - yu(j + 1))
+      r(3*j) = m25*(xv(j - 1) + xv(j + 1)) + m26*(xt(j + 1) - xt(j - 1)) + 2*m22*xv(j) &
+               + k22*(2*yv(j) - yv(j - 1) - yv(j + 1)) + k23*(yt(j + 1) - yt(j - 1))
+      r(3*j + 1) = m26*(xv(j - 1) - xv(j + 1)) + m36*(xt(j - 1) + xt(j + 1)) + 2*m33*xt(j) &
+                   + k23*(yv(j - 1) - yv(j + 1)) + k36*(yt(j - 1) + yt(j + 1)) + 2*k33*yt(j)
+    end do
+    ! slider node: rows 4-6 of element nel, rotated onto U_X
+    j = nel
+    ru = m14*xu(j - 1) + m11*xu(j) + k11*(yu(j) - yu(j - 1))
+    rv = m25*xv(j - 1) + m35*xt(j - 1) + m22*xv(j) + m56*xt(j) - k22*(yv(j - 1) - yv(j)) - k23*(yt(j - 1) + yt(j))
+    rt = m26*xv(j - 1) + m36*xt(j - 1) + m56*xv(j) + m33*xt(j) + k23*(yv(j - 1) - yv(j)) + k36*yt(j - 1) &
+         + k33*yt(j)
+    r(nq) = c3*ru - s3*rv + msl*(qm(nq) - load*kin(5))
+    r(nq - 1) = rt
+    if (use_g) then
+      do e = 1, nel
+        j = e - 1
+        if (j == 0) then
+          xg(1:3) = [0.0_dp, 0.0_dp, qg(1)]
+        else
+          xg(1:3) = qg(3*j - 1:3*j + 1)
+        end if
+        if (e == nel) then
+          xg(4:6) = [c3*qg(nq), -s3*qg(nq), qg(nq - 1)]
+        else
+          xg(4:6) = qg(3*e - 1:3*e + 1)
+        end if
+        f = nbar(e)*matmul(kg1, xg)
+        if (j == 0) then
+          r(1) = r(1) + f(3)
+        else
+          r(3*j - 1:3*j + 1) = r(3*j - 1:3*j + 1) + f(1:3)
+        end if
+        if (e == nel) then
+          r(nq) = r(nq) + c3*f(4) - s3*f(5)
+          r(nq - 1) = r(nq - 1) + f(6)
+        else
+          r(3*e - 1:3*e + 1) = r(3*e - 1:3*e + 1) + f(4:6)
+        end if
+      end do
+    end if
   end subroutine apply_ops
 
   ! ------------------------------------------------------------------ banded Cholesky
