@@ -173,3 +173,19 @@ def test_simeon_deck_end_state(tmp_path):
 def test_progress_bar_quiet_when_disabled(tmp_path, capsys):
     run(_params(tmp_path, SMALL), progress=False)
     assert capsys.readouterr().err == ""
+
+
+def test_deck_keys_override_the_named_material(tmp_path):
+    text = SMALL.replace("material = 'aluminium'", "material = 'aluminium', second_moment = 1.8225e-10") \
+        .replace("steps_per_rev = 360", "steps_per_rev = 1000")     # stiffer in bending: finer steps
+    res = run(_params(tmp_path, text))
+    line = next(l for l in res.text.splitlines() if "second moment I" in l)
+    assert "1.8225e-10" in line and "(deck)" in line
+    assert "(Table 1a)" in next(l for l in res.text.splitlines() if "section area A" in l)
+    # 9 x 3 mm bar turned strong axis in plane (I = 3 * 9^3 / 12 mm^4): Euler load 81 times larger
+    assert res.summary["euler_ratio_2"] < 0.02
+
+
+def test_progress_bar_runs_when_enabled(tmp_path, capsys):
+    run(_params(tmp_path, SMALL), progress=True)
+    assert "slidercrank" in capsys.readouterr().err
