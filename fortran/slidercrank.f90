@@ -438,48 +438,28 @@ contains
     integer, intent(in) :: n
     real(dp), intent(in) :: d(n), lf(kd, n), lb(kd, n)
     real(dp), intent(inout) :: b(n)
-    integer :: j
+    integer :: j, i, m
     real(dp) :: t
-    if (n <= kd) then
-      do j = 1, n
-        t = d(j)*b(j)
-        if (j > 4) t = t - lf(4, j)*b(j - 4)
-        if (j > 3) t = t - lf(3, j)*b(j - 3)
-        if (j > 2) t = t - lf(2, j)*b(j - 2)
-        if (j > 1) t = t - lf(1, j)*b(j - 1)
-        b(j) = t
-      end do
-      do j = n, 1, -1
-        t = d(j)*b(j)
-        if (j + 4 <= n) t = t - lb(4, j)*b(j + 4)
-        if (j + 3 <= n) t = t - lb(3, j)*b(j + 3)
-        if (j + 2 <= n) t = t - lb(2, j)*b(j + 2)
-        if (j + 1 <= n) t = t - lb(1, j)*b(j + 1)
-        b(j) = t
-      end do
-      return
-    end if
-    do j = 1, kd
+    m = min(kd, n)
+    do j = 1, m                    ! head rows: fewer than kd neighbours, furthest first
       t = d(j)*b(j)
-      if (j > 4) t = t - lf(4, j)*b(j - 4)
-      if (j > 3) t = t - lf(3, j)*b(j - 3)
-      if (j > 2) t = t - lf(2, j)*b(j - 2)
-      if (j > 1) t = t - lf(1, j)*b(j - 1)
+      do i = j - 1, 1, -1
+        t = t - lf(i, j)*b(j - i)
+      end do
       b(j) = t
     end do
-    do j = kd + 1, n
+    do j = m + 1, n
       b(j) = ((((d(j)*b(j) - lf(5, j)*b(j - 5)) - lf(4, j)*b(j - 4)) - lf(3, j)*b(j - 3)) &
               - lf(2, j)*b(j - 2)) - lf(1, j)*b(j - 1)
     end do
-    do j = n, n - kd + 1, -1
+    do j = n, n - m + 1, -1        ! tail rows of the back substitution
       t = d(j)*b(j)
-      if (j + 4 <= n) t = t - lb(4, j)*b(j + 4)
-      if (j + 3 <= n) t = t - lb(3, j)*b(j + 3)
-      if (j + 2 <= n) t = t - lb(2, j)*b(j + 2)
-      if (j + 1 <= n) t = t - lb(1, j)*b(j + 1)
+      do i = n - j, 1, -1
+        t = t - lb(i, j)*b(j + i)
+      end do
       b(j) = t
     end do
-    do j = n - kd, 1, -1
+    do j = n - m, 1, -1
       b(j) = ((((d(j)*b(j) - lb(5, j)*b(j + 5)) - lb(4, j)*b(j + 4)) - lb(3, j)*b(j + 3)) &
               - lb(2, j)*b(j + 2)) - lb(1, j)*b(j + 1)
     end do
@@ -643,7 +623,11 @@ contains
       end if
       call quasi_static_solve(nel, nq, r2, rl, rhoa, msl, omega, le, use_g, me, ke, kg1, zero, at, &
                               info, h, qd)
-      if (info /= 0) return
+      if (info /= 0) then
+        status = merge(st_buckled, st_not_spd, use_g)
+        fail_step = 0
+        return
+      end if
       qd = (qd - tmp)/(2*h)
       call quasi_static_solve(nel, nq, r2, rl, rhoa, msl, omega, le, use_g, me, ke, kg1, zero, at, &
                               info, 0.0_dp, q)
@@ -829,12 +813,12 @@ contains
       eps_of(ee, j) = abs(ep) + half_depth*abs(ka)
     end do
     do ee = 1, nel, max(1, nel - 1)      ! the two end elements (one when nel = 1)
-      if (ee == 1) then
-        ua = 0
-        ta = q(1)
-      else
-        ua = q(3*ee - 4)
-        ta = q(3*ee - 2)
+      ua = 0
+      ta = q(1)
+      if (ee > 1) then
+        m = 3*ee - 4
+        ua = q(m)
+        ta = q(m + 2)
       end if
       if (ee == nel) then
         ub = cc*q(nq)
