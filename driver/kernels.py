@@ -15,7 +15,9 @@ __all__ = ["farray", "fourbar_listing", "fourbar_exact", "FOURBAR_STATUS",
            "MANIPULATOR_STATUS", "manipulator_arm_states", "manipulator_torques", "manipulator_ik",
            "manipulator_design_indices", "manipulator_position_errors",
            "UJOINT_MODELS", "UJOINT_OBJECTIVES", "ujoint_speed", "ujoint_objective",
-           "ujoint_equivalent", "ujoint_geometry"]
+           "ujoint_equivalent", "ujoint_geometry",
+           "SLIDERCRANK_STATUS", "slidercrank_simulate", "slidercrank_matrices", "slidercrank_rigid",
+           "slidercrank_axial_force", "slidercrank_frequencies"]
 
 
 def farray(x, ndim: int | None = None) -> np.ndarray:
@@ -220,3 +222,86 @@ def ujoint_geometry(axes) -> tuple[np.ndarray, np.ndarray, int]:
     a = farray(np.asarray(axes, dtype=np.float64).T, 2)
     beta, rho, status = _kernels.ujoint.chain_geometry(a)
     return beta, rho, int(status)
+
+
+
+# ----------------------------------------------------------------------------- slidercrank
+
+#: status codes of the slider-crank kernel (fortran/slidercrank.f90)
+SLIDERCRANK_STATUS = {"ok": int(_kernels.slidercrank.st_ok), "buckled": int(_kernels.slidercrank.st_buckled),
+                      "diverged": int(_kernels.slidercrank.st_diverged),
+                      "not_spd": int(_kernels.slidercrank.st_not_spd),
+                      "bad_args": int(_kernels.slidercrank.st_bad_args)}
+_SC_START = {"rest": 0, "quasistatic": 1, "given": 2}
+
+
+def slidercrank_simulate(n_elements: int, crank_radius: float, rod_length: float, rho_a: float,
+                         ea: float, ei: float, half_depth: float, slider_mass: float, omega: float,
+                         dt: float, n_steps: int, rec_start: int, n_rec: int, alpha: float = 0.0,
+                         beta: float = 0.0, start: str = "quasistatic", dynamic: bool = True,
+                         geometric_stiffness: bool = False, fast: bool = True,
+                         q_init: np.ndarray | None = None, qd_init: np.ndarray | None = None) -> dict:
+    """Elastic connecting rod of a slider-crank, whole time loop in Fortran.
+
+    SI units: lengths [m], rho_a mass per length [kg/m], ea [N], ei [N m^2], masses [kg],
+    omega crank speed [rad/s] (theta2 = omega t from 0), dt [s].  alpha [1/s] and beta [s]
+    are the Rayleigh coefficients (C = alpha M + beta K).  start: 'rest', 'quasistatic' or
+    'given' (q_init, qd_init in the kernel's q ordering, 3*n_elements values [m, rad]).
+    Records steps rec_start .. rec_start + n_rec - 1 (step 0 is the start).
+
+    Returns a dict: eps_ax, eps_of (n_elements, n_rec) axial and outer-fibre strain [-];
+    n_avg (n_elements, n_rec) element-averaged rigid-body axial force [N]; mid midpoint
+    deflection from the chord [m]; slider position [m]; elong rod elongation [m];
+    q_end, qd_end final state; status (a SLIDERCRANK_STATUS value) and fail_step.
+    """
+    nq = 3 * int(n_elements)
+    q0 = farray(np.zeros(nq) if q_init is None else q_init, 1)
+    qd0 = farray(np.zeros(nq) if qd_init is None else qd_init, 1)
+    out = _kernels.slidercrank.simulate(
+        int(n_elements), int(n_rec), crank_radius, rod_length, rho_a, ea, ei, half_depth, slider_mass,
+        omega, dt, int(n_steps), int(rec_start), alpha, beta, _SC_START[start], int(bool(dynamic)),
+        int(bool(geometric_stiffness)), int(bool(fast)), q0, qd0)
+    names = ("eps_ax", "eps_of", "n_avg", "mid", "slider", "elong", "q_end", "qd_end", "status", "fail_step")
+    res = dict(zip(names, out))
+    res["status"], res["fail_step"] = int(res["status"]), int(res["fail_step"])
+    return res
+
+
+def slidercrank_matrices(n_elements: int, crank_radius: float, rod_length: float, rho_a: float,
+                         ea: float, ei: float, slider_mass: float, theta2: float, omega: float = 0.0,
+                         geometric_stiffness: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Banded mass and stiffness (LAPACK lower storage, shape (6, 3 n)) at crank angle theta2 [rad].
+
+    The mass includes the slider mass on U_X; with geometric_stiffness the stiffness includes
+    K_G of the rigid-body axial force at crank speed omega [rad/s].
+    """
+    mb, kb = _kernels.slidercrank.assemble_matrices(
+        int(n_elements), 3 * int(n_elements), crank_radius, rod_length, rho_a, ea, ei, slider_mass,
+        theta2, omega, int(bool(geometric_stiffness)))
+    return mb, kb
+
+
+def slidercrank_rigid(theta2: np.ndarray, omega: float, crank_radius: float, rod_length: float) -> np.ndarray:
+    """Rigid kinematics at crank angles theta2 [rad], constant crank speed omega [rad/s]: (n, 7).
+
+    Columns: theta3 [rad], theta3' [rad/s], theta3'' [rad/s^2], slider position x4 [m],
+    slider acceleration A_h [m/s^2], crank-pin acceleration along and across the rod [m/s^2].
+    """
+    theta2 = farray(np.atleast_1d(theta2), 1)
+    return _kernels.slidercrank.rigid_states(theta2, omega, crank_radius, rod_length)
+
+
+def slidercrank_axial_force(theta2: np.ndarray, s: np.ndarray, omega: float, crank_radius: float,
+                            rod_length: float, rho_a: float, slider_mass: float) -> np.ndarray:
+    """Rigid-body axial force N [N] (tension positive) at stations s [m]: shape (len(s), len(theta2))."""
+    theta2 = farray(np.atleast_1d(theta2), 1)
+    s = farray(np.atleast_1d(s), 1)
+    return _kernels.slidercrank.axial_force_at(theta2, s, omega, crank_radius, rod_length, rho_a, slider_mass)
+
+
+def slidercrank_frequencies(rho_a: float, ea: float, ei: float, rod_length: float,
+                            slider_mass: float) -> tuple[float, float, float]:
+    """Closed forms: first bending (pinned-pinned) and first axial (fixed / slider mass) natural
+    frequencies [rad/s], and the pinned-pinned Euler load pi^2 EI / L^2 [N]."""
+    wb, wa, pe = _kernels.slidercrank.analytic_frequencies(rho_a, ea, ei, rod_length, slider_mass)
+    return float(wb), float(wa), float(pe)

@@ -246,3 +246,40 @@ def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.
         axes[0].legend(fontsize=7, loc="lower left", bbox_to_anchor=(-0.1, -0.15))
     fig.suptitle("Hooke-joint chain: input and output shaft speed")
     return fig
+
+
+# ----------------------------------------------------------------------------- slidercrank
+
+
+def slidercrank_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray]], title: str,
+                              ylabel: str = "axial strain [microstrain]") -> Figure:
+    """A quantity against crank angle [deg], one line per case (label, angle, value): Figure 10."""
+    fig, axes = new_figure(1, 1, figsize=(7.0, 3.6))
+    ax = axes[0]
+    for label, x, y in series:
+        ax.plot(x, y, label=label, lw=1.2)
+    ax.axhline(0.0, color="k", lw=0.6)
+    ax.set_xlim(0, 360)
+    ax.set_xticks(np.arange(0, 361, 45))
+    ax.set_xlabel("crank angle theta2 [deg]")
+    ax.set_ylabel(ylabel)
+    ax.legend(fontsize=7, loc="best")
+    ax.set_title(title)
+    return fig
+
+
+def slidercrank_convergence_figure(series: dict[str, tuple[list[int], list[float]]], title: str) -> Figure:
+    """Peak strain against element count and its percentage change (the paper's Figures 8-9)."""
+    fig, axes = new_figure(2, 1, sharex=True, figsize=(7.0, 5.0))
+    for label, (n, peak) in series.items():
+        n, peak = np.asarray(n, dtype=float), np.asarray(peak, dtype=float)
+        axes[0].plot(n, peak, "o-", ms=3, label=label)
+        if n.size > 1:
+            axes[1].plot(n[1:], 100 * np.diff(peak) / peak[:-1], "o-", ms=3, label=label)
+    axes[0].set_xscale("log")
+    axes[0].set_ylabel("peak tensile strain [microstrain]")
+    axes[1].set_ylabel("change from previous count [%]")
+    axes[1].set_xlabel("number of elements")
+    axes[0].legend(fontsize=7)
+    fig.suptitle(title)
+    return fig

@@ -1,0 +1,615 @@
+"""Slider-crank with an elastic connecting rod (seed 003, Univ. Andalas): the &slidercrank study.
+
+Rigid crank, elastic rod meshed with frame elements, slider on its guide; kineto-elastodynamic
+(KED) finite-element model integrated with Newmark's average-acceleration rule.  The physics
+(kinematics, rigid-body axial force, element matrices, banded Cholesky, the whole time loop)
+lives in ``fortran/slidercrank.f90``; this module validates the deck, runs the cases, and
+writes the paper's results: peak axial strain per crank speed, strain of the crank-end
+element against crank angle (Figure 10), the element-convergence study (Figures 8-9), the
+Euler-load ratio of every case and, with geometric stiffness, buckling.
+
+Units in decks: SI (m, kg, Pa, rad/s, s).  Strains are reported in microstrain.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from tqdm import tqdm
+
+from driver import kernels
+from driver.deck import GroupSpec, Key, Params, non_negative, positive
+from driver.study import Figure, Result
+from driver.table import Column, render_table
+
+__all__ = ["SPEC", "run", "MATERIALS", "PAPER_SPEEDS", "SIMEON1996", "simeon_initial_state",
+           "min_steps_per_rev", "rayleigh"]
+
+#: Table 1a of the paper (columns re-ordered as in the study note, section 1.1); the depth is the
+#: in-plane section depth used for the outer-fibre strain (weak axis in plane).
+MATERIALS: dict[str, dict[str, Any]] = {
+    "aluminium": dict(area=27e-6, second_moment=2.025e-11, density=2660.0, youngs_modulus=7.17e10,
+                      section_depth=3.0e-3, section="rectangle 9 x 3 mm, weak axis in plane"),
+    "medium_carbon_steel": dict(area=22.5e-6, second_moment=1.1718e-11, density=7800.0,
+                                youngs_modulus=20.68e10, section_depth=2.5e-3,
+                                section="rectangle 9 x 2.5 mm, weak axis in plane"),
+    "low_carbon_steel": dict(area=7.8965e-5, second_moment=4.9620e-10, density=7800.0,
+                             youngs_modulus=18.96e10, section_depth=10.03e-3,
+                             section="round bar D = 10.03 mm"),
+}
+SECTION_KEYS = ("area", "second_moment", "density", "youngs_modulus", "section_depth")
+#: the paper's six crank speeds [rad/s]
+PAPER_SPEEDS = (11.52, 14.66, 18.85, 21.99, 25.13, 29.32)
+#: time-step criterion: steps per period of the first bending mode, and per revolution
+MIN_STEPS_PER_BENDING_PERIOD = 20
+MIN_STEPS_PER_REV = 36
+EULER_WARN = 0.8
+MAX_ELEMENTS = 5000
+
+#: Simeon (1996) / IVP test set "crank": published initial values (ini = 1, consistent) of the
+#: modal coordinates q1, q2 (lateral sin(pi x), sin(2 pi x)), q3, q4 (axial, quadratic: midpoint
+#: and end node) and their rates, and the reference solution at t = 0.1 s (MEBDFI, tol 1e-14).
+SIMEON1996 = {
+    "crank_radius": 0.15, "rod_length": 0.30, "speed": 150.0,
+    "q0": (0.0, 0.0, 0.103339863e-04, 0.169327969e-04),
+    "qd0": (0.444896105, 0.463434311e-02, -0.178591076e-05, -0.268938672e-05),
+    "t": 0.1, "q1": 1.893192899613509e-4, "q4": -8.363313279112129e-6,
+    "x3": 0.1697373, "phi2": -0.3311735,
+}
+
+
+def _valid_count(v: Any) -> str | None:
+    vals = v if isinstance(v, list) else [v]
+    bad = [x for x in vals if not 1 <= x <= MAX_ELEMENTS]
+    return f"must be between 1 and {MAX_ELEMENTS} elements (got {bad[0]})" if bad else None
+
+
+def _damping(v: float) -> str | None:
+    return None if 0 <= v < 1 else f"must be a fraction in [0, 1), e.g. 0.02 for 2 % (got {v})"
+
+
+def _revs(v: int) -> str | None:
+    return None if 1 <= v <= 1000 else f"must be between 1 and 1000 (got {v})"
+
+
+_SECTION_DOC = "(default: from the named material's Table 1a column)"
+
+_KEYS: dict[str, Key] = {
+    "material": Key("str", default="custom", choices=("custom",) + tuple(MATERIALS),
+                    doc="named rod of Table 1a (fills area, second_moment, density, youngs_modulus, "
+                        "section_depth; keys given in the deck override it)"),
+    "crank_radius": Key("float", default=0.125, check=positive, units="m", doc="r2 (Table 1b)"),
+    "rod_length": Key("float", default=0.505, check=positive, units="m", doc="L3 (Table 1a)"),
+    "area": Key("float", check=positive, units="m^2", doc=f"rod section area {_SECTION_DOC}"),
+    "second_moment": Key("float", check=positive, units="m^4",
+                         doc=f"in-plane second moment of area {_SECTION_DOC}"),
+    "density": Key("float", check=positive, units="kg/m^3", doc=_SECTION_DOC),
+    "youngs_modulus": Key("float", check=positive, units="Pa", doc=_SECTION_DOC),
+    "section_depth": Key("float", check=positive, units="m",
+                         doc=f"in-plane depth; outer fibre at depth/2 {_SECTION_DOC}"),
+    "slider_mass": Key("float", default=0.9, check=positive, units="kg", doc="M (Table 1b)"),
+    "bearing_mass_crank": Key("float", default=0.05, check=non_negative, units="kg",
+                              doc="m_B at the crank pin (prescribed motion: does not load the rod)"),
+    "bearing_mass_slider": Key("float", default=0.05, check=non_negative, units="kg",
+                               doc="m_C, lumped with the slider on the guide"),
+    "speeds": Key("floats", required=True, check=positive, units="rad/s",
+                  doc="crank speeds; the paper's: 11.52, 14.66, 18.85, 21.99, 25.13, 29.32"),
+    "n_elements": Key("int", default=700, check=_valid_count, doc="rod elements (the paper: 700)"),
+    "element_counts": Key("ints", default=None, check=_valid_count,
+                          doc="convergence study: element counts to run (e.g. 1, 2, 4, ..., 700)"),
+    "steps_per_rev": Key("int", default=1440, check=positive, doc="time steps per crank revolution"),
+    "revolutions": Key("int", default=4, check=_revs, doc="revolutions run; the last one is reported"),
+    "damping_ratio": Key("float", default=0.02, check=_damping,
+                         doc="Rayleigh damping ratio at the first bending and first axial modes"),
+    "start": Key("str", default="quasistatic", choices=("quasistatic", "rest", "simeon1996"),
+                 doc="initial state: quasi-static solution, rest, or the Simeon (1996) benchmark's "
+                     "published initial values"),
+    "analysis": Key("str", default="dynamic", choices=("dynamic", "quasistatic"),
+                    doc="Newmark integration, or quasi-static K u = Q at every step"),
+    "geometric_stiffness": Key("bool", default=False,
+                               doc="add K_G of the rigid-body axial force; report buckling"),
+    "end_time": Key("float", default=0.0, check=non_negative, units="s",
+                    doc="> 0: integrate from t = 0 to this time and report the end state "
+                        "(benchmark mode, one speed) instead of the last revolution"),
+    "benchmark": Key("str", default="none", choices=("none", "simeon1996"),
+                     doc="compare the end state with a published reference solution"),
+}
+
+
+# --------------------------------------------------------------------------- model
+
+
+@dataclass
+class Model:
+    """The rod and mechanism in SI units, with derived constants."""
+
+    r2: float
+    length: float
+    area: float
+    inertia: float
+    density: float
+    modulus: float
+    depth: float
+    slider_mass: float
+    bearing_crank: float
+    bearing_slider: float
+    sources: dict[str, str] = field(default_factory=dict)
+
+    @property
+    def rho_a(self) -> float:
+        return self.density * self.area
+
+    @property
+    def ea(self) -> float:
+        return self.modulus * self.area
+
+    @property
+    def ei(self) -> float:
+        return self.modulus * self.inertia
+
+    @property
+    def m_s(self) -> float:
+        """Mass on the guide: slider + its bearing [kg]."""
+        return self.slider_mass + self.bearing_slider
+
+    def frequencies(self) -> tuple[float, float, float]:
+        """First bending, first axial frequency [rad/s] and Euler load [N] (closed forms, kernel)."""
+        return kernels.slidercrank_frequencies(self.rho_a, self.ea, self.ei, self.length, self.m_s)
+
+
+def _model(params: Params) -> Model:
+    values, sources = {}, {}
+    table = MATERIALS.get(params.material, {})
+    for key in SECTION_KEYS:
+        if key in params.given and params[key] is not None:
+            values[key], sources[key] = params[key], "deck"
+        elif key in table:
+            values[key], sources[key] = table[key], "Table 1a"
+        else:
+            raise params.error(key, f"missing: give {key} or name a material "
+                                    f"({', '.join(repr(m) for m in MATERIALS)})")
+    return Model(params.crank_radius, params.rod_length, values["area"], values["second_moment"],
+                 values["density"], values["youngs_modulus"], values["section_depth"], params.slider_mass,
+                 params.bearing_mass_crank, params.bearing_mass_slider, sources)
+
+
+def rayleigh(zeta: float, w1: float, w2: float) -> tuple[float, float]:
+    """Rayleigh coefficients (alpha [1/s], beta [s]) giving ratio zeta at w1 and w2 [rad/s]."""
+    return 2 * zeta * w1 * w2 / (w1 + w2), 2 * zeta / (w1 + w2)
+
+
+def min_steps_per_rev(omega: float, w_bend: float) -> int:
+    """Fewest steps per revolution at crank speed omega [rad/s] for the time-step criterion.
+
+    Newmark's average-acceleration rule is unconditionally stable but lengthens periods by
+    about (w dt)^2 / 12: 20 steps per period of the first bending mode w_bend keep that error
+    below 1 %.  Steps per bending period = steps_per_rev * omega / w_bend.
+    """
+    return max(MIN_STEPS_PER_REV, math.ceil(MIN_STEPS_PER_BENDING_PERIOD * w_bend / omega))
+
+
+def _cross_check(params: Params) -> None:
+    model = _model(params)
+    if model.r2 >= model.length:
+        raise params.error("crank_radius", f"crank radius {model.r2:g} m is not shorter than the rod "
+                                           f"({model.length:g} m): the slider-crank cannot turn; "
+                                           "crank_radius must be < rod_length")
+    w_bend, _, _ = model.frequencies()
+    for omega in params.speeds:
+        need = min_steps_per_rev(omega, w_bend)
+        if params.steps_per_rev < need:
+            per = params.steps_per_rev * omega / w_bend
+            raise params.error(
+                "steps_per_rev",
+                f"time step too coarse: {params.steps_per_rev} steps per revolution at {omega:g} rad/s "
+                f"give {per:.1f} steps per period of the first bending mode ({w_bend:.1f} rad/s); "
+                f"the Newmark average-acceleration rule needs at least {MIN_STEPS_PER_BENDING_PERIOD} "
+                f"(period error < 1 %) and at least {MIN_STEPS_PER_REV} per revolution: use "
+                f"steps_per_rev >= {need}")
+    if params.end_time > 0 and len(params.speeds) != 1:
+        raise params.error("end_time", "benchmark mode (end_time > 0) runs one crank speed; "
+                                       f"speeds lists {len(params.speeds)}")
+    if params.end_time > 0 and params.element_counts:
+        raise params.error("element_counts", "a convergence study reports last revolutions; "
+                                             "remove element_counts or end_time")
+    if params.start == "simeon1996" or params.benchmark == "simeon1996":
+        key = "start" if params.start == "simeon1996" else "benchmark"
+        ref = SIMEON1996
+        if not (math.isclose(model.r2, ref["crank_radius"]) and math.isclose(model.length, ref["rod_length"])
+                and all(math.isclose(w, ref["speed"]) for w in params.speeds)):
+            raise params.error(key, "the Simeon (1996) benchmark needs crank_radius = 0.15 m, "
+                                    "rod_length = 0.30 m and speeds = 150 rad/s")
+        if params.benchmark == "simeon1996" and params.end_time <= 0:
+            raise params.error("end_time", "benchmark 'simeon1996' compares the state at end_time; "
+                                           "set end_time = 0.1")
+
+
+SPEC = GroupSpec("slidercrank", _KEYS,
+                 "slider-crank with a rigid crank and an elastic connecting rod (KED finite elements, Newmark)",
+                 check=_cross_check)
+
+
+def simeon_initial_state(n_elements: int, length: float) -> tuple[np.ndarray, np.ndarray]:
+    """Simeon's published initial modal values mapped onto the FE nodes (kernel q ordering).
+
+    Lateral v(x) = q1 sin(pi x/L) + q2 sin(2 pi x/L) with rotations v'(x); axial u(x) the
+    quadratic through (0, 0), (L/2, q3), (L, q4); the slider's U_X = q4 (theta3 = 0 at t = 0).
+    """
+    x = np.linspace(0.0, 1.0, n_elements + 1)
+
+    def nodal(q: tuple[float, ...]) -> np.ndarray:
+        v = q[0] * np.sin(np.pi * x) + q[1] * np.sin(2 * np.pi * x)
+        th = (q[0] * np.pi * np.cos(np.pi * x) + q[1] * 2 * np.pi * np.cos(2 * np.pi * x)) / length
+        u = q[2] * 4 * x * (1 - x) + q[3] * x * (2 * x - 1)
+        out = np.zeros(3 * n_elements)
+        out[0] = th[0]
+        inner = np.column_stack([u[1:-1], v[1:-1], th[1:-1]]).ravel()
+        out[1:1 + inner.size] = inner
+        out[-2], out[-1] = th[-1], u[-1]
+        return out
+
+    return nodal(SIMEON1996["q0"]), nodal(SIMEON1996["qd0"])
+
+
+# --------------------------------------------------------------------------- cases
+
+
+@dataclass
+class Case:
+    """One run: crank speed, element count and its last-revolution (or end-state) results."""
+
+    omega: float
+    n_elements: int
+    status: str
+    dt: float = 0.0
+    fail_angle_deg: float | None = None
+    fail_rev: int | None = None
+    angle_deg: np.ndarray | None = None
+    time: np.ndarray | None = None
+    eps_ax: np.ndarray | None = None
+    eps_of: np.ndarray | None = None
+    n_avg: np.ndarray | None = None
+    mid: np.ndarray | None = None
+    slider: np.ndarray | None = None
+    elong: np.ndarray | None = None
+    euler_ratio: float = 0.0
+    peak_compression: float = 0.0
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "ok"
+
+    def peak(self, sign: int) -> tuple[float, float, int]:
+        """Peak tensile (sign=+1) or compressive (-1) axial strain [-], crank angle [deg], element."""
+        flat = np.argmax(sign * self.eps_ax)
+        e, j = np.unravel_index(flat, self.eps_ax.shape)
+        return float(self.eps_ax[e, j]), float(self.angle_deg[j] % 360.0), int(e) + 1
+
+
+def _run_case(model: Model, params: Params, omega: float, n_el: int, alpha: float, beta: float,
+              p_euler: float) -> Case:
+    spr = params.steps_per_rev
+    dt = 2 * math.pi / (omega * spr)
+    if params.end_time > 0:
+        n_steps = max(1, round(params.end_time / dt))
+        dt = params.end_time / n_steps
+        rec_start, n_rec = n_steps, 1
+    else:
+        n_steps = params.revolutions * spr
+        rec_start, n_rec = (params.revolutions - 1) * spr, spr + 1
+    q0 = qd0 = None
+    start = params.start
+    if start == "simeon1996":
+        q0, qd0 = simeon_initial_state(n_el, model.length)
+        start = "given"
+    res = kernels.slidercrank_simulate(
+        n_el, model.r2, model.length, model.rho_a, model.ea, model.ei, model.depth / 2, model.m_s, omega,
+        dt, n_steps, rec_start, n_rec, alpha, beta, start=start, dynamic=params.analysis == "dynamic",
+        geometric_stiffness=params.geometric_stiffness, q_init=q0, qd_init=qd0)
+    steps = rec_start + np.arange(n_rec)
+    theta = omega * dt * steps
+    # peak rod compression from rigid-body statics over the reported revolution (N is quadratic in s)
+    s = np.linspace(0.0, model.length, 41)
+    n_rigid = kernels.slidercrank_axial_force(theta, s, omega, model.r2, model.length, model.rho_a, model.m_s)
+    peak_c = max(0.0, float(-n_rigid.min()))
+    status = {v: k for k, v in kernels.SLIDERCRANK_STATUS.items()}[res["status"]]
+    case = Case(omega, n_el, status, dt, euler_ratio=peak_c / p_euler, peak_compression=peak_c)
+    if status != "ok":
+        t_fail = max(res["fail_step"], 0) * dt
+        case.fail_angle_deg = math.degrees(omega * t_fail) % 360.0
+        case.fail_rev = int(omega * t_fail // (2 * math.pi)) + 1
+        return case
+    case.time = dt * steps
+    case.angle_deg = np.degrees(theta) - 360.0 * (params.revolutions - 1) if params.end_time <= 0 \
+        else np.degrees(theta)
+    for name in ("eps_ax", "eps_of", "n_avg", "mid", "slider", "elong"):
+        setattr(case, name, res[name])
+    return case
+
+
+# --------------------------------------------------------------------------- text
+
+
+def _f(x: float, d: int = 3) -> str:
+    return f"{x:.{d}f}"
+
+
+def _header(params: Params, model: Model, derived: dict[str, float]) -> list[str]:
+    mat = params.material if params.material != "custom" else "custom (section from the deck)"
+    src = model.sources
+    rows = [
+        ("material", "", mat),
+        ("crank radius r2", "m", f"{model.r2:g}"),
+        ("rod length L3", "m", f"{model.length:g}"),
+        ("section area A", "m^2", f"{model.area:.5g}   ({src['area']})"),
+        ("second moment I", "m^4", f"{model.inertia:.5g}   ({src['second_moment']})"),
+        ("density rho", "kg/m^3", f"{model.density:g}   ({src['density']})"),
+        ("Young's modulus E", "Pa", f"{model.modulus:.5g}   ({src['youngs_modulus']})"),
+        ("section depth (outer fibre at depth/2)", "m", f"{model.depth:g}   ({src['section_depth']})"),
+        ("slider mass M", "kg", f"{model.slider_mass:g}"),
+        ("bearing masses m_B (crank pin), m_C (slider)", "kg",
+         f"{model.bearing_crank:g}, {model.bearing_slider:g}"),
+        ("crank speeds", "rad/s", ", ".join(f"{w:g}" for w in params.speeds)),
+        ("elements", "", ", ".join(map(str, params.element_counts)) if params.element_counts
+         else str(params.n_elements)),
+        ("steps per revolution", "", str(params.steps_per_rev)),
+        ("revolutions (last one reported)" if params.end_time <= 0 else "end time", "" if params.end_time <= 0
+         else "s", str(params.revolutions) if params.end_time <= 0 else f"{params.end_time:g}"),
+        ("start", "", params.start),
+        ("analysis", "", params.analysis),
+        ("geometric stiffness K_G", "", "on" if params.geometric_stiffness else "off"),
+        ("damping ratio (Rayleigh)", "", f"{params.damping_ratio:g}"),
+    ]
+    out = ["Slider-crank with an elastic connecting rod: KED finite elements, Newmark average acceleration",
+           "Seed 003 (Univ. Andalas); formulation and corrections: study note slidercrank.md", "", "Inputs"]
+    out += [f"  {name:<46} {('[' + u + ']') if u else '':<9} {val}" for name, u, val in rows]
+    out += ["", "Model",
+            "  rod: planar frame elements (axial + bending), consistent mass and stiffness (eqs. 26, 29",
+            "  corrected); crank pin pinned, slider node on the guide (global X free, Y fixed) with",
+            "  M + m_C lumped; rigid-body inertia loading in the rod frame (eq. 23); Rayleigh damping",
+            f"  C = alpha M + beta K, alpha = {derived['alpha']:.5g} 1/s, beta = {derived['beta']:.5g} s",
+            f"  first bending frequency (pinned-pinned)       {derived['w_bend']:10.2f} rad/s",
+            f"  first axial frequency (fixed / slider mass)   {derived['w_axial']:10.2f} rad/s",
+            f"  Euler load pi^2 EI / L^2 (pinned-pinned)      {derived['p_euler']:10.2f} N",
+            f"  rod mass                                      {model.rho_a * model.length:10.4f} kg",
+            f"  axial stiffness EA, bending stiffness EI      {model.ea:.5g} N, {model.ei:.5g} N m^2"]
+    return out
+
+
+def _status_text(c: Case) -> str:
+    if c.ok:
+        return "ok"
+    what = "BUCKLED" if c.status in ("buckled", "diverged") else c.status.upper()
+    return f"{what} at theta2 = {c.fail_angle_deg:.2f} deg (revolution {c.fail_rev})"
+
+
+def _peak_table(cases: list[Case]) -> list[str]:
+    cols = [Column("omega", "f", 7, 2), Column("tensile", "f", 9, 2), Column("theta2", "f", 7, 2),
+            Column("el", "i", 4), Column("compress", "f", 9, 2), Column("theta2", "f", 7, 2),
+            Column("el", "i", 4), Column("outer", "f", 9, 2), Column("middefl", "f", 8, 4),
+            Column("N/P_E", "f", 6, 3)]
+    rows, trailers = [], []
+    for c in cases:
+        if c.ok:
+            t, ta, te = c.peak(+1)
+            p, pa, pe = c.peak(-1)
+            rows.append([c.omega, t * 1e6, ta, te, p * 1e6, pa, pe, float(c.eps_of.max()) * 1e6,
+                         float(np.abs(c.mid).max()) * 1e3, c.euler_ratio])
+            trailers.append("warning: N/P_E > 0.8" if c.euler_ratio > EULER_WARN else "")
+        else:
+            rows.append([c.omega, "-", "-", "-", "-", "-", "-", "-", "-", c.euler_ratio])
+            trailers.append(_status_text(c))
+    return ["Table 1  Peak axial strain of the rod over the last revolution",
+            "         omega [rad/s]; strains in microstrain; theta2 [deg] where the peak occurs; el = element",
+            "         (1 = crank end); outer = peak outer-fibre strain |eps| + c|kappa|; middefl = peak |midpoint",
+            "         deflection| [mm]; N/P_E = peak rigid-body rod compression / Euler load", ""] \
+        + render_table(cols, rows, trailers)
+
+
+def _crank_end_table(cases: list[Case], every_deg: float = 10.0) -> list[str]:
+    grid = np.arange(0.0, 360.0 + 1e-9, every_deg)
+    cols = [Column("theta2", "f", 7, 1)] + [Column(f"w={c.omega:g}", "f", 9, 2) for c in cases]
+    series = []
+    for c in cases:
+        if c.ok:
+            series.append(np.interp(grid, c.angle_deg, c.eps_ax[0]) * 1e6)
+        else:
+            series.append(None)
+    rows = [[g] + [("-" if s is None else float(s[k])) for s in series] for k, g in enumerate(grid)]
+    lines = ["Table 2  Axial strain of the crank-end element vs crank angle, last revolution (microstrain)",
+             "         (one column per crank speed [rad/s], like the paper's Figure 10)", ""]
+    lines += render_table(cols, rows)
+    bad = [c for c in cases if not c.ok]
+    for c in bad:
+        lines.append(f"  w={c.omega:g}: {_status_text(c)}; no strains reported")
+    return lines
+
+
+def _convergence_table(conv: dict[float, list[Case]], length: float) -> list[str]:
+    lines = ["Table 3  Element convergence: peak axial strain over the last revolution (microstrain) and",
+             "         percentage change from the previous element count (like the paper's Figures 8-9)"]
+    cols = [Column("elements", "i", 8), Column("le [mm]", "f", 8, 3), Column("tensile", "f", 9, 3),
+            Column("change%", "f", 8, 3), Column("compress", "f", 9, 3), Column("change%", "f", 8, 3)]
+    for omega, cases in conv.items():
+        rows, trailers, prev = [], [], None
+        for c in cases:
+            le = 1e3 * length / c.n_elements
+            if not c.ok:
+                rows.append([c.n_elements, le, "-", "-", "-", "-"])
+                trailers.append(_status_text(c))
+                prev = None
+                continue
+            t, p = c.peak(+1)[0] * 1e6, c.peak(-1)[0] * 1e6
+            dt = "-" if prev is None else 100 * (t - prev[0]) / prev[0]
+            dp = "-" if prev is None else 100 * (p - prev[1]) / prev[1]
+            rows.append([c.n_elements, le, t, dt, p, dp])
+            trailers.append("")
+            prev = (t, p)
+        lines += ["", f"  crank speed {omega:g} rad/s", ""] + render_table(cols, rows, trailers)
+    return lines
+
+
+# --------------------------------------------------------------------------- run
+
+
+def _tidy(model_name: str, cases: list[Case]) -> pd.DataFrame:
+    frames = []
+    for c in cases:
+        if not c.ok:
+            continue
+        frames.append(pd.DataFrame({
+            "material": model_name, "omega_rad_s": c.omega, "n_elements": c.n_elements,
+            "crank_angle_deg": c.angle_deg, "time_s": c.time,
+            "eps_crank_end_microstrain": c.eps_ax[0] * 1e6,
+            "eps_max_microstrain": c.eps_ax.max(axis=0) * 1e6,
+            "eps_min_microstrain": c.eps_ax.min(axis=0) * 1e6,
+            "outer_fibre_max_microstrain": c.eps_of.max(axis=0) * 1e6,
+            "n_rigid_crank_end_N": c.n_avg[0],
+            "midpoint_deflection_mm": c.mid * 1e3,
+            "slider_position_m": c.slider,
+            "rod_elongation_um": c.elong * 1e6,
+        }))
+    if not frames:
+        return pd.DataFrame(columns=["material", "omega_rad_s", "n_elements", "crank_angle_deg"])
+    return pd.concat(frames, ignore_index=True)
+
+
+def _summary(cases: list[Case]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for i, c in enumerate(cases, start=1):
+        out[f"omega_{i}_rad_s"] = c.omega
+        out[f"euler_ratio_{i}"] = c.euler_ratio
+        out[f"buckled_{i}"] = not c.ok
+        if c.ok:
+            t, ta, _ = c.peak(+1)
+            p, pa, _ = c.peak(-1)
+            out.update({f"peak_tensile_{i}_microstrain": t * 1e6, f"peak_tensile_{i}_deg": ta,
+                        f"peak_compressive_{i}_microstrain": p * 1e6, f"peak_compressive_{i}_deg": pa})
+    good = [c for c in cases if c.ok]
+    if good:
+        best = max(good, key=lambda c: c.peak(+1)[0])
+        worst = min(good, key=lambda c: c.peak(-1)[0])
+        out.update({"peak_tensile_microstrain": best.peak(+1)[0] * 1e6, "peak_tensile_deg": best.peak(+1)[1],
+                    "peak_compressive_microstrain": worst.peak(-1)[0] * 1e6,
+                    "peak_compressive_deg": worst.peak(-1)[1]})
+    out["euler_ratio_max"] = max(c.euler_ratio for c in cases)
+    out["buckled"] = any(not c.ok for c in cases)
+    out["n_buckled"] = sum(not c.ok for c in cases)
+    return out
+
+
+def _benchmark_lines(params: Params, case: Case) -> list[str]:
+    lines = ["Table 4  End state at t = " + f"{params.end_time:g} s", ""]
+    if not case.ok:
+        return lines + [f"  {_status_text(case)}"]
+    kin = kernels.slidercrank_rigid(np.array([case.omega * case.time[-1]]), case.omega,
+                                    params.crank_radius, params.rod_length)[0]
+    vals = [("midpoint deflection from the chord (q1)", "m", float(case.mid[-1]), "q1"),
+            ("rod elongation (q4)", "m", float(case.elong[-1]), "q4"),
+            ("slider position (x3)", "m", float(case.slider[-1]), "x3"),
+            ("rod angle, rigid (phi2)", "rad", float(kin[0]), "phi2")]
+    cols = [Column("quantity", "s", 40), Column("unit", "s", 4), Column("this model", "s", 16)]
+    if params.benchmark == "simeon1996":
+        cols += [Column("Simeon 1996", "s", 16), Column("diff %", "f", 8, 3)]
+    rows = []
+    for name, unit, v, ref in vals:
+        row = [name, unit, f"{v:.9e}"]
+        if params.benchmark == "simeon1996":
+            r = SIMEON1996[ref]
+            row += [f"{r:.9e}", 100 * (v - r) / abs(r)]
+        rows.append(row)
+    lines += render_table(cols, rows)
+    if params.benchmark == "simeon1996":
+        lines += ["", "  Reference: Simeon (1996), IVP test set 'crank' (MEBDFI, tol 1e-14): 2 lateral sine modes,",
+                  "  quadratic axial field, full rigid-elastic coupling; this model is linear KED (eq. 23)."]
+    return lines
+
+
+def run(params: Params, progress: bool = False) -> Result:
+    """Run every crank speed (and element count) of the deck; see the module docstring."""
+    model = _model(params)
+    w_bend, w_axial, p_euler = model.frequencies()
+    alpha, beta = rayleigh(params.damping_ratio, w_bend, w_axial)
+    derived = dict(w_bend=w_bend, w_axial=w_axial, p_euler=p_euler, alpha=alpha, beta=beta)
+    counts = list(params.element_counts) if params.element_counts else [params.n_elements]
+    jobs = [(w, n) for w in params.speeds for n in counts]
+    done: dict[tuple[float, int], Case] = {}
+    for w, n in tqdm(jobs, desc="slidercrank", unit="case", disable=not progress):
+        done[(w, n)] = _run_case(model, params, w, n, alpha, beta, p_euler)
+    main_n = counts[-1] if params.element_counts else params.n_elements
+    cases = [done[(w, main_n)] for w in params.speeds]
+
+    text = _header(params, model, derived) + [""]
+    warnings: list[str] = []
+    failure = None
+    if params.end_time > 0:
+        text += _benchmark_lines(params, cases[0]) + [""]
+    else:
+        text += _peak_table(cases) + [""] + _crank_end_table(cases) + [""]
+    conv = {w: [done[(w, n)] for n in counts] for w in params.speeds} if params.element_counts else {}
+    if conv:
+        text += _convergence_table(conv, model.length) + [""]
+    for c in cases:
+        if c.euler_ratio > EULER_WARN:
+            msg = (f"crank speed {c.omega:g} rad/s: peak rod compression {c.peak_compression:.1f} N is "
+                   f"{c.euler_ratio:.2f} of the Euler load {p_euler:.1f} N (> {EULER_WARN})")
+            if not params.geometric_stiffness:
+                msg += "; the linear model cannot show buckling: rerun with geometric_stiffness = .true."
+            warnings.append(msg)
+    for c in done.values():
+        if not c.ok:
+            if params.geometric_stiffness and c.status in ("buckled", "diverged"):
+                warnings.append(f"crank speed {c.omega:g} rad/s, {c.n_elements} elements: rod "
+                                f"{_status_text(c)}")
+            else:
+                failure = f"crank speed {c.omega:g} rad/s, {c.n_elements} elements: {_status_text(c)}"
+                warnings.append(failure)
+    le = model.length / max(counts)
+    notes = ["Notes"]
+    if params.end_time <= 0:
+        notes += ["  * Strains: element axial strain (u_e - u_e-1)/le (the paper's 'regangan aksial'); tension",
+                  "    positive. The peak tensile strain occurs in the crank-end element near theta2 = 0 (rod",
+                  "    stretched), the peak compressive strain near theta2 = 180 deg.",
+                  "  * The paper publishes figures only; validation is against closed forms (quasi-static",
+                  "    limit N(s)/EA, natural frequencies) and the Simeon (1996) benchmark (see tests).",
+                  "  * Damping is not given in the paper: Rayleigh damping at the first bending and axial modes."]
+    else:
+        notes += [f"  * Benchmark mode: integrated from t = 0 to end_time with the time step {cases[0].dt:.6g} s.",
+                  "  * Midpoint deflection is measured from the chord A-C; elongation is the axial elastic",
+                  "    displacement of the slider end of the rod."]
+    notes.append(f"  * Time-step criterion: >= {MIN_STEPS_PER_BENDING_PERIOD} steps per period of the first "
+                 f"bending mode and >= {MIN_STEPS_PER_REV} per revolution.")
+    if le < model.depth:
+        notes.append(f"  * Elements ({le * 1e3:.3f} mm) are shorter than the section depth "
+                     f"({model.depth * 1e3:g} mm), as in the paper's")
+        notes.append("    700-element mesh; Euler-Bernoulli elements are used regardless (shear neglected).")
+    if params.geometric_stiffness:
+        notes.append("  * Geometric stiffness on: a case is reported BUCKLED when the tangent stiffness K + K_G")
+        notes.append("    of the rigid-body axial force loses definiteness, or the elastic motion exceeds L/20;")
+        notes.append("    the numbers of such a case are not reported.")
+    else:
+        notes.append("  * Geometric stiffness off (the paper's linear model); N/P_E is reported for every case.")
+    text += notes
+    if warnings:
+        text += ["", "Warnings"] + [f"  * {w}" for w in warnings]
+    figures = []
+    good = [c for c in cases if c.ok]
+    if good and params.end_time <= 0:
+        from driver import plotting
+        figures.append(Figure("strain", lambda: plotting.slidercrank_strain_figure(
+            [(f"{c.omega:g} rad/s", c.angle_deg, c.eps_ax[0] * 1e6) for c in good],
+            f"{params.material}: crank-end element axial strain")))
+        figures.append(Figure("deflection", lambda: plotting.slidercrank_strain_figure(
+            [(f"{c.omega:g} rad/s", c.angle_deg, c.mid * 1e3) for c in good],
+            f"{params.material}: midpoint deflection", ylabel="midpoint deflection [mm]")))
+    if conv:
+        from driver import plotting
+        series = {f"{w:g} rad/s": ([c.n_elements for c in cs if c.ok], [c.peak(+1)[0] * 1e6 for c in cs if c.ok])
+                  for w, cs in conv.items()}
+        figures.append(Figure("convergence", lambda: plotting.slidercrank_convergence_figure(
+            series, f"{params.material}: element convergence")))
+    return Result(text="\n".join(text) + "\n", tidy=_tidy(params.material, list(done.values())),
+                  summary=_summary(cases), warnings=warnings, failure=failure, figures=figures)
