@@ -1,5 +1,7 @@
 """Atomic output: write to a temporary file in the target folder, then rename.
 
+The temporary file is removed if writing fails or is interrupted.
+
 A reader (or ``git diff outputs/``) never sees a half-written file, and an
 interrupted run leaves the previous complete file in place.
 """
@@ -23,8 +25,9 @@ def atomic_open(path: str | Path, mode: str = "w") -> Iterator[IO]:
     try:
         with os.fdopen(fd, mode) as fh:
             yield fh
-            fh.flush()
-            os.fsync(fh.fileno())
+        # no fsync: the rename alone means a reader never sees a partial file after an
+        # interrupt or a crash of this process (durability across power loss is not the
+        # point, and fsync per file serialises parallel sweep workers on the disk)
         os.chmod(tmp, 0o644)
         os.replace(tmp, path)
     except BaseException:

@@ -332,44 +332,67 @@ def auto_chunk(seconds_per_case: float, n_cases: int, workers: int, target: floa
     return max(1, min(by_time, by_balance))
 
 
-def _execute(tasks: list[Task], jobs: int, scheduler: str, progress: bool, total: int,
-             done0: int) -> list[CaseResult]:
-    """Run tasks locally (process pool) or on Dask; results in any order (sorted later)."""
+def _execute(cases: list[Case], task_of, jobs: int, scheduler: Any, chunk: int, progress: bool,
+             total: int, done0: int) -> tuple[list[CaseResult], int]:
+    """Run cases locally (process pool) or on Dask; returns results (any order) and the chunk used.
+
+    With ``chunk == 0`` the first ``jobs`` cases go out as single-case tasks and the chunk
+    size is chosen from the first one that returns, so timing it costs no parallelism.
+    """
     from tqdm import tqdm
     bar = tqdm(total=total, initial=done0, unit="case", disable=not progress, dynamic_ncols=True)
     results: list[CaseResult] = []
+    workers = jobs if not scheduler else max(jobs, 1)
+    first = cases[:max(1, workers)] if not chunk else []
+    rest = cases[len(first):]
+
+    def collect(part: list[CaseResult]) -> None:
+        results.extend(part)
+        bar.update(len(part))
+
     try:
+        if not scheduler and (jobs <= 1 or len(cases) <= 1):
+            if not chunk and cases:   # time the first case, then chunks of ~0.1 s (progress granularity)
+                collect(run_task(task_of(cases[:1])))
+                chunk = auto_chunk(results[-1].seconds, len(cases) - 1, 1)
+                cases = cases[1:]
+            for cs in _chunks(cases, chunk or 1):
+                collect(run_task(task_of(cs)))
+            return results, chunk or 1
         if scheduler:
-            from dask.distributed import Client, as_completed
+            from dask.distributed import Client, wait
             client = scheduler if not isinstance(scheduler, str) else Client(scheduler)
-            try:
-                futures = client.map(run_task, tasks, pure=False)
-                for fut in as_completed(futures):
-                    part = fut.result()
-                    results += part
-                    bar.update(len(part))
-            finally:
-                if isinstance(scheduler, str):
-                    client.close()
-        elif jobs <= 1 or len(tasks) <= 1:
-            for t in tasks:
-                part = run_task(t)
-                results += part
-                bar.update(len(part))
+            submit = lambda t: client.submit(run_task, t, pure=False)
+            wait_any = lambda fs: wait(list(fs), return_when="FIRST_COMPLETED")
+            workers = len(client.scheduler_info().get("workers", {})) or workers
+            close = (lambda: client.close()) if isinstance(scheduler, str) else (lambda: None)
         else:
-            with cf.ProcessPoolExecutor(max_workers=jobs) as pool:
-                futures = [pool.submit(run_task, t) for t in tasks]
-                try:
-                    for fut in cf.as_completed(futures):
-                        part = fut.result()
-                        results += part
-                        bar.update(len(part))
-                except KeyboardInterrupt:
-                    pool.shutdown(wait=False, cancel_futures=True)
-                    raise
+            pool = cf.ProcessPoolExecutor(max_workers=jobs)
+            submit = lambda t: pool.submit(run_task, t)
+            wait_any = lambda fs: cf.wait(fs, return_when=cf.FIRST_COMPLETED)
+            close = lambda: pool.shutdown(wait=True)
+        try:
+            pending = {submit(task_of([c])) for c in first}
+            if chunk:
+                pending |= {submit(task_of(cs)) for cs in _chunks(rest, chunk)}
+            while pending:
+                done, not_done = wait_any(pending)
+                pending = set(not_done)
+                for fut in done:
+                    part = fut.result()
+                    collect(part)
+                    if not chunk:   # first result: choose the chunk for everything else
+                        chunk = auto_chunk(part[0].seconds, len(rest), workers)
+                        pending |= {submit(task_of(cs)) for cs in _chunks(rest, chunk)}
+        except KeyboardInterrupt:
+            if not scheduler:
+                pool.shutdown(wait=False, cancel_futures=True)
+            raise
+        finally:
+            close()
     finally:
         bar.close()
-    return results
+    return results, chunk or 1
 
 
 # ----------------------------------------------------------------------------- driver entry
@@ -484,14 +507,8 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
         if not quiet:
             print(f"resume: {len(skip)} of {len(cases)} cases complete, {len(todo)} to run")
     t_start = time.perf_counter()
-    chunk = sw.chunk
-    if todo and not chunk:
-        first = run_task(task_of(todo[:1]))        # the first case also times the chunk size
-        done += first
-        todo = todo[1:]
-        chunk = auto_chunk(first[0].seconds, len(todo), 1 if (jobs <= 1 and not scheduler) else jobs)
-    tasks = [task_of(c) for c in _chunks(todo, chunk or 1)]
-    done += _execute(tasks, jobs, scheduler, progress, len(cases), len(cases) - len(todo))
+    ran, chunk = _execute(todo, task_of, jobs, scheduler, sw.chunk, progress, len(cases), len(cases) - len(todo))
+    done += ran
     elapsed = time.perf_counter() - t_start
     done.sort(key=lambda r: r.index)
     for r, k in zip(done, _kept_many(sw.keep, done)):   # one vectorised filter over every case
@@ -530,7 +547,7 @@ def _sweep_text(deck: Deck, sw: Params, base: Params, names: list[str], cases: l
                 frame: pd.DataFrame, failed: list[CaseResult], chunk: int, jobs: int, scheduler: Any) -> str:
     lines = [f"  sweep over &{base.group} from deck {deck.path}", ""]
     for k, name in enumerate(names, start=1):
-        vals = sorted({c.values[name] for c in cases}, key=lambda v: (isinstance(v, str), v))
+        vals = list(dict.fromkeys(c.values[name] for c in cases))   # deck order
         fmt = lambda v: v if isinstance(v, str) else f"{v:.6g}"
         shown = (", ".join(map(fmt, vals[:8])) if len(vals) <= 8 else
                  f"{fmt(vals[0])}, {fmt(vals[1])}, ..., {fmt(vals[-1])} ({len(vals)} values)")
