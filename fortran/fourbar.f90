@@ -155,7 +155,8 @@ contains
     real(dp) :: r2, s2, c, sn, ax, ay, dx, dy, d2, a, h2, h, bx, by
     real(dp) :: e2x, e2y, e3x, e3y, s23, c23, w2, w3, den2, den3, sinv, ok, placed
     real(dp) :: st, isno, istog, isdeg, degst, dmin2, ys(256, 3), xs(256, 3)
-    real(dp), parameter :: ok_ = st_ok, none_ = st_no_assembly, tog_ = st_toggle, ind_ = st_indeterminate
+    ! st_ok = 0 is the value left when no flag is set
+    real(dp), parameter :: none_ = st_no_assembly, tog_ = st_toggle, ind_ = st_indeterminate
     integer :: k, j
     r2 = r*r
     s2 = s*s
