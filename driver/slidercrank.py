@@ -282,6 +282,13 @@ class Case:
     def ok(self) -> bool:
         return self.status == "ok"
 
+    def crank_end_peak(self, sign: int) -> float:
+        """Peak strain [-] at the crank pin itself (s = 0), recovered by linear extrapolation
+        of the first two element strains (midpoints L/2n, 3L/2n); exact for a strain field
+        linear in s.  Element averages converge as 1/n where N(s) varies; this converges fast."""
+        e = self.eps_ax[0] if self.eps_ax.shape[0] < 2 else 1.5 * self.eps_ax[0] - 0.5 * self.eps_ax[1]
+        return float(np.max(sign * e) * sign)
+
     def peak(self, sign: int) -> tuple[float, float, int]:
         """Peak tensile (sign=+1) or compressive (-1) axial strain [-], crank angle [deg], element."""
         flat = np.argmax(sign * self.eps_ax)
@@ -431,24 +438,32 @@ def _crank_end_table(cases: list[Case], every_deg: float = 10.0) -> list[str]:
 def _convergence_table(conv: dict[float, list[Case]], length: float) -> list[str]:
     lines = ["Table 3  Element convergence: peak axial strain over the last revolution (microstrain) and",
              "         percentage change from the previous element count (like the paper's Figures 8-9)"]
+    lines += ["         element: peak strain of the crank-end element (an element average, the paper's",
+              "         quantity); at pin: strain at the crank pin recovered from the first two elements"]
     cols = [Column("elements", "i", 8), Column("le [mm]", "f", 8, 3), Column("tensile", "f", 9, 3),
-            Column("change%", "f", 8, 3), Column("compress", "f", 9, 3), Column("change%", "f", 8, 3)]
+            Column("change%", "f", 8, 3), Column("compress", "f", 9, 3), Column("change%", "f", 8, 3),
+            Column("tens@pin", "f", 9, 3), Column("change%", "f", 8, 3), Column("comp@pin", "f", 9, 3),
+            Column("change%", "f", 8, 3)]
+    change = lambda new, old: "-" if old is None else 100 * (new - old) / old
     for omega, cases in conv.items():
         rows, trailers, prev = [], [], None
         for c in cases:
             le = 1e3 * length / c.n_elements
             if not c.ok:
-                rows.append([c.n_elements, le, "-", "-", "-", "-"])
+                rows.append([c.n_elements, le] + ["-"] * 8)
                 trailers.append(_status_text(c))
                 prev = None
                 continue
-            t, p = c.peak(+1)[0] * 1e6, c.peak(-1)[0] * 1e6
-            dt = "-" if prev is None else 100 * (t - prev[0]) / prev[0]
-            dp = "-" if prev is None else 100 * (p - prev[1]) / prev[1]
-            rows.append([c.n_elements, le, t, dt, p, dp])
+            vals = (c.peak(+1)[0] * 1e6, c.peak(-1)[0] * 1e6, c.crank_end_peak(+1) * 1e6, c.crank_end_peak(-1) * 1e6)
+            old = prev or (None,) * 4
+            rows.append([c.n_elements, le] + [x for v, o in zip(vals, old) for x in (v, change(v, o))])
             trailers.append("")
-            prev = (t, p)
+            prev = vals
         lines += ["", f"  crank speed {omega:g} rad/s", ""] + render_table(cols, rows, trailers)
+    lines += ["", "  Why the element strain needs many elements: the rigid-body axial force falls along the rod",
+              "  (inertia of the rod itself), and an element strain is its average over the element, so the",
+              "  crank-end element converges to the pin value only as 1/n (the paper's 700 elements). The",
+              "  recovered pin strain removes that averaging error and is converged with a few elements."]
     return lines
 
 
