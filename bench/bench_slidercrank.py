@@ -17,13 +17,12 @@ Run:  .venv/bin/python bench/bench_slidercrank.py
 from __future__ import annotations
 
 import math
-import statistics
-import time
 
 import numpy as np
 from scipy.linalg import solveh_banded
 
 from driver import kernels as K
+from timing import median_time  # noqa: E402
 from driver.slidercrank import MATERIALS, rayleigh
 
 N_EL, SPR, OMEGA = 700, 1440, 29.32
@@ -132,15 +131,6 @@ class NumpyKED:
         return eps
 
 
-def _median_time(fn, repeat: int) -> float:
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times)
-
-
 def main() -> None:
     mat = MATERIALS["aluminium"]
     rho_a, ea, ei = mat["density"] * mat["area"], mat["youngs_modulus"] * mat["area"], \
@@ -161,8 +151,8 @@ def main() -> None:
     diff = np.abs(got - ref).max() / np.abs(ref).max()
     print(f"baseline vs kernel, {short} steps, crank-end strain: max relative difference {diff:.2e}")
     kernel()                                            # warm-up
-    t_kernel = _median_time(kernel, 7)
-    t_base_short = _median_time(lambda: base.run(short), 3)
+    t_kernel = median_time(kernel, 7)
+    t_base_short = median_time(lambda: base.run(short), 3)
     t_base = t_base_short / short * SPR
     ratio = t_base / t_kernel
     print(f"case: aluminium rod, {N_EL} elements ({3 * N_EL} unknowns), {SPR} steps per revolution, "
