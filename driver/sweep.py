@@ -332,6 +332,12 @@ def auto_chunk(seconds_per_case: float, n_cases: int, workers: int, target: floa
     return max(1, min(by_time, by_balance))
 
 
+def _ignore_sigint() -> None:
+    """Worker initializer: Ctrl-C is handled by the parent only."""
+    import signal
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
 def _execute(cases: list[Case], task_of, jobs: int, scheduler: Any, chunk: int, progress: bool,
              total: int, done0: int) -> tuple[list[CaseResult], int]:
     """Run cases locally (process pool) or on Dask; returns results (any order) and the chunk used.
@@ -367,7 +373,9 @@ def _execute(cases: list[Case], task_of, jobs: int, scheduler: Any, chunk: int, 
             workers = len(client.scheduler_info().get("workers", {})) or workers
             close = (lambda: client.close()) if isinstance(scheduler, str) else (lambda: None)
         else:
-            pool = cf.ProcessPoolExecutor(max_workers=jobs)
+            # workers ignore Ctrl-C: the parent cancels queued chunks and lets running ones finish,
+            # so every case a worker started is written completely
+            pool = cf.ProcessPoolExecutor(max_workers=jobs, initializer=_ignore_sigint)
             submit = lambda t: pool.submit(run_task, t)
             wait_any = lambda fs: cf.wait(fs, return_when=cf.FIRST_COMPLETED)
             close = lambda: pool.shutdown(wait=True)
@@ -385,8 +393,11 @@ def _execute(cases: list[Case], task_of, jobs: int, scheduler: Any, chunk: int, 
                         chunk = auto_chunk(part[0].seconds, len(rest), workers)
                         pending |= {submit(task_of(cs)) for cs in _chunks(rest, chunk)}
         except KeyboardInterrupt:
-            if not scheduler:
-                pool.shutdown(wait=False, cancel_futures=True)
+            print("interrupt: cancelling queued cases, finishing the running ones", file=sys.stderr)
+            if scheduler:
+                client.cancel(list(pending))
+            else:
+                pool.shutdown(wait=True, cancel_futures=True)
             raise
         finally:
             close()

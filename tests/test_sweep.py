@@ -175,3 +175,37 @@ def test_design_search_filter_and_kept_rows(tmp_path):
     # crank 2 keeps mu in 40-120 deg with a 32.3 deg swing; crank 1 swings too little; crank >= 3 leaves the band
     assert list(summary["fourbar.crank"]) == [2.0]
     assert sorted(p.name for p in (out / "sw").glob("*.out")) == ["case_0002.out"]
+
+
+def test_ctrl_c_on_worker_processes(tmp_path):
+    """Real SIGINT to the whole process group of a 2-worker sweep: prompt exit 130, every
+    started case complete (.json marker <=> .out), no temporary file, then --resume finishes."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+    path = deck(tmp_path, "&sweep key1 = 'fourbar.crank', start1 = 1, stop1 = 5, count1 = 30\n"
+                          "       key2 = 'fourbar.rocker', start2 = 6, stop2 = 12, count2 = 30 /\n",
+                base=BASE.replace("method = 'listing'", "method = 'exact'"))
+    out = tmp_path / "o"
+    cmd = [sys.executable, "-m", "driver", str(path), "-o", str(out), "-q", "-j", "2"]
+    proc = subprocess.Popen(cmd, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    case_dir = out / "sw"
+    deadline = time.time() + 60
+    while time.time() < deadline and (not case_dir.exists() or len(list(case_dir.glob("*.json"))) < 20):
+        time.sleep(0.05)
+    os.killpg(proc.pid, signal.SIGINT)
+    t0 = time.time()
+    proc.communicate(timeout=60)
+    assert proc.returncode == 130
+    assert time.time() - t0 < 10
+    names = [p.name for p in case_dir.iterdir()]
+    assert not [n for n in names if n.startswith(".") or n.endswith(".tmp")]
+    done = {n[:-5] for n in names if n.endswith(".json")}
+    assert 20 <= len(done) < 900
+    assert done == {n[:-4] for n in names if n.endswith(".out")}
+    assert not (out / "sw_summary.csv").exists()
+    res = subprocess.run(cmd + ["--resume"], capture_output=True, text=True)
+    assert res.returncode == 0
+    assert len(pd.read_csv(out / "sw_summary.csv")) == 900
