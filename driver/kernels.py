@@ -63,8 +63,13 @@ def fourbar_exact(theta: np.ndarray, p: float, q: float, r: float, s: float, ome
     n = theta.shape[0]
     if out is None:
         out = np.empty((n, 11), dtype=np.float64, order="F")
+    elif not (out.flags.f_contiguous and out.dtype == np.float64 and out.shape == (n, 11)):
+        raise ValueError("out must be a Fortran-ordered float64 array of shape (n, 11); "
+                         "f2py would otherwise work on a hidden copy")
     if status is None:
         status = np.empty(n, dtype=np.int32)
+    elif not (status.dtype == np.int32 and status.shape == (n,)):
+        raise ValueError("status must be an int32 array of shape (n,)")
     return _kernels.fourbar.exact_states(theta, p, q, r, s, omega, alpha, int(branch), out, status)
 
 

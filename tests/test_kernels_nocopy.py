@@ -1,0 +1,48 @@
+"""Large arrays cross the f2py boundary without hidden copies (shared/notes/build.md, pitfall 2.2).
+
+numpy reports its data buffers to tracemalloc, so the peak allocation during a call shows
+whether f2py (or the wrapper) copied an input: it equals the array's size when it did.
+"""
+from __future__ import annotations
+
+import tracemalloc
+
+import numpy as np
+import pytest
+
+from driver import kernels
+
+
+def peak_alloc(fn) -> int:
+    tracemalloc.start()
+    tracemalloc.reset_peak()
+    try:
+        fn()
+        return tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+
+
+def test_fourbar_reused_buffers_are_not_copied():
+    n = 200_000
+    theta = np.linspace(0, 2 * np.pi, n)
+    out = np.empty((n, 11), order="F")
+    status = np.empty(n, dtype=np.int32)
+    kernels.fourbar_exact(theta, 12, 5, 15, 9, 5, out=out, status=status)   # warm up
+    assert peak_alloc(lambda: kernels.fourbar_exact(theta, 12, 5, 15, 9, 5, out=out, status=status)) < out.nbytes // 20
+
+
+def test_fourbar_refuses_a_c_ordered_buffer_instead_of_copying_it():
+    n = 1000
+    out = np.empty((n, 11))               # C order: f2py must not silently work on a copy
+    with pytest.raises(ValueError):
+        kernels.fourbar_exact(np.zeros(n), 12, 5, 15, 9, 5, out=out, status=np.empty(n, dtype=np.int32))
+
+
+def test_manipulator_monte_carlo_samples_are_not_copied():
+    ns = 400_000
+    dl = np.asfortranarray(np.random.default_rng(0).uniform(-1e-3, 1e-3, (ns, 2)))
+    th1, th2 = np.radians([30.0, 50.0, 70.0]), np.radians([60.0, 40.0, 20.0])
+    kernels.manipulator_position_errors(th1, th2, dl)
+    peak = peak_alloc(lambda: kernels.manipulator_position_errors(th1, th2, dl))
+    assert peak < 1.5 * dl.nbytes          # the (ns, 2) result only, no copy of the input
