@@ -129,15 +129,6 @@ class Params(Mapping):
         """A DeckError located at ``key`` (for cross-key checks in studies)."""
         return DeckError(self.path, self.line_of(key) if key else self.line, key, message)
 
-    def replace(self, **changes: Any) -> "Params":
-        """A copy with some values changed (used by sweeps); lines are kept."""
-        values = dict(self._values)
-        values.update(changes)
-        return Params(self.group, self.path, values, self._lines, self.line, self.given | set(changes))
-
-    def as_dict(self) -> dict[str, Any]:
-        return dict(self._values)
-
 
 # --------------------------------------------------------------------------- parsing
 

@@ -19,7 +19,7 @@ from typing import Any, Callable
 
 import pandas as pd
 
-__all__ = ["Figure", "Result", "load_study", "is_study"]
+__all__ = ["Figure", "Result", "load_study"]
 
 _CORE = {"cli", "deck", "study", "table", "export", "plotting", "atomic", "kernels", "sweep"}
 
@@ -53,11 +53,6 @@ class Result:
     failure: str | None = None
     figures: list[Figure] = field(default_factory=list)
     extra: dict[str, str] = field(default_factory=dict)
-
-
-def is_study(group: str) -> bool:
-    """True when ``driver.<group>`` exists and defines SPEC and run."""
-    return load_study(group) is not None
 
 
 def load_study(group: str) -> ModuleType | None:

@@ -48,7 +48,7 @@ from driver.export import write_tidy
 from driver.study import load_study
 from driver.table import Column, render_table
 
-__all__ = ["SPEC", "Case", "build_cases", "run_sweep_deck", "run_task", "MAX_KEYS"]
+__all__ = ["SPEC", "Case", "build_cases", "run_sweep_deck", "run_task", "auto_chunk", "MAX_KEYS"]
 
 MAX_KEYS = 9
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
@@ -287,11 +287,6 @@ def _write_case(task: Task, case: Case, res: CaseResult, result, params: Params,
     except Exception as exc:
         res.status, res.error, res.kept = EXIT_FAILED, f"{exc.__class__.__name__}: {exc}", False
     res.seconds += time.perf_counter() - t0
-
-
-def run_case(task: Task, case: Case) -> CaseResult:
-    """Run one case in this process (compute, filter, write); never raises for a case failure."""
-    return run_task(Task(**{**task.__dict__, "cases": [case]}))[0]
 
 
 def run_task(task: Task) -> list[CaseResult]:
