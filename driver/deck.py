@@ -27,6 +27,8 @@ import f90nml
 __all__ = ["DeckError", "Key", "GroupSpec", "Params", "RawGroup", "Deck", "read_deck", "validate"]
 
 KINDS = ("float", "int", "str", "bool", "floats", "ints", "strs", "list")
+#: magnitudes no deck value of any study needs; larger ones only overflow the kernels
+MAX_FLOAT, MAX_INT = 1e15, 10**9
 
 
 class DeckError(Exception):
@@ -299,11 +301,15 @@ def _coerce(kind: str, v: Any) -> tuple[Any, str | None]:
             return None, f"not a number: {v!r}"
         if not math.isfinite(f):
             return None, f"not a finite number: {v!r}"
+        if abs(f) > MAX_FLOAT:
+            return None, f"{f:g} is beyond +-{MAX_FLOAT:g}, outside what any study here computes"
         return f, None
     if kind == "int":
         f = _as_float(v)
         if f is None or not f.is_integer():
             return None, f"not a whole number: {v!r}"
+        if abs(f) > MAX_INT:
+            return None, f"{f:g} is beyond +-{MAX_INT:g}"
         return int(f), None
     if kind == "bool":
         if isinstance(v, bool):

@@ -263,7 +263,7 @@ def listing_text(p: Params, table: np.ndarray, status: np.ndarray) -> list[str]:
     for row, st in zip(table, status):
         if st == ST["no_assembly"]:
             rows.append([int(row[0])] + [None] * 9)
-            trailers.append("cannot be assembled (the listing would print NaN)")
+            trailers.append("cannot be assembled: the listing's arccos argument leaves [-1, 1]")
         elif st == ST["toggle"]:
             rows.append([int(row[0])] + list(row[1:8]) + [None, None])
             trailers.append("toggle: sin(phi - epsl) = 0, velocities unbounded")

@@ -129,12 +129,16 @@ SPEC = GroupSpec(
         "sweep_l1_start": Key("float", default=0.0, units="m", doc="first l1 of the sweep along C_rob (Table 4.8)"),
         "sweep_l1_step": Key("float", default=0.25, check=positive, units="m", doc="l1 step of the sweep"),
         "sweep_count": Key("int", default=0, doc="rows of the sweep; 0 = up to the C_rob radius"),
-        "tolerance_bound": Key("float", default=0.01, check=positive, units="m",
+        "tolerance_bound": Key("float", default=0.01, units="m",
+                               check=lambda v: positive(v) or ("below 1e-9 m the tolerance box underflows"
+                                                               if v < 1e-9 else None),
                                doc="largest allowed positioning error epsilon"),
         "error_measure": Key("str", default="global", choices=("global", "per_point"),
                              doc="'global': ||J_x dl||_2 over all points stacked (Caro); "
                                  "'per_point': error at every single point"),
-        "mc_samples": Key("int", default=100000, check=_min_one, doc="Monte Carlo samples in the tolerance box"),
+        "mc_samples": Key("int", default=100000,
+                          check=lambda v: _min_one(v) or ("at most 10^8 samples (memory)" if v > 10**8 else None),
+                          doc="Monte Carlo samples in the tolerance box"),
         "mc_seed": Key("int", default=2005, doc="seed of the Monte Carlo sampler"),
     },
 )

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from decimal import ROUND_HALF_UP, Decimal
+from decimal import ROUND_HALF_UP, Context, Decimal, localcontext
 from typing import Iterable, Sequence
 
 __all__ = ["TableValueError", "Column", "fortran_f", "fortran_i", "render_table"]
@@ -29,7 +29,8 @@ class TableValueError(ValueError):
 def _round_half_up(value: float, decimals: int) -> str:
     """Decimal text of ``value`` rounded half away from zero (Fortran's RN-compatible)."""
     q = Decimal(1).scaleb(-decimals)
-    return format(Decimal(value).quantize(q, rounding=ROUND_HALF_UP), "f")
+    with localcontext(Context(prec=330 + decimals)):   # room for every finite double (<= 1.8e308)
+        return format(Decimal(value).quantize(q, rounding=ROUND_HALF_UP), "f")
 
 
 def fortran_f(value: float, w: int | None, d: int, style: str = "modern") -> str:

@@ -23,6 +23,11 @@ def test_f_editing(x, w, d, modern, legacy):
     assert fortran_f(x, w, d, "legacy") == legacy
 
 
+def test_huge_values_are_written_in_full():
+    text = fortran_f(1e300, 8, 4)
+    assert text.endswith(".0000") and len(text) == 301 + 5 and "E" not in text
+
+
 def test_non_finite_never_reaches_a_table():
     for bad in (math.nan, math.inf, -math.inf):
         with pytest.raises(TableValueError):
