@@ -218,7 +218,9 @@ def run(params: Params, progress: bool = False) -> Result:
         L += [f"  {f}" for f in flags]
         if p.printed_eq212 is not None:
             bp = np.array(p.printed_eq212)
-            L.append(f"  printed (2.12) would give sigma_Y(10) = {math.exp(bp @ [1, 10, 100]):.3g} (Table 2.5: "
+            log_s10 = float(bp @ [1, 10, 100])
+            s10 = f"{math.exp(log_s10):.3g}" if log_s10 < 700 else f"exp({log_s10:.4g})"
+            L.append(f"  printed (2.12) would give sigma_Y(10) = {s10} (Table 2.5: "
                      f"{r['std25'][0]:.3g}) and t_min = {_tmin(bp):.3f}: a transcription error")
         L.append("")
     if report:
