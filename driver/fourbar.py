@@ -64,6 +64,10 @@ SPEC = GroupSpec(
                       doc="'listing' = published program cell for cell; 'exact' = closed loop"),
         "branch": Key("str", default="open", choices=("open", "crossed"),
                       doc="'open': B left of the line A->O_B; 'crossed': mirror assembly"),
+        "coupler_point": Key("floats", default=None, units="length",
+                             check=lambda v: None if len(v) == 2 else f"give two numbers u, v (got {len(v)})",
+                             doc="a point P on the coupler: u along A->B, v to its left; adds its path, "
+                                 "velocity and acceleration (exact method)"),
         "title": Key("str", default="", doc="free text echoed in the output"),
     },
     check=_check,
@@ -121,6 +125,14 @@ def exact_grid(p: Params, theta_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray
     """Closed-loop states at ``theta_deg`` (kernel columns, see kernels.fourbar_exact)."""
     return kernels.fourbar_exact(np.radians(theta_deg), p.fixed_link, p.crank, p.coupler, p.rocker,
                                  p.omega, p.alpha, 1 if p.branch == "open" else -1)
+
+
+def coupler_point(p: Params, theta_deg: np.ndarray, out: np.ndarray, status: np.ndarray) -> np.ndarray | None:
+    """Position, velocity and acceleration of the deck's coupler point (None if it has none)."""
+    if not p.coupler_point:
+        return None
+    u, v = p.coupler_point
+    return kernels.fourbar_coupler_point(np.radians(theta_deg), out, status, p.crank, p.omega, p.alpha, u, v)
 
 
 def listing_grid(p: Params) -> tuple[np.ndarray, np.ndarray]:
@@ -274,14 +286,21 @@ def listing_text(p: Params, table: np.ndarray, status: np.ndarray) -> list[str]:
     return head + [lines[0], ""] + lines[1:], cols
 
 
-def exact_table(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarray) -> list[str]:
-    """Fixed-format exact table: the listing's ten columns (angles rounded) plus accelerations."""
+def exact_table(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarray,
+                cp: np.ndarray | None = None) -> list[str]:
+    """Fixed-format exact table: the listing's ten columns (angles rounded) plus accelerations,
+    and the coupler point's position and speed when the deck defines one (``cp`` from
+    kernels.fourbar_coupler_point)."""
     whole = np.all(np.isclose(theta, np.round(theta)))
     tcol = Column("theta", "i", 5, 0, 2) if whole else Column("theta", "f", 8, 3, 2)
     cols = [tcol, Column("coupler", "f", 7, 1), Column("rocker", "f", 7, 1), Column("transm", "f", 7, 1)]
     cols += [Column(h, "f", 9, 4) for h in ("xa", "ya", "xb", "yb")]
     cols += [Column(h, "f", 10, 4) for h in ("omega2", "omega3")] + [Column(h, "f", 11, 4) for h in ("alpha2", "alpha3")]
     units = ["[deg]", "[deg]", "[deg]", "[deg]", "", "", "", "", "[rad/s]", "[rad/s]", "[rad/s2]", "[rad/s2]"]
+    if cp is not None:
+        cols += [Column("xp", "f", 9, 4), Column("yp", "f", 9, 4), Column("vp", "f", 10, 4)]
+        units += ["", "", "[len/s]"]
+        extra = np.column_stack([cp[:, 0], cp[:, 1], np.hypot(cp[:, 2], cp[:, 3])])
     ang = np.column_stack([_deg360(out[:, 0]), _deg360(out[:, 1]), np.degrees(out[:, 2])])
     rows, trailers = [], []
     d = np.hypot(p.fixed_link - out[:, 3], out[:, 4])
@@ -300,6 +319,10 @@ def exact_table(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarra
         else:
             rows.append([t, *ang[k], *out[k, 3:11]])
             trailers.append("")
+        if cp is not None:
+            placed = status[k] in (ST["ok"], ST["toggle"])
+            rows[-1] += [extra[k, 0] if placed else None, extra[k, 1] if placed else None,
+                         extra[k, 2] if status[k] == ST["ok"] else None]
     lines = render_table(cols, rows, trailers)
     unit_line = "".join(" " * c.sep + u.rjust(max(c.width, len(c.header))) for c, u in zip(cols, units)).rstrip()
     return [lines[0], unit_line] + lines[1:]
@@ -376,18 +399,21 @@ def tidy_frame(method: str, theta: np.ndarray, cols: dict[str, np.ndarray], stat
     return frame
 
 
-def _exact_columns(out: np.ndarray, status: np.ndarray) -> dict[str, np.ndarray]:
+def _exact_columns(out: np.ndarray, status: np.ndarray, cp: np.ndarray | None = None) -> dict[str, np.ndarray]:
     vals = {"coupler_deg": _deg360(out[:, 0]), "rocker_deg": _deg360(out[:, 1]),
             "transmission_deg": np.degrees(out[:, 2]), "xa": out[:, 3], "ya": out[:, 4],
             "xb": out[:, 5], "yb": out[:, 6], "omega2_rad_s": out[:, 7], "omega3_rad_s": out[:, 8],
             "alpha2_rad_s2": out[:, 9], "alpha3_rad_s2": out[:, 10]}
+    if cp is not None:
+        vals.update({"xp": cp[:, 0], "yp": cp[:, 1], "vxp_per_s": cp[:, 2], "vyp_per_s": cp[:, 3],
+                     "axp_per_s2": cp[:, 4], "ayp_per_s2": cp[:, 5]})
     nope = (status == ST["no_assembly"]) | (status == ST["indeterminate"])
     tog = status == ST["toggle"]
     for k, v in vals.items():
         v = v.copy()
         if k not in ("xa", "ya"):
             v[nope] = np.nan
-        if k.startswith(("omega", "alpha")):
+        if k.startswith(("omega", "alpha", "vxp", "vyp", "axp", "ayp")):
             v[tog] = np.nan
         vals[k] = v
     return vals
@@ -405,7 +431,9 @@ def _figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> list[F
     def linkage():
         theta = np.linspace(0.0, 360.0, 721)
         out, st = exact_grid(p, theta)
-        return plotting.fourbar_linkage(p.fixed_link, theta, out, st == ST["ok"], listing, stem_title)
+        cp = coupler_point(p, theta, out, st)
+        return plotting.fourbar_linkage(p.fixed_link, theta, out, st == ST["ok"], listing, stem_title,
+                                        point=None if cp is None else cp[:, :2])
 
     return [Figure("curves", curves), Figure("linkage", linkage)]
 
@@ -418,8 +446,9 @@ def run(params: Params, progress: bool = False) -> Result:
     theta = crank_angles(p)
     g = grashof(p.fixed_link, p.crank, p.coupler, p.rocker)
     out, status = exact_grid(p, theta)
+    cp = coupler_point(p, theta, out, status)
     ex = extremes(p)
-    exact_frame = tidy_frame("exact", theta, _exact_columns(out, status), status)
+    exact_frame = tidy_frame("exact", theta, _exact_columns(out, status, cp), status)
     warnings: list[str] = []
     title = p.title or f"{p.path.stem}"
     if p.method == "listing":
@@ -437,7 +466,10 @@ def run(params: Params, progress: bool = False) -> Result:
         listing_frame = None
         lines = [f"  four-bar linkage: closed-loop analysis (method = exact, branch = {p.branch})",
                  f"  deck: {p.path}" + (f" -- {p.title}" if p.title else ""), ""] + _echo(p) + [""]
-        lines += exact_table(p, theta, out, status) + summary_lines(p, g, ex)
+        lines += exact_table(p, theta, out, status, cp) + summary_lines(p, g, ex)
+        if cp is not None:
+            lines += [f"    coupler point P ...... u = {p.coupler_point[0]:g} along A->B, v = {p.coupler_point[1]:g} "
+                      "to its left; xp, yp its position, vp its speed [length/s]"]
         for k in np.flatnonzero(status == ST["no_assembly"])[:1]:
             warnings.append(f"the linkage cannot be assembled at {int((status == ST['no_assembly']).sum())} "
                             f"of {len(theta)} crank angles (first at {theta[k]:g} deg)")

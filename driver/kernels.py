@@ -11,7 +11,7 @@ import numpy as np
 
 from driver import _kernels
 
-__all__ = ["farray", "fourbar_listing", "fourbar_exact", "FOURBAR_STATUS",
+__all__ = ["farray", "fourbar_listing", "fourbar_exact", "fourbar_coupler_point", "FOURBAR_STATUS",
            "MANIPULATOR_STATUS", "manipulator_arm_states", "manipulator_torques", "manipulator_ik",
            "manipulator_design_indices", "manipulator_position_errors",
            "UJOINT_MODELS", "UJOINT_OBJECTIVES", "ujoint_speed", "ujoint_objective",
@@ -71,6 +71,16 @@ def fourbar_exact(theta: np.ndarray, p: float, q: float, r: float, s: float, ome
     elif not (status.dtype == np.int32 and status.shape == (n,)):
         raise ValueError("status must be an int32 array of shape (n,)")
     return _kernels.fourbar.exact_states(theta, p, q, r, s, omega, alpha, int(branch), out, status)
+
+
+def fourbar_coupler_point(theta: np.ndarray, states: np.ndarray, status: np.ndarray, q: float,
+                          omega: float, alpha: float, u: float, v: float) -> np.ndarray:
+    """A point fixed to the coupler, u along A->B and v to its left [length], from the
+    ``fourbar_exact`` results at crank angles ``theta`` [rad]: (n, 6) position, velocity
+    [length/s] and acceleration [length/s^2] (zero where the linkage is not placed)."""
+    theta = farray(np.atleast_1d(theta), 1)
+    return _kernels.fourbar.coupler_point(theta, q, omega, alpha, u, v, farray(states, 2),
+                                          np.asarray(status, dtype=np.int32))
 
 
 # ----------------------------------------------------------------------------- manipulator

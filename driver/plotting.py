@@ -85,13 +85,17 @@ def fourbar_curves(exact, listing, title: str) -> Figure:
 
 
 def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.ndarray,
-                    listing, title: str, n_poses: int = 6) -> Figure:
-    """The linkage drawn at a few crank angles with the paths of A and B (exact)."""
+                    listing, title: str, n_poses: int = 6, point: np.ndarray | None = None) -> Figure:
+    """The linkage drawn at a few crank angles with the paths of A and B (exact), and the
+    path of a coupler point (``point``: (n, 2) positions) when the deck defines one."""
     fig, (ax,) = new_figure(1, 1, figsize=(7.0, 5.0))
     ax.plot(out[:, 3], out[:, 4], color="0.6", lw=0.8, label="path of A")
     bx = np.where(ok, out[:, 5], np.nan)
     by = np.where(ok, out[:, 6], np.nan)
     ax.plot(bx, by, color="C3", lw=1.2, label="path of B (exact)")
+    if point is not None:
+        ax.plot(np.where(ok, point[:, 0], np.nan), np.where(ok, point[:, 1], np.nan), color="C4", lw=1.2,
+                ls="--", label="coupler point P")
     if listing is not None:
         ax.plot(listing["xb"], listing["yb"], "x", color="k", ms=5, label="B (listing)")
     idx = np.flatnonzero(ok)

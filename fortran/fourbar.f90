@@ -15,7 +15,7 @@ module fourbar
   use kinds, only: dp, sp
   implicit none
   private
-  public :: listing_table, exact_states
+  public :: listing_table, exact_states, coupler_point
 
   !> status codes shared with driver/fourbar.py
   integer, parameter, public :: st_ok = 0, st_no_assembly = 1, st_toggle = 2, st_indeterminate = 3
@@ -220,6 +220,37 @@ contains
       end do
     end do
   end subroutine exact_block
+
+  !> A point P fixed to the coupler: P = A + u e2 + v n2, with e2 the unit vector A->B and
+  !> n2 its left normal (u along the coupler, v to its left; length units of the linkage).
+  !> From exact_states' output: pout(:, 1:2) position, pout(:, 3:4) velocity [length/s],
+  !> pout(:, 5:6) acceleration [length/s^2] (crank speed omega, acceleration alpha1).
+  !> Rows whose status is not 0 (ok) or 2 (toggle; position only) are zeroed.
+  subroutine coupler_point(n, theta, q, omega, alpha1, u, v, states, status, pout)
+    integer, intent(in) :: n
+    real(dp), intent(in) :: theta(n), q, omega, alpha1, u, v, states(n, 11)
+    integer, intent(in) :: status(n)
+    real(dp), intent(out) :: pout(n, 6)
+    real(dp) :: c2, s2, rx, ry, w2, a2, ok, placed, c, sn
+    integer :: k
+    do k = 1, n
+      placed = merge(1.0_dp, 0.0_dp, status(k) == st_ok .or. status(k) == st_toggle)
+      ok = merge(1.0_dp, 0.0_dp, status(k) == st_ok)
+      call vsincos(states(k, 1), s2, c2)
+      call vsincos(theta(k), sn, c)
+      rx = u*c2 - v*s2                  ! P - A
+      ry = u*s2 + v*c2
+      w2 = states(k, 8)
+      a2 = states(k, 10)
+      pout(k, 1) = placed*(states(k, 4) + rx)
+      pout(k, 2) = placed*(states(k, 5) + ry)
+      ! v_P = v_A + w2 x (P - A);  a_P = a_A + a2 x (P - A) - w2^2 (P - A)
+      pout(k, 3) = ok*(-q*omega*sn - w2*ry)
+      pout(k, 4) = ok*(q*omega*c + w2*rx)
+      pout(k, 5) = ok*(-q*(alpha1*sn + omega*omega*c) - a2*ry - w2*w2*rx)
+      pout(k, 6) = ok*(q*(alpha1*c - omega*omega*sn) + a2*rx - w2*w2*ry)
+    end do
+  end subroutine coupler_point
 
   !> sin and cos of x [rad], branch-free so that loops calling it vectorise.
   !> Cody-Waite reduction by pi/2 in three parts (fdlibm constants), then the

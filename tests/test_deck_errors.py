@@ -27,6 +27,7 @@ GOOD = """! a good deck
     (("step_deg = 20", "step_deg = 0"), 7, "step_deg", "must not be 0"),
     (("step_deg = 20", "step_deg = 20\n  method = 'magic'"), 8, "method", "not one of"),
     (("step_deg = 20", "step_deg = 2.5\n  method = 'listing'"), 7, "step_deg", "whole degrees"),
+    (("step_deg = 20", "step_deg = 20\n  coupler_point = 1, 2, 3"), 8, "coupler_point", "two numbers"),
 ])
 def test_bad_deck(change, line, key, words, tmp_path, capsys):
     deck = tmp_path / "bad.dat"

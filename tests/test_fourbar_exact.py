@@ -149,3 +149,38 @@ def test_vectorised_trig_matches_libm():
     e2 = (out[:, 5] - out[:, 3], out[:, 6] - out[:, 4])
     assert np.max(np.abs(np.angle(np.exp(1j * (out[:, 0] - np.arctan2(e2[1], e2[0])))))) < 1e-15
     assert np.max(np.abs(np.angle(np.exp(1j * (out[:, 1] - np.arctan2(out[:, 6], out[:, 5] - 12.0)))))) < 1e-15
+
+
+@settings(max_examples=60, deadline=None)
+@given(p=length, q=length, r=length, s=length, branch=st.sampled_from([1, -1]),
+       u=st.floats(-10, 10), v=st.floats(-10, 10), omega=st.floats(0.5, 10), alpha=st.floats(-20, 20))
+def test_coupler_point_is_rigid_with_the_coupler_and_its_derivatives(p, q, r, s, branch, u, v, omega, alpha):
+    theta = np.linspace(0.05, 2 * np.pi - 0.05, 61)
+    h = 1e-5
+
+    def point(t):
+        o, st_ = states(t, p, q, r, s, omega, alpha, branch)
+        return kernels.fourbar_coupler_point(t, o, st_, q, omega, alpha, u, v), o, st_
+
+    cp, out, st0 = point(theta)
+    ok = (st0 == OK) & (np.sin(out[:, 2]) > 0.2)
+    if not ok.any():
+        return
+    a, b, pp = out[ok, 3:5], out[ok, 5:7], cp[ok, :2]
+    scale = max(p, q, r, s, abs(u), abs(v))
+    assert np.allclose(np.hypot(*(pp - a).T), math.hypot(u, v), atol=1e-11 * scale)
+    assert np.allclose(np.hypot(*(pp - b).T), math.hypot(r - u, v), atol=1e-11 * scale)
+    cross = (b - a)[:, 0] * (pp - a)[:, 1] - (b - a)[:, 1] * (pp - a)[:, 0]   # = r v: P left of A->B when v > 0
+    assert np.allclose(cross, r * v, atol=1e-10 * scale**2)
+    cpp, _, stp = point(theta + h)
+    cpm, _, stm = point(theta - h)
+    good = ok & (stp == OK) & (stm == OK)
+    if not good.any():
+        return
+    vel = omega * (cpp[good, :2] - cpm[good, :2]) / (2 * h)                          # dP/dt at constant omega
+    tol = 1e-5 * (1 + omega**2 + abs(alpha)) * scale / np.sin(out[good, 2])[:, None] ** 3
+    assert np.all(np.abs(cp[good, 2:4] - vel) <= tol)
+    # a_P = omega^2 d2P/dtheta2 + alpha dP/dtheta
+    d2 = (cpp[good, :2] - 2 * cp[good, :2] + cpm[good, :2]) / h**2
+    acc = omega**2 * d2 + alpha * (cpp[good, :2] - cpm[good, :2]) / (2 * h)
+    assert np.all(np.abs(cp[good, 4:6] - acc) <= 1e3 * tol)
