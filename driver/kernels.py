@@ -101,6 +101,16 @@ def _pair(x, n: int) -> np.ndarray:
     return farray(np.broadcast_to(np.asarray(x, dtype=np.float64), (n, 2)), 2)
 
 
+def _arm_inputs(l1, l2, th1, th2, qd, qdd, m1, m2, mass_per_length: float) -> tuple:
+    """Kernel arguments of the 2R routines: every input broadcast to n rows, masses defaulted
+    to ``mass_per_length`` times the link length."""
+    n = max(np.size(l1), np.size(l2), np.size(th1), np.size(th2))
+    l1v, l2v = _col(l1, n), _col(l2, n)
+    m1v = _col(mass_per_length * l1v if m1 is None else m1, n)
+    m2v = _col(mass_per_length * l2v if m2 is None else m2, n)
+    return l1v, l2v, _col(th1, n), _col(th2, n), _pair(qd, n), _pair(qdd, n), m1v, m2v
+
+
 def manipulator_arm_states(l1, l2, th1, th2, qd=(1.0, 1.0), qdd=(1.0, 1.0), m1=None, m2=None,
                            g: float = 9.8, mass_per_length: float = 10.0):
     """Jacobian, manipulability, condition number and torques of 2R configurations.
@@ -111,12 +121,8 @@ def manipulator_arm_states(l1, l2, th1, th2, qd=(1.0, 1.0), qdd=(1.0, 1.0), m1=N
     Returns (jac (n, 4) = J11, J12, J21, J22 [m] of eq. 4.18, w = |det J| [m^2],
     kappa = sigma_max/sigma_min (0 where J is singular), tau (n, 2) [N m]).
     """
-    n = max(np.size(l1), np.size(l2), np.size(th1), np.size(th2))
-    l1v, l2v = _col(l1, n), _col(l2, n)
-    m1v = _col(mass_per_length * l1v if m1 is None else m1, n)
-    m2v = _col(mass_per_length * l2v if m2 is None else m2, n)
-    return _kernels.manipulator.arm_states(l1v, l2v, _col(th1, n), _col(th2, n), _pair(qd, n),
-                                           _pair(qdd, n), m1v, m2v, float(g))
+    return _kernels.manipulator.arm_states(*_arm_inputs(l1, l2, th1, th2, qd, qdd, m1, m2, mass_per_length),
+                                           float(g))
 
 
 def manipulator_torques(l1, l2, th1, th2, qd=(1.0, 1.0), qdd=(1.0, 1.0), m1=None, m2=None,
@@ -125,12 +131,8 @@ def manipulator_torques(l1, l2, th1, th2, qd=(1.0, 1.0), qdd=(1.0, 1.0), m1=None
 
     Same inputs and units as :func:`manipulator_arm_states`.
     """
-    n = max(np.size(l1), np.size(l2), np.size(th1), np.size(th2))
-    l1v, l2v = _col(l1, n), _col(l2, n)
-    m1v = _col(mass_per_length * l1v if m1 is None else m1, n)
-    m2v = _col(mass_per_length * l2v if m2 is None else m2, n)
-    return _kernels.manipulator.craig_torques(l1v, l2v, _col(th1, n), _col(th2, n), _pair(qd, n),
-                                              _pair(qdd, n), m1v, m2v, float(g))
+    return _kernels.manipulator.craig_torques(*_arm_inputs(l1, l2, th1, th2, qd, qdd, m1, m2, mass_per_length),
+                                              float(g))
 
 
 def manipulator_ik(l1, l2, x, y, branch: int = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

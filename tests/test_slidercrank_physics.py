@@ -43,6 +43,17 @@ def _rod(name: str) -> tuple[float, float, float]:
         t["youngs_modulus_pa"] * t["second_moment_m4"]
 
 
+
+
+def dense(ab: np.ndarray) -> np.ndarray:
+    """Symmetric dense matrix from LAPACK lower band storage (test helper)."""
+    nq = ab.shape[1]
+    a = np.zeros((nq, nq))
+    for d in range(ab.shape[0]):
+        idx = np.arange(nq - d)
+        a[idx + d, idx] = ab[d, : nq - d]
+        a[idx, idx + d] = ab[d, : nq - d]
+    return a
 # --------------------------------------------------------------------------- oracles (test-only)
 
 
@@ -192,14 +203,6 @@ def test_first_natural_frequencies(name):
     n = 16
     mb, kb = K.slidercrank_matrices(n, R2, L, rho_a, ea, ei, MS, 0.0)
 
-    def dense(ab: np.ndarray) -> np.ndarray:
-        nq = ab.shape[1]
-        a = np.zeros((nq, nq))
-        for d in range(ab.shape[0]):
-            idx = np.arange(nq - d)
-            a[idx + d, idx] = ab[d, : nq - d]
-            a[idx, idx + d] = ab[d, : nq - d]
-        return a
 
     m, k = dense(mb), dense(kb)
     lam, vec = eigh(k, m)
@@ -326,13 +329,7 @@ def test_geometric_stiffness_buckles_at_the_rayleigh_load(name):
 
     def lowest(w: float) -> float:
         _, kb = K.slidercrank_matrices(16, R2, L, rho_a, ea, ei, MS, math.pi, w, geometric_stiffness=True)
-        nq = kb.shape[1]
-        k = np.zeros((nq, nq))
-        for d in range(kb.shape[0]):
-            i = np.arange(nq - d)
-            k[i + d, i] = kb[d, : nq - d]
-            k[i, i + d] = kb[d, : nq - d]
-        return float(np.linalg.eigvalsh(k)[0])
+        return float(np.linalg.eigvalsh(dense(kb))[0])
 
     assert lowest(0.99 * w_crit) > 0
     assert lowest(1.01 * w_crit) < 0
