@@ -110,11 +110,14 @@ def test_results_do_not_depend_on_scheduling(tmp_path):
 
 def test_dask_local_cluster_gives_identical_tables(tmp_path):
     distributed = pytest.importorskip("distributed")
+    import dask
     path = deck(tmp_path, SWEEP_GRID)
     local = tmp_path / "local"
     assert main([str(path), "-o", str(local), "-q", "-j", "2"]) == 0
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
-                                  dashboard_address=None) as cluster:
+    # generous timeouts: worker start-up and connections are slow on a loaded CI machine
+    with dask.config.set({"distributed.comm.timeouts.connect": "120s", "distributed.comm.timeouts.tcp": "120s"}), \
+            distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                     dashboard_address=None) as cluster:
         dsk = tmp_path / "dask"
         assert main([str(path), "-o", str(dsk), "-q", "--scheduler", cluster.scheduler_address]) == 0
     tl, td = _tables(local, "sw"), _tables(dsk, "sw")
@@ -199,7 +202,7 @@ def test_ctrl_c_on_worker_processes(tmp_path):
     t0 = time.time()
     proc.communicate(timeout=60)
     assert proc.returncode == 130
-    assert time.time() - t0 < 10
+    assert time.time() - t0 < 30          # prompt (0.2 s measured); generous for a loaded CI machine
     names = [p.name for p in case_dir.iterdir()]
     assert not [n for n in names if n.startswith(".") or n.endswith(".tmp")]
     done = {n[:-5] for n in names if n.endswith(".json")}
