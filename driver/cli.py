@@ -8,69 +8,19 @@ from __future__ import annotations
 
 import argparse
 import os
-import pkgutil
 import sys
 import traceback
 from pathlib import Path
-from types import ModuleType
 
 import driver
-from driver.atomic import write_text
-from driver.deck import Deck, DeckError, Params, read_deck, validate
-from driver.export import FORMATS, write_tidy
-from driver.study import Result, load_study
+from driver.deck import DeckError, read_deck
+from driver.export import FORMATS
+from driver.runner import available_studies, run_study
+from driver.study import load_study
 
-__all__ = ["main", "study_of", "write_outputs", "run_deck", "EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT"]
+__all__ = ["main", "run_deck", "EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT"]
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
-
-#: groups handled by the driver itself rather than by a study module
-CONTROL_GROUPS = ("sweep",)
-
-
-def available_studies() -> dict[str, ModuleType]:
-    """Every study module in the package, by group name."""
-    found = {}
-    for info in pkgutil.iter_modules(driver.__path__):
-        module = load_study(info.name)
-        if module is not None:
-            found[info.name] = module
-    return found
-
-
-def study_of(deck: Deck) -> tuple[ModuleType, Params]:
-    """The single study group of a deck, validated; DeckError otherwise."""
-    studies = []
-    for name, raw in deck.groups.items():
-        if name in CONTROL_GROUPS:
-            continue
-        module = load_study(name)
-        if module is None:
-            known = ", ".join(f"&{g}" for g in sorted(available_studies()) + list(CONTROL_GROUPS))
-            raise DeckError(deck.path, raw.line, None, f"unknown group &{name} (known groups: {known})")
-        studies.append((module, raw))
-    if not studies:
-        raise DeckError(deck.path, None, None, "deck has no study group")
-    if len(studies) > 1:
-        names = ", ".join(f"&{raw.name} (line {raw.line})" for _, raw in studies)
-        raise DeckError(deck.path, studies[1][1].line, None,
-                        f"a deck describes one study; found {names}")
-    module, raw = studies[0]
-    return module, validate(raw, module.SPEC, deck.path)
-
-
-def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool) -> list[Path]:
-    """Write the .out file, extra files, tidy tables and figures for one case (all atomic)."""
-    written = [write_text(stem.with_name(stem.name + ".out"), result.text)]
-    for suffix, text in result.extra.items():
-        written.append(write_text(stem.with_name(stem.name + suffix), text))
-    for fmt in formats:
-        written.append(write_tidy(result.tidy, stem, fmt))
-    if plot and result.figures:
-        from driver.plotting import save_figure
-        for fig in result.figures:
-            written.append(save_figure(fig.draw(), stem.with_name(f"{stem.name}_{fig.name}.png")))
-    return written
 
 
 def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool, progress: bool,
@@ -84,8 +34,7 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool, progress:
         if "sweep" in deck.groups:
             from driver import sweep
             return sweep.run_sweep_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))
-        module, params = study_of(deck)
-        result = module.run(params, progress=progress)
+        outcome = run_study(deck, outdir, formats, plot, progress)
     except DeckError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -96,11 +45,11 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool, progress:
         if os.environ.get("DRIVER_DEBUG"):
             traceback.print_exc()
         return EXIT_FAILED
+    result = outcome.result
     for w in result.warnings:
         print(f"warning: {path}: {w}", file=sys.stderr)
-    written = write_outputs(result, outdir / Path(path).stem, formats, plot)
     if not quiet:
-        for p in written:
+        for p in outcome.written:
             print(f"wrote {p}")
     if result.failure:
         print(f"error: {path}: {result.failure}", file=sys.stderr)

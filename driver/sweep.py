@@ -45,6 +45,7 @@ import pandas as pd
 from driver.atomic import write_text
 from driver.deck import Deck, DeckError, GroupSpec, Key, Params, RawGroup, validate
 from driver.export import write_tidy
+from driver.runner import study_of, write_outputs
 from driver.study import load_study
 from driver.table import Column, render_table
 
@@ -270,7 +271,6 @@ def _write_case(task: Task, case: Case, res: CaseResult, result, params: Params,
             if result.failure:
                 res.status, res.error = EXIT_FAILED, result.failure
         res.warnings = list(result.warnings)
-        from driver.cli import write_outputs
         stem = Path(task.case_dir) / _case_name(case.index, task.width)
         write_text(stem.with_suffix(".dat"), _case_deck_text(task.raw.name, params, case, Path(task.deck_path)))
         tidy = result.tidy.copy()
@@ -480,7 +480,6 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
                    quiet: bool = False, jobs: int | None = None, scheduler: Any = None,
                    resume: bool = False) -> int:
     """Run a deck with a &sweep group; returns the exit status (see driver.cli)."""
-    from driver.cli import study_of  # the one place that picks and validates the study group
     sw = validate(deck.groups["sweep"], SPEC, deck.path)
     study_raw = {n: g for n, g in deck.groups.items() if n != "sweep"}
     module, base_params = study_of(Deck(deck.path, study_raw))   # the base deck must be valid on its own

@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from driver import kernels
-from driver.cli import study_of
+from driver.runner import study_of
 from driver.deck import read_deck
 from driver.manipulator import _sensitivity_blocks, tolerance_box
 

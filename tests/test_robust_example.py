@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from driver.cli import study_of
+from driver.runner import study_of
 from driver.deck import read_deck
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from driver.cli import study_of
+from driver.runner import study_of
 from driver.deck import read_deck
 from driver.kernels import UJOINT_MODELS, ujoint_speed
 
