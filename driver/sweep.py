@@ -42,6 +42,7 @@ import f90nml
 import numpy as np
 import pandas as pd
 
+from driver import expr
 from driver.atomic import write_text
 from driver.deck import Deck, DeckError, GroupSpec, Key, Params, RawGroup, validate
 from driver.export import write_tidy
@@ -65,7 +66,8 @@ def _spec() -> GroupSpec:
         keys[f"count{k}"] = Key("int", doc="number of values from start to stop")
     keys.update({
         "zip": Key("bool", default=False, doc=".true.: vary the keys together instead of a full grid"),
-        "keep": Key("str", default="", doc="pandas query on the summary table (swept keys in backticks)"),
+        "keep": Key("str", default="", doc="filter on the summary columns in the deck expression language (driver.expr): "
+                    "comparisons, and/or/not, arithmetic, abs/min/max/sqrt...; swept keys as group.key"),
         "case_outputs": Key("str", default="all", choices=("all", "kept", "none"),
                             doc="which cases get their own .out/.parquet/.json files"),
         "summary_rows": Key("str", default="all", choices=("all", "kept"),
@@ -205,17 +207,17 @@ def _case_name(index: int, width: int) -> str:
     return f"case_{index:0{width}d}"
 
 
-def _kept(keep: str, values: dict, summary: dict, strict: bool = False) -> bool:
-    """Whether a case passes the deck's ``keep`` filter (a pandas query on its summary row)."""
+def _keep_mask(keep: str, rows: pd.DataFrame) -> np.ndarray:
+    """The deck's ``keep`` filter (safe expression language, :mod:`driver.expr`) on summary rows.
+
+    A row whose figures are missing (a failed case) is not kept.
+    """
     if not keep:
-        return True
-    row = pd.DataFrame([{**values, **summary}])
+        return np.ones(len(rows), dtype=bool)
     try:
-        return bool(len(row.query(keep)))
-    except (NameError, KeyError, TypeError):   # a figure missing or None for this case: not kept
-        if strict:
-            raise
-        return False
+        return expr.parse(keep).mask(rows)
+    except expr.ExprError:   # a column absent from every row of this chunk: nothing kept
+        return np.zeros(len(rows), dtype=bool)
 
 
 def _json_default(o: Any) -> Any:
@@ -250,16 +252,12 @@ def _compute(task: Task, case: Case, module) -> tuple[CaseResult, Any, Params | 
 
 
 def _kept_many(keep: str, results: list[CaseResult]) -> list[bool]:
-    """The keep filter on a chunk of cases at once (one pandas query per chunk, not per case)."""
+    """The keep filter on a chunk of cases at once (vectorised over the chunk)."""
     ok = [r.status == EXIT_OK for r in results]
-    if not keep:
+    if not keep or not results:
         return ok
     rows = pd.DataFrame([{**r.values, **r.summary} for r in results])
-    try:
-        hit = set(rows.query(keep).index)
-        return [o and i in hit for i, o in enumerate(ok)]
-    except (NameError, KeyError, TypeError):   # some case lacks a figure: decide one by one
-        return [o and _kept(keep, r.values, r.summary) for o, r in zip(ok, results)]
+    return [o and bool(k) for o, k in zip(ok, _keep_mask(keep, rows))]
 
 
 def _write_case(task: Task, case: Case, res: CaseResult, result, params: Params, module) -> None:
@@ -486,14 +484,13 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
     raw = study_raw[base_params.group]
     cases = build_cases(sw, base_params.group, module.SPEC)
     names = list(cases[0].values)
-    if sw.keep:   # check the filter on the base deck's summary before running anything
+    if sw.keep:   # check the filter on the base deck's summary columns before running anything
         probe = (module.summarise(base_params) if hasattr(module, "summarise")
                  else module.run(base_params).summary)
         try:
-            _kept(sw.keep, cases[0].values, probe, strict=True)
-        except Exception as exc:
-            raise sw.error("keep", f"not a valid filter on the summary columns "
-                                   f"({', '.join([*names, *probe])}): {exc}") from None
+            expr.parse(sw.keep, [*names, *probe])
+        except expr.ExprError as exc:
+            raise sw.error("keep", f"{exc.message}" + (f" (at '{exc.token}')" if exc.token else "")) from None
     stem = Path(deck.path).stem
     case_dir = outdir / stem
     width = max(4, len(str(len(cases))))

@@ -63,7 +63,7 @@ def test_case_counts(tmp_path, text, n):
     ("&sweep\n key1 = 'fourbar.crank' /\n", 6, "key1", "needs values1"),
     ("&sweep\n values1 = 2, 3 /\n", 6, "values1", "without key1"),
     ("&sweep\n key1 = 'fourbar.crank', start1 = 1, stop1 = 2 /\n", 5, "count1", "go together"),
-    ("&sweep\n key1 = 'fourbar.crank', values1 = 2\n keep = 'no_such_column > 1' /\n", 7, "keep", "not a valid filter"),
+    ("&sweep\n key1 = 'fourbar.crank', values1 = 2\n keep = 'no_such_column > 1' /\n", 7, "keep", "unknown column 'no_such_column'"),
 ])
 def test_sweep_deck_errors(tmp_path, capsys, text, line, key, words):
     path = deck(tmp_path, text)
@@ -212,3 +212,15 @@ def test_ctrl_c_on_worker_processes(tmp_path):
     res = subprocess.run(cmd + ["--resume"], capture_output=True, text=True)
     assert res.returncode == 0
     assert len(pd.read_csv(out / "sw_summary.csv")) == 900
+
+
+def test_keep_filter_is_never_code(tmp_path, capsys):
+    """A keep filter that would run a command under a pandas query is a deck error; no canary file."""
+    canary = tmp_path / "canary"
+    for keep in (f'@os.system("touch {canary}") == 1', f'__import__("os").system("touch {canary}")',
+                 "@time.sleep(30) is None", f'open("{canary}", "w").close() is None'):
+        deck = tmp_path / "inject.dat"
+        deck.write_text(BASE + f"&sweep\n key1 = 'fourbar.crank', values1 = 2, 3\n keep = '{keep}' /\n")
+        assert main([str(deck), "-o", str(tmp_path / "out"), "-q", "-j", "1"]) == 2
+        assert "key 'keep'" in capsys.readouterr().err
+    assert not canary.exists() and not (tmp_path / "out" / "inject.out").exists()
