@@ -142,10 +142,103 @@ def _one_digit_apart(a: str, b: str, column: str) -> bool:
         return False
 
 
+# ----------------------------------------------------------------------------- printed numbers
+
+def _numeric_cell(table: str, row: str, column: str, printed: str, value: float | None,
+                  flagged: str | None, departs: str | None) -> dict:
+    """One printed number against a computed one (None/NaN: the run leaves the cell blank).
+
+    ``flagged``: why the printed value is known not to be reproducible; ``departs``: why the
+    deck's correct answer differs (None when the deck reproduces the published conventions).
+    """
+    blank = value is None or not np.isfinite(value)
+    if printed == "":
+        comp = "" if blank else f"{value:g}"
+        return _cell(table, row, column, "", comp, "identical" if blank else "differs",
+                     "" if blank else "the report leaves this cell blank (target out of reach)")
+    if blank:
+        return _cell(table, row, column, printed, "", "not reproducible" if flagged else
+                     ("departs" if departs else "differs"), flagged or departs or "the run leaves this cell blank")
+    comp = f"{value:.{_decimals(printed)}f}"
+    if comp.startswith("-") and float(comp) == 0.0:
+        comp = comp[1:]
+    if agrees_printed(value, printed):
+        return _cell(table, row, column, printed, comp, "identical" if comp == printed else "agrees")
+    if flagged:
+        return _cell(table, row, column, printed, comp, "not reproducible", flagged)
+    if departs:
+        return _cell(table, row, column, printed, comp, "departs", departs)
+    return _cell(table, row, column, printed, comp, "differs", "")
+
+
+def _manipulator(params: Params, result: Result) -> list[dict]:
+    from driver import manipulator as m
+    tidy, s = result.tidy, result.summary
+    exact = params.mode == "exact"
+    text_values = {
+        "r_squared": s["r_m"] ** 2, "R_squared": s["R_m"] ** 2, "crob_radius": s["crob_radius_m"],
+        "crob_c_sweep": s["crob_radius_m"] ** 2,
+        "dexterity_l1": s["dexterity_l1_m"], "dexterity_l2": s["dexterity_l2_m"],
+        "manipulability_l1": s["manipulability_l1_m"], "manipulability_l2": s["manipulability_l2_m"],
+        "manipulability_l1_t44": None,
+        "min_total_torque": s.get("sweep_min_total_torque_Nm"), "min_total_l1": s.get("sweep_min_l1_m"),
+        "min_total_l2": s.get("sweep_min_l2_m")}
+    t44 = tidy[tidy["table"] == "4.4"]
+    if len(t44) > 1:
+        text_values["manipulability_l1_t44"] = float(t44["l1_m"].iloc[1])
+    cells = []
+    for path in published.records("manipulator"):
+        pub = published.read_blocks(path)
+        if not published.matches(pub.match, params):
+            continue
+        for rec in pub.cells.itertuples():
+            table = str(rec.table)
+            if table == "Text values":
+                value = text_values.get(str(rec.row))
+                why_exact = m.TEXT_REASONS.get(str(rec.row), "follows from the cells above") if exact else None
+                cells.append(_numeric_cell(table, rec.row, "value", rec.printed, value, None, why_exact))
+                continue
+            number = table.split()[-1]
+            key_t = "4.1" if number == "4.3" else number
+            rows = tidy[tidy["table"] == key_t]
+            label = str(rec.row)
+            if label.endswith("."):
+                k = int(label[:-1]) - 1
+            else:
+                k = next((i for i, v in enumerate(rows["label"]) if v == label), -1)
+            value = None
+            if 0 <= k < len(rows):
+                v = rows[m.TIDY_NAMES.get(rec.column, rec.column)].iloc[k]
+                value = None if v is None else float(v)
+            flagged = m.NOT_REPRODUCIBLE.get((key_t, label, rec.column, rec.printed))
+            departs = m.REASONS.get((key_t, rec.column), "follows from the cells above") if exact else None
+            cells.append(_numeric_cell(table, label, rec.column, rec.printed, value, flagged, departs))
+    return cells
+
+
+def _robust_example(params: Params, result: Result) -> list[dict]:
+    from driver import robust_example as rx
+    tidy = result.tidy
+    values = {(str(r.item), int(r.index)): float(r.value) for r in tidy.itertuples()}
+    exact = params.mode == "exact"
+    cells = []
+    for path in published.records("robust_example"):
+        pub = published.read_blocks(path)
+        for rec in pub.cells.itertuples():
+            item, index = str(rec.row).rstrip("]").split("[")
+            key = (item, int(index))
+            departs = rx.MODE_REASONS.get(item, "follows from the unrounded fits") if exact else None
+            cells.append(_numeric_cell(f"Section 2.3 {rec.note}", rec.row, "value", rec.printed, values.get(key),
+                                       rx.NOT_REPRODUCIBLE.get(key), departs))
+    return cells
+
+
 # ----------------------------------------------------------------------------- driver
 
 _COMPARERS: dict[str, Callable[[Params, Result], list[dict]]] = {
     "fourbar": _fourbar,
+    "manipulator": _manipulator,
+    "robust_example": _robust_example,
 }
 
 
@@ -154,6 +247,14 @@ class Comparison:
 
     def __init__(self, deck: Path, group: str, frame: pd.DataFrame, params: Params):
         self.deck, self.group, self.frame, self.params = deck, group, frame, params
+
+    @property
+    def variant(self) -> str:
+        """The deck's mode or method (``mode = 'report'``), or '' for a study without one."""
+        for key in ("mode", "method"):
+            if key in self.params:
+                return f"{key} = '{self.params[key]}'"
+        return ""
 
     @property
     def ok(self) -> bool:
@@ -217,13 +318,14 @@ def compare_text(cmp: Comparison) -> list[str]:
 def totals_text(comparisons: list[Comparison]) -> list[str]:
     """One total line per study over several decks."""
     lines = []
-    by_group: dict[str, list[pd.DataFrame]] = {}
+    by_group: dict[tuple[str, str], list[pd.DataFrame]] = {}
     for c in comparisons:
         if not c.frame.empty:
-            by_group.setdefault(c.group, []).append(c.frame)
-    for group, frames in by_group.items():
+            by_group.setdefault((c.group, c.variant), []).append(c.frame)
+    for (group, variant), frames in by_group.items():
         f = pd.concat(frames, ignore_index=True)
-        lines.append(f"  &{group} ({len(frames)} deck{'s' if len(frames) > 1 else ''}): "
+        what = f"&{group}" + (f" {variant}" if variant else "")
+        lines.append(f"  {what} ({len(frames)} deck{'s' if len(frames) > 1 else ''}): "
                      + _table_line("", f).lstrip(": "))
     return lines
 

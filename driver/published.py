@@ -18,7 +18,7 @@ from pathlib import Path
 import pandas as pd
 
 __all__ = ["PUBLISHED_DIR", "Published", "PublishedError", "match_line", "records", "read_listing",
-           "matches"]
+           "read_blocks", "matches", "listing_rows", "LISTING_COLUMNS"]
 
 #: the folder of published tables (next to ``outputs/`` in the source tree)
 PUBLISHED_DIR = Path(__file__).resolve().parents[1] / "published"
@@ -77,19 +77,24 @@ def records(group: str, folder: Path | None = None) -> list[Path]:
 
 
 def matches(match: dict[str, str], values: dict[str, object], rel: float = 1e-12) -> bool:
-    """Whether deck ``values`` equal a file's ``match`` values (numbers compared as numbers)."""
+    """Whether deck ``values`` equal a file's ``match`` values (numbers compared as numbers,
+    comma-separated lists element by element)."""
     for key, text in match.items():
         if key not in values:
             return False
-        v = values[key]
-        try:
-            a, b = float(text), float(v)  # type: ignore[arg-type]
-        except (TypeError, ValueError):
-            if str(v).strip().lower() != text.strip().lower():
-                return False
-            continue
-        if abs(a - b) > rel * max(1.0, abs(a)):
+        want = text.split(",")
+        got = values[key] if isinstance(values[key], (list, tuple)) else [values[key]]
+        if len(want) != len(got):
             return False
+        for t, v in zip(want, got):
+            try:
+                a, b = float(t), float(v)  # type: ignore[arg-type]
+            except (TypeError, ValueError):
+                if str(v).strip().lower() != t.strip().lower():
+                    return False
+                continue
+            if abs(a - b) > rel * max(1.0, abs(a)):
+                return False
     return True
 
 
@@ -133,3 +138,42 @@ def read_listing(path: Path) -> Published:
         for col, value in zip(LISTING_COLUMNS, row):
             recs.append({"table": name, "row": row[0], "column": col, "printed": value})
     return Published(name, path, group, match, pd.DataFrame.from_records(recs))
+
+
+# ----------------------------------------------------------------------------- titled blocks
+
+def read_blocks(path: Path) -> Published:
+    """A file of titled tables (the manipulator report, section 2.3, the Hooke-joint paper, ...).
+
+    A block is a title line starting in column 1 (``Table 4.8  ...``, ``Text values``), a dashed
+    underline, a column line, and rows up to the next blank line.  The first column is the row
+    label; a row with fewer fields than columns has its last cells blank (printed blank); a last
+    column named ``where`` takes the rest of the line (where in the paper the value is printed).
+    The table name is the title up to two spaces (``Table 4.8``).
+    """
+    path = Path(path)
+    group, match = match_line(path)
+    lines = path.read_text().splitlines()
+    recs = []
+    k = 0
+    while k < len(lines):
+        line = lines[k]
+        if (line[:1].isalpha() and k + 2 < len(lines) and lines[k + 1].startswith("---")
+                and not line.startswith("match:")):
+            table = line.split("  ")[0].strip()
+            header = lines[k + 2].split()
+            free = header[-1] == "where"
+            k += 3
+            while k < len(lines) and lines[k].strip():
+                fields = lines[k].split(None, len(header) - 1) if free else lines[k].split()
+                if len(fields) > len(header):
+                    raise PublishedError(f"{path}: line {k + 1} has {len(fields)} fields for {len(header)} columns")
+                fields += [""] * (len(header) - len(fields))
+                note = fields[-1].strip() if free else ""
+                for col, value in zip(header[1:len(header) - free], fields[1:len(fields) - free]):
+                    recs.append({"table": table, "row": fields[0], "column": col, "printed": value, "note": note})
+                k += 1
+        k += 1
+    if not recs:
+        raise PublishedError(f"{path}: no table found")
+    return Published(path.stem, path, group, match, pd.DataFrame.from_records(recs))
