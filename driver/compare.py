@@ -266,11 +266,12 @@ def run_comparison(deck: str | Path) -> Comparison:
     """Run ``deck`` in memory and compare it with its published tables (DeckError for bad input)."""
     path = Path(deck)
     d = read_deck(path)
-    if "sweep" in d.groups:
-        from driver.deck import DeckError
-        raise DeckError(path, d.groups["sweep"].line, None,
-                        "--compare takes single-case decks; the published tables belong to the single-case "
-                        "paper decks (a sweep's cases are compared by comparing their case decks)")
+    for control in ("sweep", "optimize"):
+        if control in d.groups:
+            from driver.deck import DeckError
+            raise DeckError(path, d.groups[control].line, None,
+                            f"--compare takes single-case decks, not a &{control} deck; the published tables "
+                            "belong to the single-case paper decks (compare a case's written .dat deck instead)")
     module, params = study_of(d)
     group = module.SPEC.name
     comparer = _COMPARERS.get(group)
