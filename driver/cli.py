@@ -49,6 +49,9 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool, progress:
     """
     try:
         deck = read_deck(path)
+        if "synthesis" in deck.groups:
+            from driver import synthesis
+            return synthesis.run_synthesis_deck(deck, outdir, formats, plot, progress, quiet)
         if "optimize" in deck.groups:
             from driver import optimize
             return optimize.run_optimize_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))

@@ -266,7 +266,7 @@ def run_comparison(deck: str | Path) -> Comparison:
     """Run ``deck`` in memory and compare it with its published tables (DeckError for bad input)."""
     path = Path(deck)
     d = read_deck(path)
-    for control in ("sweep", "optimize"):
+    for control in ("sweep", "optimize", "synthesis"):
         if control in d.groups:
             from driver.deck import DeckError
             raise DeckError(path, d.groups[control].line, None,

@@ -26,7 +26,7 @@ __all__ = ["CONTROL_GROUPS", "Outcome", "available_studies", "study_of", "run_st
            "output_stem", "check_finite", "compute", "numerical_error"]
 
 #: groups handled by the driver itself rather than by a study module
-CONTROL_GROUPS = ("sweep", "optimize")
+CONTROL_GROUPS = ("sweep", "optimize", "synthesis")
 
 
 def available_studies() -> dict[str, ModuleType]:
