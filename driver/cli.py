@@ -17,6 +17,7 @@ import traceback
 from pathlib import Path
 
 import driver
+from driver import limits
 from driver.deck import DeckError, read_deck
 from driver.export import FORMATS
 from driver.runner import CONTROL_GROUPS, available_studies, run_study
@@ -142,6 +143,12 @@ def build_parser() -> argparse.ArgumentParser:
                         help="sweeps: run cases on this Dask distributed scheduler")
     parser.add_argument("--resume", action="store_true",
                         help="sweeps: skip cases whose outputs are already complete; optimisations: replay the run's journal and compute only new designs")
+    parser.add_argument("--max-memory", metavar="SIZE", default=None,
+                        help="refuse a deck (a sweep case) whose estimated memory is larger "
+                             "(e.g. 8G, 512M; default: half of this machine's memory)")
+    parser.add_argument("--max-work", metavar="SECONDS", default=None,
+                        help="refuse a deck (a sweep case) whose estimated work is longer "
+                             "(e.g. 600, 30min, 2h; default: 2 min)")
     parser.add_argument("--version", action="version", version=f"%(prog)s {driver.__version__}")
     return parser
 
@@ -164,6 +171,10 @@ def main(argv: list[str] | None = None) -> int:
         except BrokenPipeError:
             sys.stderr.close()
             return EXIT_OK
+    try:
+        configured = limits.configure(args.max_memory, args.max_work)
+    except ValueError as exc:
+        parser.error(str(exc))
     formats = list(dict.fromkeys((["csv"] if args.csv else []) + args.formats))
     progress = sys.stderr.isatty() and not args.quiet and not os.environ.get("CI")
     sweep_options = {"jobs": args.jobs, "scheduler": args.scheduler, "resume": args.resume}
@@ -183,6 +194,7 @@ def main(argv: list[str] | None = None) -> int:
         return 143 if isinstance(exc, Terminated) else 130
     finally:
         _restore_signals(handlers)
+        limits.restore(configured)
     return status
 
 

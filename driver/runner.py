@@ -15,6 +15,7 @@ from types import ModuleType
 import numpy as np
 
 import driver
+from driver import limits
 from driver.atomic import inside, output_set, remove_stale_temporaries, write_text
 from driver.deck import Deck, DeckError, Params
 from driver.deck import validate
@@ -151,8 +152,10 @@ def check_finite(result: Result, params: Params) -> Result:
 
 
 def compute(module: ModuleType, params: Params, progress: bool = False) -> Result:
-    """``module.run(params)`` with numerical failures turned into deck errors and the result
-    checked for non-finite numbers (no NaN, inf or '****' ever reaches a table)."""
+    """``module.run(params)`` within the budget (:mod:`driver.limits`), with numerical failures
+    turned into deck errors and the result checked for non-finite numbers (no NaN, inf or '****'
+    ever reaches a table)."""
+    limits.check(module, params)   # absurd requests are refused before anything is allocated
     try:
         with np.errstate(all="ignore"):
             result = module.run(params, progress=progress)

@@ -43,7 +43,7 @@ import f90nml
 import numpy as np
 import pandas as pd
 
-from driver import expr
+from driver import expr, limits
 from driver.atomic import output_set, remove_stale_temporaries, write_text
 from driver.deck import Deck, DeckError, GroupSpec, Key, Params, RawGroup, validate
 from driver.export import write_tidy
@@ -221,7 +221,7 @@ def validate_sweep(sw: Params, raw: RawGroup, module: Any, cases: list[Case]) ->
     and every case too for sweeps up to FULL_VALIDATION cases (else the grid's corners)."""
     def check(values: dict[str, Any], case_no: int | None) -> None:
         try:
-            validate(_case_raw(raw, Case(0, values)), module.SPEC, sw.path)
+            limits.check(module, validate(_case_raw(raw, Case(0, values)), module.SPEC, sw.path), "each case ")
         except DeckError as exc:
             name = next((n for n in values if n.partition(".")[2] == exc.key), next(iter(values)))
             key, line = _axis_line(sw, name)
