@@ -7,10 +7,12 @@ so nothing is drawn unless ``--plot`` is given.
 """
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 from typing import Sequence
 
 import matplotlib
+import matplotlib.ticker
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -18,6 +20,7 @@ import numpy as np  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
 from driver.atomic import atomic_open  # noqa: E402
+from driver.study import PLOT_FORMATS, plot_format  # noqa: E402
 
 __all__ = ["new_figure", "save_figure", "line_panels"]
 
@@ -32,11 +35,29 @@ def new_figure(nrows: int = 1, ncols: int = 1, **kw) -> tuple[Figure, np.ndarray
     return fig, axes.ravel()
 
 
-def save_figure(fig: Figure, path: str | Path) -> Path:
-    """Write ``fig`` as PNG to ``path`` atomically."""
+#: metadata written into every figure file: no dates, no software versions, so the same
+#: inputs give byte-identical files (PNG, SVG and PDF alike)
+_METADATA = {"png": {"Software": None},
+             "svg": {"Date": None, "Creator": None},
+             "pdf": {"Creator": None, "Producer": None, "CreationDate": None}}
+#: fixed seed for the ids matplotlib writes into SVG files (otherwise random per run)
+_SVG_SALT = "driver-figures"
+
+
+def save_figure(fig: Figure, path: str | Path, fmt: bool | str | None = None) -> Path:
+    """Write ``fig`` to ``path`` atomically and reproducibly (no dates or versions inside).
+
+    ``fmt`` is a format of :data:`driver.study.PLOT_FORMATS` (``True`` or None: PNG, or the
+    format of ``path``'s suffix when that is one); ``path``'s suffix is replaced by it.
+    Returns the path written.
+    """
     path = Path(path)
-    with atomic_open(path, "wb") as fh:
-        fig.savefig(fh, format="png")
+    if fmt is None or fmt is True:
+        fmt = path.suffix.lstrip(".").lower() if path.suffix.lstrip(".").lower() in PLOT_FORMATS else "png"
+    fmt = plot_format(fmt)
+    path = path.with_suffix(f".{fmt}")
+    with matplotlib.rc_context({"svg.hashsalt": _SVG_SALT}), atomic_open(path, "wb") as fh:
+        fig.savefig(fh, format=fmt, metadata=_METADATA[fmt])
     return path
 
 
@@ -177,78 +198,132 @@ def manipulator_torque_crob(l1: np.ndarray, tau1: np.ndarray, tau2: np.ndarray, 
 
 # ----------------------------------------------------------------------------- sweep
 
-def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (), title: str = "") -> Figure:
-    """Summary of a sweep: chosen (or all numeric) headline figures against a swept key.
+def _trivial(y, x, chosen) -> bool:
+    """A panel that shows nothing: a constant column, the x column again, or a column already shown."""
+    import pandas as pd
+    v = pd.to_numeric(y, errors="coerce").to_numpy(dtype=float)
+    fin = v[np.isfinite(v)]
+    if fin.size == 0 or np.ptp(fin) <= 1e-12 * max(1.0, float(np.max(np.abs(fin)))):
+        return True
+    for other in [x, *chosen]:
+        w = pd.to_numeric(other, errors="coerce").to_numpy(dtype=float)
+        if w.shape == v.shape and np.array_equal(np.isfinite(w), np.isfinite(v)) and \
+                np.allclose(w[np.isfinite(w)], fin, rtol=1e-12, atol=0.0):
+            return True
+    return False
 
-    With one numeric x the figures are drawn as lines over the cases; a boolean
-    ``kept`` column, when some cases are not kept, is shown as filled vs hollow markers.
+
+def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (), title: str = "",
+                  labels: dict[str, str] | None = None, preferred: Sequence[str] = ()) -> Figure:
+    """Summary of a sweep: chosen (or the study's headline) figures against a swept key.
+
+    ``labels`` maps column names to axis labels with units (driver.study.column_label);
+    ``preferred`` are the study's headline columns, plotted when ``ys`` is empty.  Panels
+    chosen automatically never repeat x, a constant or another panel.  With one numeric x
+    the figures are drawn as lines over the cases, one line per value of the other keys;
+    when some cases are not kept, kept cases are circled.
     """
     import pandas as pd
+    labels = labels or {}
+    label = lambda c: textwrap.fill(labels.get(c, c), 28)  # noqa: E731  (two lines fit a panel)
     x = x or next((k for k in keys if pd.api.types.is_numeric_dtype(frame[k])), "case")
-    numeric = [c for c in frame.columns if c not in (x, "case") and pd.api.types.is_numeric_dtype(frame[c])
-               and not pd.api.types.is_bool_dtype(frame[c]) and c not in keys]
-    ys = list(ys) or numeric[:6]
-    fig, axes = new_figure(len(ys), 1, sharex=True, figsize=(7.0, 1.9 * len(ys) + 0.8))
+    if ys:
+        ys = list(ys)
+    else:
+        numeric = [c for c in frame.columns if c not in (x, "case") and pd.api.types.is_numeric_dtype(frame[c])
+                   and not pd.api.types.is_bool_dtype(frame[c]) and c not in keys]
+        ordered = [c for c in preferred if c in numeric] + [c for c in numeric if c not in preferred]
+        ys = []
+        for c in ordered:
+            if len(ys) < 6 and not _trivial(frame[c], frame[x], [frame[k] for k in ys]):
+                ys.append(c)
+        ys = ys or ordered[:1]
+    fig, axes = new_figure(len(ys), 1, sharex=True, figsize=(7.0, 1.9 * len(ys) + 0.9))
     kept = frame["kept"].astype(bool) if "kept" in frame else pd.Series(True, index=frame.index)
     others = [k for k in keys if k != x]
-    many = len(frame) > 2000 or (others and frame.groupby(others).ngroups > 12)
+    many = len(frame) > 2000 or bool(others and frame.groupby(others).ngroups > 12)
     groups = [("", frame)] if (many or not others) else frame.groupby(others, sort=False)
     if many:
         others = []
     for ax, y in zip(axes, ys):
         if many:   # a design-space search: every case as a dot, kept cases circled
-            ax.plot(frame[x], frame[y], ".", ms=1, color="0.6", alpha=0.3, rasterized=True)
+            ax.plot(frame[x], frame[y], ".", ms=1, color="0.6", alpha=0.3, rasterized=True, label="all cases")
             if not kept.all():
                 ax.plot(frame.loc[kept, x], frame.loc[kept, y], "o", ms=3, mfc="none", color="C3", label="kept")
-            ax.set_ylabel(y, fontsize=7)
+            ax.set_ylabel(label(y))
             continue
-        for label, g in groups:
+        for key, g in groups:
             g = g.sort_values(x)
             style = "-" if len(frame) <= 2000 else ""
             ax.plot(g[x], g[y], style, marker="o" if len(frame) <= 200 else ".", ms=3, lw=1,
-                    label=", ".join(f"{k}={v}" for k, v in zip(others, label if isinstance(label, tuple) else (label,))) or None)
+                    label=", ".join(f"{labels.get(k, k).split(' [')[0]} = {v}"
+                                    for k, v in zip(others, key if isinstance(key, tuple) else (key,))) or None)
         if not kept.all():
             ax.plot(frame.loc[kept, x], frame.loc[kept, y], "o", ms=4, mfc="none", color="k", label="kept")
-        ax.set_ylabel(y, fontsize=7)
+        ax.set_ylabel(label(y))
     if others or not kept.all():
-        axes[0].legend(fontsize=6, ncol=2)
-    axes[-1].set_xlabel(x)
+        axes[0].legend(fontsize=7, ncol=min(3, max(1, len(frame.groupby(others)) if others else 1)),
+                       loc="lower left", bbox_to_anchor=(0.0, 1.02), frameon=False)
+    axes[-1].set_xlabel(label(x))
     fig.suptitle(f"{title}: sweep summary" if title else "sweep summary")
     return fig
 
 
 # ---- ujoint
 
+#: line styles of the Hooke-joint designs, by the label driver.ujoint gives them
+_UJOINT_STYLES = {"trial": dict(color="C1", lw=1.4), "design": dict(color="C1", lw=1.4),
+                  "optimum": dict(color="C0", lw=2.0), "last iterate": dict(color="C3", lw=1.6, ls="-."),
+                  "paper printed": dict(color="C2", lw=1.2, ls=":")}
+
+
 def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.ndarray],
-                        polar: bool = False) -> Figure:
-    """Input and output shaft speed [rpm] against the input angle [deg], one panel per design
-    (the paper's Figures 6-11: trial and optimum), cartesian or polar."""
-    n = len(curves)
+                        polar: bool = False, band: Sequence[float] | None = None, title: str = "") -> Figure:
+    """Input and output shaft speed [rpm] against the input angle [deg], every design (trial,
+    optimum, the paper's printed optimum) overlaid on one panel as in the paper's Figures 6-11,
+    with the paper's trial band ``band`` = (min, max) [rpm] shaded when given.
+
+    Cartesian or polar (angle = input angle, radius = speed); the polar radius starts near
+    the slowest speed, not at 0, so a fluctuation of a fraction of an rpm stays visible (the
+    empty centre says the radius does not start at 0)."""
     if polar:
-        fig = Figure(figsize=(3.6 * n, 3.8), layout="constrained")
-        axes = [fig.add_subplot(1, n, k + 1, projection="polar") for k in range(n)]
+        fig = Figure(figsize=(7.4, 5.2), layout="constrained")
+        ax = fig.add_subplot(1, 1, 1, projection="polar")
     else:
-        fig, axes = new_figure(n, 1, sharex=True, figsize=(7.0, 2.3 * n + 0.6))
-    top = max(float(np.max(w)) for w in curves.values())
-    low = min(float(np.min(w)) for w in curves.values())
-    for ax, (label, w) in zip(axes, curves.items()):
-        x = np.radians(theta_deg) if polar else theta_deg
-        ax.plot(x, np.full_like(theta_deg, rpm), "k--", lw=1.0, label="input shaft")
-        ax.plot(x, w, lw=1.5, label="output shaft")
-        ax.set_title(f"{label}: output {w.min():.2f}-{w.max():.2f} rpm", fontsize=9, pad=14 if polar else 4)
+        fig, (ax,) = new_figure(1, 1, figsize=(7.4, 4.0))
+    x = np.radians(theta_deg) if polar else theta_deg
+    values = [rpm, *(float(v) for w in curves.values() for v in (np.min(w), np.max(w)))] + list(band or [])
+    low, top = min(values), max(values)
+    pad = 0.08 * max(top - low, 1e-3 * rpm)
+    if band is not None:
+        lo, hi = band
+        text = f"paper's trial band {lo:g}-{hi:g} rpm (read off its plot)"
         if polar:
-            ax.set_ylim(0.0, 1.05 * top)
+            ax.fill_between(x, lo, hi, color="0.5", alpha=0.15, lw=0, label=text)
         else:
-            pad = 0.05 * max(top - low, 1e-3 * rpm)
-            ax.set_ylim(low - pad, top + pad)
-            ax.set_ylabel("speed [rpm]")
-            ax.legend(fontsize=7, loc="upper right")
-    if not polar:
-        axes[-1].set_xlabel("input angle [deg]")
-        axes[-1].set_xlim(0.0, 360.0)
+            ax.axhspan(lo, hi, color="0.5", alpha=0.15, lw=0, label=text)
+    ax.plot(x, np.full_like(theta_deg, rpm, dtype=float), "k--", lw=0.9, label=f"input shaft {rpm:g} rpm")
+    for k, (label, w) in enumerate(curves.items()):
+        style = _UJOINT_STYLES.get(label, dict(color=f"C{k + 4}", lw=1.4))
+        ax.plot(x, w, label=f"{label}: output {np.min(w):.2f}-{np.max(w):.2f} rpm", **style)
+    if polar:
+        ax.set_rlim(low - pad, top + pad)
+        ax.set_rorigin(low - pad - 0.6 * (top - low + 2 * pad))
+        ax.set_rlabel_position(100.0)
+        ax.yaxis.set_major_locator(matplotlib.ticker.MaxNLocator(4))
+        ax.yaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g} rpm"))
+        ax.tick_params(axis="y", labelsize=7)
+        ax.set_xlabel("input angle [deg]; radius: shaft speed [rpm], not starting at 0", fontsize=8)
+        fig.legend(loc="outside lower center", fontsize=7, ncol=2, frameon=False)
     else:
-        axes[0].legend(fontsize=7, loc="lower left", bbox_to_anchor=(-0.1, -0.15))
-    fig.suptitle("Hooke-joint chain: input and output shaft speed")
+        ax.set_ylim(low - pad, top + pad)
+        ax.set_ylabel("shaft speed [rpm]")
+        ax.set_xlabel("input angle [deg]")
+        ax.set_xlim(0.0, 360.0)
+        ax.set_xticks(np.arange(0, 361, 45))
+        fig.legend(loc="outside lower center", fontsize=7, ncol=2, frameon=False)
+    fig.suptitle(f"{title}: Hooke-joint chain, input and output shaft speed" if title
+                 else "Hooke-joint chain: input and output shaft speed")
     return fig
 
 

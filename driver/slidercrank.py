@@ -228,6 +228,24 @@ def _cross_check(params: Params) -> None:
                                            "set end_time = 0.1")
 
 
+#: axis labels of summary columns and deck keys (driver.study.column_label): name -> (words, units);
+#: {i} is the number of a crank speed in the deck's list
+LABELS = {"speeds": ("crank speed", "rad/s"), "n_elements": ("rod elements", "-"),
+          "omega_{i}_rad_s": ("crank speed {i}", "rad/s"), "euler_ratio_{i}": ("peak compression / Euler load, speed {i}", "-"),
+          "peak_tensile_{i}_microstrain": ("peak tensile strain, speed {i}", "microstrain"),
+          "peak_tensile_{i}_deg": ("crank angle of peak tension, speed {i}", "deg"),
+          "peak_compressive_{i}_microstrain": ("peak compressive strain, speed {i}", "microstrain"),
+          "peak_compressive_{i}_deg": ("crank angle of peak compression, speed {i}", "deg"),
+          "peak_tensile_microstrain": ("peak tensile strain", "microstrain"),
+          "peak_tensile_deg": ("crank angle of peak tension", "deg"),
+          "peak_compressive_microstrain": ("peak compressive strain", "microstrain"),
+          "peak_compressive_deg": ("crank angle of peak compression", "deg"),
+          "euler_ratio_max": ("peak compression / Euler load", "-"), "n_buckled": ("speeds buckled", "-")}
+#: what a sweep summary plots when its deck names no plot_y
+SWEEP_PLOT = ("peak_tensile_microstrain", "peak_compressive_microstrain", "euler_ratio_max", "peak_tensile_deg",
+              "peak_compressive_deg", "n_buckled")
+
+
 SPEC = GroupSpec("slidercrank", _KEYS,
                  "slider-crank with a rigid crank and an elastic connecting rod (KED finite elements, Newmark)",
                  check=_cross_check)

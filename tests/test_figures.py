@@ -1,0 +1,187 @@
+"""Figures as a reader sees them: labels with units, the artists a title promises, no
+wrapped-angle jumps, no clipped legends or overlapping titles, reproducible files.
+
+The checks look inside the matplotlib Figure objects the studies build (what is drawn),
+and at the bytes of the files written (PNG, SVG, PDF).
+"""
+from __future__ import annotations
+
+import subprocess
+import sys
+from functools import lru_cache
+
+import numpy as np
+import pandas as pd
+import pytest
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure as MplFigure
+
+from conftest import INPUTS
+from driver import plotting
+from driver.deck import read_deck
+from driver.runner import compute, study_of
+from driver.study import column_label, load_study, plot_format
+
+
+@lru_cache(maxsize=None)
+def figures_of(deck: str) -> dict[str, MplFigure]:
+    """Every figure a shipped deck draws with --plot, by name (drawn once per test session)."""
+    module, params = study_of(read_deck(INPUTS / deck))
+    result = compute(module, params)
+    return {f.name: f.draw() for f in result.figures}
+
+
+def _renderer(fig: MplFigure):
+    """Lay the figure out on an Agg canvas (as save_figure does) and return its renderer."""
+    canvas = fig.canvas if isinstance(fig.canvas, FigureCanvasAgg) else FigureCanvasAgg(fig)
+    canvas.draw()
+    return canvas.get_renderer()
+
+
+def _inside_figure(fig: MplFigure, artist) -> bool:
+    box = artist.get_window_extent(_renderer(fig))
+    fb = fig.bbox
+    return box.x0 >= fb.x0 - 1 and box.y0 >= fb.y0 - 1 and box.x1 <= fb.x1 + 1 and box.y1 <= fb.y1 + 1
+
+
+def _texts(fig: MplFigure) -> list:
+    """Every visible, non-empty title and axis label of ``fig``."""
+    out = [fig._suptitle] if fig._suptitle is not None else []
+    for ax in fig.axes:
+        out += [t for t in (ax.title, ax._left_title, ax._right_title, ax.xaxis.label, ax.yaxis.label)
+                if t.get_visible() and t.get_text()]
+    return out
+
+
+def assert_no_overlapping_text(fig: MplFigure) -> None:
+    r = _renderer(fig)
+    boxes = [(t.get_text(), t.get_window_extent(r)) for t in _texts(fig)]
+    for i, (a, ba) in enumerate(boxes):
+        for b, bb in boxes[i + 1:]:
+            assert not ba.overlaps(bb), f"{a!r} overlaps {b!r}"
+
+
+# ----------------------------------------------------------------------------- labels
+
+
+def test_column_labels_have_words_and_units():
+    sc, fb = load_study("slidercrank"), load_study("fourbar")
+    assert column_label(sc, "slidercrank.speeds") == "crank speed [rad/s]"
+    assert column_label(sc, "peak_tensile_2_deg") == "crank angle of peak tension, speed 2 [deg]"
+    assert column_label(sc, "peak_compressive_microstrain") == "peak compressive strain [microstrain]"
+    assert column_label(fb, "fourbar.omega") == "crank speed [rad/s]"          # units from the key's SPEC
+    assert column_label(fb, "mu_min_deg") == "minimum transmission angle [deg]"
+    assert column_label(None, "something_rad_s") == "something [rad/s]"       # units read off the suffix
+    assert column_label(fb, "mu_max_deg - mu_min_deg") == "mu_max_deg - mu_min_deg"   # an expression
+
+
+def _slider_sweep_frame() -> pd.DataFrame:
+    rows = []
+    for k, mat in enumerate(("aluminium", "steel")):
+        for w in (10.0, 20.0, 30.0):
+            rows.append({"case": len(rows) + 1, "slidercrank.material": mat, "slidercrank.speeds": w,
+                         "status": "ok", "kept": True, "omega_1_rad_s": w, "euler_ratio_1": 1e-3 * w * w * (k + 1),
+                         "peak_tensile_1_microstrain": 0.1 * w * w / (k + 1), "peak_tensile_1_deg": 0.0,
+                         "peak_tensile_microstrain": 0.1 * w * w / (k + 1), "peak_tensile_deg": 0.0,
+                         "euler_ratio_max": 1e-3 * w * w * (k + 1), "n_buckled": 0})
+    return pd.DataFrame(rows)
+
+
+def test_sweep_summary_labels_and_no_trivial_panels():
+    frame = _slider_sweep_frame()
+    module = load_study("slidercrank")
+    labels = {c: column_label(module, c) for c in frame.columns}
+    fig = plotting.sweep_summary(frame, ["slidercrank.material", "slidercrank.speeds"], title="t", labels=labels,
+                                 preferred=module.SWEEP_PLOT)
+    ylabels = [ax.get_ylabel().replace("\n", " ") for ax in fig.axes]
+    # omega_1 repeats x, the angles and n_buckled are constants, the _1 columns repeat the totals
+    assert ylabels == ["peak tensile strain [microstrain]", "peak compression / Euler load [-]"]
+    assert fig.axes[-1].get_xlabel() == "crank speed [rad/s]"
+    assert all("_" not in y for y in ylabels)
+    legend = fig.axes[0].get_legend()
+    assert [t.get_text() for t in legend.get_texts()] == ["material = aluminium", "material = steel"]
+    assert _inside_figure(fig, legend)
+    assert_no_overlapping_text(fig)
+
+
+def test_sweep_summary_keeps_panels_the_deck_asks_for():
+    frame = _slider_sweep_frame()
+    fig = plotting.sweep_summary(frame, ["slidercrank.material", "slidercrank.speeds"],
+                                 ys=["omega_1_rad_s", "peak_tensile_deg"])
+    assert len(fig.axes) == 2
+
+
+# ----------------------------------------------------------------------------- ujoint
+
+
+def test_ujoint_trial_and_optimum_on_one_panel_with_the_paper_band():
+    figs = figures_of("ujoint_option1.dat")
+    for name in ("speed", "polar"):
+        fig = figs[name]
+        (ax,) = fig.axes
+        labels = [ln.get_label() for ln in ax.get_lines()]
+        assert any(s.startswith("trial: output") for s in labels), labels
+        assert any(s.startswith("optimum: output") for s in labels), labels
+        assert any(s.startswith("input shaft") for s in labels), labels
+        band = [c for c in ax.collections + ax.patches if "trial band 24-26 rpm" in c.get_label()]
+        assert len(band) == 1, name
+        legend = fig.legends[0]
+        assert _inside_figure(fig, legend), f"{name}: legend clipped"
+        assert_no_overlapping_text(fig)
+    polar = figs["polar"].axes[0]
+    lo, hi = polar.get_ylim()
+    assert 20.0 < lo < 23.0 and 27.17 < hi < 28.0          # not from 0: the fluctuation fills the radius
+    assert polar.get_rorigin() < lo                         # an empty centre says so
+    ticks = [t.get_text() for t in polar.get_yticklabels() if t.get_text()]
+    assert ticks and all(t.endswith(" rpm") for t in ticks)
+
+
+def test_ujoint_small_fluctuation_fills_the_polar_radius():
+    theta = np.arange(0.0, 361.0)
+    w = 25.0 + 0.4 * np.sin(np.radians(2 * theta))
+    fig = plotting.ujoint_speed_figure(theta, 25.0, {"optimum": w}, polar=True)
+    lo, hi = fig.axes[0].get_ylim()
+    assert lo > 24.0 and hi < 26.0 and (0.8 / (hi - lo)) > 0.5
+
+
+# ----------------------------------------------------------------------------- files
+
+
+def _figure() -> MplFigure:
+    theta = np.arange(0.0, 361.0)
+    return plotting.ujoint_speed_figure(theta, 25.0, {"trial": 25 + np.sin(np.radians(2 * theta))},
+                                        band=(24.0, 26.0), title="t")
+
+
+@pytest.mark.parametrize("fmt, magic", [("png", b"\x89PNG"), ("svg", b"<?xml"), ("pdf", b"%PDF")])
+def test_figures_are_byte_identical_for_the_same_inputs(tmp_path, fmt, magic):
+    a = plotting.save_figure(_figure(), tmp_path / "a.png", fmt)
+    b = plotting.save_figure(_figure(), tmp_path / "b.png", fmt)
+    assert a.suffix == f".{fmt}" and b.suffix == f".{fmt}"
+    assert a.read_bytes()[:len(magic)] == magic
+    assert a.read_bytes() == b.read_bytes()
+    if fmt != "png":   # no date written into the file
+        assert b"CreationDate" not in a.read_bytes() and b"<dc:date>" not in a.read_bytes()
+
+
+def test_plot_format_names():
+    assert plot_format(True) == "png" and plot_format(False) is None and plot_format("SVG") == "svg"
+    with pytest.raises(ValueError):
+        plot_format("jpeg")
+
+
+def test_cli_plot_format_svg_and_repeatable(tmp_path):
+    def run(out):
+        return subprocess.run([sys.executable, "-m", "driver", str(INPUTS / "ujoint_analyse.dat"), "-q",
+                               "-o", str(tmp_path / out), "--plot-format", "svg"], capture_output=True, text=True)
+    for out in ("a", "b"):
+        res = run(out)
+        assert res.returncode == 0, res.stderr
+    names = sorted(p.name for p in (tmp_path / "a").glob("*.svg"))
+    assert names == ["ujoint_analyse_polar.svg", "ujoint_analyse_speed.svg"]
+    assert not list((tmp_path / "a").glob("*.png"))
+    for n in names:
+        assert (tmp_path / "a" / n).read_bytes() == (tmp_path / "b" / n).read_bytes()
+    bad = subprocess.run([sys.executable, "-m", "driver", str(INPUTS / "ujoint_analyse.dat"), "--plot-format", "gif"],
+                         capture_output=True, text=True, cwd=tmp_path)
+    assert bad.returncode == 2 and "gif" in bad.stderr
