@@ -75,13 +75,11 @@ class OptimizeOutcome:
 
 def _probe(problem: Problem) -> None:
     """Run the deck's own design once: every expression must name columns of the study's summary."""
-    keys = [v.key for v in problem.variables]
-    kinds = [problem.study.SPEC.keys[k].kind for k in keys]
-    x = []
-    for k in keys:
-        v = problem.base[k]
-        x.append(float(v[0] if isinstance(v, list) else v))
-    status, _, summary = evaluate_cases(problem.raw.name, str(problem.deck.path), problem.raw, keys, kinds, [x])[0]
+    from driver.optimize.evaluate import _slots
+    kinds = [problem.study.SPEC.keys[v.key].kind for v in problem.variables]
+    x = [base_value(problem, v) for v in problem.variables]
+    status, _, summary = evaluate_cases(problem.raw.name, str(problem.deck.path), problem.raw, _slots(problem),
+                                        kinds, [x])[0]
     if status != "ok" or not summary:
         return    # the deck's design fails; names are checked per design (missing -> infeasible)
     from driver import expr
@@ -101,6 +99,14 @@ def _probe(problem: Problem) -> None:
                 v.astype(np.float64)
         except (expr.ExprError, TypeError, ValueError) as exc:
             raise o.error(key, f"cannot be evaluated on the study's summary: {exc}") from None
+
+
+def base_value(problem: Problem, v) -> float:
+    """The deck's own value of variable ``v``."""
+    val = problem.base[v.key]
+    if isinstance(val, list):
+        val = val[(v.index or 1) - 1]
+    return float(val)
 
 
 def _resumed(problem: Problem, stem: Path) -> list[dict]:
