@@ -212,3 +212,32 @@ def test_manipulator_least_torque_robust_design_beats_the_walk_along_crob(tmp_pa
     res = minimize_scalar(torque, bounds=(t0 - 0.05, t0 + 0.05), method="bounded", options={"xatol": 1e-7})
     assert oc.fun == pytest.approx(res.fun, abs=1e-3)
     assert math.atan2(l2, l1) == pytest.approx(res.x, abs=1e-4)
+
+
+@pytest.mark.slow
+def test_slidercrank_lightest_rod_is_bound_by_the_euler_constraint(tmp_path):
+    """Width fixed: the lightest depth is where N_peak / P_E = 1/3; found again by bisection on the study."""
+    from scipy.optimize import brentq
+    from driver import slidercrank
+    text = (ROOT / "inputs" / "optimize_slidercrank_section.dat").read_text()
+    text = text.replace("  var2 = 'slidercrank.section_depth', lower2 = 2e-3, upper2 = 20e-3\n", "")
+    text = text.replace("var1 = 'slidercrank.section_width', lower1 = 6e-3, upper1 = 20e-3",
+                        "var1 = 'slidercrank.section_depth', lower1 = 2e-3, upper1 = 20e-3")
+    text = text.replace("section_width = 9e-3, section_depth = 3e-3", "section_width = 6e-3, section_depth = 8e-3")
+    text = text.replace("n_elements = 20", "n_elements = 10")
+    text = text.replace("method = 'differential_evolution', seed = 1, tol = 1e-4, atol = 0",
+                        "method = 'slsqp', starts = 2, tol = 1e-6")
+    path = tmp_path / "sc.dat"
+    path.write_text(text)
+    oc = optimize(path, tmp_path / "out", jobs=1)
+    assert oc.success
+    raw = read_deck(path).groups["slidercrank"]
+
+    def ratio(h: float) -> float:
+        p = validate(RawGroup("slidercrank", dict(raw.values, section_depth=h), raw.lines, raw.line),
+                     slidercrank.SPEC, "x.dat")
+        return slidercrank.run(p).summary["euler_ratio_max"] - 1 / 3
+
+    h = brentq(ratio, 4e-3, 8e-3, xtol=1e-12)
+    assert oc.x["slidercrank.section_depth"] == pytest.approx(h, rel=1e-5)
+    assert oc.fun == pytest.approx(2660 * 6e-3 * h * 0.505, rel=1e-5)     # rho w h L

@@ -216,6 +216,17 @@ class Evaluator:
                 r.met = tuple(False for _ in p.constraints)
         if not ok:
             return
+        names = _names(p)
+        for r in list(ok):
+            miss = sorted(n for n in names if n not in r.summary)
+            if miss:
+                r.why = f"no '{miss[0]}' in the case's summary"
+                r.violation = FAILED_VIOLATION
+                r.margins = tuple(-math.inf for _ in p.constraints)
+                r.met = tuple(False for _ in p.constraints)
+                ok.remove(r)
+        if not ok:
+            return
         frame = pd.DataFrame([r.summary for r in ok])
         for name in _names(p):
             if name not in frame:
