@@ -187,10 +187,11 @@ def polish(pp: PathProblem, design: PathDesign) -> PathDesign:
         r[st != ST_OK] = 10 * pp.length_max
         return r.ravel()
 
-    try:
-        res = least_squares(residuals, z0, bounds=(zlo, zhi), method="trf", xtol=1e-14, ftol=1e-14,
-                            gtol=1e-14, max_nfev=2000)
+    try:   # Levenberg-Marquardt (unbounded; the bounds are checked on its answer)
+        res = least_squares(residuals, z0, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=5000)
     except ValueError:
+        return design
+    if not (np.all(res.x[:n9] >= lo) and np.all(res.x[:n9] <= hi)):
         return design
     x = res.x[:n9] if pp.timing_deg is None else res.x
     if pp.timing_deg is None:
