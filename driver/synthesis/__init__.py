@@ -351,7 +351,8 @@ def _path(p: Params) -> Synthesis:
              f"    transmission band .... {p.transmission_min_deg:g} .. {p.transmission_max_deg:g} deg",
              f"    link lengths ......... {pp.length_min:.6g} .. {pp.length_max:.6g}",
              f"    search ............... differential evolution (seed {p.seed}, popsize {p.popsize}, maxiter "
-             f"{p.maxiter}) + L-BFGS-B polish: {nfev} designs, {'converged' if converged else 'NOT converged'} ({message})",
+             f"{p.maxiter}) then least squares from its best distinct designs: {nfev} designs; evolution "
+             f"{'converged' if converged else 'stopped'} ({message})",
              "",
              f"  linkage: ground {q['ground']:.10g}, crank {q['crank']:.10g}, coupler {q['coupler']:.10g}, "
              f"rocker {q['rocker']:.10g}",
@@ -370,8 +371,6 @@ def _path(p: Params) -> Synthesis:
     elif design.errors.max() > p.tolerance:
         failure = (f"the coupler point misses a target by {design.errors.max():.4g} > tolerance {p.tolerance:g}: "
                    "the best design found passes near, not through, the points")
-    elif not converged:
-        failure = f"differential evolution did not converge ({message})"
     linkage = {"fixed_link": q["ground"], "crank": q["crank"], "coupler": q["coupler"], "rocker": q["rocker"],
                "omega": p.omega, "step_deg": p.step_deg, "branch": p.branch,
                "coupler_point": [q["u"], q["v"]]}
