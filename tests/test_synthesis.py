@@ -147,10 +147,14 @@ def test_bad_synthesis_decks_exit_2(tmp_path, capsys, body, key):
 
 
 @pytest.mark.slow
-def test_path_generation_through_five_points_verified_by_the_kernel():
+def test_path_generation_through_five_points_verified_by_the_kernel(tmp_path):
     from pathlib import Path
-    deck = Path(__file__).resolve().parents[1] / "inputs" / "synthesis_path.dat"
+    text = (Path(__file__).resolve().parents[1] / "inputs" / "synthesis_path.dat").read_text()
+    deck = tmp_path / "path.dat"
+    deck.write_text(text.replace("maxiter = 200, popsize = 10", "maxiter = 60, popsize = 8"))
     syn = synthesise(deck)
+    from driver.synthesis import _path_figure
+    assert _path_figure(syn, tmp_path / "path_path.png", "path").stat().st_size > 0
     assert syn.failure is None
     q = syn.design.parts
     targets = np.column_stack([syn.params.target_x, syn.params.target_y])

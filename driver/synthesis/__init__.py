@@ -412,6 +412,25 @@ def synthesise(deck: Deck | str | Path) -> Synthesis:
     return syn
 
 
+def _path_figure(syn: Synthesis, path: Path, title: str) -> Path:
+    """The linkage, its coupler curve and the target points, in the linkage deck's frame."""
+    from driver import plotting
+    from driver.synthesis import path as pg
+    q = syn.design.parts
+    theta = np.linspace(0.0, 360.0, 721)
+    out, st = kernels.fourbar_exact(np.radians(theta), q["ground"], q["crank"], q["coupler"], q["rocker"], 1.0, 0.0,
+                                    1 if syn.params.branch == "open" else -1)
+    cp = kernels.fourbar_coupler_point(np.radians(theta), out, st, q["crank"], 1.0, 0.0, q["u"], q["v"])
+    fig = plotting.fourbar_linkage(q["ground"], theta, out, st == ST["ok"], None, title, point=cp[:, :2])
+    targets = np.column_stack([syn.params.target_x, syn.params.target_y]).astype(float)
+    pp = pg.PathProblem(targets, None, 1, False, (0.0, 180.0), 1.0, 1.0)
+    tk = pg._to_kernel(pp, syn.design.x)
+    ax = fig.axes[0]
+    ax.plot(tk[:, 0], tk[:, 1], "s", mfc="none", mec="k", ms=7, label="target points")
+    ax.legend(fontsize=7, loc="best")
+    return plotting.save_figure(fig, path)
+
+
 def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool = False,
                        quiet: bool = False, **_: Any) -> int:
     """Command-line entry: synthesise, write, return the exit status (DeckError propagates)."""
@@ -438,6 +457,8 @@ def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool,
                                               ("structural error", {"error": fd.y_generated - fd.y_desired})],
                                        "x", title=f"{Path(deck.path).stem}: function generation")
             written.append(plotting.save_figure(fig, stem.with_name(stem.name + "_error.png")))
+    if plot and syn.params.task == "path" and syn.design is not None:
+        written.append(_path_figure(syn, stem.with_name(stem.name + "_path.png"), Path(deck.path).stem))
     if not quiet:
         for w in written:
             print(f"wrote {w}")
