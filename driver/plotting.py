@@ -79,37 +79,79 @@ def line_panels(x: np.ndarray, panels: Sequence[tuple[str, dict[str, np.ndarray]
 
 # ----------------------------------------------------------------------------- fourbar
 
+def break_wraps(x: np.ndarray, y: np.ndarray, period: float = 360.0) -> tuple[np.ndarray, np.ndarray]:
+    """``x``, ``y`` with a NaN inserted wherever ``y`` (an angle wrapped into one period) jumps
+    by more than half a period between neighbours, so the drawn line breaks at the wrap
+    instead of running vertically across the panel."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    jumps = np.flatnonzero(np.abs(np.diff(y)) > 0.5 * period) + 1
+    return np.insert(x, jumps, np.nan), np.insert(y, jumps, np.nan)
+
+
+def _unassembled_spans(theta: np.ndarray, ok: np.ndarray) -> list[tuple[float, float]]:
+    """Crank-angle intervals [deg] where ``ok`` is False (the linkage cannot be assembled)."""
+    spans, start = [], None
+    for t, good in zip(theta, ok):
+        if not good and start is None:
+            start = t
+        elif good and start is not None:
+            spans.append((start, t))
+            start = None
+    if start is not None:
+        spans.append((start, theta[-1]))
+    return spans
+
+
+#: legend words of the four-bar curves
+_FOURBAR_NAMES = {"coupler_deg": "coupler angle", "rocker_deg": "rocker angle", "transmission_deg": "transmission angle",
+                  "omega2_rad_s": "coupler speed omega2", "omega3_rad_s": "rocker speed omega3"}
+
+
 def fourbar_curves(exact, listing, title: str) -> Figure:
     """Angles, angular velocities and transmission angle against crank angle.
 
     ``exact`` and ``listing`` are tidy frames from driver.fourbar; listing rows are
-    drawn as markers over the exact curves so the listing's defect is visible.
+    drawn as markers over the exact curves so the listing's defect is visible.  Angles
+    wrapped into 0-360 deg break at the wrap (no vertical line); crank angles where the
+    linkage cannot be assembled are shaded and said so.
     """
-    panels = [("coupler, rocker [deg]", ["coupler_deg", "rocker_deg"]),
-              ("transmission [deg]", ["transmission_deg"]),
+    panels = [("link angle [deg]", ["coupler_deg", "rocker_deg"]),
+              ("transmission angle [deg]", ["transmission_deg"]),
               ("angular velocity [rad/s]", ["omega2_rad_s", "omega3_rad_s"])]
-    fig, axes = new_figure(3, 1, sharex=True, figsize=(7.0, 7.4))
+    fig, axes = new_figure(3, 1, sharex=True, figsize=(7.0, 7.6))
     colors = {"coupler_deg": "C0", "rocker_deg": "C1", "transmission_deg": "C2",
               "omega2_rad_s": "C0", "omega3_rad_s": "C1"}
+    theta = exact["theta_deg"].to_numpy(dtype=float)
+    spans = _unassembled_spans(theta, np.isfinite(exact["transmission_deg"].to_numpy(dtype=float)))
     for ax, (label, keys) in zip(axes, panels):
+        for j, (lo, hi) in enumerate(spans):
+            ax.axvspan(lo, hi, color="0.85", alpha=0.6, lw=0, label="cannot be assembled" if j == 0 else None)
         for k in keys:
-            ax.plot(exact["theta_deg"], exact[k], color=colors[k], label=f"{k.split('_')[0]} (exact)")
+            wrap = k.endswith("_deg")
+            ax.plot(*(break_wraps(theta, exact[k]) if wrap else (theta, exact[k])), color=colors[k],
+                    label=f"{_FOURBAR_NAMES[k]} (exact)")
             if listing is not None:
                 ax.plot(listing["theta_deg"], listing[k], "o", ms=4, mfc="none", color=colors[k],
-                        label=f"{k.split('_')[0]} (listing)")
+                        label=f"{_FOURBAR_NAMES[k]} (listing)")
         ax.set_ylabel(label)
-        ax.legend(fontsize=7, ncol=2)
-    axes[1].axhspan(40, 120, color="C2", alpha=0.08, label="40-120 deg")
+    axes[0].set_ylim(-5, 365)
+    axes[0].set_yticks(np.arange(0, 361, 90))
+    axes[1].axhspan(40, 120, color="C2", alpha=0.08, label="40-120 deg band")
+    for ax in axes:
+        ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
     axes[-1].set_xlabel("crank angle [deg]")
     fig.suptitle(f"{title}: four-bar kinematics")
     return fig
 
 
 def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.ndarray,
-                    listing, title: str, n_poses: int = 6, point: np.ndarray | None = None) -> Figure:
+                    listing, title: str, n_poses: int = 6, point: np.ndarray | None = None,
+                    units: str = "length units") -> Figure:
     """The linkage drawn at a few crank angles with the paths of A and B (exact), and the
-    path of a coupler point (``point``: (n, 2) positions) when the deck defines one."""
-    fig, (ax,) = new_figure(1, 1, figsize=(7.0, 5.0))
+    path of a coupler point (``point``: (n, 2) positions) when the deck defines one.
+    Coordinates are in the deck's length ``units``, the crank pivot at the origin and the
+    ground link along +x; the legend sits beside the drawing, never on it."""
+    fig, (ax,) = new_figure(1, 1, figsize=(8.2, 5.0))
     ax.plot(out[:, 3], out[:, 4], color="0.6", lw=0.8, label="path of A")
     bx = np.where(ok, out[:, 5], np.nan)
     by = np.where(ok, out[:, 6], np.nan)
@@ -120,15 +162,18 @@ def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.nd
     if listing is not None:
         ax.plot(listing["xb"], listing["yb"], "x", color="k", ms=5, label="B (listing)")
     idx = np.flatnonzero(ok)
+    cmap = matplotlib.colormaps["viridis"]
     for j, k in enumerate(idx[np.linspace(0, len(idx) - 1, n_poses, endpoint=False).astype(int)] if len(idx) else []):
         xs = [0.0, out[k, 3], out[k, 5], ground]
         ys = [0.0, out[k, 4], out[k, 6], 0.0]
-        ax.plot(xs, ys, "-o", color=plt.cm.viridis(j / max(1, n_poses - 1)), ms=3, lw=1.4,
+        ax.plot(xs, ys, "-o", color=cmap(j / max(1, n_poses - 1)), ms=3, lw=1.4,
                 label=f"theta = {theta[k]:.0f} deg")
     ax.plot([0.0, ground], [0.0, 0.0], color="k", lw=2.5)
-    ax.plot([0.0, ground], [0.0, 0.0], "^", color="k", ms=9)
+    ax.plot([0.0, ground], [0.0, 0.0], "^", color="k", ms=9, label="ground pivots")
     ax.set_aspect("equal")
-    ax.legend(fontsize=7, loc="best")
+    ax.set_xlabel(f"x [{units}]")
+    ax.set_ylabel(f"y [{units}]")
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
     ax.set_title(f"{title}: linkage positions")
     return fig
 

@@ -185,3 +185,43 @@ def test_cli_plot_format_svg_and_repeatable(tmp_path):
     bad = subprocess.run([sys.executable, "-m", "driver", str(INPUTS / "ujoint_analyse.dat"), "--plot-format", "gif"],
                          capture_output=True, text=True, cwd=tmp_path)
     assert bad.returncode == 2 and "gif" in bad.stderr
+
+
+# ----------------------------------------------------------------------------- fourbar
+
+
+def test_break_wraps_breaks_only_at_the_wrap():
+    x = np.arange(6.0)
+    y = np.array([350.0, 355.0, 2.0, 8.0, 10.0, 12.0])
+    bx, by = plotting.break_wraps(x, y)
+    assert np.isnan(by[2]) and np.count_nonzero(np.isnan(by)) == 1
+    assert np.allclose(by[~np.isnan(by)], y)
+
+
+def test_fourbar_wrapped_angle_curves_have_no_vertical_jump():
+    fig = figures_of("nongrashof.dat")["curves"]
+    angles = fig.axes[0]
+    lines = [ln for ln in angles.get_lines() if "(exact)" in ln.get_label()]
+    assert len(lines) == 2
+    for ln in lines:
+        y = np.asarray(ln.get_ydata(), dtype=float)
+        pairs = np.isfinite(y[1:]) & np.isfinite(y[:-1])
+        assert np.abs(np.diff(y))[pairs].max() < 180.0, ln.get_label()
+    coupler = np.asarray(lines[0].get_ydata(), dtype=float)
+    assert lines[0].get_label().startswith("coupler") and np.nanmax(coupler) > 350.0 and np.nanmin(coupler) < 5.0
+    # the crank angles where it cannot be assembled are shaded and named
+    assert any(p.get_label() == "cannot be assembled" for p in angles.patches)
+    for ax in fig.axes:
+        assert "[" in ax.get_ylabel()
+    assert "[deg]" in fig.axes[-1].get_xlabel()
+
+
+def test_fourbar_linkage_labelled_with_the_legend_off_the_mechanism():
+    fig = figures_of("crank5.dat")["linkage"]
+    (ax,) = fig.axes
+    assert ax.get_xlabel() == "x [length units]" and ax.get_ylabel() == "y [length units]"
+    r = _renderer(fig)
+    legend = ax.get_legend()
+    assert not legend.get_window_extent(r).overlaps(ax.get_window_extent(r))
+    assert _inside_figure(fig, legend)
+    assert_no_overlapping_text(fig)
