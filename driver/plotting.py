@@ -376,18 +376,32 @@ def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.
 
 
 def slidercrank_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray]], title: str,
-                              ylabel: str = "axial strain [microstrain]") -> Figure:
-    """A quantity against crank angle [deg], one line per case (label, angle, value): Figure 10."""
-    fig, axes = new_figure(1, 1, figsize=(7.0, 3.6))
+                              ylabel: str = "axial strain [microstrain]", above: dict[str, float] | None = None,
+                              missing: Sequence[str] = ()) -> Figure:
+    """A quantity against crank angle [deg], one line per case (label, angle, value): Figure 10.
+
+    ``above`` maps the labels of cases whose rod compression exceeds the Euler load to that
+    ratio N/P_E: their curves are dashed and flagged in the legend (a linear model draws
+    them although the rod would buckle).  ``missing`` are one-line texts of cases not drawn (e.g. a speed that
+    buckled): they are listed in the legend, so no speed silently disappears.
+    """
+    from matplotlib.lines import Line2D
+    above = above or {}
+    fig, axes = new_figure(1, 1, figsize=(7.4, 4.4))
     ax = axes[0]
     for label, x, y in series:
-        ax.plot(x, y, label=label, lw=1.2)
+        flagged = label in above
+        ax.plot(x, y, label=f"{label}: N = {above[label]:.2f} P_E, above the Euler load" if flagged else label,
+                lw=1.2, ls="--" if flagged else "-")
+    for text in missing:
+        ax.add_line(Line2D([], [], ls="none", marker="x", color="C3", label=text))
     ax.axhline(0.0, color="k", lw=0.6)
     ax.set_xlim(0, 360)
     ax.set_xticks(np.arange(0, 361, 45))
     ax.set_xlabel("crank angle theta2 [deg]")
     ax.set_ylabel(ylabel)
-    ax.legend(fontsize=7, loc="best")
+    fig.legend(fontsize=7, loc="outside lower center", ncol=3 if len(series) + len(missing) > 4 else 2,
+               frameon=False, title="crank speed", title_fontsize=7)
     ax.set_title(title)
     return fig
 

@@ -225,3 +225,47 @@ def test_fourbar_linkage_labelled_with_the_legend_off_the_mechanism():
     assert not legend.get_window_extent(r).overlaps(ax.get_window_extent(r))
     assert _inside_figure(fig, legend)
     assert_no_overlapping_text(fig)
+
+
+# ----------------------------------------------------------------------------- slidercrank
+
+_SLIDER = """&slidercrank
+  material = 'aluminium'
+  geometric_stiffness = {g}
+  speeds = 11.52, 29.32        ! rad/s; N/P_E = 1.43 at 29.32 (the Euler load is exceeded)
+  n_elements = 20
+  steps_per_rev = 720, revolutions = 2
+/
+"""
+
+
+def _slider_figures(write_deck, geometric: bool) -> dict[str, MplFigure]:
+    deck = write_deck(_SLIDER.format(g=".true." if geometric else ".false."), f"sc_{geometric}.dat")
+    module, params = study_of(read_deck(deck))
+    return {f.name: f.draw() for f in compute(module, params).figures}
+
+
+def _legend_texts(fig: MplFigure) -> list[str]:
+    legends = list(fig.legends) + [ax.get_legend() for ax in fig.axes if ax.get_legend() is not None]
+    return [t.get_text() for lg in legends for t in lg.get_texts()]
+
+
+def test_slidercrank_buckled_speed_is_named_not_missing(write_deck):
+    figs = _slider_figures(write_deck, True)
+    for name in ("strain", "deflection"):
+        fig = figs[name]
+        texts = _legend_texts(fig)
+        drawn = [ln for ln in fig.axes[0].get_lines() if len(ln.get_xdata()) > 2]
+        assert [ln.get_label() for ln in drawn] == ["11.52 rad/s"]          # 29.32 has no numbers to draw
+        assert any(t.startswith("29.32 rad/s: buckled at theta2 = ") and t.endswith("not drawn") for t in texts), texts
+        assert _inside_figure(fig, fig.legends[0])
+        assert_no_overlapping_text(fig)
+
+
+def test_slidercrank_linear_model_flags_cases_above_the_euler_load(write_deck):
+    fig = _slider_figures(write_deck, False)["strain"]
+    lines = {ln.get_label(): ln for ln in fig.axes[0].get_lines() if len(ln.get_xdata()) > 2}
+    assert set(lines) == {"11.52 rad/s", "29.32 rad/s: N = 1.43 P_E, above the Euler load"}
+    assert lines["29.32 rad/s: N = 1.43 P_E, above the Euler load"].get_linestyle() == "--"
+    assert lines["11.52 rad/s"].get_linestyle() == "-"
+    assert "linear model" in fig.axes[0].get_title()
