@@ -782,7 +782,7 @@ def run(params: Params, progress: bool = False) -> Result:
         lines += ["Warnings", "--------"] + [f"  {w}" for w in warnings] + [""]
     tidy = _tidy(tables, tol, sweep, used)
     figures = [Figure("design_space", lambda: _fig_design(p, ws, conv, used)),
-               Figure("torque_crob", lambda: _fig_torque(sweep, conv))]
+               Figure("torque_crob", lambda: _fig_torque(sweep, conv, p.title or p.path.stem))]
     return Result(text="\n".join(lines).rstrip() + "\n", tidy=tidy, summary=_summary(p, ws, conv, used, sweep, tol),
                   warnings=warnings, figures=figures)
 
@@ -860,7 +860,8 @@ def _fig_design(p: Params, ws: Workspace, conv: Conv, used: dict):
                                     title=p.title or p.path.stem)
 
 
-def _fig_torque(sweep: dict, conv: Conv):
+def _fig_torque(sweep: dict, conv: Conv, title: str = ""):
     from driver.plotting import manipulator_torque_crob
     return manipulator_torque_crob(sweep["l1"], np.where(sweep["ok"], sweep["tau"][:, 0], np.nan),
-                                   np.where(sweep["ok"], sweep["tau"][:, 1], np.nan), conv.c_sweep)
+                                   np.where(sweep["ok"], sweep["tau"][:, 1], np.nan), conv.c_sweep,
+                                   violates=sweep["ok"] & ~sweep["reach_all"], title=title)

@@ -7,6 +7,7 @@ so nothing is drawn unless ``--plot`` is given.
 """
 from __future__ import annotations
 
+import math
 import textwrap
 from pathlib import Path
 from typing import Sequence
@@ -180,6 +181,28 @@ def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.nd
 
 # ----------------------------------------------------------------------------- manipulator
 
+def _ellipse_levels(levels: Sequence[float], n: int) -> list[float]:
+    """The RI2 values whose ellipses the design-space figure draws: the deck's (its Table 4.1
+    rows) and, as RI2 = sqrt(n) is the C_rob circle itself, three more so the family shows."""
+    lo, hi = math.sqrt(n), math.sqrt(2 * n)
+    extra = [lo + f * (hi - lo) for f in (0.05, 0.2, 0.5)]
+    return sorted({round(float(v), 12) for v in [*levels, *extra] if 0.0 < v < hi})
+
+
+def ri2_ellipses(ri2: float, n: int, c: float, samples: int = 721) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The two iso-RI2 ellipses (the report's eqs 4.14-4.17) as (l1, l2) [m] point arrays, cut to
+    l1, l2 >= 0: in the 45-deg frame L1 = (l1 + l2)/sqrt2, L2 = (l1 - l2)/sqrt2 they are
+    RI2^2 L1^2 + (2n - RI2^2) L2^2 = c and the same with the coefficients swapped (c = sum d^2 [m^2])."""
+    phi = np.linspace(0.0, 2.0 * np.pi, samples)
+    out = []
+    for ca, cb in ((ri2 * ri2, 2 * n - ri2 * ri2), (2 * n - ri2 * ri2, ri2 * ri2)):
+        P, Q = math.sqrt(c / ca) * np.cos(phi), math.sqrt(c / cb) * np.sin(phi)
+        x, y = (P + Q) / math.sqrt(2.0), (P - Q) / math.sqrt(2.0)
+        keep = (x >= -1e-9) & (y >= -1e-9)
+        out.append((np.where(keep, x, np.nan), np.where(keep, y, np.nan)))
+    return out
+
+
 def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, L2: np.ndarray,
                              ri2: np.ndarray, sum_d2: float, n: int, levels: Sequence[float],
                              optima: dict, names: Sequence[str], l1: np.ndarray, l2: np.ndarray,
@@ -202,14 +225,10 @@ def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, 
             ax.plot(g, g - r, "b-", lw=0.8, label="|l1 - l2| = r")
             ax.plot(g, g + r, "b-", lw=0.8)
             ax.plot(g, R - g, "g-", lw=0.8, label="l1 + l2 = R")
-            for v in levels:  # ellipses in the 45-deg frame; both branches
-                for ca, cb in ((v * v, 2 * n - v * v), (2 * n - v * v, v * v)):
-                    phi = np.linspace(0, 2 * np.pi, 400)
-                    A, B = np.sqrt(sum_d2 / ca), np.sqrt(sum_d2 / cb)
-                    P, Q = A * np.cos(phi), B * np.sin(phi)
-                    keep = np.abs(P) >= np.abs(Q)
-                    x, y = (P + Q) / np.sqrt(2), (P - Q) / np.sqrt(2)
-                    ax.plot(np.where(keep, x, np.nan), np.where(keep, y, np.nan), ":", lw=0.8, color="gray")
+            for j, v in enumerate(_ellipse_levels(levels, n)):
+                for k2, (x, y) in enumerate(ri2_ellipses(v, n, sum_d2)):
+                    ax.plot(x, y, ":", lw=1.0, color=plt.cm.viridis(j / 4), gid=f"iso-RI2 ellipse {v!r}",
+                            label=f"iso-RI2 ellipse, RI2 = {v:.3g}" if k2 == 0 else None)
         else:
             cs = ax.contour(L1, L2, ri2, levels=np.sqrt(n) + np.array([0.001, 0.01, 0.05, 0.1, 0.2, 0.4, 0.8]),
                             linewidths=0.7, cmap="viridis")
@@ -229,16 +248,33 @@ def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, 
         ax.set_ylabel("l2 [m]")
     axes[0].set_title("reach region, C_rob, iso-RI2 ellipses")
     axes[1].set_title("RI2 over the design plane")
-    axes[0].legend(fontsize=7, loc="upper right")
+    fig.legend(*axes[0].get_legend_handles_labels(), fontsize=7, loc="outside lower center", ncol=4, frameon=False)
     if title:
         fig.suptitle(title)
     return fig
 
 
-def manipulator_torque_crob(l1: np.ndarray, tau1: np.ndarray, tau2: np.ndarray, c: float) -> Figure:
-    """Motor torques tau1, tau2 and their sum [N m] against l1 [m] along C_rob (Table 4.8)."""
-    return line_panels(l1, [("torque [N m]", {"tau1": tau1, "tau2": tau2, "tau1 + tau2": tau1 + tau2})],
-                       xlabel="l1 [m] (l2 = sqrt(%g - l1^2))" % c, title="Motor torques along C_rob")
+def manipulator_torque_crob(l1: np.ndarray, tau1: np.ndarray, tau2: np.ndarray, c: float,
+                            violates: np.ndarray | None = None, title: str = "") -> Figure:
+    """Motor torques tau1, tau2 and their sum [N m] against l1 [m] along C_rob (Table 4.8).
+
+    Rows where the target is out of reach are gaps; ``violates`` marks the rows (a boolean
+    per row) whose design does not reach the whole workspace (the reach conditions
+    |l1 - l2| <= r, l1 + l2 >= R fail): their points are crossed and named in the legend."""
+    fig, (ax,) = new_figure(1, 1, figsize=(7.4, 3.8))
+    total = tau1 + tau2
+    for label, y in (("tau1", tau1), ("tau2", tau2), ("tau1 + tau2", total)):
+        ax.plot(l1, y, "-o", ms=2.5, lw=1.2, label=label)
+    if violates is not None and np.any(violates):
+        bad = np.asarray(violates, dtype=bool)
+        for k, y in enumerate((tau1, tau2, total)):
+            ax.plot(l1[bad], y[bad], "x", color="C3", ms=7, mew=1.5,
+                    label="violates the workspace reach conditions" if k == 0 else None)
+    ax.set_ylabel("motor torque [N m]")
+    ax.set_xlabel("l1 [m]  (l2 = sqrt(%g - l1^2) [m])" % c)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    fig.suptitle(f"{title}: motor torques along C_rob" if title else "Motor torques along C_rob")
+    return fig
 
 
 # ----------------------------------------------------------------------------- sweep

@@ -269,3 +269,49 @@ def test_slidercrank_linear_model_flags_cases_above_the_euler_load(write_deck):
     assert lines["29.32 rad/s: N = 1.43 P_E, above the Euler load"].get_linestyle() == "--"
     assert lines["11.52 rad/s"].get_linestyle() == "-"
     assert "linear model" in fig.axes[0].get_title()
+
+
+# ----------------------------------------------------------------------------- manipulator
+
+
+def test_manipulator_design_space_draws_the_iso_ri2_ellipses():
+    fig = figures_of("manipulator_case1_report.dat")["design_space"]
+    left = fig.axes[0]
+    assert "iso-RI2 ellipses" in left.get_title()
+    ellipses = [ln for ln in left.get_lines() if (ln.get_gid() or "").startswith("iso-RI2 ellipse")]
+    levels = sorted({float(ln.get_gid().split()[-1]) for ln in ellipses})
+    assert len(ellipses) == 2 * len(levels) and len(levels) >= 3 and 2.0 in levels   # the deck's Table 4.1 level
+    n, c = 4, 189.0      # four workspace points; c = sum of d^2 = 26 + 53 + 58 + 52 m^2
+    for ln in ellipses:
+        v = float(ln.get_gid().split()[-1])
+        l1, l2 = (np.asarray(a, dtype=float) for a in ln.get_data())
+        ok = np.isfinite(l1) & np.isfinite(l2)
+        assert ok.sum() > 100 and (l1[ok] >= -1e-6).all() and (l2[ok] >= -1e-6).all()
+        big, small = (l1[ok] + l2[ok]) ** 2 / 2, (l1[ok] - l2[ok]) ** 2 / 2      # L1^2, L2^2 (45-deg frame)
+        lhs = np.minimum(np.abs(v * v * big + (2 * n - v * v) * small - c),
+                         np.abs((2 * n - v * v) * big + v * v * small - c))
+        assert lhs.max() < 1e-9 * c
+        if v == 2.0:   # RI2 = sqrt(n): the C_rob circle of the report, radius 6.874 m
+            assert np.allclose(np.hypot(l1[ok], l2[ok]), 6.874, atol=5e-4)
+    assert_no_overlapping_text(fig)
+
+
+def test_manipulator_torque_curves_mark_rows_violating_the_reach_conditions():
+    module, params = study_of(read_deck(INPUTS / "manipulator_case2_exact.dat"))
+    result = compute(module, params)
+    fig = next(f.draw() for f in result.figures if f.name == "torque_crob")
+    (ax,) = fig.axes
+    curves = {ln.get_label(): ln for ln in ax.get_lines() if ln.get_label().startswith("tau")}
+    l1 = np.asarray(curves["tau1"].get_xdata(), dtype=float)
+    drawn = np.isfinite(np.asarray(curves["tau1"].get_ydata(), dtype=float))
+    c = 51.5                                        # C_rob: l1^2 + l2^2 [m^2] of this deck
+    l2 = np.sqrt(c - l1 ** 2)
+    r, R = result.summary["r_m"], result.summary["R_m"]
+    violating = drawn & ((np.abs(l1 - l2) > r + 1e-9) | (l1 + l2 < R - 1e-9))
+    assert violating.sum() == 4
+    marks = [ln for ln in ax.get_lines() if ln.get_marker() == "x"]
+    assert len(marks) == 3 and marks[0].get_label() == "violates the workspace reach conditions"
+    for ln in marks:
+        assert np.allclose(np.sort(ln.get_xdata()), np.sort(l1[violating]))
+    assert "[N m]" in ax.get_ylabel() and "[m]" in ax.get_xlabel()
+    assert _inside_figure(fig, ax.get_legend())
