@@ -19,7 +19,7 @@ from scipy.optimize import brentq, minimize_scalar
 
 from driver import kernels
 from driver.deck import GroupSpec, Key, Params, positive
-from driver.study import Figure, Result
+from driver.study import Figure, Result, keyword_run
 from driver.table import Column, fortran_f, render_table
 
 __all__ = ["SPEC", "run", "summarise", "grashof", "limit_angles", "exact_grid", "listing_grid"]
@@ -440,6 +440,7 @@ def _figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> list[F
 
 # ----------------------------------------------------------------------------- run
 
+@keyword_run
 def run(params: Params, progress: bool = False) -> Result:
     """Analyse one four-bar deck (see module docstring)."""
     p = params

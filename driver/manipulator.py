@@ -36,7 +36,7 @@ from scipy.optimize import minimize
 
 from driver import kernels
 from driver.deck import GroupSpec, Key, Params, non_empty, positive
-from driver.study import Figure, Result
+from driver.study import Figure, Result, keyword_run
 from driver.table import Column, fortran_f, render_table
 
 __all__ = ["SPEC", "run", "Workspace", "tolerance_box", "round_half_up"]
@@ -681,6 +681,7 @@ def _summary(p: Params, ws: Workspace, conv: Conv, used: dict, sweep: dict, tol:
     return s
 
 
+@keyword_run
 def run(params: Params, progress: bool = False) -> Result:
     """Run one &manipulator deck (see the module docstring)."""
     p = params

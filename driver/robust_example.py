@@ -28,7 +28,7 @@ import numpy as np
 import pandas as pd
 
 from driver.deck import GroupSpec, Key, Params, non_empty, positive
-from driver.study import Result
+from driver.study import Result, keyword_run
 from driver.table import Column, render_table
 
 __all__ = ["SPEC", "run", "quadratic_fit", "analyse"]
@@ -169,6 +169,7 @@ def _compare(name: str, printed: list[float] | None, computed: np.ndarray,
     return lines, flags
 
 
+@keyword_run
 def run(params: Params, progress: bool = False) -> Result:
     """Run one &robust_example deck."""
     p = params

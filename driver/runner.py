@@ -15,7 +15,7 @@ import driver
 from driver.atomic import write_text
 from driver.deck import Deck, DeckError, Params
 from driver.deck import validate
-from driver.export import write_tidy
+from driver.export import summary_json_text, write_tidy
 from driver.study import Result, load_study
 
 __all__ = ["CONTROL_GROUPS", "Outcome", "available_studies", "study_of", "run_study", "write_outputs"]
@@ -55,13 +55,17 @@ def study_of(deck: Deck) -> tuple[ModuleType, Params]:
     return module, validate(raw, module.SPEC, deck.path)
 
 
-def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool) -> list[Path]:
-    """Write the .out file, extra files, tidy tables and figures for one case (all atomic)."""
+def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool,
+                  summary_json: bool = False) -> list[Path]:
+    """Write the .out file, extra files, tidy tables, the summary as ``<stem>.json`` (when
+    ``summary_json``) and figures for one case (all atomic; the folder is created when missing)."""
     written = [write_text(stem.with_name(stem.name + ".out"), result.text)]
     for suffix, text in result.extra.items():
         written.append(write_text(stem.with_name(stem.name + suffix), text))
     for fmt in formats:
         written.append(write_tidy(result.tidy, stem, fmt))
+    if summary_json:
+        written.append(write_text(stem.with_name(stem.name + ".json"), summary_json_text(result)))
     if plot and result.figures:
         from driver.plotting import save_figure
         for fig in result.figures:
@@ -78,12 +82,15 @@ class Outcome:
 
 
 def run_study(deck: Deck, outdir: Path | None, formats: list[str], plot: bool,
-              progress: bool = False) -> Outcome:
-    """Validate and run the deck's study; write its outputs to ``outdir`` (None: write nothing).
+              progress: bool = False, summary_json: bool = False, name: str | None = None) -> Outcome:
+    """Validate and run the deck's study; write its outputs to ``outdir`` (None: write nothing)
+    as ``<name>.*`` (default: the deck's file stem).
 
     Raises DeckError for bad input (nothing is written then); other exceptions are run failures.
     """
     module, params = study_of(deck)
     result = module.run(params, progress=progress)
-    written = [] if outdir is None else write_outputs(result, Path(outdir) / Path(deck.path).stem, formats, plot)
+    result.name, result.study = name or Path(deck.path).stem, params.group
+    written = ([] if outdir is None else
+               write_outputs(result, Path(outdir) / result.name, formats, plot, summary_json))
     return Outcome(result, written)

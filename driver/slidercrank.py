@@ -22,7 +22,7 @@ from tqdm import tqdm
 
 from driver import kernels
 from driver.deck import GroupSpec, Key, Params, non_negative, positive
-from driver.study import Figure, Result
+from driver.study import Figure, Result, keyword_run
 from driver.table import Column, render_table
 
 __all__ = ["SPEC", "run", "MATERIALS", "PAPER_SPEEDS", "SIMEON1996", "simeon_initial_state",
@@ -543,6 +543,7 @@ def _benchmark_lines(params: Params, case: Case) -> list[str]:
     return lines
 
 
+@keyword_run
 def run(params: Params, progress: bool = False) -> Result:
     """Run every crank speed (and element count) of the deck; see the module docstring."""
     model = _model(params)

@@ -31,7 +31,7 @@ from tqdm import tqdm
 from driver.deck import GroupSpec, Key, Params, non_empty, positive
 from driver.kernels import (UJOINT_MODELS, UJOINT_OBJECTIVES, ujoint_equivalent, ujoint_geometry,
                             ujoint_objective, ujoint_speed)
-from driver.study import Figure, Result
+from driver.study import Figure, Result, keyword_run
 from driver.table import Column, fortran_f, render_table
 
 __all__ = ["SPEC", "run", "Chain", "Design", "evaluate", "optimise"]
@@ -387,6 +387,7 @@ def _starts(params: Params, option: int, beta: np.ndarray, phi: np.ndarray, lb: 
     return np.vstack([x0, rand]), notes
 
 
+@keyword_run
 def run(params: Params, progress: bool = False) -> Result:
     """Analyse (option 0) or optimise (options 1-3) the chain of the deck."""
     beta, rho = _geometry(params)
