@@ -15,7 +15,7 @@ from pathlib import Path
 import driver
 from driver.deck import DeckError, read_deck
 from driver.export import FORMATS
-from driver.runner import available_studies, run_study
+from driver.runner import CONTROL_GROUPS, available_studies, run_study
 from driver.study import load_study
 
 __all__ = ["main", "run_deck", "EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT"]
@@ -33,6 +33,9 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool, progress:
     """
     try:
         deck = read_deck(path)
+        if "optimize" in deck.groups:
+            from driver import optimize
+            return optimize.run_optimize_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))
         if "sweep" in deck.groups:
             from driver import sweep
             return sweep.run_sweep_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))
@@ -61,6 +64,9 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool, progress:
 
 def _keys_help(group: str) -> str:
     module = load_study(group)
+    if module is None and group in CONTROL_GROUPS:
+        import importlib
+        module = importlib.import_module(f"driver.{group}")
     if module is None:
         return f"no study group &{group}"
     spec = module.SPEC
@@ -82,7 +88,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Run mechanism-analysis decks (Fortran namelist files) and write "
                     "fixed-format tables to OUTDIR/<deck stem>.out.",
         epilog=f"Study groups: {studies}; a &sweep group turns a deck into a study over "
-               "several cases. 'python -m driver --keys GROUP' lists a group's keys. "
+               "several cases, an &optimize group into an optimisation. 'python -m driver --keys GROUP' lists a group's keys. "
                "Exit status: 0 all decks succeeded, 1 a run failed, 2 bad input.",
     )
     parser.add_argument("decks", nargs="*", type=Path, metavar="DECK", help="input deck(s), e.g. inputs/crank5.dat")
@@ -97,11 +103,11 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("-q", "--quiet", action="store_true", help="print only warnings and errors")
     parser.add_argument("--keys", metavar="GROUP", help="list the keys of a namelist group and exit")
     parser.add_argument("-j", "--jobs", type=int, default=None,
-                        help="sweeps: worker processes (default: all cores)")
+                        help="sweeps and optimisations: worker processes (default: all cores)")
     parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
                         help="sweeps: run cases on this Dask distributed scheduler")
     parser.add_argument("--resume", action="store_true",
-                        help="sweeps: skip cases whose outputs are already complete")
+                        help="sweeps: skip cases whose outputs are already complete; optimisations: replay the run's journal and compute only new designs")
     parser.add_argument("--version", action="version", version=f"%(prog)s {driver.__version__}")
     return parser
 
