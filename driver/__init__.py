@@ -17,6 +17,7 @@ run Fortran 90 kernels through :mod:`driver.kernels`.  Names are imported on fir
 from __future__ import annotations
 
 import importlib
+import importlib.util
 from typing import TYPE_CHECKING, Any
 
 __version__ = "0.1.0"
@@ -33,16 +34,14 @@ if TYPE_CHECKING:   # pragma: no cover - for type checkers and IDEs only
 
 
 def __getattr__(name: str) -> Any:
-    """PEP 562: the public names and the study modules (``driver.fourbar``) on first use."""
+    """PEP 562: the public names and the modules (``driver.fourbar``, ``driver.optimize``) on first use."""
     if name in _API:
         value = getattr(importlib.import_module(_API[name]), name)
         globals()[name] = value
         return value
-    from driver.study import load_study
-    module = load_study(name) if not name.startswith("__") else None
-    if module is None:
-        raise AttributeError(f"module 'driver' has no attribute {name!r}")
-    return module
+    if name.isidentifier() and not name.startswith("_") and importlib.util.find_spec(f"driver.{name}"):
+        return importlib.import_module(f"driver.{name}")   # a study (driver.fourbar) or a subpackage
+    raise AttributeError(f"module 'driver' has no attribute {name!r}")
 
 
 def __dir__() -> list[str]:

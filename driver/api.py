@@ -104,9 +104,10 @@ def run(source: DeckSource, *, name: str | None = None, progress: bool = False) 
     and key; a deck with a ``&sweep`` group is run by :func:`run_sweep`.
     """
     deck = _deck(source, name)
-    if "sweep" in deck.groups:
-        raise DeckError(deck.path, deck.groups["sweep"].line or None, None,
-                        "this deck has a &sweep group: run it with driver.run_sweep()")
+    for group, how in (("sweep", "driver.run_sweep()"), ("optimize", "driver.optimize.optimize()")):
+        if group in deck.groups:
+            raise DeckError(deck.path, deck.groups[group].line or None, None,
+                            f"this deck has a &{group} group: run it with {how}")
     from_text = isinstance(source, str) and _is_text(source)
     outcome = run_study(deck, None, [], False, progress=progress, name=None if from_text else name)
     if from_text:   # a deck's text has no file name: name the outputs after the study
