@@ -104,7 +104,8 @@ def run(source: DeckSource, *, name: str | None = None, progress: bool = False) 
     and key; a deck with a ``&sweep`` group is run by :func:`run_sweep`.
     """
     deck = _deck(source, name)
-    for group, how in (("sweep", "driver.run_sweep()"), ("optimize", "driver.optimize.optimize()")):
+    for group, how in (("sweep", "driver.run_sweep()"), ("optimize", "driver.optimize.optimize()"),
+                       ("synthesis", "driver.synthesis.synthesise()")):
         if group in deck.groups:
             raise DeckError(deck.path, deck.groups[group].line or None, None,
                             f"this deck has a &{group} group: run it with {how}")

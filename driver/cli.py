@@ -1,4 +1,4 @@
-"""Command line: ``python -m driver DECK [DECK ...] [-o OUTDIR] [--csv|--format F] [--json] [--plot]``.
+"""Command line: ``python -m driver DECK [DECK ...] [-o OUTDIR] [--csv|--format F] [--json] [--plot] [--compare]``.
 
 Each deck runs on its own; the exit status is 0 when every deck succeeded,
 2 when any deck had bad input (nothing written for that deck), 1 when a run
@@ -33,6 +33,9 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool, progress:
     """
     try:
         deck = read_deck(path)
+        if "synthesis" in deck.groups:
+            from driver import synthesis
+            return synthesis.run_synthesis_deck(deck, outdir, formats, plot, progress, quiet)
         if "optimize" in deck.groups:
             from driver import optimize
             return optimize.run_optimize_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))
@@ -102,6 +105,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--plot", action="store_true", help="write PNG figures <stem>_<name>.png")
     parser.add_argument("-q", "--quiet", action="store_true", help="print only warnings and errors")
     parser.add_argument("--keys", metavar="GROUP", help="list the keys of a namelist group and exit")
+    parser.add_argument("--compare", action="store_true",
+                        help="compare each deck's run with the published tables in published/ (cell by cell, "
+                             "with reasons; writes nothing); exit 0 when every reproducible cell agrees")
     parser.add_argument("-j", "--jobs", type=int, default=None,
                         help="sweeps and optimisations: worker processes (default: all cores)")
     parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
@@ -123,6 +129,13 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_OK
     if not args.decks:
         parser.error("no deck given")
+    if args.compare:
+        from driver.compare import compare_decks
+        try:
+            return compare_decks(args.decks)
+        except BrokenPipeError:
+            sys.stderr.close()
+            return EXIT_OK
     formats = list(dict.fromkeys((["csv"] if args.csv else []) + args.formats))
     progress = sys.stderr.isatty() and not args.quiet and not os.environ.get("CI")
     sweep_options = {"jobs": args.jobs, "scheduler": args.scheduler, "resume": args.resume}

@@ -28,7 +28,8 @@ if TYPE_CHECKING:
 
 __all__ = ["Figure", "Result", "keyword_run", "load_study"]
 
-_CORE = {"cli", "deck", "study", "table", "export", "plotting", "atomic", "kernels", "sweep", "runner", "expr", "optimize", "synthesis"}
+_CORE = {"cli", "deck", "study", "table", "export", "plotting", "atomic", "kernels", "sweep", "runner", "expr",
+         "optimize", "synthesis", "published", "compare"}
 
 
 @dataclass

@@ -32,8 +32,8 @@ def _decks(sweep: bool) -> list:
     out = []
     for p in sorted(INPUTS.glob("*.dat")):
         text = p.read_text().lower()
-        if ("&sweep" in text) != sweep or "&optimize" in text or p.stem == "fourbar_design_search":
-            continue   # optimisation decks have their own API (driver.optimize.optimize); the design
+        if ("&sweep" in text) != sweep or "&optimize" in text or "&synthesis" in text or p.stem == "fourbar_design_search":
+            continue   # optimisation and synthesis decks have their own API (driver.optimize, driver.synthesis); the design
                        # search takes minutes and runs the same sweep code as the other sweep decks
         marks = [pytest.mark.slow] if p.stem in SLOW else []
         out.append(pytest.param(p, id=p.stem, marks=marks))
@@ -122,6 +122,8 @@ def test_bad_input_raises_deck_error_with_line_and_key():
         driver.run(INPUTS / "fourbar_paper_sweep.dat")
     with pytest.raises(driver.DeckError, match="optimize"):
         driver.run(INPUTS / "optimize_fourbar_design.dat")
+    with pytest.raises(driver.DeckError, match="synthesise"):
+        driver.run(INPUTS / "synthesis_crank_rocker.dat")
     with pytest.raises(TypeError):
         driver.fourbar.run(read_deck(INPUTS / "crank5.dat"), crank=3)
     with pytest.raises(TypeError):
