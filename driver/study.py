@@ -28,7 +28,7 @@ if TYPE_CHECKING:
 
 __all__ = ["Figure", "Result", "keyword_run", "load_study"]
 
-_CORE = {"cli", "deck", "study", "table", "export", "plotting", "atomic", "kernels", "sweep", "runner", "expr",
+_CORE = {"cli", "limits", "deck", "study", "table", "export", "plotting", "atomic", "kernels", "sweep", "runner", "expr",
          "optimize", "synthesis", "published", "compare"}
 
 
