@@ -1,32 +1,53 @@
-"""The one plotting module (matplotlib, Agg backend, no screen needed).
+"""The one plotting module (matplotlib object API; no screen, no pyplot state).
 
 Shared helpers first; then one section per study with its figure builders.
-Every builder returns a matplotlib Figure; :func:`save_figure` writes it
-atomically as PNG.  Studies wrap builders in :class:`driver.study.Figure`
-so nothing is drawn unless ``--plot`` is given.
+Every builder returns a :class:`matplotlib.figure.Figure` drawn inside
+:func:`style` (an ``rc_context``), and :func:`save_figure` writes it atomically
+as PNG, SVG or PDF, byte for byte the same for the same inputs.  Nothing here selects a backend or changes the global ``rcParams``:
+importing this module or drawing a figure leaves a user's own matplotlib
+settings (e.g. Jupyter's inline backend) exactly as they were.  Studies wrap
+builders in :class:`driver.study.Figure` so nothing is drawn unless asked.
 """
 from __future__ import annotations
 
+import contextlib
+import functools
 import math
 import textwrap
 from pathlib import Path
-from typing import Sequence
+from typing import Any, Callable, Iterator, Sequence, TypeVar
 
 import matplotlib
 import matplotlib.ticker
+import numpy as np
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
+from driver.atomic import atomic_open
+from driver.study import PLOT_FORMATS, plot_format
 
-from driver.atomic import atomic_open  # noqa: E402
-from driver.study import PLOT_FORMATS, plot_format  # noqa: E402
+__all__ = ["STYLE", "style", "styled", "new_figure", "save_figure", "line_panels"]
 
-__all__ = ["new_figure", "save_figure", "line_panels"]
+#: the house style, applied only inside :func:`style` (never written to the global rcParams)
+STYLE: dict[str, Any] = {"figure.dpi": 110, "savefig.dpi": 110, "axes.grid": True, "grid.alpha": 0.3,
+                         "axes.spines.top": False, "axes.spines.right": False, "font.size": 9}
 
-plt.rcParams.update({"figure.dpi": 110, "axes.grid": True, "grid.alpha": 0.3,
-                     "axes.spines.top": False, "axes.spines.right": False, "font.size": 9})
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+
+@contextlib.contextmanager
+def style(**overrides: Any) -> Iterator[None]:
+    """Draw inside this context to get the house style; rcParams are restored on exit."""
+    with matplotlib.rc_context({**STYLE, **overrides}):
+        yield
+
+
+def styled(builder: _F) -> _F:
+    """Decorator: run a figure builder inside :func:`style`."""
+    @functools.wraps(builder)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        with style():
+            return builder(*args, **kwargs)
+    return wrapper  # type: ignore[return-value]
 
 
 def new_figure(nrows: int = 1, ncols: int = 1, **kw) -> tuple[Figure, np.ndarray]:
@@ -46,7 +67,8 @@ _SVG_SALT = "driver-figures"
 
 
 def save_figure(fig: Figure, path: str | Path, fmt: bool | str | None = None) -> Path:
-    """Write ``fig`` to ``path`` atomically and reproducibly (no dates or versions inside).
+    """Write ``fig`` to ``path`` atomically and reproducibly (no dates or versions inside), in the
+    house style's resolution.
 
     ``fmt`` is a format of :data:`driver.study.PLOT_FORMATS` (``True`` or None: PNG, or the
     format of ``path``'s suffix when that is one); ``path``'s suffix is replaced by it.
@@ -57,11 +79,12 @@ def save_figure(fig: Figure, path: str | Path, fmt: bool | str | None = None) ->
         fmt = path.suffix.lstrip(".").lower() if path.suffix.lstrip(".").lower() in PLOT_FORMATS else "png"
     fmt = plot_format(fmt)
     path = path.with_suffix(f".{fmt}")
-    with matplotlib.rc_context({"svg.hashsalt": _SVG_SALT}), atomic_open(path, "wb") as fh:
+    with style(**{"svg.hashsalt": _SVG_SALT}), atomic_open(path, "wb") as fh:
         fig.savefig(fh, format=fmt, metadata=_METADATA[fmt])
     return path
 
 
+@styled
 def line_panels(x: np.ndarray, panels: Sequence[tuple[str, dict[str, np.ndarray]]], xlabel: str,
                 title: str = "", styles: dict[str, dict] | None = None) -> Figure:
     """Stacked panels sharing x: each panel is (ylabel, {label: y}); NaN gaps break lines."""
@@ -108,6 +131,7 @@ _FOURBAR_NAMES = {"coupler_deg": "coupler angle", "rocker_deg": "rocker angle", 
                   "omega2_rad_s": "coupler speed omega2", "omega3_rad_s": "rocker speed omega3"}
 
 
+@styled
 def fourbar_curves(exact, listing, title: str) -> Figure:
     """Angles, angular velocities and transmission angle against crank angle.
 
@@ -145,6 +169,7 @@ def fourbar_curves(exact, listing, title: str) -> Figure:
     return fig
 
 
+@styled
 def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.ndarray,
                     listing, title: str, n_poses: int = 6, point: np.ndarray | None = None,
                     units: str = "length units") -> Figure:
@@ -203,6 +228,7 @@ def ri2_ellipses(ri2: float, n: int, c: float, samples: int = 721) -> list[tuple
     return out
 
 
+@styled
 def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, L2: np.ndarray,
                              ri2: np.ndarray, sum_d2: float, n: int, levels: Sequence[float],
                              optima: dict, names: Sequence[str], l1: np.ndarray, l2: np.ndarray,
@@ -227,7 +253,7 @@ def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, 
             ax.plot(g, R - g, "g-", lw=0.8, label="l1 + l2 = R")
             for j, v in enumerate(_ellipse_levels(levels, n)):
                 for k2, (x, y) in enumerate(ri2_ellipses(v, n, sum_d2)):
-                    ax.plot(x, y, ":", lw=1.0, color=plt.cm.viridis(j / 4), gid=f"iso-RI2 ellipse {v!r}",
+                    ax.plot(x, y, ":", lw=1.0, color=matplotlib.colormaps["viridis"](j / 4), gid=f"iso-RI2 ellipse {v!r}",
                             label=f"iso-RI2 ellipse, RI2 = {v:.3g}" if k2 == 0 else None)
         else:
             cs = ax.contour(L1, L2, ri2, levels=np.sqrt(n) + np.array([0.001, 0.01, 0.05, 0.1, 0.2, 0.4, 0.8]),
@@ -254,6 +280,7 @@ def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, 
     return fig
 
 
+@styled
 def manipulator_torque_crob(l1: np.ndarray, tau1: np.ndarray, tau2: np.ndarray, c: float,
                             violates: np.ndarray | None = None, title: str = "") -> Figure:
     """Motor torques tau1, tau2 and their sum [N m] against l1 [m] along C_rob (Table 4.8).
@@ -294,6 +321,7 @@ def _trivial(y, x, chosen) -> bool:
     return False
 
 
+@styled
 def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (), title: str = "",
                   labels: dict[str, str] | None = None, preferred: Sequence[str] = ()) -> Figure:
     """Summary of a sweep: chosen (or the study's headline) figures against a swept key.
@@ -358,6 +386,7 @@ _UJOINT_STYLES = {"trial": dict(color="C1", lw=1.4), "design": dict(color="C1", 
                   "paper printed": dict(color="C2", lw=1.2, ls=":")}
 
 
+@styled
 def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.ndarray],
                         polar: bool = False, band: Sequence[float] | None = None, title: str = "") -> Figure:
     """Input and output shaft speed [rpm] against the input angle [deg], every design (trial,
@@ -411,6 +440,7 @@ def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.
 # ----------------------------------------------------------------------------- slidercrank
 
 
+@styled
 def slidercrank_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray]], title: str,
                               ylabel: str = "axial strain [microstrain]", above: dict[str, float] | None = None,
                               missing: Sequence[str] = ()) -> Figure:
@@ -442,6 +472,7 @@ def slidercrank_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray
     return fig
 
 
+@styled
 def slidercrank_convergence_figure(series: dict[str, tuple[list[int], list[float]]], title: str) -> Figure:
     """Peak strain against element count and its percentage change (the paper's Figures 8-9)."""
     fig, axes = new_figure(2, 1, sharex=True, figsize=(7.0, 5.0))
