@@ -695,13 +695,13 @@ def run(params: Params, progress: bool = False) -> Result:
         from driver import plotting
         above = {f"{c.omega:g} rad/s": c.euler_ratio for c in good if c.euler_ratio > 1.0}
         missing = [f"{c.omega:g} rad/s: {_status_text(c).split(' (')[0].lower()}, not drawn" for c in cases if not c.ok]
-        model = "K + K_G" if params.geometric_stiffness else "linear model"
+        stiffness = "K + K_G" if params.geometric_stiffness else "linear model"
         figures.append(Figure("strain", lambda: plotting.slidercrank_strain_figure(
             [(f"{c.omega:g} rad/s", c.angle_deg, c.eps_ax[0] * 1e6) for c in good],
-            f"{params.material}: crank-end element axial strain ({model})", above=above, missing=missing)))
+            f"{params.material}: crank-end element axial strain ({stiffness})", above=above, missing=missing)))
         figures.append(Figure("deflection", lambda: plotting.slidercrank_strain_figure(
             [(f"{c.omega:g} rad/s", c.angle_deg, c.mid * 1e3) for c in good],
-            f"{params.material}: midpoint deflection ({model})", ylabel="midpoint deflection [mm]",
+            f"{params.material}: midpoint deflection ({stiffness})", ylabel="midpoint deflection [mm]",
             above=above, missing=missing)))
     if conv:
         from driver import plotting
