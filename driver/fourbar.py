@@ -208,13 +208,22 @@ def extremes(p: Params) -> Extremes | None:
 #: deck keys a batch may vary (one value per design); every other key of &fourbar leaves the
 #: summary unchanged (alpha, step_deg, method, title, coupler_point) and is accepted but ignored
 BATCH_KEYS = ("fixed_link", "crank", "coupler", "rocker", "omega", "start_deg", "stop_deg", "branch")
-_NO_EFFECT = ("alpha", "step_deg", "method", "title", "coupler_point")
+BATCH_IGNORED = ("alpha", "step_deg", "method", "title", "coupler_point")
+#: keys whose deck checks do not involve other keys (a sweep validates each of their values once)
+BATCH_INDEPENDENT = ("fixed_link", "crank", "coupler", "rocker", "omega", "alpha", "title", "coupler_point")
 
 #: kernel Grashof codes -> (class name as grashof() prints it, full crank rotation)
 GRASHOF_NAMES = {"double_crank": ("double-crank (drag link)", True), "crank_rocker": ("crank-rocker", True),
                  "rocker_crank": ("rocker-crank", False), "double_rocker": ("Grashof double-rocker", False),
                  "change_point": ("change-point (special Grashof)", True),
                  "triple_rocker": ("non-Grashof triple-rocker", False)}
+
+
+def _bad(base: Mapping[str, Any], key: str | None, message: str) -> Exception:
+    """A DeckError at the key's deck line when ``base`` is a deck's Params, else a ValueError."""
+    if isinstance(base, Params):
+        return base.error(key, message)
+    return ValueError(f"{key}: {message}" if key else message)
 
 
 def _param_matrix(base: Mapping[str, Any], columns: Mapping[str, Any], n: int) -> np.ndarray:
@@ -227,7 +236,7 @@ def _param_matrix(base: Mapping[str, Any], columns: Mapping[str, Any], n: int) -
             if v.dtype.kind in "US":
                 bad = ~np.isin(v, ("open", "crossed"))
                 if bad.any():
-                    raise ValueError(f"branch: must be 'open' or 'crossed' (got {v[np.argmax(bad)]!r})")
+                    raise _bad(base, "branch", f"must be 'open' or 'crossed' (got {v[np.argmax(bad)]!r})")
                 v = np.where(v == "open", 1.0, -1.0)
         v = np.broadcast_to(np.asarray(v, dtype=np.float64), (n,))
         bad = ~np.isfinite(v)
@@ -235,7 +244,7 @@ def _param_matrix(base: Mapping[str, Any], columns: Mapping[str, Any], n: int) -
             bad |= ~(v > 0)
         if bad.any():
             i = int(np.argmax(bad))
-            raise ValueError(f"{key}: design {i} has {v[i]!r} (lengths must be positive, all values finite)")
+            raise _bad(base, key, f"design {i} has {float(v[i])!r} (lengths must be positive, all values finite)")
         cols[key] = v
     m = np.empty((n, 8), dtype=np.float64, order="F")
     for j, key in enumerate(BATCH_KEYS):
@@ -256,17 +265,18 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     mu_max_deg, meets_band_40_120, rocker_turns_fully, rocker_swing_deg, toggle_in_range,
     omega3_peak_rad_s, omega2_peak_rad_s, assembled_fraction; with ``detail`` also the crank
     angles [deg] of those extremes, the rocker extreme positions [deg] and the number of
-    toggle positions in the range.  Raises ValueError naming the key of a bad value.
+    toggle positions in the range.  A bad value raises DeckError (``base`` a deck's Params:
+    deck, line and key of the base deck, the design's index in the message) or ValueError.
     About 20 microseconds per design on one core (bench/bench_sweep.py).
     """
     columns = {k.partition(".")[2] if k.startswith("fourbar.") else k: v for k, v in (columns or {}).items()}
-    unknown = [k for k in columns if k not in BATCH_KEYS and k not in _NO_EFFECT]
+    unknown = [k for k in columns if k not in BATCH_KEYS and k not in BATCH_IGNORED]
     if unknown:
-        raise ValueError(f"{unknown[0]}: not a &fourbar key the summary depends on ({', '.join(BATCH_KEYS)})")
+        raise _bad(base, unknown[0], f"not a &fourbar key the summary depends on ({', '.join(BATCH_KEYS)})")
     columns = {k: v for k, v in columns.items() if k in BATCH_KEYS}
     sizes = {np.size(v) for v in columns.values() if np.ndim(v) > 0}
     if len(sizes) > 1:
-        raise ValueError(f"columns have different lengths {sorted(sizes)}")
+        raise _bad(base, None, f"batch columns have different lengths {sorted(sizes)}")
     n = sizes.pop() if sizes else 1
     res = kernels.fourbar_summaries(_param_matrix(base, columns, n))
     return _frame(res, detail)

@@ -42,7 +42,7 @@ import f90nml
 import numpy as np
 import pandas as pd
 
-from driver import expr
+from driver import expr, sweep_batch
 from driver.atomic import write_text
 from driver.deck import Deck, DeckError, GroupSpec, Key, Params, RawGroup, validate
 from driver.export import write_tidy
@@ -154,16 +154,23 @@ def _axes(sw: Params, study_group: str, study_spec: GroupSpec) -> list[tuple[str
     return axes
 
 
+def _check_zip(sw: Params, axes: list[tuple[str, list]]) -> None:
+    """zip = .true. needs equally long value lists."""
+    if not sw.zip:
+        return
+    n = len(axes[0][1])
+    for k, (name, vals) in enumerate(axes):
+        if len(vals) != n:
+            raise sw.error(f"values{k + 1}" if sw[f"values{k + 1}"] is not None else f"count{k + 1}",
+                           f"zip = .true. needs equally long value lists ({axes[0][0]}: {n}, {name}: {len(vals)})")
+
+
 def build_cases(sw: Params, study_group: str, study_spec: GroupSpec) -> list[Case]:
     """All cases of the sweep, numbered from 1: a full grid, or zipped axes."""
     axes = _axes(sw, study_group, study_spec)
     names = [a[0] for a in axes]
+    _check_zip(sw, axes)
     if sw.zip:
-        n = len(axes[0][1])
-        for k, (name, vals) in enumerate(axes):
-            if len(vals) != n:
-                raise sw.error(f"values{k + 1}" if sw[f"values{k + 1}"] is not None else f"count{k + 1}",
-                               f"zip = .true. needs equally long value lists ({names[0]}: {n}, {name}: {len(vals)})")
         combos: Iterable = zip(*(v for _, v in axes))
     else:
         combos = itertools.product(*(v for _, v in axes))
@@ -325,12 +332,6 @@ def auto_chunk(seconds_per_case: float, n_cases: int, workers: int, target: floa
     return max(1, min(by_time, by_balance))
 
 
-def _ignore_sigint() -> None:
-    """Worker initializer: Ctrl-C is handled by the parent only."""
-    import signal
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-
-
 def _execute(cases: list[Case], task_of, jobs: int, scheduler: Any, chunk: int, progress: bool,
              total: int, done0: int) -> tuple[list[CaseResult], int]:
     """Run cases locally (process pool) or on Dask; returns results (any order) and the chunk used.
@@ -368,7 +369,7 @@ def _execute(cases: list[Case], task_of, jobs: int, scheduler: Any, chunk: int, 
         else:
             # workers ignore Ctrl-C: the parent cancels queued chunks and lets running ones finish,
             # so every case a worker started is written completely
-            pool = cf.ProcessPoolExecutor(max_workers=jobs, initializer=_ignore_sigint)
+            pool = cf.ProcessPoolExecutor(max_workers=jobs, initializer=sweep_batch.worker_init)
             submit = lambda t: pool.submit(run_task, t)
             wait_any = lambda fs: cf.wait(fs, return_when=cf.FIRST_COMPLETED)
             close = lambda: pool.shutdown(wait=True)
@@ -437,9 +438,12 @@ def summary_frame(results: list[CaseResult], names: list[str]) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def _summary_table(frame: pd.DataFrame, limit: int = 2000) -> list[str]:
-    """Fixed-format rendering of the summary frame (kept cases only above ``limit`` rows)."""
-    show = frame if len(frame) <= limit else frame[frame["kept"]]
+def _summary_table(frame: pd.DataFrame, limit: int = 2000, n_cases: int | None = None,
+                   rows: str = "all") -> list[str]:
+    """Fixed-format rendering of the summary frame (kept and failed cases only above ``limit``
+    cases; ``frame`` may hold only those already, then ``n_cases`` is the study's total)."""
+    n_cases = len(frame) if n_cases is None else n_cases
+    show = frame if n_cases <= limit else frame[frame["kept"] | (frame["status"] != "ok")]
     cols, keys = [], []
     for name in frame.columns:
         if name in ("error",):
@@ -469,8 +473,9 @@ def _summary_table(frame: pd.DataFrame, limit: int = 2000) -> list[str]:
                 row.append(v)
         rows.append(row)
     lines = render_table(cols, rows)
-    if len(show) < len(frame):
-        lines.append(f"  ({len(frame) - len(show)} cases not kept are in the _summary table only)")
+    if len(show) < n_cases:
+        where = "are in the _summary table only" if rows == "all" else "are not listed (summary_rows = 'kept')"
+        lines.append(f"  ({n_cases - len(show)} cases not kept {where})")
     return lines
 
 
@@ -482,8 +487,9 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
     study_raw = {n: g for n, g in deck.groups.items() if n != "sweep"}
     module, base_params = study_of(Deck(deck.path, study_raw))   # the base deck must be valid on its own
     raw = study_raw[base_params.group]
-    cases = build_cases(sw, base_params.group, module.SPEC)
-    names = list(cases[0].values)
+    axes = _axes(sw, base_params.group, module.SPEC)
+    names = [a[0] for a in axes]
+    _check_zip(sw, axes)
     if sw.keep:   # check the filter on the base deck's summary columns before running anything
         probe = (module.summarise(base_params) if hasattr(module, "summarise")
                  else module.run(base_params).summary)
@@ -493,12 +499,18 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
             raise sw.error("keep", f"{exc.message}" + (f" (at '{exc.token}')" if exc.token else "")) from None
     stem = Path(deck.path).stem
     case_dir = outdir / stem
-    width = max(4, len(str(len(cases))))
+    grid = sweep_batch.Grid(names, [v for _, v in axes], bool(sw.zip))
+    width = max(4, len(str(grid.n)))
     base = _base_hash(raw)
     scheduler = scheduler or sw.scheduler or ""
     jobs = jobs or os.cpu_count() or 1
     task_of = lambda cs: Task(str(deck.path), raw, cs, str(case_dir), width, sw.keep, sw.case_outputs,
                               formats, plot, base)
+    bplan = sweep_batch.plan(module, raw, str(deck.path), grid, sw.keep, sw.case_outputs, sw.summary_rows)
+    if bplan is not None:
+        return _run_batch(deck, sw, base_params, bplan, axes, outdir, stem, task_of, formats, plot, progress,
+                          quiet, jobs, scheduler, resume)
+    cases = build_cases(sw, base_params.group, module.SPEC)
 
     done: list[CaseResult] = []
     todo = cases
@@ -526,7 +538,8 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
         for fmt in ("csv", "parquet"):
             write_tidy(allcases, outdir / f"{stem}_cases", fmt)
     failed = [r for r in done if r.status != EXIT_OK]
-    text = _sweep_text(deck, sw, base_params, names, cases, frame, failed, chunk, jobs, scheduler)
+    text = _sweep_text(deck, sw, base_params, axes, len(cases), frame, int(frame["kept"].sum()),
+                       [(r.index, r.values, r.error) for r in failed], sw.summary_rows)
     write_text(outdir / f"{stem}.out", text)
     if plot:
         from driver.plotting import save_figure, sweep_summary
@@ -545,23 +558,82 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
     return max([EXIT_OK] + [r.status for r in failed])
 
 
-def _sweep_text(deck: Deck, sw: Params, base: Params, names: list[str], cases: list[Case],
-                frame: pd.DataFrame, failed: list[CaseResult], chunk: int, jobs: int, scheduler: Any) -> str:
+def _run_batch(deck: Deck, sw: Params, base_params: Params, bplan, axes, outdir: Path, stem: str, task_of,
+               formats: list[str], plot: bool, progress: bool, quiet: bool, jobs: int, scheduler: Any,
+               resume: bool) -> int:
+    """A sweep on the study's batch path (driver.sweep_batch); same outputs as case by case."""
+    names = [a[0] for a in axes]
+    n = bplan.grid.n
+    t_start = time.perf_counter()
+
+    def announce(resumed: int) -> None:
+        if resume and not quiet:
+            print(f"resume: {resumed} of {n} cases complete, {n - resumed} to run")
+
+    rows, counts, chunk = sweep_batch.run(bplan, outdir / f"{stem}.sweep", jobs, scheduler, resume, progress,
+                                          sw.chunk, announce)
+    elapsed = time.perf_counter() - t_start
+    if rows.empty:
+        rows = pd.DataFrame(columns=["case", *names, "status", "kept", "error"])
+    tidies = []
+    if sw.case_outputs == "kept" and counts["kept"]:   # the kept cases' own files, case by case
+        kept = rows[rows["kept"]]
+        cases = [Case(int(r["case"]), {k: (r[k].item() if hasattr(r[k], "item") else r[k]) for k in names})
+                 for _, r in kept.iterrows()]
+        done, _ = _execute(cases, task_of, jobs, scheduler, 0, False, len(cases), 0)
+        done.sort(key=lambda r: r.index)
+        tidies = [r.tidy for r in done if r.tidy is not None]
+        for r in done:
+            if r.status != EXIT_OK:
+                rows.loc[rows["case"] == r.index, ["status", "kept", "error"]] = ["failed", False, r.error]
+    for fmt in ("csv", "parquet"):
+        write_tidy(rows, outdir / f"{stem}_summary", fmt)
+    if tidies:
+        allcases = pd.concat(tidies, ignore_index=True)
+        for fmt in ("csv", "parquet"):
+            write_tidy(allcases, outdir / f"{stem}_cases", fmt)
+    bad = rows[rows["status"] != "ok"]
+    failed = [(int(r["case"]), {k: r[k] for k in names}, r["error"]) for _, r in bad.iterrows()]
+    text = _sweep_text(deck, sw, base_params, axes, n, rows, int(rows["kept"].sum()), failed, sw.summary_rows)
+    write_text(outdir / f"{stem}.out", text)
+    if plot:
+        from driver.plotting import save_figure, sweep_summary
+        save_figure(sweep_summary(rows, names, sw.plot_x, sw.plot_y, stem), outdir / f"{stem}_summary.png")
+    for index, values, error in failed[:20]:
+        vals = ", ".join(f"{k} = {v!r}" for k, v in values.items())
+        print(f"error: {deck.path}: case {index} ({vals}): {error}", file=sys.stderr)
+    if len(failed) > 20:
+        print(f"error: {deck.path}: ... and {len(failed) - 20} more failed cases (see {stem}.out)", file=sys.stderr)
+    if not quiet:
+        print(f"sweep {deck.path}: {n - len(failed)} of {n} cases ok, {int(rows['kept'].sum())} kept, "
+              f"{elapsed:.2f} s, {n / max(elapsed, 1e-9):.0f} cases/s "
+              f"({'dask ' + str(scheduler) if scheduler else f'{jobs} worker(s)'}, batch path, chunk {chunk})")
+        print(f"wrote {outdir / (stem + '.out')} and {outdir / stem}_summary.{{csv,parquet}}")
+    if failed:
+        return EXIT_BAD_INPUT if (bad["status"] == "bad input").any() else EXIT_FAILED
+    return EXIT_OK
+
+
+def _sweep_text(deck: Deck, sw: Params, base: Params, axes: list[tuple[str, list]], n_cases: int,
+                frame: pd.DataFrame, n_kept: int, failed: list[tuple[int, dict, str]], rows: str) -> str:
+    """The sweep's fixed-format .out: axes, counts, the summary table, failed cases."""
     lines = [f"  sweep over &{base.group} from deck {deck.path}", ""]
-    for k, name in enumerate(names, start=1):
-        vals = list(dict.fromkeys(c.values[name] for c in cases))   # deck order
+    for name, values in axes:
+        vals = list(dict.fromkeys(values))   # deck order
         fmt = lambda v: v if isinstance(v, str) else f"{v:.6g}"
         shown = (", ".join(map(fmt, vals[:8])) if len(vals) <= 8 else
                  f"{fmt(vals[0])}, {fmt(vals[1])}, ..., {fmt(vals[-1])} ({len(vals)} values)")
         lines.append(f"    {name:<28} {shown}")
-    lines += [f"    {'cases':<28} {len(cases)} ({'zipped' if sw.zip else 'full grid'})",
+    lines += [f"    {'cases':<28} {n_cases} ({'zipped' if sw.zip else 'full grid'})",
               f"    {'case outputs':<28} {sw.case_outputs}" + (f"   keep: {sw.keep}" if sw.keep else ""),
-              f"    {'kept':<28} {int(frame['kept'].sum())}",
+              f"    {'kept':<28} {n_kept}",
               f"    {'failed':<28} {len(failed)}", ""]
-    lines += _summary_table(frame)
+    lines += _summary_table(frame, n_cases=n_cases, rows=rows)
     if failed:
         lines += ["", "  Failed cases"]
-        for r in failed:
-            vals = ", ".join(f"{k} = {v!r}" for k, v in r.values.items())
-            lines.append(f"    case {r.index} ({vals}): {r.error}")
+        for index, values, error in failed[:1000]:
+            vals = ", ".join(f"{k} = {v!r}" for k, v in values.items())
+            lines.append(f"    case {index} ({vals}): {error}")
+        if len(failed) > 1000:
+            lines.append(f"    ... and {len(failed) - 1000} more (status column of the _summary table)")
     return "\n".join(lines) + "\n"

@@ -443,7 +443,7 @@ contains
 
     m = min(maxscan, max(2, ceiling((hie - lo)/scan_step) + 1))
     h = (hie - lo)/(m - 1)
-    ! hot-loop: one vectorised kernel call over the whole scan
+    ! the whole scan in one (vectorised) kernel call
     do k = 1, m
       th(k) = (lo + (k - 1)*h)*rad
     end do

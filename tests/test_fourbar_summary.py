@@ -19,7 +19,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from driver import kernels
-from driver.deck import Params
+from driver.deck import DeckError, Params
 from driver.fourbar import SPEC, grashof, limit_angles, summarise, summarise_batch
 
 OK, TOG = kernels.FOURBAR_STATUS["ok"], kernels.FOURBAR_STATUS["toggle"]
@@ -169,15 +169,15 @@ def test_single_case_equals_batch(links, branch, lo, span, omega):
 
 def test_batch_input_errors():
     base = params(fixed_link=12.0, crank=5.0, coupler=15.0, rocker=9.0)
-    with pytest.raises(ValueError, match="crank: design 1"):
+    with pytest.raises(DeckError, match="test.dat:1: key 'crank': design 1 has -2.0"):
         summarise_batch(base, {"crank": [1.0, -2.0]})
-    with pytest.raises(ValueError, match="rocker: design 0"):
+    with pytest.raises(DeckError, match="key 'rocker': design 0 has nan"):
         summarise_batch(base, {"fourbar.rocker": [np.nan]})
-    with pytest.raises(ValueError, match="different lengths"):
+    with pytest.raises(DeckError, match="different lengths"):
         summarise_batch(base, {"crank": [1.0, 2.0], "coupler": [1.0, 2.0, 3.0]})
-    with pytest.raises(ValueError, match="colour: not a &fourbar key"):
+    with pytest.raises(DeckError, match="key 'colour': not a &fourbar key"):
         summarise_batch(base, {"colour": [1.0]})
-    with pytest.raises(ValueError, match="branch: must be"):
-        summarise_batch(base, {"branch": ["open", "sideways"]})
+    with pytest.raises(ValueError, match="branch: must be"):   # a plain mapping as the base
+        summarise_batch(dict(base), {"branch": ["open", "sideways"]})
     f = summarise_batch(base, {"crank": np.linspace(1, 5, 5), "step_deg": 7.0, "branch": ["open"] * 5})
     assert len(f) == 5 and f["assemblable"].all()
