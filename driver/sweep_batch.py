@@ -50,10 +50,12 @@ from driver.atomic import atomic_open
 from driver.deck import DeckError, RawGroup, validate
 from driver.study import load_study
 
-__all__ = ["Grid", "BatchPlan", "plan", "run", "worker_init", "chunk_rows"]
+__all__ = ["Grid", "BatchPlan", "batchable", "plan", "run", "worker_init", "chunk_rows", "MAX_CASES"]
 
 #: cases per task: ~0.3-0.6 s of kernel time on one core for the four-bar
 CHUNK = 16384
+#: largest batch sweep (no case is listed, so only the grid's size is limited)
+MAX_CASES = 10**10
 #: largest number of combinations of coupled swept keys validated one by one
 MAX_COMBOS = 20000
 DIED = "worker process died twice computing this chunk (killed, out of memory or a crash in a kernel)"
@@ -120,15 +122,17 @@ def _swap(raw: RawGroup, values: dict[str, Any]) -> RawGroup:
     return RawGroup(raw.name, v, raw.lines, raw.line)
 
 
-def plan(module, raw: RawGroup, deck_path: str, grid: Grid, keep: str, case_outputs: str,
-         rows: str) -> BatchPlan | None:
-    """A batch plan for this sweep, or None when it must run case by case (see module doc)."""
+def batchable(module, names: list[str], keep: str, case_outputs: str) -> bool:
+    """Whether a sweep over ``names`` ('group.key') can take the study's batch path."""
     if not hasattr(module, "summarise_batch") or case_outputs == "all" or (case_outputs == "kept" and not keep):
-        return None
+        return False
     batch_keys = set(getattr(module, "BATCH_KEYS", ())) | set(getattr(module, "BATCH_IGNORED", ()))
+    return all(n.partition(".")[2] in batch_keys for n in names)
+
+
+def plan(module, raw: RawGroup, deck_path: str, grid: Grid, keep: str, rows: str) -> BatchPlan | None:
+    """A batch plan for this sweep (see :func:`batchable`), or None when it must run case by case."""
     keys = [n.partition(".")[2] for n in grid.names]
-    if not all(k in batch_keys for k in keys):
-        return None
     independent = set(getattr(module, "BATCH_INDEPENDENT", ()))
     single: dict[str, dict[int, str]] = {}
     coupled = [i for i, k in enumerate(keys) if k not in independent]

@@ -70,20 +70,38 @@ def test_one_process_two_workers_and_dask_agree(tmp_path):
     pd.testing.assert_frame_equal(summary(one), summary(dsk))
 
 
-def test_bad_values_are_reported_per_case_and_the_rest_completes(tmp_path, capsys):
+def test_bad_values_refuse_the_sweep_before_anything_runs(tmp_path, capsys):
     path = tmp_path / "bad.dat"
     path.write_text(BASE + "&sweep key1 = 'fourbar.crank', values1 = 2, -1, 5\n"
                            "       key2 = 'fourbar.start_deg', values2 = 0, 400\n"
                            "       case_outputs = 'none' /\n")
     out = tmp_path / "o"
     assert main([str(path), "-o", str(out), "-q", "-j", "1"]) == 2
-    s = summary(out, "bad")
-    assert list(s["status"]) == ["ok", "bad input", "bad input", "bad input", "ok", "bad input"]
-    assert "must be positive" in s["error"][2] and "key 'crank'" in s["error"][2]
-    assert "key 'step_deg'" in s["error"][1]   # start 400 > stop 360 with a positive step: a cross-key check
-    assert s["mu_min_deg"].notna().tolist() == [True, False, False, False, True, False]
-    assert "Failed cases" in (out / "bad.out").read_text()
-    assert "case 3 (fourbar.crank = -1, fourbar.start_deg = 0)" in capsys.readouterr().err
+    assert "is bad input" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_interior_bad_combination_of_a_large_grid_is_a_failed_case(tmp_path):
+    """Above FULL_VALIDATION cases only each value and the grid's corners are validated up
+    front; a bad combination inside the grid is found per chunk and reported as bad input."""
+    from driver import fourbar, sweep
+    from driver.deck import read_deck, validate
+    path = tmp_path / "inner.dat"
+    path.write_text(BASE + "&sweep key1 = 'fourbar.start_deg', values1 = 0, 300, 0\n"
+                           "       key2 = 'fourbar.stop_deg', values2 = 360, 200, 360\n"
+                           "       key3 = 'fourbar.crank', start3 = 1, stop3 = 3, count3 = 700\n"
+                           "       case_outputs = 'none' /\n")
+    d = read_deck(path)
+    sw = validate(d.groups["sweep"], sweep.SPEC, d.path)
+    axes = sweep._axes(sw, "fourbar", fourbar.SPEC)
+    grid = sweep_batch.Grid([a[0] for a in axes], [a[1] for a in axes], False)
+    p = sweep_batch.plan(fourbar, d.groups["fourbar"], str(path), grid, "", "all")
+    res = sweep_batch.chunk_rows(p, 0, grid.n)
+    f = res.frame
+    bad = (f["fourbar.start_deg"] == 300) & (f["fourbar.stop_deg"] == 200)
+    assert res.n_failed == bad.sum() == 700
+    assert (f.loc[bad, "status"] == "bad input").all() and f.loc[bad, "error"].str.contains("key 'step_deg'").all()
+    assert f.loc[~bad, "mu_min_deg"].notna().all()
 
 
 def _kill_after_parts(cmd: list[str], folder: Path, parts: int, timeout: float = 120.0) -> None:
