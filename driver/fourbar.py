@@ -26,6 +26,7 @@ from driver.table import Column, fortran_f, render_table
 __all__ = ["SPEC", "run", "summarise", "summarise_batch", "BATCH_KEYS", "grashof", "limit_angles", "exact_grid", "listing_grid"]
 
 ST = kernels.FOURBAR_STATUS
+MAX_ANGLE = 1.0e6   # |crank angle| [deg] a deck may give (ulp of 1e6 is 1.2e-10 deg)
 BAND = (40.0, 120.0)  # transmission-angle band recommended by the paper [deg]
 
 #: why the published listing's rows for crank angles in (180, 360) deg are wrong (see :func:`audit`)
@@ -40,6 +41,10 @@ def _check(p: Params) -> None:
     """Cross-key checks: step, range, and what the listing method can do."""
     if p.step_deg == 0:
         raise p.error("step_deg", "must not be 0 (the crank angle would never advance)")
+    for key in ("start_deg", "stop_deg"):
+        if abs(p[key]) > MAX_ANGLE:
+            raise p.error(key, f"|{p[key]:g}| deg is beyond {MAX_ANGLE:g} deg: a crank angle that large has lost "
+                               "its fraction of a degree in double precision (the motion repeats every 360 deg)")
     span = p.stop_deg - p.start_deg
     if span * p.step_deg < 0:
         raise p.error("step_deg", f"steps away from stop_deg ({p.start_deg:g} -> {p.stop_deg:g} "
