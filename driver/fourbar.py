@@ -20,7 +20,7 @@ import pandas as pd
 from driver import kernels
 from driver.limits import Estimate
 from driver.deck import GroupSpec, Key, Params, positive
-from driver.study import Figure, Result
+from driver.study import Figure, Result, keyword_run
 from driver.table import Column, fortran_f, render_table
 
 __all__ = ["SPEC", "run", "summarise", "summarise_batch", "BATCH_KEYS", "grashof", "limit_angles", "exact_grid",
@@ -561,6 +561,7 @@ def blame(params: Params, exc: BaseException) -> tuple[str, str] | None:
 
 # ----------------------------------------------------------------------------- run
 
+@keyword_run
 def run(params: Params, progress: bool = False) -> Result:
     """Analyse one four-bar deck (see module docstring)."""
     p = params
