@@ -422,6 +422,10 @@ def compare_decks(decks: list[Path], out=None) -> int:
     import sys
     from driver.deck import DeckError
     out = sys.stdout if out is None else out
+    if not published.PUBLISHED_DIR.is_dir():
+        print(f"error: the published tables are not installed ({published.PUBLISHED_DIR} is missing); "
+              "--compare needs the source tree (pip install -e .)", file=sys.stderr)
+        return 1
     status, done = 0, []
     for deck in decks:
         try:

@@ -254,3 +254,10 @@ def test_listing_deck_on_a_coarser_grid_departs_on_the_rows_it_does_not_print(wr
     missing = f[f["status"] == "departs"]
     assert sorted({int(r) for r in missing["row"]}) == list(range(20, 360, 40))
     assert (f[f["row"].astype(int) % 40 == 0]["status"] == "identical").all()
+
+
+def test_missing_published_folder_is_one_line_not_a_traceback(tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(published, "PUBLISHED_DIR", tmp_path / "nowhere")
+    assert main(["--compare", str(INPUTS / "crank5.dat")]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "published tables are not installed" in err
