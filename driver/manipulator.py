@@ -750,7 +750,14 @@ def estimate(params: Params) -> Estimate:
     sweep = Estimate(2000.0 * rows, 2e-3 * rows, "sweep_count" if p.sweep_count > 0 else "sweep_l1_step",
                      "sweep_count" if p.sweep_count > 0 else "sweep_l1_step", f"{rows:.4g} sweep rows")
     tables = Estimate(1e4 * designs * pts + 5e6, 5e-6 * designs * pts, "points_x", "points_x", "")
-    return mc + sweep + tables
+    if p.crob_l1:
+        crob = Estimate(0.0, 0.0)
+    else:   # Table 4.2 lists l1 = floor(radius), ..., 1 along C_rob; the radius grows with the workspace
+        far = "points_x" if max(map(abs, p.points_x)) >= max(map(abs, p.points_y)) else "points_y"
+        reach = max(math.hypot(x, y) for x, y in zip(p.points_x, p.points_y)) if pts else 1.0
+        rows = 2.0 * reach + 2.0
+        crob = Estimate(1000.0 * rows, 1e-4 * rows, far, far, f"about {rows:.4g} C_rob rows (workspace size)")
+    return mc + sweep + tables + crob
 
 
 @keyword_run

@@ -77,7 +77,7 @@ def output_stem(outdir: str | Path, deck_path: str | Path) -> Path:
 
 
 def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool | str,
-                  summary_json: bool = False) -> list[Path]:
+                  summary_json: bool = False, clean: bool = True) -> list[Path]:
     """Write the .out file, extra files, tidy tables, the summary as ``<stem>.json`` (when
     ``summary_json``) and figures for one case.
 
@@ -85,9 +85,10 @@ def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool | s
 
     The files form one set (:func:`driver.atomic.output_set`): all are renamed into place
     together once every one is complete, or none is.  Stale temporaries of this stem left
-    by a killed earlier run are removed first.
+    by a killed earlier run are removed first (``clean``; a sweep cleans its folder once).
     """
-    remove_stale_temporaries(stem.parent, stem.name)
+    if clean:
+        remove_stale_temporaries(stem.parent, stem.name)
     written: list[Path] = []
     with output_set(stem.parent):
         written.append(write_text(stem.with_name(stem.name + ".out"), result.text))

@@ -358,18 +358,19 @@ def _write_case(task: Task, case: Case, res: CaseResult, result, params: Params,
                 res.status, res.error = EXIT_FAILED, result.failure
         res.warnings = list(result.warnings)
         stem = Path(task.case_dir) / _case_name(case.index, task.width)
-        write_text(stem.with_suffix(".dat"), _case_deck_text(task.raw.name, params, case, Path(task.deck_path)))
         tidy = result.tidy.copy()
         for name, v in reversed(case.values.items()):
             tidy.insert(0, name, v)
-        write_outputs(result, stem, [f for f in task.formats if f != "parquet"], task.plot)
-        write_tidy(tidy, stem, "parquet")
-        res.tidy = tidy
-        res.written = True
         record = {"index": case.index, "values": case.values, "base": task.base_hash,
                   "status": res.status, "error": res.error, "summary": res.summary,
                   "kept": res.kept, "warnings": res.warnings}
-        write_text(stem.with_suffix(".json"), json.dumps(record, default=_json_default, indent=1))
+        with output_set(stem.parent):   # the case's files together (json marker last), or none
+            write_text(stem.with_suffix(".dat"), _case_deck_text(task.raw.name, params, case, Path(task.deck_path)))
+            write_outputs(result, stem, [f for f in task.formats if f != "parquet"], task.plot, clean=False)
+            write_tidy(tidy, stem, "parquet")
+            write_text(stem.with_suffix(".json"), json.dumps(record, default=_json_default, indent=1))
+        res.tidy = tidy
+        res.written = True
     except Exception as exc:
         res.status, res.error, res.kept = EXIT_FAILED, f"{exc.__class__.__name__}: {exc}", False
     res.seconds += time.perf_counter() - t0
@@ -609,6 +610,8 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
         if cases is None:
             cases = build_cases(sw, base_params.group, module.SPEC)
 
+    remove_stale_temporaries(case_dir, "case_")   # left by a killed earlier run of this deck
+    remove_stale_temporaries(outdir, stem)
     done: list[CaseResult] = []
     todo = cases
     if resume:
@@ -630,7 +633,6 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
     failed = [r for r in done if r.status != EXIT_OK]
     text = _sweep_text(deck, sw, base_params, axes, len(cases), frame, int(frame["kept"].sum()),
                        [(r.index, r.values, r.error) for r in failed], sw.summary_rows)
-    remove_stale_temporaries(outdir, stem)
     with output_set(outdir):   # the sweep's own files: all renamed into place together, or none
         for fmt in ("csv", "parquet"):
             write_tidy(table, outdir / f"{stem}_summary", fmt)
