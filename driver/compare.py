@@ -157,7 +157,7 @@ def _manipulator(params: Params, result: Result) -> list[dict]:
                "manipulability_l1_t44": None,
                "min_total_torque": s.get("sweep_min_total_torque_Nm"), "min_total_l1": s.get("sweep_min_l1_m"),
                "min_total_l2": s.get("sweep_min_l2_m")}
-        t44 = result.tidy[result.tidy["table"] == "4.4"]
+        t44 = m.table_frame(result.tidy, "4.4")
         if len(t44) > 1:
             out["manipulability_l1_t44"] = float(t44["l1_m"].iloc[1])
         return out
@@ -177,7 +177,7 @@ def _manipulator(params: Params, result: Result) -> list[dict]:
                 continue
             number = table.split()[-1]
             key_t = "4.1" if number == "4.3" else number
-            rows = tidy[tidy["table"] == key_t]
+            rows = m.table_frame(tidy, key_t)
             label = str(rec.row)
             if label.endswith("."):
                 k = int(label[:-1]) - 1
@@ -185,7 +185,8 @@ def _manipulator(params: Params, result: Result) -> list[dict]:
                 k = next((i for i, v in enumerate(rows["label"]) if v == label), -1)
             value = None
             if 0 <= k < len(rows):
-                v = rows[m.TIDY_NAMES.get(rec.column, rec.column)].iloc[k]
+                name = m.TIDY_NAMES.get(rec.column, rec.column)
+                v = rows[name].iloc[k] if name in rows else None   # a blank printed cell has no tidy row
                 value = None if v is None else float(v)
             flagged = m.NOT_REPRODUCIBLE.get((key_t, label, rec.column, rec.printed))
             departs = m.REASONS.get((key_t, rec.column), "follows from the cells above") if exact else None

@@ -20,6 +20,7 @@ import pandas as pd
 from driver import kernels
 from driver.limits import Estimate
 from driver.deck import GroupSpec, Key, Params, positive
+from driver.export import with_units
 from driver.study import Figure, Result, keyword_run
 from driver.table import Column, fortran_f, render_table
 
@@ -449,7 +450,7 @@ def audit(p: Params, theta: np.ndarray, table: np.ndarray, lst_status: np.ndarra
     good = (lst_status == ST["ok"]) & (status == ST["ok"])
     bad = good & (np.abs(dev) > 1e-4 * p.coupler)
     lines = ["", "  Audit of the listing against the closed loop (method = 'exact', branch = 'open')"]
-    frame = pd.DataFrame({"theta_deg": theta, "ab_length": ab, "ab_deviation": dev})
+    frame = pd.DataFrame({"theta_deg": theta, "ab_length": ab, "ab_deviation": dev, "loop_not_closed": bad})
     if not bad.any():
         lines.append(f"    every row closes the loop: |AB| = coupler within {np.max(np.abs(dev[good]), initial=0):.2e}")
         return lines, None, frame
@@ -497,18 +498,29 @@ def exact_as_listed(p: Params, theta_deg: np.ndarray) -> dict[tuple[int, str], s
     return res
 
 
-def tidy_frame(method: str, theta: np.ndarray, cols: dict[str, np.ndarray], status: np.ndarray) -> pd.DataFrame:
-    """One row per crank angle; status in words; unassemblable cells left empty (NaN in the frame)."""
-    words = np.array(["ok", "cannot_assemble", "toggle", "indeterminate"])[status]
+#: units of the tidy columns whose names do not say them ('length': the deck's length unit)
+TIDY_UNITS = {"xa": "length", "ya": "length", "xb": "length", "yb": "length", "xp": "length", "yp": "length",
+              "ab_error": "length"}
+
+
+def tidy_frame(method: str, theta: np.ndarray, cols: dict[str, np.ndarray], status: np.ndarray,
+               not_closed: np.ndarray | None = None) -> pd.DataFrame:
+    """One row per crank angle; status in words ('loop_not_closed' where ``not_closed``: a
+    listing row whose |AB| is not the coupler length); unassemblable cells left empty (NaN)."""
+    words = np.array(["ok", "cannot_assemble", "toggle", "indeterminate", "loop_not_closed"])[
+        np.where(not_closed, 4, status) if not_closed is not None else status]
     frame = pd.DataFrame({"method": method, "theta_deg": theta, **cols, "status": words})
-    return frame
+    return with_units(frame, TIDY_UNITS)
 
 
-def _exact_columns(out: np.ndarray, status: np.ndarray, cp: np.ndarray | None = None) -> dict[str, np.ndarray]:
+def _exact_columns(out: np.ndarray, status: np.ndarray, cp: np.ndarray | None = None,
+                   coupler: float | None = None) -> dict[str, np.ndarray]:
     vals = {"coupler_deg": _deg360(out[:, 0]), "rocker_deg": _deg360(out[:, 1]),
             "transmission_deg": np.degrees(out[:, 2]), "xa": out[:, 3], "ya": out[:, 4],
             "xb": out[:, 5], "yb": out[:, 6], "omega2_rad_s": out[:, 7], "omega3_rad_s": out[:, 8],
             "alpha2_rad_s2": out[:, 9], "alpha3_rad_s2": out[:, 10]}
+    if coupler is not None:   # loop closure of the solution: |AB| - coupler (round-off only)
+        vals["ab_error"] = np.hypot(out[:, 5] - out[:, 3], out[:, 6] - out[:, 4]) - coupler
     if cp is not None:
         vals.update({"xp": cp[:, 0], "yp": cp[:, 1], "vxp_per_s": cp[:, 2], "vyp_per_s": cp[:, 3],
                      "axp_per_s2": cp[:, 4], "ayp_per_s2": cp[:, 5]})
@@ -583,20 +595,21 @@ def run(params: Params, progress: bool = False) -> Result:
     out, status = exact_grid(p, theta)
     cp = coupler_point(p, theta, out, status)
     ex = extremes(p)
-    exact_frame = tidy_frame("exact", theta, _exact_columns(out, status, cp), status)
+    exact_frame = tidy_frame("exact", theta, _exact_columns(out, status, cp, p.coupler), status)
     warnings: list[str] = []
     title = p.title or f"{p.path.stem}"
     if p.method == "listing":
         table, lst_status = listing_grid(p)
         lines, _ = listing_text(p, table, lst_status)
-        alines, warn, _ = audit(p, theta, table, lst_status, out, status)
+        alines, warn, closure = audit(p, theta, table, lst_status, out, status)
         lines += alines + summary_lines(p, g, ex)
         if warn:
             warnings.append(warn)
         lst_cols = dict(zip(["coupler_deg", "rocker_deg", "transmission_deg", "xa", "ya", "xb", "yb",
                              "omega2_rad_s", "omega3_rad_s"], table[:, 1:].T))
-        listing_frame = tidy_frame("listing", theta, lst_cols, lst_status)
-        tidy = pd.concat([listing_frame, exact_frame], ignore_index=True)
+        lst_cols["ab_error"] = np.where(lst_status == ST["ok"], closure["ab_deviation"].to_numpy(), np.nan)
+        listing_frame = tidy_frame("listing", theta, lst_cols, lst_status, closure["loop_not_closed"].to_numpy())
+        tidy = with_units(pd.concat([listing_frame, exact_frame], ignore_index=True), TIDY_UNITS)
     else:
         listing_frame = None
         lines = [f"  four-bar linkage: closed-loop analysis (method = exact, branch = {p.branch})",

@@ -36,12 +36,13 @@ from scipy.optimize import minimize
 
 from driver import kernels
 from driver.deck import GroupSpec, Key, Params, non_empty, positive
+from driver.export import with_units
 from driver.limits import Estimate
 from driver.study import Figure, Result, keyword_run
 from driver.table import Column, fortran_f, render_table
 
 __all__ = ["SPEC", "run", "Workspace", "tolerance_box", "round_half_up", "REASONS", "NOT_REPRODUCIBLE", "TEXT_REASONS",
-           "TIDY_NAMES"]
+           "TIDY_NAMES", "TIDY_UNITS", "table_frame"]
 
 STATUS = kernels.MANIPULATOR_STATUS
 
@@ -682,21 +683,56 @@ def _header(p: Params, ws: Workspace, conv: Conv) -> list[str]:
     return lines
 
 
+#: unit of every tidy quantity ('1' dimensionless, 'bool' 1 = yes / 0 = no)
+TIDY_UNITS = {"l1_m": "m", "l2_m": "m", "m1_kg": "kg", "m2_kg": "kg", "g_m_s2": "m/s^2", "theta1_deg": "deg",
+              "theta2_deg": "deg", "tau1_Nm": "N m", "tau2_Nm": "N m", "ri1": "1", "ri2": "1", "ri3": "1",
+              "n": "1", "a1": "1", "b1": "1", "a2": "1", "b2": "1", "reach": "bool",
+              "theta1_rate_rad_s": "rad/s", "theta2_rate_rad_s": "rad/s", "theta1_acc_rad_s2": "rad/s^2",
+              "theta2_acc_rad_s2": "rad/s^2", "manipulability_m2": "m^2", "condition_number": "1",
+              "dl1_m": "m", "dl2_m": "m", "worst_corner_m": "m", "mc_max_m": "m", "mc_p99_m": "m"}
+
+
 def _tidy(tables: list[Table], tol: list[dict], sweep: dict, used: dict) -> pd.DataFrame:
+    """One long tidy frame for every table: table, row, label, quantity, value, unit.
+
+    A blank printed cell (e.g. angles of a design that cannot reach the target) has no row,
+    so no cell is empty; ``reach`` is 1 (yes) or 0 (no).  :func:`table_frame` gives one
+    table back in its printed (wide) shape.
+    """
     recs = []
+
+    def add(table: str, row: int, label: str, name: str, v: Any) -> None:
+        if v is None or (isinstance(v, float) and not math.isfinite(v)):
+            return
+        if name == "reach":
+            v = 1.0 if v == "yes" else 0.0
+        recs.append((table, row, label, name, float(v), TIDY_UNITS[name]))
+
     for t in tables:
         for i, row in enumerate(t.rows):
-            rec = {"table": t.key, "row": i + 1, "label": str(row[0]).rstrip(".")}
+            label = str(row[0]).rstrip(".")
             for col, v in zip(t.columns[1:], row[1:]):
-                name = TIDY_NAMES.get(col.header.strip(), col.header.strip())
-                rec[name] = np.nan if v is None else v
-            rec["note"] = t.trailers[i] if t.trailers else ""
-            recs.append(rec)
-    for rec in tol:
-        recs.append({"table": "tolerance", "row": 0, "label": rec["name"], "l1_m": rec["l1"], "l2_m": rec["l2"],
-                     "ri2": rec["ri2"], "dl1_m": rec["dl1"], "dl2_m": rec["dl2"], "worst_corner_m": rec["worst_corner"],
-                     "mc_max_m": rec["mc_max"], "mc_p99_m": rec["mc_p99"]})
-    return pd.DataFrame.from_records(recs)
+                add(t.key, i + 1, label, TIDY_NAMES.get(col.header.strip(), col.header.strip()), v)
+    for k, rec in enumerate(tol, start=1):
+        for name, key in (("l1_m", "l1"), ("l2_m", "l2"), ("ri2", "ri2"), ("dl1_m", "dl1"), ("dl2_m", "dl2"),
+                          ("worst_corner_m", "worst_corner"), ("mc_max_m", "mc_max"), ("mc_p99_m", "mc_p99")):
+            add("tolerance", k, rec["name"], name, rec[key])
+    frame = pd.DataFrame.from_records(recs, columns=["table", "row", "label", "quantity", "value", "unit"])
+    return with_units(frame, {"row": "1", "value": "see unit column"})
+
+
+def table_frame(tidy: pd.DataFrame, table: str) -> pd.DataFrame:
+    """One table of the long tidy frame in its printed shape: a row per printed row (row,
+    label, then a column per quantity in printed order; NaN where the printed cell is blank)."""
+    part = tidy[tidy["table"] == table]
+    if part.empty:
+        known = ", ".join(dict.fromkeys(tidy["table"]))
+        raise KeyError(f"no table {table!r} (tables: {known})")
+    wide = part.pivot(index=["row", "label"], columns="quantity", values="value")
+    wide = wide[list(dict.fromkeys(part["quantity"]))].reset_index()
+    wide.columns.name = None
+    wide.attrs["units"] = {"row": "1", "label": "", **{q: TIDY_UNITS[q] for q in wide.columns[2:]}}
+    return wide
 
 
 def _summary(p: Params, ws: Workspace, conv: Conv, used: dict, sweep: dict, tol: list[dict]) -> dict[str, Any]:

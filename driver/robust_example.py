@@ -28,6 +28,7 @@ import numpy as np
 import pandas as pd
 
 from driver.deck import GroupSpec, Key, Params, non_empty, positive
+from driver.export import with_units
 from driver.limits import Estimate
 from driver.study import Result, keyword_run
 from driver.table import Column, render_table
@@ -195,6 +196,11 @@ def estimate(params: Params) -> Estimate:
     return Estimate(1e6 + 1e3 * n, 0.05 + 1e-5 * n, "taguchi_y", "taguchi_y", f"{n} observations")
 
 
+#: the tidy table is long: ``value`` is the printed quantity named by ``item`` (coefficients of the
+#: fitted response models and times in the example's units; see the .out for each)
+TIDY_UNITS = {"index": "1", "value": "unit of item"}
+
+
 @keyword_run
 def run(params: Params, progress: bool = False) -> Result:
     """Run one &robust_example deck."""
@@ -279,5 +285,5 @@ def run(params: Params, progress: bool = False) -> Result:
             recs.append({"item": "t24", "index": i * len(row) + j, "value": float(v)})
     summary = {"mode": p.mode, "tmin_true": r["eq22_tmin"], "tmin_dual_response": r["eq29"],
                "tmin_taguchi": r["eq213"], "tmin_tolerance_analysis": r["eq215"], "flagged": len(flags)}
-    return Result(text="\n".join(L).rstrip() + "\n", tidy=pd.DataFrame.from_records(recs), summary=summary,
+    return Result(text="\n".join(L).rstrip() + "\n", tidy=with_units(pd.DataFrame.from_records(recs), TIDY_UNITS), summary=summary,
                   warnings=[f"printed value does not reproduce: {f}" for f in flags])

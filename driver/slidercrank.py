@@ -23,6 +23,7 @@ from tqdm import tqdm
 from driver import kernels
 from driver.limits import Estimate
 from driver.deck import GroupSpec, Key, Params, non_negative, positive
+from driver.export import with_units
 from driver.study import Figure, Result, keyword_run
 from driver.table import Column, render_table
 
@@ -537,8 +538,9 @@ def _tidy(model_name: str, cases: list[Case]) -> pd.DataFrame:
             "rod_elongation_um": c.elong * 1e6,
         }))
     if not frames:
-        return pd.DataFrame(columns=["material", "omega_rad_s", "n_elements", "crank_angle_deg"])
-    return pd.concat(frames, ignore_index=True)
+        return with_units(pd.DataFrame(columns=["material", "omega_rad_s", "n_elements", "crank_angle_deg"]),
+                          {"n_elements": "1"})
+    return with_units(pd.concat(frames, ignore_index=True), {"n_elements": "1"})
 
 
 def _summary(cases: list[Case], model: Model | None = None) -> dict[str, Any]:

@@ -29,6 +29,7 @@ from scipy.optimize import minimize
 from tqdm import tqdm
 
 from driver.deck import GroupSpec, Key, Params, non_empty, positive
+from driver.export import with_units
 from driver.limits import Estimate
 from driver.kernels import (UJOINT_MODELS, UJOINT_OBJECTIVES, ujoint_equivalent, ujoint_geometry,
                             ujoint_objective, ujoint_speed)
@@ -726,7 +727,7 @@ def _tidy(chain: Chain, designs: list[Design]) -> pd.DataFrame:
         if chain.model == UJOINT_MODELS["exact"]:
             frame["theta_out_deg"] = to
         frames.append(frame)
-    return pd.concat(frames, ignore_index=True)
+    return with_units(pd.concat(frames, ignore_index=True), {"ratio": "1"})
 
 
 def _summary(trial: Design, best: Design | None, runs: list[StartRun], failure: str | None) -> dict:

@@ -12,7 +12,7 @@ from hypothesis import given, settings, strategies as st
 from driver import kernels
 from driver.runner import study_of
 from driver.deck import read_deck
-from driver.manipulator import _sensitivity_blocks, tolerance_box
+from driver.manipulator import _sensitivity_blocks, table_frame, tolerance_box
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -56,7 +56,7 @@ def exact_runs():
 def test_exact_angles_reach_the_target(exact_runs):
     for case, (res, p) in exact_runs.items():
         for key in ("4.5", "4.8"):
-            t = res.tidy[res.tidy["table"] == key].dropna(subset=["theta1_deg"])
+            t = table_frame(res.tidy, key).dropna(subset=["theta1_deg"])
             assert len(t) > 0
             x, y = fk(t["l1_m"].to_numpy(), t["l2_m"].to_numpy(), np.radians(t["theta1_deg"]),
                       np.radians(t["theta2_deg"]))
@@ -68,8 +68,8 @@ def test_exact_angles_reach_the_target(exact_runs):
 def test_exact_torques_match_newton_euler(exact_runs):
     for case, (res, p) in exact_runs.items():
         for key in ("4.7", "4.8"):
-            ang = res.tidy[res.tidy["table"] == ("4.5" if key == "4.7" else key)]
-            tq = res.tidy[res.tidy["table"] == key]
+            ang = table_frame(res.tidy, "4.5" if key == "4.7" else key)
+            tq = table_frame(res.tidy, key)
             for (_, a), (_, b) in zip(ang.iterrows(), tq.iterrows()):
                 if np.isnan(a["theta1_deg"]):
                     continue
@@ -177,7 +177,7 @@ def test_tolerance_box_worst_corner_on_bound_and_monte_carlo(measure):
 
 def test_study_tolerance_rows(exact_runs):
     for case, (res, p) in exact_runs.items():
-        t = res.tidy[res.tidy["table"] == "tolerance"]
+        t = table_frame(res.tidy, "tolerance")
         assert len(t) == 2
         np.testing.assert_allclose(t["worst_corner_m"], p.tolerance_bound, rtol=1e-12)
         assert (t["mc_max_m"] <= p.tolerance_bound).all()

@@ -18,6 +18,7 @@ import pytest
 
 from driver.runner import study_of
 from driver.deck import read_deck
+from driver.manipulator import table_frame
 
 from driver.published import PUBLISHED_DIR, read_blocks
 
@@ -39,8 +40,7 @@ def run_deck(name: str):
 
 
 def table(result, key: str) -> pd.DataFrame:
-    t = result.tidy
-    return t[t["table"] == key].reset_index(drop=True)
+    return table_frame(result.tidy, key)
 
 
 def _cells(case: str, table: str) -> pd.DataFrame:
