@@ -418,35 +418,44 @@ def _execute(cases: list[Case], task_of, jobs: int, scheduler: Any, chunk: int, 
              total: int, done0: int) -> tuple[list[CaseResult], int]:
     """Run cases locally (process pool) or on Dask; returns results (any order) and the chunk used.
 
-    With ``chunk == 0`` the first ``jobs`` cases go out as single-case tasks and the chunk
-    size is chosen from the first one that returns, so timing it costs no parallelism.
+    With ``chunk == 0`` the first ``2 x workers`` cases go out as single-case tasks and the
+    chunk size is chosen once ``workers + 1`` of them have returned, from the fastest: some
+    worker has then run its second case, so the time is a warm one (a worker's first case
+    includes its cold imports, 40-60x slower).  On Dask the workers are the cluster's.
     """
     from tqdm import tqdm
     bar = tqdm(total=total, initial=done0, unit="case", disable=not progress, dynamic_ncols=True)
     results: list[CaseResult] = []
-    workers = jobs if not scheduler else max(jobs, 1)
-    first = cases[:max(1, workers)] if not chunk else []
+    client = None
+    if scheduler:
+        from dask.distributed import Client, wait
+        client = scheduler if not isinstance(scheduler, str) else Client(scheduler)
+        workers = max(1, sum(w.get("nthreads", 1) for w in client.scheduler_info().get("workers", {}).values()))
+    else:
+        workers = max(1, jobs)
+    first = cases[:2 * workers] if not chunk else []
     rest = cases[len(first):]
 
     def collect(part: list[CaseResult]) -> None:
         results.extend(part)
         bar.update(len(part))
 
+    def warm() -> float:
+        return min(r.seconds for r in results)
+
     try:
         if not scheduler and (jobs <= 1 or len(cases) <= 1):
-            if not chunk and cases:   # time the first case, then chunks of ~0.1 s (progress granularity)
-                collect(run_task(task_of(cases[:1])))
-                chunk = auto_chunk(results[-1].seconds, len(cases) - 1, 1)
-                cases = cases[1:]
+            if not chunk and cases:   # time two cases (the second is warm), then chunks of ~0.1 s
+                for c in cases[:2]:
+                    collect(run_task(task_of([c])))
+                cases = cases[2:]
+                chunk = auto_chunk(warm(), len(cases), 1)
             for cs in _chunks(cases, chunk or 1):
                 collect(run_task(task_of(cs)))
             return results, chunk or 1
         if scheduler:
-            from dask.distributed import Client, wait
-            client = scheduler if not isinstance(scheduler, str) else Client(scheduler)
             submit = lambda t: client.submit(run_task, t, pure=False)
             wait_any = lambda fs: wait(list(fs), return_when="FIRST_COMPLETED")
-            workers = len(client.scheduler_info().get("workers", {})) or workers
             close = (lambda: client.close()) if isinstance(scheduler, str) else (lambda: None)
         else:
             # workers ignore Ctrl-C: the parent cancels queued chunks and lets running ones finish,
@@ -463,11 +472,10 @@ def _execute(cases: list[Case], task_of, jobs: int, scheduler: Any, chunk: int, 
                 done, not_done = wait_any(pending)
                 pending = set(not_done)
                 for fut in done:
-                    part = fut.result()
-                    collect(part)
-                    if not chunk:   # first result: choose the chunk for everything else
-                        chunk = auto_chunk(part[0].seconds, len(rest), workers)
-                        pending |= {submit(task_of(cs)) for cs in _chunks(rest, chunk)}
+                    collect(fut.result())
+                if not chunk and (len(results) >= min(workers + 1, len(first)) or not pending):
+                    chunk = auto_chunk(warm(), len(rest), workers)   # warm case: choose the chunk once
+                    pending |= {submit(task_of(cs)) for cs in _chunks(rest, chunk)}
         except KeyboardInterrupt:
             print("interrupt: cancelling queued cases, finishing the running ones", file=sys.stderr)
             if scheduler:
@@ -651,9 +659,8 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
             labels = {c: column_label(module, c) for c in shown.columns}
             save_figure(sweep_summary(shown, names, sw.plot_x, sw.plot_y, stem, labels,
                                       getattr(module, "SWEEP_PLOT", ())), outdir / f"{stem}_summary.png", plot)
-    for r in done:
-        for w in r.warnings:
-            print(f"warning: {deck.path}: case {r.index}: {w}", file=sys.stderr)
+    for line in _warning_lines(deck.path, done):
+        print(line, file=sys.stderr)
     for r in failed:
         vals = ", ".join(f"{k} = {v!r}" for k, v in r.values.items())
         print(f"error: {deck.path}: case {r.index} ({vals}): {r.error}", file=sys.stderr)
@@ -663,6 +670,21 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
               f"{elapsed:.2f} s ({'dask ' + str(scheduler) if scheduler else f'{jobs} worker(s)'}, chunk {chunk})")
         print(f"wrote {outdir / (stem + '.out')} and {outdir / stem}_summary.{{csv,parquet}}")
     return max([EXIT_OK] + [r.status for r in failed])
+
+
+def _warning_lines(path: Path, done: list[CaseResult]) -> list[str]:
+    """One line per distinct warning: a warning many cases repeat is printed once, with how
+    many cases gave it and their range (not 31 identical lines for a 31-case sweep)."""
+    by_text: dict[str, list[int]] = {}
+    for r in done:
+        for w in r.warnings:
+            by_text.setdefault(w, []).append(r.index)
+    lines = []
+    for w, idx in by_text.items():
+        where = (f"case {idx[0]}" if len(idx) == 1 else
+                 f"{len(idx)} cases ({min(idx)}..{max(idx)})" if len(idx) < len(done) else f"all {len(idx)} cases")
+        lines.append(f"warning: {path}: {where}: {w}")
+    return lines
 
 
 def _run_batch(deck: Deck, sw: Params, base_params: Params, bplan, axes, outdir: Path, stem: str, task_of,

@@ -215,3 +215,13 @@ def test_grid_columns_follow_product_order():
     z = sweep_batch.Grid(["a.x", "a.y"], [[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]], True)
     assert list(zip(*z.columns(1, 3).values())) == [(2.0, 5.0), (3.0, 6.0)]
     assert np.asarray(z.columns(0, 3)["a.x"]).dtype == np.float64
+
+
+def test_a_warning_every_case_repeats_is_printed_once(tmp_path, capsys):
+    path = tmp_path / "warn.dat"
+    path.write_text("&fourbar fixed_link = 8.0, crank = 6.0, coupler = 2.0, rocker = 7.0, step_deg = 5.0 /\n"
+                    "&sweep key1 = 'fourbar.omega', values1 = 1, 2, 3, 4\n"
+                    "       key2 = 'fourbar.crank', values2 = 6, 6.5 /\n")
+    assert main([str(path), "-o", str(tmp_path / "o"), "-q", "-j", "1"]) == 0
+    err = [l for l in capsys.readouterr().err.splitlines() if l.startswith("warning:")]
+    assert len(err) == 1 and "all 8 cases: the linkage cannot be assembled" in err[0], err
