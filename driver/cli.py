@@ -1,4 +1,4 @@
-"""Command line: ``python -m driver DECK [DECK ...] [-o OUTDIR] [--csv|--format F] [--plot]``.
+"""Command line: ``python -m driver DECK [DECK ...] [-o OUTDIR] [--csv|--format F] [--plot] [--compare]``.
 
 Each deck runs on its own; the exit status is 0 when every deck succeeded,
 2 when any deck had bad input (nothing written for that deck), 1 when a run
@@ -15,7 +15,7 @@ from pathlib import Path
 import driver
 from driver.deck import DeckError, read_deck
 from driver.export import FORMATS
-from driver.runner import available_studies, run_study
+from driver.runner import CONTROL_GROUPS, available_studies, run_study
 from driver.study import load_study
 
 __all__ = ["main", "run_deck", "EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT"]
@@ -31,6 +31,12 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool, progress:
     """
     try:
         deck = read_deck(path)
+        if "synthesis" in deck.groups:
+            from driver import synthesis
+            return synthesis.run_synthesis_deck(deck, outdir, formats, plot, progress, quiet)
+        if "optimize" in deck.groups:
+            from driver import optimize
+            return optimize.run_optimize_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))
         if "sweep" in deck.groups:
             from driver import sweep
             return sweep.run_sweep_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))
@@ -59,6 +65,9 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool, progress:
 
 def _keys_help(group: str) -> str:
     module = load_study(group)
+    if module is None and group in CONTROL_GROUPS:
+        import importlib
+        module = importlib.import_module(f"driver.{group}")
     if module is None:
         return f"no study group &{group}"
     spec = module.SPEC
@@ -80,7 +89,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Run mechanism-analysis decks (Fortran namelist files) and write "
                     "fixed-format tables to OUTDIR/<deck stem>.out.",
         epilog=f"Study groups: {studies}; a &sweep group turns a deck into a study over "
-               "several cases. 'python -m driver --keys GROUP' lists a group's keys. "
+               "several cases, an &optimize group into an optimisation. 'python -m driver --keys GROUP' lists a group's keys. "
                "Exit status: 0 all decks succeeded, 1 a run failed, 2 bad input.",
     )
     parser.add_argument("decks", nargs="*", type=Path, metavar="DECK", help="input deck(s), e.g. inputs/crank5.dat")
@@ -92,12 +101,15 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--plot", action="store_true", help="write PNG figures <stem>_<name>.png")
     parser.add_argument("-q", "--quiet", action="store_true", help="print only warnings and errors")
     parser.add_argument("--keys", metavar="GROUP", help="list the keys of a namelist group and exit")
+    parser.add_argument("--compare", action="store_true",
+                        help="compare each deck's run with the published tables in published/ (cell by cell, "
+                             "with reasons; writes nothing); exit 0 when every reproducible cell agrees")
     parser.add_argument("-j", "--jobs", type=int, default=None,
-                        help="sweeps: worker processes (default: all cores)")
+                        help="sweeps and optimisations: worker processes (default: all cores)")
     parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
                         help="sweeps: run cases on this Dask distributed scheduler")
     parser.add_argument("--resume", action="store_true",
-                        help="sweeps: skip cases whose outputs are already complete")
+                        help="sweeps: skip cases whose outputs are already complete; optimisations: replay the run's journal and compute only new designs")
     parser.add_argument("--version", action="version", version=f"%(prog)s {driver.__version__}")
     return parser
 
@@ -113,6 +125,13 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_OK
     if not args.decks:
         parser.error("no deck given")
+    if args.compare:
+        from driver.compare import compare_decks
+        try:
+            return compare_decks(args.decks)
+        except BrokenPipeError:
+            sys.stderr.close()
+            return EXIT_OK
     formats = list(dict.fromkeys((["csv"] if args.csv else []) + args.formats))
     progress = sys.stderr.isatty() and not args.quiet and not os.environ.get("CI")
     sweep_options = {"jobs": args.jobs, "scheduler": args.scheduler, "resume": args.resume}
