@@ -277,11 +277,11 @@ def objective_scale(chain: Chain, f_trial: float, beta_max_deg: float) -> float:
     return scale if scale > 0.0 else 1.0
 
 
-def pick_best(runs: list[StartRun], resolution: float, n_beta: int) -> int:
+def pick_best(runs: list[StartRun], n_beta: int) -> int:
     """Index of the reported optimum among the starts (TIE RULE, deterministic).
 
-    Converged starts within TIE_RTOL (relative) or ``resolution`` (absolute) of the best
-    objective tie.  Among them the trial start (index 0) wins if it is there (so feeding an
+    Converged starts within TIE_RTOL (relative) of the best objective tie (mirror optima
+    agree to rounding; along a continuous family of optima the most converged start wins).  Among them the trial start (index 0) wins if it is there (so feeding an
     optimum back as the trial reproduces it); otherwise the smallest phases, compared
     lexicographically at 1e-6 deg, then the smallest joint angles; the tied starts within
     CLUSTER_TOL of that end point are one optimum, and the one of them with the lowest
@@ -291,8 +291,7 @@ def pick_best(runs: list[StartRun], resolution: float, n_beta: int) -> int:
     if not ok:
         return min(range(len(runs)), key=lambda k: runs[k].f)
     fbest = min(runs[k].f for k in ok)
-    tol = max(TIE_RTOL * abs(fbest), resolution)
-    tied = [k for k in ok if runs[k].f <= fbest + tol]
+    tied = [k for k in ok if runs[k].f <= fbest + TIE_RTOL * abs(fbest)]
     if 0 in tied:
         return 0
 
@@ -517,7 +516,7 @@ def run(params: Params, progress: bool = False) -> Result:
             runs = optimise(chain, option, beta * DEG, phi * DEG, lb, ub, starts, params.maxiter,
                             params.ftol, scale, progress)
             ok = any(r.success for r in runs)
-            ipick = pick_best(runs, params.ftol * scale, int(np.sum(free < n)))
+            ipick = pick_best(runs, int(np.sum(free < n)))
             pick = runs[ipick]
             z[free] = pick.x / DEG
             best = evaluate(chain, "optimum" if ok else "last iterate", z[:n], z[n:])
@@ -735,8 +734,8 @@ def _render_runs(runs: list[StartRun], best: Design, names: list[str]) -> list[s
             "point(s) (0.01 deg; phases mod 180)",
             f"   {ended} of {len(runs)} start(s) ended on a bound (listed 'at bound'); phases whose "
             "bounds span 180 deg are periodic and searched without bounds, so no phase bound stops a start",
-            "   tie rule: among tied optima the trial start's end point, else the smallest phases "
-            "(lexicographic), then the smallest joint angles"]
+            f"   tie rule: among optima within {TIE_RTOL:g} relative of the best, the trial start's end "
+            "point, else the smallest phases (lexicographic), then the smallest joint angles"]
     if len(distinct) > 1:
         out.append("   distinct optima (a family: the objective does not single out one design), first 8 [deg]:")
         out += render_table([Column(nm, "f", 10, 2) for nm in names], distinct[:8])
