@@ -21,7 +21,7 @@ import pandas as pd
 
 __all__ = ["Figure", "Result", "load_study"]
 
-_CORE = {"cli", "deck", "study", "table", "export", "plotting", "atomic", "kernels", "sweep", "runner", "expr",
+_CORE = {"cli", "limits", "deck", "study", "table", "export", "plotting", "atomic", "kernels", "sweep", "runner", "expr",
          "optimize", "synthesis", "published", "compare"}
 
 
