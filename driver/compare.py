@@ -173,28 +173,32 @@ def _numeric_cell(table: str, row: str, column: str, printed: str, value: float 
 
 def _manipulator(params: Params, result: Result) -> list[dict]:
     from driver import manipulator as m
-    tidy, s = result.tidy, result.summary
     exact = params.mode == "exact"
-    text_values = {
-        "r_squared": s["r_m"] ** 2, "R_squared": s["R_m"] ** 2, "crob_radius": s["crob_radius_m"],
-        "crob_c_sweep": s["crob_radius_m"] ** 2,
-        "dexterity_l1": s["dexterity_l1_m"], "dexterity_l2": s["dexterity_l2_m"],
-        "manipulability_l1": s["manipulability_l1_m"], "manipulability_l2": s["manipulability_l2_m"],
-        "manipulability_l1_t44": None,
-        "min_total_torque": s.get("sweep_min_total_torque_Nm"), "min_total_l1": s.get("sweep_min_l1_m"),
-        "min_total_l2": s.get("sweep_min_l2_m")}
-    t44 = tidy[tidy["table"] == "4.4"]
-    if len(t44) > 1:
-        text_values["manipulability_l1_t44"] = float(t44["l1_m"].iloc[1])
+
+    def text_values() -> dict[str, float | None]:
+        s = result.summary
+        out = {"r_squared": s["r_m"] ** 2, "R_squared": s["R_m"] ** 2, "crob_radius": s["crob_radius_m"],
+               "crob_c_sweep": s["crob_radius_m"] ** 2,
+               "dexterity_l1": s["dexterity_l1_m"], "dexterity_l2": s["dexterity_l2_m"],
+               "manipulability_l1": s["manipulability_l1_m"], "manipulability_l2": s["manipulability_l2_m"],
+               "manipulability_l1_t44": None,
+               "min_total_torque": s.get("sweep_min_total_torque_Nm"), "min_total_l1": s.get("sweep_min_l1_m"),
+               "min_total_l2": s.get("sweep_min_l2_m")}
+        t44 = result.tidy[result.tidy["table"] == "4.4"]
+        if len(t44) > 1:
+            out["manipulability_l1_t44"] = float(t44["l1_m"].iloc[1])
+        return out
+
     cells = []
     for path in published.records("manipulator"):
         pub = published.read_blocks(path)
         if not published.matches(pub.match, params):
             continue
+        tidy, values = result.tidy, text_values()
         for rec in pub.cells.itertuples():
             table = str(rec.table)
             if table == "Text values":
-                value = text_values.get(str(rec.row))
+                value = values.get(str(rec.row))
                 why_exact = m.TEXT_REASONS.get(str(rec.row), "follows from the cells above") if exact else None
                 cells.append(_numeric_cell(table, rec.row, "value", rec.printed, value, None, why_exact))
                 continue
@@ -235,14 +239,14 @@ def _robust_example(params: Params, result: Result) -> list[dict]:
 
 def _ujoint(params: Params, result: Result) -> list[dict]:
     from driver import ujoint as u
-    t, s = result.tidy, result.summary
-    trial = t[t["design"] == "trial"]
-    printed_design = t[t["design"] == "paper printed"]
     cells = []
     for path in published.records("ujoint"):
         pub = published.read_blocks(path)
         if not published.matches(pub.match, params):
             continue
+        t, s = result.tidy, result.summary
+        trial = t[t["design"] == "trial"]
+        printed_design = t[t["design"] == "paper printed"]
         option = pub.match.get("option", "?")
         for rec in pub.cells.itertuples():
             q, table = str(rec.row), f"SSO option {option}"
@@ -351,14 +355,14 @@ class _LazyResult:
 class Comparison:
     """The comparison of one deck: ``frame`` (one row per published cell) and the run's result."""
 
-    def __init__(self, deck: Path, group: str, frame: pd.DataFrame, params: Params):
-        self.deck, self.group, self.frame, self.params = deck, group, frame, params
+    def __init__(self, deck: Path, group: str, frame: pd.DataFrame, params: Params | None, note: str = ""):
+        self.deck, self.group, self.frame, self.params, self.note = deck, group, frame, params, note
 
     @property
     def variant(self) -> str:
         """The deck's mode or method (``mode = 'report'``), or '' for a study without one."""
         for key in ("mode", "method"):
-            if key in self.params:
+            if self.params is not None and key in self.params:
                 return f"{key} = '{self.params[key]}'"
         return ""
 
@@ -372,12 +376,13 @@ def run_comparison(deck: str | Path) -> Comparison:
     """Run ``deck`` in memory and compare it with its published tables (DeckError for bad input)."""
     path = Path(deck)
     d = read_deck(path)
-    for control in ("sweep", "optimize", "synthesis"):
+    from driver.runner import CONTROL_GROUPS
+    for control in CONTROL_GROUPS:
         if control in d.groups:
-            from driver.deck import DeckError
-            raise DeckError(path, d.groups[control].line, None,
-                            f"--compare takes single-case decks, not a &{control} deck; the published tables "
-                            "belong to the single-case paper decks (compare a case's written .dat deck instead)")
+            frame = pd.DataFrame(columns=COLUMNS)
+            return Comparison(path, control, frame, None,
+                              note=f"a &{control} deck runs the study over many cases or designs; the published tables "
+                                   "belong to single-case decks (compare a case deck it writes instead)")
     module, params = study_of(d)
     group = module.SPEC.name
     comparer = _COMPARERS.get(group)
@@ -400,6 +405,8 @@ def compare_text(cmp: Comparison) -> list[str]:
     ``identical``/``agrees`` with its printed and computed values and reason."""
     f = cmp.frame
     lines = [f"{cmp.deck}: &{cmp.group}"]
+    if cmp.note:
+        return lines + [f"  {cmp.note}"]
     if f.empty:
         lines.append("  no published table belongs to this deck (its study or values are not in published/)")
         return lines
@@ -485,7 +492,8 @@ def _table_line(table: str, t: pd.DataFrame) -> str:
     if nr:
         extra.append(f"{nr} not reproducible (flagged)")
     if counts.get("departs", 0):
-        extra.append(f"{int(counts['departs'])} depart from the published values (the deck asks for the correct answer)")
+        nd = int(counts["departs"])
+        extra.append(f"{nd} depart{'s' if nd == 1 else ''} from the published values (the deck asks for the correct answer)")
     if counts.get("differs", 0):
         extra.append(f"{int(counts['differs'])} DIFFER")
     return text + ("; " + "; ".join(extra) if extra else "")

@@ -238,3 +238,10 @@ def test_every_published_file_is_read_and_has_a_comparer():
     groups = {published.match_line(folder / name)[0] for name in files}
     assert groups <= set(compare._COMPARERS)
     assert len(files) == 12
+
+
+def test_sweep_and_other_multi_case_decks_are_skipped_with_a_note(capsys):
+    assert main(["--compare", str(INPUTS / "fourbar_paper_sweep.dat"), str(INPUTS / "crank2.dat")]) == 0
+    out = capsys.readouterr().out
+    assert "a &sweep deck runs the study over many cases" in out
+    assert "Lampiran 2 (crank 2): 190/190 cells identical" in out
