@@ -38,7 +38,6 @@ from driver import published
 from driver.deck import Params, read_deck
 from driver.runner import study_of
 from driver.study import Result
-from driver.table import fortran_f
 
 __all__ = ["COLUMNS", "OK", "Comparison", "agrees_printed", "compare", "compare_decks", "compare_text",
            "run_comparison", "totals_text"]
@@ -70,32 +69,6 @@ def _cell(table: str, row: Any, column: str, printed: str, computed: str, status
 
 # ----------------------------------------------------------------------------- four-bar
 
-def _fourbar_correct(params: Params, angles: np.ndarray) -> dict[tuple[int, str], str]:
-    """The closed-loop solution at ``angles`` [deg] printed the listing's way (angles truncated to
-    whole degrees, legacy F5.1/F7.4): what the published table would show without its defect."""
-    from driver import fourbar
-    out, status = fourbar.exact_grid(params, angles)
-    cols = fourbar._exact_columns(out, status)
-    res: dict[tuple[int, str], str] = {}
-    for k, i in enumerate(angles.astype(int)):
-        vals = {"i": None, "epsl": cols["coupler_deg"][k], "phi": cols["rocker_deg"][k],
-                "beta": cols["transmission_deg"][k], "xa": cols["xa"][k], "ya": cols["ya"][k],
-                "xb": cols["xb"][k], "yb": cols["yb"][k], "omr": cols["omega2_rad_s"][k],
-                "oms": cols["omega3_rad_s"][k]}
-        for col, v in vals.items():
-            if col == "i":
-                res[(i, col)] = str(i)
-            elif v is None or not np.isfinite(v):
-                res[(i, col)] = ""
-            elif col in ("epsl", "phi", "beta"):
-                res[(i, col)] = fortran_f(math.trunc(v), None, 1, "legacy")
-            elif col in ("omr", "oms"):
-                res[(i, col)] = fortran_f(v, None, 4, "legacy")
-            else:
-                res[(i, col)] = fortran_f(v, None, 1, "legacy")
-    return res
-
-
 def _fourbar(params: Params, result: Result) -> list[dict]:
     from driver import fourbar
     cells = []
@@ -104,7 +77,7 @@ def _fourbar(params: Params, result: Result) -> list[dict]:
         if not published.matches(pub.match, params):
             continue
         angles = np.array(sorted({int(r) for r in pub.cells["row"]}), float)
-        correct = _fourbar_correct(params, angles)
+        correct = fourbar.exact_as_listed(params, angles)
         if params.method == "listing":
             computed = {(int(r[0]), c): v for r in published.listing_rows(result.text)
                         for c, v in zip(published.LISTING_COLUMNS, r)}
@@ -119,8 +92,8 @@ def _fourbar(params: Params, result: Result) -> list[dict]:
             else:
                 why = fourbar.LISTING_PRECISION
             if got is None:
-                cells.append(_cell(pub.name, rec.row, rec.column, rec.printed, "", "differs",
-                                   "the run has no row at this crank angle (step_deg must divide 20)"))
+                cells.append(_cell(pub.name, rec.row, rec.column, rec.printed, "", "departs",
+                                   "the deck's crank angles (start_deg, step_deg) do not include this published row"))
             elif got == rec.printed:
                 cells.append(_cell(pub.name, rec.row, rec.column, rec.printed, got, "identical",
                                    f"erratum: correct value {correct.get(key)}; {why}" if wrong else ""))
@@ -449,6 +422,10 @@ def compare_decks(decks: list[Path], out=None) -> int:
     import sys
     from driver.deck import DeckError
     out = sys.stdout if out is None else out
+    if not published.PUBLISHED_DIR.is_dir():
+        print(f"error: the published tables are not installed ({published.PUBLISHED_DIR} is missing); "
+              "--compare needs the source tree (pip install -e .)", file=sys.stderr)
+        return 1
     status, done = 0, []
     for deck in decks:
         try:
