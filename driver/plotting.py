@@ -1,28 +1,49 @@
-"""The one plotting module (matplotlib, Agg backend, no screen needed).
+"""The one plotting module (matplotlib object API; no screen, no pyplot state).
 
 Shared helpers first; then one section per study with its figure builders.
-Every builder returns a matplotlib Figure; :func:`save_figure` writes it
-atomically as PNG.  Studies wrap builders in :class:`driver.study.Figure`
-so nothing is drawn unless ``--plot`` is given.
+Every builder returns a :class:`matplotlib.figure.Figure` drawn inside
+:func:`style` (an ``rc_context``), and :func:`save_figure` writes it atomically
+as PNG.  Nothing here selects a backend or changes the global ``rcParams``:
+importing this module or drawing a figure leaves a user's own matplotlib
+settings (e.g. Jupyter's inline backend) exactly as they were.  Studies wrap
+builders in :class:`driver.study.Figure` so nothing is drawn unless asked.
 """
 from __future__ import annotations
 
+import contextlib
+import functools
 from pathlib import Path
-from typing import Sequence
+from typing import Any, Callable, Iterator, Sequence, TypeVar
 
 import matplotlib
+import numpy as np
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
+from driver.atomic import atomic_open
 
-from driver.atomic import atomic_open  # noqa: E402
+__all__ = ["STYLE", "style", "styled", "new_figure", "save_figure", "line_panels"]
 
-__all__ = ["new_figure", "save_figure", "line_panels"]
+#: the house style, applied only inside :func:`style` (never written to the global rcParams)
+STYLE: dict[str, Any] = {"figure.dpi": 110, "savefig.dpi": 110, "axes.grid": True, "grid.alpha": 0.3,
+                         "axes.spines.top": False, "axes.spines.right": False, "font.size": 9}
 
-plt.rcParams.update({"figure.dpi": 110, "axes.grid": True, "grid.alpha": 0.3,
-                     "axes.spines.top": False, "axes.spines.right": False, "font.size": 9})
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+
+@contextlib.contextmanager
+def style(**overrides: Any) -> Iterator[None]:
+    """Draw inside this context to get the house style; rcParams are restored on exit."""
+    with matplotlib.rc_context({**STYLE, **overrides}):
+        yield
+
+
+def styled(builder: _F) -> _F:
+    """Decorator: run a figure builder inside :func:`style`."""
+    @functools.wraps(builder)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        with style():
+            return builder(*args, **kwargs)
+    return wrapper  # type: ignore[return-value]
 
 
 def new_figure(nrows: int = 1, ncols: int = 1, **kw) -> tuple[Figure, np.ndarray]:
@@ -33,13 +54,14 @@ def new_figure(nrows: int = 1, ncols: int = 1, **kw) -> tuple[Figure, np.ndarray
 
 
 def save_figure(fig: Figure, path: str | Path) -> Path:
-    """Write ``fig`` as PNG to ``path`` atomically."""
+    """Write ``fig`` as PNG to ``path`` atomically (in the house style's resolution)."""
     path = Path(path)
-    with atomic_open(path, "wb") as fh:
+    with style(), atomic_open(path, "wb") as fh:
         fig.savefig(fh, format="png")
     return path
 
 
+@styled
 def line_panels(x: np.ndarray, panels: Sequence[tuple[str, dict[str, np.ndarray]]], xlabel: str,
                 title: str = "", styles: dict[str, dict] | None = None) -> Figure:
     """Stacked panels sharing x: each panel is (ylabel, {label: y}); NaN gaps break lines."""
@@ -58,6 +80,7 @@ def line_panels(x: np.ndarray, panels: Sequence[tuple[str, dict[str, np.ndarray]
 
 # ----------------------------------------------------------------------------- fourbar
 
+@styled
 def fourbar_curves(exact, listing, title: str) -> Figure:
     """Angles, angular velocities and transmission angle against crank angle.
 
@@ -84,6 +107,7 @@ def fourbar_curves(exact, listing, title: str) -> Figure:
     return fig
 
 
+@styled
 def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.ndarray,
                     listing, title: str, n_poses: int = 6, point: np.ndarray | None = None) -> Figure:
     """The linkage drawn at a few crank angles with the paths of A and B (exact), and the
@@ -102,7 +126,7 @@ def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.nd
     for j, k in enumerate(idx[np.linspace(0, len(idx) - 1, n_poses, endpoint=False).astype(int)] if len(idx) else []):
         xs = [0.0, out[k, 3], out[k, 5], ground]
         ys = [0.0, out[k, 4], out[k, 6], 0.0]
-        ax.plot(xs, ys, "-o", color=plt.cm.viridis(j / max(1, n_poses - 1)), ms=3, lw=1.4,
+        ax.plot(xs, ys, "-o", color=matplotlib.colormaps["viridis"](j / max(1, n_poses - 1)), ms=3, lw=1.4,
                 label=f"theta = {theta[k]:.0f} deg")
     ax.plot([0.0, ground], [0.0, 0.0], color="k", lw=2.5)
     ax.plot([0.0, ground], [0.0, 0.0], "^", color="k", ms=9)
@@ -114,6 +138,7 @@ def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.nd
 
 # ----------------------------------------------------------------------------- manipulator
 
+@styled
 def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, L2: np.ndarray,
                              ri2: np.ndarray, sum_d2: float, n: int, levels: Sequence[float],
                              optima: dict, names: Sequence[str], l1: np.ndarray, l2: np.ndarray,
@@ -169,6 +194,7 @@ def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, 
     return fig
 
 
+@styled
 def manipulator_torque_crob(l1: np.ndarray, tau1: np.ndarray, tau2: np.ndarray, c: float) -> Figure:
     """Motor torques tau1, tau2 and their sum [N m] against l1 [m] along C_rob (Table 4.8)."""
     return line_panels(l1, [("torque [N m]", {"tau1": tau1, "tau2": tau2, "tau1 + tau2": tau1 + tau2})],
@@ -177,6 +203,7 @@ def manipulator_torque_crob(l1: np.ndarray, tau1: np.ndarray, tau2: np.ndarray, 
 
 # ----------------------------------------------------------------------------- sweep
 
+@styled
 def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (), title: str = "") -> Figure:
     """Summary of a sweep: chosen (or all numeric) headline figures against a swept key.
 
@@ -219,6 +246,7 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
 
 # ---- ujoint
 
+@styled
 def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.ndarray],
                         polar: bool = False) -> Figure:
     """Input and output shaft speed [rpm] against the input angle [deg], one panel per design
@@ -255,6 +283,7 @@ def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.
 # ----------------------------------------------------------------------------- slidercrank
 
 
+@styled
 def slidercrank_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray]], title: str,
                               ylabel: str = "axial strain [microstrain]") -> Figure:
     """A quantity against crank angle [deg], one line per case (label, angle, value): Figure 10."""
@@ -272,6 +301,7 @@ def slidercrank_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray
     return fig
 
 
+@styled
 def slidercrank_convergence_figure(series: dict[str, tuple[list[int], list[float]]], title: str) -> Figure:
     """Peak strain against element count and its percentage change (the paper's Figures 8-9)."""
     fig, axes = new_figure(2, 1, sharex=True, figsize=(7.0, 5.0))
