@@ -35,16 +35,19 @@ import pandas as pd
 from scipy.optimize import minimize
 
 from driver import kernels
-from driver.deck import GroupSpec, Key, Params, non_empty, positive
+from driver.deck import GroupSpec, Key, Params, non_empty, non_negative, positive
 from driver.export import with_units
 from driver.limits import Estimate
 from driver.study import Figure, Result, keyword_run
-from driver.table import Column, fortran_f, render_table
+from driver.table import Column, fortran_f, render_table, significant
 
 __all__ = ["SPEC", "run", "Workspace", "tolerance_box", "round_half_up", "REASONS", "NOT_REPRODUCIBLE", "TEXT_REASONS",
            "TIDY_NAMES", "TIDY_UNITS", "table_frame"]
 
 STATUS = kernels.MANIPULATOR_STATUS
+#: significant digits of every number column outside report mode (the report's fixed decimals
+#: would print a 1e-7 m tolerance as 0.000000 and a g of 3.71 as 3.7)
+SIGNIFICANT = 6
 
 
 def _pair_check(v: Any) -> str | None:
@@ -78,6 +81,12 @@ def _cross_check(p: Params) -> None:
     elif p.design_names is not None:
         raise p.error("design_names", "only allowed with designs_l1/designs_l2")
     ndes = len(p.designs_l1) if p.designs_l1 is not None else 2
+    if p.text_optimum_decimals is not None and p.mode != "report":
+        raise p.error("text_optimum_decimals", "applies only to mode = 'report'")
+    if p.printed_angles_deg is not None and len(p.printed_angles_deg) == 2 * ndes and p.mode != "report":
+        raise p.error("printed_angles_deg", "applies only to mode = 'report' (the report's printed Table 4.5 "
+                                            "angles); mode = 'exact' takes the joint angles from the inverse "
+                                            "kinematics: remove the key or set mode = 'report'")
     if p.printed_angles_deg is not None and len(p.printed_angles_deg) != 2 * ndes:
         raise p.error("printed_angles_deg", f"needs theta1, theta2 for each of the {ndes} designs "
                                             f"({2 * ndes} values), got {len(p.printed_angles_deg)}")
@@ -137,7 +146,11 @@ SPEC = GroupSpec(
                            doc="joint rates (theta1', theta2') for the torques"),
         "joint_accels": Key("floats", default=[1.0, 1.0], check=_pair_check, units="rad/s^2",
                             doc="joint accelerations (theta1'', theta2'')"),
-        "gravity": Key("float", default=9.8, check=positive, units="m/s^2", doc="g, along -y"),
+        "gravity": Key("float", default=9.8, check=non_negative, units="m/s^2",
+                       doc="g, along -y; 0 for an arm moving in a horizontal plane"),
+        "text_optimum_decimals": Key("int", check=lambda v: None if 0 <= v <= 6 else "must be 0 to 6",
+                                     doc="report mode: decimals of the optima as the report's text prints "
+                                         "them (e.g. 3 for (4.76) l1 = l2 = 5.074; Table 4.4 prints 2)"),
         "mass_per_length": Key("float", default=10.0, check=positive, units="kg/m",
                                doc="link mass per unit length (m_i = value * l_i)"),
         "crob_l1": Key("floats", check=positive, units="m",
@@ -236,6 +249,13 @@ class Table:
     trailers: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     labels: list[str] = field(default_factory=list)
+
+    def significant(self, digits: int) -> "Table":
+        """The same table with every fixed-decimal number column printed to ``digits`` significant
+        digits (outside report mode); returns self."""
+        self.columns = [Column(c.header, "g", c.width, digits, c.sep) if c.kind == "f" else c
+                        for c in self.columns]
+        return self
 
     def lines(self) -> list[str]:
         out = [self.title, "-" * len(self.title)]
@@ -377,6 +397,11 @@ def _t44(p: Params, conv: Conv) -> Table:
     cols = [Column("Criterion", "s", 10), Column("l1opt", "f", 8, d), Column("l2opt", "f", 8, d),
             Column("RI2", "f", 8, 4), Column("reach", "s", 6)]
     notes = ["Dexterity: l2 = l1 sqrt(2)/2 on C_rob, Workspace (manipulability w = l1 l2 |s2|): l1 = l2"]
+    if conv.report and p.text_optimum_decimals is not None:
+        k = p.text_optimum_decimals
+        txt = lambda v: fortran_f(round_half_up(v, k), None, k)
+        notes.append(f"the report's text prints the optima to {k} dp: dexterity l1 = {txt(opt['dexterity'][0])}, "
+                     f"l2 = {txt(opt['dexterity'][1])}; workspace l1 = l2 = {txt(opt['manipulability'][0])}")
     return Table("4.4", "Table 4.4  Optimum dimensions on C_rob", cols, rows, notes=notes)
 
 
@@ -470,7 +495,9 @@ def _designs_table(p: Params, conv: Conv) -> Table:
         rows.append([name, l1[i], l2[i], float(ri[i, 0]) if ri[i, 0] > 0 else None, float(ri[i, 1]),
                      float(ri[i, 2]), float(w[i]) if ok else None, float(kappa[i]) if ok and kappa[i] > 0 else None,
                      "yes" if reach[i] else "no"])
-        trailers.append("" if ok else "target out of reach of this design")
+        trailers.append("target out of reach of this design" if not ok else
+                        "" if kappa[i] > 0 else "kappa blank: J is singular at the target (arm stretched "
+                                                "or folded, w = 0), so cond(J) is infinite")
     cols = [Column("Design", "s", 10), Column("l1", "f", 8, 4), Column("l2", "f", 8, 4), Column("RI1", "f", 9, 3),
             Column("RI2", "f", 8, 5), Column("RI3", "f", 8, 5), Column("w", "f", 9, 4), Column("kappa", "f", 8, 4),
             Column("reach", "s", 6)]
@@ -551,8 +578,21 @@ def _tolerance(p: Params, ws: Workspace, names: list[str], l1: np.ndarray, l2: n
     unit = rng.uniform(-1.0, 1.0, size=(p.mc_samples, 2))
     col = 0 if p.error_measure == "global" else 1
     rows, out = [], []
+    trailers = []
     for i, name in enumerate(names):
         th1, th2, st = kernels.manipulator_ik(l1[i], l2[i], ws.x, ws.y, p.elbow)
+        bad = np.flatnonzero(st != STATUS["ok"])
+        if bad.size:
+            d = np.hypot(ws.x[bad], ws.y[bad])
+            pts = ", ".join(f"{k + 1} ({ws.x[k]:g}, {ws.y[k]:g}; d = {dk:.4g} m)" for k, dk in zip(bad, d))
+            why = (f"no box: the design cannot reach workspace point(s) {pts}; it reaches "
+                   f"{abs(l1[i] - l2[i]):.4g} <= d <= {l1[i] + l2[i]:.4g} m")
+            out.append({"name": name, "l1": float(l1[i]), "l2": float(l2[i]), "ri2": None, "dl1": None,
+                        "dl2": None, "slsqp_dl1": None, "slsqp_dl2": None, "converged": False,
+                        "worst_corner": None, "mc_max": None, "mc_p99": None, "reason": why})
+            rows.append([name, float(l1[i]), float(l2[i])] + [None] * 8 + ["-"])
+            trailers.append(why)
+            continue
         blocks = _sensitivity_blocks(th1, th2)
         box = tolerance_box(blocks, eps, p.error_measure)
         dl = box["closed"] if box["closed"] is not None else box["u"]
@@ -563,8 +603,9 @@ def _tolerance(p: Params, ws: Workspace, names: list[str], l1: np.ndarray, l2: n
         rec = {"name": name, "l1": float(l1[i]), "l2": float(l2[i]), "ri2": ri2, "dl1": float(dl[0]),
                "dl2": float(dl[1]), "slsqp_dl1": float(box["u"][0]), "slsqp_dl2": float(box["u"][1]),
                "converged": box["converged"], "worst_corner": float(worst), "mc_max": float(err.max()),
-               "mc_p99": float(np.percentile(err, 99.0))}
+               "mc_p99": float(np.percentile(err, 99.0)), "reason": ""}
         out.append(rec)
+        trailers.append("")
         rows.append([name, rec["l1"], rec["l2"], ri2, rec["dl1"], rec["dl2"], rec["slsqp_dl1"], rec["slsqp_dl2"],
                      rec["worst_corner"], rec["mc_max"], rec["mc_p99"], "yes" if rec["mc_max"] <= eps * (1 + 1e-12) else "NO"])
     cols = [Column("Design", "s", 10), Column("l1", "f", 7, 3), Column("l2", "f", 7, 3), Column("RI2", "f", 7, 4),
@@ -576,7 +617,7 @@ def _tolerance(p: Params, ws: Workspace, names: list[str], l1: np.ndarray, l2: n
              if col == 0 else f"bound epsilon = {eps:g} m on the {meas}; closed form dl = eps/sqrt(2(1 + max|c2_i|))",
              f"Monte Carlo: {p.mc_samples} uniform samples in the box (seed {p.mc_seed}), joint angles held at the "
              f"nominal IK ({'elbow +1' if p.elbow > 0 else 'elbow -1'})"]
-    return Table("tol", "Tolerance synthesis (Caro 2005, eq. 2.45)", cols, rows, notes=notes), out
+    return Table("tol", "Tolerance synthesis (Caro 2005, eq. 2.45)", cols, rows, trailers, notes=notes), out
 
 
 # ----------------------------------------------------------------------------- differences between modes
@@ -636,7 +677,9 @@ def _differences(report: list[Table], exact: list[Table]) -> list[str]:
     """Every cell whose printed text differs between the two modes, with the reason."""
     lines = []
     for a, b in zip(report, exact):
-        ca, cb = a.cells(), b.cells()
+        ca = a.cells()
+        cb = {(i, col.header.strip()): col.cell(v) for i, row in enumerate(b.rows)
+              for col, v in zip(a.columns, row)}     # exact values at the report's printed digits
         for key in sorted(set(ca) | set(cb)):
             va, vb = ca.get(key, "(none)"), cb.get(key, "(none)")
             if va != vb:
@@ -651,7 +694,8 @@ def _differences(report: list[Table], exact: list[Table]) -> list[str]:
 def _tables(p: Params, conv: Conv) -> tuple[list[Table], dict[str, Any], dict[str, Any]]:
     t45, t46, t47, used = _torque_tables(p, conv)
     t48, sweep = _t48(p, conv)
-    return [_t41(p, conv), _t42(p, conv), _t44(p, conv), _designs_table(p, conv), t45, t46, t47, t48], used, sweep
+    tables = [_t41(p, conv), _t42(p, conv), _t44(p, conv), _designs_table(p, conv), t45, t46, t47, t48]
+    return tables, used, sweep
 
 
 def _header(p: Params, ws: Workspace, conv: Conv) -> list[str]:
@@ -714,8 +758,12 @@ def _tidy(tables: list[Table], tol: list[dict], sweep: dict, used: dict) -> pd.D
             for col, v in zip(t.columns[1:], row[1:]):
                 add(t.key, i + 1, label, TIDY_NAMES.get(col.header.strip(), col.header.strip()), v)
     for k, rec in enumerate(tol, start=1):
-        for name, key in (("l1_m", "l1"), ("l2_m", "l2"), ("ri2", "ri2"), ("dl1_m", "dl1"), ("dl2_m", "dl2"),
-                          ("worst_corner_m", "worst_corner"), ("mc_max_m", "mc_max"), ("mc_p99_m", "mc_p99")):
+        # a box with a reason (e.g. the design cannot reach a target) has only its lengths
+        pairs = [("l1_m", "l1"), ("l2_m", "l2")]
+        if not rec.get("reason"):
+            pairs += [("ri2", "ri2"), ("dl1_m", "dl1"), ("dl2_m", "dl2"), ("worst_corner_m", "worst_corner"),
+                      ("mc_max_m", "mc_max"), ("mc_p99_m", "mc_p99")]
+        for name, key in pairs:
             add("tolerance", k, rec["name"], name, rec[key])
     frame = pd.DataFrame.from_records(recs, columns=["table", "row", "label", "quantity", "value", "unit"])
     return with_units(frame, {"row": "1", "value": "see unit column"})
@@ -749,6 +797,7 @@ def _summary(p: Params, ws: Workspace, conv: Conv, used: dict, sweep: dict, tol:
         key = rec["name"].lower().replace(" ", "_")
         s[f"{key}_dl_m"] = rec["dl1"]
         s[f"{key}_mc_max_m"] = rec["mc_max"]
+        s[f"{key}_reaches_workspace"] = not rec["reason"]
     # design measures of the first design (what an &optimize deck varies: designs_l1, designs_l2)
     l1, l2 = float(used["l1"][0]), float(used["l2"][0])
     ri, _, reach = kernels.manipulator_design_indices(ws.x, ws.y, [l1], [l2])
@@ -805,8 +854,14 @@ def run(params: Params, progress: bool = False) -> Result:
     _check_designs(p, ws, conv)
     tables, used, sweep = _tables(p, conv)
     tol_table, tol = _tolerance(p, ws, used["names"], used["l1"], used["l2"])
+    if not conv.report:
+        for t in tables + [tol_table]:
+            t.significant(SIGNIFICANT)
     warnings = []
     for rec in tol:
+        if rec["reason"]:
+            warnings.append(f"design {rec['name']}: {rec['reason']}")
+            continue
         if not rec["converged"] or abs(rec["slsqp_dl1"] * rec["slsqp_dl2"] / (rec["dl1"] * rec["dl2"]) - 1) > 1e-6:
             warnings.append(f"design {rec['name']}: SLSQP box ({rec['slsqp_dl1']:.6g}, {rec['slsqp_dl2']:.6g}) "
                             f"does not match the closed form ({rec['dl1']:.6g}, {rec['dl2']:.6g})")

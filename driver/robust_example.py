@@ -62,6 +62,11 @@ def _cross_check(p: Params) -> None:
     nt = len(p.dual_targets)
     if nt < 3:
         raise p.error("dual_targets", f"a quadratic needs at least 3 targets, got {nt}")
+    for key in ("dual_targets", "taguchi_targets"):
+        distinct = sorted(set(p[key]))
+        if len(p[key]) >= 3 and len(distinct) < 3:
+            raise p.error(key, f"a quadratic needs at least 3 distinct targets, got {len(distinct)} "
+                               f"({', '.join(f'{v:g}' for v in distinct)}): the fit would be singular")
     if len(p.dual_y) % nt or len(p.dual_y) // nt < 2:
         raise p.error("dual_y", f"{len(p.dual_y)} values do not split into {nt} targets of at least 2 "
                                 "replicates each (values are listed target by target)")
@@ -109,15 +114,62 @@ SPEC = GroupSpec(
 )
 
 
+#: largest condition number of the normal equations X'X accepted for a quadratic fit
+MAX_COND = 1e12
+
+
+class FitError(ValueError):
+    """The targets do not determine a quadratic (singular or ill-conditioned normal equations)."""
+
+
 def quadratic_fit(t: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Least-squares quadratic b0 + b1 t + b2 t^2 through (t, y): B = (X'X)^-1 X'Y (eq. 2.4)."""
+    """Least-squares quadratic b0 + b1 t + b2 t^2 through (t, y): B = (X'X)^-1 X'Y (eq. 2.4).
+
+    Raises FitError when X'X is singular or its condition number exceeds MAX_COND (targets
+    too few or too close together for the digits of a double)."""
     X = np.vander(np.asarray(t, float), 3, increasing=True)
-    return np.linalg.solve(X.T @ X, X.T @ np.asarray(y, float))
+    A = X.T @ X
+    cond = np.linalg.cond(A)
+    if not cond < MAX_COND:
+        raise FitError(f"the normal equations of the quadratic fit are "
+                       f"{'singular' if not np.isfinite(cond) else f'ill-conditioned (condition number {cond:.2g})'}: "
+                       "the targets do not determine a quadratic")
+    return np.linalg.solve(A, X.T @ np.asarray(y, float))
 
 
 def _tmin(b: np.ndarray) -> float:
     """-b1 / (2 b2): stationary point of a quadratic (eqs 2.9, 2.13, 2.15)."""
     return float(-b[1] / (2.0 * b[2]))
+
+
+def _flat(b: np.ndarray, t: np.ndarray) -> bool:
+    """b2 is zero to the fit's rounding: its term is below 1e-9 of the fitted values' size over
+    the targets' span."""
+    t = np.asarray(t, float)
+    span = float(t.max() - t.min())
+    size = float(np.max(np.abs(b[0] + b[1] * t + b[2] * t * t))) + abs(b[1]) * span
+    return abs(b[2]) * span * span <= 1e-9 * max(size, 1e-300)
+
+
+def stationary(b: np.ndarray, t: np.ndarray, need_minimum: bool) -> tuple[float | None, str]:
+    """t_min of a fitted quadratic, or None with the reason in words.
+
+    ``need_minimum``: the quadratic itself is minimised (ln sigma fits 2.8/2.12), so b2 must be
+    positive; otherwise (tolerance analyses 2.2/2.14/2.15) only b2 != 0 is needed, as
+    sigma_Y^2 = (b1 + 2 b2 t)^2 sigma_x^2 + 2 b2^2 sigma_x^4 is least at -b1/(2 b2) either way.
+    """
+    if _flat(b, t):
+        return None, (f"no t_min: the fitted quadratic is flat (b2 = {b[2]:.3g} is rounding noise), "
+                      "the data show no curvature")
+    tm = _tmin(b)
+    if need_minimum and b[2] < 0:
+        return None, (f"no t_min: b2 = {b[2]:.6g} < 0, the fitted quadratic has a maximum at t = {tm:.3f}; "
+                      "the data show no robust target inside their range")
+    return tm, ""
+
+
+def _tmin_text(name: str, value: float | None, why: str) -> str:
+    return f"  {name} t_min = {value:.3f}" if value is not None else f"  {name} {why}"
 
 
 def _r(x: np.ndarray, d: int) -> np.ndarray:
@@ -136,9 +188,12 @@ def analyse(p: Params, report: bool) -> dict[str, Any]:
     if np.any(std <= 0):
         raise p.error("dual_y", "a target's observations are all equal: ln(std) is undefined")
     out.update(t22=t, mean22=mean, std22=std)
-    out["eq27"] = quadratic_fit(t, mean)
-    out["eq28"] = quadratic_fit(t, np.log(_r(std, 7) if report else std))
-    out["eq29"] = _tmin(out["eq28"])
+    try:
+        out["eq27"] = quadratic_fit(t, mean)
+        out["eq28"] = quadratic_fit(t, np.log(_r(std, 7) if report else std))
+    except FitError as exc:
+        raise p.error("dual_targets", str(exc)) from None
+    out["eq29"], out["eq29_why"] = stationary(out["eq28"], t, need_minimum=True)
     tt, off = np.array(p.taguchi_targets, float), np.array(p.taguchi_offsets, float)
     yt = np.array(p.taguchi_y, float).reshape(tt.size, off.size, -1)
     t24 = yt.mean(2)
@@ -147,15 +202,18 @@ def analyse(p: Params, report: bool) -> dict[str, Any]:
     if np.any(s25 <= 0):
         raise p.error("taguchi_y", "a target's row means are all equal: ln(std) is undefined")
     out.update(mean25=m25, std25=s25)
-    out["eq211"] = quadratic_fit(tt, _r(m25, 4) if report else m25)
-    out["eq212"] = quadratic_fit(tt, np.log(_r(s25, 7) if report else s25))
-    out["eq213"] = _tmin(out["eq212"])
+    try:
+        out["eq211"] = quadratic_fit(tt, _r(m25, 4) if report else m25)
+        out["eq212"] = quadratic_fit(tt, np.log(_r(s25, 7) if report else s25))
+    except FitError as exc:
+        raise p.error("taguchi_targets", str(exc)) from None
+    out["eq213"], out["eq213_why"] = stationary(out["eq212"], tt, need_minimum=True)
     b27 = out["eq27"]
     if report:  # (2.14) is written from the printed 6-significant-digit coefficients of (2.7)
         b27 = np.array([float(f"{v:.6g}") for v in b27])
     out["eq214_slope"] = (b27[1], 2 * b27[2])
     out["eq214_quartic"] = 2 * b27[2] ** 2
-    out["eq215"] = _tmin(b27)
+    out["eq215"], out["eq215_why"] = stationary(b27, t, need_minimum=False)
     out["sigma_at"] = lambda tx, bb=b27: math.sqrt((bb[1] + 2 * bb[2] * tx) ** 2 * sx ** 2 + 2 * bb[2] ** 2 * sx ** 4)
     return out
 
@@ -222,7 +280,7 @@ def run(params: Params, progress: bool = False) -> Result:
     L += ["Table 2.2  Mean and standard deviation (sample std, ddof = 1)", "-" * 61]
     L += render_table(cols, [[a, m, s] for a, m, s in zip(r["t22"], r["mean22"], r["std22"])]) + [""]
     L += ["Dual response fits", "-" * 18, f"  (2.7) mu_Y(t)    = {_poly(r['eq27'])}",
-          f"  (2.8) sigma_Y(t) = exp({_poly(r['eq28'])})", f"  (2.9) t_min = {r['eq29']:.3f}", ""]
+          f"  (2.8) sigma_Y(t) = exp({_poly(r['eq28'])})", _tmin_text("(2.9)", r["eq29"], r["eq29_why"]), ""]
     head = [Column("Target", "f", 8, 1)] + [Column(f"{o:+g}", "f", 9, 4) for o in r["t24_offsets"]]
     L += ["Table 2.4  Means of the Table 2.3 rows (target x noise offset of X)", "-" * 66]
     L += render_table(head, [[t, *row] for t, row in zip(r["t24_targets"], r["t24"])]) + [""]
@@ -230,12 +288,12 @@ def run(params: Params, progress: bool = False) -> Result:
     cols5 = [Column("Target", "f", 8, 1), Column("Mean", "f", 10, 4), Column("Std dev", "f", 12, 7)]
     L += render_table(cols5, [[t, m, s] for t, m, s in zip(r["t24_targets"], r["mean25"], r["std25"])]) + [""]
     L += ["Taguchi fits", "-" * 12, f"  (2.11) mu_Y(t)    = {_poly(r['eq211'])}",
-          f"  (2.12) sigma_Y(t) = exp({_poly(r['eq212'])})", f"  (2.13) t_min = {r['eq213']:.3f}", ""]
+          f"  (2.12) sigma_Y(t) = exp({_poly(r['eq212'])})", _tmin_text("(2.13)", r["eq213"], r["eq213_why"]), ""]
     s1, s2 = r["eq214_slope"]
     L += ["Tolerance analysis of the fitted mean", "-" * 37,
           f"  (2.14) sigma_Y(t) = sqrt(({_g(s1)} {'+' if s2 >= 0 else '-'} {_g(abs(s2))} t)^2 sigma_x^2 + "
           f"{_g(r['eq214_quartic'])} sigma_x^4)",
-          f"  (2.15) t_min = {r['eq215']:.3f}", ""]
+          _tmin_text("(2.15)", r["eq215"], r["eq215_why"]), ""]
     comp, flags = [], []
     for name, printed, computed, dec in (("(2.8)", p.printed_eq28, r["eq28"], None),
                                          ("(2.11)", p.printed_eq211, r["eq211"], None),
@@ -264,15 +322,17 @@ def run(params: Params, progress: bool = False) -> Result:
                 if _g(r[key][i]) != _g(e[key][i]):
                     L.append(f"  {key}[b{i}]  report {_g(r[key][i]):>11}  exact {_g(e[key][i]):>11}  {why}")
         for key in ("eq29", "eq213"):
-            if f"{r[key]:.3f}" != f"{e[key]:.3f}":
-                L.append(f"  {key}  report {r[key]:.3f}  exact {e[key]:.3f}  follows from the fit")
+            a, c = (f"{v:.3f}" if v is not None else "none" for v in (r[key], e[key]))
+            if a != c:
+                L.append(f"  {key}  report {a}  exact {c}  follows from the fit")
         L.append("")
     recs = []
     for key in ("eq27", "eq28", "eq211", "eq212"):
         for i, v in enumerate(r[key]):
             recs.append({"item": key, "index": i, "value": float(v)})
     for key in ("eq22_tmin", "eq29", "eq213", "eq215", "eq22_quartic", "eq214_quartic"):
-        recs.append({"item": key, "index": 0, "value": float(r[key])})
+        if r[key] is not None:     # a t_min that does not exist has no row (the .out says why)
+            recs.append({"item": key, "index": 0, "value": float(r[key])})
     recs.append({"item": "eq22_slope", "index": 0, "value": float(r["eq22_slope"][0])})
     recs.append({"item": "eq22_slope", "index": 1, "value": float(r["eq22_slope"][1])})
     recs.append({"item": "eq214_slope", "index": 0, "value": float(r["eq214_slope"][0])})

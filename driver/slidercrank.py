@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+from scipy.linalg import LinAlgError, cholesky_banded
 from tqdm import tqdm
 
 from driver import kernels
@@ -28,7 +29,7 @@ from driver.study import Figure, Result, keyword_run
 from driver.table import Column, render_table
 
 __all__ = ["SPEC", "run", "MATERIALS", "PAPER_SPEEDS", "SIMEON1996", "simeon_initial_state",
-           "min_steps_per_rev", "rayleigh"]
+           "min_steps_per_rev", "rayleigh", "static_onset", "STATUS_TEXT"]
 
 #: Table 1a of the paper (columns re-ordered as in the study note, section 1.1); the depth is the
 #: in-plane section depth used for the outer-fibre strain (weak axis in plane).
@@ -50,6 +51,14 @@ MIN_STEPS_PER_BENDING_PERIOD = 20
 MIN_STEPS_PER_REV = 36
 EULER_WARN = 0.8
 MAX_ELEMENTS = 5000
+#: what each failed case status means (the kernel's triggers, fortran/slidercrank.f90)
+STATUS_TEXT = {
+    "buckled": ("STATIC INSTABILITY", "K + K_G lost definiteness (the rod buckles)"),
+    "diverged": ("LIMIT L/20", "elastic deflection exceeded L/20 (or a rotation 0.25 rad): "
+                               "the linear model is no longer valid"),
+    "not_spd": ("NOT SPD", "the iteration matrix is not positive definite"),
+    "bad_args": ("BAD ARGUMENTS", "the kernel refused its arguments"),
+}
 
 #: Simeon (1996) / IVP test set "crank": published initial values (ini = 1, consistent) of the
 #: modal coordinates q1, q2 (lateral sin(pi x), sin(2 pi x)), q3, q4 (axial, quadratic: midpoint
@@ -110,6 +119,10 @@ _KEYS: dict[str, Key] = {
                           doc="convergence study: element counts to run (e.g. 1, 2, 4, ..., 700)"),
     "steps_per_rev": Key("int", default=1440, check=positive, doc="time steps per crank revolution"),
     "revolutions": Key("int", default=4, check=_revs, doc="revolutions run; the last one is reported"),
+    "settle_tolerance": Key("float", default=1e-3, check=positive, units="-",
+                            doc="the reported revolution counts as settled (periodic) when strain and "
+                                "midpoint deflection change by less than this fraction of their peak "
+                                "between the last two revolutions"),
     "damping_ratio": Key("float", default=0.02, check=_damping,
                          doc="Rayleigh damping ratio at the first bending and first axial modes"),
     "start": Key("str", default="quasistatic", choices=("quasistatic", "rest", "simeon1996"),
@@ -304,6 +317,51 @@ def simeon_initial_state(n_elements: int, length: float) -> tuple[np.ndarray, np
     return nodal(SIMEON1996["q0"]), nodal(SIMEON1996["qd0"])
 
 
+def static_onset(model: Model, n_elements: int, step_deg: float = 10.0) -> tuple[float, float] | None:
+    """Lowest constant crank speed [rad/s] at which the static tangent K + K_G of the rigid-body
+    axial force loses definiteness at some crank angle, and that angle [deg] to the ``step_deg``
+    scan; None if never (below 1e6 rad/s).
+
+    The rigid-body axial force, hence K_G, scales with omega^2 at constant crank speed, so at
+    each crank angle the onset is the largest t = omega^2 keeping K + t K_G(omega = 1) positive
+    definite (bisection on the kernel's banded matrices, LAPACK Cholesky as the test); a
+    ``step_deg`` scan finds the critical angle and a 1-deg scan around it the speed.  Near the
+    critical angle the speed varies by ~1e-4 only and the Cholesky test is that noisy on fine
+    meshes, so the speed is good to about 0.01 rad/s and the angle only to the coarse scan.
+    """
+    args = (n_elements, model.r2, model.length, model.rho_a, model.ea, model.ei, model.m_s)
+
+    def omega_at(theta_deg: float) -> float:
+        th = math.radians(theta_deg)
+        k0 = kernels.slidercrank_matrices(*args, th, 0.0, False)[1]
+        g = kernels.slidercrank_matrices(*args, th, 1.0, True)[1] - k0
+
+        def definite(t: float) -> bool:
+            try:
+                cholesky_banded(k0 + t * g, lower=True, check_finite=False)
+            except LinAlgError:
+                return False
+            return True
+
+        lo, hi = 0.0, 1.0
+        while definite(hi):
+            lo, hi = hi, 4.0 * hi
+            if hi > 1e12:
+                return math.inf
+        while hi - lo > 1e-8 * hi:
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if definite(mid) else (lo, mid)
+        return math.sqrt(0.5 * (lo + hi))
+
+    grid = np.arange(0.0, 360.0, step_deg)
+    w = np.array([omega_at(t) for t in grid])
+    k = int(np.argmin(w))
+    if not math.isfinite(w[k]):
+        return None
+    fine = grid[k] + np.arange(-step_deg + 1.0, step_deg - 0.5, 1.0)
+    return float(min(w[k], min(omega_at(t) for t in fine))), float(grid[k] % 360.0)
+
+
 # --------------------------------------------------------------------------- cases
 
 
@@ -327,6 +385,8 @@ class Case:
     elong: np.ndarray | None = None
     euler_ratio: float = 0.0
     peak_compression: float = 0.0
+    settle_strain: float | None = None    # relative change between the last two revolutions
+    settle_mid: float | None = None
 
     @property
     def ok(self) -> bool:
@@ -356,7 +416,8 @@ def _run_case(model: Model, params: Params, omega: float, n_el: int, alpha: floa
         rec_start, n_rec = n_steps, 1
     else:
         n_steps = params.revolutions * spr
-        rec_start, n_rec = (params.revolutions - 1) * spr, spr + 1
+        two = params.revolutions >= 2     # record the last two revolutions to judge settling
+        rec_start, n_rec = (params.revolutions - (2 if two else 1)) * spr, (2 if two else 1) * spr + 1
     q0 = qd0 = None
     start = params.start
     if start == "simeon1996":
@@ -366,6 +427,9 @@ def _run_case(model: Model, params: Params, omega: float, n_el: int, alpha: floa
         n_el, model.r2, model.length, model.rho_a, model.ea, model.ei, model.depth / 2, model.m_s, omega,
         dt, n_steps, rec_start, n_rec, alpha, beta, start=start, dynamic=params.analysis == "dynamic",
         geometric_stiffness=params.geometric_stiffness, q_init=q0, qd_init=qd0)
+    if params.end_time <= 0 and params.revolutions >= 2:
+        res = _settle(res, spr)
+        rec_start, n_rec = rec_start + spr, spr + 1
     steps = rec_start + np.arange(n_rec)
     theta = omega * dt * steps
     # peak rod compression from rigid-body statics over the reported revolution (N is quadratic in s)
@@ -384,7 +448,26 @@ def _run_case(model: Model, params: Params, omega: float, n_el: int, alpha: floa
         else np.degrees(theta)
     for name in ("eps_ax", "eps_of", "n_avg", "mid", "slider", "elong"):
         setattr(case, name, res[name])
+    case.settle_strain, case.settle_mid = res.get("settle_strain"), res.get("settle_mid")
     return case
+
+
+def _settle(res: dict, spr: int) -> dict:
+    """Split a two-revolution record: keep the last revolution, and measure how far it is from
+    periodic: the largest change of the strain field and of the midpoint deflection between
+    the two revolutions, relative to their peak in the last one."""
+    out = dict(res)
+    for name in ("eps_ax", "eps_of", "n_avg"):
+        out[name] = res[name][:, spr:]
+    for name in ("mid", "slider", "elong"):
+        out[name] = res[name][spr:]
+
+    def change(a: np.ndarray, b: np.ndarray) -> float:
+        peak = float(np.abs(b).max())
+        return float(np.abs(b - a).max()) / peak if peak > 0 else 0.0
+    out["settle_strain"] = change(res["eps_ax"][:, :spr + 1], out["eps_ax"])
+    out["settle_mid"] = change(res["mid"][:spr + 1], out["mid"])
+    return out
 
 
 # --------------------------------------------------------------------------- text
@@ -431,38 +514,59 @@ def _header(params: Params, model: Model, derived: dict[str, float]) -> list[str
             f"  first bending frequency (pinned-pinned)       {derived['w_bend']:10.2f} rad/s",
             f"  first axial frequency (fixed / slider mass)   {derived['w_axial']:10.2f} rad/s",
             f"  Euler load pi^2 EI / L^2 (pinned-pinned)      {derived['p_euler']:10.2f} N",
+            _onset_line(derived["onset"]),
             f"  rod mass                                      {model.rho_a * model.length:10.4f} kg",
             f"  axial stiffness EA, bending stiffness EI      {model.ea:.5g} N, {model.ei:.5g} N m^2"]
     return out
 
 
-def _status_text(c: Case) -> str:
+def _onset_line(onset: tuple[float, float] | None) -> str:
+    head = "  static buckling onset (K + K_G singular)      "
+    if onset is None:
+        return head + "      none below 1e6 rad/s"
+    return head + f"{onset[0]:10.2f} rad/s near theta2 = {onset[1]:.0f} deg"
+
+
+def _status_text(c: Case, why: bool = True) -> str:
     if c.ok:
         return "ok"
-    what = "BUCKLED" if c.status in ("buckled", "diverged") else c.status.upper()
-    return f"{what} at theta2 = {c.fail_angle_deg:.2f} deg (revolution {c.fail_rev})"
+    what, reason = STATUS_TEXT[c.status]
+    text = f"{what} at theta2 = {c.fail_angle_deg:.2f} deg (revolution {c.fail_rev})"
+    return f"{text}: {reason}" if why else text
 
 
-def _peak_table(cases: list[Case]) -> list[str]:
+def _unsettled(c: Case, tol: float) -> bool:
+    return c.settle_strain is not None and max(c.settle_strain, c.settle_mid) > tol
+
+
+def _settle_text(c: Case) -> str:
+    return "-" if c.settle_strain is None else f"{100 * max(c.settle_strain, c.settle_mid):.3f}"
+
+
+def _peak_table(cases: list[Case], tol: float) -> list[str]:
     cols = [Column("omega", "f", 7, 2), Column("tensile", "f", 9, 2), Column("theta2", "f", 7, 2),
             Column("el", "i", 4), Column("compress", "f", 9, 2), Column("theta2", "f", 7, 2),
             Column("el", "i", 4), Column("outer", "f", 9, 2), Column("middefl", "f", 8, 4),
-            Column("N/P_E", "f", 6, 3)]
+            Column("N/P_E", "f", 6, 3), Column("settle%", "s", 8)]
     rows, trailers = [], []
     for c in cases:
         if c.ok:
             t, ta, te = c.peak(+1)
             p, pa, pe = c.peak(-1)
             rows.append([c.omega, t * 1e6, ta, te, p * 1e6, pa, pe, float(c.eps_of.max()) * 1e6,
-                         float(np.abs(c.mid).max()) * 1e3, c.euler_ratio])
-            trailers.append("warning: N/P_E > 0.8" if c.euler_ratio > EULER_WARN else "")
+                         float(np.abs(c.mid).max()) * 1e3, c.euler_ratio, _settle_text(c)])
+            notes = (["NOT SETTLED"] if _unsettled(c, tol) else []) + \
+                (["warning: N/P_E > 0.8"] if c.euler_ratio > EULER_WARN else [])
+            trailers.append("; ".join(notes))
         else:
-            rows.append([c.omega, "-", "-", "-", "-", "-", "-", "-", "-", c.euler_ratio])
-            trailers.append(_status_text(c))
+            rows.append([c.omega, "-", "-", "-", "-", "-", "-", "-", "-", c.euler_ratio, "-"])
+            trailers.append(_status_text(c, why=False))
     return ["Table 1  Peak axial strain of the rod over the last revolution",
             "         omega [rad/s]; strains in microstrain; theta2 [deg] where the peak occurs; el = element",
             "         (1 = crank end); outer = peak outer-fibre strain |eps| + c|kappa|; middefl = peak |midpoint",
-            "         deflection| [mm]; N/P_E = peak rigid-body rod compression / Euler load", ""] \
+            "         deflection| [mm]; N/P_E = peak rigid-body rod compression / Euler load; settle% = largest",
+            "         change of strain or midpoint deflection between the last two revolutions, % of its peak",
+            f"         (NOT SETTLED above {100 * tol:g} %: the printed revolution is not yet periodic)", ""] \
         + render_table(cols, rows, trailers)
 
 
@@ -481,7 +585,7 @@ def _crank_end_table(cases: list[Case], every_deg: float = 10.0) -> list[str]:
     lines += render_table(cols, rows)
     bad = [c for c in cases if not c.ok]
     for c in bad:
-        lines.append(f"  w={c.omega:g}: {_status_text(c)}; no strains reported")
+        lines.append(f"  w={c.omega:g}: {_status_text(c, why=False)}; no strains reported")
     return lines
 
 
@@ -501,7 +605,7 @@ def _convergence_table(conv: dict[float, list[Case]], length: float) -> list[str
             le = 1e3 * length / c.n_elements
             if not c.ok:
                 rows.append([c.n_elements, le] + ["-"] * 8)
-                trailers.append(_status_text(c))
+                trailers.append(_status_text(c, why=False))
                 prev = None
                 continue
             vals = (c.peak(+1)[0] * 1e6, c.peak(-1)[0] * 1e6, c.crank_end_peak(+1) * 1e6, c.crank_end_peak(-1) * 1e6)
@@ -570,6 +674,23 @@ def _summary(cases: list[Case], model: Model | None = None) -> dict[str, Any]:
     return out
 
 
+def _peak_notes(cases: list[Case]) -> list[str]:
+    """Where the peaks of this run occur, from the table (not fixed text)."""
+    good = [c for c in cases if c.ok]
+    if not good:
+        return []
+    out = []
+    for sign, name in ((+1, "tensile"), (-1, "compressive")):
+        peaks = [c.peak(sign) for c in good]
+        els = sorted({e for _, _, e in peaks})
+        ang = [a for _, a, _ in peaks]
+        where = f"element {els[0]}" if len(els) == 1 else "elements " + ", ".join(map(str, els))
+        span = f"{min(ang):.1f}" if max(ang) - min(ang) < 0.05 else f"{min(ang):.1f} to {max(ang):.1f}"
+        out.append(f"    The peak {name} strain of this run occurs in {where} (1 = crank end) at theta2 = "
+                   f"{span} deg.")
+    return out
+
+
 def _benchmark_lines(params: Params, case: Case) -> list[str]:
     lines = ["Table 4  End state at t = " + f"{params.end_time:g} s", ""]
     if not case.ok:
@@ -600,7 +721,8 @@ def _benchmark_lines(params: Params, case: Case) -> list[str]:
 def estimate(params: Params) -> Estimate:
     """Memory and work of a run from the keys alone (driver.limits): every (speed, element count)
     integrates n_steps Newmark steps over 3 (n + 1) degrees of freedom (banded, about 0.2 us per
-    dof and step) and records one revolution of states."""
+    dof and step) and records the last two revolutions of states (to judge settling); the static
+    buckling onset factors K + K_G some 2000 times (about 0.3 ms per dof in all)."""
     p = params
     counts = list(p.element_counts) if p.element_counts else [p.n_elements]
     work, mem, steps_max = 0.0, 0.0, 0.0
@@ -610,12 +732,13 @@ def estimate(params: Params) -> Estimate:
             rec = 1.0
         else:
             steps = float(p.revolutions) * p.steps_per_rev
-            rec = p.steps_per_rev + 1.0
+            rec = (2.0 if p.revolutions >= 2 else 1.0) * p.steps_per_rev + 1.0
         steps_max = max(steps_max, steps)
         for n in counts:
             dof = 3.0 * (n + 1)
             work += 2e-7 * dof * steps
             mem = max(mem, dof * 8.0 * 40 + rec * (dof * 8.0 * 3 + 400.0))
+    work += 3e-4 * 3.0 * (counts[-1] + 1)      # static_onset on the reported mesh
     key = "end_time" if p.end_time > 0 else ("steps_per_rev" if p.steps_per_rev > 100_000 else
                                              ("element_counts" if p.element_counts else "n_elements"))
     wkey = key if key != "n_elements" or len(p.speeds) < 100 else "speeds"
@@ -629,8 +752,9 @@ def run(params: Params, progress: bool = False) -> Result:
     model = _model(params)
     w_bend, w_axial, p_euler = model.frequencies()
     alpha, beta = rayleigh(params.damping_ratio, w_bend, w_axial)
-    derived = dict(w_bend=w_bend, w_axial=w_axial, p_euler=p_euler, alpha=alpha, beta=beta)
     counts = list(params.element_counts) if params.element_counts else [params.n_elements]
+    derived = dict(w_bend=w_bend, w_axial=w_axial, p_euler=p_euler, alpha=alpha, beta=beta,
+                   onset=static_onset(model, counts[-1]))
     jobs = [(w, n) for w in params.speeds for n in counts]
     done: dict[tuple[float, int], Case] = {}
     for w, n in tqdm(jobs, desc="slidercrank", unit="case", disable=not progress):
@@ -644,7 +768,7 @@ def run(params: Params, progress: bool = False) -> Result:
     if params.end_time > 0:
         text += _benchmark_lines(params, cases[0]) + [""]
     else:
-        text += _peak_table(cases) + [""] + _crank_end_table(cases) + [""]
+        text += _peak_table(cases, params.settle_tolerance) + [""] + _crank_end_table(cases) + [""]
     conv = {w: [done[(w, n)] for n in counts] for w in params.speeds} if params.element_counts else {}
     if conv:
         text += _convergence_table(conv, model.length) + [""]
@@ -655,10 +779,17 @@ def run(params: Params, progress: bool = False) -> Result:
             if not params.geometric_stiffness:
                 msg += "; the linear model cannot show buckling: rerun with geometric_stiffness = .true."
             warnings.append(msg)
+    for c in cases:
+        if c.ok and _unsettled(c, params.settle_tolerance):
+            warnings.append(f"crank speed {c.omega:g} rad/s: the reported revolution has not settled: strain "
+                            f"changes {100 * c.settle_strain:.3f} % and midpoint deflection "
+                            f"{100 * c.settle_mid:.3f} % of their peaks between the last two revolutions "
+                            f"(> {100 * params.settle_tolerance:g} %); run more revolutions")
+    onset = derived["onset"]
     for c in done.values():
         if not c.ok:
             if params.geometric_stiffness and c.status in ("buckled", "diverged"):
-                warnings.append(f"crank speed {c.omega:g} rad/s, {c.n_elements} elements: rod "
+                warnings.append(f"crank speed {c.omega:g} rad/s, {c.n_elements} elements: "
                                 f"{_status_text(c)}")
             else:
                 failure = f"crank speed {c.omega:g} rad/s, {c.n_elements} elements: {_status_text(c)}"
@@ -667,8 +798,7 @@ def run(params: Params, progress: bool = False) -> Result:
     notes = ["Notes"]
     if params.end_time <= 0:
         notes += ["  * Strains: element axial strain (u_e - u_e-1)/le (the paper's 'regangan aksial'); tension",
-                  "    positive. The peak tensile strain occurs in the crank-end element near theta2 = 0 (rod",
-                  "    stretched), the peak compressive strain near theta2 = 180 deg.",
+                  "    positive."] + _peak_notes(cases) + [
                   "  * The paper publishes figures only; validation is against closed forms (quasi-static",
                   "    limit N(s)/EA, natural frequencies) and the Simeon (1996) benchmark (see tests).",
                   "  * Damping is not given in the paper: Rayleigh damping at the first bending and axial modes."]
@@ -682,12 +812,19 @@ def run(params: Params, progress: bool = False) -> Result:
         notes.append(f"  * Elements ({le * 1e3:.3f} mm) are shorter than the section depth "
                      f"({model.depth * 1e3:g} mm), as in the paper's")
         notes.append("    700-element mesh; Euler-Bernoulli elements are used regardless (shear neglected).")
+    notes.append("  * A case stops, and its numbers are not reported, on one of two named triggers: STATIC")
+    notes.append("    INSTABILITY when the tangent stiffness K + K_G of the rigid-body axial force loses")
+    notes.append("    definiteness (geometric stiffness on only), LIMIT L/20 when the elastic deflection exceeds")
+    notes.append("    L/20 (or a rotation 0.25 rad), where the small-motion model is no longer valid.")
+    if onset is not None:
+        notes.append(f"  * Static buckling onset {onset[0]:.2f} rad/s (Model above): the lowest constant crank speed at")
+        notes.append("    which K + K_G loses definiteness at some crank angle; it is a property of the rod, not of")
+        notes.append("    the small-motion guard, which can trip earlier through dynamic amplification.")
     if params.geometric_stiffness:
-        notes.append("  * Geometric stiffness on: a case is reported BUCKLED when the tangent stiffness K + K_G")
-        notes.append("    of the rigid-body axial force loses definiteness, or the elastic motion exceeds L/20;")
-        notes.append("    the numbers of such a case are not reported.")
+        notes.append("  * Geometric stiffness on: K_G of the rigid-body axial force is part of the model.")
     else:
-        notes.append("  * Geometric stiffness off (the paper's linear model); N/P_E is reported for every case.")
+        notes.append("  * Geometric stiffness off (the paper's linear model, which cannot buckle); N/P_E is reported")
+        notes.append("    for every case.")
     text += notes
     if warnings:
         text += ["", "Warnings"] + [f"  * {w}" for w in warnings]

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from decimal import ROUND_HALF_UP, Context, Decimal, localcontext
 from typing import Iterable, Sequence
 
-__all__ = ["TableValueError", "Column", "fortran_f", "fortran_i", "render_table"]
+__all__ = ["TableValueError", "Column", "fortran_f", "fortran_i", "significant", "render_table"]
 
 
 class TableValueError(ValueError):
@@ -57,6 +57,23 @@ def fortran_f(value: float, w: int | None, d: int, style: str = "modern") -> str
     return text if w is None else text.rjust(w)
 
 
+def significant(value: float, digits: int, style: str = "modern") -> str:
+    """``value`` to ``digits`` significant digits: fixed notation (F editing, rounded half away
+    from zero: 3.71000, 5.61249 for 6 digits) for magnitudes from 1e-4 up to 10^digits, ES
+    notation (``3.53553E-07``) outside.  Zero is ``0.00000``.  Raises TableValueError for NaN/inf."""
+    x = float(value)
+    if not math.isfinite(x):
+        raise TableValueError(f"non-finite value {x!r} cannot be written to {digits} significant digits")
+    if x == 0.0:
+        return fortran_f(0.0, None, max(1, digits - 1), style)
+    e = math.floor(math.log10(abs(x)))
+    if float(_round_half_up(abs(x), max(0, digits - 1 - e))) >= 10.0 ** (e + 1):
+        e += 1                        # rounding carried into the next decade (9.999996 -> 10.0000)
+    if -4 <= e < digits:
+        return fortran_f(x, None, max(1, digits - 1 - e), style)
+    return f"{x:.{digits - 1}E}"
+
+
 def fortran_i(value: int, w: int | None) -> str:
     """Fortran ``Iw`` editing; may exceed ``w`` (callers widen, never ``***``)."""
     text = str(int(value))
@@ -65,7 +82,8 @@ def fortran_i(value: int, w: int | None) -> str:
 
 @dataclass
 class Column:
-    """One table column: header text, Fortran edit (``f``/``i``/``s``), field width, decimals.
+    """One table column: header text, edit (``f``/``i``/``s``, or ``g``: ``decimals``
+    significant digits, see :func:`significant`), field width, decimals.
 
     ``sep`` is the number of blanks written before the field (the ``nx`` of a format).
     """
@@ -88,6 +106,8 @@ class Column:
             return fortran_f(float(value), None, self.decimals, self.style)
         if self.kind == "i":
             return fortran_i(int(value), None)
+        if self.kind == "g":
+            return significant(float(value), self.decimals, self.style)
         return str(value)
 
 

@@ -21,6 +21,7 @@ See ../shared/notes/ujoint.md for what reproduces and what does not.
 from __future__ import annotations
 
 import math
+import textwrap
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -47,6 +48,24 @@ SYM_TOL = 1e-7
 SADDLE_NUDGE = 1.0
 #: reading precision of the paper's plotted bands [rpm] (it quotes whole rpm)
 BAND_TOL = 1.0
+#: the phases repeat every half turn (each joint's ratio depends on sin^2 of its input angle)
+PHASE_PERIOD = 180.0
+#: optima within this relative difference of the best objective tie (the mirror optima of a
+#: symmetric chain differ only by rounding); ties are broken by TIE RULE in :func:`pick_best`
+TIE_RTOL = 1e-6
+#: tied end points closer than this are one optimum [deg] (the tie rule then takes the most
+#: converged of them, so the reported digits do not depend on which start stopped first)
+CLUSTER_TOL = 0.05
+#: a start that ends within this of a bound counts as ended on it [rad]
+BOUND_TOL = 1e-7
+#: how the θ, ρ and output angles are measured (printed in --keys and every .out)
+CONVENTIONS = (
+    "theta (the input angle) and every shaft angle turn right-handed about their shaft's "
+    "direction (input towards output; the 'axes' vectors); theta = 0 when joint 1's input yoke "
+    "lies along the normal to the plane of joint 1. rho_k > 0 when the plane of joint k+1 is "
+    "turned right-handed about shaft k from the plane of joint k. th_out is the last joint's "
+    "output yoke angle from the normal to the plane of the last joint, in the sense of theta; "
+    "it includes the phases (in phase: th_out = theta + 90 (n-1) deg + the joints' error)")
 
 #: why the paper's printed results are not reproducible (published quantity -> why)
 NOT_REPRODUCIBLE = {
@@ -78,7 +97,8 @@ _KEYS = dict(
     delta=Key("floats", units="deg",
               doc="yoke phases instead of phi (0 = in phase; delta = phi - 90)"),
     rho=Key("floats", units="deg",
-            doc="angle between the planes of joints k and k+1 about their shared shaft "
+            doc="angle between the planes of joints k and k+1 about their shared shaft k, "
+            "positive right-handed about the shaft's direction (input towards output) "
             "(n-1 values; exact model only; default coplanar)"),
     axes=Key("floats", units="-",
              doc="3-D chain: shaft direction vectors x,y,z of shafts 0..n (input first); "
@@ -90,7 +110,8 @@ _KEYS = dict(
               "'exact': each joint's output drives the next"),
     phasing=Key("str", default="cumulative", choices=("cumulative", "eq13"),
                 doc="paper model only: joint k at theta+phi_1+..+phi_(k-1) (the text) "
-                "or theta+phi_(k-1) (eq. 13 as printed)"),
+                "or theta+phi_(k-1) (eq. 13 as printed; the yoke phase of shaft k is then "
+                "phi_k - phi_(k-1) - 90, and every derived figure uses it)"),
     option=Key("int", default=0, choices=(0, 1, 2, 3),
                doc="0 analyse, 1 phases free, 2 angles free (phases fixed), 3 both free"),
     objective=Key("str", default="mean_square", choices=("mean_square", "rms", "peak_to_peak"),
@@ -100,7 +121,9 @@ _KEYS = dict(
     beta_upper=Key("floats", default=[40.0], units="deg",
                    doc="upper bound(s) on joint angles (the paper: 40)"),
     phi_lower=Key("floats", default=[0.0], units="deg", doc="lower bound(s) on phases phi"),
-    phi_upper=Key("floats", default=[180.0], units="deg", doc="upper bound(s) on phases phi"),
+    phi_upper=Key("floats", default=[180.0], units="deg",
+                  doc="upper bound(s) on phases phi; bounds spanning 180 deg or more make the "
+                  "phase periodic (searched without bounds, reported in [phi_lower, phi_lower+180))"),
     n_starts=Key("int", default=16,
                  check=lambda v: positive(v) or ("at most 100000 starts" if v > 100_000 else None),
                  doc="multi-start: the trial point plus n_starts-1 seeded random starts"),
@@ -111,7 +134,9 @@ _KEYS = dict(
                    doc="input-angle step of the speed table"),
     maxiter=Key("int", default=200, check=positive, doc="SLSQP iteration limit per start"),
     ftol=Key("float", default=1e-12, check=positive,
-             doc="SLSQP tolerance on the objective scaled by its trial value"),
+             doc="SLSQP tolerance on the objective divided by its scale, the larger of the "
+             "trial's value and a single joint's at the largest joint angle; objectives below "
+             "ftol times the scale are reported as below the resolution"),
     paper_beta=Key("floats", units="deg", doc="the paper's printed optimum: joint angles"),
     paper_phi=Key("floats", units="deg", doc="the paper's printed optimum: phases phi"),
     paper_u=Key("float", doc="the paper's printed objective value (for display only)"),
@@ -158,6 +183,21 @@ class Design:
     extra: dict = field(default_factory=dict)
 
 
+def yoke_shifts(model: int, phi_deg) -> np.ndarray:
+    """The phase shift between joints k and k+1 of a design's phases [deg], in the
+    cumulative/exact convention: phi itself, or phi_k - phi_(k-1) under eq. 13 as printed
+    (where phi_k is the absolute phase of joint k+1)."""
+    phi = np.asarray(phi_deg, float)
+    return np.diff(phi, prepend=0.0) if model == UJOINT_MODELS["eq13"] else phi
+
+
+def phases_for(model: int, shifts_deg) -> np.ndarray:
+    """The phases [deg] that give the shifts ``shifts_deg`` under ``model`` (inverse of
+    :func:`yoke_shifts`): the same physical assembly in another model's convention."""
+    s = np.asarray(shifts_deg, float)
+    return np.cumsum(s) if model == UJOINT_MODELS["eq13"] else s
+
+
 def evaluate(chain: Chain, label: str, beta_deg, phi_deg, model: int | None = None) -> Design:
     """All headline figures of one design under ``chain`` (``model`` overrides its model)."""
     model = chain.model if model is None else model
@@ -187,6 +227,7 @@ class StartRun:
     njev: int
     success: bool
     message: str
+    on_bound: np.ndarray = field(default_factory=lambda: np.empty(0, int))  # free-variable indices
 
 
 def _symmetric(chain: Chain, phi_rad: np.ndarray) -> bool:
@@ -199,11 +240,13 @@ def _symmetric(chain: Chain, phi_rad: np.ndarray) -> bool:
 
 def optimise(chain: Chain, option: int, beta0: np.ndarray, phi0: np.ndarray,
              lb: np.ndarray, ub: np.ndarray, starts: np.ndarray, maxiter: int,
-             ftol: float, progress: bool = False) -> list[StartRun]:
+             ftol: float, scale: float, progress: bool = False) -> list[StartRun]:
     """SLSQP from every row of ``starts`` (free variables, rad) with the kernel gradient.
 
     beta0, phi0 [rad] hold the fixed variables; lb/ub the bounds of the free ones [rad].
-    The objective is divided by its value at the first start so ``ftol`` is relative.
+    The objective is divided by ``scale`` (:func:`objective_scale`, never 0) so ``ftol`` is
+    relative.  Phases whose bounds span a period are searched unbounded and wrapped into
+    [lb, lb + 180 deg): a bound there is no stopping point.
     """
     n = beta0.size
     free = _free_index(option, n)
@@ -213,25 +256,73 @@ def optimise(chain: Chain, option: int, beta0: np.ndarray, phi0: np.ndarray,
         z[free] = x
         return z[:n], z[n:]
 
-    b, p = full(starts[0])
-    fref = ujoint_objective(chain.model, chain.kind, b, p, chain.rho, chain.m, grad=False)[0]
-    fref = fref if fref > 1e-300 else 1.0
+    fref = scale
 
     def fun(x: np.ndarray) -> tuple[float, np.ndarray]:
         b, p = full(x)
         f, g = ujoint_objective(chain.model, chain.kind, b, p, chain.rho, chain.m)
         return f / fref, g[free] / fref
 
-    bounds = list(zip(lb, ub))
+    periodic = _periodic(option, n, lb, ub)
+    bounds = [(None, None) if per else (a, b) for per, a, b in zip(periodic, lb, ub)]
     runs = []
     for x0 in tqdm(starts, desc="multi-start", unit="start", disable=not progress):
         res = minimize(fun, x0, jac=True, method="SLSQP", bounds=bounds,
                        options={"maxiter": maxiter, "ftol": ftol})
-        x = np.clip(res.x, lb, ub)
+        x = np.where(periodic, lb + np.mod(res.x - lb, PHASE_PERIOD * DEG), np.clip(res.x, lb, ub))
         f = ujoint_objective(chain.model, chain.kind, *full(x), chain.rho, chain.m, grad=False)[0]
+        on_bound = ~periodic & (lb < ub) & ((x - lb < BOUND_TOL) | (ub - x < BOUND_TOL))
         runs.append(StartRun(x0, x, float(f), int(res.nit), int(res.nfev), int(getattr(res, "njev", 0)),
-                             bool(res.success), str(res.message)))
+                             bool(res.success), str(res.message), np.flatnonzero(on_bound)))
     return runs
+
+
+def _periodic(option: int, n: int, lb: np.ndarray, ub: np.ndarray) -> np.ndarray:
+    """Which free variables are phases whose bounds span a whole period (searched unbounded)."""
+    is_phase = _free_index(option, n) >= n
+    return is_phase & (ub - lb >= PHASE_PERIOD * DEG * (1.0 - 1e-12))
+
+
+def objective_scale(chain: Chain, f_trial: float, beta_max_deg: float) -> float:
+    """The objective's scale, which cannot vanish: the larger of the trial's value and a
+    single joint's objective at the largest joint angle the run can reach (1 if that is 0)."""
+    b = np.array([abs(beta_max_deg) * DEG])
+    ref = ujoint_objective(chain.model, chain.kind, b, None, None, chain.m, grad=False)[0]
+    scale = max(f_trial, ref)
+    return scale if scale > 0.0 else 1.0
+
+
+def pick_best(runs: list[StartRun], n_beta: int) -> int:
+    """Index of the reported optimum among the starts (TIE RULE, deterministic).
+
+    Converged starts within TIE_RTOL (relative) of the best objective tie (mirror optima
+    agree to rounding; along a continuous family of optima the most converged start wins).  Among them the trial start (index 0) wins if it is there (so feeding an
+    optimum back as the trial reproduces it); otherwise the smallest phases, compared
+    lexicographically at 1e-6 deg, then the smallest joint angles; the tied starts within
+    CLUSTER_TOL of that end point are one optimum, and the one of them with the lowest
+    objective is reported (then the start order).  With no converged start, the lowest objective (a last iterate, reported as such).
+    """
+    ok = [k for k, r in enumerate(runs) if r.success]
+    if not ok:
+        return min(range(len(runs)), key=lambda k: runs[k].f)
+    fbest = min(runs[k].f for k in ok)
+    tied = [k for k in ok if runs[k].f <= fbest + TIE_RTOL * abs(fbest)]
+    if 0 in tied:
+        return 0
+
+    def key(k: int) -> tuple:
+        x = np.round(runs[k].x / DEG, 6)
+        return (*x[n_beta:], *x[:n_beta], k)
+    first = runs[min(tied, key=key)].x
+    same = [k for k in tied if _distance_deg(runs[k].x, first, n_beta) < CLUSTER_TOL]
+    return min(same, key=lambda k: (runs[k].f, k))
+
+
+def _distance_deg(x: np.ndarray, y: np.ndarray, n_beta: int) -> float:
+    """Largest difference between two points of the free variables [deg], phases modulo 180."""
+    d = np.abs(x - y) / DEG
+    d[n_beta:] = np.minimum(d[n_beta:] % PHASE_PERIOD, PHASE_PERIOD - d[n_beta:] % PHASE_PERIOD)
+    return float(d.max(initial=0.0))
 
 
 def _free_index(option: int, n: int) -> np.ndarray:
@@ -298,7 +389,7 @@ def _phases(params: Params, n: int, key: str | None = None) -> np.ndarray:
     v = np.asarray(params[k], float)
     if v.size != n - 1:
         extra = (" (the paper's phi_3 does not exist: three joints on four shafts leave two "
-                 "intermediate shafts)" if v.size > n - 1 else "")
+                 "intermediate shafts)" if n == 3 and v.size > n - 1 else "")
         raise params.error(k, f"a chain of {n} joint(s) has {n - 1} intermediate shaft(s), so "
                               f"{n - 1} phase(s); got {v.size}{extra}")
     return v + 90.0 if k == "delta" else v
@@ -366,7 +457,8 @@ SWEEP_PLOT = ("omega_out_min_rpm", "omega_out_max_rpm", "pp_ratio", "beta_e_deg"
 
 
 SPEC = GroupSpec("ujoint", _KEYS, check=cross_check,
-                 doc="Hooke-joint shaft chain: speed fluctuation, exact 3-D kinematics, SSO options 0-3")
+                 doc="Hooke-joint shaft chain: speed fluctuation, exact 3-D kinematics, SSO options 0-3. "
+                 "Conventions: " + CONVENTIONS)
 
 
 # --------------------------------------------------------------------------- run
@@ -460,22 +552,33 @@ def run(params: Params, progress: bool = False) -> Result:
         hi = np.concatenate([_per(params, "beta_upper", n, "joints"),
                              _per(params, "phi_upper", n - 1, "phases") if n > 1 else []])
         lb, ub = lo[free] * DEG, hi[free] * DEG
-        starts, start_notes = _starts(params, option, beta, phi, lb, ub, chain)
-        notes += start_notes
-        runs = optimise(chain, option, beta * DEG, phi * DEG, lb, ub, starts, params.maxiter, params.ftol,
-                        progress)
-        ok = [r for r in runs if r.success]
-        ipick = min((k for k, r in enumerate(runs) if r.success or not ok), key=lambda k: runs[k].f)
-        pick = runs[ipick]
+        beta_max = max(np.max(np.abs(beta)), np.max(np.abs(hi[:n])) if option in (2, 3) else 0.0)
+        scale = objective_scale(chain, trial.objective, beta_max)
         z = np.concatenate([beta, phi])
-        z[free] = pick.x / DEG
-        best = evaluate(chain, "optimum" if ok else "last iterate", z[:n], z[n:])
-        best.extra = {"run": pick, "index": ipick + 1}
-        designs.append(best)
-        if not ok:
-            failure = (f"the optimiser did not converge from any of {len(runs)} start(s) "
-                       f"(best start: {pick.message}); no optimum is reported")
-            warnings.append(failure)
+        if np.all(lb == ub):
+            z[free] = lb / DEG
+            best = evaluate(chain, "fixed design", z[:n], z[n:])
+            best.extra = {"run": None, "index": None}
+            designs.append(best)
+            notes.append("equal bounds fix every free variable: the fixed design is evaluated, "
+                         "not optimised (no multi-start)")
+        else:
+            starts, start_notes = _starts(params, option, beta, phi, lb, ub, chain)
+            notes += start_notes
+            runs = optimise(chain, option, beta * DEG, phi * DEG, lb, ub, starts, params.maxiter,
+                            params.ftol, scale, progress)
+            ok = any(r.success for r in runs)
+            ipick = pick_best(runs, int(np.sum(free < n)))
+            pick = runs[ipick]
+            z[free] = pick.x / DEG
+            best = evaluate(chain, "optimum" if ok else "last iterate", z[:n], z[n:])
+            best.extra = {"run": pick, "index": ipick + 1, "scale": scale,
+                          "resolution": params.ftol * scale}
+            designs.append(best)
+            if not ok:
+                failure = (f"the optimiser did not converge from any of {len(runs)} start(s) "
+                           f"(best start: {pick.message}); no optimum is reported")
+                warnings.append(failure)
     printed = None
     if params.paper_beta is not None or params.paper_phi is not None:
         pb = np.asarray(params.paper_beta if params.paper_beta is not None else beta, float)
@@ -521,6 +624,14 @@ def _es(x: float, d: int = 5) -> str:
     return f"{x:.{d}E}"
 
 
+def _objective_text(f: float, resolution: float | None, d: int = 5) -> str:
+    """An objective value, or '<res' when it lies below the optimiser's resolution (ftol
+    times the objective scale): below it the digits are the stopping point's noise."""
+    if resolution is not None and f < resolution:
+        return f"<{resolution:.1E}"
+    return _es(f, d)
+
+
 def _render(params: Params, chain: Chain, beta, rho, designs: list[Design], runs: list[StartRun],
             notes: list[str], warnings: list[str], failure: str | None) -> str:
     n = beta.size
@@ -538,7 +649,8 @@ def _render(params: Params, chain: Chain, beta, rho, designs: list[Design], runs
                           "peak_to_peak": "peak_to_peak: max R - min R on the grid [-]"}[params.objective]),
            ("grid", f"{params.n_grid} input angles per revolution (theta from the normal to joint 1's plane)"),
            ("phases", "phi (the paper's convention): 90 deg = yokes on the shaft in phase; "
-                      "yoke phase delta = phi - 90")]
+                      + ("yoke phase delta_k = phi_k - phi_(k-1) - 90 (eq. 13: phi_k is absolute)"
+                         if chain.model == UJOINT_MODELS["eq13"] else "yoke phase delta = phi - 90"))]
     if params.axes is not None:
         a = np.asarray(params.axes, float).reshape(-1, 3)
         for k, v in enumerate(a):
@@ -554,13 +666,16 @@ def _render(params: Params, chain: Chain, beta, rho, designs: list[Design], runs
                                    f"bounds (seed {params.seed}); SLSQP, analytic gradient, maxiter "
                                    f"{params.maxiter}, ftol {params.ftol:g} (relative)"))
     width = max(len(k) for k, _ in hdr)
-    out += [f" {k:<{width}} : {v}" for k, v in hdr] + [""]
+    out += [f" {k:<{width}} : {v}" for k, v in hdr]
+    out += [f" {'conventions':<{width}} : {line}" if i == 0 else f" {'':<{width}}   {line}"
+            for i, line in enumerate(textwrap.wrap(CONVENTIONS, 100))] + [""]
+    res = designs[1].extra.get("resolution") if len(designs) > 1 else None
 
     out.append(" DESIGNS (angles in deg)")
     cols = [Column("design", "s", 14)] + [Column(f"beta_{k + 1}", "f", 9, 4) for k in range(n)] + \
            [Column(f"phi_{k + 1}", "f", 9, 4) for k in range(n - 1)] + \
            [Column(f"delta_{k + 1}", "f", 9, 4) for k in range(n - 1)]
-    rows = [[d.label, *d.beta, *d.phi, *(d.phi - 90.0)] for d in designs]
+    rows = [[d.label, *d.beta, *d.phi, *(yoke_shifts(chain.model, d.phi) - 90.0)] for d in designs]
     out += render_table(cols, rows) + [""]
 
     out.append(" PERFORMANCE (under this deck's model and objective; rpm at the input speed)")
@@ -568,13 +683,14 @@ def _render(params: Params, chain: Chain, beta, rho, designs: list[Design], runs
             Column("p-p ratio", "f", 10, 6), Column("w_min rpm", "f", 10, 4),
             Column("w_max rpm", "f", 10, 4), Column("beta_e", "f", 8, 4), Column("beta_res", "s", 9),
             Column("peak acc", "f", 11, 6)]
-    rows = [[d.label, _es(d.objective), _es(d.u_rpm2), d.pp, d.w_min, d.w_max, d.beta_e, _fmt(d.beta_res),
+    ures = res * params.rpm ** 2 if res is not None and params.objective == "mean_square" else None
+    rows = [[d.label, _objective_text(d.objective, res), _objective_text(d.u_rpm2, ures), d.pp, d.w_min, d.w_max, d.beta_e, _fmt(d.beta_res),
              d.peak_acc] for d in designs]
     out += render_table(cols, rows)
     out += ["   beta_e [deg]: first-order residual angle, beta_e^2 = |sum beta_k^2 exp(2i gamma_k)| "
             "(p-p ratio ~ beta_e^2 [rad^2])",
-            "   beta_res [deg]: the single joint the exact chain equals (closed form; n/a unless every "
-            "phi_k - rho_k is a multiple of 90 deg)",
+            "   beta_res [deg]: the single joint the exact chain with these yoke phases equals (closed "
+            "form; n/a unless every yoke shift is a multiple of 90 deg)",
             "   peak acc [rad/s^2]: max |d omega_out/dt| at constant input speed", ""]
     printed = next((d for d in designs if d.label == "paper printed"), None)
     if printed is not None and params.paper_u is not None:
@@ -630,11 +746,12 @@ def _free_names(option: int, n: int) -> list[str]:
     return [names[i] for i in _free_index(option, n)]
 
 
-def _family(runs: list[StartRun], pick: StartRun, n_beta: int) -> tuple[int, np.ndarray]:
-    """Converged starts that reach the best objective, and their distinct end points [deg]
-    (rounded to 0.01 deg; phases taken modulo 180 deg)."""
-    tol = 1e-6 * abs(pick.f) + 1e-12
-    good = [r for r in runs if r.success and r.f <= pick.f + tol]
+def _family(runs: list[StartRun], pick: StartRun, n_beta: int, resolution: float) -> tuple[int, np.ndarray]:
+    """Converged starts that tie with the best objective (as in :func:`pick_best`), and their
+    distinct end points [deg] (rounded to 0.01 deg; phases taken modulo 180 deg)."""
+    fbest = min(r.f for r in runs if r.success)
+    tol = max(TIE_RTOL * abs(fbest), resolution)
+    good = [r for r in runs if r.success and r.f <= fbest + tol]
     x = np.array([r.x for r in good]) / DEG
     x[:, n_beta:] %= 180.0
     x = np.round(x, 2)
@@ -647,18 +764,31 @@ def _render_runs(runs: list[StartRun], best: Design, names: list[str]) -> list[s
     pick = best.extra["run"]
     ok = sum(r.success for r in runs)
     n_beta = sum(name.startswith("beta") for name in names)
-    close, distinct = _family(runs, pick, n_beta) if ok else (0, np.empty((0, len(names))))
+    res = best.extra["resolution"]
+    close, distinct = _family(runs, pick, n_beta, res) if ok else (0, np.empty((0, len(names))))
     out = [" OPTIMISER (scipy SLSQP per start; objective values unscaled)"]
     cols = [Column("start", "i", 5), Column("objective", "s", 14), Column("iter", "i", 5),
             Column("f-evals", "i", 7), Column("status", "s", 9)]
-    rows = [[k + 1, _es(r.f, 7), r.nit, r.nfev, "converged" if r.success else "FAILED"] for k, r in enumerate(runs)]
-    trail = ["<- best" if k + 1 == idx else (r.message if not r.success else "") for k, r in enumerate(runs)]
+    rows = [[k + 1, _objective_text(r.f, res, 7), r.nit, r.nfev, "converged" if r.success else "FAILED"]
+            for k, r in enumerate(runs)]
+    trail = []
+    for k, r in enumerate(runs):
+        t = ["<- best"] if k + 1 == idx else ([r.message] if not r.success else [])
+        if r.on_bound.size:
+            t.append("at bound: " + " ".join(names[i] for i in r.on_bound))
+        trail.append("  ".join(t))
     out += render_table(cols, rows, trail)
+    ended = sum(r.on_bound.size > 0 for r in runs)
     out += [f"   best start {idx}: {pick.nit} iterations, {pick.nfev} function evaluations "
             f"({pick.njev} gradient evaluations); all starts: {sum(r.nit for r in runs)} iterations, "
             f"{sum(r.nfev for r in runs)} evaluations",
             f"   {ok} of {len(runs)} start(s) converged; {close} reached the best objective "
-            f"(within 1e-6 relative) at {len(distinct)} distinct point(s) (0.01 deg; phases mod 180)"]
+            f"(within {TIE_RTOL:g} relative or the resolution {res:.1E}) at {len(distinct)} distinct "
+            "point(s) (0.01 deg; phases mod 180)",
+            f"   {ended} of {len(runs)} start(s) ended on a bound (listed 'at bound'); phases whose "
+            "bounds span 180 deg are periodic and searched without bounds, so no phase bound stops a start",
+            f"   tie rule: among optima within {TIE_RTOL:g} relative of the best, the trial start's end "
+            "point, else the smallest phases (lexicographic), then the smallest joint angles"]
     if len(distinct) > 1:
         out.append("   distinct optima (a family: the objective does not single out one design), first 8 [deg]:")
         out += render_table([Column(nm, "f", 10, 2) for nm in names], distinct[:8])
@@ -672,13 +802,15 @@ def _render_compare(params: Params, chain: Chain, designs: list[Design]) -> list
               ("exact chain", "exact")]
     if params.model == "exact" and (params.rho is not None or params.axes is not None):
         models = [("exact chain", "exact")]   # the paper's models are coplanar
-    out = [" MODEL COMPARISON (same angles; omega_out band in rpm, p-p ratio)"]
+    out = [" MODEL COMPARISON (same joint angles and yoke phases delta, each model's phi; omega_out band "
+           "in rpm, p-p ratio)"]
     cols = [Column("design", "s", 14), Column("model", "s", 25), Column("w_min rpm", "f", 10, 4),
             Column("w_max rpm", "f", 10, 4), Column("p-p ratio", "f", 10, 6), Column("objective", "s", 12)]
     rows = []
     for d in designs:
         for label, code in models:
-            e = evaluate(chain, d.label, d.beta, d.phi, model=UJOINT_MODELS[code])
+            m = UJOINT_MODELS[code]
+            e = evaluate(chain, d.label, d.beta, phases_for(m, yoke_shifts(chain.model, d.phi)), model=m)
             rows.append([d.label, label, e.w_min, e.w_max, e.pp, _es(e.objective)])
     out += render_table(cols, rows)
     if params.paper_band is not None:
@@ -703,7 +835,7 @@ def _render_speed_table(params: Params, chain: Chain, designs: list[Design], exa
     data = []
     for d in shown:
         w, a, to = _speed(chain, d, th)
-        tag = {"optimum": "opt", "last iterate": "last"}.get(d.label, d.label)
+        tag = {"optimum": "opt", "last iterate": "last", "fixed design": "fixed"}.get(d.label, d.label)
         cols += [Column(f"{tag} w_out", "f", 12, 5), Column(f"{tag} ratio", "f", 11, 7),
                  Column(f"{tag} acc", "f", 11, 6)]
         data += [w, w / params.rpm, a]
@@ -746,15 +878,17 @@ def _result_dat(params: Params, chain: Chain, designs: list[Design], best: Desig
                 runs: list[StartRun]) -> str:
     """The paper's post-processing 'save result': optimum, objective and its speed curve."""
     pick = best.extra["run"]
+    fixed = pick is None
     lines = ["% result.dat of &ujoint (SSO post-processing 'save result'); angles in deg",
              f"% deck {params.path}; model {_model_text(params)}; objective {params.objective}",
              f"option     = {params.option}",
              "x          = " + " ".join(fortran_f(v, None, 6) for v in np.concatenate([best.beta, best.phi])),
              f"fval       = {best.objective:.10e}",
-             f"exitflag   = {1 if pick.success else 0}",
-             f"iterations = {pick.nit}",
-             f"funccount  = {pick.nfev}",
-             *([] if pick.success else ["% NOT CONVERGED: x is the last iterate, not an optimum"]),
+             f"exitflag   = {1 if fixed or pick.success else 0}",
+             f"iterations = {0 if fixed else pick.nit}",
+             f"funccount  = {1 if fixed else pick.nfev}",
+             *(["% FIXED DESIGN: equal bounds fix every free variable; evaluated, not optimised"] if fixed
+               else [] if pick.success else ["% NOT CONVERGED: x is the last iterate, not an optimum"]),
              "% theta_in_deg  omega_in_rpm  omega_out_trial_rpm  omega_out_optimum_rpm"]
     th = np.arange(0.0, 360.0 + 1e-9, 1.0)
     w0 = _speed(chain, designs[0], th)[0]

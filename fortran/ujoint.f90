@@ -325,8 +325,10 @@ contains
   !> beta_e: first-order residual angle, beta_e**2 = |sum_k beta_k**2 exp(2i gamma_k)| with
   !>   gamma_1 = 0 and gamma_{k+1} = gamma_k + (shift of the model); the ratio's
   !>   peak-to-peak is about beta_e**2.
-  !> beta_res: the single Hooke joint that the EXACT chain equals when every phi(k) - rho(k)
-  !>   is a multiple of 90 deg (tolerance tol [rad]): cos(beta_res) = min(K, 1/K), K built
+  !> beta_res: the single Hooke joint that the EXACT chain equals when every shift between
+  !>   successive joints (the model's: phi(k) - rho(k) exact, phi(k) cumulative,
+  !>   phi(k) - phi(k-1) eq13) is a multiple of 90 deg (tolerance tol [rad]): the exact chain
+  !>   with those shifts; cos(beta_res) = min(K, 1/K), K built
   !>   from the tan-law composition.  status = st_res_undefined (beta_res = 0) otherwise.
   subroutine chain_equivalent(model, n, beta, phi, rho, tol, beta_e, beta_res, status)
     integer, intent(in) :: model, n
@@ -351,7 +353,7 @@ contains
     do k = 1, n
       kk = kk*cos(beta(k))
       if (k == n) exit
-      sh = phi(k) - rho(k)
+      sh = atan2(sn(k), cs(k))           ! the model's shift between joints k and k+1
       q = sh/(0.5_dp*pi)
       if (abs(q - real(nint(q), dp))*0.5_dp*pi > tol) then
         status = st_res_undefined
