@@ -6,12 +6,13 @@ one column per quantity, with units in the column names (``omega3_rad_s``).
 from __future__ import annotations
 
 from pathlib import Path
-
-import pandas as pd
-import pyarrow as pa
-import pyarrow.csv as pacsv
+from typing import TYPE_CHECKING
 
 from driver.atomic import atomic_open
+from driver.extras import available, require
+
+if TYPE_CHECKING:   # annotations only: keeps `python -m driver --help` light
+    import pandas as pd
 
 __all__ = ["FORMATS", "write_tidy"]
 
@@ -28,11 +29,17 @@ def write_tidy(frame: pd.DataFrame, path_stem: str | Path, fmt: str) -> Path:
     if fmt not in FORMATS:
         raise ValueError(f"unknown table format {fmt!r} (choose {', '.join(FORMATS)})")
     path = Path(f"{path_stem}.{fmt}")
+    if fmt == "parquet":
+        require("parquet")
     if fmt == "csv":
-        try:   # pyarrow writes CSV about 10x faster than pandas (matters for large sweeps)
-            table = pa.Table.from_pandas(frame, preserve_index=False)
-        except (pa.ArrowInvalid, pa.ArrowTypeError):   # a column mixing types: let pandas stringify it
-            table = None
+        table = None
+        if available("parquet"):   # pyarrow writes CSV about 10x faster than pandas (large sweeps)
+            import pyarrow as pa
+            import pyarrow.csv as pacsv
+            try:
+                table = pa.Table.from_pandas(frame, preserve_index=False)
+            except (pa.ArrowInvalid, pa.ArrowTypeError):   # a column mixing types: let pandas stringify it
+                table = None
         if table is not None:
             with atomic_open(path, "wb") as fh:
                 fh.write((",".join(_csv_name(c) for c in table.column_names) + "\n").encode())

@@ -10,7 +10,10 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Sequence
 
-import matplotlib
+from driver.extras import require
+
+require("plot")   # a clear message naming the [plot] extra when matplotlib is missing
+import matplotlib  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402

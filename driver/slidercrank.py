@@ -612,19 +612,24 @@ def run(params: Params, progress: bool = False) -> Result:
         text += ["", "Warnings"] + [f"  * {w}" for w in warnings]
     figures = []
     good = [c for c in cases if c.ok]
+    plotting = _plotting   # imported when a figure is drawn (matplotlib is the optional [plot] extra)
     if good and params.end_time <= 0:
-        from driver import plotting
-        figures.append(Figure("strain", lambda: plotting.slidercrank_strain_figure(
+        figures.append(Figure("strain", lambda: plotting().slidercrank_strain_figure(
             [(f"{c.omega:g} rad/s", c.angle_deg, c.eps_ax[0] * 1e6) for c in good],
             f"{params.material}: crank-end element axial strain")))
-        figures.append(Figure("deflection", lambda: plotting.slidercrank_strain_figure(
+        figures.append(Figure("deflection", lambda: plotting().slidercrank_strain_figure(
             [(f"{c.omega:g} rad/s", c.angle_deg, c.mid * 1e3) for c in good],
             f"{params.material}: midpoint deflection", ylabel="midpoint deflection [mm]")))
     if conv:
-        from driver import plotting
         series = {f"{w:g} rad/s": ([c.n_elements for c in cs if c.ok], [c.peak(+1)[0] * 1e6 for c in cs if c.ok])
                   for w, cs in conv.items()}
-        figures.append(Figure("convergence", lambda: plotting.slidercrank_convergence_figure(
+        figures.append(Figure("convergence", lambda: plotting().slidercrank_convergence_figure(
             series, f"{params.material}: element convergence")))
     return Result(text="\n".join(text) + "\n", tidy=_tidy(params.material, list(done.values())),
                   summary=_summary(cases), warnings=warnings, failure=failure, figures=figures)
+
+
+def _plotting():
+    """driver.plotting, imported only when a figure is drawn (matplotlib is optional)."""
+    from driver import plotting
+    return plotting

@@ -15,13 +15,15 @@ import importlib
 import re
 from dataclasses import dataclass, field
 from types import ModuleType
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
-import pandas as pd
+if TYPE_CHECKING:   # annotations only: keeps `python -m driver --help` light
+    import pandas as pd
 
-__all__ = ["Figure", "Result", "load_study"]
+__all__ = ["Figure", "Result", "load_study", "study_names"]
 
-_CORE = {"cli", "deck", "study", "table", "export", "plotting", "atomic", "kernels", "sweep", "runner", "expr"}
+_CORE = {"cli", "deck", "study", "table", "export", "plotting", "atomic", "kernels", "sweep", "runner", "expr",
+         "extras", "example_decks", "examples"}
 
 
 @dataclass
@@ -68,3 +70,12 @@ def load_study(group: str) -> ModuleType | None:
     if not (hasattr(module, "SPEC") and hasattr(module, "run")):
         return None
     return module
+
+
+def study_names() -> list[str]:
+    """Group names of every study module in the package, found without importing them."""
+    import pkgutil
+
+    import driver
+    return sorted(info.name for info in pkgutil.iter_modules(driver.__path__)
+                  if not info.ispkg and info.name not in _CORE and not info.name.startswith("_"))

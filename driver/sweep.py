@@ -46,6 +46,7 @@ from driver import expr
 from driver.atomic import write_text
 from driver.deck import Deck, DeckError, GroupSpec, Key, Params, RawGroup, validate
 from driver.export import write_tidy
+from driver.extras import require
 from driver.runner import study_of, write_outputs
 from driver.study import load_study
 from driver.table import Column, render_table
@@ -477,8 +478,15 @@ def _summary_table(frame: pd.DataFrame, limit: int = 2000) -> list[str]:
 def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool,
                    quiet: bool = False, jobs: int | None = None, scheduler: Any = None,
                    resume: bool = False) -> int:
-    """Run a deck with a &sweep group; returns the exit status (see driver.cli)."""
+    """Run a deck with a &sweep group; returns the exit status (see driver.cli).
+
+    Raises :class:`~driver.extras.MissingExtra` before running anything when pyarrow (case
+    files and summaries are Parquet) or, with a scheduler, Dask is not installed.
+    """
     sw = validate(deck.groups["sweep"], SPEC, deck.path)
+    require("parquet")
+    if scheduler or sw.scheduler:
+        require("dask")
     study_raw = {n: g for n, g in deck.groups.items() if n != "sweep"}
     module, base_params = study_of(Deck(deck.path, study_raw))   # the base deck must be valid on its own
     raw = study_raw[base_params.group]
