@@ -3,6 +3,9 @@
 Each deck runs on its own; the exit status is 0 when every deck succeeded,
 2 when any deck had bad input (nothing written for that deck), 1 when a run
 failed otherwise (e.g. an optimiser did not converge; its outputs say so).
+Only argument parsing lives here; running is :mod:`driver.runner` and
+:mod:`driver.sweep`.  Heavy modules (pandas, the kernels, the studies) are
+imported after parsing, so ``--help`` and ``--version`` answer at once.
 """
 from __future__ import annotations
 
@@ -12,32 +15,45 @@ import sys
 import traceback
 from pathlib import Path
 
-import driver
-from driver.deck import DeckError, read_deck
+from driver import __version__
 from driver.export import FORMATS
-from driver.runner import available_studies, run_study
-from driver.study import load_study
+from driver.extras import MissingExtra, require
+from driver.study import study_names
 
 __all__ = ["main", "run_deck", "EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT"]
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+
+#: groups the driver itself handles (documented by --keys like a study group)
+_CONTROL = ("sweep",)
 
 
 def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool, progress: bool,
              quiet: bool = False, sweep_options: dict | None = None) -> int:
     """Run one deck; returns its exit status. Errors are printed, never raised.
 
-    ``sweep_options`` (jobs, scheduler, resume) apply when the deck has a &sweep group.
+    ``sweep_options`` (jobs, scheduler, resume) apply when the deck has a &sweep group;
+    given for a deck without one, they are reported as ignored.
     """
+    from driver.deck import DeckError, read_deck
+    from driver.runner import run_study
     try:
         deck = read_deck(path)
         if "sweep" in deck.groups:
             from driver import sweep
             return sweep.run_sweep_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))
+        given = [opt for opt, key in (("-j/--jobs", "jobs"), ("--scheduler", "scheduler"), ("--resume", "resume"))
+                 if (sweep_options or {}).get(key)]
+        if given:
+            print(f"warning: {path}: {', '.join(given)} apply to sweep decks (a &sweep group) only; "
+                  f"ignored for this deck", file=sys.stderr)
         outcome = run_study(deck, outdir, formats, plot, progress)
     except DeckError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except MissingExtra as exc:
+        print(f"error: {path}: {exc}", file=sys.stderr)
+        return EXIT_FAILED
     except KeyboardInterrupt:
         raise
     except Exception as exc:  # a bug or an unexpected numerical failure: say so plainly
@@ -57,11 +73,17 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool, progress:
     return EXIT_OK
 
 
-def _keys_help(group: str) -> str:
-    module = load_study(group)
-    if module is None:
-        return f"no study group &{group}"
-    spec = module.SPEC
+def keys_help(group: str) -> str | None:
+    """Every key of namelist group ``group`` with kind, units, default and doc; None if no such group."""
+    if group in _CONTROL:
+        from driver import sweep
+        spec = sweep.SPEC
+    else:
+        from driver.study import load_study
+        module = load_study(group)
+        if module is None:
+            return None
+        spec = module.SPEC
     lines = [f"&{spec.name}: {spec.doc}".rstrip(": "), ""]
     for name, key in spec.keys.items():
         req = "required" if key.required else f"default {key.default!r}"
@@ -73,54 +95,119 @@ def _keys_help(group: str) -> str:
     return "\n".join(lines)
 
 
+def _examples(args: argparse.Namespace) -> int:
+    """--examples: list the shipped decks; --example NAME: copy one out."""
+    from driver import example_decks
+    try:
+        if args.examples:
+            names = example_decks.list_examples()
+            width = max(map(len, names))
+            print(f"example decks ({example_decks.examples_dir()}); copy one with: python -m driver --example NAME")
+            for name in names:
+                text = example_decks.describe(name) or "(the listing's terminal input: p q r s, omega, increment)"
+                print(f"  {name:<{width}}  {text[:100] + ('...' if len(text) > 100 else '')}")
+        for name in args.example:
+            target = example_decks.copy_example(name, args.outdir or Path("."))
+            print(f"copied {target}; run it with: python -m driver {target}")
+    except KeyError as exc:
+        print(f"error: {exc.args[0]}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except BrokenPipeError:   # e.g. piped into head
+        sys.stderr.close()
+    except OSError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return EXIT_FAILED
+    return EXIT_OK
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number of worker processes, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"needs at least 1 worker process, got {value} "
+                                         "(leave -j out to use every core)")
+    return value
+
+
 def build_parser() -> argparse.ArgumentParser:
-    studies = ", ".join(f"&{g}" for g in sorted(available_studies()))
+    studies = ", ".join(f"&{g}" for g in study_names())
     parser = argparse.ArgumentParser(
         prog="python -m driver",
         description="Run mechanism-analysis decks (Fortran namelist files) and write "
                     "fixed-format tables to OUTDIR/<deck stem>.out.",
         epilog=f"Study groups: {studies}; a &sweep group turns a deck into a study over "
-               "several cases. 'python -m driver --keys GROUP' lists a group's keys. "
+               "several cases. 'python -m driver --keys GROUP' lists a group's keys (also --keys sweep); "
+               "'python -m driver --examples' lists the shipped example decks. "
                "Exit status: 0 all decks succeeded, 1 a run failed, 2 bad input.",
     )
     parser.add_argument("decks", nargs="*", type=Path, metavar="DECK", help="input deck(s), e.g. inputs/crank5.dat")
-    parser.add_argument("-o", "--outdir", type=Path, default=Path("outputs"),
-                        help="output folder (default: outputs/, created when missing)")
+    parser.add_argument("-o", "--outdir", type=Path, default=None,
+                        help="output folder (default: outputs/, created when missing); "
+                             "with --example, where the deck is copied (default: here)")
     parser.add_argument("--csv", action="store_true", help="also write the tidy table as <stem>.csv")
     parser.add_argument("--format", dest="formats", action="append", choices=FORMATS, default=[],
                         help="also write the tidy table in this format (repeatable)")
     parser.add_argument("--plot", action="store_true", help="write PNG figures <stem>_<name>.png")
     parser.add_argument("-q", "--quiet", action="store_true", help="print only warnings and errors")
     parser.add_argument("--keys", metavar="GROUP", help="list the keys of a namelist group and exit")
-    parser.add_argument("-j", "--jobs", type=int, default=None,
-                        help="sweeps: worker processes (default: all cores)")
+    parser.add_argument("--examples", action="store_true",
+                        help="list the example decks shipped with the package and exit")
+    parser.add_argument("--example", metavar="NAME", action="append", default=[],
+                        help="copy the shipped example deck NAME.dat here (or into -o DIR) and exit (repeatable)")
+    parser.add_argument("-j", "--jobs", type=_positive_int, default=None,
+                        help="sweeps: worker processes, at least 1 (default: all cores)")
     parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
                         help="sweeps: run cases on this Dask distributed scheduler")
     parser.add_argument("--resume", action="store_true",
                         help="sweeps: skip cases whose outputs are already complete")
-    parser.add_argument("--version", action="version", version=f"%(prog)s {driver.__version__}")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    try:
+        return _main(parser, args)
+    except ImportError as exc:   # e.g. the kernels are not built: driver.kernels says what to do
+        print(f"error: {exc}", file=sys.stderr)
+        return EXIT_FAILED
+
+
+def _main(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
     if args.keys:
+        group = args.keys.lstrip("&").lower()
+        text = keys_help(group)
+        if text is None:
+            known = ", ".join(f"&{g}" for g in (*study_names(), *_CONTROL))
+            print(f"error: --keys: no namelist group &{group} (known groups: {known})", file=sys.stderr)
+            return EXIT_BAD_INPUT
         try:
-            print(_keys_help(args.keys.lstrip("&").lower()))
+            print(text)
         except BrokenPipeError:  # e.g. piped into head
             sys.stderr.close()
         return EXIT_OK
+    if args.examples or args.example:
+        return _examples(args)
     if not args.decks:
-        parser.error("no deck given")
+        parser.error("no deck given (python -m driver --examples lists the shipped example decks)")
     formats = list(dict.fromkeys((["csv"] if args.csv else []) + args.formats))
+    needs = ([("plot", "--plot")] if args.plot else []) + ([("parquet", "--format parquet")]
+             if "parquet" in formats else []) + ([("dask", "--scheduler")] if args.scheduler else [])
+    for extra, option in needs:
+        try:
+            require(extra)
+        except MissingExtra as exc:
+            parser.error(f"{option}: {exc}")
+    outdir = args.outdir or Path("outputs")
     progress = sys.stderr.isatty() and not args.quiet and not os.environ.get("CI")
     sweep_options = {"jobs": args.jobs, "scheduler": args.scheduler, "resume": args.resume}
     status = EXIT_OK
     try:
         for deck in args.decks:
-            status = max(status, run_deck(deck, args.outdir, formats, args.plot, progress, args.quiet,
-                                         sweep_options))
+            status = max(status, run_deck(deck, outdir, formats, args.plot, progress, args.quiet, sweep_options))
     except KeyboardInterrupt:
         print("interrupted: finished outputs are complete; no partial file was left", file=sys.stderr)
         return 130
