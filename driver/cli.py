@@ -1,10 +1,10 @@
-"""Command line: ``python -m driver DECK [DECK ...] [-o OUTDIR] [--csv|--format F] [--plot]``.
+"""Command line: ``python -m driver DECK [DECK ...] [-o OUTDIR] [--csv|--format F] [--plot] [--compare]``.
 
 Each deck runs on its own; the exit status is 0 when every deck succeeded,
 2 when any deck had bad input (nothing written for that deck), 1 when a run
 failed otherwise (e.g. an optimiser did not converge; its outputs say so).
 Only argument parsing lives here; running is :mod:`driver.runner` and
-:mod:`driver.sweep`.  Heavy modules (pandas, the kernels, the studies) are
+:mod:`driver.sweep`, :mod:`driver.optimize`, :mod:`driver.synthesis`.  Heavy modules (pandas, the kernels, the studies) are
 imported after parsing, so ``--help`` and ``--version`` answer at once.
 """
 from __future__ import annotations
@@ -24,29 +24,32 @@ __all__ = ["main", "run_deck", "EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT"]
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
 
-#: groups the driver itself handles (documented by --keys like a study group)
-_CONTROL = ("sweep",)
-
-
 def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool, progress: bool,
              quiet: bool = False, sweep_options: dict | None = None) -> int:
     """Run one deck; returns its exit status. Errors are printed, never raised.
 
-    ``sweep_options`` (jobs, scheduler, resume) apply when the deck has a &sweep group;
-    given for a deck without one, they are reported as ignored.
+    ``sweep_options`` (jobs, scheduler, resume) apply when the deck has a &sweep or an
+    &optimize group; given for any other deck, they are reported as ignored.
     """
     from driver.deck import DeckError, read_deck
     from driver.runner import run_study
     try:
         deck = read_deck(path)
+        if not ({"sweep", "optimize"} & set(deck.groups)):
+            given = [opt for opt, key in (("-j/--jobs", "jobs"), ("--scheduler", "scheduler"),
+                                          ("--resume", "resume")) if (sweep_options or {}).get(key)]
+            if given:
+                print(f"warning: {path}: {', '.join(given)} apply to sweep and optimisation decks "
+                      f"(a &sweep or &optimize group) only; ignored for this deck", file=sys.stderr)
+        if "synthesis" in deck.groups:
+            from driver import synthesis
+            return synthesis.run_synthesis_deck(deck, outdir, formats, plot, progress, quiet)
+        if "optimize" in deck.groups:
+            from driver import optimize
+            return optimize.run_optimize_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))
         if "sweep" in deck.groups:
             from driver import sweep
             return sweep.run_sweep_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))
-        given = [opt for opt, key in (("-j/--jobs", "jobs"), ("--scheduler", "scheduler"), ("--resume", "resume"))
-                 if (sweep_options or {}).get(key)]
-        if given:
-            print(f"warning: {path}: {', '.join(given)} apply to sweep decks (a &sweep group) only; "
-                  f"ignored for this deck", file=sys.stderr)
         outcome = run_study(deck, outdir, formats, plot, progress)
     except DeckError as exc:
         print(f"error: {exc}", file=sys.stderr)
@@ -75,9 +78,10 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool, progress:
 
 def keys_help(group: str) -> str | None:
     """Every key of namelist group ``group`` with kind, units, default and doc; None if no such group."""
-    if group in _CONTROL:
-        from driver import sweep
-        spec = sweep.SPEC
+    from driver.runner import CONTROL_GROUPS
+    if group in CONTROL_GROUPS:
+        import importlib
+        spec = importlib.import_module(f"driver.{group}").SPEC
     else:
         from driver.study import load_study
         module = load_study(group)
@@ -138,7 +142,8 @@ def build_parser() -> argparse.ArgumentParser:
         description="Run mechanism-analysis decks (Fortran namelist files) and write "
                     "fixed-format tables to OUTDIR/<deck stem>.out.",
         epilog=f"Study groups: {studies}; a &sweep group turns a deck into a study over "
-               "several cases. 'python -m driver --keys GROUP' lists a group's keys (also --keys sweep); "
+               "several cases, an &optimize group into an optimisation. 'python -m driver --keys GROUP' lists a "
+               "group's keys (also --keys sweep, --keys optimize); "
                "'python -m driver --examples' lists the shipped example decks. "
                "Exit status: 0 all decks succeeded, 1 a run failed, 2 bad input.",
     )
@@ -156,12 +161,16 @@ def build_parser() -> argparse.ArgumentParser:
                         help="list the example decks shipped with the package and exit")
     parser.add_argument("--example", metavar="NAME", action="append", default=[],
                         help="copy the shipped example deck NAME.dat here (or into -o DIR) and exit (repeatable)")
+    parser.add_argument("--compare", action="store_true",
+                        help="compare each deck's run with the published tables in published/ (cell by cell, "
+                             "with reasons; writes nothing); exit 0 when every reproducible cell agrees")
     parser.add_argument("-j", "--jobs", type=_positive_int, default=None,
-                        help="sweeps: worker processes, at least 1 (default: all cores)")
+                        help="sweeps and optimisations: worker processes, at least 1 (default: all cores)")
     parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
                         help="sweeps: run cases on this Dask distributed scheduler")
     parser.add_argument("--resume", action="store_true",
-                        help="sweeps: skip cases whose outputs are already complete")
+                        help="sweeps: skip cases whose outputs are already complete; optimisations: replay "
+                             "the run's journal and compute only new designs")
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     return parser
 
@@ -181,7 +190,8 @@ def _main(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
         group = args.keys.lstrip("&").lower()
         text = keys_help(group)
         if text is None:
-            known = ", ".join(f"&{g}" for g in (*study_names(), *_CONTROL))
+            from driver.runner import CONTROL_GROUPS
+            known = ", ".join(f"&{g}" for g in (*study_names(), *CONTROL_GROUPS))
             print(f"error: --keys: no namelist group &{group} (known groups: {known})", file=sys.stderr)
             return EXIT_BAD_INPUT
         try:
@@ -193,6 +203,13 @@ def _main(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
         return _examples(args)
     if not args.decks:
         parser.error("no deck given (python -m driver --examples lists the shipped example decks)")
+    if args.compare:
+        from driver.compare import compare_decks
+        try:
+            return compare_decks(args.decks)
+        except BrokenPipeError:
+            sys.stderr.close()
+            return EXIT_OK
     formats = list(dict.fromkeys((["csv"] if args.csv else []) + args.formats))
     needs = ([("plot", "--plot")] if args.plot else []) + ([("parquet", "--format parquet")]
              if "parquet" in formats else []) + ([("dask", "--scheduler")] if args.scheduler else [])

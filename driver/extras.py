@@ -1,7 +1,8 @@
 """Optional features and the extra that installs each one.
 
 The core (decks, kernels, ``.out`` tables, CSV) needs numpy, scipy, pandas, f90nml
-and tqdm only.  Figures, Parquet (and so sweeps, whose case files are Parquet) and
+and tqdm only.  Figures, Parquet (and so sweeps and optimisations, which keep their
+cases in Parquet) and
 Dask clusters need the extras below; :func:`require` imports a feature's module or
 raises :class:`MissingExtra` with the one command that installs it.
 """
@@ -15,7 +16,7 @@ __all__ = ["EXTRAS", "MissingExtra", "available", "require"]
 #: extra -> (module it provides, what needs it)
 EXTRAS: dict[str, tuple[str, str]] = {
     "plot": ("matplotlib", "figures (--plot)"),
-    "parquet": ("pyarrow", "Parquet tables (--format parquet) and sweeps"),
+    "parquet": ("pyarrow", "Parquet tables (--format parquet), sweeps and optimisations"),
     "dask": ("distributed", "running sweeps on a Dask cluster (--scheduler)"),
 }
 

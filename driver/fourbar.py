@@ -27,6 +27,13 @@ __all__ = ["SPEC", "run", "summarise", "grashof", "limit_angles", "exact_grid", 
 ST = kernels.FOURBAR_STATUS
 BAND = (40.0, 120.0)  # transmission-angle band recommended by the paper [deg]
 
+#: why the published listing's rows for crank angles in (180, 360) deg are wrong (see :func:`audit`)
+LISTING_DEFECT = ("the listing's quadrant test sends sigy > 0, sigx > 0 to sigma = 2 pi - |atan| (meant |atan|), "
+                  "so rows 200-340 repeat the mirror position 360 - i and their speeds are wrong")
+#: why a correct value may differ from a correct published row in its last printed digit
+LISTING_PRECISION = ("the listing works in single precision with pi/180 = 0.0174532 and truncates angles "
+                     "to whole degrees")
+
 
 def _check(p: Params) -> None:
     """Cross-key checks: step, range, and what the listing method can do."""

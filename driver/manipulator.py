@@ -39,7 +39,8 @@ from driver.deck import GroupSpec, Key, Params, non_empty, positive
 from driver.study import Figure, Result
 from driver.table import Column, fortran_f, render_table
 
-__all__ = ["SPEC", "run", "Workspace", "tolerance_box", "round_half_up"]
+__all__ = ["SPEC", "run", "Workspace", "tolerance_box", "round_half_up", "REASONS", "NOT_REPRODUCIBLE", "TEXT_REASONS",
+           "TIDY_NAMES"]
 
 STATUS = kernels.MANIPULATOR_STATUS
 
@@ -584,6 +585,37 @@ REASONS = {
 }
 
 
+#: printed cells of chapter 4 that the report's own data and formulas do not give:
+#: (table, row label, column, printed) -> why.  The report uses them as inputs further on.
+NOT_REPRODUCIBLE = {
+    ("4.4", "Dexterity", "l1opt", "5.85"): "case 2 dexterity optimum l1 = sqrt(2C/3) = 5.859 prints 5.86; 5.85 "
+                                            "(a truncation) was read off Fig. 4.10",
+    ("4.4", "Dexterity", "l2opt", "4.16"): "case 2 dexterity optimum l2 = l1 sqrt(2)/2 = 4.143 prints 4.14; no "
+                                            "variant of the formulas gives 4.16 (read off Fig. 4.10)",
+    ("4.5", "1.", "theta1", "34.81"): "the report's own IK at P = (1, 5) gives 35.50 for (5.61, 3.97); 34.81 = "
+                                       "78.00 - beta, a slip in the base angle",
+    ("4.6", "1.", "theta1", "34.81"): "as Table 4.5 (the same printed angle)",
+}
+
+#: why the exact mode departs from values the report prints in its text (quantity -> why)
+TEXT_REASONS = {
+    "crob_c_sweep": "report uses C = round(radius^2, 2) = 51.49 instead of mean d^2 = 51.5",
+    "min_total_torque": "follows from Table 4.8: with angles that reach the target the smallest total torque "
+                        "is another design",
+    "min_total_l1": "follows from Table 4.8 (chapter 5 minimum)",
+    "min_total_l2": "follows from Table 4.8 (chapter 5 minimum)",
+}
+
+#: tidy-table column of each .out column header
+TIDY_NAMES = {"l1": "l1_m", "l2": "l2_m", "m1": "m1_kg", "m2": "m2_kg", "g": "g_m_s2",
+              "theta1": "theta1_deg", "theta2": "theta2_deg", "tau1": "tau1_Nm", "tau2": "tau2_Nm",
+              "l1opt": "l1_m", "l2opt": "l2_m", "RI2": "ri2", "n": "n", "a1": "a1", "b2": "b2",
+              "a2": "a2", "b1": "b1", "reach": "reach", "th1'": "theta1_rate_rad_s",
+              "th2'": "theta2_rate_rad_s", "th1''": "theta1_acc_rad_s2",
+              "th2''": "theta2_acc_rad_s2", "RI1": "ri1", "RI3": "ri3",
+              "w": "manipulability_m2", "kappa": "condition_number"}
+
+
 def _differences(report: list[Table], exact: list[Table]) -> list[str]:
     """Every cell whose printed text differs between the two modes, with the reason."""
     lines = []
@@ -641,13 +673,7 @@ def _tidy(tables: list[Table], tol: list[dict], sweep: dict, used: dict) -> pd.D
         for i, row in enumerate(t.rows):
             rec = {"table": t.key, "row": i + 1, "label": str(row[0]).rstrip(".")}
             for col, v in zip(t.columns[1:], row[1:]):
-                name = {"l1": "l1_m", "l2": "l2_m", "m1": "m1_kg", "m2": "m2_kg", "g": "g_m_s2",
-                        "theta1": "theta1_deg", "theta2": "theta2_deg", "tau1": "tau1_Nm", "tau2": "tau2_Nm",
-                        "l1opt": "l1_m", "l2opt": "l2_m", "RI2": "ri2", "n": "n", "a1": "a1", "b2": "b2",
-                        "a2": "a2", "b1": "b1", "reach": "reach", "th1'": "theta1_rate_rad_s",
-                        "th2'": "theta2_rate_rad_s", "th1''": "theta1_acc_rad_s2",
-                        "th2''": "theta2_acc_rad_s2", "RI1": "ri1", "RI3": "ri3",
-                        "w": "manipulability_m2", "kappa": "condition_number"}.get(col.header.strip(), col.header.strip())
+                name = TIDY_NAMES.get(col.header.strip(), col.header.strip())
                 rec[name] = np.nan if v is None else v
             rec["note"] = t.trailers[i] if t.trailers else ""
             recs.append(rec)

@@ -31,7 +31,25 @@ from driver.deck import GroupSpec, Key, Params, non_empty, positive
 from driver.study import Result
 from driver.table import Column, render_table
 
-__all__ = ["SPEC", "run", "quadratic_fit", "analyse"]
+__all__ = ["SPEC", "run", "quadratic_fit", "analyse", "MODE_REASONS", "NOT_REPRODUCIBLE"]
+
+#: why mode = 'report' and mode = 'exact' differ, by result item
+MODE_REASONS = {
+    "eq28": "report fits ln of the std rounded to 7 dp (as printed in Table 2.2)",
+    "eq211": "report fits the means rounded to 4 dp (as printed in Table 2.5)",
+    "eq212": "report fits ln of the std rounded to 7 dp (as printed in Table 2.5)",
+    "eq29": "follows from the fit (2.8)",
+    "eq213": "follows from the fit (2.12)",
+}
+
+#: printed results of section 2.3 that the printed data do not give, (item, index) -> why
+NOT_REPRODUCIBLE = {
+    **{("eq212", i): "(2.12) printed coefficients are corrupt: the fit to ln(std) of Table 2.5 gives 29.3118, "
+                     "-4.65146, 0.155077; the printed ones give sigma_Y(10) = 0.0004 instead of 0.18 and "
+                     "t_min = 15.026 (a transcription error)" for i in range(3)},
+    ("std25", 1): "last printed digit: the sample std of the Table 2.4 row is 0.00381881 (prints 0.0038188)",
+    ("std25", 2): "last printed digit: the sample std of the Table 2.4 row is 0.18513509 (prints 0.1851351)",
+}
 
 
 def _three(v: Any) -> str | None:
@@ -226,9 +244,7 @@ def run(params: Params, progress: bool = False) -> Result:
     if report:
         e = analyse(p, False)
         L += ["Where mode = 'report' and mode = 'exact' differ", "-" * 47]
-        for key, why in (("eq28", "report fits ln of the std rounded to 7 dp (as printed in Table 2.2)"),
-                         ("eq211", "report fits the means rounded to 4 dp (as printed in Table 2.5)"),
-                         ("eq212", "report fits ln of the std rounded to 7 dp (as printed in Table 2.5)")):
+        for key, why in ((k, MODE_REASONS[k]) for k in ("eq28", "eq211", "eq212")):
             for i in range(3):
                 if _g(r[key][i]) != _g(e[key][i]):
                     L.append(f"  {key}[b{i}]  report {_g(r[key][i]):>11}  exact {_g(e[key][i]):>11}  {why}")

@@ -21,7 +21,7 @@ from driver.study import Result, load_study
 __all__ = ["CONTROL_GROUPS", "Outcome", "available_studies", "study_of", "run_study", "write_outputs"]
 
 #: groups handled by the driver itself rather than by a study module
-CONTROL_GROUPS = ("sweep",)
+CONTROL_GROUPS = ("sweep", "optimize", "synthesis")
 
 
 def available_studies() -> dict[str, ModuleType]:

@@ -23,7 +23,7 @@ if TYPE_CHECKING:   # annotations only: keeps `python -m driver --help` light
 __all__ = ["Figure", "Result", "load_study", "study_names"]
 
 _CORE = {"cli", "deck", "study", "table", "export", "plotting", "atomic", "kernels", "sweep", "runner", "expr",
-         "extras", "example_decks", "examples"}
+         "optimize", "synthesis", "published", "compare", "extras", "example_decks", "examples"}
 
 
 @dataclass
@@ -78,4 +78,4 @@ def study_names() -> list[str]:
 
     import driver
     return sorted(info.name for info in pkgutil.iter_modules(driver.__path__)
-                  if not info.ispkg and info.name not in _CORE and not info.name.startswith("_"))
+                  if info.name not in _CORE and not info.name.startswith("_"))

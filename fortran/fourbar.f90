@@ -13,6 +13,7 @@
 !>                and accelerations of coupler and rocker, with per-row status.
 module fourbar
   use kinds, only: dp, sp
+  use vecmath, only: sincos_array, atan2_array
   implicit none
   private
   public :: listing_table, exact_states, coupler_point
@@ -145,7 +146,10 @@ contains
     end do
   end subroutine exact_states
 
-  !> One block of exact_states (see there); m <= size of the local arrays of the caller.
+  !> One block of exact_states (see there); m <= nb = 256 (the size of the caller's local arrays).
+  !> Every loop here is free of calls: the transcendental functions are evaluated on the
+  !> whole block by vecmath before and after the main loop, so the loops vectorise by
+  !> construction (not by the inliner's grace).
   subroutine exact_block(m, theta, p, q, r, s, omega, alpha1, sgn, out, status)
     integer, intent(in) :: m
     real(dp), intent(in) :: theta(m), p, q, r, s, omega, alpha1, sgn
@@ -154,7 +158,7 @@ contains
     real(dp), parameter :: tol = 1.0e-13_dp
     real(dp) :: r2, s2, c, sn, ax, ay, dx, dy, d2, a, h2, h, bx, by
     real(dp) :: e2x, e2y, e3x, e3y, s23, c23, w2, w3, den2, den3, sinv, ok, placed
-    real(dp) :: st, isno, istog, isdeg, degst, dmin2, ys(256, 3), xs(256, 3)
+    real(dp) :: st, isno, istog, isdeg, degst, dmin2, ys(256, 3), xs(256, 3), sns(256), cs(256), ang(256)
     ! st_ok = 0 is the value left when no flag is set
     real(dp), parameter :: none_ = st_no_assembly, tog_ = st_toggle, ind_ = st_indeterminate
     integer :: k, j
@@ -163,8 +167,11 @@ contains
     dmin2 = (tol*(p + q))**2
     ! A on O_B: B free on a circle if r = s (indeterminate), else impossible
     degst = merge(ind_, none_, abs(r - s) <= tol*(r + s))
+    call sincos_array(m, theta, sns, cs)
+    ! hot-loop: fourbar exact_block
     do k = 1, m
-      call vsincos(theta(k), sn, c)
+      sn = sns(k)
+      c = cs(k)
       ax = q*c
       ay = q*sn
       dx = p - ax
@@ -212,11 +219,12 @@ contains
                    + r*w2*w2 - s*w3*w3*c23)/(ok*den3 + (1.0_dp - ok))
       status(k) = st
     end do
-    ! angles in a second pass: one call site, so vatan2 is inlined and vectorised
-    ! (an unplaced row has y = 0 and x = 0 or a unit vector; its angle is then zeroed)
+    ! angles: an unplaced row has y = 0 and x = 0 or a unit vector; its angle is then zeroed
     do j = 1, 3
+      call atan2_array(m, ys(:, j), xs(:, j), ang)
+      ! hot-loop: fourbar angle mask
       do k = 1, m
-        out(k, j) = vatan2(ys(k, j), xs(k, j))*merge(0.0_dp, 1.0_dp, status(k) == none_ .or. status(k) == ind_)
+        out(k, j) = ang(k)*merge(0.0_dp, 1.0_dp, status(k) == none_ .or. status(k) == ind_)
       end do
     end do
   end subroutine exact_block
@@ -231,81 +239,53 @@ contains
     real(dp), intent(in) :: theta(n), q, omega, alpha1, u, v, states(n, 11)
     integer, intent(in) :: status(n)
     real(dp), intent(out) :: pout(n, 6)
-    real(dp) :: c2, s2, rx, ry, w2, a2, ok, placed, c, sn
-    integer :: k
-    do k = 1, n
-      placed = merge(1.0_dp, 0.0_dp, status(k) == st_ok .or. status(k) == st_toggle)
-      ok = merge(1.0_dp, 0.0_dp, status(k) == st_ok)
-      call vsincos(states(k, 1), s2, c2)
-      call vsincos(theta(k), sn, c)
-      rx = u*c2 - v*s2                  ! P - A
-      ry = u*s2 + v*c2
-      w2 = states(k, 8)
-      a2 = states(k, 10)
-      pout(k, 1) = placed*(states(k, 4) + rx)
-      pout(k, 2) = placed*(states(k, 5) + ry)
-      ! v_P = v_A + w2 x (P - A);  a_P = a_A + a2 x (P - A) - w2^2 (P - A)
-      pout(k, 3) = ok*(-q*omega*sn - w2*ry)
-      pout(k, 4) = ok*(q*omega*c + w2*rx)
-      pout(k, 5) = ok*(-q*(alpha1*sn + omega*omega*c) - a2*ry - w2*w2*rx)
-      pout(k, 6) = ok*(q*(alpha1*c - omega*omega*sn) + a2*rx - w2*w2*ry)
+    integer, parameter :: nb = 256
+    real(dp) :: blk(nb, 6), sblk(nb, 5)
+    integer :: k0, m, i
+    ! blocks of nb rows gathered into fixed-size local arrays (see exact_states)
+    do k0 = 1, n, nb
+      m = min(nb, n - k0 + 1)
+      do i = 1, m      ! row masks as reals: the main loop then works in one vector width
+        sblk(i, 1) = merge(1.0_dp, 0.0_dp, status(k0 + i - 1) == st_ok .or. status(k0 + i - 1) == st_toggle)
+        sblk(i, 2) = merge(1.0_dp, 0.0_dp, status(k0 + i - 1) == st_ok)
+      end do
+      sblk(1:m, 3) = states(k0:k0 + m - 1, 1)
+      sblk(1:m, 4) = states(k0:k0 + m - 1, 8)
+      sblk(1:m, 5) = states(k0:k0 + m - 1, 10)
+      blk(1:m, 1) = states(k0:k0 + m - 1, 4)
+      blk(1:m, 2) = states(k0:k0 + m - 1, 5)
+      call coupler_block(m, theta(k0:k0 + m - 1), q, omega, alpha1, u, v, sblk, blk)
+      pout(k0:k0 + m - 1, :) = blk(1:m, :)
     end do
   end subroutine coupler_point
 
-  !> sin and cos of x [rad], branch-free so that loops calling it vectorise.
-  !> Cody-Waite reduction by pi/2 in three parts (fdlibm constants), then the
-  !> fdlibm kernel polynomials on |r| <= pi/4.  Accurate to ~1 ulp for |x| < 1e5.
-  elemental subroutine vsincos(x, s, c)
-    real(dp), intent(in) :: x
-    real(dp), intent(out) :: s, c
-    real(dp), parameter :: twoopi = 6.36619772367581382433e-01_dp
-    real(dp), parameter :: pio2_1 = 1.57079632673412561417e+00_dp, pio2_2 = 6.07710050630396597660e-11_dp, &
-                           pio2_2t = 2.02226624879595063154e-21_dp
-    real(dp), parameter :: magic = 6755399441055744.0_dp   ! 1.5 * 2**52: adding/subtracting rounds to nearest
-    real(dp), parameter :: s1 = -1.66666666666666324348e-01_dp, s2 = 8.33333333332248946124e-03_dp, &
-      s3 = -1.98412698298579493134e-04_dp, s4 = 2.75573137070700676789e-06_dp, &
-      s5 = -2.50507602534068634195e-08_dp, s6 = 1.58969099521155010221e-10_dp
-    real(dp), parameter :: c1 = 4.16666666666666019037e-02_dp, c2 = -1.38888888888741095749e-03_dp, &
-      c3 = 2.48015872894767294178e-05_dp, c4 = -2.75573143513906633035e-07_dp, &
-      c5 = 2.08757232129817482790e-09_dp, c6 = -1.13596475577881948265e-11_dp
-    real(dp) :: kf, m, r, z, sr, cr
-    kf = (x*twoopi + magic) - magic                     ! nearest integer k
-    r = ((x - kf*pio2_1) - kf*pio2_2) - kf*pio2_2t
-    m = kf - 4.0_dp*(((kf*0.25_dp - 0.375_dp) + magic) - magic)   ! k mod 4 in {0,1,2,3}
-    z = r*r
-    sr = r + r*z*(s1 + z*(s2 + z*(s3 + z*(s4 + z*(s5 + z*s6)))))
-    cr = 1.0_dp - 0.5_dp*z + z*z*(c1 + z*(c2 + z*(c3 + z*(c4 + z*(c5 + z*c6)))))
-    s = merge(cr, sr, m == 1.0_dp .or. m == 3.0_dp)*merge(-1.0_dp, 1.0_dp, m >= 2.0_dp)
-    c = merge(sr, cr, m == 1.0_dp .or. m == 3.0_dp)*merge(-1.0_dp, 1.0_dp, m == 1.0_dp .or. m == 2.0_dp)
-  end subroutine vsincos
-
-  !> atan2(y, x) [rad] in (-pi, pi], branch-free (Cephes atan rational on [0, 1]).
-  elemental function vatan2(y, x) result(t)
-    real(dp), intent(in) :: y, x
-    real(dp) :: t
-    real(dp), parameter :: pio2 = 1.57079632679489661923_dp, pio4 = 0.78539816339744830962_dp, &
-                           pi = 3.14159265358979323846_dp, morebits = 6.123233995736765886130e-17_dp
-    real(dp), parameter :: p0 = -8.750608600031904122785e-01_dp, p1 = -1.615753718733365076637e+01_dp, &
-      p2 = -7.500855792314704667340e+01_dp, p3 = -1.228866684490136173410e+02_dp, &
-      p4 = -6.485021904942025371773e+01_dp
-    real(dp), parameter :: q0 = 2.485846490142306297962e+01_dp, q1 = 1.650270098316988542046e+02_dp, &
-      q2 = 4.328810604912902668951e+02_dp, q3 = 4.853903996359136964868e+02_dp, &
-      q4 = 1.945506571482613964425e+02_dp
-    real(dp) :: ax, ay, mn, mx, u, v, z, base, big   ! big: 1 or 0 (a real keeps one vector width)
-    ax = abs(x)
-    ay = abs(y)
-    mx = max(ax, ay)
-    mn = min(ax, ay)
-    u = mn/max(mx, tiny(1.0_dp))                      ! in [0, 1]
-    big = merge(1.0_dp, 0.0_dp, u > 0.66_dp)
-    v = big*((u - 1.0_dp)/(u + 1.0_dp)) + (1.0_dp - big)*u
-    base = big*pio4
-    z = v*v
-    z = z*((((p0*z + p1)*z + p2)*z + p3)*z + p4)/(((((z + q0)*z + q1)*z + q2)*z + q3)*z + q4)
-    t = base + (v*z + v + big*(0.5_dp*morebits))
-    t = merge(pio2 - t, t, ay > ax)
-    t = merge(pi - t, t, x < 0.0_dp)
-    t = sign(t, y)
-  end function vatan2
+  !> One block of coupler_point: sb(:, 1..5) = placed and ok masks (0/1), coupler angle,
+  !> coupler angular velocity and acceleration; out(:, 1:2) holds xa, ya on entry and
+  !> pout's six columns on return.  m <= 256.
+  subroutine coupler_block(m, theta, q, omega, alpha1, u, v, sb, out)
+    integer, intent(in) :: m
+    real(dp), intent(in) :: theta(m), q, omega, alpha1, u, v, sb(256, 5)
+    real(dp), intent(inout) :: out(256, 6)
+    real(dp) :: s2(256), c2(256), sn(256), c(256), rx, ry, w2, a2, ok, placed
+    integer :: k
+    call sincos_array(m, sb(:, 3), s2, c2)
+    call sincos_array(m, theta, sn, c)
+    ! hot-loop: fourbar coupler_block
+    do k = 1, m
+      placed = sb(k, 1)
+      ok = sb(k, 2)
+      rx = u*c2(k) - v*s2(k)            ! P - A
+      ry = u*s2(k) + v*c2(k)
+      w2 = sb(k, 4)
+      a2 = sb(k, 5)
+      out(k, 1) = placed*(out(k, 1) + rx)
+      out(k, 2) = placed*(out(k, 2) + ry)
+      ! v_P = v_A + w2 x (P - A);  a_P = a_A + a2 x (P - A) - w2^2 (P - A)
+      out(k, 3) = ok*(-q*omega*sn(k) - w2*ry)
+      out(k, 4) = ok*(q*omega*c(k) + w2*rx)
+      out(k, 5) = ok*(-q*(alpha1*sn(k) + omega*omega*c(k)) - a2*ry - w2*w2*rx)
+      out(k, 6) = ok*(q*(alpha1*c(k) - omega*omega*sn(k)) + a2*rx - w2*w2*ry)
+    end do
+  end subroutine coupler_block
 
 end module fourbar

@@ -15,6 +15,7 @@
 !>                 errors at fixed joint angles (exactly linear in the errors)
 module manipulator
   use kinds, only: dp
+  use vecmath, only: sincos_array
   implicit none
   private
   public :: arm_states, craig_torques, inverse_kin, design_indices, position_errors
@@ -29,31 +30,36 @@ contains
   !> torques tau(:,1..2) [N m] of Craig's point-mass 2R arm (masses m1, m2 [kg] at the
   !> link ends), joint rates qd(:,1..2) [rad/s], accelerations qdd(:,1..2) [rad/s^2],
   !> gravity g [m/s^2] along -y.
+  !> Processed in blocks of nb configurations: sin/cos of a block by vecmath, then
+  !> call-free loops (vectorised by construction).
   subroutine arm_states(n, l1, l2, th1, th2, qd, qdd, m1, m2, g, jac, w, kappa, tau)
     integer, intent(in) :: n
     real(dp), intent(in) :: l1(n), l2(n), th1(n), th2(n), qd(n, 2), qdd(n, 2), m1(n), m2(n), g
     real(dp), intent(out) :: jac(n, 4), w(n), kappa(n), tau(n, 2)
-    real(dp) :: s1, c1, s2, c2, s12, c12, a, b, c, d, t, det, disc
-    integer :: k
+    integer, parameter :: nb = 256
+    real(dp) :: sc(nb, 4), s12, c12, a, b, c, d, t, det, disc
+    integer :: k, k0, m, i
     !f2py threadsafe
-    do k = 1, n
-      s1 = sin(th1(k)); c1 = cos(th1(k))
-      s2 = sin(th2(k)); c2 = cos(th2(k))
-      s12 = s1*c2 + c1*s2; c12 = c1*c2 - s1*s2
-      a = -l1(k)*s1 - l2(k)*s12; b = -l2(k)*s12
-      c = l1(k)*c1 + l2(k)*c12;  d = l2(k)*c12
-      jac(k, 1) = a; jac(k, 2) = b; jac(k, 3) = c; jac(k, 4) = d
-      det = abs(a*d - b*c)
-      w(k) = det
-      t = a*a + b*b + c*c + d*d
-      disc = sqrt(max(t*t - 4.0_dp*det*det, 0.0_dp))
-      if (det > 0.0_dp) then
-        kappa(k) = (t + disc)/(2.0_dp*det)
-      else
-        kappa(k) = 0.0_dp
-      end if
-      call torque_one(l1(k), l2(k), m1(k), m2(k), g, c1, s2, c2, c12, qd(k, 1), qd(k, 2), &
-                      qdd(k, 1), qdd(k, 2), tau(k, 1), tau(k, 2))
+    do k0 = 1, n, nb
+      m = min(nb, n - k0 + 1)
+      call block_trig(m, th1(k0:k0 + m - 1), th2(k0:k0 + m - 1), sc)
+      ! hot-loop: manipulator arm_states
+      do i = 1, m
+        k = k0 + i - 1
+        s12 = sc(i, 1)*sc(i, 4) + sc(i, 2)*sc(i, 3)
+        c12 = sc(i, 2)*sc(i, 4) - sc(i, 1)*sc(i, 3)
+        a = -l1(k)*sc(i, 1) - l2(k)*s12; b = -l2(k)*s12
+        c = l1(k)*sc(i, 2) + l2(k)*c12;  d = l2(k)*c12
+        jac(k, 1) = a; jac(k, 2) = b; jac(k, 3) = c; jac(k, 4) = d
+        det = abs(a*d - b*c)
+        w(k) = det
+        t = a*a + b*b + c*c + d*d
+        disc = sqrt(max(t*t - 4.0_dp*det*det, 0.0_dp))
+        kappa(k) = merge((t + disc)/(2.0_dp*merge(det, 1.0_dp, det > 0.0_dp)), 0.0_dp, det > 0.0_dp)
+      end do
+      call torque_block(m, l1(k0:k0 + m - 1), l2(k0:k0 + m - 1), m1(k0:k0 + m - 1), m2(k0:k0 + m - 1), &
+                        g, sc, qd(k0:k0 + m - 1, 1), qd(k0:k0 + m - 1, 2), qdd(k0:k0 + m - 1, 1), &
+                        qdd(k0:k0 + m - 1, 2), tau(k0:k0 + m - 1, 1), tau(k0:k0 + m - 1, 2))
     end do
   end subroutine arm_states
 
@@ -62,28 +68,50 @@ contains
     integer, intent(in) :: n
     real(dp), intent(in) :: l1(n), l2(n), th1(n), th2(n), qd(n, 2), qdd(n, 2), m1(n), m2(n), g
     real(dp), intent(out) :: tau(n, 2)
-    real(dp) :: s1, c1, s2, c2, c12
-    integer :: k
+    integer, parameter :: nb = 256
+    real(dp) :: sc(nb, 4)
+    integer :: k0, m
     !f2py threadsafe
-    do k = 1, n
-      s1 = sin(th1(k)); c1 = cos(th1(k))
-      s2 = sin(th2(k)); c2 = cos(th2(k))
-      c12 = c1*c2 - s1*s2
-      call torque_one(l1(k), l2(k), m1(k), m2(k), g, c1, s2, c2, c12, qd(k, 1), qd(k, 2), &
-                      qdd(k, 1), qdd(k, 2), tau(k, 1), tau(k, 2))
+    do k0 = 1, n, nb
+      m = min(nb, n - k0 + 1)
+      call block_trig(m, th1(k0:k0 + m - 1), th2(k0:k0 + m - 1), sc)
+      call torque_block(m, l1(k0:k0 + m - 1), l2(k0:k0 + m - 1), m1(k0:k0 + m - 1), m2(k0:k0 + m - 1), &
+                        g, sc, qd(k0:k0 + m - 1, 1), qd(k0:k0 + m - 1, 2), qdd(k0:k0 + m - 1, 1), &
+                        qdd(k0:k0 + m - 1, 2), tau(k0:k0 + m - 1, 1), tau(k0:k0 + m - 1, 2))
     end do
   end subroutine craig_torques
 
-  !> Report eqs (2.52)/(2.53) = Craig (1989) eq. 6.60, point masses at the link ends.
-  pure subroutine torque_one(l1, l2, m1, m2, g, c1, s2, c2, c12, qd1, qd2, qdd1, qdd2, tau1, tau2)
-    real(dp), intent(in) :: l1, l2, m1, m2, g, c1, s2, c2, c12, qd1, qd2, qdd1, qdd2
-    real(dp), intent(out) :: tau1, tau2
-    real(dp) :: m2l1l2
-    m2l1l2 = m2*l1*l2
-    tau1 = m2*l2*l2*(qdd1 + qdd2) + m2l1l2*c2*(2.0_dp*qdd1 + qdd2) + (m1 + m2)*l1*l1*qdd1 &
-           - m2l1l2*s2*qd2*qd2 - 2.0_dp*m2l1l2*s2*qd1*qd2 + m2*l2*g*c12 + (m1 + m2)*l1*g*c1
-    tau2 = m2l1l2*c2*qdd1 + m2l1l2*s2*qd1*qd1 + m2*l2*g*c12 + m2*l2*l2*(qdd1 + qdd2)
-  end subroutine torque_one
+  !> sc(:, 1..4) = sin th1, cos th1, sin th2, cos th2 of one block (m <= 256).
+  subroutine block_trig(m, th1, th2, sc)
+    integer, intent(in) :: m
+    real(dp), intent(in) :: th1(m), th2(m)
+    real(dp), intent(out) :: sc(256, 4)
+    call sincos_array(m, th1, sc(:, 1), sc(:, 2))
+    call sincos_array(m, th2, sc(:, 3), sc(:, 4))
+  end subroutine block_trig
+
+  !> Report eqs (2.52)/(2.53) = Craig (1989) eq. 6.60, point masses at the link ends, for
+  !> one block of m <= 256 configurations with sines and cosines sc from block_trig.
+  subroutine torque_block(m, l1, l2, m1, m2, g, sc, qd1, qd2, qdd1, qdd2, tau1, tau2)
+    integer, intent(in) :: m
+    real(dp), intent(in) :: l1(m), l2(m), m1(m), m2(m), g, sc(256, 4), qd1(m), qd2(m), qdd1(m), qdd2(m)
+    real(dp), intent(out) :: tau1(m), tau2(m)
+    real(dp) :: m2l1l2, c1, s2, c2, c12
+    integer :: k
+    ! hot-loop: manipulator torque_block
+    do k = 1, m
+      c1 = sc(k, 2)
+      s2 = sc(k, 3)
+      c2 = sc(k, 4)
+      c12 = c1*c2 - sc(k, 1)*s2
+      m2l1l2 = m2(k)*l1(k)*l2(k)
+      tau1(k) = m2(k)*l2(k)*l2(k)*(qdd1(k) + qdd2(k)) + m2l1l2*c2*(2.0_dp*qdd1(k) + qdd2(k)) &
+                + (m1(k) + m2(k))*l1(k)*l1(k)*qdd1(k) - m2l1l2*s2*qd2(k)*qd2(k) &
+                - 2.0_dp*m2l1l2*s2*qd1(k)*qd2(k) + m2(k)*l2(k)*g*c12 + (m1(k) + m2(k))*l1(k)*g*c1
+      tau2(k) = m2l1l2*c2*qdd1(k) + m2l1l2*s2*qd1(k)*qd1(k) + m2(k)*l2(k)*g*c12 &
+                + m2(k)*l2(k)*l2(k)*(qdd1(k) + qdd2(k))
+    end do
+  end subroutine torque_block
 
   !> Inverse kinematics of target (x, y) for arm (l1, l2) on elbow branch (+1: th2 >= 0,
   !> -1: th2 <= 0).  Angles in radians, th1 in (-pi, pi].  status 1: out of reach
@@ -131,29 +159,34 @@ contains
     real(dp), intent(in) :: x(npt), y(npt), l1(nd), l2(nd)
     real(dp), intent(out) :: ri(nd, 3), sumc2(nd)
     integer, intent(out) :: reach(nd)
-    real(dp) :: d2, sc, smax2, smin2, tol
+    real(dp) :: d2, sc, smax2, smin2, tol, lo2, hi2, out(nd)
     integer :: i, k
     !f2py threadsafe
-    do k = 1, nd
-      sc = 0.0_dp
-      reach(k) = 1
-      do i = 1, npt
-        d2 = x(i)**2 + y(i)**2
-        sc = sc + (d2 - l1(k)**2 - l2(k)**2)/(2.0_dp*l1(k)*l2(k))
-        tol = 1.0e-12_dp*max(1.0_dp, d2)
-        if (d2 < (l1(k) - l2(k))**2 - tol .or. d2 > (l1(k) + l2(k))**2 + tol) reach(k) = 0
+    ! points outer, designs inner: the inner loop runs across independent designs (it
+    ! vectorises; each design's sum keeps its order over the points)
+    sumc2 = 0.0_dp
+    out = 0.0_dp
+    do i = 1, npt
+      d2 = x(i)**2 + y(i)**2
+      tol = 1.0e-12_dp*max(1.0_dp, d2)
+      ! hot-loop: manipulator design_indices
+      do k = 1, nd
+        sumc2(k) = sumc2(k) + (d2 - l1(k)**2 - l2(k)**2)/(2.0_dp*l1(k)*l2(k))
+        lo2 = (l1(k) - l2(k))**2 - tol
+        hi2 = (l1(k) + l2(k))**2 + tol
+        out(k) = max(out(k), merge(1.0_dp, 0.0_dp, d2 < lo2 .or. d2 > hi2))
       end do
-      sumc2(k) = sc
+    end do
+    ! hot-loop: manipulator design_indices ri
+    do k = 1, nd
+      sc = sumc2(k)
       smax2 = real(npt, dp) + abs(sc)
       smin2 = real(npt, dp) - abs(sc)
       ri(k, 2) = sqrt(smax2)
-      if (smin2 > 0.0_dp) then
-        ri(k, 1) = sqrt(smax2/smin2)
-      else
-        ri(k, 1) = 0.0_dp
-      end if
+      ri(k, 1) = merge(sqrt(smax2/merge(smin2, 1.0_dp, smin2 > 0.0_dp)), 0.0_dp, smin2 > 0.0_dp)
       ri(k, 3) = sqrt(smax2) + sqrt(2.0_dp*real(npt, dp))
     end do
+    reach = nint(1.0_dp - out)
   end subroutine design_indices
 
   !> Positioning errors for ns sampled link-length errors dl(:,1..2) of an arm held at
@@ -165,26 +198,27 @@ contains
     integer, intent(in) :: npt, ns
     real(dp), intent(in) :: th1(npt), th2(npt), dl(ns, 2)
     real(dp), intent(out) :: err(ns, 2)
-    real(dp) :: u1x(npt), u1y(npt), u2x(npt), u2y(npt), ex, ey, e2, tot, big
+    real(dp) :: u1x(npt), u1y(npt), u2x(npt), u2y(npt), ex, ey, e2
     integer :: i, k
     !f2py threadsafe
     do i = 1, npt
       u1x(i) = cos(th1(i)); u1y(i) = sin(th1(i))
       u2x(i) = cos(th1(i) + th2(i)); u2y(i) = sin(th1(i) + th2(i))
     end do
-    do k = 1, ns
-      tot = 0.0_dp
-      big = 0.0_dp
-      do i = 1, npt
+    ! points outer, samples inner (vectorises across samples; each sample's sum keeps
+    ! its order over the points): err(:, 1) accumulates the squared norm, err(:, 2) the max
+    err = 0.0_dp
+    do i = 1, npt
+      ! hot-loop: manipulator position_errors
+      do k = 1, ns
         ex = dl(k, 1)*u1x(i) + dl(k, 2)*u2x(i)
         ey = dl(k, 1)*u1y(i) + dl(k, 2)*u2y(i)
         e2 = ex*ex + ey*ey
-        tot = tot + e2
-        big = max(big, e2)
+        err(k, 1) = err(k, 1) + e2
+        err(k, 2) = max(err(k, 2), e2)
       end do
-      err(k, 1) = sqrt(tot)
-      err(k, 2) = sqrt(big)
     end do
+    err = sqrt(err)
   end subroutine position_errors
 
 end module manipulator

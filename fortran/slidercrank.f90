@@ -287,6 +287,7 @@ contains
     ! nodal values in rod axes; x = T qm - load * rigid acceleration, y = T qk
     xu(0) = 0; xv(0) = 0; xt(0) = qm(1)
     yu(0) = 0; yv(0) = 0; yt(0) = qk(1)
+    ! hot-loop: slidercrank apply_ops gather
     do j = 1, nel - 1
       xu(j) = qm(3*j - 1); xv(j) = qm(3*j); xt(j) = qm(3*j + 1)
       yu(j) = qk(3*j - 1); yv(j) = qk(3*j); yt(j) = qk(3*j + 1)
@@ -294,6 +295,7 @@ contains
     xu(nel) = c3*qm(nq); xv(nel) = -s3*qm(nq); xt(nel) = qm(nq - 1)
     yu(nel) = c3*qk(nq); yv(nel) = -s3*qk(nq); yt(nel) = qk(nq - 1)
     if (abs(load) > 0) then
+      ! hot-loop: slidercrank apply_ops rigid load
       do j = 0, nel
         xu(j) = xu(j) - load*(kin(6) - j*le*w2)
         xv(j) = xv(j) - load*(kin(7) + j*le*th3dd)
@@ -302,6 +304,7 @@ contains
     end if
     ! crank-pin node: only its rotation is free (row 3 of element 1)
     r(1) = m23*xv(0) + m33*xt(0) + m35*xv(1) + m36*xt(1) + k23*(yv(0) - yv(1)) + k33*yt(0) + k36*yt(1)
+    ! hot-loop: slidercrank apply_ops stencil
     do j = 1, nel - 1
       r(3*j - 1) = m14*(xu(j - 1) + xu(j + 1)) + 2*m11*xu(j) + k11*(2*yu(j) - yu(j - 1) - yu(j + 1))
       r(3*j) = m25*(xv(j - 1) + xv(j + 1)) + m26*(xt(j + 1) - xt(j - 1)) + 2*m22*xv(j) &
@@ -679,6 +682,7 @@ contains
         end if
       end if
       if (dyn) then
+        ! hot-loop: slidercrank newmark predictor
         do j = 1, nq
           w1(j) = (a0 + alpha*a1)*q(j) + (a2 + alpha*a4)*qd(j) + (a3 + alpha*a5)*qdd(j)
           w2(j) = beta*(a1*q(j) + a4*qd(j) + a5*qdd(j))
@@ -694,6 +698,7 @@ contains
         bz = c3*c3*uu - 2*c3*s3*uv + s3*s3*vv
         den = c3*c3*d44 - 2*c3*s3*d45 + s3*s3*d55 + cm*msl - bz
         ux = (r(nq) - by)/den
+        ! hot-loop: slidercrank schur correction
         do j = 1, nl
           qn(j) = qn(j) - ux*(c3*zu(j) - s3*zv(j))
         end do
@@ -715,6 +720,7 @@ contains
         end if
       end if
       if (dyn) then
+        ! hot-loop: slidercrank newmark update
         do j = 1, nq
           h = a0*(qn(j) - q(j)) - a2*qd(j) - a3*qdd(j)
           qd(j) = qd(j) + 0.5_dp*dt*(qdd(j) + h)
@@ -748,6 +754,7 @@ contains
     real(dp) :: tmax, rmax
     tmax = abs(q(nq))
     rmax = max(abs(q(1)), abs(q(nq - 1)))
+    ! hot-loop: slidercrank small_motion
     do j = 1, nq/3 - 1
       tmax = max(tmax, abs(q(3*j - 1)), abs(q(3*j)))
       rmax = max(rmax, abs(q(3*j + 1)))
@@ -802,10 +809,12 @@ contains
     third = 1.0_dp/3
     c1 = nc(2)*le
     c2 = nc(3)*le*le
+    ! hot-loop: slidercrank record_step axial force
     do ee = 1, nel
       ! element average of N over [(ee-1) le, ee le]: sa^2 + sa sb + sb^2 = le^2 (3 ee^2 - 3 ee + 1)
       n_avg(ee, j) = nc(1) + c1*(ee - 0.5_dp) + c2*(real(ee, dp)*(ee - 1) + third)
     end do
+    ! hot-loop: slidercrank record_step strains
     do ee = 2, nel - 1
       ep = (q(3*ee - 1) - q(3*ee - 4))*inv
       ka = (q(3*ee + 1) - q(3*ee - 2))*inv

@@ -27,6 +27,7 @@
 !> (cos, sin), so the exact transfer needs one square root and no trigonometric call.
 module ujoint
   use kinds, only: dp
+  use vecmath, only: sincos_array, atan2_array
   implicit none
   private
   public :: chain_speed, chain_objective, chain_equivalent, chain_geometry
@@ -78,7 +79,7 @@ contains
     real(dp), intent(in) :: beta(n), phi(n - 1), rho(n - 1), c0(m), s0(m)
     real(dp), intent(out) :: rat(m), dlth(m), dlp(m, 2*n - 1), thout(m)
     real(dp) :: c(m), s(m), dth(m), dtp(m, 2*n - 1), cn(m), sq(m)
-    real(dp) :: cs(n), sn(n), cb, sb, s2, d, r, a, isd, x, y, tanb
+    real(dp) :: cs(n), sn(n), cb, sb, s2, d, r, a, isd, x, y, tanb, ty(m), tx(m), ta(m), shift
     integer :: j, k, p
     logical :: exact
 
@@ -99,6 +100,7 @@ contains
       sb = sin(beta(k))
       s2 = sb*sb
       tanb = sb/cb
+      ! hot-loop: ujoint propagate ratio
       do j = 1, m
         d = 1.0_dp - s2*s(j)*s(j)
         r = cb/d
@@ -110,43 +112,51 @@ contains
       end do
       if (want_grad /= 0) then
         do p = 1, 2*n - 1
+          ! hot-loop: ujoint propagate grad chain
           do j = 1, m
             dlp(j, p) = dlp(j, p) + 2.0_dp*s2*s(j)*c(j)/sq(j)*dtp(j, p)
           end do
         end do
+        ! hot-loop: ujoint propagate dbeta
         do j = 1, m                               ! d ln r / d beta_k
           dlp(j, k) = dlp(j, k) - tanb + 2.0_dp*sb*cb*s(j)*s(j)/sq(j)
         end do
       end if
-      if (k == n) then
-        if (exact .and. want_out /= 0) then
-          do j = 1, m
-            thout(j) = thout(j) + atan2((cb - 1.0_dp)*s(j)*c(j), c(j)*c(j) + cb*s(j)*s(j))
-          end do
-        end if
-        exit
+      if (exact .and. want_out /= 0) then
+        ! output angle of joint k minus its input angle, atan2 of the whole grid by vecmath
+        ! hot-loop: ujoint propagate out-angle args
+        do j = 1, m
+          ty(j) = (cb - 1.0_dp)*s(j)*c(j)
+          tx(j) = c(j)*c(j) + cb*s(j)*s(j)
+        end do
+        call atan2_array(m, ty, tx, ta)
+        shift = 0.0_dp
+        if (k < n) shift = atan2(sn(k), cs(k))
+        ! hot-loop: ujoint propagate out-angle
+        do j = 1, m
+          thout(j) = thout(j) + ta(j) + shift
+        end do
       end if
+      if (k == n) exit
       ! transfer to joint k+1
       if (exact) then
-        if (want_out /= 0) then
-          do j = 1, m
-            thout(j) = thout(j) + atan2((cb - 1.0_dp)*s(j)*c(j), c(j)*c(j) + cb*s(j)*s(j)) &
-                       + atan2(sn(k), cs(k))
-          end do
-        end if
         if (want_grad /= 0) then
           do p = 1, 2*n - 1
+            ! hot-loop: ujoint propagate dtheta chain
             do j = 1, m
               dtp(j, p) = cn(j)*dtp(j, p)
             end do
           end do
+          ! hot-loop: ujoint propagate dtheta dbeta
           do j = 1, m                             ! d theta_out / d beta_k
             dtp(j, k) = dtp(j, k) - sb*s(j)*c(j)/sq(j)
           end do
+          ! hot-loop: ujoint propagate dtheta dphi
           do j = 1, m
             dtp(j, n + k) = dtp(j, n + k) + 1.0_dp
           end do
         end if
+        ! hot-loop: ujoint propagate exact transfer
         do j = 1, m
           dth(j) = cn(j)*dth(j)
           isd = 1.0_dp/sqrt(sq(j))
@@ -157,15 +167,18 @@ contains
         end do
       else
         if (want_grad /= 0) then
+          ! hot-loop: ujoint propagate dphi
           do j = 1, m
             dtp(j, n + k) = dtp(j, n + k) + 1.0_dp
           end do
           if (model == model_eq13 .and. k > 1) then
+            ! hot-loop: ujoint propagate eq13 dphi
             do j = 1, m
               dtp(j, n + k - 1) = dtp(j, n + k - 1) - 1.0_dp
             end do
           end if
         end if
+        ! hot-loop: ujoint propagate shift
         do j = 1, m
           x = c(j)
           y = s(j)
@@ -184,10 +197,10 @@ contains
     integer, intent(in) :: model, n, m
     real(dp), intent(in) :: beta(n), phi(n - 1), rho(n - 1), theta(m)
     real(dp), intent(out) :: ratio(m), dratio(m), thout(m)
-    real(dp) :: dlth(m), dlp(m, 2*n - 1)
+    real(dp) :: dlth(m), dlp(m, 2*n - 1), c(m), s(m)
     !f2py threadsafe
-    call propagate(model, n, beta, phi, rho, m, cos(theta), sin(theta), 0, 1, &
-                   ratio, dlth, dlp, thout)
+    call sincos_array(m, theta, s, c)
+    call propagate(model, n, beta, phi, rho, m, c, s, 0, 1, ratio, dlth, dlp, thout)
     dratio = ratio*dlth
     if (model == model_exact) thout = thout + theta
   end subroutine chain_speed
@@ -290,10 +303,12 @@ contains
       cb = cos(beta(k))
       s2 = sin(beta(k))**2
       if (k == n) then
+        ! hot-loop: ujoint nograd last joint
         do j = 1, m
           rat(j) = rat(j)*cb/(1.0_dp - s2*s(j)*s(j))
         end do
       else if (model == model_exact) then
+        ! hot-loop: ujoint nograd exact transfer
         do j = 1, m
           d = 1.0_dp - s2*s(j)*s(j)
           isd = 1.0_dp/sqrt(d)
@@ -304,6 +319,7 @@ contains
           s(j) = x*sn(k) + y*cs(k)
         end do
       else
+        ! hot-loop: ujoint nograd shift
         do j = 1, m
           rat(j) = rat(j)*cb/(1.0_dp - s2*s(j)*s(j))
           x = c(j)

@@ -1,33 +1,27 @@
-"""The listing method against the published tables (Lampiran 2-3 of seed 001), cell for cell.
+"""The listing method against the published tables (Lampiran 2-3 of the four-bar paper), cell for cell.
 
-The transcriptions in tests/data/lampiran/ were copied from the seed text; the
-.out files are produced by the CLI exactly as a user runs it.
+The transcriptions are the files published/crank2.out ... crank5.out (read through
+driver.published, the same reader the comparison uses); the .out files are produced by the
+CLI exactly as a user runs it.
 """
 from __future__ import annotations
 
 import pytest
 
 from driver.cli import main
-from conftest import DATA, INPUTS
+from driver.published import PUBLISHED_DIR, listing_rows
+from conftest import INPUTS
 
 CRANKS = (2, 3, 4, 5)
 
 
 def published(crank: int) -> list[list[str]]:
-    lines = (DATA / "lampiran" / f"crank{crank}.txt").read_text().splitlines()
-    return [l.split() for l in lines if l and not l.startswith("#")]
+    return listing_rows((PUBLISHED_DIR / f"crank{crank}.out").read_text())
 
 
 def table_rows(out_text: str) -> list[list[str]]:
     """Rows of the listing table: the lines between the column header and the next blank line."""
-    lines = out_text.splitlines()
-    start = next(i for i, l in enumerate(lines) if l.split()[:3] == ["i", "epsl", "phi"])
-    rows = []
-    for line in lines[start + 2:]:
-        if not line.strip():
-            break
-        rows.append(line.split())
-    return rows
+    return listing_rows(out_text)
 
 
 def run_deck(deck, tmp_path) -> str:

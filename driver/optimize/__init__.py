@@ -1,0 +1,238 @@
+"""Optimisation of any study: an ``&optimize`` group beside the study group.
+
+See :mod:`driver.optimize.problem` for the deck keys.  Outputs for a deck ``<stem>.dat``:
+
+* ``<stem>.out``: problem, method, result (converged or not -- a design is called an optimum
+  only when the method converged), the optimum's constraint values and margins, the check of
+  the optimum by the full study, infeasible designs counted by reason, and the history;
+* ``<stem>.optimum.dat``: the optimum as a complete deck, and ``<stem>.optimum.out`` (plus tidy
+  tables and figures when asked) from running that deck through the study;
+* ``<stem>_history.csv``: the best feasible design after every generation / iteration;
+* ``<stem>_evals.parquet``: every evaluated design (variables, feasibility and reason,
+  objective, margins, the study's summary columns), also as CSV with ``--csv``;
+* ``<stem>_convergence.png`` with ``--plot``.
+
+While a run goes, each evaluation is appended to ``<stem>.journal.jsonl``; ``--resume``
+replays the (deterministic) run from the journal, or from a finished run's ``_evals``
+table, computing only designs not evaluated before.  The journal is removed when the
+outputs are complete.
+
+Python API: :func:`optimize` returns an :class:`OptimizeOutcome` (``scipy.optimize``-like
+fields ``x``, ``fun``, ``success``, ``message``, ``nfev``).
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from driver.atomic import write_text
+from driver.deck import Deck, DeckError, read_deck
+from driver.export import write_tidy
+from driver.extras import require
+from driver.optimize.evaluate import Evaluator, Record, design_params, evaluate_cases
+from driver.optimize.methods import HistoryRow, MethodResult, run_method
+from driver.optimize.problem import SPEC, Problem, problem_of
+from driver.optimize import report
+from driver.runner import write_outputs
+
+__all__ = ["SPEC", "OptimizeOutcome", "optimize", "run_optimize_deck", "problem_of"]
+
+EXIT_OK, EXIT_FAILED = 0, 1
+
+
+@dataclass
+class OptimizeOutcome:
+    """Result of an optimisation (scipy.optimize.OptimizeResult-like).
+
+    x         best feasible design {'group.key': value} (None when none is feasible)
+    fun       its objective value (the expression's value, not sign-flipped)
+    success   the method converged and x is feasible: x is an optimum
+    message   the method's words
+    nfev      designs evaluated (each distinct design once)
+    """
+
+    problem: Problem
+    x: dict[str, float] | None
+    fun: float | None
+    success: bool
+    message: str
+    nfev: int
+    best: Record | None
+    check: Record | None
+    method: MethodResult
+    history: list[HistoryRow]
+    evaluator: Evaluator
+    written: list[Path] = field(default_factory=list)
+    study_result: Any = None
+
+
+def _probe(problem: Problem) -> None:
+    """Run the deck's own design once: every expression must name columns of the study's summary."""
+    keys = [v.key for v in problem.variables]
+    kinds = [problem.study.SPEC.keys[k].kind for k in keys]
+    x = []
+    for k in keys:
+        v = problem.base[k]
+        x.append(float(v[0] if isinstance(v, list) else v))
+    status, _, summary = evaluate_cases(problem.raw.name, str(problem.deck.path), problem.raw, keys, kinds, [x])[0]
+    if status != "ok" or not summary:
+        return    # the deck's design fails; names are checked per design (missing -> infeasible)
+    from driver import expr
+    frame = pd.DataFrame([summary])
+    o = problem.opts
+    exprs = [("minimize" if problem.sense > 0 else "maximize", problem.objective)]
+    nums = [n for n in range(1, 10) if o[f"constraint{n}"] is not None]
+    exprs += [(f"constraint{n}", c.whole) for n, c in zip(nums, problem.constraints)]
+    for key, e in exprs:
+        for name in sorted(e.names):
+            if name not in frame:
+                raise o.error(key, f"unknown summary column '{name}' of &{problem.raw.name} "
+                                   f"(columns: {', '.join(frame.columns)})")
+        try:
+            v = np.asarray(e.evaluate(frame))
+            if key in ("minimize", "maximize") and v.dtype.kind not in "biuf":
+                v.astype(np.float64)
+        except (expr.ExprError, TypeError, ValueError) as exc:
+            raise o.error(key, f"cannot be evaluated on the study's summary: {exc}") from None
+
+
+def _resumed(problem: Problem, stem: Path) -> list[dict]:
+    """Evaluations of an earlier run of the same problem: its journal, or a finished run's table."""
+    fp = problem.fingerprint()
+    rows: list[dict] = []
+    journal = stem.with_name(stem.name + ".journal.jsonl")
+    if journal.exists():
+        for line in journal.read_text().splitlines():
+            try:
+                row = json.loads(line)
+            except json.JSONDecodeError:     # a line cut by an interrupt
+                continue
+            if row.get("base") == fp and len(row.get("x", ())) == len(problem.variables):
+                rows.append(row)
+    table = stem.with_name(stem.name + "_evals.parquet")
+    if table.exists():
+        try:
+            frame = pd.read_parquet(table)
+        except Exception:
+            frame = None
+        if frame is not None and "base" in frame and set(problem.names) <= set(frame.columns):
+            summ = [c for c in frame.columns if c.startswith("summary.")]
+            for rec in frame[frame["base"] == fp].to_dict("records"):
+                summary = {c[len("summary."):]: (None if isinstance(rec[c], float) and math.isnan(rec[c]) else rec[c])
+                           for c in summ}
+                summary = {k: (v.item() if hasattr(v, "item") else v) for k, v in summary.items()}
+                rows.append({"x": [rec[n] for n in problem.names], "status": rec["status"],
+                             "reason": rec["case_error"] or "", "summary": summary})
+    return rows
+
+
+def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[str] | None = None,
+             plot: bool = False, jobs: int | None = None, resume: bool = False) -> OptimizeOutcome:
+    """Run an optimisation deck; write its outputs to ``outdir`` (None: write nothing).
+
+    Raises DeckError for bad input before anything is computed or written.
+    """
+    if not isinstance(deck, Deck):
+        deck = read_deck(deck)
+    problem = problem_of(deck)
+    _probe(problem)
+    formats = list(formats or [])
+    stem = None if outdir is None else Path(outdir) / Path(deck.path).stem
+    journal = None if stem is None else stem.with_name(stem.name + ".journal.jsonl")
+    resumed = _resumed(problem, stem) if (resume and stem is not None) else []
+    if journal is not None and journal.exists() and not resume:
+        journal.unlink()
+    njobs = jobs if jobs is not None else problem.opts.jobs
+    history: list[HistoryRow] = []
+    with Evaluator(problem, njobs, journal, resumed) as ev:
+        mres = run_method(ev, history)
+    best = ev.best()
+    check, result, params = None, None, None
+    if best is not None:
+        params = design_params(problem, np.array(best.x))
+        result = problem.study.run(params, progress=False)
+        probe = Evaluator(problem, 1)
+        rec = Record(0, best.x, "failed" if result.failure else "ok", result.failure or "", dict(result.summary))
+        probe._score([rec])
+        check = rec
+    outcome = OptimizeOutcome(problem, None if best is None else dict(zip(problem.names, best.x)),
+                              None if best is None else best.objective, bool(mres.converged and best is not None),
+                              mres.message, len(ev.records), best, check, mres, history, ev, study_result=result)
+    if stem is not None:
+        outcome.written = _write(outcome, stem, params, formats, plot, njobs)
+        if journal is not None and journal.exists():
+            journal.unlink()
+    return outcome
+
+
+def _write(oc: OptimizeOutcome, stem: Path, params, formats: list[str], plot: bool, jobs: int) -> list[Path]:
+    p, ev = oc.problem, oc.evaluator
+    written: list[Path] = []
+    files: list[str] = []
+    if oc.best is not None:
+        opt_stem = stem.with_name(stem.name + ".optimum")
+        written.append(write_text(opt_stem.with_suffix(".optimum.dat"),
+                                  report.optimum_deck(p, params, oc.best, oc.success)))
+        files = [str(Path(opt_stem.name + ".dat"))]
+        written += write_outputs(oc.study_result, opt_stem, formats, plot)
+    evals = ev.frame()
+    evals.insert(1, "base", p.fingerprint())
+    hist = report.history_frame(p, oc.history)
+    text = report.report_text(p, ev, oc.method, oc.history, oc.best, oc.check, files,
+                              ev.jobs)
+    written.append(write_text(stem.with_name(stem.name + ".out"), text))
+    written.append(write_tidy(hist, stem.with_name(stem.name + "_history"), "csv"))
+    for fmt in dict.fromkeys(["parquet"] + formats):
+        written.append(write_tidy(evals, stem.with_name(stem.name + "_evals"), fmt))
+    if "parquet" in formats:
+        written.append(write_tidy(hist, stem.with_name(stem.name + "_history"), "parquet"))
+    if plot:
+        from driver.plotting import save_figure
+        fig = report.convergence_figure(p, hist, evals, Path(p.deck.path).stem)
+        written.append(save_figure(fig, stem.with_name(stem.name + "_convergence.png")))
+    return written
+
+
+def run_optimize_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool = False,
+                      quiet: bool = False, jobs: int | None = None, resume: bool = False, **_: Any) -> int:
+    """Command-line entry: run, report written files, return the exit status (DeckError propagates).
+
+    Raises :class:`~driver.extras.MissingExtra` before running when pyarrow is missing (the
+    evaluation journal is Parquet).
+    """
+    require("parquet")
+    oc = optimize(deck, outdir, formats, plot, jobs, resume)
+    if oc.study_result is not None:
+        for w in oc.study_result.warnings:
+            print(f"warning: {deck.path}: optimum: {w}", file=sys.stderr)
+    if not quiet:
+        for path in oc.written:
+            print(f"wrote {path}")
+        if oc.best is not None:
+            word = "optimum" if oc.success else "best design (not converged)"
+            print(f"{deck.path}: {word} {p_obj(oc)} after {oc.nfev} designs: "
+                  + ", ".join(f"{k} = {v:.6g}" for k, v in oc.x.items()))
+        ev = oc.evaluator
+        if ev.computed:
+            how = "batch path" if hasattr(oc.problem.study, "summarise_batch") else f"{ev.jobs} process(es)"
+            print(f"{deck.path}: {ev.computed} designs computed ({len(ev.records) - ev.computed} replayed), "
+                  f"{1e3 * ev.compute_seconds / ev.computed:.3f} ms per design ({how})")
+    if not oc.success:
+        print(f"error: {deck.path}: optimisation did not converge: {oc.message}", file=sys.stderr)
+        return EXIT_FAILED
+    if oc.check is not None and oc.study_result is not None and oc.study_result.failure:
+        print(f"error: {deck.path}: the optimum's full run failed: {oc.study_result.failure}", file=sys.stderr)
+        return EXIT_FAILED
+    return EXIT_OK
+
+
+def p_obj(oc: OptimizeOutcome) -> str:
+    return f"{oc.problem.objective.text} = {oc.fun:.6g}"

@@ -1,0 +1,334 @@
+"""Design evaluations of an optimisation: study summaries -> objective, constraint values, margins.
+
+Every design the optimiser asks for goes through :class:`Evaluator`, which
+
+* validates the design as a complete deck (the study group with the variables replaced) and
+  computes the study's summary: in one batched call where the study has a batch path
+  (``summarise_batch``), otherwise case by case, in worker processes when that pays;
+* never raises for a bad design: a case that cannot be validated, fails, or leaves the
+  objective undefined is *infeasible*, with its reason recorded and counted;
+* evaluates the objective and constraints (deck expression language) over the whole batch
+  at once, and keeps every evaluation (so a design is never computed twice, and ``--resume``
+  replays a deterministic run from its journal without recomputing).
+"""
+from __future__ import annotations
+
+import concurrent.futures as cf
+import json
+import math
+import os
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from driver import expr
+from driver.deck import DeckError, Params, RawGroup, validate
+from driver.study import load_study
+from driver.optimize.problem import Problem
+
+__all__ = ["Evaluator", "evaluate_cases", "FAILED_VIOLATION"]
+
+#: constraint violation given to a design whose case failed (ranks below every evaluated design)
+FAILED_VIOLATION = 1e6
+#: objective given to failed designs in the local methods (which need a finite number)
+FAILED_OBJECTIVE = 1e12
+
+
+def _design_raw(raw: RawGroup, keys: list[str], kinds: list[str], x: np.ndarray) -> RawGroup:
+    values = dict(raw.values)
+    for key, kind, v in zip(keys, kinds, x):
+        values[key] = [float(v)] if kind == "floats" else float(v)
+    return RawGroup(raw.name, values, raw.lines, raw.line)
+
+
+def design_params(problem: Problem, x: np.ndarray) -> Params:
+    """The validated study group of design ``x`` (DeckError if the design is not a valid deck)."""
+    kinds = [problem.study.SPEC.keys[v.key].kind for v in problem.variables]
+    raw = _design_raw(problem.raw, [v.key for v in problem.variables], kinds, x)
+    return validate(raw, problem.study.SPEC, problem.deck.path)
+
+
+def evaluate_cases(group: str, deck_path: str, raw: RawGroup, keys: list[str], kinds: list[str],
+                   xs: list[list[float]]) -> list[tuple[str, str, dict]]:
+    """Summaries of designs ``xs`` case by case: [(status, reason, summary)] (worker entry point).
+
+    status is 'ok', 'bad_input' (the design is not a valid deck) or 'failed'.
+    """
+    module = load_study(group)
+    out = []
+    for x in xs:
+        try:
+            params = validate(_design_raw(raw, keys, kinds, np.asarray(x)), module.SPEC, deck_path)
+            if hasattr(module, "summarise"):
+                out.append(("ok", "", dict(module.summarise(params))))
+            else:
+                result = module.run(params, progress=False)
+                if result.failure:
+                    out.append(("failed", str(result.failure), dict(result.summary)))
+                else:
+                    out.append(("ok", "", dict(result.summary)))
+        except DeckError as exc:
+            out.append(("bad_input", exc.message if exc.key is None else f"{exc.key}: {exc.message}", {}))
+        except Exception as exc:   # a failing design is infeasible, never the end of the run
+            out.append(("failed", f"{exc.__class__.__name__}: {exc}", {}))
+    return out
+
+
+def _ignore_sigint() -> None:
+    import signal
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+@dataclass
+class Record:
+    """One evaluated design."""
+
+    index: int
+    x: tuple[float, ...]
+    status: str
+    reason: str
+    summary: dict
+    objective: float = math.nan     # the expression's value (not sign-flipped)
+    feasible: bool = False
+    violation: float = math.inf     # total constraint violation (0 when feasible)
+    margins: tuple[float, ...] = ()
+    met: tuple[bool, ...] = ()
+    why: str = ""                   # infeasibility reason (counted in the report)
+
+
+class Evaluator:
+    """Evaluates designs for one :class:`Problem`; keeps every evaluation in order."""
+
+    def __init__(self, problem: Problem, jobs: int = 1, journal: Path | None = None,
+                 resumed: list[dict] | None = None):
+        self.problem = problem
+        self.jobs = jobs if jobs > 0 else (os.cpu_count() or 1)
+        self.records: list[Record] = []
+        self.cache: dict[tuple[float, ...], int] = {}
+        self.replayed: dict[tuple[float, ...], dict] = {}
+        self.keys = [v.key for v in problem.variables]
+        self.kinds = [problem.study.SPEC.keys[k].kind for k in self.keys]
+        self.journal = journal
+        self._journal_fh = None
+        self._pool: cf.ProcessPoolExecutor | None = None
+        self.seconds_per_case: float | None = None
+        self.compute_seconds = 0.0
+        self.computed = 0
+        for row in resumed or []:
+            self.replayed[tuple(float(v) for v in row["x"])] = row
+
+    # ------------------------------------------------------------------ lifecycle
+    def close(self) -> None:
+        if self._pool is not None:
+            self._pool.shutdown(wait=True, cancel_futures=True)
+            self._pool = None
+        if self._journal_fh is not None:
+            self._journal_fh.close()
+            self._journal_fh = None
+
+    def __enter__(self) -> "Evaluator":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+    # ------------------------------------------------------------------ computing
+    def _compute(self, xs: list[tuple[float, ...]]) -> list[tuple[str, str, dict]]:
+        """Summaries of new designs: the study's batch path, worker processes, or serially."""
+        t0 = time.perf_counter()
+        out = _batch_summaries(self.problem, xs)
+        if out is None:
+            args = (self.problem.raw.name, str(self.problem.deck.path), self.problem.raw, self.keys, self.kinds)
+            slow = self.seconds_per_case is not None and self.seconds_per_case * len(xs) > 0.2
+            if self.jobs > 1 and len(xs) > 1 and slow:
+                if self._pool is None:
+                    self._pool = cf.ProcessPoolExecutor(self.jobs, initializer=_ignore_sigint)
+                size = max(1, math.ceil(len(xs) / self.jobs))
+                parts = [list(map(list, xs[i:i + size])) for i in range(0, len(xs), size)]
+                out = [r for part in self._pool.map(evaluate_cases, *zip(*[args + (p,) for p in parts]))
+                       for r in part]
+            else:
+                out = evaluate_cases(*args, [list(x) for x in xs])
+        dt = time.perf_counter() - t0
+        self.compute_seconds += dt
+        self.computed += len(xs)
+        if self.seconds_per_case is None and xs:
+            self.seconds_per_case = dt / len(xs)
+        return out
+
+    def evaluate(self, X: np.ndarray) -> list[Record]:
+        """Records of designs ``X`` (rows), evaluating the ones not seen before in one batch."""
+        X = np.atleast_2d(np.asarray(X, dtype=np.float64))
+        keys = [tuple(float(v) for v in row) for row in X]
+        new = list(dict.fromkeys(k for k in keys if k not in self.cache))
+        if new:
+            todo = [k for k in new if k not in self.replayed]
+            computed = dict(zip(todo, self._compute(todo))) if todo else {}
+            rows = []
+            for k in new:
+                if k in computed:
+                    rows.append(computed[k])
+                else:
+                    r = self.replayed[k]
+                    rows.append((r["status"], r["reason"], r["summary"]))
+            self._add(new, rows, journal=[k in computed for k in new])
+        return [self.records[self.cache[k]] for k in keys]
+
+    def _add(self, xs: list[tuple[float, ...]], rows: list[tuple[str, str, dict]], journal: list[bool]) -> None:
+        first = len(self.records)
+        recs = [Record(first + i, x, st, reason, summary) for i, (x, (st, reason, summary)) in enumerate(zip(xs, rows))]
+        self._score(recs)
+        for r in recs:
+            self.cache[r.x] = r.index
+            self.records.append(r)
+        if self.journal is not None and any(journal):
+            if self._journal_fh is None:
+                self.journal.parent.mkdir(parents=True, exist_ok=True)
+                self._journal_fh = open(self.journal, "a")
+            for r, j in zip(recs, journal):
+                if j:
+                    self._journal_fh.write(json.dumps({"base": self.problem.fingerprint(), "x": list(r.x),
+                                                       "status": r.status, "reason": r.reason,
+                                                       "summary": r.summary}, default=_plain) + "\n")
+            self._journal_fh.flush()
+
+    def _score(self, recs: list[Record]) -> None:
+        """Objective, margins and feasibility of new records (vectorised over the batch)."""
+        p = self.problem
+        ok = [r for r in recs if r.status == "ok"]
+        for r in recs:
+            if r.status != "ok":
+                r.why = f"{'not a valid design' if r.status == 'bad_input' else 'case failed'}: {_short(r.reason)}"
+                r.violation = FAILED_VIOLATION
+                r.margins = tuple(-math.inf for _ in p.constraints)
+                r.met = tuple(False for _ in p.constraints)
+        if not ok:
+            return
+        frame = pd.DataFrame([r.summary for r in ok])
+        for name in _names(p):
+            if name not in frame:
+                frame[name] = np.nan
+        f = _values(p.objective, frame)
+        margins, met = [], []
+        for c in p.constraints:
+            truth = c.whole.mask(frame)
+            if c.sense:
+                m = c.sense * (_values(c.left, frame) - _values(c.right, frame))
+                m = np.where(np.isnan(m), -math.inf, m)
+            else:
+                m = np.where(truth, 0.0, -1.0)
+            margins.append(m)
+            met.append(truth)
+        for i, r in enumerate(ok):
+            r.objective = float(f[i])
+            r.margins = tuple(float(m[i]) for m in margins)
+            r.met = tuple(bool(t[i]) for t in met)
+            viol = [0.0 if t else (min(-m, FAILED_VIOLATION) if math.isfinite(m) and m < 0 else
+                                   (1.0 if math.isfinite(m) else FAILED_VIOLATION))
+                    for m, t in zip(r.margins, r.met)]
+            r.violation = float(sum(viol))
+            if not math.isfinite(r.objective):
+                r.why = "objective undefined"
+                r.violation = max(r.violation, 1.0)
+            elif not all(r.met):
+                k = r.met.index(False)
+                r.why = f"violates constraint{_constraint_number(p, k)}"
+            r.feasible = not r.why
+
+    # ------------------------------------------------------------------ views for the methods
+    def best(self) -> Record | None:
+        """Best feasible record so far; ties go to the design evaluated first."""
+        sense = self.problem.sense
+        feas = [r for r in self.records if r.feasible]
+        if not feas:
+            return None
+        return min(feas, key=lambda r: (sense * r.objective, r.index))
+
+    def least_infeasible(self) -> Record | None:
+        if not self.records:
+            return None
+        return min(self.records, key=lambda r: (r.violation, r.index))
+
+    def reasons(self) -> dict[str, int]:
+        """Infeasible designs counted by reason (most frequent first)."""
+        out: dict[str, int] = {}
+        for r in self.records:
+            if not r.feasible:
+                out[r.why] = out.get(r.why, 0) + 1
+        return dict(sorted(out.items(), key=lambda kv: (-kv[1], kv[0])))
+
+    def frame(self) -> pd.DataFrame:
+        """Every evaluation as a tidy table: variables, status, objective, margins, summary columns."""
+        p = self.problem
+        rows = []
+        for r in self.records:
+            row: dict[str, Any] = {"eval": r.index + 1, **dict(zip(p.names, r.x)), "status": r.status,
+                                   "feasible": r.feasible, "infeasible_reason": r.why,
+                                   "objective": r.objective, "violation": r.violation}
+            for k, m in enumerate(r.margins):
+                row[f"margin{_constraint_number(p, k)}"] = m if math.isfinite(m) else np.nan
+            row["case_error"] = r.reason
+            row.update({f"summary.{k}": v for k, v in r.summary.items()})
+            rows.append(row)
+        return pd.DataFrame(rows)
+
+
+def _batch_summaries(problem: Problem, xs: list[tuple[float, ...]]) -> list[tuple[str, str, dict]] | None:
+    """The study's batch path (``summarise_batch``), when it has one; None otherwise."""
+    fn = getattr(problem.study, "summarise_batch", None)
+    if fn is None or not xs:
+        return None
+    columns = {v.key: np.array([x[i] for x in xs]) for i, v in enumerate(problem.variables)}
+    try:
+        frame = fn(problem.base, columns)
+    except DeckError:
+        return None                     # some design is not a valid deck: case by case says which
+    rows = frame.to_dict("records") if hasattr(frame, "to_dict") else list(frame)
+    out = []
+    for row in rows:
+        row = {k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in row.items()}
+        err = row.pop("error", None) or row.pop("case_error", None)
+        out.append(("failed", str(err), row) if err else ("ok", "", row))
+    return out
+
+
+def _constraint_number(p: Problem, k: int) -> int:
+    """The deck's number N of the k-th given constraint (constraintN)."""
+    nums = [n for n in range(1, 10) if p.opts[f"constraint{n}"] is not None]
+    return nums[k]
+
+
+def _names(p: Problem) -> set[str]:
+    names = set(p.objective.names)
+    for c in p.constraints:
+        names |= set(c.whole.names)
+    return names
+
+
+def _values(e: expr.Expr, frame: pd.DataFrame) -> np.ndarray:
+    v = np.asarray(e.evaluate(frame))
+    if v.dtype.kind == "b":
+        return v.astype(np.float64)
+    if v.dtype.kind not in "iuf":
+        try:
+            return v.astype(np.float64)
+        except (TypeError, ValueError):
+            raise expr.ExprError("the expression is not a number (a text column?)", e.text) from None
+    return v.astype(np.float64)
+
+
+def _short(text: str, n: int = 70) -> str:
+    text = " ".join(str(text).split())
+    return text if len(text) <= n else text[: n - 3] + "..."
+
+
+def _plain(o: Any) -> Any:
+    if isinstance(o, (np.floating, np.integer)):
+        return o.item()
+    if isinstance(o, np.bool_):
+        return bool(o)
+    return str(o)

@@ -1,0 +1,354 @@
+"""Four-bar synthesis: a ``&synthesis`` deck designs a linkage, the exact kernel checks it.
+
+    &synthesis
+      task = 'function'                    ! Freudenstein function generation
+      function = 'log10(x)', x_start = 1, x_stop = 2     ! or x_values = ..., y_values = ...
+      crank_start_deg = 45, crank_range_deg = 60, rocker_start_deg = 135, rocker_range_deg = 60
+      points = 3                           ! 3: closed form at Chebyshev points; more: least squares
+      fixed_link = 1.0, omega = 1.0, step_deg = 5, branch = 'open'
+    /
+
+    &synthesis
+      task = 'crank_rocker', swing_deg = 60, time_ratio = 1.2, fixed_link = 10
+    /
+
+Outputs for ``<stem>.dat``: ``<stem>.out`` (the synthesis and its check by the exact kernel),
+``<stem>.linkage.dat`` (the linkage as a complete &fourbar deck) and everything a run of that
+deck writes (``<stem>.linkage.out``, tidy tables, with ``--plot`` the linkage figure), and
+``<stem>_error.csv`` (function generation: the structural error curve) or ``<stem>_family.csv``
+(crank-rocker: the family searched).  A synthesis whose linkage the kernel rejects (wrong
+branch, cannot be assembled over the range, not a crank-rocker) is reported and exits 1.
+"""
+from __future__ import annotations
+
+import math
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import f90nml
+import numpy as np
+import pandas as pd
+
+from driver import expr, fourbar, kernels
+from driver.atomic import write_text
+from driver.deck import Deck, DeckError, GroupSpec, Key, Params, RawGroup, positive, read_deck, validate
+from driver.export import write_tidy
+from driver.runner import write_outputs
+from driver.synthesis import crank_rocker as cr
+from driver.synthesis.function import FunctionDesign, chebyshev, freudenstein, links_from_k, wrap180
+
+__all__ = ["SPEC", "Synthesis", "synthesise", "run_synthesis_deck"]
+
+ST = kernels.FOURBAR_STATUS
+
+
+def _check(p: Params) -> None:
+    if p.task == "function":
+        if (p.function is None) == (p.x_values is None):
+            raise p.error("function", "function generation needs function = 'expression in x' or "
+                                      "x_values/y_values, not both")
+        if p.x_values is not None:
+            if p.y_values is None or len(p.y_values) != len(p.x_values):
+                raise p.error("y_values", "needs one y for every x in x_values")
+            if len(p.x_values) < 3:
+                raise p.error("x_values", f"at least 3 precision points (got {len(p.x_values)})")
+            if len(set(p.x_values)) != len(p.x_values):
+                raise p.error("x_values", "precision points repeat an x")
+        else:
+            for key in ("x_start", "x_stop"):
+                if p[key] is None:
+                    raise p.error(key, "needed with function")
+            if p.x_start == p.x_stop:
+                raise p.error("x_stop", "must differ from x_start")
+        for key in ("crank_range_deg", "rocker_range_deg"):
+            if p[key] is None:
+                raise p.error(key, "needed for function generation")
+            if not 0 < abs(p[key]) < 360:
+                raise p.error(key, "must be between 0 and 360 deg in size")
+    else:
+        for key in ("swing_deg", "time_ratio"):
+            if p[key] is None:
+                raise p.error(key, "needed for task = 'crank_rocker'")
+        if not 0 < p.swing_deg < 180:
+            raise p.error("swing_deg", "must be between 0 and 180 deg")
+        if not 1 <= p.time_ratio <= 10:
+            raise p.error("time_ratio", "must be between 1 and 10")
+
+
+def _between(lo: float, hi: float):
+    return lambda v: None if lo <= v <= hi else f"must be between {lo:g} and {hi:g} (got {v})"
+
+
+SPEC = GroupSpec(
+    name="synthesis",
+    doc="four-bar synthesis: function generation (Freudenstein) or a crank-rocker for a swing and time ratio",
+    keys={
+        "task": Key("str", required=True, choices=("function", "crank_rocker"),
+                    doc="'function': rocker angle follows y(x); 'crank_rocker': given swing and time ratio"),
+        "fixed_link": Key("float", default=1.0, check=positive, units="length", doc="ground link (sets the scale)"),
+        "omega": Key("float", default=1.0, units="rad/s", doc="crank speed of the linkage deck"),
+        "step_deg": Key("float", default=5.0, check=positive, units="deg", doc="crank step of the linkage deck"),
+        "branch": Key("str", default="open", choices=("open", "crossed"), doc="assembly branch to design for"),
+        "title": Key("str", default="", doc="free text"),
+        "function": Key("str", doc="y(x) in the deck expression language, e.g. 'log10(x)' or 'x**2'"),
+        "x_start": Key("float", doc="first x of the range"),
+        "x_stop": Key("float", doc="last x of the range"),
+        "x_values": Key("floats", doc="precision points x (instead of function)"),
+        "y_values": Key("floats", doc="y at the precision points"),
+        "crank_start_deg": Key("float", default=0.0, units="deg", doc="crank angle at x_start"),
+        "crank_range_deg": Key("float", units="deg", doc="crank rotation from x_start to x_stop"),
+        "rocker_start_deg": Key("float", default=90.0, units="deg", doc="rocker angle at y(x_start)"),
+        "rocker_range_deg": Key("float", units="deg", doc="rocker rotation from y(x_start) to y(x_stop)"),
+        "points": Key("int", default=3, check=_between(3, 10000),
+                      doc="precision points at Chebyshev spacing: 3 closed form, more least squares"),
+        "error_points": Key("int", default=201, check=_between(11, 100000), doc="samples of the structural error"),
+        "swing_deg": Key("float", units="deg", doc="crank-rocker: rocker swing"),
+        "time_ratio": Key("float", doc="crank-rocker: slow stroke / fast stroke crank angle (>= 1)"),
+        "family_points": Key("int", default=721, check=_between(11, 100000),
+                             doc="crank-rocker: members scanned per arc of the family"),
+    },
+    check=_check,
+)
+
+
+@dataclass
+class Synthesis:
+    """A synthesis result: the linkage deck, the study run of it, and the report."""
+
+    params: Params
+    linkage: dict[str, Any]
+    text: str
+    failure: str | None
+    table: pd.DataFrame
+    table_name: str
+    study_result: Any = None
+    design: Any = None
+    checks: dict[str, float] = field(default_factory=dict)
+
+
+# ----------------------------------------------------------------------------- function generation
+
+def _y_of(p: Params, x: np.ndarray) -> np.ndarray:
+    try:
+        e = expr.parse(p.function, ["x"])
+    except expr.ExprError as exc:
+        raise p.error("function", str(exc)) from None
+    with np.errstate(all="ignore"):
+        y = np.asarray(e.evaluate({"x": np.asarray(x, dtype=float)}), dtype=float)
+    return y
+
+
+def _function(p: Params) -> Synthesis:
+    d = p.fixed_link
+    if p.x_values is not None:
+        xs, ys = np.array(p.x_values, float), np.array(p.y_values, float)
+        order = np.argsort(xs)
+        xs, ys = xs[order], ys[order]
+        x0, xf = (p.x_start, p.x_stop) if p.x_start is not None and p.x_stop is not None else (xs[0], xs[-1])
+        y_end = np.interp([x0, xf], xs, ys)
+        curve = lambda x: np.interp(x, xs, ys)
+        how = f"{len(xs)} given precision points"
+    else:
+        x0, xf = p.x_start, p.x_stop
+        xs = chebyshev(x0, xf, p.points)
+        ys = _y_of(p, xs)
+        y_end = _y_of(p, np.array([x0, xf]))
+        curve = lambda x: _y_of(p, x)
+        how = f"{p.points} precision points at Chebyshev spacing"
+    if not np.all(np.isfinite(ys)) or not np.all(np.isfinite(y_end)):
+        raise p.error("function", "y(x) is not finite at every precision point and range end")
+    y0, yf = float(y_end[0]), float(y_end[1])
+    if y0 == yf:
+        raise p.error("function", "y(x_start) = y(x_stop): the rocker range cannot be mapped")
+    phi = lambda x: p.crank_start_deg + (np.asarray(x) - x0) / (xf - x0) * p.crank_range_deg
+    psi = lambda y: p.rocker_start_deg + (np.asarray(y) - y0) / (yf - y0) * p.rocker_range_deg
+    th2, th4 = np.radians(phi(xs)), np.radians(psi(ys))
+    k, cond = freudenstein(th2, th4)
+    a, b, c, reason = links_from_k(k, d)
+    fd = FunctionDesign(xs, ys, phi(xs), psi(ys), k, cond, abs(a), b, abs(c),
+                        p.crank_start_deg + (180.0 if a < 0 else 0.0), p.rocker_start_deg + (180.0 if c < 0 else 0.0),
+                        (bool(a < 0), bool(c < 0)), reason)
+    lines = [f"  four-bar synthesis: function generation (Freudenstein), {how}",
+             f"  deck: {p.path}" + (f" -- {p.title}" if p.title else ""), "",
+             f"    y(x) ................. {p.function if p.function else 'given points (linear between them)'}",
+             f"    x range .............. {x0:.10g} .. {xf:.10g}   y range {y0:.10g} .. {yf:.10g}",
+             f"    crank ................ {p.crank_start_deg:g} deg + {p.crank_range_deg:g} deg over the x range",
+             f"    rocker ............... {p.rocker_start_deg:g} deg + {p.rocker_range_deg:g} deg over the y range",
+             f"    branch ............... {p.branch}", "",
+             "  Precision points",
+             "         x                  y          crank [deg]     rocker [deg]"]
+    lines += [f"  {x:12.6f}  {y:17.10g}  {t2:15.6f}  {t4:15.6f}" for x, y, t2, t4 in zip(xs, ys, phi(xs), psi(ys))]
+    lines += ["", f"  Freudenstein K1 = {k[0]:.10g}, K2 = {k[1]:.10g}, K3 = {k[2]:.10g} "
+                  f"({'exact solve' if len(xs) == 3 else 'least squares'}, condition number {cond:.3g})"]
+    linkage = None
+    failure = None
+    table = pd.DataFrame()
+    if reason:
+        failure = f"no four-bar satisfies these precision points: {reason}"
+        lines += [f"  {failure}"]
+    else:
+        if fd.shifted[0] or fd.shifted[1]:
+            lines += ["  signed solution " + f"a = {a:.10g}, c = {c:.10g}: " +
+                      " and ".join(w for w, s in zip(("the crank", "the rocker"), fd.shifted) if s) +
+                      " point the other way (angles + 180 deg)"]
+        lines += [f"  linkage: ground {d:.10g}, crank {fd.crank:.10g}, coupler {fd.coupler:.10g}, rocker {fd.rocker:.10g}"]
+        # the exact kernel on the requested branch over the x range, and at the precision points on both branches
+        sgn = 1 if p.branch == "open" else -1
+        x = np.linspace(x0, xf, p.error_points)
+        crank_deg = fd.crank_start_deg + (x - x0) / (xf - x0) * p.crank_range_deg
+        out, st = kernels.fourbar_exact(np.radians(crank_deg), d, fd.crank, fd.coupler, fd.rocker, 1.0, 0.0, sgn)
+        desired_psi = fd.rocker_start_deg + (curve(x) - y0) / (yf - y0) * p.rocker_range_deg
+        err = wrap180(np.degrees(out[:, 1]) - desired_psi)
+        err = np.where(st == ST["ok"], err, np.nan)
+        y_gen = curve(x) + err / p.rocker_range_deg * (yf - y0)
+        fd.x, fd.y_desired, fd.y_generated, fd.rocker_error_deg, fd.status = x, curve(x), y_gen, err, st
+        pc = fd.crank_start_deg + (xs - x0) / (xf - x0) * p.crank_range_deg
+        pr = fd.rocker_start_deg + (ys - y0) / (yf - y0) * p.rocker_range_deg
+        for s, attr in ((sgn, "point_error_deg"), (-sgn, "other_branch_point_error_deg")):
+            o2, s2 = kernels.fourbar_exact(np.radians(pc), d, fd.crank, fd.coupler, fd.rocker, 1.0, 0.0, s)
+            setattr(fd, attr, np.where(s2 == ST["ok"], wrap180(np.degrees(o2[:, 1]) - pr), np.nan))
+        worst = int(np.nanargmax(np.abs(err))) if np.isfinite(err).any() else 0
+        tol_deg = 1e-6 if len(xs) == 3 else math.inf
+        bad = np.flatnonzero(st != ST["ok"])
+        lines += ["", f"  Check by the exact kernel ({p.branch} branch, {p.error_points} points over the x range)"]
+        lines += ["    precision point   rocker error, this branch [deg]   other branch [deg]"]
+        lines += [f"    {xx:15.6f}   {e1:31.3e}   {e2:18.3e}".replace("nan", "  -")
+                  for xx, e1, e2 in zip(xs, fd.point_error_deg, fd.other_branch_point_error_deg)]
+        if len(bad):
+            failure = (f"the linkage cannot run the x range on the {p.branch} branch: "
+                       f"{len(bad)} of {len(x)} points cannot be assembled or are at a toggle "
+                       f"(first at x = {x[bad[0]]:.6g})")
+        elif len(xs) == 3 and not np.all(np.abs(fd.point_error_deg) < tol_deg):
+            other_ok = np.all(np.abs(fd.other_branch_point_error_deg) < tol_deg)
+            failure = ("the precision points are met on the other assembly branch: set branch = '"
+                       + ("crossed" if p.branch == "open" else "open") + "'") if other_ok else \
+                      "the precision points lie on different assembly branches (branch defect)"
+        if failure is None:
+            lines += [f"    structural error: max |y_generated - y(x)| = {fd.max_error_y:.6e} at x = {x[worst]:.6g}"
+                      f"  (rocker {err[worst]:+.6f} deg); every point of the range assembled, no toggle"]
+        else:
+            lines += [f"    FAILED: {failure}"]
+        linkage = {"fixed_link": d, "crank": fd.crank, "coupler": fd.coupler, "rocker": fd.rocker,
+                   "omega": p.omega, "step_deg": p.step_deg, "start_deg": float(fd.crank_start_deg),
+                   "stop_deg": float(fd.crank_start_deg + p.crank_range_deg), "branch": p.branch}
+        if p.crank_range_deg < 0:
+            linkage["step_deg"] = -p.step_deg
+        table = pd.DataFrame({"x": x, "crank_deg": crank_deg, "y_desired": fd.y_desired, "y_generated": y_gen,
+                              "structural_error": y_gen - fd.y_desired, "rocker_error_deg": err,
+                              "status": np.array(["ok", "cannot_assemble", "toggle", "indeterminate"])[st]})
+    return Synthesis(p, linkage, "\n".join(lines), failure, table, "_error", design=fd,
+                     checks={"max_error_y": fd.max_error_y})
+
+
+# ----------------------------------------------------------------------------- crank-rocker
+
+def _crank_rocker(p: Params) -> Synthesis:
+    members = cr.family(p.swing_deg, p.time_ratio, p.family_points)
+    best = cr.best_member(p.swing_deg, p.time_ratio, members)
+    al = cr.alpha_deg(p.time_ratio)
+    lines = ["  four-bar synthesis: crank-rocker for a rocker swing and a time ratio",
+             f"  deck: {p.path}" + (f" -- {p.title}" if p.title else ""), "",
+             f"    rocker swing ......... {p.swing_deg:g} deg",
+             f"    time ratio ........... {p.time_ratio:g}  (crank turns 180 + {al:.6g} and 180 - {al:.6g} deg)",
+             f"    family ............... O_A on the {'line through the rocker extremes' if al <= 1e-12 else 'circle through the rocker extremes seeing them under alpha'}; "
+             f"{len(members)} members scanned ({p.family_points} per arc)",
+             f"    crank-rockers ........ {sum(m.crank_rocker for m in members)} of them", ""]
+    table = pd.DataFrame([{"arc": m.arc, "t": m.t, "crank": m.crank * p.fixed_link / m.ground,
+                           "coupler": m.coupler * p.fixed_link / m.ground, "rocker": m.rocker * p.fixed_link / m.ground,
+                           "fixed_link": p.fixed_link, "crank_rocker": m.crank_rocker, "mu_min_deg": m.mu_min_deg,
+                           "mu_max_deg": m.mu_max_deg, "quality_deg": m.quality_deg} for m in members])
+    if best is None:
+        failure = "no member of the family is a crank-rocker"
+        return Synthesis(p, None, "\n".join(lines + [f"  {failure}"]), failure, table, "_family")
+    a, b, c = best.scaled(p.fixed_link)
+    lines += ["  Family (every tenth member of each arc; the _family table has all)",
+              "     arc        t       crank     coupler      rocker   crank-rocker   mu_min   mu_max   quality"]
+    for arc in sorted(set(table["arc"]), reverse=True):
+        sub = table[table["arc"] == arc]
+        for _, r in sub.iloc[:: max(1, len(sub) // 10)].iterrows():
+            mm = lambda v: f"{v:8.3f}" if math.isfinite(v) else "       -"
+            lines.append(f"  {int(r.arc):6d}  {r.t:7.4f}  {r.crank:10.5f}  {r.coupler:10.5f}  {r.rocker:10.5f}"
+                         f"   {'yes' if r.crank_rocker else 'no':>12} {mm(r.mu_min_deg)} {mm(r.mu_max_deg)}"
+                         f" {mm(r.quality_deg)}")
+    lines += ["", f"  Best member (arc {best.arc}, t = {best.t:.10f}): min(mu_min, 180 - mu_max) = {best.quality_deg:.6f} deg",
+              f"  linkage: ground {p.fixed_link:.10g}, crank {a:.10g}, coupler {b:.10g}, rocker {c:.10g}",
+              f"    transmission angle {best.mu_min_deg:.6f} .. {best.mu_max_deg:.6f} deg (closed form)"]
+    linkage = {"fixed_link": p.fixed_link, "crank": a, "coupler": b, "rocker": c, "omega": p.omega,
+               "step_deg": p.step_deg, "branch": p.branch}
+    # check by the exact kernel: swing, time ratio, transmission angle over a full turn
+    raw = RawGroup("fourbar", dict(linkage), {}, p.line)
+    fp = validate(raw, fourbar.SPEC, p.path)
+    ex = fourbar.extremes(fp)
+    failure = None
+    checks: dict[str, float] = {}
+    if ex is None or ex.assembled_fraction < 1.0 or ex.toggles:
+        failure = "the exact kernel cannot run the linkage over a full turn"
+    else:
+        swing = (ex.rocker_max - ex.rocker_min) % 360.0
+        turn = (ex.rocker_max_at - ex.rocker_min_at) % 360.0
+        q = max(turn, 360 - turn) / min(turn, 360 - turn)
+        checks = {"swing_deg": swing, "time_ratio": q, "mu_min_deg": ex.mu_min, "mu_max_deg": ex.mu_max}
+        lines += ["", f"  Check by the exact kernel ({p.branch} branch, full turn): swing {swing:.9f} deg "
+                      f"(asked {p.swing_deg:g}), time ratio {q:.9f} (asked {p.time_ratio:g}), "
+                      f"transmission angle {ex.mu_min:.6f} .. {ex.mu_max:.6f} deg"]
+        if abs(swing - p.swing_deg) > 1e-6 or abs(q - p.time_ratio) > 1e-6 * p.time_ratio:
+            failure = "the exact kernel does not confirm the swing and time ratio"
+            lines += [f"    FAILED: {failure}"]
+    return Synthesis(p, linkage, "\n".join(lines), failure, table, "_family", design=best, checks=checks)
+
+
+# ----------------------------------------------------------------------------- run
+
+def synthesise(deck: Deck | str | Path) -> Synthesis:
+    """Run a &synthesis deck: design the linkage, check it, and run its &fourbar deck."""
+    if not isinstance(deck, Deck):
+        deck = read_deck(deck)
+    others = [g for g in deck.groups if g != "synthesis"]
+    if others:
+        raw = deck.groups[others[0]]
+        raise DeckError(deck.path, raw.line, None, f"a &synthesis deck has no other group (found &{others[0]}); "
+                                                   "it writes the &fourbar deck of its linkage")
+    p = validate(deck.groups["synthesis"], SPEC, deck.path)
+    syn = _function(p) if p.task == "function" else _crank_rocker(p)
+    if syn.linkage is not None:
+        fp = validate(RawGroup("fourbar", dict(syn.linkage, title=p.title or f"synthesised by {deck.path}"),
+                               {}, p.line), fourbar.SPEC, deck.path)
+        syn.study_result = fourbar.run(fp)
+        syn.linkage = {k: v for k, v in fp.items() if v is not None and v != [] and v != ""}
+    return syn
+
+
+def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool = False,
+                       quiet: bool = False, **_: Any) -> int:
+    """Command-line entry: synthesise, write, return the exit status (DeckError propagates)."""
+    syn = synthesise(deck)
+    stem = Path(outdir) / Path(deck.path).stem
+    written = []
+    if syn.linkage is not None:
+        head = f"! four-bar synthesised by {deck.path} ({syn.params.task})" + (
+            "" if syn.failure is None else f"; FAILED CHECK: {syn.failure}")
+        written.append(write_text(stem.with_name(stem.name + ".linkage.dat"),
+                                  head + "\n" + str(f90nml.Namelist({"fourbar": syn.linkage})) + "\n"))
+        written += write_outputs(syn.study_result, stem.with_name(stem.name + ".linkage"), formats, plot)
+    text = syn.text.rstrip() + "\n"
+    if syn.linkage is not None:
+        text += f"\n  linkage deck {stem.name}.linkage.dat; its exact analysis in {stem.name}.linkage.out\n"
+    written.append(write_text(stem.with_name(stem.name + ".out"), text))
+    if len(syn.table):
+        written.append(write_tidy(syn.table, stem.with_name(stem.name + syn.table_name), "csv"))
+    if plot and syn.params.task == "function" and syn.design is not None and len(syn.design.x):
+        from driver import plotting
+        fd = syn.design
+        fig = plotting.line_panels(fd.x, [("y", {"desired y(x)": fd.y_desired, "generated": fd.y_generated}),
+                                          ("structural error", {"error": fd.y_generated - fd.y_desired})],
+                                   "x", title=f"{Path(deck.path).stem}: function generation")
+        written.append(plotting.save_figure(fig, stem.with_name(stem.name + "_error.png")))
+    if not quiet:
+        for w in written:
+            print(f"wrote {w}")
+    if syn.failure:
+        print(f"error: {deck.path}: {syn.failure}", file=sys.stderr)
+        return 1
+    return 0

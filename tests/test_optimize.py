@@ -1,0 +1,174 @@
+"""&optimize: reported optima checked against independent truth.
+
+* the four-bar design problem against the committed 10^5-point grid search of the same
+  problem (outputs/fourbar_design_search_summary.csv) and a brute-force box around the optimum;
+* local methods against a closed form (Freudenstein-free: the transmission angle at theta = 0);
+* bad decks refused before anything runs; failing designs counted, never fatal; a run that
+  does not converge says so and exits 1; --resume replays a run without recomputing.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from driver import fourbar
+from driver.cli import main
+from driver.deck import DeckError, RawGroup, read_deck, validate
+from driver.optimize import optimize
+
+ROOT = Path(__file__).resolve().parents[1]
+DECK = ROOT / "inputs" / "optimize_fourbar_design.dat"
+
+
+def _fourbar_summary(crank: float, coupler: float, rocker: float) -> dict:
+    raw = RawGroup("fourbar", {"fixed_link": 12.0, "crank": float(crank), "coupler": float(coupler),
+                               "rocker": float(rocker), "omega": 5.0, "step_deg": 10.0}, {}, 1)
+    return fourbar.summarise(validate(raw, fourbar.SPEC, "x.dat"))
+
+
+def _feasible(s: dict) -> bool:
+    return bool(s["meets_band_40_120"]) and s["rocker_swing_deg"] is not None and s["rocker_swing_deg"] >= 60
+
+
+@pytest.fixture(scope="module")
+def design(tmp_path_factory):
+    out = tmp_path_factory.mktemp("opt")
+    return optimize(DECK, out, jobs=1), out
+
+
+def test_design_problem_beats_the_grid_search_with_few_evaluations(design):
+    oc, _ = design
+    assert oc.success
+    grid = pd.read_csv(ROOT / "outputs" / "fourbar_design_search_summary.csv")   # 102400 designs, kept rows
+    grid_best = grid["mu_min_deg"].max()
+    assert grid_best == pytest.approx(55.2846, abs=1e-3)
+    assert oc.fun >= grid_best
+    assert oc.nfev <= 0.05 * 25 * 64 * 64
+
+
+def test_design_optimum_checked_by_the_exact_kernel_and_a_brute_force_box(design):
+    oc, _ = design
+    x = oc.x
+    s = _fourbar_summary(x["fourbar.crank"], x["fourbar.coupler"], x["fourbar.rocker"])
+    assert _feasible(s) and s["grashof_class"] == "crank-rocker"
+    assert s["mu_min_deg"] == pytest.approx(oc.fun, abs=1e-12)
+    # closed form of the minimum transmission angle of a crank-rocker (A nearest O_B, theta = 0)
+    p, q, r, t = 12.0, x["fourbar.crank"], x["fourbar.coupler"], x["fourbar.rocker"]
+    assert oc.fun == pytest.approx(math.degrees(math.acos((r * r + t * t - (p - q) ** 2) / (2 * r * t))), abs=1e-9)
+    # no feasible design in a +-1 % box around the optimum is better by more than the stopping tolerance
+    best = -np.inf
+    for f in np.linspace(0.99, 1.01, 5):
+        for g in np.linspace(0.99, 1.01, 5):
+            for h in np.linspace(0.99, 1.01, 5):
+                s = _fourbar_summary(q * f, r * g, t * h)
+                if _feasible(s):
+                    best = max(best, s["mu_min_deg"])
+    assert best <= oc.fun + 0.05
+
+
+def test_design_outputs_say_optimum_and_verify_it(design):
+    oc, out = design
+    text = (out / "optimize_fourbar_design.out").read_text()
+    assert "Result: CONVERGED" in text and "agrees with the evaluation" in text
+    deck = read_deck(out / "optimize_fourbar_design.optimum.dat")
+    assert "optimize" not in deck.groups
+    assert deck.groups["fourbar"].values["crank"] == pytest.approx(oc.x["fourbar.crank"], rel=1e-12)
+    assert (out / "optimize_fourbar_design.optimum.out").exists()
+    hist = pd.read_csv(out / "optimize_fourbar_design_history.csv")
+    assert hist["objective"].dropna().is_monotonic_increasing
+    assert hist["objective"].iloc[-1] == pytest.approx(oc.fun)
+    evals = pd.read_parquet(out / "optimize_fourbar_design_evals.parquet")
+    assert len(evals) == oc.nfev and evals["eval"].is_unique
+    assert evals.loc[evals["feasible"], "objective"].max() == pytest.approx(oc.fun)
+    assert not (out / "optimize_fourbar_design.journal.jsonl").exists()
+
+
+def test_resume_replays_without_computing(design, tmp_path):
+    oc, out = design
+    for f in out.iterdir():
+        (tmp_path / f.name).write_bytes(f.read_bytes())
+    again = optimize(DECK, tmp_path, jobs=1, resume=True)
+    assert again.evaluator.computed == 0
+    assert again.x == oc.x and again.nfev == oc.nfev
+
+
+def _deck(tmp_path, body: str, study: str | None = None) -> Path:
+    study = study or "&fourbar fixed_link = 12, crank = 3, coupler = 15, rocker = 9, omega = 5, step_deg = 10 /"
+    path = tmp_path / "opt.dat"
+    path.write_text(f"{study}\n&optimize\n{body}\n/\n")
+    return path
+
+
+@pytest.mark.parametrize("method", ["slsqp", "trust-constr"])
+def test_local_methods_reach_the_closed_form(tmp_path, method):
+    """mu_min of a crank-rocker = 45 deg: coupler r from r^2 - 2 s cos45 r + s^2 - (p - q)^2 = 0."""
+    path = _deck(tmp_path, f"var1 = 'fourbar.coupler', lower1 = 10, upper1 = 20\n"
+                           f"minimize = '(mu_min_deg - 45)**2'\nmethod = '{method}', starts = 3")
+    oc = optimize(path, tmp_path / "out", jobs=1)
+    p, q, s = 12.0, 3.0, 9.0
+    c = math.cos(math.radians(45))
+    r = s * c + math.sqrt(s * s * c * c - s * s + (p - q) ** 2)
+    assert oc.success
+    assert oc.x["fourbar.coupler"] == pytest.approx(r, abs=1e-4)
+
+
+def test_failing_designs_are_counted_not_fatal(tmp_path):
+    # cranks longer than the others: many designs cannot turn or assemble
+    path = _deck(tmp_path, "var1 = 'fourbar.crank', lower1 = 1, upper1 = 30\n"
+                           "maximize = 'mu_min_deg'\nconstraint1 = 'grashof_class == \"crank-rocker\"'\n"
+                           "method = 'grid', grid_count = 30")
+    oc = optimize(path, tmp_path / "out", jobs=1)
+    assert oc.success
+    text = (tmp_path / "out" / "opt.out").read_text()
+    assert "violates constraint1" in text
+    bad = sum(1 for r in oc.evaluator.records if not r.feasible)
+    assert bad > 0 and oc.nfev == 30
+    # independent: the best crank-rocker of the grid by direct evaluation
+    best = max((s["mu_min_deg"], c) for c in np.linspace(1, 30, 30)
+               for s in [_fourbar_summary(c, 15, 9)] if s["grashof_class"] == "crank-rocker")
+    assert oc.fun == best[0] and oc.x["fourbar.crank"] == best[1]
+
+
+def test_not_converged_exits_1_and_never_says_optimum(tmp_path, capsys):
+    path = _deck(tmp_path, "var1 = 'fourbar.crank', lower1 = 1, upper1 = 5\n"
+                           "var2 = 'fourbar.rocker', lower2 = 4, upper2 = 12\n"
+                           "maximize = 'mu_min_deg'\nmaxiter = 2, tol = 0, atol = 0")
+    assert main([str(path), "-o", str(tmp_path / "out"), "-q", "-j", "1"]) == 1
+    assert "did not converge" in capsys.readouterr().err
+    text = (tmp_path / "out" / "opt.out").read_text()
+    assert "NOT CONVERGED" in text and "not an optimum" in text
+    assert "NOT converged" in (tmp_path / "out" / "opt.optimum.dat").read_text()
+
+
+@pytest.mark.parametrize("body, key, words", [
+    ("var1 = 'fourbar.crank', lower1 = 1, upper1 = 5\nmaximize = 'mu_minimum'", "maximize", "unknown summary column"),
+    ("var1 = 'fourbar.crank', lower1 = 1, upper1 = 5\nmaximize = '__import__(\"os\")'", "maximize", "not allowed"),
+    ("var1 = 'fourbar.crank', lower1 = 5, upper1 = 1\nmaximize = 'mu_min_deg'", "upper1", "must exceed"),
+    ("var1 = 'fourbar.crank', lower1 = 1\nmaximize = 'mu_min_deg'", "var1", "needs upper1"),
+    ("var1 = 'fourbar.method', lower1 = 1, upper1 = 2\nmaximize = 'mu_min_deg'", "var1", "not a real number"),
+    ("var1 = 'fourbar.cranks', lower1 = 1, upper1 = 2\nmaximize = 'mu_min_deg'", "var1", "no key"),
+    ("var1 = 'fourbar.crank', lower1 = 1, upper1 = 2\nmaximize = 'mu_min_deg', minimize = 'mu_max_deg'",
+     "maximize", "exactly one"),
+    ("var1 = 'fourbar.crank', lower1 = 1, upper1 = 2\nvar2 = 'fourbar.rocker', lower2 = 1, upper2 = 2\n"
+     "maximize = 'mu_min_deg', method = 'grid', grid_count = 100000", "grid_count", "max_evals"),
+    ("var1 = 'fourbar.crank', lower1 = 1, upper1 = 2\nmaximize = 'mu_min_deg'\nconstraint1 = 'x[0] > 1'",
+     "constraint1", "not allowed"),
+])
+def test_bad_decks_exit_2_and_write_nothing(tmp_path, capsys, body, key, words):
+    path = _deck(tmp_path, body)
+    out = tmp_path / "out"
+    assert main([str(path), "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert f"key '{key}'" in err and words in err
+    assert not out.exists()
+
+
+def test_sweep_and_optimize_together_refused(tmp_path):
+    path = _deck(tmp_path, "var1 = 'fourbar.crank', lower1 = 1, upper1 = 2\nmaximize = 'mu_min_deg'\n/\n"
+                           "&sweep key1 = 'fourbar.rocker', values1 = 8, 9")
+    with pytest.raises(DeckError, match="not both"):
+        optimize(path)
