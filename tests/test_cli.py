@@ -69,7 +69,7 @@ def test_jobs_must_be_a_positive_count(tmp_path, jobs):
 def test_sweep_options_on_a_plain_deck_are_reported(tmp_path):
     res = run([str(INPUTS / "crank5_exact.dat"), "-j", "2", "--resume", "-o", "o"], tmp_path)
     assert res.returncode == 0
-    assert "-j/--jobs, --resume apply to sweep decks" in res.stderr and "ignored" in res.stderr
+    assert "-j/--jobs, --resume apply to sweep and optimisation decks" in res.stderr and "ignored" in res.stderr
 
 
 def test_help_and_version_import_no_study(tmp_path):
