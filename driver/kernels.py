@@ -35,6 +35,9 @@ __all__ = ["farray", "fourbar_listing", "fourbar_exact", "fourbar_coupler_point"
 
 def farray(x, ndim: int | None = None) -> np.ndarray:
     """``x`` as a Fortran-contiguous float64 array (no copy when it already is one)."""
+    if type(x) is np.ndarray and x.dtype == np.float64 and x.flags.f_contiguous \
+            and (ndim is None or x.ndim == ndim):
+        return x          # fast path: the optimisers call kernels with such arrays (~1 us saved)
     a = np.asfortranarray(x, dtype=np.float64)
     if ndim is not None and a.ndim != ndim:
         raise ValueError(f"expected a {ndim}-D array, got shape {a.shape}")
@@ -196,15 +199,22 @@ UJOINT_OBJECTIVES = {"mean_square": int(_kernels.ujoint.obj_mean_square), "rms":
 
 def _ujoint_chain(beta, phi, rho) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """beta (n,), phi and rho (n-1,) [rad; rho None = coplanar] as float64 arrays."""
-    beta = farray(np.atleast_1d(beta), 1)
+    beta = _vector(beta)
     if beta.size == 1:   # f2py refuses a 0-length input for dimension(n-1); it takes a dummy of 1
         return beta, _ONE_ZERO, _ONE_ZERO
-    ph = farray(np.atleast_1d(phi), 1)
-    rh = np.zeros(ph.size) if rho is None else farray(np.atleast_1d(rho), 1)
+    ph = _vector(phi)
+    rh = np.zeros(ph.size) if rho is None else _vector(rho)
     return beta, ph, rh
 
 
 _ONE_ZERO = np.zeros(1)
+
+
+def _vector(x) -> np.ndarray:
+    """``x`` (scalar or sequence) as a 1-D float64 array; no copy for one already."""
+    if type(x) is np.ndarray and x.ndim == 1:
+        return farray(x, 1)
+    return farray(np.atleast_1d(x), 1)
 
 
 def ujoint_speed(model: int, beta, phi, rho, theta) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -34,7 +34,7 @@ from driver.kernels import (UJOINT_MODELS, UJOINT_OBJECTIVES, ujoint_equivalent,
 from driver.study import Figure, Result
 from driver.table import Column, fortran_f, render_table
 
-__all__ = ["SPEC", "run", "Chain", "Design", "evaluate", "optimise"]
+__all__ = ["SPEC", "run", "Chain", "Design", "evaluate", "optimise", "BAND_TOL", "NOT_REPRODUCIBLE"]
 
 DEG = math.pi / 180.0
 OPTIONS = {0: "analyse only", 1: "phases free, joint angles fixed",
@@ -45,6 +45,19 @@ SYM_TOL = 1e-7
 SADDLE_NUDGE = 1.0
 #: reading precision of the paper's plotted bands [rpm] (it quotes whole rpm)
 BAND_TOL = 1.0
+
+#: why the paper's printed results are not reproducible (published quantity -> why)
+NOT_REPRODUCIBLE = {
+    "x": "the printed optima are not reproducible: no tested definition of U (phase convention, exact or "
+         "approximate kinematics, grid, units, aggregation) makes them stationary points; computed: the tool's optimum",
+    "U": "the printed objective values are not reproducible under any tested definition of U; computed: the "
+         "printed design evaluated under this deck's objective [rpm^2]",
+    "iterations": "MATLAB fmincon's count; the tool runs scipy SLSQP from several starts (its counts are in the .out)",
+    "evaluations": "MATLAB fmincon's count; the tool runs scipy SLSQP from several starts (its counts are in the .out)",
+    "phi_3": "phi_3 does not exist: three joints on four shafts have two intermediate shafts, so two phases",
+    "option1_band": "the paper reads 24-26 rpm loosely off its Figure 6; every model gives about 23-27 rpm for the "
+                    "trial point (reported, not forced)",
+}
 
 
 def _open_angles(v) -> str | None:

@@ -132,16 +132,21 @@ contains
     integer, intent(inout) :: status(n)
     !f2py intent(in,out) :: status
     integer, parameter :: nb = 256
-    real(dp) :: sgn, blk(nb, 11), sblk(nb)
+    real(dp) :: sgn, sblk(nb)
     integer :: k0, m
 
     sgn = merge(1.0_dp, -1.0_dp, branch >= 0)
-    ! Work in blocks of nb positions held in fixed-size local arrays, so the
-    ! compiler can prove the eleven output columns independent and vectorise.
+    ! Blocks of nb positions: the block's transcendental functions are evaluated on whole
+    ! arrays (vecmath) and its temporaries stay in cache.  Each output column is passed as
+    ! its own dummy argument, so the compiler knows the columns do not overlap and
+    ! vectorises the block's loops writing straight into out.
     do k0 = 1, n, nb
       m = min(nb, n - k0 + 1)
-      call exact_block(m, theta(k0:k0 + m - 1), p, q, r, s, omega, alpha1, sgn, blk, sblk)
-      out(k0:k0 + m - 1, :) = blk(1:m, :)
+      call exact_block(m, theta(k0:k0 + m - 1), p, q, r, s, omega, alpha1, sgn, &
+                       out(k0:k0 + m - 1, 1), out(k0:k0 + m - 1, 2), out(k0:k0 + m - 1, 3), &
+                       out(k0:k0 + m - 1, 4), out(k0:k0 + m - 1, 5), out(k0:k0 + m - 1, 6), &
+                       out(k0:k0 + m - 1, 7), out(k0:k0 + m - 1, 8), out(k0:k0 + m - 1, 9), &
+                       out(k0:k0 + m - 1, 10), out(k0:k0 + m - 1, 11), sblk)
       status(k0:k0 + m - 1) = nint(sblk(1:m))
     end do
   end subroutine exact_states
@@ -150,18 +155,20 @@ contains
   !> Every loop here is free of calls: the transcendental functions are evaluated on the
   !> whole block by vecmath before and after the main loop, so the loops vectorise by
   !> construction (not by the inliner's grace).
-  subroutine exact_block(m, theta, p, q, r, s, omega, alpha1, sgn, out, status)
+  subroutine exact_block(m, theta, p, q, r, s, omega, alpha1, sgn, th2, th3, mu, xa, ya, xb, yb, &
+                         w2o, w3o, a2o, a3o, status)
     integer, intent(in) :: m
     real(dp), intent(in) :: theta(m), p, q, r, s, omega, alpha1, sgn
-    real(dp), intent(inout) :: out(256, 11)
+    real(dp), intent(out) :: th2(m), th3(m), mu(m), xa(m), ya(m), xb(m), yb(m), w2o(m), w3o(m), &
+                             a2o(m), a3o(m)   ! the eleven columns of exact_states' out
     real(dp), intent(inout) :: status(256)   ! status code as a real: keeps the loop in one vector width
     real(dp), parameter :: tol = 1.0e-13_dp
     real(dp) :: r2, s2, c, sn, ax, ay, dx, dy, d2, a, h2, h, bx, by
     real(dp) :: e2x, e2y, e3x, e3y, s23, c23, w2, w3, den2, den3, sinv, ok, placed
-    real(dp) :: st, isno, istog, isdeg, degst, dmin2, ys(256, 3), xs(256, 3), sns(256), cs(256), ang(256)
+    real(dp) :: st, isno, istog, isdeg, degst, dmin2, ys(256, 3), xs(256, 3), sns(256), cs(256), keep(256)
     ! st_ok = 0 is the value left when no flag is set
     real(dp), parameter :: none_ = st_no_assembly, tog_ = st_toggle, ind_ = st_indeterminate
-    integer :: k, j
+    integer :: k
     r2 = r*r
     s2 = s*s
     dmin2 = (tol*(p + q))**2
@@ -207,25 +214,31 @@ contains
       xs(k, 2) = e3x
       ys(k, 3) = abs(s23)*placed
       xs(k, 3) = c23
-      out(k, 4) = ax
-      out(k, 5) = ay
-      out(k, 6) = bx*placed
-      out(k, 7) = by*placed
-      out(k, 8) = w2
-      out(k, 9) = w3
-      out(k, 10) = ok*(-q*alpha1*(sn*e3x - c*e3y) - q*omega*omega*(c*e3x + sn*e3y) &
+      xa(k) = ax
+      ya(k) = ay
+      xb(k) = bx*placed
+      yb(k) = by*placed
+      w2o(k) = w2
+      w3o(k) = w3
+      a2o(k) = ok*(-q*alpha1*(sn*e3x - c*e3y) - q*omega*omega*(c*e3x + sn*e3y) &
                    - r*w2*w2*c23 + s*w3*w3)/(ok*den2 + (1.0_dp - ok))
-      out(k, 11) = ok*(q*alpha1*(sn*e2x - c*e2y) + q*omega*omega*(c*e2x + sn*e2y) &
+      a3o(k) = ok*(q*alpha1*(sn*e2x - c*e2y) + q*omega*omega*(c*e2x + sn*e2y) &
                    + r*w2*w2 - s*w3*w3*c23)/(ok*den3 + (1.0_dp - ok))
       status(k) = st
     end do
     ! angles: an unplaced row has y = 0 and x = 0 or a unit vector; its angle is then zeroed
-    do j = 1, 3
-      call atan2_array(m, ys(:, j), xs(:, j), ang)
-      ! hot-loop: fourbar angle mask
-      do k = 1, m
-        out(k, j) = ang(k)*merge(0.0_dp, 1.0_dp, status(k) == none_ .or. status(k) == ind_)
-      end do
+    ! hot-loop: fourbar angle mask
+    do k = 1, m
+      keep(k) = merge(0.0_dp, 1.0_dp, status(k) == none_ .or. status(k) == ind_)
+    end do
+    call atan2_array(m, ys(:, 1), xs(:, 1), th2)
+    call atan2_array(m, ys(:, 2), xs(:, 2), th3)
+    call atan2_array(m, ys(:, 3), xs(:, 3), mu)
+    ! hot-loop: fourbar angles zeroed where unplaced
+    do k = 1, m
+      th2(k) = th2(k)*keep(k)
+      th3(k) = th3(k)*keep(k)
+      mu(k) = mu(k)*keep(k)
     end do
   end subroutine exact_block
 
@@ -240,51 +253,46 @@ contains
     integer, intent(in) :: status(n)
     real(dp), intent(out) :: pout(n, 6)
     integer, parameter :: nb = 256
-    real(dp) :: blk(nb, 6), sblk(nb, 5)
-    integer :: k0, m, i
-    ! blocks of nb rows gathered into fixed-size local arrays (see exact_states)
+    integer :: k0, m
+    ! blocks of nb rows, columns passed separately (see exact_states)
     do k0 = 1, n, nb
       m = min(nb, n - k0 + 1)
-      do i = 1, m      ! row masks as reals: the main loop then works in one vector width
-        sblk(i, 1) = merge(1.0_dp, 0.0_dp, status(k0 + i - 1) == st_ok .or. status(k0 + i - 1) == st_toggle)
-        sblk(i, 2) = merge(1.0_dp, 0.0_dp, status(k0 + i - 1) == st_ok)
-      end do
-      sblk(1:m, 3) = states(k0:k0 + m - 1, 1)
-      sblk(1:m, 4) = states(k0:k0 + m - 1, 8)
-      sblk(1:m, 5) = states(k0:k0 + m - 1, 10)
-      blk(1:m, 1) = states(k0:k0 + m - 1, 4)
-      blk(1:m, 2) = states(k0:k0 + m - 1, 5)
-      call coupler_block(m, theta(k0:k0 + m - 1), q, omega, alpha1, u, v, sblk, blk)
-      pout(k0:k0 + m - 1, :) = blk(1:m, :)
+      call coupler_block(m, theta(k0:k0 + m - 1), q, omega, alpha1, u, v, status(k0:k0 + m - 1), &
+                         states(k0:k0 + m - 1, 1), states(k0:k0 + m - 1, 4), states(k0:k0 + m - 1, 5), &
+                         states(k0:k0 + m - 1, 8), states(k0:k0 + m - 1, 10), &
+                         pout(k0:k0 + m - 1, 1), pout(k0:k0 + m - 1, 2), pout(k0:k0 + m - 1, 3), &
+                         pout(k0:k0 + m - 1, 4), pout(k0:k0 + m - 1, 5), pout(k0:k0 + m - 1, 6))
     end do
   end subroutine coupler_point
 
-  !> One block of coupler_point: sb(:, 1..5) = placed and ok masks (0/1), coupler angle,
-  !> coupler angular velocity and acceleration; out(:, 1:2) holds xa, ya on entry and
-  !> pout's six columns on return.  m <= 256.
-  subroutine coupler_block(m, theta, q, omega, alpha1, u, v, sb, out)
+  !> One block of coupler_point (m <= 256): coupler angle th2, crank pin (xa, ya), coupler
+  !> angular velocity w2 and acceleration a2 in; position, velocity, acceleration of P out.
+  subroutine coupler_block(m, theta, q, omega, alpha1, u, v, status, th2, xa, ya, w2, a2, &
+                           px, py, vx, vy, ax, ay)
     integer, intent(in) :: m
-    real(dp), intent(in) :: theta(m), q, omega, alpha1, u, v, sb(256, 5)
-    real(dp), intent(inout) :: out(256, 6)
-    real(dp) :: s2(256), c2(256), sn(256), c(256), rx, ry, w2, a2, ok, placed
+    integer, intent(in) :: status(m)
+    real(dp), intent(in) :: theta(m), q, omega, alpha1, u, v, th2(m), xa(m), ya(m), w2(m), a2(m)
+    real(dp), intent(out) :: px(m), py(m), vx(m), vy(m), ax(m), ay(m)
+    real(dp) :: s2(256), c2(256), sn(256), c(256), okb(256), placedb(256), rx, ry
     integer :: k
-    call sincos_array(m, sb(:, 3), s2, c2)
+    ! hot-loop: fourbar coupler masks
+    do k = 1, m      ! row masks as reals: the main loop then works in one vector width
+      placedb(k) = merge(1.0_dp, 0.0_dp, status(k) == st_ok .or. status(k) == st_toggle)
+      okb(k) = merge(1.0_dp, 0.0_dp, status(k) == st_ok)
+    end do
+    call sincos_array(m, th2, s2, c2)
     call sincos_array(m, theta, sn, c)
     ! hot-loop: fourbar coupler_block
     do k = 1, m
-      placed = sb(k, 1)
-      ok = sb(k, 2)
       rx = u*c2(k) - v*s2(k)            ! P - A
       ry = u*s2(k) + v*c2(k)
-      w2 = sb(k, 4)
-      a2 = sb(k, 5)
-      out(k, 1) = placed*(out(k, 1) + rx)
-      out(k, 2) = placed*(out(k, 2) + ry)
+      px(k) = placedb(k)*(xa(k) + rx)
+      py(k) = placedb(k)*(ya(k) + ry)
       ! v_P = v_A + w2 x (P - A);  a_P = a_A + a2 x (P - A) - w2^2 (P - A)
-      out(k, 3) = ok*(-q*omega*sn(k) - w2*ry)
-      out(k, 4) = ok*(q*omega*c(k) + w2*rx)
-      out(k, 5) = ok*(-q*(alpha1*sn(k) + omega*omega*c(k)) - a2*ry - w2*w2*rx)
-      out(k, 6) = ok*(q*(alpha1*c(k) - omega*omega*sn(k)) + a2*rx - w2*w2*ry)
+      vx(k) = okb(k)*(-q*omega*sn(k) - w2(k)*ry)
+      vy(k) = okb(k)*(q*omega*c(k) + w2(k)*rx)
+      ax(k) = okb(k)*(-q*(alpha1*sn(k) + omega*omega*c(k)) - a2(k)*ry - w2(k)*w2(k)*rx)
+      ay(k) = okb(k)*(q*(alpha1*c(k) - omega*omega*sn(k)) + a2(k)*rx - w2(k)*w2(k)*ry)
     end do
   end subroutine coupler_block
 

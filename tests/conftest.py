@@ -7,7 +7,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 INPUTS = ROOT / "inputs"
-DATA = Path(__file__).resolve().parent / "data"
+
 
 
 @pytest.fixture

@@ -194,3 +194,47 @@ def test_cli_totals_over_the_paper_decks(capsys):
     assert "&fourbar method = 'listing' (4 decks): 760/760 cells identical" in out
     assert "&manipulator mode = 'report' (2 decks): 369/369 reproducible cells agree; 4 not reproducible" in out
     assert "&robust_example mode = 'report' (1 deck): 37/37 reproducible cells agree; 5 not reproducible" in out
+
+
+# ----------------------------------------------------------------------------- Hooke joint, slider-crank
+
+def test_ujoint_printed_optima_are_flagged_and_trial_bands_agree():
+    """Trial bands of options 2 and 3 agree within the figure's whole-rpm reading; option 1's band,
+    every printed optimum, U and iteration count are flagged with a reason (study note section 2)."""
+    total = {}
+    for n in (1, 2, 3):
+        f = compare.compare(INPUTS / f"ujoint_option{n}.dat")
+        assert not (f["status"] == "differs").any()
+        bands = f[f["row"].str.startswith("trial_band")]
+        want = "not reproducible" if n == 1 else "agrees"
+        assert (bands["status"] == want).all()
+        rest = f[~f["row"].str.startswith("trial_band")]
+        assert (rest["status"] == "not reproducible").all() and (rest["reason"] != "").all()
+        assert {"U", "iterations", "evaluations"} <= set(rest["row"])
+        total[n] = len(f)
+    assert total == {1: 8, 2: 8, 3: 11}
+
+
+def test_simeon_benchmark_within_half_a_percent():
+    f = compare.compare(INPUTS / "slidercrank_simeon1996.dat")
+    assert list(f["row"]) == ["q1_m", "q4_m", "x3_m", "phi2_rad"]
+    assert (f["status"] == "agrees").all()
+    for r in f.itertuples():
+        assert abs(float(r.computed) / float(r.printed) - 1) <= 5e-3
+
+
+def test_slidercrank_decks_use_table_1_and_a_changed_value_departs(write_deck):
+    f = compare.compare(INPUTS / "slidercrank_aluminium.dat")
+    assert len(f) == 8 and (f["status"] == "identical").all()
+    text = (INPUTS / "slidercrank_aluminium.dat").read_text().replace("slider_mass = 0.9", "slider_mass = 1.2")
+    f = compare.compare(write_deck(text))
+    dep = f[f["status"] == "departs"]
+    assert list(zip(dep["row"], dep["printed"], dep["computed"])) == [("slider_mass_kg", "0.9", "1.2")]
+
+
+def test_every_published_file_is_read_and_has_a_comparer():
+    folder = published.PUBLISHED_DIR
+    files = sorted(p.name for p in folder.iterdir() if p.suffix in (".out", ".txt"))
+    groups = {published.match_line(folder / name)[0] for name in files}
+    assert groups <= set(compare._COMPARERS)
+    assert len(files) == 12

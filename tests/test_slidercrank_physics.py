@@ -2,12 +2,10 @@
 frequencies, the Simeon (1996) benchmark and the element-convergence property.
 
 Every oracle here is written in the test (numpy/scipy) or transcribed from a publication
-(tests/data/slidercrank/); nothing is compared with numbers the kernel produced earlier.
+(published/slidercrank_table1.txt, published/simeon1996.txt); nothing is compared with numbers the kernel produced earlier.
 """
 from __future__ import annotations
 
-import csv
-import json
 import math
 from pathlib import Path
 
@@ -20,18 +18,33 @@ from scipy.optimize import brentq
 from driver import kernels as K
 from driver.slidercrank import MATERIALS
 
-DATA = Path(__file__).parent / "data" / "slidercrank"
+from driver.published import PUBLISHED_DIR, read_blocks
 
 
-def _table1() -> dict[str, dict[str, float]]:
-    lines = [l for l in (DATA / "table1.csv").read_text().splitlines() if not l.startswith("#")]
-    return {row["material"]: {k: float(v) for k, v in row.items() if k != "material"}
-            for row in csv.DictReader(lines)}
+def _table1() -> tuple[dict[str, dict[str, float]], dict[str, float]]:
+    """Tables 1a and 1b of the paper, from published/slidercrank_table1.txt."""
+    c = read_blocks(PUBLISHED_DIR / "slidercrank_table1.txt").cells
+    t1a: dict[str, dict[str, float]] = {}
+    for r in c[c["table"] == "Table 1a"].itertuples():
+        t1a.setdefault(r.row, {})[r.column] = float(r.printed)
+    t1b = {r.row: float(r.printed) for r in c[c["table"] == "Table 1b"].itertuples()}
+    return t1a, t1b
 
 
-TABLE1 = _table1()
-TABLE1B = json.loads((DATA / "table1b.json").read_text())
-SIMEON = json.loads((DATA / "simeon1996.json").read_text())
+def _simeon() -> dict:
+    """Data, initial values and reference solution of Simeon (1996), from published/simeon1996.txt."""
+    c = read_blocks(PUBLISHED_DIR / "simeon1996.txt").cells
+    v = {(r.table, r.row): float(r.printed) for r in c.itertuples()}
+    data = {row: val for (table, row), val in v.items() if table == "Data"}
+    ref = {row: val for (table, row), val in v.items() if table.startswith("Reference")}
+    return {**data, "q0": [v[("Initial values", f"q{k}_0")] for k in range(1, 5)],
+            "qd0": [v[("Initial values", f"qd{k}_0")] for k in range(1, 5)],
+            "t_ref_s": ref["t_s"], "q1_ref_m": ref["q1_m"], "q4_ref_m": ref["q4_m"], "x3_ref_m": ref["x3_m"],
+            "phi2_ref_rad": ref["phi2_rad"]}
+
+
+TABLE1, TABLE1B = _table1()
+SIMEON = _simeon()
 R2, L = TABLE1B["crank_radius_m"], TABLE1["aluminium"]["length_m"]
 MS = TABLE1B["slider_mass_kg"] + TABLE1B["bearing_masses_kg"] / 2   # m_C = 0.05 kg on the guide
 

@@ -1,9 +1,8 @@
-"""The paper's SSO options: trial bands (transcribed from the seed) and optimiser outcomes
+"""The paper's SSO options: trial bands (published/ujoint_sso_option*.txt) and optimiser outcomes
 against closed-form answers (study notes sections 2-5).  The paper's printed optima and U
 values are not reproducible and are never used as targets here."""
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 
@@ -14,7 +13,23 @@ from driver.runner import study_of
 from driver.deck import read_deck
 from driver.kernels import UJOINT_MODELS, ujoint_speed
 
-DATA = json.loads((Path(__file__).parent / "data" / "ujoint" / "sso_paper.json").read_text())
+from driver.published import PUBLISHED_DIR, read_blocks
+
+
+def _paper() -> dict:
+    """The paper's trial points (the files' match lines) and trial bands, from published/ujoint_sso_option*.txt."""
+    out: dict = {"rpm": 25.0}
+    for n in (1, 2, 3):
+        pub = read_blocks(PUBLISHED_DIR / f"ujoint_sso_option{n}.txt")
+        c = dict(zip(pub.cells["row"], pub.cells["printed"]))
+        beta = [float(v) for v in pub.match["beta"].split(",")]
+        phi = [float(v) for v in pub.match["phi"].split(",")]
+        out[f"option{n}"] = {"beta": beta, "trial_beta": beta, "phi": phi, "trial_phi": phi,
+                             "trial_band_rpm": [float(c["trial_band_min"]), float(c["trial_band_max"])]}
+    return out
+
+
+DATA = _paper()
 INPUTS = Path(__file__).resolve().parents[1] / "inputs"
 D = math.pi / 180.0
 TH = np.arange(3600) * (2 * math.pi / 3600)

@@ -183,3 +183,59 @@ def test_guard_catches_the_regressed_fourbar_kernel(flags, tmp_path):
     missing, total = unvectorised([FORTRAN / "kinds.f90", src], flags, tmp_path)
     assert total == 1
     assert len(missing) == 1 and "exact_block main loop" in missing[0]
+
+
+BITS_PROGRAM = """program bits
+  use kinds, only: dp
+  use vecmath, only: sincos_array, atan2_array
+  use fourbar, only: exact_states
+  use manipulator, only: arm_states
+  use ujoint, only: chain_speed, chain_objective
+  implicit none
+  integer, parameter :: n = 1000
+  real(dp) :: x(n), y(n), s(n), c(n), t(n), out(n, 11), qd(n, 2), qdd(n, 2), jac(n, 4), w(n), kap(n)
+  real(dp) :: tau(n, 2), l(n), r(n), dr(n), th(n), f, g(5)
+  integer :: st(n), k, u
+  do k = 1, n
+    x(k) = -40.0_dp + 80.0_dp*real(k - 1, dp)/real(n - 1, dp)
+    y(k) = 3.0_dp*real(mod(37*k, 101) - 50, dp)/50.0_dp   ! no libm here: its vector variants differ
+  end do
+  call sincos_array(n, x, s, c)
+  call atan2_array(n, y, x, t)
+  call exact_states(n, x, 12.0_dp, 5.0_dp, 15.0_dp, 9.0_dp, 5.0_dp, 2.0_dp, 1, out, st)
+  qd = 1.5_dp
+  qdd = -0.5_dp
+  l = 1.0_dp + abs(y)
+  call arm_states(n, l, 2.0_dp*l, x, y, qd, qdd, l, l, 9.81_dp, jac, w, kap, tau)
+  call chain_speed(2, 3, [0.3_dp, 0.2_dp, 0.25_dp], [1.0_dp, 1.4_dp], [0.1_dp, -0.2_dp], n, x, r, dr, th)
+  call chain_objective(2, 0, 3, [0.3_dp, 0.2_dp, 0.25_dp], [1.0_dp, 1.4_dp], [0.1_dp, -0.2_dp], 360, 1, f, g)
+  open (newunit=u, file='bits.bin', access='stream', form='unformatted', status='replace')
+  write (u) s, c, t, out, st, jac, w, kap, tau, r, dr, th, f, g
+  close (u)
+end program bits
+"""
+
+
+def test_native_and_portable_builds_give_identical_bits(flags, tmp_path):
+    """vecmath's own polynomials (no libmvec) and -ffp-contract=off make the kernels'
+    results independent of the instruction set: the same bits from both build flavours.
+    (The ujoint kernel before vecmath fails this: gfortran vectorised its cos/sin/atan2
+    loops with glibc's libmvec, whose AVX-512 and SSE variants round differently.)"""
+    base = [f for f in flags if not f.startswith(("-march=", "-mprefer-vector-width", "-mtune="))]
+    blobs = []
+    for arch, extra in (("portable", []), ("native", ["-march=native", "-mprefer-vector-width=512"])):
+        work = tmp_path / arch
+        work.mkdir()
+        objs = []
+        for src in kernel_sources():
+            obj = work / (src.stem + ".o")
+            subprocess.run(["gfortran", *base, *extra, "-c", str(src), "-J", str(work), "-o", str(obj)],
+                           check=True, capture_output=True, cwd=work)
+            objs.append(str(obj))
+        (work / "bits.f90").write_text(BITS_PROGRAM)
+        subprocess.run(["gfortran", *base, *extra, "-I", str(work), str(work / "bits.f90"), *objs, "-o", "bits"],
+                       check=True, capture_output=True, cwd=work)
+        subprocess.run([str(work / "bits")], check=True, cwd=work)
+        blobs.append((work / "bits.bin").read_bytes())
+    assert len(blobs[0]) > 100_000
+    assert blobs[0] == blobs[1]

@@ -1,0 +1,246 @@
+"""Every kernel benchmark in one table: cost per unit, ratio against its numpy baseline
+measured in the same run, and the target.
+
+    .venv/bin/python bench/run_all.py            # full sizes (about a minute on an idle machine)
+    .venv/bin/python bench/run_all.py --quick    # smaller sizes and fewer repeats
+
+Kernel and baseline calls are interleaved (kernel, baseline, kernel, ...), timed by the
+process's CPU time, and the median of each is taken, so a machine whose load changes
+during the run slows both alike and the ratio stays meaningful.  Each baseline is checked against its kernel before timing.  The
+detailed per-study benchmarks (bench_<study>.py) remain for the wider measurements
+(fresh vs reused buffers, searches, sweeps).  Exit status 0 whether or not targets are met:
+this reports, the test suite guards (tests/test_vectorisation.py).
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import statistics
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+import bench_fourbar  # noqa: E402
+import bench_manipulator  # noqa: E402
+import bench_slidercrank  # noqa: E402
+import bench_ujoint  # noqa: E402
+from driver import kernels  # noqa: E402
+from driver.slidercrank import MATERIALS, rayleigh  # noqa: E402
+
+
+@dataclass
+class Row:
+    """One benchmark line: cost per unit [s] of the kernel and its baseline, and targets."""
+    name: str
+    unit: str
+    kernel_s: float
+    baseline_s: float
+    target_s: float | None        # at most this many seconds per unit
+    target_ratio: float | None    # at least this many times faster than the baseline
+    limit: str                    # what bounds the kernel
+    floor_s: float | None = None  # time to just write the kernel's outputs (numpy fill), same run
+
+    @property
+    def ratio(self) -> float:
+        return self.baseline_s / self.kernel_s
+
+    def met(self) -> bool:
+        return ((self.target_s is None or self.kernel_s <= self.target_s)
+                and (self.target_ratio is None or self.ratio >= self.target_ratio))
+
+
+def interleaved(kernel: Callable[[], object], baseline: Callable[[], object], repeat: int,
+                kernel_per_round: int = 1, baseline_per_round: int = 1) -> tuple[float, float]:
+    """Median CPU time [s] of this process for one kernel call and one baseline call,
+    measured alternately (after one warm-up call of each).  CPU time, not wall time: on a
+    shared machine other processes' load then does not count (their cache and memory
+    traffic still does, which the interleaving spreads over both sides)."""
+    kernel()
+    baseline()
+    tk, tb = [], []
+    for _ in range(repeat):
+        t0 = time.process_time()
+        for _ in range(kernel_per_round):
+            kernel()
+        tk.append((time.process_time() - t0) / kernel_per_round)
+        t0 = time.process_time()
+        for _ in range(baseline_per_round):
+            baseline()
+        tb.append((time.process_time() - t0) / baseline_per_round)
+    return statistics.median(tk), statistics.median(tb)
+
+
+def write_floor(fill: Callable[[], object], repeat: int) -> float:
+    """Median CPU time [s] of writing the same output bytes with numpy (a memory-traffic floor)."""
+    fill()
+    times = []
+    for _ in range(repeat):
+        t0 = time.process_time()
+        fill()
+        times.append(time.process_time() - t0)
+    return statistics.median(times)
+
+
+def fourbar(n: int, repeat: int) -> list[Row]:
+    theta = np.linspace(0.0, 2 * np.pi, n)
+    link = (12.0, 5.0, 15.0, 9.0, 5.0, 0.0)
+    out = np.empty((n, 11), order="F")
+    sts = np.empty(n, dtype=np.int32)
+    kernels.fourbar_exact(theta, *link, out=out, status=sts)
+    ref = bench_fourbar.numpy_baseline(theta, *link, 1)
+    for j in range(11):
+        np.testing.assert_allclose(out[:, j], ref[j], rtol=1e-9, atol=1e-9)
+    tk, tb = interleaved(lambda: kernels.fourbar_exact(theta, *link, out=out, status=sts),
+                         lambda: bench_fourbar.numpy_baseline(theta, *link, 1), repeat)
+    floor = write_floor(lambda: (out.fill(0.0), sts.fill(0)), repeat)
+    rows = [Row("four-bar exact states (reused buffers)", "ns/position", tk / n, tb / n, 20e-9, 5.0,
+                "writes 92 B/position (11 float64 + int32 status); 1 sincos + 3 atan2 + 20 divisions (9 of them in the atan2) + 1 sqrt",
+                floor / n)]
+    u, v = 4.0, 2.0
+
+    def coupler_numpy():
+        c2, s2 = np.cos(out[:, 0]), np.sin(out[:, 0])
+        rx, ry = u * c2 - v * s2, u * s2 + v * c2
+        c, s = np.cos(theta), np.sin(theta)
+        w2, a2 = out[:, 7], out[:, 9]
+        q, om = link[1], link[4]
+        return (out[:, 3] + rx, out[:, 4] + ry, -q * om * s - w2 * ry, q * om * c + w2 * rx,
+                -q * om * om * c - a2 * ry - w2 * w2 * rx, -q * om * om * s + a2 * rx - w2 * w2 * ry)
+
+    got = kernels.fourbar_coupler_point(theta, out, sts, link[1], link[4], link[5], u, v)
+    for j, col in enumerate(coupler_numpy()):
+        np.testing.assert_allclose(got[:, j], col, rtol=1e-9, atol=1e-9)
+    tk, tb = interleaved(lambda: kernels.fourbar_coupler_point(theta, out, sts, link[1], link[4], link[5], u, v),
+                         coupler_numpy, repeat)
+    floor = write_floor(lambda: np.empty((n, 6), order="F").fill(0.0), repeat)
+    rows.append(Row("four-bar coupler point", "ns/position", tk / n, tb / n, None, None,
+                    "reads 44 B, writes 48 B/position (fresh array); 2 sincos", floor / n))
+    return rows
+
+
+def manipulator(n: int, samples: int, repeat: int) -> list[Row]:
+    rng = np.random.default_rng(0)
+    l1, l2 = rng.uniform(1, 7, n), rng.uniform(1, 7, n)
+    th1, th2 = rng.uniform(-np.pi, np.pi, n), rng.uniform(-np.pi, np.pi, n)
+    qd = np.asfortranarray(rng.uniform(-2, 2, (n, 2)))
+    qdd = np.asfortranarray(rng.uniform(-2, 2, (n, 2)))
+    m1, m2 = 10 * l1, 10 * l2
+    ker = kernels.manipulator_arm_states(l1, l2, th1, th2, qd, qdd, m1, m2, 9.8)
+    ref = bench_manipulator.numpy_arm_states(l1, l2, th1, th2, qd, qdd, m1, m2, 9.8)
+    for a, b in zip(ker, ref):
+        np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-9)
+    tk, tb = interleaved(lambda: kernels.manipulator_arm_states(l1, l2, th1, th2, qd, qdd, m1, m2, 9.8),
+                         lambda: bench_manipulator.numpy_arm_states(l1, l2, th1, th2, qd, qdd, m1, m2, 9.8),
+                         repeat)
+    floor = write_floor(lambda: [np.empty(shape, order="F").fill(0.0) for shape in ((n, 4), n, n, (n, 2))], repeat)
+    rows = [Row("2R manipulator: Jacobian, w, kappa, torques", "us/config", tk / n, tb / n, 0.04e-6, None,
+                "reads 80 B, writes 64 B/config (fresh arrays); 2 sincos + 1 division + 1 sqrt", floor / n)]
+    a1, a2 = rng.uniform(-np.pi, np.pi, 4), rng.uniform(-np.pi, np.pi, 4)
+    dl = np.asfortranarray(rng.uniform(-1e-3, 1e-3, (samples, 2)))
+    np.testing.assert_allclose(kernels.manipulator_position_errors(a1, a2, dl),
+                               bench_manipulator.numpy_position_errors(a1, a2, dl), rtol=1e-12)
+    tk, tb = interleaved(lambda: kernels.manipulator_position_errors(a1, a2, dl),
+                         lambda: bench_manipulator.numpy_position_errors(a1, a2, dl), repeat)
+    rows.append(Row("2R manipulator: position errors, 4 points", "ns/sample", tk / samples, tb / samples,
+                    None, None, "reads 16 B, writes 16 B/sample; 4 x 10 flops"))
+    return rows
+
+
+def ujoint(repeat: int) -> list[Row]:
+    m, beta, phi, rho = bench_ujoint.M, bench_ujoint.BETA, bench_ujoint.PHI, bench_ujoint.RHO
+    code = kernels.UJOINT_MODELS["exact"]
+    f = kernels.ujoint_objective(code, 0, beta, phi, rho, m, grad=False)
+    f = f[0] if isinstance(f, tuple) else f
+    assert math.isclose(f, bench_ujoint.numpy_objective("exact", beta, phi, rho), rel_tol=1e-10)
+    tk, tb = interleaved(lambda: kernels.ujoint_objective(code, 0, beta, phi, rho, m, grad=False),
+                         lambda: bench_ujoint.numpy_objective("exact", beta, phi, rho), repeat,
+                         kernel_per_round=200, baseline_per_round=20)
+    return [Row("Hooke joint: objective, 3 joints x 360 angles", "us/objective", tk, tb, 5e-6, None,
+                "180 points (period pi) x 3 joints: 1 division + 1 sqrt per point and joint; "
+                "Python call overhead ~1 us")]
+
+
+def slidercrank(n_el: int, spr: int, base_steps: int, repeat: int) -> list[Row]:
+    mat = MATERIALS["aluminium"]
+    rho_a, ea = mat["density"] * mat["area"], mat["youngs_modulus"] * mat["area"]
+    ei = mat["youngs_modulus"] * mat["second_moment"]
+    omega, r2, length, ms = bench_slidercrank.OMEGA, bench_slidercrank.R2, bench_slidercrank.LEN, bench_slidercrank.M_S
+    wb, wa, _ = kernels.slidercrank_frequencies(rho_a, ea, ei, length, ms)
+    alpha, beta = rayleigh(0.02, wb, wa)
+    dt = 2 * math.pi / (omega * spr)
+
+    def kernel(n_steps: int = spr) -> dict:
+        return kernels.slidercrank_simulate(n_el, r2, length, rho_a, ea, ei, 1.5e-3, ms, omega, dt, n_steps, 1,
+                                            n_steps, alpha, beta)
+
+    base = bench_slidercrank.NumpyKED(n_el, rho_a, ea, ei, omega, dt, alpha, beta)
+    ref = kernel(base_steps)["eps_ax"][0]
+    np.testing.assert_allclose(base.run(base_steps), ref, rtol=1e-6, atol=1e-12 * np.abs(ref).max())
+    tk, tb = interleaved(kernel, lambda: base.run(base_steps), repeat)
+    return [Row(f"slider-crank: {n_el} elements, {spr} steps", "ms/revolution", tk, tb / base_steps * spr,
+                100e-3, 10.0, "sequential banded triangular solves (latency of 2 x 6 multiply-adds per unknown)")]
+
+
+SCALE = {"ns/position": 1e9, "ns/sample": 1e9, "us/config": 1e6, "us/objective": 1e6, "ms/revolution": 1e3}
+
+
+def print_table(rows: list[Row]) -> None:
+    print(f"{'benchmark':<46}{'unit':>14}{'kernel':>10}{'numpy':>11}{'ratio':>8}   target")
+    for r in rows:
+        k = SCALE[r.unit]
+        tgt = []
+        if r.target_s is not None:
+            tgt.append(f"<= {r.target_s * k:g}")
+        if r.target_ratio is not None:
+            tgt.append(f">= {r.target_ratio:g}x")
+        verdict = ("met" if r.met() else "NOT met") if tgt else "-"
+        print(f"{r.name:<46}{r.unit:>14}{r.kernel_s * k:10.3f}{r.baseline_s * k:11.3f}{r.ratio:7.1f}x   "
+              f"{', '.join(tgt) or '-'} {verdict if tgt else ''}")
+    print("\nlimits (floor: numpy writing the same output bytes in the same run):")
+    for r in rows:
+        k = SCALE[r.unit]
+        floor = (f"; floor {r.floor_s * k:.3f} {r.unit.split('/')[0]}, kernel at {r.kernel_s / r.floor_s:.1f}x the floor"
+                 if r.floor_s else "")
+        print(f"  {r.name}: {r.limit}{floor}")
+
+
+def main(argv: list[str] | None = None) -> list[Row]:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="smaller sizes, fewer repeats")
+    ap.add_argument("--smoke", action="store_true", help="tiny sizes (the test suite's check that this runs)")
+    ap.add_argument("--only", choices=["fourbar", "manipulator", "ujoint", "slidercrank"], action="append",
+                    help="run only these studies (repeatable)")
+    args = ap.parse_args(argv)
+    only = set(args.only or ["fourbar", "manipulator", "ujoint", "slidercrank"])
+    if args.smoke:
+        sizes = dict(n=2048, samples=4096, n_el=20, spr=72, base_steps=4, repeat=2)
+    elif args.quick:
+        sizes = dict(n=200_000, samples=200_000, n_el=700, spr=1440, base_steps=20, repeat=5)
+    else:
+        sizes = dict(n=1_000_000, samples=1_000_000, n_el=700, spr=1440, base_steps=60, repeat=9)
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+    print(f"bench/run_all.py: cpu count {os.cpu_count()}, load average {load:.2f} at start, one thread, CPU time, "
+          f"medians of {sizes['repeat']} interleaved rounds\n")
+    rows: list[Row] = []
+    if "fourbar" in only:
+        rows += fourbar(sizes["n"], sizes["repeat"])
+    if "manipulator" in only:
+        rows += manipulator(sizes["n"] // 10 if not args.smoke else sizes["n"], sizes["samples"], sizes["repeat"])
+    if "ujoint" in only:
+        rows += ujoint(sizes["repeat"])
+    if "slidercrank" in only:
+        rows += slidercrank(sizes["n_el"], sizes["spr"], sizes["base_steps"], max(3, sizes["repeat"] // 3))
+    print_table(rows)
+    return rows
+
+
+if __name__ == "__main__":
+    main()
