@@ -10,12 +10,16 @@ imported after parsing, so ``--help`` and ``--version`` answer at once.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import errno
 import os
+import signal
 import sys
+import threading
 import traceback
 from pathlib import Path
 
-from driver import __version__
+from driver import __version__, limits
 from driver.export import FORMATS
 from driver.extras import MissingExtra, require
 from driver.study import study_names
@@ -23,6 +27,21 @@ from driver.study import study_names
 __all__ = ["main", "run_deck", "EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT"]
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+
+
+def _fs_error(exc: OSError) -> str:
+    """One line for a file-system fault: the path and the reason in words."""
+    reasons = {errno.ENOSPC: "no space left on the device", errno.EFBIG: "file too large (file size limit)",
+               errno.EROFS: "read-only file system", errno.EACCES: "permission denied",
+               errno.EPERM: "not permitted", errno.ENOTDIR: "a part of the path is a file, not a folder",
+               errno.EISDIR: "is a folder, not a file", errno.EDQUOT: "disk quota exceeded",
+               errno.ENAMETOOLONG: "file name too long"}
+    reason = reasons.get(exc.errno or 0, exc.strerror or str(exc))
+    if exc.strerror and exc.errno not in reasons:
+        reason = exc.strerror
+    where = exc.filename if exc.filename is not None else "output"
+    return f"cannot write {where}: {reason}"
+
 
 def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool, progress: bool,
              quiet: bool = False, sweep_options: dict | None = None) -> int:
@@ -57,8 +76,14 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool, progress:
     except MissingExtra as exc:
         print(f"error: {path}: {exc}", file=sys.stderr)
         return EXIT_FAILED
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, BrokenPipeError):
         raise
+    except OSError as exc:   # the file system: one line naming the path, then the next deck
+        print(f"error: {path}: {_fs_error(exc)}", file=sys.stderr)
+        return EXIT_FAILED
+    except MemoryError:
+        print(f"error: {path}: out of memory (see --max-memory)", file=sys.stderr)
+        return EXIT_FAILED
     except Exception as exc:  # a bug or an unexpected numerical failure: say so plainly
         print(f"error: {path}: run failed: {exc.__class__.__name__}: {exc}", file=sys.stderr)
         if os.environ.get("DRIVER_DEBUG"):
@@ -74,6 +99,14 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool, progress:
         print(f"error: {path}: {result.failure}", file=sys.stderr)
         return EXIT_FAILED
     return EXIT_OK
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, handled like Ctrl-C: temporaries removed, finished outputs kept."""
+
+
+def _on_sigterm(signum: int, frame: object) -> None:
+    raise Terminated()
 
 
 def keys_help(group: str) -> str | None:
@@ -169,8 +202,13 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
                         help="sweeps: run cases on this Dask distributed scheduler")
     parser.add_argument("--resume", action="store_true",
-                        help="sweeps: skip cases whose outputs are already complete; optimisations: replay "
-                             "the run's journal and compute only new designs")
+                        help="sweeps: skip cases whose outputs are already complete; optimisations: replay the run's journal and compute only new designs")
+    parser.add_argument("--max-memory", metavar="SIZE", default=None,
+                        help="refuse a deck (a sweep case) whose estimated memory is larger "
+                             "(e.g. 8G, 512M; default: half of this machine's memory)")
+    parser.add_argument("--max-work", metavar="SECONDS", default=None,
+                        help="refuse a deck (a sweep case) whose estimated work is longer "
+                             "(e.g. 600, 30min, 2h; default: 2 min)")
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     return parser
 
@@ -210,6 +248,10 @@ def _main(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
         except BrokenPipeError:
             sys.stderr.close()
             return EXIT_OK
+    try:
+        configured = limits.configure(args.max_memory, args.max_work)
+    except ValueError as exc:
+        parser.error(str(exc))
     formats = list(dict.fromkeys((["csv"] if args.csv else []) + args.formats))
     needs = ([("plot", "--plot")] if args.plot else []) + ([("parquet", "--format parquet")]
              if "parquet" in formats else []) + ([("dask", "--scheduler")] if args.scheduler else [])
@@ -222,10 +264,44 @@ def _main(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
     progress = sys.stderr.isatty() and not args.quiet and not os.environ.get("CI")
     sweep_options = {"jobs": args.jobs, "scheduler": args.scheduler, "resume": args.resume}
     status = EXIT_OK
+    handlers = _install_signals()
     try:
         for deck in args.decks:
-            status = max(status, run_deck(deck, outdir, formats, args.plot, progress, args.quiet, sweep_options))
-    except KeyboardInterrupt:
-        print("interrupted: finished outputs are complete; no partial file was left", file=sys.stderr)
-        return 130
+            try:
+                status = max(status, run_deck(deck, outdir, formats, args.plot, progress, args.quiet,
+                                             sweep_options))
+                sys.stdout.flush()
+            except BrokenPipeError:   # stdout closed early (e.g. piped into head): the files are
+                _quiet_stdout()       # written; go on with the other decks without printing
+    except KeyboardInterrupt as exc:
+        what = "terminated" if isinstance(exc, Terminated) else "interrupted"
+        print(f"{what}: finished outputs are complete; no partial file was left", file=sys.stderr)
+        return 143 if isinstance(exc, Terminated) else 130
+    finally:
+        _restore_signals(handlers)
+        limits.restore(configured)
     return status
+
+
+def _quiet_stdout() -> None:
+    """After a broken pipe: point stdout at /dev/null so the interpreter's final flush is silent."""
+    with contextlib.suppress(OSError, ValueError):
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+
+
+def _install_signals() -> dict:
+    """SIGTERM like Ctrl-C; SIGXFSZ ignored so a file size limit is an EFBIG error, not a kill."""
+    old = {}
+    if threading.current_thread() is not threading.main_thread():
+        return old
+    for sig, handler in ((getattr(signal, "SIGTERM", None), _on_sigterm),
+                         (getattr(signal, "SIGXFSZ", None), signal.SIG_IGN)):
+        if sig is not None:
+            old[sig] = signal.signal(sig, handler)
+    return old
+
+
+def _restore_signals(old: dict) -> None:
+    for sig, handler in old.items():
+        signal.signal(sig, handler)

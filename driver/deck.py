@@ -16,7 +16,11 @@ the line and the key.  The four-bar listing's own terminal input (three lines
 from __future__ import annotations
 
 import math
+import os
 import re
+import stat
+import unicodedata
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -132,12 +136,207 @@ class Params(Mapping):
         return DeckError(self.path, self.line_of(key) if key else self.line, key, message)
 
 
+# --------------------------------------------------------------------------- reading the file
+
+#: a deck larger than this is refused without reading it all (the largest shipped deck is < 4 KiB)
+MAX_DECK_BYTES = 1 << 20
+#: a repeat count ``n*value`` and the values of one key are capped before f90nml expands them
+MAX_VALUES = 10_000
+
+
+def _read_text(path: Path) -> str:
+    """The deck's text: a regular UTF-8 file of at most MAX_DECK_BYTES, BOM dropped, newlines unified."""
+    try:
+        st = os.stat(path)
+        if stat.S_ISDIR(st.st_mode):
+            raise DeckError(path, None, None, "is a folder, not a deck file")
+        if not stat.S_ISREG(st.st_mode):
+            raise DeckError(path, None, None, "is not a regular file (a FIFO, socket or device); "
+                            "decks are read from ordinary files only")
+        if st.st_size > MAX_DECK_BYTES:
+            raise DeckError(path, None, None, f"deck is {st.st_size} bytes; decks larger than "
+                            f"{MAX_DECK_BYTES} bytes are refused (a deck is a few lines of text)")
+        with open(path, "rb") as fh:
+            data = fh.read(MAX_DECK_BYTES + 1)
+    except OSError as exc:
+        raise DeckError(path, None, None, f"cannot read deck: {exc.strerror or exc}") from None
+    if len(data) > MAX_DECK_BYTES:   # grew while we looked
+        raise DeckError(path, None, None, f"deck is larger than {MAX_DECK_BYTES} bytes")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data[:exc.start].count(b"\n") + 1
+        col = exc.start - (data.rfind(b"\n", 0, exc.start) + 1) + 1
+        raise DeckError(path, line, None, f"column {col}: byte 0x{data[exc.start]:02x} is not UTF-8 text "
+                        "(is this a binary file?)") from None
+
+
+def _normalise(text: str) -> str:
+    """Drop a UTF-8 byte-order mark; CRLF and lone CR line ends become LF."""
+    if text.startswith("\ufeff"):
+        text = text[1:]
+    return text.replace("\r\n", "\n").replace("\r", "\n")
+
+
+# --------------------------------------------------------------------------- pre-scan
+
+@dataclass
+class _Item:
+    """One ``key = value`` of a group as found by the pre-scan."""
+
+    group: str
+    key: str
+    line: int
+    text: str          # the value text (strings kept), possibly over several lines
+    count: int = 0     # number of values after repeat-count expansion
+
+
+def _code_mask(path: Path, n: int, line: str) -> tuple[str, str]:
+    """(code, raw code): the line without its comment, and with strings blanked to '0's.
+
+    Checks on the way that no string is left open and that the code outside strings and
+    comments is printable ASCII (a Unicode minus pasted from a PDF is an error, not dropped).
+    """
+    quote, start = None, 0
+    code = []
+    for i, ch in enumerate(line):
+        if quote:
+            code.append("0" if ch != quote else ch)
+            if ch == quote:
+                quote = None
+            continue
+        if ch in "'\"":
+            quote, start = ch, i
+            code.append(ch)
+            continue
+        if ch == "!":
+            line = line[:i]
+            break
+        if not (" " <= ch <= "~" or ch == "\t"):
+            name = unicodedata.name(ch, "") if ch.isprintable() else "a control character"
+            hint = " (write an ASCII '-')" if ch in _DASHES else ""
+            raise DeckError(path, n, None, f"column {i + 1}: character {ch!r} (U+{ord(ch):04X} "
+                            f"{name}) is not allowed outside comments and strings{hint}")
+        code.append(ch)
+    if quote:
+        raise DeckError(path, n, None, f"column {start + 1}: string not closed on this line")
+    return "".join(code), line
+
+
+_DASHES = "\u2212\u2010\u2011\u2012\u2013\u2014\ufe63\uff0d"
+_NAME_EQ = re.compile(r"(?<![\w.%])([A-Za-z_]\w*)\s*(\([^)]*\)|%\s*\w+)?\s*=")
+_REPEAT = re.compile(r"(?<![\w.])(\d+)\s*\*")
+
+
+def _count_values(text: str) -> int:
+    """Number of values in a value text (strings already blanked), repeat counts expanded."""
+    n = 0
+    for tok in re.split(r"[\s,]+", text.strip()):
+        if not tok:
+            continue
+        m = re.match(r"(\d+)\s*\*", tok)
+        n += (int(m.group(1)) if len(m.group(1)) <= 6 else 10**6) if m else 1
+    return max(n, 1)
+
+
+def _prescan(path: Path, text: str) -> tuple[list[tuple[str, int]], list[_Item]]:
+    """Check the deck's layout line by line before f90nml sees it.
+
+    Returns the groups (name, line) in order and every key item.  Refused (DeckError with
+    line and key): non-ASCII outside comments and strings, text outside a group, text after
+    a group's closing '/', a group not closed, array subscripts and derived-type components
+    on keys, a key given twice, repeat counts and lists beyond MAX_VALUES values.
+    """
+    groups: list[tuple[str, int]] = []
+    items: list[_Item] = []
+    current: str | None = None
+    group_line = 0
+    seen: dict[str, dict[str, int]] = {}
+    item: _Item | None = None
+    for n, raw_line in enumerate(text.split("\n"), start=1):
+        code, raw = _code_mask(path, n, raw_line)
+        pos, after_slash = 0, None
+        while pos < len(code):
+            if current is None:
+                m = re.compile(r"\s*").match(code, pos)
+                pos = m.end()
+                if pos >= len(code):
+                    break
+                g = re.compile(r"[&$]\s*([A-Za-z_]\w*)").match(code, pos)
+                if g and g.group(1).lower() != "end":
+                    current, group_line, item = g.group(1).lower(), n, None
+                    groups.append((current, n))
+                    seen.setdefault(current, {})
+                    pos = g.end()
+                    after_slash = None
+                    continue
+                rest = raw[pos:].strip()
+                if after_slash is not None:
+                    raise DeckError(path, n, None, f"column {pos + 1}: text after the closing '/' of "
+                                    f"&{after_slash}: {rest!r} (a '/' ends the group, also inside a value "
+                                    "such as 360/7: write the number itself)")
+                if code[pos] == "/" or (g and g.group(1).lower() == "end"):
+                    raise DeckError(path, n, None, f"column {pos + 1}: '{rest[:4]}' closes no group")
+                raise DeckError(path, n, None, f"column {pos + 1}: text outside a namelist group: {rest!r} "
+                                "(a group starts with '&name' and ends with '/')")
+            # inside a group: up to the closing '/' (or '&end'), or the end of the line
+            end = re.compile(r"/|[&$]\s*end\b|[&$]", re.IGNORECASE).search(code, pos)
+            stop = end.start() if end else len(code)
+            segment = code[pos:stop]
+            keys = list(_NAME_EQ.finditer(segment))
+            cut = 0
+            stray = re.compile(r"=").search(_NAME_EQ.sub(lambda m: " " * len(m.group()), segment))
+            if stray:
+                raise DeckError(path, n, item.key if item else None,
+                                f"column {pos + stray.start() + 1}: '=' without a key name before it")
+            for km in keys:
+                if item is not None:
+                    item.text += raw[pos + cut:pos + km.start()] + " "
+                elif segment[cut:km.start()].strip(" \t,"):
+                    raise DeckError(path, n, None, f"column {pos + cut + 1}: value without a key: "
+                                    f"{raw[pos + cut:pos + km.start()].strip()!r}")
+                key = km.group(1).lower()
+                if km.group(2):
+                    what = "array subscripts" if km.group(2).startswith("(") else "derived-type components"
+                    raise DeckError(path, n, key, f"{what} are not supported ('{km.group(0).rstrip('= ')}'): "
+                                    "give the whole list, e.g. key = 1, 2, 4")
+                if key in seen[current]:
+                    raise DeckError(path, n, key, f"given twice in &{current}: on line {seen[current][key]} "
+                                    f"and on line {n} (keep one)")
+                seen[current][key] = n
+                item = _Item(current, key, n, "")
+                items.append(item)
+                cut = km.end()
+            tail = raw[pos + cut:stop]
+            if item is not None:
+                item.text += tail + " "
+            elif segment[cut:].strip(" \t,"):
+                raise DeckError(path, n, None, f"column {pos + cut + 1}: value without a key: "
+                                f"{segment[cut:].strip()!r}")
+            if end is None:
+                pos = len(code)
+                break
+            if end.group(0) in "&$" and not end.group(0).lower().endswith("end"):
+                nxt = re.compile(r"[&$]\s*(\w*)").match(code, stop)
+                raise DeckError(path, n, None, f"group &{current} (line {group_line}) is not closed with '/' "
+                                f"before '&{nxt.group(1) if nxt else ''}'")
+            after_slash, current, item = current, None, None
+            pos = end.end()
+    if current is not None:
+        raise DeckError(path, group_line, None, f"group &{current} is not closed (end it with '/')")
+    for it in items:
+        blank, _ = _code_mask(path, it.line, it.text)
+        big = [m.group(1) for m in _REPEAT.finditer(blank) if len(m.group(1)) > 6 or int(m.group(1)) > MAX_VALUES]
+        if big:
+            raise DeckError(path, it.line, it.key, f"repeat count {big[0][:20]}* is beyond {MAX_VALUES} values "
+                            "(checked before anything is expanded)")
+        it.count = _count_values(blank)
+        if it.count > MAX_VALUES:
+            raise DeckError(path, it.line, it.key, f"{it.count} values; at most {MAX_VALUES} are read per key")
+    return groups, items
+
+
 # --------------------------------------------------------------------------- parsing
-
-_GROUP_RE = re.compile(r"^\s*[&$]\s*([A-Za-z_]\w*)")
-_END_RE = re.compile(r"^\s*(/|[&$]\s*end\b)", re.IGNORECASE)
-_KEY_RE = re.compile(r"(?:^|[\s,])([A-Za-z_]\w*)\s*(?:\([^)]*\))?\s*=")
-
 
 def _strip_comment(line: str) -> str:
     """Remove a trailing ``!`` comment, respecting quoted strings."""
@@ -151,33 +350,6 @@ def _strip_comment(line: str) -> str:
         elif ch == "!":
             return line[:i]
     return line
-
-
-def _blank_strings(line: str) -> str:
-    """Replace quoted text by blanks so key scanning ignores ``=`` inside strings."""
-    return re.sub(r"'[^']*'|\"[^\"]*\"", lambda m: " " * len(m.group()), line)
-
-
-def _scan_lines(text: str) -> tuple[list[tuple[str, int]], dict[str, dict[str, int]]]:
-    """Groups (name, line) in order and the first line of every key in each group."""
-    groups: list[tuple[str, int]] = []
-    keys: dict[str, dict[str, int]] = {}
-    current = None
-    for n, raw in enumerate(text.splitlines(), start=1):
-        line = _blank_strings(_strip_comment(raw))
-        m = _GROUP_RE.match(line)
-        if m and not _END_RE.match(line):
-            current = m.group(1).lower()
-            groups.append((current, n))
-            keys.setdefault(current, {})
-            line = line[m.end():]
-        if current is None:
-            continue
-        for km in _KEY_RE.finditer(line):
-            keys[current].setdefault(km.group(1).lower(), n)
-        if re.search(r"(^|\s)/\s*$", line) or _END_RE.match(line):
-            current = None
-    return groups, keys
 
 
 def _is_legacy(text: str) -> bool:
@@ -221,19 +393,45 @@ def _plain(value: Any) -> Any:
     return value
 
 
+def _f90nml_reads(text: str) -> tuple[Any, list[str]]:
+    """f90nml's parse of ``text`` with its warnings captured (never printed)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        nml = f90nml.reads(text)
+    return nml, [str(w.message) for w in caught]
+
+
+def _locate(path: Path, items: list[_Item], exc: Exception | None) -> DeckError:
+    """The deck error for an f90nml failure or misread: the first item that fails alone."""
+    for it in items:
+        try:
+            _, warned = _f90nml_reads(f"&{it.group}\n{it.key} = {it.text}\n/\n")
+        except Exception:   # f90nml raises ValueError, AssertionError, IndexError, StopIteration...
+            return DeckError(path, it.line, it.key, f"cannot read the value {it.text.strip()[:60]!r} "
+                             "(numbers, 'strings' in quotes, .true./.false., lists separated by commas)")
+        if warned:
+            return DeckError(path, it.line, it.key, f"cannot read the value {it.text.strip()[:60]!r}: "
+                             "part of it would be dropped")
+    what = "values not assigned to any key" if exc is None else "namelist syntax error"
+    return DeckError(path, None, None, what)
+
+
 def read_deck(path: str | Path, text: str | None = None) -> Deck:
-    """Parse a deck file (or ``text`` attributed to ``path``) into raw groups."""
+    """Parse a deck file (or ``text`` attributed to ``path``) into raw groups.
+
+    The text is pre-scanned (:func:`_prescan`) so that everything f90nml would silently
+    misread is a :class:`DeckError` with line and key, and repeat counts are capped before
+    f90nml expands them.
+    """
     path = Path(path)
     if text is None:
-        try:
-            text = path.read_text()
-        except OSError as exc:
-            raise DeckError(path, None, None, f"cannot read deck: {exc.strerror}") from None
-        except UnicodeDecodeError:
-            raise DeckError(path, None, None, "deck is not a text file") from None
+        text = _read_text(path)
+    text = _normalise(text)
+    for n, line in enumerate(text.split("\n"), start=1):   # non-ASCII is an error in legacy decks too
+        _code_mask(path, n, line)
     if _is_legacy(text):
         return _read_legacy(path, text)
-    order, key_lines = _scan_lines(text)
+    order, items = _prescan(path, text)
     if not order:
         raise DeckError(path, None, None, "no namelist group found (a deck starts a group with '&name')")
     seen: dict[str, int] = {}
@@ -242,16 +440,21 @@ def read_deck(path: str | Path, text: str | None = None) -> Deck:
             raise DeckError(path, line, None, f"group &{name} given twice (first on line {seen[name]})")
         seen[name] = line
     try:
-        nml = f90nml.reads(text)
-    except Exception as exc:  # f90nml raises ValueError, StopIteration, IndexError, ...
-        msg = str(exc) or exc.__class__.__name__
-        m = re.search(r"line (\d+)", msg)
-        raise DeckError(path, int(m.group(1)) if m else None, None,
-                        f"namelist syntax error: {msg}") from None
+        nml, warned = _f90nml_reads(text)
+    except Exception as exc:  # f90nml raises ValueError, StopIteration, IndexError, AssertionError...
+        raise _locate(path, items, exc) from None
+    if warned:
+        raise _locate(path, items, None)
+    key_lines: dict[str, dict[str, int]] = {}
+    for it in items:
+        key_lines.setdefault(it.group, {})[it.key] = it.line
     groups: dict[str, RawGroup] = {}
     for name, line in order:
         raw = nml.get(name, {}) or {}
         values = {k.lower(): _plain(v) for k, v in raw.items()}
+        if set(values) != set(key_lines.get(name, {})):   # f90nml read keys the pre-scan did not see
+            raise DeckError(path, line, None, f"cannot read &{name}: its keys are "
+                            f"{sorted(key_lines.get(name, {}))} but the namelist reader found {sorted(values)}")
         groups[name] = RawGroup(name, values, key_lines.get(name, {}), line)
     return Deck(path, groups)
 

@@ -18,6 +18,7 @@ import pandas as pd
 from scipy.optimize import brentq, minimize_scalar
 
 from driver import kernels
+from driver.limits import Estimate
 from driver.deck import GroupSpec, Key, Params, positive
 from driver.study import Figure, Result
 from driver.table import Column, fortran_f, render_table
@@ -443,6 +444,35 @@ def _figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> list[F
                                         point=None if cp is None else cp[:, :2])
 
     return [Figure("curves", curves), Figure("linkage", linkage)]
+
+
+def estimate(params: Params) -> Estimate:
+    """Memory and work of a run from the keys alone (driver.limits): per crank angle a table row
+    (text, two tidy frames, kernel columns; about 2 KB and 50 us of Python formatting), and the
+    0.5 deg grid of the extremes over the crank range (about 500 bytes and 1 us a point)."""
+    p = params
+    try:
+        n = float(math.floor((p.stop_deg - p.start_deg) / p.step_deg + 1e-9) + 1)
+    except (OverflowError, ZeroDivisionError, ValueError):
+        n = math.inf
+    n = max(n, 1.0)
+    span = abs(p.stop_deg - p.start_deg) / 0.5 + 1.0
+    range_key = "start_deg" if "start_deg" in p.given else ("stop_deg" if "stop_deg" in p.given else "step_deg")
+    rows = Estimate(2000.0 * n + 5e6, 5e-5 * n + 0.05, "step_deg", "step_deg", f"{n:.4g} crank angles")
+    grid = Estimate(500.0 * span, 1e-6 * span, range_key, range_key,
+                    f"a {span:.4g}-point grid over the crank range for the extremes")
+    return rows + grid
+
+
+def blame(params: Params, exc: BaseException) -> tuple[str, str] | None:
+    """The key and words for a numerical failure of a run (driver.runner.numerical_error)."""
+    p = params
+    g = grashof(p.fixed_link, p.crank, p.coupler, p.rocker)
+    if p.method == "listing" and g.name.startswith("change-point"):
+        return ("method", f"the listing's formulas divide 0 by 0 for this change-point linkage ({g.condition}) "
+                          "where it folds flat, so its table has no finite value there; use method = 'exact' "
+                          "(the closed-loop solution names both branches at the fold)")
+    return None
 
 
 # ----------------------------------------------------------------------------- run

@@ -36,6 +36,7 @@ from scipy.optimize import minimize
 
 from driver import kernels
 from driver.deck import GroupSpec, Key, Params, non_empty, positive
+from driver.limits import Estimate
 from driver.study import Figure, Result
 from driver.table import Column, fortran_f, render_table
 
@@ -705,6 +706,29 @@ def _summary(p: Params, ws: Workspace, conv: Conv, used: dict, sweep: dict, tol:
                   "sweep_min_l2_m": float(sweep["l2"][k]), "sweep_min_row": k + 1,
                   "sweep_min_reaches_workspace": bool(sweep["reach_all"][k])})
     return s
+
+
+def estimate(params: Params) -> Estimate:
+    """Memory and work of a run from the keys alone (driver.limits): the Monte Carlo check holds
+    mc_samples x points errors (about 64 bytes and 50 ns each), every row of the C_rob sweep is a
+    small design evaluation (about 2 ms), the designs tables a few us per design and point."""
+    p = params
+    pts = max(len(p.points_x), len(p.points_y))
+    designs = len(p.designs_l1 or []) + len(p.crob_l1 or []) + 10
+    mc = Estimate(64.0 * p.mc_samples * pts, 5e-8 * p.mc_samples * pts, "mc_samples", "mc_samples",
+                  f"{p.mc_samples} Monte Carlo samples x {pts} points")
+    if p.sweep_count > 0:
+        rows = float(p.sweep_count)
+    else:   # up to the C_rob radius, bounded by the workspace's size
+        reach = max(math.hypot(x, y) for x, y in zip(p.points_x, p.points_y)) if pts else 1.0
+        try:
+            rows = (10.0 * reach + 10.0) / p.sweep_l1_step + 1.0
+        except (OverflowError, ZeroDivisionError):
+            rows = math.inf
+    sweep = Estimate(2000.0 * rows, 2e-3 * rows, "sweep_count" if p.sweep_count > 0 else "sweep_l1_step",
+                     "sweep_count" if p.sweep_count > 0 else "sweep_l1_step", f"{rows:.4g} sweep rows")
+    tables = Estimate(1e4 * designs * pts + 5e6, 5e-6 * designs * pts, "points_x", "points_x", "")
+    return mc + sweep + tables
 
 
 def run(params: Params, progress: bool = False) -> Result:

@@ -28,6 +28,7 @@ import numpy as np
 import pandas as pd
 
 from driver.deck import GroupSpec, Key, Params, non_empty, positive
+from driver.limits import Estimate
 from driver.study import Result
 from driver.table import Column, render_table
 
@@ -185,6 +186,13 @@ def _compare(name: str, printed: list[float] | None, computed: np.ndarray,
         if not ok:
             flags.append(f"{name}[{i}]: printed {text}, computed {c:.10g}")
     return lines, flags
+
+
+def estimate(params: Params) -> Estimate:
+    """Memory and work from the keys alone (driver.limits): least-squares fits of a few dozen
+    numbers; the lists are bounded by the deck reader (10 000 values per key)."""
+    n = len(params.dual_y) + len(params.taguchi_y) + len(params.taguchi_targets) * len(params.taguchi_offsets)
+    return Estimate(1e6 + 1e3 * n, 0.05 + 1e-5 * n, "taguchi_y", "taguchi_y", f"{n} observations")
 
 
 def run(params: Params, progress: bool = False) -> Result:

@@ -7,18 +7,24 @@ exits; it raises :class:`~driver.deck.DeckError` for bad input and returns what 
 from __future__ import annotations
 
 import pkgutil
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
 
+import numpy as np
+
 import driver
-from driver.atomic import write_text
+from driver import limits
+from driver.atomic import inside, output_set, remove_stale_temporaries, write_text
 from driver.deck import Deck, DeckError, Params
 from driver.deck import validate
-from driver.export import write_tidy
+from driver.export import FORMATS, write_tidy
 from driver.study import Result, load_study
+from driver.table import TableValueError
 
-__all__ = ["CONTROL_GROUPS", "Outcome", "available_studies", "study_of", "run_study", "write_outputs"]
+__all__ = ["CONTROL_GROUPS", "Outcome", "available_studies", "study_of", "run_study", "write_outputs",
+           "output_stem", "check_finite", "compute", "numerical_error"]
 
 #: groups handled by the driver itself rather than by a study module
 CONTROL_GROUPS = ("sweep", "optimize", "synthesis")
@@ -55,18 +61,109 @@ def study_of(deck: Deck) -> tuple[ModuleType, Params]:
     return module, validate(raw, module.SPEC, deck.path)
 
 
+def output_stem(outdir: str | Path, deck_path: str | Path) -> Path:
+    """``OUTDIR/<deck stem>``, refused (DeckError) unless every output named after it stays in OUTDIR.
+
+    A deck named ``..dat`` has the stem ``.``, ``...dat`` the stem ``..``: their outputs would
+    land beside or above OUTDIR.
+    """
+    name = Path(deck_path).name
+    stem = name[: -len(Path(name).suffix)] if Path(name).suffix else name
+    candidate = Path(outdir) / stem
+    if not stem or stem.strip(".") == "" or "/" in stem or "\\" in stem or not inside(outdir, candidate):
+        raise DeckError(deck_path, None, None, f"outputs are named after the deck file, and {name!r} would name "
+                        f"them outside the output folder {outdir}: rename the deck (e.g. case.dat)")
+    return candidate
+
+
 def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool) -> list[Path]:
-    """Write the .out file, extra files, tidy tables and figures for one case (all atomic)."""
-    written = [write_text(stem.with_name(stem.name + ".out"), result.text)]
-    for suffix, text in result.extra.items():
-        written.append(write_text(stem.with_name(stem.name + suffix), text))
-    for fmt in formats:
-        written.append(write_tidy(result.tidy, stem, fmt))
-    if plot and result.figures:
-        from driver.plotting import save_figure
-        for fig in result.figures:
-            written.append(save_figure(fig.draw(), stem.with_name(f"{stem.name}_{fig.name}.png")))
+    """Write the .out file, extra files, tidy tables and figures for one case.
+
+    The files form one set (:func:`driver.atomic.output_set`): all are renamed into place
+    together once every one is complete, or none is.  Stale temporaries of this stem left
+    by a killed earlier run are removed first.
+    """
+    remove_stale_temporaries(stem.parent, stem.name)
+    written: list[Path] = []
+    with output_set(stem.parent):
+        written.append(write_text(stem.with_name(stem.name + ".out"), result.text))
+        for suffix, text in result.extra.items():
+            written.append(write_text(stem.with_name(stem.name + suffix), text))
+        for fmt in formats:
+            written.append(write_tidy(result.tidy, stem, fmt))
+        if plot and result.figures:
+            from driver.plotting import save_figure
+            for fig in result.figures:
+                written.append(save_figure(fig.draw(), stem.with_name(f"{stem.name}_{fig.name}.png")))
+    # the set replaces an earlier run's: its tidy tables in formats not written now go
+    for fmt in FORMATS:
+        old = stem.with_name(f"{stem.name}.{fmt}")
+        if fmt not in formats and old.is_file():
+            old.unlink()
     return written
+
+
+#: exceptions that bad input can reach inside a study: they become deck errors in words
+NUMERICAL = (ArithmeticError, FloatingPointError, np.linalg.LinAlgError, ValueError, MemoryError)
+
+_WORDS = [(TableValueError, "a result that is not a finite number"),
+          (ZeroDivisionError, "a division by zero"),
+          (OverflowError, "a number beyond the range of floating point"),
+          (FloatingPointError, "an invalid floating-point operation"),
+          (np.linalg.LinAlgError, "a singular system of equations"),
+          (MemoryError, "more memory than the machine has (see --max-memory)"),
+          (ArithmeticError, "an arithmetic error"),
+          (ValueError, "a value outside what the computation accepts")]
+
+_NON_FINITE = re.compile(r"(?<![A-Za-z_])(nan|[+-]?inf(inity)?)(?![A-Za-z_])|\*\*\*\*", re.IGNORECASE)
+
+
+def numerical_error(params: Params, exc: BaseException) -> DeckError:
+    """The deck error for a numerical failure reached from ``params``.
+
+    A study may define ``blame(params, exc) -> (key, message) | None`` to name the key; otherwise
+    the error is placed at the group and lists the keys the deck gave.
+    """
+    module = load_study(params.group)
+    blamed = module.blame(params, exc) if module is not None and hasattr(module, "blame") else None
+    if blamed:
+        return params.error(*blamed)
+    words = next(w for cls, w in _WORDS if isinstance(exc, cls))
+    detail = str(exc).strip().splitlines()[0][:120] if str(exc).strip() else exc.__class__.__name__
+    given = ", ".join(sorted(params.given)) or "none"
+    return params.error(None, f"the values of &{params.group} lead to {words} ({detail}); this case cannot "
+                        f"be computed (keys given: {given})")
+
+
+def check_finite(result: Result, params: Params) -> Result:
+    """DeckError when a NaN, an infinity or a '****' overflow field would reach a table."""
+    texts = [("the .out table", result.text), *((f"the {s} file", x) for s, x in result.extra.items())]
+    for what, text in texts:
+        m = _NON_FINITE.search(text)
+        if m:
+            line = text.count("\n", 0, m.start()) + 1
+            raise numerical_error(params, TableValueError(
+                f"'{m.group(0)}' would be written on line {line} of {what}"))
+    num = result.tidy.select_dtypes("number") if result.tidy is not None else None
+    if num is not None and num.size and not np.isfinite(num.to_numpy(dtype=float, na_value=0.0)).all():
+        bad = [c for c in num.columns if not np.isfinite(num[c].to_numpy(dtype=float, na_value=0.0)).all()]
+        raise numerical_error(params, TableValueError(f"non-finite values in column {bad[0]} of the tidy table"))
+    return result
+
+
+def compute(module: ModuleType, params: Params, progress: bool = False) -> Result:
+    """``module.run(params)`` within the budget (:mod:`driver.limits`), with numerical failures
+    turned into deck errors and the result checked for non-finite numbers (no NaN, inf or '****'
+    ever reaches a table)."""
+    limits.check(module, params)   # absurd requests are refused before anything is allocated
+    try:
+        with np.errstate(all="ignore"):
+            result = module.run(params, progress=progress)
+    except DeckError:
+        raise
+    except NUMERICAL as exc:
+        raise numerical_error(params, exc) from None
+    return check_finite(result, params)
 
 
 @dataclass
@@ -84,6 +181,6 @@ def run_study(deck: Deck, outdir: Path | None, formats: list[str], plot: bool,
     Raises DeckError for bad input (nothing is written then); other exceptions are run failures.
     """
     module, params = study_of(deck)
-    result = module.run(params, progress=progress)
-    written = [] if outdir is None else write_outputs(result, Path(outdir) / Path(deck.path).stem, formats, plot)
+    result = compute(module, params, progress=progress)
+    written = [] if outdir is None else write_outputs(result, output_stem(outdir, deck.path), formats, plot)
     return Outcome(result, written)

@@ -21,6 +21,7 @@ import pandas as pd
 from tqdm import tqdm
 
 from driver import kernels
+from driver.limits import Estimate
 from driver.deck import GroupSpec, Key, Params, non_negative, positive
 from driver.study import Figure, Result
 from driver.table import Column, render_table
@@ -541,6 +542,32 @@ def _benchmark_lines(params: Params, case: Case) -> list[str]:
         lines += ["", "  Reference: Simeon (1996), IVP test set 'crank' (MEBDFI, tol 1e-14): 2 lateral sine modes,",
                   "  quadratic axial field, full rigid-elastic coupling; this model is linear KED (eq. 23)."]
     return lines
+
+
+def estimate(params: Params) -> Estimate:
+    """Memory and work of a run from the keys alone (driver.limits): every (speed, element count)
+    integrates n_steps Newmark steps over 3 (n + 1) degrees of freedom (banded, about 0.2 us per
+    dof and step) and records one revolution of states."""
+    p = params
+    counts = list(p.element_counts) if p.element_counts else [p.n_elements]
+    work, mem, steps_max = 0.0, 0.0, 0.0
+    for w in p.speeds:
+        if p.end_time > 0:
+            steps = p.end_time * w * p.steps_per_rev / (2 * math.pi) + 1.0
+            rec = 1.0
+        else:
+            steps = float(p.revolutions) * p.steps_per_rev
+            rec = p.steps_per_rev + 1.0
+        steps_max = max(steps_max, steps)
+        for n in counts:
+            dof = 3.0 * (n + 1)
+            work += 2e-7 * dof * steps
+            mem = max(mem, dof * 8.0 * 40 + rec * (dof * 8.0 * 3 + 400.0))
+    key = "end_time" if p.end_time > 0 else ("steps_per_rev" if p.steps_per_rev > 100_000 else
+                                             ("element_counts" if p.element_counts else "n_elements"))
+    wkey = key if key != "n_elements" or len(p.speeds) < 100 else "speeds"
+    return Estimate(mem + 5e6, work + 0.1, key, wkey,
+                    f"{len(p.speeds)} speed(s) x {len(counts)} element count(s), up to {steps_max:.4g} time steps")
 
 
 def run(params: Params, progress: bool = False) -> Result:

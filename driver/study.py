@@ -22,7 +22,7 @@ if TYPE_CHECKING:   # annotations only: keeps `python -m driver --help` light
 
 __all__ = ["Figure", "Result", "load_study", "study_names"]
 
-_CORE = {"cli", "deck", "study", "table", "export", "plotting", "atomic", "kernels", "sweep", "runner", "expr",
+_CORE = {"cli", "limits", "deck", "study", "table", "export", "plotting", "atomic", "kernels", "sweep", "runner", "expr",
          "optimize", "synthesis", "published", "compare", "extras", "example_decks", "examples"}
 
 

@@ -20,7 +20,8 @@ and run exactly as a single run would be.  Outputs, for a deck ``<stem>.dat``:
   column for every swept key.
 
 Cases run in worker processes (``--jobs``, default all cores) or on a Dask
-cluster (``--scheduler ADDRESS`` or ``scheduler = '...'``), in chunks sized so
+cluster (``--scheduler ADDRESS`` or Dask's ``scheduler-address`` configuration; never
+the deck: a deck naming a scheduler is refused), in chunks sized so
 that scheduling costs little; results are ordered by case whatever the
 scheduling.  ``--resume`` skips cases whose outputs are complete.
 """
@@ -42,19 +43,40 @@ import f90nml
 import numpy as np
 import pandas as pd
 
-from driver import expr
-from driver.atomic import write_text
+from driver import expr, limits
+from driver.atomic import output_set, remove_stale_temporaries, write_text
 from driver.deck import Deck, DeckError, GroupSpec, Key, Params, RawGroup, validate
 from driver.export import write_tidy
 from driver.extras import require
-from driver.runner import study_of, write_outputs
+from driver.runner import compute, output_stem, study_of, write_outputs
 from driver.study import load_study
 from driver.table import Column, render_table
 
 __all__ = ["SPEC", "Case", "build_cases", "run_sweep_deck", "run_task", "auto_chunk", "MAX_KEYS"]
 
 MAX_KEYS = 9
+#: most cases one sweep deck may have (the shipped design search has 102 400)
+MAX_CASES = 1_000_000
+#: sweeps up to this many cases have every case validated before anything runs
+FULL_VALIDATION = 5_000
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+
+
+def _no_scheduler_in_deck(value: str) -> str:
+    """Key check of ``scheduler``: a deck never chooses where the tool connects."""
+    return ("a deck may not choose the Dask scheduler: Dask deserialises what a scheduler sends, so a "
+            "hostile address in a shared deck would run code on your machine; remove the key and give "
+            "the address on the command line (--scheduler ADDRESS) or in Dask's configuration "
+            "(scheduler-address, e.g. the environment variable DASK_SCHEDULER_ADDRESS)")
+
+
+def _configured_scheduler() -> str:
+    """The scheduler address from Dask's own configuration/environment, or ''."""
+    try:
+        import dask.config
+    except ImportError:
+        return ""
+    return str(dask.config.get("scheduler-address", default=None) or "")
 
 
 def _spec() -> GroupSpec:
@@ -73,11 +95,12 @@ def _spec() -> GroupSpec:
                             doc="which cases get their own .out/.parquet/.json files"),
         "summary_rows": Key("str", default="all", choices=("all", "kept"),
                             doc="which cases go into the _summary tables (large searches: 'kept')"),
-        "scheduler": Key("str", default="", doc="Dask scheduler address (else local worker processes)"),
+        "scheduler": Key("str", check=_no_scheduler_in_deck,
+                         doc="refused: the scheduler comes from --scheduler or Dask's configuration"),
         "chunk": Key("int", default=0, check=lambda v: "must not be negative" if v < 0 else None,
                      doc="cases per task; 0 = chosen from the time of the first case"),
-        "plot_x": Key("str", default="", doc="summary column on the x axis of the summary plot"),
-        "plot_y": Key("strs", default=[], doc="summary columns plotted against plot_x"),
+        "plot_x": Key("str", default="", doc="summary column (or expression, driver.expr) on the x axis of the summary plot"),
+        "plot_y": Key("strs", default=[], doc="summary columns (or expressions) plotted against plot_x"),
     })
     return GroupSpec("sweep", keys, doc="run a study over a grid or list of deck values")
 
@@ -155,10 +178,23 @@ def _axes(sw: Params, study_group: str, study_spec: GroupSpec) -> list[tuple[str
     return axes
 
 
+def case_count(sw: Params, axes: list[tuple[str, list]]) -> int:
+    """Number of cases of the axes (full grid or zipped), computed before any case is built."""
+    return len(axes[0][1]) if sw.zip else math.prod(len(v) for _, v in axes)
+
+
 def build_cases(sw: Params, study_group: str, study_spec: GroupSpec) -> list[Case]:
-    """All cases of the sweep, numbered from 1: a full grid, or zipped axes."""
+    """All cases of the sweep, numbered from 1: a full grid, or zipped axes.
+
+    A sweep of more than :data:`MAX_CASES` cases is refused before a case is built.
+    """
     axes = _axes(sw, study_group, study_spec)
     names = [a[0] for a in axes]
+    n_cases = case_count(sw, axes)
+    if n_cases > MAX_CASES:
+        sizes = " x ".join(f"{len(v)} ({n})" for n, v in axes)
+        raise sw.error("key1", f"{n_cases} cases ({sizes}) is beyond the {MAX_CASES} cases one sweep deck "
+                       "may have; split the sweep into several decks or coarsen the grid")
     if sw.zip:
         n = len(axes[0][1])
         for k, (name, vals) in enumerate(axes):
@@ -169,6 +205,49 @@ def build_cases(sw: Params, study_group: str, study_spec: GroupSpec) -> list[Cas
     else:
         combos = itertools.product(*(v for _, v in axes))
     return [Case(i + 1, dict(zip(names, c))) for i, c in enumerate(combos)]
+
+
+def _axis_line(sw: Params, name: str) -> tuple[str, int]:
+    """The sweep key (values<k> or start<k>) and line that produced swept key ``name``."""
+    for k in range(1, MAX_KEYS + 1):
+        if sw[f"key{k}"] is not None and sw[f"key{k}"].lower() == name:
+            key = f"values{k}" if sw[f"values{k}"] is not None else f"start{k}"
+            return key, sw.line_of(key)
+    return "key1", sw.line_of("key1")
+
+
+def validate_sweep(sw: Params, raw: RawGroup, module: Any, cases: list[Case]) -> None:
+    """Refuse the whole sweep (DeckError naming the sweep line and key) before anything runs
+    when a case would be bad input: every value of every axis is validated in the base deck,
+    and every case too for sweeps up to FULL_VALIDATION cases (else the grid's corners)."""
+    def check(values: dict[str, Any], case_no: int | None) -> None:
+        try:
+            limits.check(module, validate(_case_raw(raw, Case(0, values)), module.SPEC, sw.path), "each case ")
+        except DeckError as exc:
+            name = next((n for n in values if n.partition(".")[2] == exc.key), next(iter(values)))
+            key, line = _axis_line(sw, name)
+            where = f"case {case_no} (" if case_no else "the value "
+            vals = ", ".join(f"{k} = {v!r}" for k, v in values.items())
+            raise DeckError(sw.path, line, key, f"{where}{vals}{')' if case_no else ''} is bad input: "
+                            f"{exc.key + ': ' if exc.key else ''}{exc.message}; nothing was run") from None
+    if not cases:
+        return
+    names = list(cases[0].values)
+    if len(cases) <= FULL_VALIDATION:
+        for c in cases:
+            check(c.values, c.index)
+        return
+    axis_values: dict[str, list] = {}
+    for n in names:
+        uniq: dict[str, Any] = {}
+        for c in cases:
+            uniq.setdefault(repr(c.values[n]), c.values[n])
+        axis_values[n] = list(uniq.values())
+        for v in axis_values[n]:
+            check({n: v}, None)
+    corners = [[vals[0], vals[-1]] if len(vals) > 1 else vals for vals in axis_values.values()]
+    for combo in itertools.islice(itertools.product(*corners), 512):
+        check(dict(zip(names, combo)), None)
 
 
 def _case_raw(raw: RawGroup, case: Case) -> RawGroup:
@@ -238,14 +317,14 @@ def _compute(task: Task, case: Case, module) -> tuple[CaseResult, Any, Params | 
         params = validate(_case_raw(task.raw, case), module.SPEC, task.deck_path)
         full = task.case_outputs == "all" or (task.case_outputs == "kept" and not task.keep)
         if full or not hasattr(module, "summarise"):
-            result = module.run(params, progress=False)
+            result = compute(module, params)
             res.summary = dict(result.summary)
             if result.failure:
                 res.status, res.error = EXIT_FAILED, result.failure
         else:
             res.summary = dict(module.summarise(params))
-    except DeckError as exc:
-        res.status, res.error = EXIT_BAD_INPUT, str(exc)
+    except DeckError as exc:   # bad input is refused before a sweep runs (validate_sweep): a case
+        res.status, res.error = EXIT_FAILED, f"bad input: {exc}"   # failing here fails, the others go on
     except Exception as exc:  # a case that fails is reported, the others go on
         res.status, res.error = EXIT_FAILED, f"{exc.__class__.__name__}: {exc}"
     res.seconds = time.perf_counter() - t0
@@ -266,7 +345,7 @@ def _write_case(task: Task, case: Case, res: CaseResult, result, params: Params,
     t0 = time.perf_counter()
     try:
         if result is None:
-            result = module.run(params, progress=False)
+            result = compute(module, params)
             if result.failure:
                 res.status, res.error = EXIT_FAILED, result.failure
         res.warnings = list(result.warnings)
@@ -291,14 +370,14 @@ def _write_case(task: Task, case: Case, res: CaseResult, result, params: Params,
 def run_task(task: Task) -> list[CaseResult]:
     """Run a chunk of cases (the unit of work sent to a process or a Dask worker)."""
     module = load_study(task.raw.name)
-    writable = lambda res, params: res.status != EXIT_BAD_INPUT and params is not None
+    writable = lambda res, result, params: params is not None and (result is not None or res.status == EXIT_OK)
     if task.case_outputs == "all":
         # write each case as soon as it is computed: an interrupt loses at most one case
         # ('kept' is decided once, over all cases, by the caller)
         results = []
         for c in task.cases:
             res, result, params = _compute(task, c, module)
-            if writable(res, params):
+            if writable(res, result, params):
                 _write_case(task, c, res, result, params, module)
             results.append(res)
         return results
@@ -308,7 +387,7 @@ def run_task(task: Task) -> list[CaseResult]:
         r.kept = k
     if task.case_outputs == "kept":
         for case, (res, result, params) in zip(task.cases, computed):
-            if res.kept and writable(res, params):
+            if res.kept and writable(res, result, params):
                 _write_case(task, case, res, result, params, module)
     return results
 
@@ -492,18 +571,24 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
     raw = study_raw[base_params.group]
     cases = build_cases(sw, base_params.group, module.SPEC)
     names = list(cases[0].values)
-    if sw.keep:   # check the filter on the base deck's summary columns before running anything
+    validate_sweep(sw, raw, module, cases)
+    named = [(k, v) for k, v in [("keep", sw.keep), ("plot_x", sw.plot_x)] + [("plot_y", y) for y in sw.plot_y] if v]
+    if named:   # check the filter and plotted columns on the base deck's summary before running anything
         probe = (module.summarise(base_params) if hasattr(module, "summarise")
-                 else module.run(base_params).summary)
-        try:
-            expr.parse(sw.keep, [*names, *probe])
-        except expr.ExprError as exc:
-            raise sw.error("keep", f"{exc.message}" + (f" (at '{exc.token}')" if exc.token else "")) from None
-    stem = Path(deck.path).stem
-    case_dir = outdir / stem
+                 else compute(module, base_params).summary)
+        columns = [*names, *probe, "case"]
+        for key, text in named:
+            try:
+                expr.parse(text, columns)
+            except expr.ExprError as exc:
+                raise sw.error(key, f"{exc.message}" + (f" (at '{exc.token}')" if exc.token else "")
+                               + ("" if key == "keep" else f"; summary columns: {', '.join(columns)}")) from None
+    stem_path = output_stem(outdir, deck.path)
+    stem = stem_path.name
+    case_dir = stem_path
     width = max(4, len(str(len(cases))))
     base = _base_hash(raw)
-    scheduler = scheduler or sw.scheduler or ""
+    scheduler = scheduler or _configured_scheduler()
     jobs = jobs or os.cpu_count() or 1
     task_of = lambda cs: Task(str(deck.path), raw, cs, str(case_dir), width, sw.keep, sw.case_outputs,
                               formats, plot, base)
@@ -526,19 +611,25 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
 
     frame = summary_frame(done, names)
     table = frame if sw.summary_rows == "all" else frame[frame["kept"] | (frame["status"] != "ok")]
-    for fmt in ("csv", "parquet"):
-        write_tidy(table, outdir / f"{stem}_summary", fmt)
-    tidies = [r.tidy for r in done if r.tidy is not None]
-    if tidies:
-        allcases = pd.concat(tidies, ignore_index=True)
-        for fmt in ("csv", "parquet"):
-            write_tidy(allcases, outdir / f"{stem}_cases", fmt)
     failed = [r for r in done if r.status != EXIT_OK]
     text = _sweep_text(deck, sw, base_params, names, cases, frame, failed, chunk, jobs, scheduler)
-    write_text(outdir / f"{stem}.out", text)
-    if plot:
-        from driver.plotting import save_figure, sweep_summary
-        save_figure(sweep_summary(frame, names, sw.plot_x, sw.plot_y, stem), outdir / f"{stem}_summary.png")
+    remove_stale_temporaries(outdir, stem)
+    with output_set(outdir):   # the sweep's own files: all renamed into place together, or none
+        for fmt in ("csv", "parquet"):
+            write_tidy(table, outdir / f"{stem}_summary", fmt)
+        tidies = [r.tidy for r in done if r.tidy is not None]
+        if tidies:
+            allcases = pd.concat(tidies, ignore_index=True)
+            for fmt in ("csv", "parquet"):
+                write_tidy(allcases, outdir / f"{stem}_cases", fmt)
+        write_text(outdir / f"{stem}.out", text)
+        if plot:
+            from driver.plotting import save_figure, sweep_summary
+            shown = frame.copy()
+            for name in [sw.plot_x, *sw.plot_y]:   # a plotted expression becomes a column
+                if name and name not in shown.columns:
+                    shown[name] = expr.parse(name).evaluate(shown)
+            save_figure(sweep_summary(shown, names, sw.plot_x, sw.plot_y, stem), outdir / f"{stem}_summary.png")
     for r in done:
         for w in r.warnings:
             print(f"warning: {deck.path}: case {r.index}: {w}", file=sys.stderr)

@@ -73,16 +73,30 @@ def test_sweep_deck_errors(tmp_path, capsys, text, line, key, words):
     assert not (tmp_path / "o").exists()
 
 
-def test_failed_case_is_reported_and_the_others_complete(tmp_path, capsys):
+def test_bad_input_refuses_the_whole_sweep_before_anything_runs(tmp_path, capsys):
     path = deck(tmp_path, "&sweep key1 = 'fourbar.crank', values1 = 2, -1, 5 /\n")
     out = tmp_path / "o"
     assert main([str(path), "-o", str(out), "-q", "-j", "1"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1
+    assert err[0].startswith(f"error: {path}:5: key 'values1': case 2 (fourbar.crank = -1)")
+    assert "must be positive" in err[0] and "nothing was run" in err[0]
+    assert not out.exists()
+
+
+def test_failed_case_is_reported_and_the_others_complete(tmp_path, capsys):
+    # case 2 is a degenerate linkage (all links 1): the listing's table cannot be computed
+    path = deck(tmp_path, "&sweep zip = .true., key1 = 'fourbar.fixed_link', values1 = 12, 1, 12\n"
+                          "  key2 = 'fourbar.crank', values2 = 2, 1, 5, key3 = 'fourbar.coupler', values3 = 15, 1, 15\n"
+                          "  key4 = 'fourbar.rocker', values4 = 9, 1, 9 /\n")
+    out = tmp_path / "o"
+    assert main([str(path), "-o", str(out), "-q", "-j", "1"]) == 1
     err = capsys.readouterr().err
-    assert "case 2 (fourbar.crank = -1)" in err and "must be positive" in err
+    assert "case 2 (fourbar.fixed_link = 1, fourbar.crank = 1" in err and "divide 0 by 0" in err
     assert table_rows((out / "sw" / "case_0003.out").read_text()) == published(5)
     assert not (out / "sw" / "case_0002.out").exists()
     summary = pd.read_csv(out / "sw_summary.csv")
-    assert list(summary["status"]) == ["ok", "bad input", "ok"]
+    assert list(summary["status"]) == ["ok", "failed", "ok"]
     assert "Failed cases" in (out / "sw.out").read_text()
 
 

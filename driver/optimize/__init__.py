@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from driver.atomic import write_text
+from driver.atomic import output_set, write_text
 from driver.deck import Deck, DeckError, read_deck
 from driver.export import write_tidy
 from driver.extras import require
@@ -41,7 +41,7 @@ from driver.optimize.evaluate import Evaluator, Record, design_params, evaluate_
 from driver.optimize.methods import HistoryRow, MethodResult, run_method
 from driver.optimize.problem import SPEC, Problem, problem_of
 from driver.optimize import report
-from driver.runner import write_outputs
+from driver.runner import compute, output_stem, write_outputs
 
 __all__ = ["SPEC", "OptimizeOutcome", "optimize", "run_optimize_deck", "problem_of"]
 
@@ -145,7 +145,7 @@ def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[
     problem = problem_of(deck)
     _probe(problem)
     formats = list(formats or [])
-    stem = None if outdir is None else Path(outdir) / Path(deck.path).stem
+    stem = None if outdir is None else output_stem(outdir, deck.path)
     journal = None if stem is None else stem.with_name(stem.name + ".journal.jsonl")
     resumed = _resumed(problem, stem) if (resume and stem is not None) else []
     if journal is not None and journal.exists() and not resume:
@@ -158,7 +158,7 @@ def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[
     check, result, params = None, None, None
     if best is not None:
         params = design_params(problem, np.array(best.x))
-        result = problem.study.run(params, progress=False)
+        result = compute(problem.study, params)
         probe = Evaluator(problem, 1)
         rec = Record(0, best.x, "failed" if result.failure else "ok", result.failure or "", dict(result.summary))
         probe._score([rec])
@@ -167,7 +167,8 @@ def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[
                               None if best is None else best.objective, bool(mres.converged and best is not None),
                               mres.message, len(ev.records), best, check, mres, history, ev, study_result=result)
     if stem is not None:
-        outcome.written = _write(outcome, stem, params, formats, plot, njobs)
+        with output_set(stem.parent):   # the run's files all together, or none
+            outcome.written = _write(outcome, stem, params, formats, plot, njobs)
         if journal is not None and journal.exists():
             journal.unlink()
     return outcome

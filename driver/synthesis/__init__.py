@@ -32,10 +32,10 @@ import numpy as np
 import pandas as pd
 
 from driver import expr, fourbar, kernels
-from driver.atomic import write_text
+from driver.atomic import output_set, write_text
 from driver.deck import Deck, DeckError, GroupSpec, Key, Params, RawGroup, positive, read_deck, validate
 from driver.export import write_tidy
-from driver.runner import write_outputs
+from driver.runner import compute, output_stem, write_outputs
 from driver.synthesis import crank_rocker as cr
 from driver.synthesis.function import FunctionDesign, chebyshev, freudenstein, links_from_k, wrap180
 
@@ -315,7 +315,7 @@ def synthesise(deck: Deck | str | Path) -> Synthesis:
     if syn.linkage is not None:
         fp = validate(RawGroup("fourbar", dict(syn.linkage, title=p.title or f"synthesised by {deck.path}"),
                                {}, p.line), fourbar.SPEC, deck.path)
-        syn.study_result = fourbar.run(fp)
+        syn.study_result = compute(fourbar, fp)
         syn.linkage = {k: v for k, v in fp.items() if v is not None and v != [] and v != ""}
     return syn
 
@@ -324,27 +324,28 @@ def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool,
                        quiet: bool = False, **_: Any) -> int:
     """Command-line entry: synthesise, write, return the exit status (DeckError propagates)."""
     syn = synthesise(deck)
-    stem = Path(outdir) / Path(deck.path).stem
+    stem = output_stem(outdir, deck.path)
     written = []
-    if syn.linkage is not None:
-        head = f"! four-bar synthesised by {deck.path} ({syn.params.task})" + (
-            "" if syn.failure is None else f"; FAILED CHECK: {syn.failure}")
-        written.append(write_text(stem.with_name(stem.name + ".linkage.dat"),
-                                  head + "\n" + str(f90nml.Namelist({"fourbar": syn.linkage})) + "\n"))
-        written += write_outputs(syn.study_result, stem.with_name(stem.name + ".linkage"), formats, plot)
-    text = syn.text.rstrip() + "\n"
-    if syn.linkage is not None:
-        text += f"\n  linkage deck {stem.name}.linkage.dat; its exact analysis in {stem.name}.linkage.out\n"
-    written.append(write_text(stem.with_name(stem.name + ".out"), text))
-    if len(syn.table):
-        written.append(write_tidy(syn.table, stem.with_name(stem.name + syn.table_name), "csv"))
-    if plot and syn.params.task == "function" and syn.design is not None and len(syn.design.x):
-        from driver import plotting
-        fd = syn.design
-        fig = plotting.line_panels(fd.x, [("y", {"desired y(x)": fd.y_desired, "generated": fd.y_generated}),
-                                          ("structural error", {"error": fd.y_generated - fd.y_desired})],
-                                   "x", title=f"{Path(deck.path).stem}: function generation")
-        written.append(plotting.save_figure(fig, stem.with_name(stem.name + "_error.png")))
+    with output_set(stem.parent):   # the deck's files all together, or none
+        if syn.linkage is not None:
+            head = f"! four-bar synthesised by {deck.path} ({syn.params.task})" + (
+                "" if syn.failure is None else f"; FAILED CHECK: {syn.failure}")
+            written.append(write_text(stem.with_name(stem.name + ".linkage.dat"),
+                                      head + "\n" + str(f90nml.Namelist({"fourbar": syn.linkage})) + "\n"))
+            written += write_outputs(syn.study_result, stem.with_name(stem.name + ".linkage"), formats, plot)
+        text = syn.text.rstrip() + "\n"
+        if syn.linkage is not None:
+            text += f"\n  linkage deck {stem.name}.linkage.dat; its exact analysis in {stem.name}.linkage.out\n"
+        written.append(write_text(stem.with_name(stem.name + ".out"), text))
+        if len(syn.table):
+            written.append(write_tidy(syn.table, stem.with_name(stem.name + syn.table_name), "csv"))
+        if plot and syn.params.task == "function" and syn.design is not None and len(syn.design.x):
+            from driver import plotting
+            fd = syn.design
+            fig = plotting.line_panels(fd.x, [("y", {"desired y(x)": fd.y_desired, "generated": fd.y_generated}),
+                                              ("structural error", {"error": fd.y_generated - fd.y_desired})],
+                                       "x", title=f"{Path(deck.path).stem}: function generation")
+            written.append(plotting.save_figure(fig, stem.with_name(stem.name + "_error.png")))
     if not quiet:
         for w in written:
             print(f"wrote {w}")
