@@ -1,4 +1,4 @@
-"""Four-bar linkage study (seed 001, Soegihardjo 2003): the ``&fourbar`` group.
+"""Four-bar linkage study [Soegihardjo 2003]: the ``&fourbar`` group.
 
 ``method = 'listing'`` runs the published Fortran 77 program (Lampiran 1), kept
 cell-for-cell, and audits it against the closed loop; ``method = 'exact'``

@@ -1,4 +1,4 @@
-"""&robust_example: Taylor's (1996) robust-design example, section 2.3 of seed 004.
+"""&robust_example: Taylor's (1996) robust-design example, section 2.3 of [Ma'arif 2006].
 
 Three estimates of the target t_x that minimises the spread of Y = b0 + b1 X + b2 X^2 when X
 varies about t_x with standard deviation sigma_x:
@@ -201,7 +201,7 @@ def run(params: Params, progress: bool = False) -> Result:
     report = p.mode == "report"
     r = analyse(p, report)
     b = np.array(p.true_coeffs, float)
-    L = ["Robust design example (Taylor 1996; seed 004, section 2.3)", "=" * 58]
+    L = ["Robust design example (Taylor 1996; [Ma'arif 2006], section 2.3)", "=" * 58]
     if p.title:
         L.append(f"case: {p.title}")
     L += [f"deck: {p.path.name}", f"mode: {p.mode}" + ("  (fits use the printed, rounded std and means)" if report

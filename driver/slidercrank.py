@@ -1,4 +1,4 @@
-"""Slider-crank with an elastic connecting rod (seed 003, Univ. Andalas): the &slidercrank study.
+"""Slider-crank with an elastic connecting rod [Andalas]: the &slidercrank study.
 
 Rigid crank, elastic rod meshed with frame elements, slider on its guide; kineto-elastodynamic
 (KED) finite-element model integrated with Newmark's average-acceleration rule.  The physics
@@ -29,7 +29,7 @@ from driver.table import Column, render_table
 __all__ = ["SPEC", "run", "MATERIALS", "PAPER_SPEEDS", "SIMEON1996", "simeon_initial_state",
            "min_steps_per_rev", "rayleigh"]
 
-#: Table 1a of the paper (columns re-ordered as in the study note, section 1.1); the depth is the
+#: Table 1a of the paper (columns re-ordered, docs/slidercrank.md); the depth is the
 #: in-plane section depth used for the outer-fibre strain (weak axis in plane).
 MATERIALS: dict[str, dict[str, Any]] = {
     "aluminium": dict(area=27e-6, second_moment=2.025e-11, density=2660.0, youngs_modulus=7.17e10,
@@ -372,7 +372,7 @@ def _header(params: Params, model: Model, derived: dict[str, float]) -> list[str
         ("damping ratio (Rayleigh)", "", f"{params.damping_ratio:g}"),
     ]
     out = ["Slider-crank with an elastic connecting rod: KED finite elements, Newmark average acceleration",
-           "Seed 003 (Univ. Andalas); formulation and corrections: study note slidercrank.md", "", "Inputs"]
+           "[Andalas]; formulation and corrections: docs/slidercrank.md", "", "Inputs"]
     out += [f"  {name:<46} {('[' + u + ']') if u else '':<9} {val}" for name, u, val in rows]
     out += ["", "Model",
             "  rod: planar frame elements (axial + bending), consistent mass and stiffness (eqs. 26, 29",

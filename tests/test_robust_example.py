@@ -1,5 +1,5 @@
 """Section 2.3 (Taylor's example) against the printed values of the report (published/robust_example.txt,
-read through driver.published); the printed results that do not reproduce (FLAGGED, study note
+read through driver.published); the printed results that do not reproduce (FLAGGED, docs/manipulator.md
 section 4) must be flagged."""
 from __future__ import annotations
 
