@@ -54,12 +54,8 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool, progress:
     from driver.runner import run_study
     try:
         deck = read_deck(path)
-        if not ({"sweep", "optimize"} & set(deck.groups)):
-            given = [opt for opt, key in (("-j/--jobs", "jobs"), ("--scheduler", "scheduler"),
-                                          ("--resume", "resume")) if (sweep_options or {}).get(key)]
-            if given:
-                print(f"warning: {path}: {', '.join(given)} apply to sweep and optimisation decks "
-                      f"(a &sweep or &optimize group) only; ignored for this deck", file=sys.stderr)
+        given = [opt for opt, key in (("-j/--jobs", "jobs"), ("--scheduler", "scheduler"), ("--resume", "resume"))
+                 if (sweep_options or {}).get(key) and not ({"sweep", "optimize"} & set(deck.groups))]
         if "synthesis" in deck.groups:
             from driver import synthesis
             return synthesis.run_synthesis_deck(deck, outdir, formats, plot, progress, quiet)
@@ -90,8 +86,12 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool, progress:
             traceback.print_exc()
         return EXIT_FAILED
     result = outcome.result
+    if given:   # reported once the deck is known to be valid (bad input gets its error line only)
+        print(f"warning: {path}: {', '.join(given)} apply to sweep and optimisation decks "
+              f"(a &sweep or &optimize group) only; ignored for this deck", file=sys.stderr)
     for w in result.warnings:
-        print(f"warning: {path}: {w}", file=sys.stderr)
+        if w != result.failure:   # a failure is printed once, as the error below
+            print(f"warning: {path}: {w}", file=sys.stderr)
     if not quiet:
         for p in outcome.written:
             print(f"wrote {p}")
