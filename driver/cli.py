@@ -187,7 +187,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--csv", action="store_true", help="also write the tidy table as <stem>.csv")
     parser.add_argument("--format", dest="formats", action="append", choices=FORMATS, default=[],
                         help="also write the tidy table in this format (repeatable)")
-    parser.add_argument("--plot", action="store_true", help="write PNG figures <stem>_<name>.png")
+    parser.add_argument("--plot", action="store_true", help="write figures <stem>_<name>.png")
+    parser.add_argument("--plot-format", choices=("png", "svg", "pdf"), default=None,
+                        help="figure file format (implies --plot); the same inputs give the same bytes")
     parser.add_argument("-q", "--quiet", action="store_true", help="print only warnings and errors")
     parser.add_argument("--keys", metavar="GROUP", help="list the keys of a namelist group and exit")
     parser.add_argument("--examples", action="store_true",
@@ -253,6 +255,8 @@ def _main(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
     except ValueError as exc:
         parser.error(str(exc))
     formats = list(dict.fromkeys((["csv"] if args.csv else []) + args.formats))
+    if args.plot_format:
+        args.plot = args.plot_format
     needs = ([("plot", "--plot")] if args.plot else []) + ([("parquet", "--format parquet")]
              if "parquet" in formats else []) + ([("dask", "--scheduler")] if args.scheduler else [])
     for extra, option in needs:

@@ -841,4 +841,5 @@ def _fig_design(p: Params, ws: Workspace, conv: Conv, used: dict):
 def _fig_torque(sweep: dict, conv: Conv):
     from driver.plotting import manipulator_torque_crob
     return manipulator_torque_crob(sweep["l1"], np.where(sweep["ok"], sweep["tau"][:, 0], np.nan),
-                                   np.where(sweep["ok"], sweep["tau"][:, 1], np.nan), conv.c_sweep)
+                                   np.where(sweep["ok"], sweep["tau"][:, 1], np.nan), conv.c_sweep,
+                                   reach=sweep["reach_all"] | ~sweep["ok"])

@@ -179,12 +179,20 @@ def _compare(name: str, printed: list[float] | None, computed: np.ndarray,
     lines, flags = [], []
     for i, (a, c) in enumerate(zip(printed, computed)):
         exp = -decimals if decimals is not None else Decimal(repr(float(a))).as_tuple().exponent
-        half = 0.5 * 10.0 ** exp
-        ok = abs(a - c) <= half + 1e-12
+        unit = 10.0 ** exp
+        ok = abs(a - c) <= 0.5 * unit + 1e-12
+        # one unit off in the last printed digit: a rounding slip, not a wrong method
+        last_digit = not ok and abs(a - c) <= 1.5 * unit + 1e-12
         text = f"{a:.{decimals}f}" if decimals is not None else repr(float(a))
-        lines.append(f"  {name}[{i}]  printed {text:>12}  computed {c:.10g}  {'reproduced' if ok else 'NOT REPRODUCED'}")
-        if not ok:
-            flags.append(f"{name}[{i}]: printed {text}, computed {c:.10g}")
+        verdict = "reproduced" if ok else ("LAST DIGIT" if last_digit else "NOT REPRODUCED")
+        lines.append(f"  {name}[{i}]  printed {text:>12}  computed {c:.10g}  {verdict}")
+        if last_digit:
+            rounded = f"{c:.{max(0, -exp)}f}"
+            flags.append(f"{name}[{i}]: printed {text}, computed {c:.10g}: the last digit only (the computed "
+                         f"value rounds to {rounded}; a rounding slip, not a wrong method)")
+        elif not ok:
+            rel = abs(a - c) / max(abs(c), 1e-300)
+            flags.append(f"{name}[{i}]: printed {text}, computed {c:.10g} (off by {100 * rel:.2g} %)")
     return lines, flags
 
 
@@ -279,4 +287,5 @@ def run(params: Params, progress: bool = False) -> Result:
     summary = {"mode": p.mode, "tmin_true": r["eq22_tmin"], "tmin_dual_response": r["eq29"],
                "tmin_taguchi": r["eq213"], "tmin_tolerance_analysis": r["eq215"], "flagged": len(flags)}
     return Result(text="\n".join(L).rstrip() + "\n", tidy=pd.DataFrame.from_records(recs), summary=summary,
-                  warnings=[f"printed value does not reproduce: {f}" for f in flags])
+                  warnings=[f"printed value differs in its last digit: {f}" if "the last digit only" in f
+                            else f"printed value does not reproduce: {f}" for f in flags])

@@ -76,7 +76,7 @@ def output_stem(outdir: str | Path, deck_path: str | Path) -> Path:
     return candidate
 
 
-def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool) -> list[Path]:
+def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool | str) -> list[Path]:
     """Write the .out file, extra files, tidy tables and figures for one case.
 
     The files form one set (:func:`driver.atomic.output_set`): all are renamed into place
@@ -91,10 +91,11 @@ def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool) ->
             written.append(write_text(stem.with_name(stem.name + suffix), text))
         for fmt in formats:
             written.append(write_tidy(result.tidy, stem, fmt))
-        if plot and result.figures:
-            from driver.plotting import save_figure
+        if plot and result.figures:   # plot: True (PNG) or a format name (png, svg, pdf)
+            from driver.plotting import figure_format, save_figure
+            suffix = figure_format(plot)
             for fig in result.figures:
-                written.append(save_figure(fig.draw(), stem.with_name(f"{stem.name}_{fig.name}.png")))
+                written.append(save_figure(fig.draw, stem.with_name(f"{stem.name}_{fig.name}.{suffix}")))
     # the set replaces an earlier run's: its tidy tables in formats not written now go
     for fmt in FORMATS:
         old = stem.with_name(f"{stem.name}.{fmt}")

@@ -640,13 +640,16 @@ def run(params: Params, progress: bool = False) -> Result:
     figures = []
     good = [c for c in cases if c.ok]
     plotting = _plotting   # imported when a figure is drawn (matplotlib is the optional [plot] extra)
+    buckled = [f"{c.omega:g} rad/s" for c in cases if not c.ok]
+    over = {f"{c.omega:g} rad/s": c.euler_ratio for c in good if c.euler_ratio > 1.0 and not params.geometric_stiffness}
     if good and params.end_time <= 0:
         figures.append(Figure("strain", lambda: plotting().slidercrank_strain_figure(
             [(f"{c.omega:g} rad/s", c.angle_deg, c.eps_ax[0] * 1e6) for c in good],
-            f"{params.material}: crank-end element axial strain")))
+            f"{params.material}: crank-end element axial strain", buckled=buckled, over_euler=over)))
         figures.append(Figure("deflection", lambda: plotting().slidercrank_strain_figure(
             [(f"{c.omega:g} rad/s", c.angle_deg, c.mid * 1e3) for c in good],
-            f"{params.material}: midpoint deflection", ylabel="midpoint deflection [mm]")))
+            f"{params.material}: midpoint deflection", ylabel="midpoint deflection [mm]",
+            buckled=buckled, over_euler=over)))
     if conv:
         series = {f"{w:g} rad/s": ([c.n_elements for c in cs if c.ok], [c.peak(+1)[0] * 1e6 for c in cs if c.ok])
                   for w, cs in conv.items()}

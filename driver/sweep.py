@@ -624,12 +624,14 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
                 write_tidy(allcases, outdir / f"{stem}_cases", fmt)
         write_text(outdir / f"{stem}.out", text)
         if plot:
-            from driver.plotting import save_figure, sweep_summary
+            from driver.plotting import figure_format, save_figure, sweep_summary
             shown = frame.copy()
             for name in [sw.plot_x, *sw.plot_y]:   # a plotted expression becomes a column
                 if name and name not in shown.columns:
                     shown[name] = expr.parse(name).evaluate(shown)
-            save_figure(sweep_summary(shown, names, sw.plot_x, sw.plot_y, stem), outdir / f"{stem}_summary.png")
+            units = {n: _units_of(n) for n in names}
+            save_figure(lambda: sweep_summary(shown, names, sw.plot_x, sw.plot_y, stem, units),
+                        outdir / f"{stem}_summary.{figure_format(plot)}")
     for r in done:
         for w in r.warnings:
             print(f"warning: {deck.path}: case {r.index}: {w}", file=sys.stderr)
@@ -642,6 +644,14 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
               f"{elapsed:.2f} s ({'dask ' + str(scheduler) if scheduler else f'{jobs} worker(s)'}, chunk {chunk})")
         print(f"wrote {outdir / (stem + '.out')} and {outdir / stem}_summary.{{csv,parquet}}")
     return max([EXIT_OK] + [r.status for r in failed])
+
+
+def _units_of(dotted: str) -> str:
+    """The unit a swept deck key ``group.key`` declares in its study's SPEC ('' if none)."""
+    group, _, key = dotted.partition(".")
+    module = load_study(group)
+    spec_key = module.SPEC.keys.get(key) if module is not None else None
+    return spec_key.units if spec_key is not None else ""
 
 
 def _sweep_text(deck: Deck, sw: Params, base: Params, names: list[str], cases: list[Case],

@@ -471,8 +471,9 @@ def run(params: Params, progress: bool = False) -> Result:
     tidy = _tidy(chain, designs)
     summary = _summary(trial, best, runs, failure)
     extra = {".result.dat": _result_dat(params, chain, designs, best, runs)} if best is not None else {}
-    figures = [Figure("speed", lambda: _figure(chain, designs, polar=False)),
-               Figure("polar", lambda: _figure(chain, designs, polar=True))]
+    band = params.paper_band
+    figures = [Figure("speed", lambda: _figure(chain, designs, polar=False, band=band)),
+               Figure("polar", lambda: _figure(chain, designs, polar=True, band=band))]
     return Result(text=text, tidy=tidy, summary=summary, warnings=warnings, failure=failure,
                   figures=figures, extra=extra)
 
@@ -748,8 +749,8 @@ def _result_dat(params: Params, chain: Chain, designs: list[Design], best: Desig
     return "\n".join(lines) + "\n"
 
 
-def _figure(chain: Chain, designs: list[Design], polar: bool):
+def _figure(chain: Chain, designs: list[Design], polar: bool, band=None):
     from driver.plotting import ujoint_speed_figure
     theta = np.arange(0.0, 360.0 + 1e-9, 1.0)
     curves = {d.label: _speed(chain, d, theta)[0] for d in designs}
-    return ujoint_speed_figure(theta, chain.rpm, curves, polar=polar)
+    return ujoint_speed_figure(theta, chain.rpm, curves, polar=polar, band=band)

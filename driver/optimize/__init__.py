@@ -10,7 +10,7 @@ See :mod:`driver.optimize.problem` for the deck keys.  Outputs for a deck ``<ste
 * ``<stem>_history.csv``: the best feasible design after every generation / iteration;
 * ``<stem>_evals.parquet``: every evaluated design (variables, feasibility and reason,
   objective, margins, the study's summary columns), also as CSV with ``--csv``;
-* ``<stem>_convergence.png`` with ``--plot``.
+* ``<stem>_convergence.png`` with ``--plot`` (``.svg``/``.pdf`` with ``--plot-format``).
 
 While a run goes, each evaluation is appended to ``<stem>.journal.jsonl``; ``--resume``
 replays the (deterministic) run from the journal, or from a finished run's ``_evals``
@@ -196,9 +196,9 @@ def _write(oc: OptimizeOutcome, stem: Path, params, formats: list[str], plot: bo
     if "parquet" in formats:
         written.append(write_tidy(hist, stem.with_name(stem.name + "_history"), "parquet"))
     if plot:
-        from driver.plotting import save_figure
-        fig = report.convergence_figure(p, hist, evals, Path(p.deck.path).stem)
-        written.append(save_figure(fig, stem.with_name(stem.name + "_convergence.png")))
+        from driver.plotting import figure_format, save_figure
+        written.append(save_figure(lambda: report.convergence_figure(p, hist, evals, Path(p.deck.path).stem),
+                                   stem.with_name(f"{stem.name}_convergence.{figure_format(plot)}")))
     return written
 
 

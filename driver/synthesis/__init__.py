@@ -345,7 +345,7 @@ def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool,
             fig = plotting.line_panels(fd.x, [("y", {"desired y(x)": fd.y_desired, "generated": fd.y_generated}),
                                               ("structural error", {"error": fd.y_generated - fd.y_desired})],
                                        "x", title=f"{Path(deck.path).stem}: function generation")
-            written.append(plotting.save_figure(fig, stem.with_name(stem.name + "_error.png")))
+            written.append(plotting.save_figure(fig, stem.with_name(f"{stem.name}_error.{plotting.figure_format(plot)}")))
     if not quiet:
         for w in written:
             print(f"wrote {w}")
