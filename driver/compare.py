@@ -38,7 +38,6 @@ from driver import published
 from driver.deck import Params, read_deck
 from driver.runner import study_of
 from driver.study import Result
-from driver.table import fortran_f
 
 __all__ = ["COLUMNS", "OK", "Comparison", "agrees_printed", "compare", "compare_decks", "compare_text",
            "run_comparison", "totals_text"]
@@ -70,32 +69,6 @@ def _cell(table: str, row: Any, column: str, printed: str, computed: str, status
 
 # ----------------------------------------------------------------------------- four-bar
 
-def _fourbar_correct(params: Params, angles: np.ndarray) -> dict[tuple[int, str], str]:
-    """The closed-loop solution at ``angles`` [deg] printed the listing's way (angles truncated to
-    whole degrees, legacy F5.1/F7.4): what the published table would show without its defect."""
-    from driver import fourbar
-    out, status = fourbar.exact_grid(params, angles)
-    cols = fourbar._exact_columns(out, status)
-    res: dict[tuple[int, str], str] = {}
-    for k, i in enumerate(angles.astype(int)):
-        vals = {"i": None, "epsl": cols["coupler_deg"][k], "phi": cols["rocker_deg"][k],
-                "beta": cols["transmission_deg"][k], "xa": cols["xa"][k], "ya": cols["ya"][k],
-                "xb": cols["xb"][k], "yb": cols["yb"][k], "omr": cols["omega2_rad_s"][k],
-                "oms": cols["omega3_rad_s"][k]}
-        for col, v in vals.items():
-            if col == "i":
-                res[(i, col)] = str(i)
-            elif v is None or not np.isfinite(v):
-                res[(i, col)] = ""
-            elif col in ("epsl", "phi", "beta"):
-                res[(i, col)] = fortran_f(math.trunc(v), None, 1, "legacy")
-            elif col in ("omr", "oms"):
-                res[(i, col)] = fortran_f(v, None, 4, "legacy")
-            else:
-                res[(i, col)] = fortran_f(v, None, 1, "legacy")
-    return res
-
-
 def _fourbar(params: Params, result: Result) -> list[dict]:
     from driver import fourbar
     cells = []
@@ -104,7 +77,7 @@ def _fourbar(params: Params, result: Result) -> list[dict]:
         if not published.matches(pub.match, params):
             continue
         angles = np.array(sorted({int(r) for r in pub.cells["row"]}), float)
-        correct = _fourbar_correct(params, angles)
+        correct = fourbar.exact_as_listed(params, angles)
         if params.method == "listing":
             computed = {(int(r[0]), c): v for r in published.listing_rows(result.text)
                         for c, v in zip(published.LISTING_COLUMNS, r)}
@@ -119,8 +92,8 @@ def _fourbar(params: Params, result: Result) -> list[dict]:
             else:
                 why = fourbar.LISTING_PRECISION
             if got is None:
-                cells.append(_cell(pub.name, rec.row, rec.column, rec.printed, "", "differs",
-                                   "the run has no row at this crank angle (step_deg must divide 20)"))
+                cells.append(_cell(pub.name, rec.row, rec.column, rec.printed, "", "departs",
+                                   "the deck's crank angles (start_deg, step_deg) do not include this published row"))
             elif got == rec.printed:
                 cells.append(_cell(pub.name, rec.row, rec.column, rec.printed, got, "identical",
                                    f"erratum: correct value {correct.get(key)}; {why}" if wrong else ""))
@@ -173,28 +146,32 @@ def _numeric_cell(table: str, row: str, column: str, printed: str, value: float 
 
 def _manipulator(params: Params, result: Result) -> list[dict]:
     from driver import manipulator as m
-    tidy, s = result.tidy, result.summary
     exact = params.mode == "exact"
-    text_values = {
-        "r_squared": s["r_m"] ** 2, "R_squared": s["R_m"] ** 2, "crob_radius": s["crob_radius_m"],
-        "crob_c_sweep": s["crob_radius_m"] ** 2,
-        "dexterity_l1": s["dexterity_l1_m"], "dexterity_l2": s["dexterity_l2_m"],
-        "manipulability_l1": s["manipulability_l1_m"], "manipulability_l2": s["manipulability_l2_m"],
-        "manipulability_l1_t44": None,
-        "min_total_torque": s.get("sweep_min_total_torque_Nm"), "min_total_l1": s.get("sweep_min_l1_m"),
-        "min_total_l2": s.get("sweep_min_l2_m")}
-    t44 = tidy[tidy["table"] == "4.4"]
-    if len(t44) > 1:
-        text_values["manipulability_l1_t44"] = float(t44["l1_m"].iloc[1])
+
+    def text_values() -> dict[str, float | None]:
+        s = result.summary
+        out = {"r_squared": s["r_m"] ** 2, "R_squared": s["R_m"] ** 2, "crob_radius": s["crob_radius_m"],
+               "crob_c_sweep": s["crob_radius_m"] ** 2,
+               "dexterity_l1": s["dexterity_l1_m"], "dexterity_l2": s["dexterity_l2_m"],
+               "manipulability_l1": s["manipulability_l1_m"], "manipulability_l2": s["manipulability_l2_m"],
+               "manipulability_l1_t44": None,
+               "min_total_torque": s.get("sweep_min_total_torque_Nm"), "min_total_l1": s.get("sweep_min_l1_m"),
+               "min_total_l2": s.get("sweep_min_l2_m")}
+        t44 = result.tidy[result.tidy["table"] == "4.4"]
+        if len(t44) > 1:
+            out["manipulability_l1_t44"] = float(t44["l1_m"].iloc[1])
+        return out
+
     cells = []
     for path in published.records("manipulator"):
         pub = published.read_blocks(path)
         if not published.matches(pub.match, params):
             continue
+        tidy, values = result.tidy, text_values()
         for rec in pub.cells.itertuples():
             table = str(rec.table)
             if table == "Text values":
-                value = text_values.get(str(rec.row))
+                value = values.get(str(rec.row))
                 why_exact = m.TEXT_REASONS.get(str(rec.row), "follows from the cells above") if exact else None
                 cells.append(_numeric_cell(table, rec.row, "value", rec.printed, value, None, why_exact))
                 continue
@@ -235,14 +212,14 @@ def _robust_example(params: Params, result: Result) -> list[dict]:
 
 def _ujoint(params: Params, result: Result) -> list[dict]:
     from driver import ujoint as u
-    t, s = result.tidy, result.summary
-    trial = t[t["design"] == "trial"]
-    printed_design = t[t["design"] == "paper printed"]
     cells = []
     for path in published.records("ujoint"):
         pub = published.read_blocks(path)
         if not published.matches(pub.match, params):
             continue
+        t, s = result.tidy, result.summary
+        trial = t[t["design"] == "trial"]
+        printed_design = t[t["design"] == "paper printed"]
         option = pub.match.get("option", "?")
         for rec in pub.cells.itertuples():
             q, table = str(rec.row), f"SSO option {option}"
@@ -351,14 +328,14 @@ class _LazyResult:
 class Comparison:
     """The comparison of one deck: ``frame`` (one row per published cell) and the run's result."""
 
-    def __init__(self, deck: Path, group: str, frame: pd.DataFrame, params: Params):
-        self.deck, self.group, self.frame, self.params = deck, group, frame, params
+    def __init__(self, deck: Path, group: str, frame: pd.DataFrame, params: Params | None, note: str = ""):
+        self.deck, self.group, self.frame, self.params, self.note = deck, group, frame, params, note
 
     @property
     def variant(self) -> str:
         """The deck's mode or method (``mode = 'report'``), or '' for a study without one."""
         for key in ("mode", "method"):
-            if key in self.params:
+            if self.params is not None and key in self.params:
                 return f"{key} = '{self.params[key]}'"
         return ""
 
@@ -372,12 +349,13 @@ def run_comparison(deck: str | Path) -> Comparison:
     """Run ``deck`` in memory and compare it with its published tables (DeckError for bad input)."""
     path = Path(deck)
     d = read_deck(path)
-    for control in ("sweep", "optimize", "synthesis"):
+    from driver.runner import CONTROL_GROUPS
+    for control in CONTROL_GROUPS:
         if control in d.groups:
-            from driver.deck import DeckError
-            raise DeckError(path, d.groups[control].line, None,
-                            f"--compare takes single-case decks, not a &{control} deck; the published tables "
-                            "belong to the single-case paper decks (compare a case's written .dat deck instead)")
+            frame = pd.DataFrame(columns=COLUMNS)
+            return Comparison(path, control, frame, None,
+                              note=f"a &{control} deck runs the study over many cases or designs; the published tables "
+                                   "belong to single-case decks (compare a case deck it writes instead)")
     module, params = study_of(d)
     group = module.SPEC.name
     comparer = _COMPARERS.get(group)
@@ -400,6 +378,8 @@ def compare_text(cmp: Comparison) -> list[str]:
     ``identical``/``agrees`` with its printed and computed values and reason."""
     f = cmp.frame
     lines = [f"{cmp.deck}: &{cmp.group}"]
+    if cmp.note:
+        return lines + [f"  {cmp.note}"]
     if f.empty:
         lines.append("  no published table belongs to this deck (its study or values are not in published/)")
         return lines
@@ -442,6 +422,10 @@ def compare_decks(decks: list[Path], out=None) -> int:
     import sys
     from driver.deck import DeckError
     out = sys.stdout if out is None else out
+    if not published.PUBLISHED_DIR.is_dir():
+        print(f"error: the published tables are not installed ({published.PUBLISHED_DIR} is missing); "
+              "--compare needs the source tree (pip install -e .)", file=sys.stderr)
+        return 1
     status, done = 0, []
     for deck in decks:
         try:
@@ -485,7 +469,8 @@ def _table_line(table: str, t: pd.DataFrame) -> str:
     if nr:
         extra.append(f"{nr} not reproducible (flagged)")
     if counts.get("departs", 0):
-        extra.append(f"{int(counts['departs'])} depart from the published values (the deck asks for the correct answer)")
+        nd = int(counts["departs"])
+        extra.append(f"{nd} depart{'s' if nd == 1 else ''} from the published values (the deck asks for the correct answer)")
     if counts.get("differs", 0):
         extra.append(f"{int(counts['differs'])} DIFFER")
     return text + ("; " + "; ".join(extra) if extra else "")

@@ -23,7 +23,7 @@ from driver.deck import GroupSpec, Key, Params, positive
 from driver.study import Figure, Result
 from driver.table import Column, fortran_f, render_table
 
-__all__ = ["SPEC", "run", "summarise", "grashof", "limit_angles", "exact_grid", "listing_grid"]
+__all__ = ["SPEC", "run", "summarise", "grashof", "limit_angles", "exact_grid", "listing_grid", "exact_as_listed"]
 
 ST = kernels.FOURBAR_STATUS
 BAND = (40.0, 120.0)  # transmission-angle band recommended by the paper [deg]
@@ -399,6 +399,29 @@ def audit(p: Params, theta: np.ndarray, table: np.ndarray, lst_status: np.ndarra
 
 
 # ----------------------------------------------------------------------------- tidy + figures
+
+def exact_as_listed(p: Params, theta_deg: np.ndarray) -> dict[tuple[int, str], str]:
+    """The closed-loop solution at whole crank angles ``theta_deg`` printed the way the listing prints
+    (FORMAT 25: angles truncated to whole degrees, legacy F5.1 / F7.4), keyed by (angle, column of
+    the listing table): what the published table shows where it is right.  Blank where the linkage
+    cannot be placed."""
+    out, status = exact_grid(p, theta_deg)
+    cols = _exact_columns(out, status)
+    names = {"epsl": "coupler_deg", "phi": "rocker_deg", "beta": "transmission_deg", "xa": "xa", "ya": "ya",
+             "xb": "xb", "yb": "yb", "omr": "omega2_rad_s", "oms": "omega3_rad_s"}
+    res: dict[tuple[int, str], str] = {}
+    for k, i in enumerate(np.asarray(theta_deg).astype(int)):
+        res[(int(i), "i")] = str(int(i))
+        for col, name in names.items():
+            v = cols[name][k]
+            if not np.isfinite(v):
+                res[(int(i), col)] = ""
+            elif col in ("epsl", "phi", "beta"):
+                res[(int(i), col)] = fortran_f(math.trunc(v), None, 1, "legacy")
+            else:
+                res[(int(i), col)] = fortran_f(v, None, 4 if col in ("omr", "oms") else 1, "legacy")
+    return res
+
 
 def tidy_frame(method: str, theta: np.ndarray, cols: dict[str, np.ndarray], status: np.ndarray) -> pd.DataFrame:
     """One row per crank angle; status in words; unassemblable cells left empty (NaN in the frame)."""

@@ -128,7 +128,8 @@ def _arm_inputs(l1, l2, th1, th2, qd, qdd, m1, m2, mass_per_length: float) -> tu
 
 
 def manipulator_arm_states(l1, l2, th1, th2, qd=(1.0, 1.0), qdd=(1.0, 1.0), m1=None, m2=None,
-                           g: float = 9.8, mass_per_length: float = 10.0):
+                           g: float = 9.8, mass_per_length: float = 10.0,
+                           out: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None):
     """Jacobian, manipulability, condition number and torques of 2R configurations.
 
     Inputs broadcast to n rows: lengths l1, l2 [m], joint angles th1, th2 [rad] (th2 relative),
@@ -136,9 +137,20 @@ def manipulator_arm_states(l1, l2, th1, th2, qd=(1.0, 1.0), qdd=(1.0, 1.0), m1=N
     masses m1, m2 [kg] (default ``mass_per_length`` [kg/m] times the length), g [m/s^2] along -y.
     Returns (jac (n, 4) = J11, J12, J21, J22 [m] of eq. 4.18, w = |det J| [m^2],
     kappa = sigma_max/sigma_min (0 where J is singular), tau (n, 2) [N m]).
+    ``out`` = (jac, w, kappa, tau) Fortran-ordered float64 arrays of those shapes may be
+    passed to reuse buffers across calls (large fresh arrays cost page faults that can
+    exceed the kernel's own time); they are overwritten and returned.
     """
-    return _kernels.manipulator.arm_states(*_arm_inputs(l1, l2, th1, th2, qd, qdd, m1, m2, mass_per_length),
-                                           float(g))
+    args = _arm_inputs(l1, l2, th1, th2, qd, qdd, m1, m2, mass_per_length)
+    n = args[0].shape[0]
+    shapes = ((n, 4), (n,), (n,), (n, 2))
+    if out is None:
+        out = tuple(np.empty(shp, dtype=np.float64, order="F") for shp in shapes)
+    elif len(out) != 4 or not all(isinstance(a, np.ndarray) and a.flags.f_contiguous and a.dtype == np.float64
+                                  and a.shape == shp for a, shp in zip(out, shapes)):
+        raise ValueError(f"out must be four Fortran-ordered float64 arrays of shapes {shapes}; "
+                         "f2py would otherwise work on hidden copies")
+    return _kernels.manipulator.arm_states(*args, float(g), *out)
 
 
 def manipulator_torques(l1, l2, th1, th2, qd=(1.0, 1.0), qdd=(1.0, 1.0), m1=None, m2=None,

@@ -31,11 +31,13 @@ contains
   !> link ends), joint rates qd(:,1..2) [rad/s], accelerations qdd(:,1..2) [rad/s^2],
   !> gravity g [m/s^2] along -y.
   !> Processed in blocks of nb configurations: sin/cos of a block by vecmath, then
-  !> call-free loops (vectorised by construction).
+  !> call-free loops (vectorised by construction).  The outputs are overwritten (intent
+  !> inout, so callers can reuse buffers and skip the page faults of fresh arrays).
   subroutine arm_states(n, l1, l2, th1, th2, qd, qdd, m1, m2, g, jac, w, kappa, tau)
     integer, intent(in) :: n
     real(dp), intent(in) :: l1(n), l2(n), th1(n), th2(n), qd(n, 2), qdd(n, 2), m1(n), m2(n), g
-    real(dp), intent(out) :: jac(n, 4), w(n), kappa(n), tau(n, 2)
+    real(dp), intent(inout) :: jac(n, 4), w(n), kappa(n), tau(n, 2)   ! overwritten (reusable buffers)
+    !f2py intent(in,out) :: jac, w, kappa, tau
     integer, parameter :: nb = 256
     real(dp) :: sc(nb, 4), s12, c12, a, b, c, d, t, det, disc
     integer :: k, k0, m, i

@@ -238,3 +238,26 @@ def test_every_published_file_is_read_and_has_a_comparer():
     groups = {published.match_line(folder / name)[0] for name in files}
     assert groups <= set(compare._COMPARERS)
     assert len(files) == 12
+
+
+def test_sweep_and_other_multi_case_decks_are_skipped_with_a_note(capsys):
+    assert main(["--compare", str(INPUTS / "fourbar_paper_sweep.dat"), str(INPUTS / "crank2.dat")]) == 0
+    out = capsys.readouterr().out
+    assert "a &sweep deck runs the study over many cases" in out
+    assert "Lampiran 2 (crank 2): 190/190 cells identical" in out
+
+
+def test_listing_deck_on_a_coarser_grid_departs_on_the_rows_it_does_not_print(write_deck):
+    text = (INPUTS / "crank5.dat").read_text().replace("step_deg   = 20", "step_deg   = 40")
+    f = compare.compare(write_deck(text))
+    assert not (f["status"] == "differs").any()
+    missing = f[f["status"] == "departs"]
+    assert sorted({int(r) for r in missing["row"]}) == list(range(20, 360, 40))
+    assert (f[f["row"].astype(int) % 40 == 0]["status"] == "identical").all()
+
+
+def test_missing_published_folder_is_one_line_not_a_traceback(tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(published, "PUBLISHED_DIR", tmp_path / "nowhere")
+    assert main(["--compare", str(INPUTS / "crank5.dat")]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "published tables are not installed" in err

@@ -46,3 +46,20 @@ def test_manipulator_monte_carlo_samples_are_not_copied():
     kernels.manipulator_position_errors(th1, th2, dl)
     peak = peak_alloc(lambda: kernels.manipulator_position_errors(th1, th2, dl))
     assert peak < 1.5 * dl.nbytes          # the (ns, 2) result only, no copy of the input
+
+
+def test_manipulator_arm_states_reused_buffers_are_not_copied():
+    n = 100_000
+    rng = np.random.default_rng(2)
+    l1, l2 = rng.uniform(1, 7, n), rng.uniform(1, 7, n)
+    th1, th2 = rng.uniform(-np.pi, np.pi, n), rng.uniform(-np.pi, np.pi, n)
+    fresh = kernels.manipulator_arm_states(l1, l2, th1, th2)
+    out = (np.empty((n, 4), order="F"), np.empty(n), np.empty(n), np.empty((n, 2), order="F"))
+    got = kernels.manipulator_arm_states(l1, l2, th1, th2, out=out)
+    assert all(a is b for a, b in zip(got, out))                     # returned in place
+    for a, b in zip(got, fresh):
+        assert np.array_equal(a, b)
+    # only the broadcast inputs (qd, qdd, masses: 6 columns) are allocated, no output
+    assert peak_alloc(lambda: kernels.manipulator_arm_states(l1, l2, th1, th2, out=out)) < 7 * 8 * n
+    with pytest.raises(ValueError):
+        kernels.manipulator_arm_states(l1, l2, th1, th2, out=(np.empty((n, 4)),) + out[1:])   # C order
