@@ -699,6 +699,14 @@ def _summary(p: Params, ws: Workspace, conv: Conv, used: dict, sweep: dict, tol:
         key = rec["name"].lower().replace(" ", "_")
         s[f"{key}_dl_m"] = rec["dl1"]
         s[f"{key}_mc_max_m"] = rec["mc_max"]
+    # design measures of the first design (what an &optimize deck varies: designs_l1, designs_l2)
+    l1, l2 = float(used["l1"][0]), float(used["l2"][0])
+    ri, _, reach = kernels.manipulator_design_indices(ws.x, ws.y, [l1], [l2])
+    s.update({"design_l1_m": l1, "design_l2_m": l2, "design_ri1": float(ri[0, 0]) if ri[0, 0] > 0 else None,
+              "design_ri2": float(ri[0, 1]), "design_ri3": float(ri[0, 2]),
+              "design_ri2_excess": float(ri[0, 1]) - math.sqrt(ws.n),
+              "design_reaches_all": bool(reach[0]), "design_crob_residual_m2": l1 * l1 + l2 * l2 - ws.mean_d2,
+              "design_total_torque_Nm": float(used["tau"][0].sum()) if used["ok"][0] else None})
     tot = np.where(sweep["ok"], sweep["tau"].sum(1), np.inf)
     if np.isfinite(tot).any():
         k = int(np.argmin(tot))

@@ -91,6 +91,12 @@ _KEYS: dict[str, Key] = {
     "youngs_modulus": Key("float", check=positive, units="Pa", doc=_SECTION_DOC),
     "section_depth": Key("float", check=positive, units="m",
                          doc=f"in-plane depth; outer fibre at depth/2 {_SECTION_DOC}"),
+    "section_width": Key("float", check=positive, units="m",
+                         doc="rectangular rod: out-of-plane width; with section_depth gives area = w h and "
+                             "second_moment = w h^3/12 (instead of area and second_moment)"),
+    "section_diameter": Key("float", check=positive, units="m",
+                            doc="round rod: diameter d gives area = pi d^2/4, second_moment = pi d^4/64, "
+                                "depth d (instead of area, second_moment and section_depth)"),
     "slider_mass": Key("float", default=0.9, check=positive, units="kg", doc="M (Table 1b)"),
     "bearing_mass_crank": Key("float", default=0.05, check=non_negative, units="kg",
                               doc="m_B at the crank pin (prescribed motion: does not load the rod)"),
@@ -161,11 +167,35 @@ class Model:
         return kernels.slidercrank_frequencies(self.rho_a, self.ea, self.ei, self.length, self.m_s)
 
 
+def _shape(params: Params) -> tuple[dict[str, float], str]:
+    """Section values from section_width (rectangle) or section_diameter (round bar), if given."""
+    given = lambda k: k in params.given and params[k] is not None
+    if given("section_diameter"):
+        for k in ("section_width", "area", "second_moment", "section_depth"):
+            if given(k):
+                raise params.error(k, "section_diameter defines the whole section; do not give " + k)
+        d = params.section_diameter
+        return {"area": math.pi * d * d / 4, "second_moment": math.pi * d ** 4 / 64, "section_depth": d}, \
+            f"round bar D = {d:g} m"
+    if given("section_width"):
+        for k in ("area", "second_moment"):
+            if given(k):
+                raise params.error(k, "section_width with section_depth defines the section; do not give " + k)
+        if not given("section_depth"):
+            raise params.error("section_width", "a rectangular section needs section_depth too (in-plane depth)")
+        w, h = params.section_width, params.section_depth
+        return {"area": w * h, "second_moment": w * h ** 3 / 12}, f"rectangle {w:g} x {h:g} m"
+    return {}, ""
+
+
 def _model(params: Params) -> Model:
     values, sources = {}, {}
     table = MATERIALS.get(params.material, {})
+    shape, shape_name = _shape(params)
     for key in SECTION_KEYS:
-        if key in params.given and params[key] is not None:
+        if key in shape:
+            values[key], sources[key] = shape[key], shape_name
+        elif key in params.given and params[key] is not None:
             values[key], sources[key] = params[key], "deck"
         elif key in table:
             values[key], sources[key] = table[key], "Table 1a"
@@ -493,7 +523,7 @@ def _tidy(model_name: str, cases: list[Case]) -> pd.DataFrame:
     return pd.concat(frames, ignore_index=True)
 
 
-def _summary(cases: list[Case]) -> dict[str, Any]:
+def _summary(cases: list[Case], model: Model | None = None) -> dict[str, Any]:
     out: dict[str, Any] = {}
     for i, c in enumerate(cases, start=1):
         out[f"omega_{i}_rad_s"] = c.omega
@@ -512,6 +542,9 @@ def _summary(cases: list[Case]) -> dict[str, Any]:
                     "peak_compressive_microstrain": worst.peak(-1)[0] * 1e6,
                     "peak_compressive_deg": worst.peak(-1)[1]})
     out["euler_ratio_max"] = max(c.euler_ratio for c in cases)
+    if model is not None:   # a section given by its shape (what a section optimisation varies)
+        out["rod_mass_kg"] = model.rho_a * model.length
+        out["section_area_m2"] = model.area
     out["buckled"] = any(not c.ok for c in cases)
     out["n_buckled"] = sum(not c.ok for c in cases)
     return out
@@ -656,7 +689,7 @@ def run(params: Params, progress: bool = False) -> Result:
         figures.append(Figure("convergence", lambda: plotting().slidercrank_convergence_figure(
             series, f"{params.material}: element convergence")))
     return Result(text="\n".join(text) + "\n", tidy=_tidy(params.material, list(done.values())),
-                  summary=_summary(cases), warnings=warnings, failure=failure, figures=figures)
+                  summary=_summary(cases, model if _shape(params)[1] else None), warnings=warnings, failure=failure, figures=figures)
 
 
 def _plotting():

@@ -157,6 +157,8 @@ def test_not_converged_exits_1_and_never_says_optimum(tmp_path, capsys):
      "maximize = 'mu_min_deg', method = 'grid', grid_count = 100000", "grid_count", "max_evals"),
     ("var1 = 'fourbar.crank', lower1 = 1, upper1 = 2\nmaximize = 'mu_min_deg'\nconstraint1 = 'x[0] > 1'",
      "constraint1", "not allowed"),
+    ("var1 = 'fourbar.crank(1)', lower1 = 1, upper1 = 2\nmaximize = 'mu_min_deg'", "var1", "one number, not a list"),
+    ("var1 = 'fourbar.coupler_point(3)', lower1 = 1, upper1 = 2\nmaximize = 'mu_min_deg'", "var1", "element 3"),
 ])
 def test_bad_decks_exit_2_and_write_nothing(tmp_path, capsys, body, key, words):
     path = _deck(tmp_path, body)
@@ -172,3 +174,70 @@ def test_sweep_and_optimize_together_refused(tmp_path):
                            "&sweep key1 = 'fourbar.rocker', values1 = 8, 9")
     with pytest.raises(DeckError, match="not both"):
         optimize(path)
+
+
+def test_ujoint_through_the_generic_group_finds_the_study_optimum(tmp_path):
+    oc = optimize(ROOT / "inputs" / "optimize_ujoint_option1.dat", tmp_path, jobs=1)
+    assert oc.success
+    # the study's own option-1 optimiser (ujoint_option1.out): U = 1.16795E-04 at phi = 90, 90 deg
+    text = (ROOT / "outputs" / "ujoint_option1.out").read_text()
+    assert "optimum    15.0000    20.0000     9.0000    90.0000    90.0000" in text
+    assert "1.16795E-04" in text
+    assert oc.fun == pytest.approx(1.16795e-4, rel=5e-6)
+    assert oc.x["ujoint.phi(1)"] == pytest.approx(90.0, abs=0.01)
+    assert oc.x["ujoint.phi(2)"] == pytest.approx(90.0, abs=0.01)
+
+
+def test_manipulator_least_torque_robust_design_beats_the_walk_along_crob(tmp_path):
+    from scipy.optimize import minimize_scalar
+    from driver import manipulator
+    oc = optimize(ROOT / "inputs" / "optimize_manipulator_torque.dat", tmp_path, jobs=1)
+    assert oc.success
+    l1, l2 = oc.x["manipulator.designs_l1"], oc.x["manipulator.designs_l2"]
+    assert l1 * l1 + l2 * l2 == pytest.approx(47.25, abs=1e-6)        # on C_rob (eq. 4.12)
+    assert oc.check.summary["design_ri2"] == pytest.approx(2.0, abs=1e-6)   # RI2 = sqrt(n) there
+    # the report's walk along C_rob in 0.25 m steps (Table 4.8) finds no less torque
+    walk = oc.study_result.summary["sweep_min_total_torque_Nm"]
+    assert oc.fun <= walk
+    # independent search: one variable, the angle along C_rob, bounded scalar minimisation
+    deck = read_deck(ROOT / "inputs" / "optimize_manipulator_torque.dat")
+    raw = deck.groups["manipulator"]
+
+    def torque(t: float) -> float:
+        values = dict(raw.values, designs_l1=[47.25 ** 0.5 * math.cos(t)], designs_l2=[47.25 ** 0.5 * math.sin(t)])
+        p = validate(RawGroup("manipulator", values, raw.lines, raw.line), manipulator.SPEC, "x.dat")
+        return manipulator.run(p).summary["design_total_torque_Nm"]
+
+    t0 = math.atan2(l2, l1)
+    res = minimize_scalar(torque, bounds=(t0 - 0.05, t0 + 0.05), method="bounded", options={"xatol": 1e-7})
+    assert oc.fun == pytest.approx(res.fun, abs=1e-3)
+    assert math.atan2(l2, l1) == pytest.approx(res.x, abs=1e-4)
+
+
+@pytest.mark.slow
+def test_slidercrank_lightest_rod_is_bound_by_the_euler_constraint(tmp_path):
+    """Width fixed: the lightest depth is where N_peak / P_E = 1/3; found again by bisection on the study."""
+    from scipy.optimize import brentq
+    from driver import slidercrank
+    text = (ROOT / "inputs" / "optimize_slidercrank_section.dat").read_text()
+    text = text.replace("  var2 = 'slidercrank.section_depth', lower2 = 2e-3, upper2 = 20e-3\n", "")
+    text = text.replace("var1 = 'slidercrank.section_width', lower1 = 6e-3, upper1 = 20e-3",
+                        "var1 = 'slidercrank.section_depth', lower1 = 2e-3, upper1 = 20e-3")
+    text = text.replace("section_width = 9e-3, section_depth = 3e-3", "section_width = 6e-3, section_depth = 8e-3")
+    text = text.replace("n_elements = 20", "n_elements = 10")
+    text = text.replace("method = 'differential_evolution', seed = 1, tol = 1e-4, atol = 0",
+                        "method = 'slsqp', starts = 2, tol = 1e-6")
+    path = tmp_path / "sc.dat"
+    path.write_text(text)
+    oc = optimize(path, tmp_path / "out", jobs=1)
+    assert oc.success
+    raw = read_deck(path).groups["slidercrank"]
+
+    def ratio(h: float) -> float:
+        p = validate(RawGroup("slidercrank", dict(raw.values, section_depth=h), raw.lines, raw.line),
+                     slidercrank.SPEC, "x.dat")
+        return slidercrank.run(p).summary["euler_ratio_max"] - 1 / 3
+
+    h = brentq(ratio, 4e-3, 8e-3, xtol=1e-12)
+    assert oc.x["slidercrank.section_depth"] == pytest.approx(h, rel=1e-5)
+    assert oc.fun == pytest.approx(2660 * 6e-3 * h * 0.505, rel=1e-5)     # rho w h L

@@ -144,3 +144,34 @@ def test_bad_synthesis_decks_exit_2(tmp_path, capsys, body, key):
     assert main([str(path), "-o", str(tmp_path / "out")]) == 2
     assert f"key '{key}'" in capsys.readouterr().err
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.slow
+def test_path_generation_through_five_points_verified_by_the_kernel(tmp_path):
+    from pathlib import Path
+    text = (Path(__file__).resolve().parents[1] / "inputs" / "synthesis_path.dat").read_text()
+    deck = tmp_path / "path.dat"
+    deck.write_text(text.replace("maxiter = 200, popsize = 10", "maxiter = 60, popsize = 8"))
+    syn = synthesise(deck)
+    from driver.synthesis import _path_figure
+    assert _path_figure(syn, tmp_path / "path_path.png", "path").stat().st_size > 0
+    assert syn.failure is None
+    q = syn.design.parts
+    targets = np.column_stack([syn.params.target_x, syn.params.target_y])
+    # independent re-measurement: the coupler point at the reported crank angles, moved to the world frame
+    th = np.radians(syn.design.theta_at_targets_deg)
+    out, st = kernels.fourbar_exact(th, q["ground"], q["crank"], q["coupler"], q["rocker"], 1.0, 0.0, 1)
+    cp = kernels.fourbar_coupler_point(th, out, st, q["crank"], 1.0, 0.0, q["u"], q["v"])[:, :2]
+    g = math.radians(q["gamma_deg"])
+    world = np.column_stack([q["x0"] + math.cos(g) * cp[:, 0] - math.sin(g) * cp[:, 1],
+                             q["y0"] + math.sin(g) * cp[:, 0] + math.cos(g) * cp[:, 1]])
+    assert np.all(st == 0)
+    assert np.hypot(*(world - targets).T) == pytest.approx(syn.design.errors, abs=1e-12)
+    assert syn.design.errors.max() < 1e-6
+    # full rotation on one branch, inside the transmission band, by the exact analysis of the linkage deck
+    raw = RawGroup("fourbar", {k: v for k, v in syn.linkage.items()}, {}, 1)
+    p = validate(raw, fourbar.SPEC, "x")
+    assert fourbar.grashof(p.fixed_link, p.crank, p.coupler, p.rocker).full_crank_rotation
+    ex = fourbar.extremes(p)
+    assert ex.assembled_fraction == 1.0 and not ex.toggles
+    assert 30.0 <= ex.mu_min and ex.mu_max <= 150.0

@@ -75,16 +75,25 @@ class OptimizeOutcome:
 
 
 def _probe(problem: Problem) -> None:
-    """Run the deck's own design once: every expression must name columns of the study's summary."""
-    keys = [v.key for v in problem.variables]
-    kinds = [problem.study.SPEC.keys[k].kind for k in keys]
-    x = []
-    for k in keys:
-        v = problem.base[k]
-        x.append(float(v[0] if isinstance(v, list) else v))
-    status, _, summary = evaluate_cases(problem.raw.name, str(problem.deck.path), problem.raw, keys, kinds, [x])[0]
-    if status != "ok" or not summary:
-        return    # the deck's design fails; names are checked per design (missing -> infeasible)
+    """Run the deck's own design once: every expression must name columns of the study's summary.
+
+    Only a clean run (no failure, no warning) proves a column does not exist; otherwise (a buckled
+    rod has no strain peaks) a design whose summary lacks a column is infeasible, with that reason.
+    """
+    from driver.optimize.evaluate import _slots
+    kinds = [problem.study.SPEC.keys[v.key].kind for v in problem.variables]
+    x = [base_value(problem, v) for v in problem.variables]
+    try:
+        params = design_params(problem, np.array(x))
+        if hasattr(problem.study, "summarise"):
+            summary, clean = dict(problem.study.summarise(params)), True
+        else:
+            result = problem.study.run(params, progress=False)
+            summary, clean = dict(result.summary), not (result.failure or result.warnings)
+    except Exception:    # the deck's design fails; names are checked per design (missing -> infeasible)
+        return
+    if not summary:
+        return
     from driver import expr
     frame = pd.DataFrame([summary])
     o = problem.opts
@@ -92,16 +101,26 @@ def _probe(problem: Problem) -> None:
     nums = [n for n in range(1, 10) if o[f"constraint{n}"] is not None]
     exprs += [(f"constraint{n}", c.whole) for n, c in zip(nums, problem.constraints)]
     for key, e in exprs:
-        for name in sorted(e.names):
-            if name not in frame:
-                raise o.error(key, f"unknown summary column '{name}' of &{problem.raw.name} "
-                                   f"(columns: {', '.join(frame.columns)})")
+        missing = [name for name in sorted(e.names) if name not in frame]
+        if missing and clean:   # a clean run of the deck's design has every column its study writes
+            raise o.error(key, f"unknown summary column '{missing[0]}' of &{problem.raw.name} "
+                               f"(columns: {', '.join(frame.columns)})")
+        if missing:             # e.g. a buckled rod has no strain peaks: checked design by design
+            continue
         try:
             v = np.asarray(e.evaluate(frame))
             if key in ("minimize", "maximize") and v.dtype.kind not in "biuf":
                 v.astype(np.float64)
         except (expr.ExprError, TypeError, ValueError) as exc:
             raise o.error(key, f"cannot be evaluated on the study's summary: {exc}") from None
+
+
+def base_value(problem: Problem, v) -> float:
+    """The deck's own value of variable ``v``."""
+    val = problem.base[v.key]
+    if isinstance(val, list):
+        val = val[(v.index or 1) - 1]
+    return float(val)
 
 
 def _resumed(problem: Problem, stem: Path) -> list[dict]:

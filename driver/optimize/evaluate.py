@@ -17,6 +17,7 @@ import concurrent.futures as cf
 import json
 import math
 import os
+import re
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -39,16 +40,23 @@ FAILED_OBJECTIVE = 1e12
 
 
 def _design_raw(raw: RawGroup, keys: list[str], kinds: list[str], x: np.ndarray) -> RawGroup:
+    """The raw study group with the variables set; ``keys`` entries are 'key' or 'key(i)'."""
     values = dict(raw.values)
     for key, kind, v in zip(keys, kinds, x):
-        values[key] = [float(v)] if kind == "floats" else float(v)
+        name, _, idx = key.partition("(")
+        if idx:
+            items = list(values[name]) if isinstance(values.get(name), list) else [values.get(name)]
+            items[int(idx.rstrip(")")) - 1] = float(v)
+            values[name] = items
+        else:
+            values[name] = [float(v)] if kind == "floats" else float(v)
     return RawGroup(raw.name, values, raw.lines, raw.line)
 
 
 def design_params(problem: Problem, x: np.ndarray) -> Params:
     """The validated study group of design ``x`` (DeckError if the design is not a valid deck)."""
     kinds = [problem.study.SPEC.keys[v.key].kind for v in problem.variables]
-    raw = _design_raw(problem.raw, [v.key for v in problem.variables], kinds, x)
+    raw = _design_raw(problem.raw, _slots(problem), kinds, x)
     return validate(raw, problem.study.SPEC, problem.deck.path)
 
 
@@ -110,8 +118,8 @@ class Evaluator:
         self.records: list[Record] = []
         self.cache: dict[tuple[float, ...], int] = {}
         self.replayed: dict[tuple[float, ...], dict] = {}
-        self.keys = [v.key for v in problem.variables]
-        self.kinds = [problem.study.SPEC.keys[k].kind for k in self.keys]
+        self.keys = _slots(problem)
+        self.kinds = [problem.study.SPEC.keys[v.key].kind for v in problem.variables]
         self.journal = journal
         self._journal_fh = None
         self._pool: cf.ProcessPoolExecutor | None = None
@@ -208,6 +216,17 @@ class Evaluator:
                 r.met = tuple(False for _ in p.constraints)
         if not ok:
             return
+        names = _names(p)
+        for r in list(ok):
+            miss = sorted(n for n in names if n not in r.summary)
+            if miss:
+                r.why = f"no '{miss[0]}' in the case's summary"
+                r.violation = FAILED_VIOLATION
+                r.margins = tuple(-math.inf for _ in p.constraints)
+                r.met = tuple(False for _ in p.constraints)
+                ok.remove(r)
+        if not ok:
+            return
         frame = pd.DataFrame([r.summary for r in ok])
         for name in _names(p):
             if name not in frame:
@@ -277,10 +296,15 @@ class Evaluator:
         return pd.DataFrame(rows)
 
 
+def _slots(problem: Problem) -> list[str]:
+    """Where each variable goes in the raw group: 'key' or 'key(i)'."""
+    return [v.key if v.index is None else f"{v.key}({v.index})" for v in problem.variables]
+
+
 def _batch_summaries(problem: Problem, xs: list[tuple[float, ...]]) -> list[tuple[str, str, dict]] | None:
     """The study's batch path (``summarise_batch``), when it has one; None otherwise."""
     fn = getattr(problem.study, "summarise_batch", None)
-    if fn is None or not xs:
+    if fn is None or not xs or any(v.index is not None for v in problem.variables):
         return None
     columns = {v.key: np.array([x[i] for x in xs]) for i, v in enumerate(problem.variables)}
     try:
@@ -321,8 +345,12 @@ def _values(e: expr.Expr, frame: pd.DataFrame) -> np.ndarray:
     return v.astype(np.float64)
 
 
-def _short(text: str, n: int = 70) -> str:
-    text = " ".join(str(text).split())
+_NUMBER = re.compile(r"(?<![\w.])[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+
+
+def _short(text: str, n: int = 90) -> str:
+    """A reason to count: one line, numbers replaced by '#' (so the same failure counts once)."""
+    text = _NUMBER.sub("#", " ".join(str(text).split()))
     return text if len(text) <= n else text[: n - 3] + "..."
 
 

@@ -7,7 +7,8 @@
 * ``slsqp`` / ``trust-constr``: multi-start local searches in bound-normalised coordinates,
   from the deck's own design and a seeded scrambled Sobol' set (or the best feasible points
   of a grid); gradients are forward differences, all n+1 points of one Jacobian evaluated in
-  one batch.
+  one batch; the objective is divided by its magnitude at the start, so the stopping
+  tolerance (tol x 1e-3) is relative.
 * ``grid``: every point of a grid_count^n grid, in batches.
 
 Whatever the method, the reported design is the best *feasible* design the run evaluated
@@ -127,7 +128,8 @@ def _starts(ev: Evaluator) -> np.ndarray:
     base = []
     for v in p.variables:
         val = p.base[v.key]
-        val = val[0] if isinstance(val, list) else val
+        if isinstance(val, list):
+            val = val[(v.index or 1) - 1]
         base.append(float(val) if val is not None else math.nan)
     base = np.array(base)
     starts = []
@@ -173,12 +175,13 @@ def _local(ev: Evaluator, history: list[HistoryRow]) -> MethodResult:
     def mvals(recs) -> np.ndarray:
         return np.array([[m if math.isfinite(m) else -1e3 for m in r.margins] for r in recs]).reshape(len(recs), -1)
 
-    fun = lambda u: float(fvals(ev.evaluate(to_x(np.atleast_2d(u))))[0])
+    scale = [1.0]   # objective scale of the current start: ftol is relative to |f(start)|
+    fun = lambda u: float(fvals(ev.evaluate(to_x(np.atleast_2d(u))))[0]) / scale[0]
 
     def jac(u):
         recs, steps = stencil(u)
         f = fvals(recs)
-        return (f[1:] - f[0]) / steps
+        return (f[1:] - f[0]) / steps / scale[0]
 
     cons_fun = lambda u: mvals(ev.evaluate(to_x(np.atleast_2d(u))))[0]
 
@@ -192,6 +195,8 @@ def _local(ev: Evaluator, history: list[HistoryRow]) -> MethodResult:
     runs, nit, nfev = [], 0, 0
     for s, u0 in enumerate(starts, 1):
         it = [0]
+        f0 = fvals(ev.evaluate(to_x(np.atleast_2d(u0))))[0]
+        scale[0] = abs(f0) if 0 < abs(f0) < FAILED_OBJECTIVE else 1.0
 
         def callback(*args, **kw) -> None:
             it[0] += 1

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import ast
 import hashlib
+import re
 import json
 import math
 from dataclasses import dataclass, field
@@ -48,7 +49,8 @@ def _at_least(n: int):
 def _spec() -> GroupSpec:
     keys: dict[str, Key] = {}
     for k in range(1, MAX_VARS + 1):
-        keys[f"var{k}"] = Key("str", doc=f"design variable {k}: a numeric deck key 'group.key'")
+        keys[f"var{k}"] = Key("str", doc=f"design variable {k}: a numeric deck key 'group.key', or one "
+                                         "element of a list key 'group.key(i)'")
         keys[f"lower{k}"] = Key("float", doc=f"lower bound of var{k} (deck units)")
         keys[f"upper{k}"] = Key("float", doc=f"upper bound of var{k} (deck units)")
     for k in range(1, MAX_CONSTRAINTS + 1):
@@ -96,6 +98,7 @@ class Variable:
     key: str
     lower: float
     upper: float
+    index: int | None = None   # element (from 1) of a list key, 'group.key(i)'
 
 
 @dataclass(frozen=True)
@@ -144,7 +147,8 @@ class Problem:
 
     def fingerprint(self) -> str:
         """Hash of everything that changes an evaluation's result (study group minus the variables)."""
-        fixed = {k: v for k, v in self.raw.values.items() if f"{self.raw.name}.{k}" not in self.names}
+        whole = {v.key for v in self.variables if v.index is None}
+        fixed = {k: v for k, v in self.raw.values.items() if k not in whole}
         blob = json.dumps([self.raw.name, sorted(fixed.items(), key=lambda kv: kv[0])], default=str)
         return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
@@ -186,9 +190,13 @@ def problem_of(deck: Deck) -> Problem:
                 if opts[f"{w}{k}"] is not None:
                     raise opts.error(f"{w}{k}", f"given without var{k}")
             continue
-        group, _, key = name.lower().partition(".")
+        group, _, key = name.lower().replace(" ", "").partition(".")
         if not key:
             raise opts.error(f"var{k}", f"write the key as 'group.key' (e.g. '{study.SPEC.name}.{name}')")
+        index = None
+        m = re.fullmatch(r"([a-z_][a-z0-9_]*)\((\d+)\)", key)
+        if m:
+            key, index = m.group(1), int(m.group(2))
         if group != study.SPEC.name:
             raise opts.error(f"var{k}", f"group '{group}' is not this deck's study group &{study.SPEC.name}")
         spec_key = study.SPEC.keys.get(key)
@@ -197,16 +205,27 @@ def problem_of(deck: Deck) -> Problem:
         if spec_key.kind not in ("float", "floats"):
             raise opts.error(f"var{k}", f"&{group} key '{key}' is not a real number ({spec_key.kind}); "
                                         "only real-valued keys can be design variables")
+        current = base[key]
+        if spec_key.kind == "float" and index is not None:
+            raise opts.error(f"var{k}", f"&{group} key '{key}' is one number, not a list: write '{group}.{key}'")
+        if spec_key.kind == "floats":
+            size = len(current) if isinstance(current, list) else 0
+            if index is None and size > 1:
+                raise opts.error(f"var{k}", f"&{group} key '{key}' is a list of {size}: name one element, "
+                                            f"'{group}.{key}(1)' ... '{group}.{key}({size})'")
+            if index is not None and not 1 <= index <= size:
+                raise opts.error(f"var{k}", f"&{group} key '{key}' has {size} value(s) in the deck; "
+                                            f"element {index} does not exist")
         lo, hi = opts[f"lower{k}"], opts[f"upper{k}"]
         for w, v in (("lower", lo), ("upper", hi)):
             if v is None:
                 raise opts.error(f"var{k}", f"needs {w}{k}")
         if not lo < hi:
             raise opts.error(f"upper{k}", f"must exceed lower{k} ({hi:g} <= {lo:g})")
-        full = f"{group}.{key}"
+        full = f"{group}.{key}" + (f"({index})" if index is not None else "")
         if any(v.name == full for v in variables):
             raise opts.error(f"var{k}", f"{full} is a variable twice")
-        variables.append(Variable(full, key, float(lo), float(hi)))
+        variables.append(Variable(full, key, float(lo), float(hi), index))
     if not variables:
         raise opts.error("var1", "an optimisation needs at least var1 with lower1 and upper1")
     if (opts.minimize is None) == (opts.maximize is None):

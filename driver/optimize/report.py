@@ -81,7 +81,7 @@ def report_text(p: Problem, ev: Evaluator, mres: MethodResult, history: list[His
     rows = []
     for i, v in enumerate(p.variables):
         base = p.base[v.key]
-        base = base[0] if isinstance(base, list) else base
+        base = base[(v.index or 1) - 1] if isinstance(base, list) else base
         rows.append([v.name, _g(v.lower), _g(v.upper), _g(base), _g(best.x[i]) if best else "-"])
     L += render_table(cols, rows) + [""]
     status = "CONVERGED" if mres.converged else "NOT CONVERGED"

@@ -67,6 +67,18 @@ def _check(p: Params) -> None:
                 raise p.error(key, "needed for function generation")
             if not 0 < abs(p[key]) < 360:
                 raise p.error(key, "must be between 0 and 360 deg in size")
+    elif p.task == "path":
+        if p.target_x is None or p.target_y is None or len(p.target_x) != len(p.target_y):
+            raise p.error("target_y" if p.target_x is not None else "target_x",
+                          "path generation needs target_x and target_y of equal length")
+        if len(p.target_x) < 2:
+            raise p.error("target_x", "at least two target points")
+        if len(p.target_x) > 100:
+            raise p.error("target_x", "at most 100 target points")
+        if p.timing_deg is not None and len(p.timing_deg) != len(p.target_x):
+            raise p.error("timing_deg", f"needs one crank angle per target ({len(p.target_x)})")
+        if not 0 <= p.transmission_min_deg < p.transmission_max_deg <= 180:
+            raise p.error("transmission_max_deg", "the band needs 0 <= min < max <= 180")
     else:
         for key in ("swing_deg", "time_ratio"):
             if p[key] is None:
@@ -85,8 +97,9 @@ SPEC = GroupSpec(
     name="synthesis",
     doc="four-bar synthesis: function generation (Freudenstein) or a crank-rocker for a swing and time ratio",
     keys={
-        "task": Key("str", required=True, choices=("function", "crank_rocker"),
-                    doc="'function': rocker angle follows y(x); 'crank_rocker': given swing and time ratio"),
+        "task": Key("str", required=True, choices=("function", "crank_rocker", "path"),
+                    doc="'function': rocker angle follows y(x); 'crank_rocker': given swing and time ratio; "
+                        "'path': coupler point through or near target points"),
         "fixed_link": Key("float", default=1.0, check=positive, units="length", doc="ground link (sets the scale)"),
         "omega": Key("float", default=1.0, units="rad/s", doc="crank speed of the linkage deck"),
         "step_deg": Key("float", default=5.0, check=positive, units="deg", doc="crank step of the linkage deck"),
@@ -108,6 +121,23 @@ SPEC = GroupSpec(
         "time_ratio": Key("float", doc="crank-rocker: slow stroke / fast stroke crank angle (>= 1)"),
         "family_points": Key("int", default=721, check=_between(11, 100000),
                              doc="crank-rocker: members scanned per arc of the family"),
+        "target_x": Key("floats", units="length", doc="path: x of the target points (world frame)"),
+        "target_y": Key("floats", units="length", doc="path: y of the target points"),
+        "timing_deg": Key("floats", units="deg",
+                          doc="path: prescribed crank angles of the targets, relative to the first (0, ...)"),
+        "full_rotation": Key("bool", default=True, doc="path: the crank must turn fully (Grashof, crank shortest)"),
+        "transmission_min_deg": Key("float", default=30.0, units="deg", doc="path: least transmission angle"),
+        "transmission_max_deg": Key("float", default=150.0, units="deg", doc="path: largest transmission angle"),
+        "length_min": Key("float", check=positive, units="length",
+                          doc="path: shortest link (default: a tenth of the targets' extent)"),
+        "length_max": Key("float", check=positive, units="length",
+                          doc="path: longest link and pivot offset (default: 4 x the targets' extent)"),
+        "samples": Key("int", default=360, check=_between(36, 100000), doc="path: crank positions per turn"),
+        "seed": Key("int", default=1, doc="path: seed of differential evolution (runs are deterministic)"),
+        "maxiter": Key("int", default=1000, check=_between(1, 100000), doc="path: generations"),
+        "popsize": Key("int", default=15, check=_between(2, 1000), doc="path: population per variable"),
+        "tolerance": Key("float", default=1e-3, check=positive, units="length",
+                         doc="path: largest target error accepted as 'through the points'"),
     },
     check=_check,
 )
@@ -299,6 +329,68 @@ def _crank_rocker(p: Params) -> Synthesis:
     return Synthesis(p, linkage, "\n".join(lines), failure, table, "_family", design=best, checks=checks)
 
 
+# ----------------------------------------------------------------------------- path generation
+
+def _path(p: Params) -> Synthesis:
+    from driver.synthesis import path as pg
+    targets = np.column_stack([p.target_x, p.target_y]).astype(float)
+    ext = float(max(np.ptp(targets, axis=0))) or 1.0
+    pp = pg.PathProblem(targets, None if p.timing_deg is None else np.array(p.timing_deg, float) - p.timing_deg[0],
+                        1 if p.branch == "open" else -1, p.full_rotation,
+                        (p.transmission_min_deg, p.transmission_max_deg),
+                        p.length_min or 0.1 * ext, p.length_max or 4.0 * ext, p.samples)
+    if pp.length_min >= pp.length_max:
+        raise p.error("length_max", f"must exceed length_min ({pp.length_min:g})")
+    design, converged, message, nfev = pg.solve(pp, p.seed, p.maxiter, p.popsize)
+    q = design.parts
+    lines = ["  four-bar synthesis: path generation (coupler point through or near target points)",
+             f"  deck: {p.path}" + (f" -- {p.title}" if p.title else ""), "",
+             f"    targets .............. {len(targets)}" + (" with prescribed crank angles" if pp.timing_deg is not None
+                                                            else " (timing free)"),
+             f"    branch ............... {p.branch}; full crank rotation {'required' if p.full_rotation else 'not required'}",
+             f"    transmission band .... {p.transmission_min_deg:g} .. {p.transmission_max_deg:g} deg",
+             f"    link lengths ......... {pp.length_min:.6g} .. {pp.length_max:.6g}",
+             f"    search ............... differential evolution (seed {p.seed}, popsize {p.popsize}, maxiter "
+             f"{p.maxiter}) then least squares from its best distinct designs: {nfev} designs; evolution "
+             f"{'converged' if converged else 'stopped'} ({message})",
+             "",
+             f"  linkage: ground {q['ground']:.10g}, crank {q['crank']:.10g}, coupler {q['coupler']:.10g}, "
+             f"rocker {q['rocker']:.10g}",
+             f"    crank pivot O_A = ({q['x0']:.10g}, {q['y0']:.10g}), ground direction {q['gamma_deg']:.10g} deg; "
+             f"coupler point u = {q['u']:.10g}, v = {q['v']:.10g}"]
+    if pp.timing_deg is not None:
+        lines.append(f"    crank angle at the first target {q['theta1_deg'] % 360:.10g} deg (deck frame)")
+    lines += ["", "  Targets (world frame) and the coupler point's distance to them, by the exact kernel",
+              "         x             y         error   crank angle [deg, deck frame]"]
+    lines += [f"  {tx:12.6f}  {ty:12.6f}  {e:12.3e}  {t:10.4f}"
+              for (tx, ty), e, t in zip(targets, design.errors, design.theta_at_targets_deg)]
+    lines += [f"  RMS error {design.rms:.6e}, largest {design.errors.max():.6e} (tolerance {p.tolerance:g})"]
+    failure = None
+    if design.violation > 0:
+        failure = f"no design met the constraints (violation {design.violation:.3g}): assembly, rotation or band"
+    elif design.errors.max() > p.tolerance:
+        failure = (f"the coupler point misses a target by {design.errors.max():.4g} > tolerance {p.tolerance:g}: "
+                   "the best design found passes near, not through, the points")
+    linkage = {"fixed_link": q["ground"], "crank": q["crank"], "coupler": q["coupler"], "rocker": q["rocker"],
+               "omega": p.omega, "step_deg": p.step_deg, "branch": p.branch,
+               "coupler_point": [q["u"], q["v"]]}
+    # the full turn by the exact kernel: assembly, Grashof class, transmission band
+    fp = validate(RawGroup("fourbar", dict(linkage), {}, p.line), fourbar.SPEC, p.path)
+    g = fourbar.grashof(fp.fixed_link, fp.crank, fp.coupler, fp.rocker)
+    ex = fourbar.extremes(fp)
+    if ex is not None:
+        lines += [f"  Check over a full turn: {g.name}; assembled {100 * ex.assembled_fraction:.1f} % of the turn; "
+                  f"transmission angle {ex.mu_min:.4f} .. {ex.mu_max:.4f} deg"]
+        if p.full_rotation and (ex.assembled_fraction < 1.0 or ex.toggles):
+            failure = failure or "the exact kernel cannot turn the crank fully"
+    if failure:
+        lines += [f"    FAILED: {failure}"]
+    table = pd.DataFrame({"target_x": targets[:, 0], "target_y": targets[:, 1], "error": design.errors,
+                          "crank_deg": design.theta_at_targets_deg})
+    return Synthesis(p, linkage, "\n".join(lines), failure, table, "_targets", design=design,
+                     checks={"rms": design.rms, "max_error": float(design.errors.max())})
+
+
 # ----------------------------------------------------------------------------- run
 
 def synthesise(deck: Deck | str | Path) -> Synthesis:
@@ -311,13 +403,32 @@ def synthesise(deck: Deck | str | Path) -> Synthesis:
         raise DeckError(deck.path, raw.line, None, f"a &synthesis deck has no other group (found &{others[0]}); "
                                                    "it writes the &fourbar deck of its linkage")
     p = validate(deck.groups["synthesis"], SPEC, deck.path)
-    syn = _function(p) if p.task == "function" else _crank_rocker(p)
+    syn = {"function": _function, "crank_rocker": _crank_rocker, "path": _path}[p.task](p)
     if syn.linkage is not None:
         fp = validate(RawGroup("fourbar", dict(syn.linkage, title=p.title or f"synthesised by {deck.path}"),
                                {}, p.line), fourbar.SPEC, deck.path)
         syn.study_result = compute(fourbar, fp)
         syn.linkage = {k: v for k, v in fp.items() if v is not None and v != [] and v != ""}
     return syn
+
+
+def _path_figure(syn: Synthesis, path: Path, title: str) -> Path:
+    """The linkage, its coupler curve and the target points, in the linkage deck's frame."""
+    from driver import plotting
+    from driver.synthesis import path as pg
+    q = syn.design.parts
+    theta = np.linspace(0.0, 360.0, 721)
+    out, st = kernels.fourbar_exact(np.radians(theta), q["ground"], q["crank"], q["coupler"], q["rocker"], 1.0, 0.0,
+                                    1 if syn.params.branch == "open" else -1)
+    cp = kernels.fourbar_coupler_point(np.radians(theta), out, st, q["crank"], 1.0, 0.0, q["u"], q["v"])
+    fig = plotting.fourbar_linkage(q["ground"], theta, out, st == ST["ok"], None, title, point=cp[:, :2])
+    targets = np.column_stack([syn.params.target_x, syn.params.target_y]).astype(float)
+    pp = pg.PathProblem(targets, None, 1, False, (0.0, 180.0), 1.0, 1.0)
+    tk = pg._to_kernel(pp, syn.design.x)
+    ax = fig.axes[0]
+    ax.plot(tk[:, 0], tk[:, 1], "s", mfc="none", mec="k", ms=7, label="target points")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0, fontsize=8)
+    return plotting.save_figure(fig, path)
 
 
 def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool = False,
@@ -346,6 +457,10 @@ def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool,
                                               ("structural error", {"error": fd.y_generated - fd.y_desired})],
                                        "x", title=f"{Path(deck.path).stem}: function generation")
             written.append(plotting.save_figure(fig, stem.with_name(f"{stem.name}_error.{plotting.figure_format(plot)}")))
+    if plot and syn.params.task == "path" and syn.design is not None:
+        from driver.plotting import figure_format
+        written.append(_path_figure(syn, stem.with_name(f"{stem.name}_path.{figure_format(plot)}"),
+                                    Path(deck.path).stem))
     if not quiet:
         for w in written:
             print(f"wrote {w}")
