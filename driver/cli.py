@@ -1,4 +1,4 @@
-"""Command line: ``python -m driver DECK [DECK ...] [-o OUTDIR] [--csv|--format F] [--plot] [--compare]``.
+"""Command line: ``python -m driver DECK [DECK ...] [-o OUTDIR] [--csv|--format F] [--json] [--plot] [--compare]``.
 
 Each deck runs on its own; the exit status is 0 when every deck succeeded,
 2 when any deck had bad input (nothing written for that deck), 1 when a run
@@ -44,11 +44,13 @@ def _fs_error(exc: OSError) -> str:
 
 
 def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool, progress: bool,
-             quiet: bool = False, sweep_options: dict | None = None) -> int:
+             quiet: bool = False, sweep_options: dict | None = None, summary_json: bool = False) -> int:
     """Run one deck; returns its exit status. Errors are printed, never raised.
 
     ``sweep_options`` (jobs, scheduler, resume) apply when the deck has a &sweep or an
-    &optimize group; given for any other deck, they are reported as ignored.
+    &optimize group (a sweep's cases always write their summary as JSON); given for any other
+    deck, they are reported as ignored.  ``summary_json`` writes a single run's summary as
+    ``<stem>.json``.
     """
     from driver.deck import DeckError, read_deck
     from driver.runner import run_study
@@ -65,7 +67,7 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool, progress:
         if "sweep" in deck.groups:
             from driver import sweep
             return sweep.run_sweep_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))
-        outcome = run_study(deck, outdir, formats, plot, progress)
+        outcome = run_study(deck, outdir, formats, plot, progress, summary_json=summary_json)
     except DeckError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -187,6 +189,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--csv", action="store_true", help="also write the tidy table as <stem>.csv")
     parser.add_argument("--format", dest="formats", action="append", choices=FORMATS, default=[],
                         help="also write the tidy table in this format (repeatable)")
+    parser.add_argument("--json", action="store_true",
+                        help="also write the run's summary (headline figures, warnings) as <stem>.json")
     parser.add_argument("--plot", action="store_true", help="write figures <stem>_<name>.png")
     parser.add_argument("--plot-format", choices=("png", "svg", "pdf"), default=None,
                         help="figure file format (implies --plot); the same inputs give the same bytes")
@@ -273,7 +277,7 @@ def _main(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
         for deck in args.decks:
             try:
                 status = max(status, run_deck(deck, outdir, formats, args.plot, progress, args.quiet,
-                                             sweep_options))
+                                             sweep_options, summary_json=args.json))
                 sys.stdout.flush()
             except BrokenPipeError:   # stdout closed early (e.g. piped into head): the files are
                 _quiet_stdout()       # written; go on with the other decks without printing

@@ -35,8 +35,12 @@ KINDS = ("float", "int", "str", "bool", "floats", "ints", "strs", "list")
 MAX_FLOAT, MAX_INT = 1e15, 10**9
 
 
-class DeckError(Exception):
-    """Bad input: names the deck, the line and the key (exit status 2)."""
+class DeckError(ValueError):
+    """Bad input: names the deck, the line and the key (exit status 2).
+
+    Attributes ``path``, ``line`` (None when unknown) and ``key`` (None for the whole group)
+    locate the problem; ``message`` says what it is.
+    """
 
     def __init__(self, path: str | Path, line: int | None, key: str | None, message: str):
         self.path, self.line, self.key, self.message = str(path), line, key, message

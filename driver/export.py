@@ -5,8 +5,12 @@ one column per quantity, with units in the column names (``omega3_rad_s``).
 """
 from __future__ import annotations
 
+import json
+import math
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
 
 from driver.atomic import atomic_open
 from driver.extras import available, require
@@ -14,7 +18,7 @@ from driver.extras import available, require
 if TYPE_CHECKING:   # annotations only: keeps `python -m driver --help` light
     import pandas as pd
 
-__all__ = ["FORMATS", "write_tidy"]
+__all__ = ["FORMATS", "write_tidy", "json_safe", "summary_json_text"]
 
 FORMATS = ("csv", "parquet")
 
@@ -51,3 +55,32 @@ def write_tidy(frame: pd.DataFrame, path_stem: str | Path, fmt: str) -> Path:
         with atomic_open(path, "wb") as fh:
             frame.to_parquet(fh, index=False)
     return path
+
+
+def json_safe(value: Any) -> Any:
+    """``value`` with numpy scalars and arrays made plain and non-finite floats made None
+    (JSON has no NaN or Infinity; a missing figure is ``null``)."""
+    if isinstance(value, dict):
+        return {str(k): json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return [json_safe(v) for v in (value.tolist() if isinstance(value, np.ndarray) else value)]
+    if isinstance(value, (np.bool_, bool)):
+        return bool(value)
+    if isinstance(value, (np.integer, int)):
+        return int(value)
+    if isinstance(value, (np.floating, float)):
+        return float(value) if math.isfinite(value) else None
+    if value is None or isinstance(value, str):
+        return value
+    if isinstance(value, Path):
+        return str(value)
+    return str(value)
+
+
+def summary_json_text(result: Any) -> str:
+    """The machine-readable summary of one run (``<stem>.json``): study, name, success,
+    failure, warnings and the summary figures (units in their names)."""
+    record = {"study": result.study, "name": result.name, "ok": result.failure is None,
+              "failure": result.failure, "warnings": list(result.warnings),
+              "summary": json_safe(result.summary)}
+    return json.dumps(record, indent=1, allow_nan=False) + "\n"

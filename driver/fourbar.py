@@ -20,7 +20,7 @@ from scipy.optimize import brentq, minimize_scalar
 from driver import kernels
 from driver.limits import Estimate
 from driver.deck import GroupSpec, Key, Params, positive
-from driver.study import Figure, Result
+from driver.study import Figure, Result, keyword_run
 from driver.table import Column, fortran_f, render_table
 
 __all__ = ["SPEC", "run", "summarise", "grashof", "limit_angles", "exact_grid", "listing_grid", "exact_as_listed"]
@@ -500,6 +500,7 @@ def blame(params: Params, exc: BaseException) -> tuple[str, str] | None:
 
 # ----------------------------------------------------------------------------- run
 
+@keyword_run
 def run(params: Params, progress: bool = False) -> Result:
     """Analyse one four-bar deck (see module docstring)."""
     p = params

@@ -37,7 +37,7 @@ from scipy.optimize import minimize
 from driver import kernels
 from driver.deck import GroupSpec, Key, Params, non_empty, positive
 from driver.limits import Estimate
-from driver.study import Figure, Result
+from driver.study import Figure, Result, keyword_run
 from driver.table import Column, fortran_f, render_table
 
 __all__ = ["SPEC", "run", "Workspace", "tolerance_box", "round_half_up", "REASONS", "NOT_REPRODUCIBLE", "TEXT_REASONS",
@@ -739,6 +739,7 @@ def estimate(params: Params) -> Estimate:
     return mc + sweep + tables
 
 
+@keyword_run
 def run(params: Params, progress: bool = False) -> Result:
     """Run one &manipulator deck (see the module docstring)."""
     p = params

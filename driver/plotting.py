@@ -9,9 +9,10 @@ names and units; matplotlib is the optional ``[plot]`` extra.
 """
 from __future__ import annotations
 
+import contextlib
 import functools
 from pathlib import Path
-from typing import Callable, Mapping, Sequence
+from typing import Any, Callable, Iterator, Mapping, Sequence
 
 from driver.extras import require
 
@@ -21,9 +22,8 @@ import numpy as np  # noqa: E402
 from matplotlib import colormaps  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
-from driver.atomic import atomic_open  # noqa: E402
 
-__all__ = ["STYLE", "FIGURE_FORMATS", "figure_format", "styled", "new_figure", "save_figure", "line_panels",
+__all__ = ["STYLE", "FIGURE_FORMATS", "figure_format", "style", "styled", "new_figure", "save_figure", "line_panels",
            "quantity_label", "break_wraps"]
 
 #: the house style: applied around every builder and every save, never globally
@@ -48,11 +48,18 @@ def figure_format(plot: bool | str) -> str:
     return fmt
 
 
+@contextlib.contextmanager
+def style(**overrides: Any) -> Iterator[None]:
+    """Draw inside this context to get the house style; rcParams are restored on exit."""
+    with matplotlib.rc_context({**STYLE, **overrides}):
+        yield
+
+
 def styled(builder: Callable[..., Figure]) -> Callable[..., Figure]:
-    """Run a figure builder inside the house style (fonts and lines are fixed when drawn)."""
+    """Run a figure builder inside :func:`style` (fonts and lines are fixed when drawn)."""
     @functools.wraps(builder)
     def wrapper(*args, **kwargs):
-        with matplotlib.rc_context(STYLE):
+        with style():
             return builder(*args, **kwargs)
     return wrapper
 

@@ -29,7 +29,7 @@ import pandas as pd
 
 from driver.deck import GroupSpec, Key, Params, non_empty, positive
 from driver.limits import Estimate
-from driver.study import Result
+from driver.study import Result, keyword_run
 from driver.table import Column, render_table
 
 __all__ = ["SPEC", "run", "quadratic_fit", "analyse", "MODE_REASONS", "NOT_REPRODUCIBLE"]
@@ -203,6 +203,7 @@ def estimate(params: Params) -> Estimate:
     return Estimate(1e6 + 1e3 * n, 0.05 + 1e-5 * n, "taguchi_y", "taguchi_y", f"{n} observations")
 
 
+@keyword_run
 def run(params: Params, progress: bool = False) -> Result:
     """Run one &robust_example deck."""
     p = params

@@ -19,7 +19,7 @@ from driver import limits
 from driver.atomic import inside, output_set, remove_stale_temporaries, write_text
 from driver.deck import Deck, DeckError, Params
 from driver.deck import validate
-from driver.export import FORMATS, write_tidy
+from driver.export import FORMATS, summary_json_text, write_tidy
 from driver.study import Result, load_study
 from driver.table import TableValueError
 
@@ -76,8 +76,10 @@ def output_stem(outdir: str | Path, deck_path: str | Path) -> Path:
     return candidate
 
 
-def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool | str) -> list[Path]:
-    """Write the .out file, extra files, tidy tables and figures for one case.
+def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool | str,
+                  summary_json: bool = False) -> list[Path]:
+    """Write the .out file, extra files, tidy tables, the summary as ``<stem>.json`` (when
+    ``summary_json``) and figures (``plot``: True for PNG, or 'png', 'svg', 'pdf') for one case.
 
     The files form one set (:func:`driver.atomic.output_set`): all are renamed into place
     together once every one is complete, or none is.  Stale temporaries of this stem left
@@ -91,6 +93,8 @@ def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool | s
             written.append(write_text(stem.with_name(stem.name + suffix), text))
         for fmt in formats:
             written.append(write_tidy(result.tidy, stem, fmt))
+        if summary_json:
+            written.append(write_text(stem.with_name(stem.name + ".json"), summary_json_text(result)))
         if plot and result.figures:   # plot: True (PNG) or a format name (png, svg, pdf)
             from driver.plotting import figure_format, save_figure
             suffix = figure_format(plot)
@@ -176,12 +180,15 @@ class Outcome:
 
 
 def run_study(deck: Deck, outdir: Path | None, formats: list[str], plot: bool,
-              progress: bool = False) -> Outcome:
-    """Validate and run the deck's study; write its outputs to ``outdir`` (None: write nothing).
+              progress: bool = False, summary_json: bool = False, name: str | None = None) -> Outcome:
+    """Validate and run the deck's study; write its outputs to ``outdir`` (None: write nothing)
+    as ``<name>.*`` (default: the deck's file stem).
 
     Raises DeckError for bad input (nothing is written then); other exceptions are run failures.
     """
     module, params = study_of(deck)
     result = compute(module, params, progress=progress)
-    written = [] if outdir is None else write_outputs(result, output_stem(outdir, deck.path), formats, plot)
+    result.name, result.study = name or Path(deck.path).stem, params.group
+    written = [] if outdir is None else write_outputs(
+        result, output_stem(outdir, deck.path if name is None else f"{name}.dat"), formats, plot, summary_json)
     return Outcome(result, written)

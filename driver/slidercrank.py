@@ -23,7 +23,7 @@ from tqdm import tqdm
 from driver import kernels
 from driver.limits import Estimate
 from driver.deck import GroupSpec, Key, Params, non_negative, positive
-from driver.study import Figure, Result
+from driver.study import Figure, Result, keyword_run
 from driver.table import Column, render_table
 
 __all__ = ["SPEC", "run", "MATERIALS", "PAPER_SPEEDS", "SIMEON1996", "simeon_initial_state",
@@ -603,6 +603,7 @@ def estimate(params: Params) -> Estimate:
                     f"{len(p.speeds)} speed(s) x {len(counts)} element count(s), up to {steps_max:.4g} time steps")
 
 
+@keyword_run
 def run(params: Params, progress: bool = False) -> Result:
     """Run every crank speed (and element count) of the deck; see the module docstring."""
     model = _model(params)

@@ -4,23 +4,30 @@ A study is a module ``driver/<group>.py`` named after its namelist group.  It
 defines
 
 * ``SPEC``: a :class:`driver.deck.GroupSpec` for its keys, and
-* ``run(params, progress=False) -> Result``: the physics (through its kernel).
+* ``run(params, progress=False) -> Result``: the physics (through its kernel),
+  decorated with :func:`keyword_run` so that Python users can also call
+  ``driver.<group>.run(key=value, ...)`` with the deck's keys as keyword arguments.
 
 Nothing else in the driver changes when a study is added: the group name of a
 deck selects the module.
 """
 from __future__ import annotations
 
+import functools
 import importlib
 import re
 from dataclasses import dataclass, field
+from pathlib import Path
 from types import ModuleType
-from typing import TYPE_CHECKING, Any, Callable
+from typing import TYPE_CHECKING, Any, Callable, Iterable
 
 if TYPE_CHECKING:   # annotations only: keeps `python -m driver --help` light
     import pandas as pd
 
-__all__ = ["Figure", "Result", "load_study", "study_names"]
+if TYPE_CHECKING:
+    import matplotlib.figure
+
+__all__ = ["Figure", "Result", "keyword_run", "load_study", "study_names"]
 
 _CORE = {"cli", "limits", "deck", "study", "table", "export", "plotting", "atomic", "kernels", "sweep", "runner", "expr",
          "optimize", "synthesis", "published", "compare", "extras", "example_decks", "examples"}
@@ -28,7 +35,8 @@ _CORE = {"cli", "limits", "deck", "study", "table", "export", "plotting", "atomi
 
 @dataclass
 class Figure:
-    """A figure to write as ``<stem>_<name>.png``; ``draw`` builds it lazily (matplotlib Figure)."""
+    """A figure to write as ``<stem>_<name>.png``; ``draw`` builds it lazily (matplotlib Figure,
+    drawn in the house style by :mod:`driver.plotting`, never through pyplot)."""
 
     name: str
     draw: Callable[[], Any]
@@ -44,8 +52,13 @@ class Result:
     warnings  messages for the terminal (also written into ``text`` by the study)
     failure   set when the run completed but did not succeed (e.g. an optimiser
               did not converge): outputs are written, the exit status is 1
-    figures   figures for --plot
+    figures   figures for --plot (drawn only on demand: :meth:`figure`)
     extra     further files: suffix -> text, written as ``<stem><suffix>``
+    name      output stem (the deck's file stem; set by the runner)
+    study     namelist group of the study (set by the runner)
+
+    Units are those of the study's deck keys; tidy and summary columns carry
+    them in their names (``omega3_rad_s``) or in ``tidy.attrs["units"]``.
     """
 
     text: str
@@ -55,6 +68,81 @@ class Result:
     failure: str | None = None
     figures: list[Figure] = field(default_factory=list)
     extra: dict[str, str] = field(default_factory=dict)
+    name: str = ""
+    study: str = ""
+
+    @property
+    def out(self) -> str:
+        """The fixed-format ``.out`` text, exactly as the command line writes it."""
+        return self.text
+
+    @property
+    def ok(self) -> bool:
+        """True when the run succeeded (``failure`` is None)."""
+        return self.failure is None
+
+    @property
+    def summary_frame(self) -> pd.DataFrame:
+        """The summary as a one-row DataFrame (columns in summary order; None becomes missing)."""
+        import pandas as pd
+        return pd.DataFrame([self.summary])
+
+    @property
+    def figure_names(self) -> list[str]:
+        """Names of the figures this result can draw (``<stem>_<name>.png`` with --plot)."""
+        return [f.name for f in self.figures]
+
+    def figure(self, name: str | None = None) -> "matplotlib.figure.Figure":
+        """Draw one figure (the first when ``name`` is None) as a new matplotlib Figure.
+
+        It is drawn in the house style inside an ``rc_context``; the matplotlib backend and
+        the global rcParams are left as they were (figures show inline in Jupyter).
+        """
+        if not self.figures:
+            raise LookupError(f"{self.name or 'this result'} has no figures")
+        if name is None:
+            return self.figures[0].draw()
+        for f in self.figures:
+            if f.name == name:
+                return f.draw()
+        raise LookupError(f"no figure {name!r}; this result draws {', '.join(self.figure_names)}")
+
+    def write(self, outdir: str | Path, formats: Iterable[str] = (), plot: bool = False,
+              json: bool = False, name: str | None = None) -> list[Path]:
+        """Write the outputs the command line writes: ``<outdir>/<name>.out`` and extra files,
+        tidy tables in ``formats`` ('csv', 'parquet'), PNG figures with ``plot``, and the
+        summary as ``<name>.json`` with ``json``.  Every file is written atomically;
+        ``outdir`` is created when missing.  Returns the paths written."""
+        from driver.runner import write_outputs
+        stem = name or self.name or self.study or "result"
+        if Path(stem).name != stem or stem in ("", ".", ".."):
+            raise ValueError(f"output name {stem!r} must be a plain file stem, not a path")
+        return write_outputs(self, Path(outdir) / stem, list(formats), plot, summary_json=json)
+
+    def __repr__(self) -> str:
+        state = "ok" if self.ok else f"failed: {self.failure}"
+        return (f"<Result {self.study or '?'} {self.name!r}: {state}; .out {len(self.text.splitlines())} lines, "
+                f"tidy {self.tidy.shape[0]}x{self.tidy.shape[1]}, summary {len(self.summary)} values, "
+                f"{len(self.warnings)} warning(s), figures {self.figure_names}>")
+
+
+def keyword_run(run: Callable[..., Result]) -> Callable[..., Result]:
+    """Decorator for a study's ``run``: accept validated Params (the runner's call) or the deck's
+    keys as keyword arguments, e.g. ``driver.fourbar.run(fixed_link=12, crank=5, coupler=15,
+    rocker=9, step_deg=20)``.  Keywords are validated by the study's SPEC exactly like a deck
+    (errors are :class:`driver.deck.DeckError`); the result is the runner's, as for a deck."""
+    group = run.__module__.rpartition(".")[2]
+
+    @functools.wraps(run)
+    def wrapper(params: Any = None, /, progress: bool = False, **keys: Any) -> Result:
+        if params is not None:
+            if keys:
+                raise TypeError(f"{group}.run() takes validated params or deck keys, not both")
+            return run(params, progress=progress)
+        from driver.api import run as api_run
+        return api_run({group: keys}, progress=progress)
+
+    return wrapper
 
 
 def load_study(group: str) -> ModuleType | None:

@@ -32,7 +32,7 @@ from driver.deck import GroupSpec, Key, Params, non_empty, positive
 from driver.limits import Estimate
 from driver.kernels import (UJOINT_MODELS, UJOINT_OBJECTIVES, ujoint_equivalent, ujoint_geometry,
                             ujoint_objective, ujoint_speed)
-from driver.study import Figure, Result
+from driver.study import Figure, Result, keyword_run
 from driver.table import Column, fortran_f, render_table
 
 __all__ = ["SPEC", "run", "Chain", "Design", "evaluate", "optimise", "BAND_TOL", "NOT_REPRODUCIBLE"]
@@ -424,6 +424,7 @@ def estimate(params: Params) -> Estimate:
     return mem + table
 
 
+@keyword_run
 def run(params: Params, progress: bool = False) -> Result:
     """Analyse (option 0) or optimise (options 1-3) the chain of the deck."""
     beta, rho = _geometry(params)
