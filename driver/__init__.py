@@ -25,7 +25,7 @@ try:
 except ImportError:   # a source checkout that was never built (driver.kernels says what to do)
     __version__ = "unknown (unbuilt source checkout)"
 
-__all__ = ["__version__", "run", "run_sweep", "studies", "keys", "Result", "SweepResult", "DeckError"]
+__all__ = ["run", "run_sweep", "studies", "keys", "Result", "SweepResult", "DeckError"]
 
 _API = {"run": "driver.api", "run_sweep": "driver.api", "studies": "driver.api", "keys": "driver.api",
         "Result": "driver.study", "SweepResult": "driver.api", "DeckError": "driver.deck"}

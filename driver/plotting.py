@@ -22,6 +22,8 @@ import numpy as np  # noqa: E402
 from matplotlib import colormaps  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
+from driver.atomic import atomic_open  # noqa: E402
+
 
 __all__ = ["STYLE", "FIGURE_FORMATS", "figure_format", "style", "styled", "new_figure", "save_figure", "line_panels",
            "quantity_label", "break_wraps"]

@@ -30,7 +30,7 @@ if TYPE_CHECKING:
 __all__ = ["Figure", "Result", "keyword_run", "load_study", "study_names"]
 
 _CORE = {"cli", "limits", "deck", "study", "table", "export", "plotting", "atomic", "kernels", "sweep", "runner", "expr",
-         "optimize", "synthesis", "published", "compare", "extras", "example_decks", "examples"}
+         "optimize", "synthesis", "published", "compare", "extras", "example_decks", "examples", "api"}
 
 
 @dataclass
