@@ -12,10 +12,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any, Mapping
 
 import numpy as np
 import pandas as pd
-from scipy.optimize import brentq, minimize_scalar
 
 from driver import kernels
 from driver.limits import Estimate
@@ -23,9 +23,11 @@ from driver.deck import GroupSpec, Key, Params, positive
 from driver.study import Figure, Result, keyword_run
 from driver.table import Column, fortran_f, render_table
 
-__all__ = ["SPEC", "run", "summarise", "grashof", "limit_angles", "exact_grid", "listing_grid", "exact_as_listed"]
+__all__ = ["SPEC", "run", "summarise", "summarise_batch", "BATCH_KEYS", "grashof", "limit_angles", "exact_grid",
+           "listing_grid", "exact_as_listed"]
 
 ST = kernels.FOURBAR_STATUS
+MAX_ANGLE = 1.0e6   # |crank angle| [deg] a deck may give (ulp of 1e6 is 1.2e-10 deg)
 BAND = (40.0, 120.0)  # transmission-angle band recommended by the paper [deg]
 
 #: why the published listing's rows for crank angles in (180, 360) deg are wrong (see :func:`audit`)
@@ -40,6 +42,10 @@ def _check(p: Params) -> None:
     """Cross-key checks: step, range, and what the listing method can do."""
     if p.step_deg == 0:
         raise p.error("step_deg", "must not be 0 (the crank angle would never advance)")
+    for key in ("start_deg", "stop_deg"):
+        if abs(p[key]) > MAX_ANGLE:
+            raise p.error(key, f"|{p[key]:g}| deg is beyond {MAX_ANGLE:g} deg: a crank angle that large has lost "
+                               "its fraction of a degree in double precision (the motion repeats every 360 deg)")
     span = p.stop_deg - p.start_deg
     if span * p.step_deg < 0:
         raise p.error("step_deg", f"steps away from stop_deg ({p.start_deg:g} -> {p.stop_deg:g} "
@@ -158,7 +164,7 @@ def _deg360(rad: np.ndarray) -> np.ndarray:
 
 @dataclass
 class Extremes:
-    """Headline figures over the analysed crank range (exact solution)."""
+    """Headline figures over the analysed crank range (exact solution), from the batch kernel."""
 
     mu_min: float
     mu_min_at: float
@@ -175,86 +181,141 @@ class Extremes:
     assembled_fraction: float
     rocker_turns: bool = False
     toggles: tuple[float, ...] = ()
+    rocker_swing: float = 0.0
 
 
-def transmission_extremes(p: Params, lo: float, hi: float, lims: list[float]) -> tuple[float, float, float, float]:
-    """Closed form: mu grows with d = |A O_B|, and d is monotonic between 0 and 180 deg.
-
-    Over [lo, hi] d takes its extremes at the range ends or at 0/180 (+360k); the
-    assemblable part is d in [|r - s|, r + s], whose ends are the limit angles.
-    Returns (mu_min, theta, mu_max, theta) in degrees.
-    """
-    P, q, r, s = p.fixed_link, p.crank, p.coupler, p.rocker
-    d = lambda t: math.hypot(P - q * math.cos(math.radians(t)), q * math.sin(math.radians(t)))
-    mu = lambda x: math.degrees(math.acos(max(-1.0, min(1.0, (r * r + s * s - x * x) / (2 * r * s)))))
-    cands = [lo, hi] + [a + 360.0 * k for a in (0.0, 180.0) for k in range(-3, 4) if lo <= a + 360.0 * k <= hi]
-    lim_in = [a + 360.0 * k for a in lims for k in range(-3, 4) if lo <= a + 360.0 * k <= hi]
-    tmin = min(cands, key=d)
-    tmax = max(cands, key=d)
-    near = lambda target: min(lim_in, key=lambda t: abs(d(t) - target))
-    t_lo = tmin if d(tmin) >= abs(r - s) else near(abs(r - s))
-    t_hi = tmax if d(tmax) <= r + s else near(r + s)
-    d_lo = max(d(tmin), abs(r - s))
-    d_hi = min(d(tmax), r + s)
-    return mu(d_lo), t_lo, mu(d_hi), t_hi
+def toggles_in_range(p: float, q: float, r: float, s: float, lo: float, hi: float) -> tuple[float, ...]:
+    """Limit (toggle) crank angles [deg] inside [lo, hi], every turn (a + 360 k), ascending."""
+    out = []
+    for a in limit_angles(p, q, r, s):
+        k0, k1 = math.ceil((lo - a) / 360.0), math.floor((hi - a) / 360.0)
+        out += [a + 360.0 * k for k in range(k0, min(k1, k0 + 1000) + 1)]
+    return tuple(sorted(out))
 
 
 def extremes(p: Params) -> Extremes | None:
     """Transmission-angle, rocker-position and speed extremes over the deck's crank range.
 
-    The transmission angle depends on |A O_B| only, which is monotonic in the crank
-    angle on [0, 180] and [180, 360], so its extremes sit at 0, 180, the range ends or
-    the limit angles, all inserted into a 0.5 deg grid (exact).  Rocker extremes
-    (omega3 = 0) are refined with brentq and speed peaks with a bounded search, both
-    on the kernel itself.
+    One row of the batch kernel (fortran/fourbar_summary.f90, see :func:`summarise_batch`),
+    so a single run and a sweep report the same figures: transmission-angle and rocker
+    extremes in closed form, peak speeds from a 1 deg scan refined to 1e-12 rad.
+    None when the linkage cannot be assembled anywhere in the range.
     """
     lo, hi = sorted((p.start_deg, p.stop_deg))
-    grid = np.linspace(lo, hi, max(2, int(math.ceil((hi - lo) / 0.5)) + 1))
-    lims = limit_angles(p.fixed_link, p.crank, p.coupler, p.rocker)
-    special = [a + 360.0 * k for a in [0.0, 180.0] + lims for k in range(-3, 4)]
-    grid = np.unique(np.concatenate([grid, [a for a in special if lo <= a <= hi]]))
-    out, st = exact_grid(p, grid)
-    ok = st == ST["ok"]
-    if not ok.any():
+    row = kernels.fourbar_summaries(_param_matrix(p, {}, 1))[0]
+    if not row[1]:
         return None
-    w2, w3 = out[:, 7], out[:, 8]
-    one = lambda t, col: float(exact_grid(p, np.array([t]))[0][0, col])
+    toggles = toggles_in_range(p.fixed_link, p.crank, p.coupler, p.rocker, lo, hi)
+    return Extremes(row[3], row[4], row[5], row[6], row[7], row[8], row[9], row[10],
+                    row[14], row[15], row[16], row[17], row[2], bool(row[12]), toggles, row[11])
 
-    def at(values: np.ndarray, pick) -> tuple[float, float]:
-        idx = np.flatnonzero(ok)[pick(values[ok])]
-        return float(values[idx]), float(grid[idx])
 
-    # rocker angle relative to its mean direction; extremes where omega3 changes sign
-    ref = np.degrees(np.angle(np.mean(np.exp(1j * out[ok, 1]))))
-    rel = (np.degrees(out[:, 1]) - ref + 180.0) % 360.0 - 180.0
-    cands = [(rel[i], grid[i]) for i in np.flatnonzero(ok)[[0, -1]]]
-    for i in np.flatnonzero(ok[:-1] & ok[1:] & (np.sign(w3[:-1]) != np.sign(w3[1:]))):
-        try:
-            t = brentq(lambda x: one(x, 8), grid[i], grid[i + 1], xtol=1e-10)
-        except ValueError:
-            t = grid[i]
-        cands.append(((math.degrees(one(t, 1)) - ref + 180.0) % 360.0 - 180.0, t))
-    rmin = min(cands, key=lambda c: c[0])
-    rmax = max(cands, key=lambda c: c[0])
+# ----------------------------------------------------------------------------- batch summaries
 
-    def peak(col: int, values: np.ndarray) -> tuple[float, float]:
-        v, t = at(values, lambda x: np.argmax(np.abs(x)))
-        a, b = max(lo, t - 0.5), min(hi, t + 0.5)
-        if b > a:
-            res = minimize_scalar(lambda x: -abs(one(x, col)), bounds=(a, b), method="bounded",
-                                  options={"xatol": 1e-7})
-            if res.success and abs(one(res.x, col)) > abs(v):
-                return one(res.x, col), float(res.x)
-        return v, t
+#: deck keys a batch may vary (one value per design); every other key of &fourbar leaves the
+#: summary unchanged (alpha, step_deg, method, title, coupler_point) and is accepted but ignored
+BATCH_KEYS = ("fixed_link", "crank", "coupler", "rocker", "omega", "start_deg", "stop_deg", "branch")
+BATCH_IGNORED = ("alpha", "step_deg", "method", "title", "coupler_point")
+#: keys whose deck checks do not involve other keys (a sweep validates each of their values once)
+BATCH_INDEPENDENT = ("fixed_link", "crank", "coupler", "rocker", "omega", "alpha", "title", "coupler_point")
 
-    mu_min, mu_min_at, mu_max, mu_max_at = transmission_extremes(p, lo, hi, lims)
-    toggles = tuple(a for a in lims if lo <= a <= hi)
-    w3v, w3a = peak(8, w3) if not toggles else at(w3, lambda x: np.argmax(np.abs(x)))
-    w2v, w2a = peak(7, w2) if not toggles else at(w2, lambda x: np.argmax(np.abs(x)))
-    turns = bool(ok.all() and np.ptp(np.unwrap(out[:, 1])) >= 2 * np.pi - 1e-6)
-    return Extremes(mu_min, mu_min_at, mu_max, mu_max_at,
-                    (rmin[0] + ref) % 360.0, float(rmin[1]), (rmax[0] + ref) % 360.0, float(rmax[1]),
-                    w3v, w3a, w2v, w2a, float(ok.mean()), turns, toggles)
+#: kernel Grashof codes -> (class name as grashof() prints it, full crank rotation)
+GRASHOF_NAMES = {"double_crank": ("double-crank (drag link)", True), "crank_rocker": ("crank-rocker", True),
+                 "rocker_crank": ("rocker-crank", False), "double_rocker": ("Grashof double-rocker", False),
+                 "change_point": ("change-point (special Grashof)", True),
+                 "triple_rocker": ("non-Grashof triple-rocker", False)}
+
+
+def _bad(base: Mapping[str, Any], key: str | None, message: str) -> Exception:
+    """A DeckError at the key's deck line when ``base`` is a deck's Params, else a ValueError."""
+    if isinstance(base, Params):
+        return base.error(key, message)
+    return ValueError(f"{key}: {message}" if key else message)
+
+
+def _param_matrix(base: Mapping[str, Any], columns: Mapping[str, Any], n: int) -> np.ndarray:
+    """The kernel's (n, 8) parameter matrix: base values, overridden column by column."""
+    cols = {}
+    for key in BATCH_KEYS:
+        v = columns.get(key, base[key])
+        if key == "branch":
+            v = np.asarray(v)
+            if v.dtype.kind in "US":
+                bad = ~np.isin(v, ("open", "crossed"))
+                if bad.any():
+                    raise _bad(base, "branch", f"must be 'open' or 'crossed' (got {v[np.argmax(bad)]!r})")
+                v = np.where(v == "open", 1.0, -1.0)
+        v = np.broadcast_to(np.asarray(v, dtype=np.float64), (n,))
+        bad = ~np.isfinite(v)
+        if key in ("fixed_link", "crank", "coupler", "rocker"):
+            bad |= ~(v > 0)
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise _bad(base, key, f"design {i} has {float(v[i])!r} (lengths must be positive, all values finite)")
+        cols[key] = v
+    m = np.empty((n, 8), dtype=np.float64, order="F")
+    for j, key in enumerate(BATCH_KEYS):
+        m[:, j] = cols[key]
+    return m
+
+
+def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None = None,
+                    detail: bool = False) -> pd.DataFrame:
+    """Summaries of many four-bar designs in one Fortran call: one row per design.
+
+    ``base``: a validated ``&fourbar`` Params (or any mapping with the BATCH_KEYS).
+    ``columns``: {key: array of n values} for keys in BATCH_KEYS (``'fourbar.crank'`` is
+    accepted for ``'crank'``); scalars broadcast.  Lengths in the deck's unit, ``omega``
+    [rad/s], ``start_deg``/``stop_deg`` [deg], ``branch`` 'open'/'crossed' or +1/-1.
+    Returns the columns of the single-case summary (``summarise``) with identical values
+    (missing figures as NaN): grashof_class, full_crank_rotation, assemblable, mu_min_deg,
+    mu_max_deg, meets_band_40_120, rocker_turns_fully, rocker_swing_deg, toggle_in_range,
+    omega3_peak_rad_s, omega2_peak_rad_s, assembled_fraction; with ``detail`` also the crank
+    angles [deg] of those extremes, the rocker extreme positions [deg] and the number of
+    toggle positions in the range.  A bad value raises DeckError (``base`` a deck's Params:
+    deck, line and key of the base deck, the design's index in the message) or ValueError.
+    About 20 microseconds per design on one core (bench/bench_sweep.py).
+    """
+    columns = {k.partition(".")[2] if k.startswith("fourbar.") else k: v for k, v in (columns or {}).items()}
+    unknown = [k for k in columns if k not in BATCH_KEYS and k not in BATCH_IGNORED]
+    if unknown:
+        raise _bad(base, unknown[0], f"not a &fourbar key the summary depends on ({', '.join(BATCH_KEYS)})")
+    columns = {k: v for k, v in columns.items() if k in BATCH_KEYS}
+    sizes = {np.size(v) for v in columns.values() if np.ndim(v) > 0}
+    if len(sizes) > 1:
+        raise _bad(base, None, f"batch columns have different lengths {sorted(sizes)}")
+    n = sizes.pop() if sizes else 1
+    res = kernels.fourbar_summaries(_param_matrix(base, columns, n))
+    return _frame(res, detail)
+
+
+def _frame(res: np.ndarray, detail: bool = False) -> pd.DataFrame:
+    """Kernel rows -> the summary columns (vectorised; the one place both paths go through)."""
+    c = dict(zip(kernels.FOURBAR_SUMMARY_COLUMNS, res.T))
+    codes = c["grashof"].astype(int)
+    lut = [GRASHOF_NAMES[kernels.FOURBAR_GRASHOF[k]] for k in range(len(GRASHOF_NAMES))]
+    names = np.array([n for n, _ in lut], dtype=object)[codes]
+    full = np.array([f for _, f in lut])[codes]
+    ok = c["assemblable"] > 0
+    turns = ok & (c["rocker_turns"] > 0)
+    tog = ok & (c["toggles_in_range"] > 0)
+    has = lambda v, m=ok: np.where(m, v, np.nan)
+    lo, hi = BAND
+    out = {"grashof_class": names, "full_crank_rotation": full, "assemblable": ok,
+           "mu_min_deg": has(c["mu_min_deg"]), "mu_max_deg": has(c["mu_max_deg"]),
+           "meets_band_40_120": ok & (c["mu_min_deg"] >= lo) & (c["mu_max_deg"] <= hi),
+           "rocker_turns_fully": turns, "rocker_swing_deg": has(c["rocker_swing_deg"]),
+           "toggle_in_range": tog, "omega3_peak_rad_s": has(c["omega3_peak_rad_s"], ok & ~tog),
+           "omega2_peak_rad_s": has(c["omega2_peak_rad_s"], ok & ~tog),
+           "assembled_fraction": np.where(ok, c["assembled_fraction"], 0.0)}
+    if detail:
+        out |= {"mu_min_at_deg": has(c["mu_min_at_deg"]), "mu_max_at_deg": has(c["mu_max_at_deg"]),
+                "rocker_min_deg": has(c["rocker_min_deg"]), "rocker_min_at_deg": has(c["rocker_min_at_deg"]),
+                "rocker_max_deg": has(c["rocker_max_deg"]), "rocker_max_at_deg": has(c["rocker_max_at_deg"]),
+                "omega3_peak_at_deg": has(c["omega3_peak_at_deg"], ok & ~tog),
+                "omega2_peak_at_deg": has(c["omega2_peak_at_deg"], ok & ~tog),
+                "toggles_in_range": c["toggles_in_range"].astype(int)}
+    return pd.DataFrame(out)
 
 
 # ----------------------------------------------------------------------------- tables
@@ -355,7 +416,7 @@ def summary_lines(p: Params, g: Grashof, ex: Extremes | None) -> list[str]:
             ("    rocker ............... turns fully (no extreme positions)" if ex.rocker_turns else
              f"    rocker positions ..... {ex.rocker_min:.3f} deg (theta = {ex.rocker_min_at:.3f}) to "
              f"{ex.rocker_max:.3f} deg (theta = {ex.rocker_max_at:.3f}); swing "
-             f"{(ex.rocker_max - ex.rocker_min) % 360.0:.3f} deg")]
+             f"{ex.rocker_swing:.3f} deg")]
     if ex.toggles:
         out.append("    peak speeds .......... unbounded at the toggle positions (theta = "
                    + ", ".join(f"{a:.3f}" for a in ex.toggles) + " deg)")
@@ -472,18 +533,18 @@ def _figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> list[F
 def estimate(params: Params) -> Estimate:
     """Memory and work of a run from the keys alone (driver.limits): per crank angle a table row
     (text, two tidy frames, kernel columns; about 2 KB and 50 us of Python formatting), and the
-    0.5 deg grid of the extremes over the crank range (about 500 bytes and 1 us a point)."""
+    summary kernel's 1 deg scan of at most one turn (the motion is periodic; about 30 us)."""
     p = params
     try:
         n = float(math.floor((p.stop_deg - p.start_deg) / p.step_deg + 1e-9) + 1)
     except (OverflowError, ZeroDivisionError, ValueError):
         n = math.inf
     n = max(n, 1.0)
-    span = abs(p.stop_deg - p.start_deg) / 0.5 + 1.0
+    span = min(abs(p.stop_deg - p.start_deg), 360.0) / 1.0 + 1.0
     range_key = "start_deg" if "start_deg" in p.given else ("stop_deg" if "stop_deg" in p.given else "step_deg")
     rows = Estimate(2000.0 * n + 5e6, 5e-5 * n + 0.05, "step_deg", "step_deg", f"{n:.4g} crank angles")
     grid = Estimate(500.0 * span, 1e-6 * span, range_key, range_key,
-                    f"a {span:.4g}-point grid over the crank range for the extremes")
+                    f"a {span:.4g}-point scan of one turn for the summary")
     return rows + grid
 
 
@@ -535,33 +596,19 @@ def run(params: Params, progress: bool = False) -> Result:
             warnings.append(f"the linkage cannot be assembled at {int((status == ST['no_assembly']).sum())} "
                             f"of {len(theta)} crank angles (first at {theta[k]:g} deg)")
         tidy = exact_frame
-    summary = _summary(p, g, ex)
+    summary = _summary(p)
     return Result(text="\n".join(lines) + "\n", tidy=tidy, summary=summary, warnings=warnings,
                   figures=_figures(p, title, listing_frame))
 
 
 def summarise(params: Params) -> dict:
     """Headline figures only (what a sweep needs when it writes no per-case files)."""
-    p = params
-    return _summary(p, grashof(p.fixed_link, p.crank, p.coupler, p.rocker), extremes(p))
+    return _summary(params)
 
 
-def _summary(p: Params, g: Grashof, ex: Extremes | None) -> dict:
-    """Headline figures for sweeps (exact solution over the deck's range)."""
-    s = {"grashof_class": g.name, "full_crank_rotation": g.full_crank_rotation}
-    if ex is None:   # same columns in every case, so sweep tables and filters line up
-        return s | {"assemblable": False, "mu_min_deg": None, "mu_max_deg": None,
-                    "meets_band_40_120": False, "rocker_turns_fully": False, "rocker_swing_deg": None,
-                    "toggle_in_range": False, "omega3_peak_rad_s": None, "omega2_peak_rad_s": None,
-                    "assembled_fraction": 0.0}
-    lo, hi = BAND
-    return s | {
-        "assemblable": True, "mu_min_deg": ex.mu_min, "mu_max_deg": ex.mu_max,
-        "meets_band_40_120": bool(lo <= ex.mu_min and ex.mu_max <= hi),
-        "rocker_turns_fully": ex.rocker_turns,
-        "rocker_swing_deg": 360.0 if ex.rocker_turns else (ex.rocker_max - ex.rocker_min) % 360.0,
-        "toggle_in_range": bool(ex.toggles),
-        "omega3_peak_rad_s": None if ex.toggles else ex.w3_peak,
-        "omega2_peak_rad_s": None if ex.toggles else ex.w2_peak,
-        "assembled_fraction": ex.assembled_fraction,
-    }
+def _summary(p: Params) -> dict:
+    """Headline figures for sweeps: one row of :func:`summarise_batch` as a dict (missing -> None)."""
+    row = summarise_batch(p).iloc[0].to_dict()
+    return {k: (None if isinstance(v, float) and math.isnan(v) else
+                bool(v) if isinstance(v, (bool, np.bool_)) else
+                float(v) if isinstance(v, np.floating) else v) for k, v in row.items()}

@@ -24,7 +24,8 @@ except ImportError as _exc:
     raise ImportError(f"the Fortran kernels (driver._kernels) cannot be loaded: {_exc}; reinstall "
                       f"mechanism-driver (see docs/install.md)") from _exc
 
-__all__ = ["farray", "fourbar_listing", "fourbar_exact", "fourbar_coupler_point", "FOURBAR_STATUS",
+__all__ = ["farray", "fourbar_listing", "fourbar_exact", "fourbar_coupler_point", "fourbar_summaries",
+           "FOURBAR_SUMMARY_COLUMNS", "FOURBAR_GRASHOF", "FOURBAR_STATUS",
            "MANIPULATOR_STATUS", "manipulator_arm_states", "manipulator_torques", "manipulator_ik",
            "manipulator_design_indices", "manipulator_position_errors",
            "UJOINT_MODELS", "UJOINT_OBJECTIVES", "ujoint_speed", "ujoint_objective",
@@ -87,6 +88,32 @@ def fourbar_exact(theta: np.ndarray, p: float, q: float, r: float, s: float, ome
     elif not (status.dtype == np.int32 and status.shape == (n,)):
         raise ValueError("status must be an int32 array of shape (n,)")
     return _kernels.fourbar.exact_states(theta, p, q, r, s, omega, alpha, int(branch), out, status)
+
+
+#: columns of fourbar_summaries (fortran/fourbar_summary.f90)
+FOURBAR_SUMMARY_COLUMNS = ("grashof", "assemblable", "assembled_fraction", "mu_min_deg", "mu_min_at_deg",
+                           "mu_max_deg", "mu_max_at_deg", "rocker_min_deg", "rocker_min_at_deg",
+                           "rocker_max_deg", "rocker_max_at_deg", "rocker_swing_deg", "rocker_turns",
+                           "toggles_in_range", "omega3_peak_rad_s", "omega3_peak_at_deg",
+                           "omega2_peak_rad_s", "omega2_peak_at_deg")
+#: Grashof class codes of fourbar_summaries
+FOURBAR_GRASHOF = {int(getattr(_kernels.fourbar_summary, f"gr_{k}")): k for k in
+                   ("double_crank", "crank_rocker", "rocker_crank", "double_rocker", "change_point",
+                    "triple_rocker")}
+
+
+def fourbar_summaries(params: np.ndarray) -> np.ndarray:
+    """Headline figures of many four-bars in one kernel call: (n, 18) array.
+
+    ``params`` (n, 8): fixed link p, crank q, coupler r, rocker s [length], crank speed
+    [rad/s], first and last crank angle of the range [deg], branch (+1 open, -1 crossed).
+    Columns: FOURBAR_SUMMARY_COLUMNS (angles in degrees, speeds in rad/s; flags 0/1;
+    figures that do not exist are 0 -- mask them with 'assemblable' and 'toggles_in_range').
+    """
+    params = farray(params, 2)
+    if params.shape[1] != 8:
+        raise ValueError(f"params must have 8 columns, got {params.shape[1]}")
+    return _kernels.fourbar_summary.summaries(params)
 
 
 def fourbar_coupler_point(theta: np.ndarray, states: np.ndarray, status: np.ndarray, q: float,

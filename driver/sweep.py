@@ -43,7 +43,7 @@ import f90nml
 import numpy as np
 import pandas as pd
 
-from driver import expr, limits
+from driver import expr, limits, sweep_batch
 from driver.atomic import output_set, remove_stale_temporaries, write_text
 from driver.deck import Deck, DeckError, GroupSpec, Key, Params, RawGroup, validate
 from driver.export import write_tidy
@@ -183,6 +183,17 @@ def case_count(sw: Params, axes: list[tuple[str, list]]) -> int:
     return len(axes[0][1]) if sw.zip else math.prod(len(v) for _, v in axes)
 
 
+def _check_zip(sw: Params, axes: list[tuple[str, list]]) -> None:
+    """zip = .true. needs equally long value lists."""
+    if not sw.zip:
+        return
+    n = len(axes[0][1])
+    for k, (name, vals) in enumerate(axes):
+        if len(vals) != n:
+            raise sw.error(f"values{k + 1}" if sw[f"values{k + 1}"] is not None else f"count{k + 1}",
+                           f"zip = .true. needs equally long value lists ({axes[0][0]}: {n}, {name}: {len(vals)})")
+
+
 def build_cases(sw: Params, study_group: str, study_spec: GroupSpec) -> list[Case]:
     """All cases of the sweep, numbered from 1: a full grid, or zipped axes.
 
@@ -195,12 +206,8 @@ def build_cases(sw: Params, study_group: str, study_spec: GroupSpec) -> list[Cas
         sizes = " x ".join(f"{len(v)} ({n})" for n, v in axes)
         raise sw.error("key1", f"{n_cases} cases ({sizes}) is beyond the {MAX_CASES} cases one sweep deck "
                        "may have; split the sweep into several decks or coarsen the grid")
+    _check_zip(sw, axes)
     if sw.zip:
-        n = len(axes[0][1])
-        for k, (name, vals) in enumerate(axes):
-            if len(vals) != n:
-                raise sw.error(f"values{k + 1}" if sw[f"values{k + 1}"] is not None else f"count{k + 1}",
-                               f"zip = .true. needs equally long value lists ({names[0]}: {n}, {name}: {len(vals)})")
         combos: Iterable = zip(*(v for _, v in axes))
     else:
         combos = itertools.product(*(v for _, v in axes))
@@ -216,10 +223,12 @@ def _axis_line(sw: Params, name: str) -> tuple[str, int]:
     return "key1", sw.line_of("key1")
 
 
-def validate_sweep(sw: Params, raw: RawGroup, module: Any, cases: list[Case]) -> None:
+def validate_sweep(sw: Params, raw: RawGroup, module: Any, cases: list[Case] | None,
+                   axes: list[tuple[str, list]] | None = None) -> None:
     """Refuse the whole sweep (DeckError naming the sweep line and key) before anything runs
     when a case would be bad input: every value of every axis is validated in the base deck,
-    and every case too for sweeps up to FULL_VALIDATION cases (else the grid's corners)."""
+    and every case too for sweeps up to FULL_VALIDATION cases (else the grid's corners).
+    ``cases`` None: a large batch sweep that lists no cases; its ``axes`` are checked."""
     def check(values: dict[str, Any], case_no: int | None) -> None:
         try:
             limits.check(module, validate(_case_raw(raw, Case(0, values)), module.SPEC, sw.path), "each case ")
@@ -230,18 +239,18 @@ def validate_sweep(sw: Params, raw: RawGroup, module: Any, cases: list[Case]) ->
             vals = ", ".join(f"{k} = {v!r}" for k, v in values.items())
             raise DeckError(sw.path, line, key, f"{where}{vals}{')' if case_no else ''} is bad input: "
                             f"{exc.key + ': ' if exc.key else ''}{exc.message}; nothing was run") from None
-    if not cases:
+    if cases is not None and not cases:
         return
-    names = list(cases[0].values)
-    if len(cases) <= FULL_VALIDATION:
+    if cases is not None and len(cases) <= FULL_VALIDATION:
         for c in cases:
             check(c.values, c.index)
         return
     axis_values: dict[str, list] = {}
-    for n in names:
+    names = [n for n, _ in axes] if cases is None else list(cases[0].values)
+    for k, n in enumerate(names):
         uniq: dict[str, Any] = {}
-        for c in cases:
-            uniq.setdefault(repr(c.values[n]), c.values[n])
+        for v in (axes[k][1] if cases is None else (c.values[n] for c in cases)):
+            uniq.setdefault(repr(v), v)
         axis_values[n] = list(uniq.values())
         for v in axis_values[n]:
             check({n: v}, None)
@@ -405,12 +414,6 @@ def auto_chunk(seconds_per_case: float, n_cases: int, workers: int, target: floa
     return max(1, min(by_time, by_balance))
 
 
-def _ignore_sigint() -> None:
-    """Worker initializer: Ctrl-C is handled by the parent only."""
-    import signal
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-
-
 def _execute(cases: list[Case], task_of, jobs: int, scheduler: Any, chunk: int, progress: bool,
              total: int, done0: int) -> tuple[list[CaseResult], int]:
     """Run cases locally (process pool) or on Dask; returns results (any order) and the chunk used.
@@ -448,7 +451,7 @@ def _execute(cases: list[Case], task_of, jobs: int, scheduler: Any, chunk: int, 
         else:
             # workers ignore Ctrl-C: the parent cancels queued chunks and lets running ones finish,
             # so every case a worker started is written completely
-            pool = cf.ProcessPoolExecutor(max_workers=jobs, initializer=_ignore_sigint)
+            pool = cf.ProcessPoolExecutor(max_workers=jobs, initializer=sweep_batch.worker_init)
             submit = lambda t: pool.submit(run_task, t)
             wait_any = lambda fs: cf.wait(fs, return_when=cf.FIRST_COMPLETED)
             close = lambda: pool.shutdown(wait=True)
@@ -517,9 +520,12 @@ def summary_frame(results: list[CaseResult], names: list[str]) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def _summary_table(frame: pd.DataFrame, limit: int = 2000) -> list[str]:
-    """Fixed-format rendering of the summary frame (kept cases only above ``limit`` rows)."""
-    show = frame if len(frame) <= limit else frame[frame["kept"]]
+def _summary_table(frame: pd.DataFrame, limit: int = 2000, n_cases: int | None = None,
+                   rows: str = "all") -> list[str]:
+    """Fixed-format rendering of the summary frame (kept and failed cases only above ``limit``
+    cases; ``frame`` may hold only those already, then ``n_cases`` is the study's total)."""
+    n_cases = len(frame) if n_cases is None else n_cases
+    show = frame if n_cases <= limit else frame[frame["kept"] | (frame["status"] != "ok")]
     cols, keys = [], []
     for name in frame.columns:
         if name in ("error",):
@@ -549,8 +555,9 @@ def _summary_table(frame: pd.DataFrame, limit: int = 2000) -> list[str]:
                 row.append(v)
         rows.append(row)
     lines = render_table(cols, rows)
-    if len(show) < len(frame):
-        lines.append(f"  ({len(frame) - len(show)} cases not kept are in the _summary table only)")
+    if len(show) < n_cases:
+        where = "are in the _summary table only" if rows == "all" else "are not listed (summary_rows = 'kept')"
+        lines.append(f"  ({n_cases - len(show)} cases not kept {where})")
     return lines
 
 
@@ -569,9 +576,19 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
     study_raw = {n: g for n, g in deck.groups.items() if n != "sweep"}
     module, base_params = study_of(Deck(deck.path, study_raw))   # the base deck must be valid on its own
     raw = study_raw[base_params.group]
-    cases = build_cases(sw, base_params.group, module.SPEC)
-    names = list(cases[0].values)
-    validate_sweep(sw, raw, module, cases)
+    axes = _axes(sw, base_params.group, module.SPEC)
+    names = [a[0] for a in axes]
+    _check_zip(sw, axes)
+    grid = sweep_batch.Grid(names, [v for _, v in axes], bool(sw.zip))
+    batchable = sweep_batch.batchable(module, names, sw.keep, sw.case_outputs)
+    if batchable and grid.n > FULL_VALIDATION:   # no case list: memory stays flat in the number of cases
+        if grid.n > sweep_batch.MAX_CASES:
+            raise sw.error("key1", f"{grid.n} cases is beyond the {sweep_batch.MAX_CASES} cases of one sweep deck")
+        cases = None
+        validate_sweep(sw, raw, module, None, axes)
+    else:
+        cases = build_cases(sw, base_params.group, module.SPEC)
+        validate_sweep(sw, raw, module, cases)
     named = [(k, v) for k, v in [("keep", sw.keep), ("plot_x", sw.plot_x)] + [("plot_y", y) for y in sw.plot_y] if v]
     if named:   # check the filter and plotted columns on the base deck's summary before running anything
         probe = (module.summarise(base_params) if hasattr(module, "summarise")
@@ -586,12 +603,19 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
     stem_path = output_stem(outdir, deck.path)
     stem = stem_path.name
     case_dir = stem_path
-    width = max(4, len(str(len(cases))))
+    width = max(4, len(str(grid.n)))
     base = _base_hash(raw)
     scheduler = scheduler or _configured_scheduler()
     jobs = jobs or os.cpu_count() or 1
     task_of = lambda cs: Task(str(deck.path), raw, cs, str(case_dir), width, sw.keep, sw.case_outputs,
                               formats, plot, base)
+    if batchable:
+        bplan = sweep_batch.plan(module, raw, str(deck.path), grid, sw.keep, sw.summary_rows)
+        if bplan is not None:
+            return _run_batch(deck, sw, base_params, bplan, axes, outdir, stem, task_of, plot, progress,
+                              quiet, jobs, scheduler, resume)
+        if cases is None:
+            cases = build_cases(sw, base_params.group, module.SPEC)
 
     done: list[CaseResult] = []
     todo = cases
@@ -612,7 +636,8 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
     frame = summary_frame(done, names)
     table = frame if sw.summary_rows == "all" else frame[frame["kept"] | (frame["status"] != "ok")]
     failed = [r for r in done if r.status != EXIT_OK]
-    text = _sweep_text(deck, sw, base_params, names, cases, frame, failed, chunk, jobs, scheduler)
+    text = _sweep_text(deck, sw, base_params, axes, len(cases), frame, int(frame["kept"].sum()),
+                       [(r.index, r.values, r.error) for r in failed], sw.summary_rows)
     remove_stale_temporaries(outdir, stem)
     with output_set(outdir):   # the sweep's own files: all renamed into place together, or none
         for fmt in ("csv", "parquet"):
@@ -646,6 +671,69 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
     return max([EXIT_OK] + [r.status for r in failed])
 
 
+def _run_batch(deck: Deck, sw: Params, base_params: Params, bplan, axes, outdir: Path, stem: str, task_of,
+               plot: bool, progress: bool, quiet: bool, jobs: int, scheduler: Any, resume: bool) -> int:
+    """A sweep on the study's batch path (driver.sweep_batch); same outputs as case by case."""
+    names = [a[0] for a in axes]
+    n = bplan.grid.n
+    t_start = time.perf_counter()
+
+    def announce(resumed: int) -> None:
+        if resume and not quiet:
+            print(f"resume: {resumed} of {n} cases complete, {n - resumed} to run")
+
+    rows, counts, chunk = sweep_batch.run(bplan, outdir / f"{stem}.sweep", jobs, scheduler, resume, progress,
+                                          sw.chunk, announce)
+    elapsed = time.perf_counter() - t_start
+    if rows.empty:
+        rows = pd.DataFrame(columns=["case", *names, "status", "kept", "error"])
+    tidies = []
+    if sw.case_outputs == "kept" and counts["kept"]:   # the kept cases' own files, case by case
+        kept = rows[rows["kept"]]
+        cases = [Case(int(r["case"]), {k: (r[k].item() if hasattr(r[k], "item") else r[k]) for k in names})
+                 for _, r in kept.iterrows()]
+        done, _ = _execute(cases, task_of, jobs, scheduler, 0, False, len(cases), 0)
+        done.sort(key=lambda r: r.index)
+        tidies = [r.tidy for r in done if r.tidy is not None]
+        for r in done:
+            if r.status != EXIT_OK:
+                rows.loc[rows["case"] == r.index, ["status", "kept", "error"]] = ["failed", False, r.error]
+    bad = rows[rows["status"] != "ok"]
+    failed = [(int(r["case"]), {k: r[k] for k in names}, r["error"]) for _, r in bad.iterrows()]
+    text = _sweep_text(deck, sw, base_params, axes, n, rows, int(rows["kept"].sum()), failed, sw.summary_rows)
+    remove_stale_temporaries(outdir, stem)
+    with output_set(outdir):   # the sweep's own files: all renamed into place together, or none
+        for fmt in ("csv", "parquet"):
+            write_tidy(rows, outdir / f"{stem}_summary", fmt)
+        if tidies:
+            allcases = pd.concat(tidies, ignore_index=True)
+            for fmt in ("csv", "parquet"):
+                write_tidy(allcases, outdir / f"{stem}_cases", fmt)
+        write_text(outdir / f"{stem}.out", text)
+        if plot:   # the summary only (per-case figures only for case_outputs with --plot)
+            from driver.plotting import figure_format, save_figure, sweep_summary
+            shown = rows.copy()
+            for name in [sw.plot_x, *sw.plot_y]:   # a plotted expression becomes a column
+                if name and name not in shown.columns:
+                    shown[name] = expr.parse(name).evaluate(shown)
+            units = {n: _units_of(n) for n in names}
+            save_figure(lambda: sweep_summary(shown, names, sw.plot_x, sw.plot_y, stem, units),
+                        outdir / f"{stem}_summary.{figure_format(plot)}")
+    for index, values, error in failed[:20]:
+        vals = ", ".join(f"{k} = {v!r}" for k, v in values.items())
+        print(f"error: {deck.path}: case {index} ({vals}): {error}", file=sys.stderr)
+    if len(failed) > 20:
+        print(f"error: {deck.path}: ... and {len(failed) - 20} more failed cases (see {stem}.out)", file=sys.stderr)
+    if not quiet:
+        print(f"sweep {deck.path}: {n - len(failed)} of {n} cases ok, {int(rows['kept'].sum())} kept, "
+              f"{elapsed:.2f} s, {n / max(elapsed, 1e-9):.0f} cases/s "
+              f"({'dask ' + str(scheduler) if scheduler else f'{jobs} worker(s)'}, batch path, chunk {chunk})")
+        print(f"wrote {outdir / (stem + '.out')} and {outdir / stem}_summary.{{csv,parquet}}")
+    if failed:
+        return EXIT_BAD_INPUT if (bad["status"] == "bad input").any() else EXIT_FAILED
+    return EXIT_OK
+
+
 def _units_of(dotted: str) -> str:
     """The unit a swept deck key ``group.key`` declares in its study's SPEC ('' if none)."""
     group, _, key = dotted.partition(".")
@@ -654,23 +742,27 @@ def _units_of(dotted: str) -> str:
     return spec_key.units if spec_key is not None else ""
 
 
-def _sweep_text(deck: Deck, sw: Params, base: Params, names: list[str], cases: list[Case],
-                frame: pd.DataFrame, failed: list[CaseResult], chunk: int, jobs: int, scheduler: Any) -> str:
+def _sweep_text(deck: Deck, sw: Params, base: Params, axes: list[tuple[str, list]], n_cases: int,
+                frame: pd.DataFrame, n_kept: int, failed: list[tuple[int, dict, str]], rows: str) -> str:
+    """The sweep's fixed-format .out: axes, counts, the summary table, failed cases."""
+
     lines = [f"  sweep over &{base.group} from deck {deck.path}", ""]
-    for k, name in enumerate(names, start=1):
-        vals = list(dict.fromkeys(c.values[name] for c in cases))   # deck order
+    for name, values in axes:
+        vals = list(dict.fromkeys(values))   # deck order
         fmt = lambda v: v if isinstance(v, str) else f"{v:.6g}"
         shown = (", ".join(map(fmt, vals[:8])) if len(vals) <= 8 else
                  f"{fmt(vals[0])}, {fmt(vals[1])}, ..., {fmt(vals[-1])} ({len(vals)} values)")
         lines.append(f"    {name:<28} {shown}")
-    lines += [f"    {'cases':<28} {len(cases)} ({'zipped' if sw.zip else 'full grid'})",
+    lines += [f"    {'cases':<28} {n_cases} ({'zipped' if sw.zip else 'full grid'})",
               f"    {'case outputs':<28} {sw.case_outputs}" + (f"   keep: {sw.keep}" if sw.keep else ""),
-              f"    {'kept':<28} {int(frame['kept'].sum())}",
+              f"    {'kept':<28} {n_kept}",
               f"    {'failed':<28} {len(failed)}", ""]
-    lines += _summary_table(frame)
+    lines += _summary_table(frame, n_cases=n_cases, rows=rows)
     if failed:
         lines += ["", "  Failed cases"]
-        for r in failed:
-            vals = ", ".join(f"{k} = {v!r}" for k, v in r.values.items())
-            lines.append(f"    case {r.index} ({vals}): {r.error}")
+        for index, values, error in failed[:1000]:
+            vals = ", ".join(f"{k} = {v!r}" for k, v in values.items())
+            lines.append(f"    case {index} ({vals}): {error}")
+        if len(failed) > 1000:
+            lines.append(f"    ... and {len(failed) - 1000} more (status column of the _summary table)")
     return "\n".join(lines) + "\n"

@@ -1,0 +1,434 @@
+"""Streaming sweeps for studies with a batch path (``summarise_batch``): the design-search engine.
+
+Used by :func:`driver.sweep.run_sweep_deck` when the study has a batch path, every swept key
+is one the batch takes (the study's ``BATCH_KEYS``, or a key its summary ignores) and no case
+needs its own files before the filter has run (``case_outputs`` 'none', or 'kept': the kept
+cases are then run one by one for their files).
+
+* Cases are never listed: a chunk is a range of case numbers, its swept values computed
+  from the grid (``np.unravel_index`` in ``itertools.product`` order) in the worker.
+* Bad values are found without validating every case: each value of a key whose checks
+  stand alone (the study's ``BATCH_INDEPENDENT``) is validated once with the base deck, and
+  every combination of the other swept keys once; a case is bad input when any of its parts
+  is, with that part's error.
+* Chunks go out with a bounded number in flight (back-pressure); each returned chunk is
+  written at once as one part file of the Parquet dataset ``<outdir>/<stem>.sweep/``
+  (only kept and failed rows with ``summary_rows = 'kept'``), with its case range and counts
+  in the file's metadata.  The dataset is the resume record: a chunk is complete when its
+  part is there; parts from another base deck, grid, filter or tool build are discarded
+  (the ``signature``: hash of the base deck's study group, the &sweep axes, keep and
+  summary_rows, the package version and the bytes of the study module and of the kernel
+  extension).  Parts are written atomically; stray temporary files are removed on start.
+* Worker processes exit when the driver dies (a watchdog thread on the parent pid) and
+  ignore Ctrl-C (the driver cancels queued chunks).  A chunk whose worker dies is retried
+  once alone in a fresh process; if that dies too its cases are reported failed with the
+  reason and the study completes.  On Dask: ``retries=1`` and ``as_completed``.
+"""
+from __future__ import annotations
+
+import concurrent.futures as cf
+import contextlib
+import hashlib
+import itertools
+import json
+import os
+import sys
+import threading
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Iterator
+
+import numpy as np
+import pandas as pd
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+import driver
+from driver import expr
+from driver.atomic import atomic_open
+from driver.deck import DeckError, RawGroup, validate
+from driver.study import load_study
+
+__all__ = ["Grid", "BatchPlan", "batchable", "plan", "run", "worker_init", "chunk_rows", "MAX_CASES"]
+
+#: cases per task: ~0.3-0.6 s of kernel time on one core for the four-bar
+CHUNK = 16384
+#: largest batch sweep (no case is listed, so only the grid's size is limited)
+MAX_CASES = 10**10
+#: largest number of combinations of coupled swept keys validated one by one
+MAX_COMBOS = 20000
+DIED = "worker process died twice computing this chunk (killed, out of memory or a crash in a kernel)"
+
+
+@dataclass
+class Grid:
+    """The swept axes: names ('group.key'), values per axis, full grid or zipped."""
+
+    names: list[str]
+    values: list[list]
+    zipped: bool
+
+    @property
+    def n(self) -> int:
+        return len(self.values[0]) if self.zipped else int(np.prod([len(v) for v in self.values]))
+
+    def indices(self, start: int, stop: int) -> list[np.ndarray]:
+        """Per axis, the value index of cases start..stop-1 (0-based; product order)."""
+        idx = np.arange(start, stop, dtype=np.int64)
+        if self.zipped:
+            return [idx] * len(self.names)
+        return list(np.unravel_index(idx, [len(v) for v in self.values]))
+
+    def columns(self, start: int, stop: int) -> dict[str, np.ndarray]:
+        return {name: _array(vals)[ix] for name, vals, ix in zip(self.names, self.values, self.indices(start, stop))}
+
+
+def _array(vals: list) -> np.ndarray:
+    a = np.asarray(vals)
+    return a if a.dtype.kind in "fiub" else np.asarray(vals, dtype=object)
+
+
+@dataclass
+class BatchPlan:
+    """Everything a worker needs for any chunk (plain data, picklable)."""
+
+    deck_path: str
+    raw: RawGroup
+    grid: Grid
+    keep: str
+    rows: str                                   # 'all' or 'kept'
+    single_errors: dict[str, dict[int, str]]    # swept key -> {value index: error}
+    coupled: list[int]                          # axes validated together
+    coupled_errors: dict[tuple, str]            # value-index tuple of the coupled axes -> error
+    signature: str = ""
+
+
+def _signature(raw: RawGroup, grid: Grid, keep: str, rows: str, module) -> str:
+    h = hashlib.sha256()
+    h.update(json.dumps([raw.name, raw.values, grid.names, grid.values, grid.zipped, keep, rows, driver.__version__],
+                        sort_keys=True, default=str).encode())
+    for path in (getattr(module, "__file__", None), getattr(sys.modules.get("driver._kernels"), "__file__", None)):
+        if path:
+            with contextlib.suppress(OSError):
+                h.update(Path(path).read_bytes())
+    return h.hexdigest()[:20]
+
+
+def _swap(raw: RawGroup, values: dict[str, Any]) -> RawGroup:
+    v = dict(raw.values)
+    for name, x in values.items():
+        v[name.partition(".")[2]] = x.item() if hasattr(x, "item") else x
+    return RawGroup(raw.name, v, raw.lines, raw.line)
+
+
+def batchable(module, names: list[str], keep: str, case_outputs: str) -> bool:
+    """Whether a sweep over ``names`` ('group.key') can take the study's batch path."""
+    if not hasattr(module, "summarise_batch") or case_outputs == "all" or (case_outputs == "kept" and not keep):
+        return False
+    batch_keys = set(getattr(module, "BATCH_KEYS", ())) | set(getattr(module, "BATCH_IGNORED", ()))
+    return all(n.partition(".")[2] in batch_keys for n in names)
+
+
+def plan(module, raw: RawGroup, deck_path: str, grid: Grid, keep: str, rows: str) -> BatchPlan | None:
+    """A batch plan for this sweep (see :func:`batchable`), or None when it must run case by case."""
+    keys = [n.partition(".")[2] for n in grid.names]
+    independent = set(getattr(module, "BATCH_INDEPENDENT", ()))
+    single: dict[str, dict[int, str]] = {}
+    coupled = [i for i, k in enumerate(keys) if k not in independent]
+    for i, (name, vals) in enumerate(zip(grid.names, grid.values)):
+        if i in coupled:
+            continue
+        errs = {}
+        for j, v in enumerate(vals):
+            try:
+                validate(_swap(raw, {name: v}), module.SPEC, deck_path)
+            except DeckError as exc:
+                errs[j] = str(exc)
+        single[name] = errs
+    coupled_errors: dict[tuple, str] = {}
+    if coupled:
+        if grid.zipped:
+            combos = [tuple([j] * len(coupled)) for j in range(grid.n)]
+        else:
+            combos = list(itertools.product(*(range(len(grid.values[i])) for i in coupled)))
+        if len(combos) > MAX_COMBOS:
+            return None
+        for combo in dict.fromkeys(combos):
+            vals = {grid.names[i]: grid.values[i][j] for i, j in zip(coupled, combo)}
+            try:
+                validate(_swap(raw, vals), module.SPEC, deck_path)
+            except DeckError as exc:
+                coupled_errors[combo] = str(exc)
+    p = BatchPlan(deck_path, raw, grid, keep, rows, single, coupled, coupled_errors)
+    p.signature = _signature(raw, grid, keep, rows, module)
+    return p
+
+
+# ----------------------------------------------------------------------------- worker side
+
+@dataclass
+class ChunkResult:
+    """One computed chunk: its rows (all, or kept and failed) and counts."""
+
+    start: int
+    stop: int
+    frame: pd.DataFrame
+    n_ok: int = 0
+    n_kept: int = 0
+    n_failed: int = 0
+    seconds: float = 0.0
+    errors: list[str] = field(default_factory=list)
+
+
+def chunk_rows(p: BatchPlan, start: int, stop: int) -> ChunkResult:
+    """Summaries of cases start+1..stop (the unit of work of a worker)."""
+    t0 = time.perf_counter()
+    module = load_study(p.raw.name)
+    n = stop - start
+    cols = p.grid.columns(start, stop)
+    idx = p.grid.indices(start, stop)
+    err = np.full(n, "", dtype=object)
+    for i, name in enumerate(p.grid.names):
+        for j, msg in p.single_errors.get(name, {}).items():
+            err[(idx[i] == j) & (err == "")] = msg
+    if p.coupled_errors:
+        keys = list(zip(*(idx[i] for i in p.coupled)))
+        for k, key in enumerate(keys):
+            msg = p.coupled_errors.get(tuple(int(x) for x in key))
+            if msg and not err[k]:
+                err[k] = msg
+    bad = err != ""
+    base = validate(p.raw, module.SPEC, p.deck_path)
+    frame = pd.DataFrame({"case": np.arange(start + 1, stop + 1, dtype=np.int64), **cols})
+    good = np.flatnonzero(~bad)
+    summ = module.summarise_batch(base, {k.partition(".")[2]: v[good] for k, v in cols.items()})
+    if bad.any():
+        summ = summ.astype(object)
+        full = pd.DataFrame(None, index=range(n), columns=summ.columns, dtype=object)
+        full.iloc[good] = summ.to_numpy()
+        summ = full
+    summ.index = frame.index
+    status = np.where(bad, "bad input", "ok").astype(object)
+    frame["status"] = status
+    frame["kept"] = False
+    frame = pd.concat([frame, summ], axis=1)
+    frame["error"] = err
+    mask = ~bad
+    if p.keep:
+        try:
+            mask &= np.asarray(expr.parse(p.keep).mask(frame), dtype=bool)
+        except expr.ExprError:
+            mask[:] = False
+    frame["kept"] = mask
+    res = ChunkResult(start, stop, frame, int((~bad).sum()), int(mask.sum()), int(bad.sum()))
+    if p.rows == "kept":
+        res.frame = frame[mask | bad].reset_index(drop=True)
+    res.seconds = time.perf_counter() - t0
+    return res
+
+
+def _watch_parent(ppid: int) -> None:
+    while True:
+        if os.getppid() != ppid:
+            os._exit(1)
+        time.sleep(0.5)
+
+
+def worker_init() -> None:
+    """Process-pool initializer: ignore Ctrl-C (the driver handles it) and exit with the driver."""
+    import signal
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    threading.Thread(target=_watch_parent, args=(os.getppid(),), daemon=True).start()
+
+
+# ----------------------------------------------------------------------------- dataset (resume record)
+
+def _part_name(start: int) -> str:
+    return f"part-{start:012d}.parquet"
+
+
+def clean(folder: Path, signature: str, resume: bool) -> dict[int, dict]:
+    """Remove stray temporaries (and, without resume or on a signature change, old parts);
+    returns {start: metadata} of the complete chunks kept."""
+    done: dict[int, dict] = {}
+    if not folder.exists():
+        return done
+    for f in folder.iterdir():
+        if f.name.startswith(".") and f.name.endswith(".tmp"):
+            f.unlink(missing_ok=True)
+            continue
+        if not f.name.startswith("part-"):
+            continue
+        meta = None
+        if resume:
+            with contextlib.suppress(Exception):
+                raw = pq.read_schema(f).metadata or {}
+                meta = json.loads(raw.get(b"sweep", b"{}"))
+        if meta and meta.get("signature") == signature:
+            done[int(meta["start"])] = meta
+        else:
+            f.unlink(missing_ok=True)
+    return done
+
+
+def write_part(folder: Path, res: ChunkResult, signature: str) -> None:
+    table = pa.Table.from_pandas(res.frame, preserve_index=False)
+    meta = {"signature": signature, "start": res.start, "stop": res.stop, "n_ok": res.n_ok,
+            "n_kept": res.n_kept, "n_failed": res.n_failed}
+    table = table.replace_schema_metadata({**(table.schema.metadata or {}), b"sweep": json.dumps(meta).encode()})
+    folder.mkdir(parents=True, exist_ok=True)
+    with atomic_open(folder / _part_name(res.start), "wb") as fh:
+        pq.write_table(table, fh)
+
+
+def read_rows(folder: Path, starts: list[int]) -> pd.DataFrame:
+    frames = [pq.read_table(folder / _part_name(s)).to_pandas() for s in sorted(starts)]
+    frames = [f for f in frames if len(f)]
+    if not frames:
+        return pd.DataFrame()
+    return pd.concat(frames, ignore_index=True) if len(frames) > 1 else frames[0]
+
+
+# ----------------------------------------------------------------------------- execution
+
+def _died(p: BatchPlan, start: int, stop: int) -> ChunkResult:
+    frame = pd.DataFrame({"case": np.arange(start + 1, stop + 1, dtype=np.int64), **p.grid.columns(start, stop)})
+    frame["status"] = "failed"
+    frame["kept"] = False
+    frame["error"] = DIED
+    return ChunkResult(start, stop, frame, 0, 0, stop - start)
+
+
+def _alone(p: BatchPlan, start: int, stop: int) -> ChunkResult:
+    """Retry of a chunk whose worker died: alone in a fresh process."""
+    with cf.ProcessPoolExecutor(max_workers=1, initializer=worker_init) as pool:
+        try:
+            return pool.submit(chunk_rows, p, start, stop).result()
+        except cf.process.BrokenProcessPool:
+            return _died(p, start, stop)
+
+
+def execute(p: BatchPlan, todo: list[tuple[int, int]], jobs: int, scheduler: Any,
+            on_result, in_flight: int = 0) -> None:
+    """Run chunks ``todo`` [(start, stop)]; ``on_result(ChunkResult)`` as each completes."""
+    if not todo:
+        return
+    if scheduler:
+        _execute_dask(p, todo, scheduler, on_result, in_flight)
+        return
+    if jobs <= 1:
+        for s, e in todo:
+            on_result(chunk_rows(p, s, e))
+        return
+    limit = in_flight or 2 * jobs
+    queue: Iterator[tuple[int, int]] = iter(todo)
+    pool = cf.ProcessPoolExecutor(max_workers=jobs, initializer=worker_init)
+    pending: dict[cf.Future, tuple[int, int]] = {}
+    try:
+        while True:
+            suspects: list[tuple[int, int]] = []
+            while len(pending) < limit and not suspects:
+                nxt = next(queue, None)
+                if nxt is None:
+                    break
+                try:
+                    pending[pool.submit(chunk_rows, p, *nxt)] = nxt
+                except cf.process.BrokenProcessPool:   # a worker died since the last wait
+                    suspects.append(nxt)
+            if not pending and not suspects:
+                break
+            if not suspects:
+                done, _ = cf.wait(pending, return_when=cf.FIRST_COMPLETED)
+                for fut in done:
+                    rng = pending.pop(fut)
+                    try:
+                        res = fut.result()
+                    except cf.process.BrokenProcessPool:
+                        suspects.append(rng)
+                        continue
+                    on_result(res)
+            if suspects:   # every chunk in flight is suspect: retry each once, alone
+                suspects += list(pending.values())
+                pending.clear()
+                pool.shutdown(wait=False, cancel_futures=True)
+                for rng in sorted(set(suspects)):
+                    on_result(_alone(p, *rng))
+                pool = cf.ProcessPoolExecutor(max_workers=jobs, initializer=worker_init)
+    except KeyboardInterrupt:
+        print("interrupt: cancelling queued chunks, finishing the running ones", file=sys.stderr)
+        pool.shutdown(wait=True, cancel_futures=True)
+        raise
+    finally:
+        pool.shutdown(wait=True)
+
+
+def _execute_dask(p: BatchPlan, todo: list[tuple[int, int]], scheduler: Any, on_result, in_flight: int) -> None:
+    from dask.distributed import Client, as_completed
+    from distributed.scheduler import KilledWorker
+    client = scheduler if not isinstance(scheduler, str) else Client(scheduler)
+    try:
+        workers = max(1, len(client.scheduler_info().get("workers", {})))
+        limit = in_flight or 2 * workers
+        queue = iter(todo)
+        ranges: dict[Any, tuple[int, int]] = {}
+        pdata = client.scatter(p, broadcast=True)
+
+        def submit(rng):
+            fut = client.submit(chunk_rows, pdata, *rng, pure=False, retries=1)
+            ranges[fut] = rng
+            return fut
+
+        ac = as_completed([submit(r) for r in itertools.islice(queue, limit)])
+        for fut in ac:
+            rng = ranges.pop(fut)
+            try:
+                on_result(fut.result())
+            except KilledWorker:
+                on_result(_died(p, *rng))
+            nxt = next(queue, None)
+            if nxt is not None:
+                ac.add(submit(nxt))
+    finally:
+        if isinstance(scheduler, str):
+            client.close()
+
+
+def run(p: BatchPlan, folder: Path, jobs: int, scheduler: Any, resume: bool, progress: bool,
+        chunk: int = 0, announce=None) -> tuple[pd.DataFrame, dict[str, int], int]:
+    """Run the whole batch sweep; returns (rows, counts, chunk size).  ``announce(resumed)``
+    is called with the number of cases found complete before anything runs."""
+    from tqdm import tqdm
+    n = p.grid.n
+    # the layout depends on the grid only (not on the workers), so --resume works with any -j
+    size = chunk or min(CHUNK, max(64, -(-n // 16)))
+    done = clean(folder, p.signature, resume)
+    # a resumed chunk counts only if it covers exactly one chunk of this run's layout
+    ranges = [(s, min(s + size, n)) for s in range(0, n, size)]
+    complete = {s for s, m in done.items() if (s, m["stop"]) in ranges}
+    for s in set(done) - complete:
+        (folder / _part_name(s)).unlink(missing_ok=True)
+    counts = {"ok": 0, "kept": 0, "failed": 0}
+    for s in complete:
+        for k in counts:
+            counts[k] += int(done[s][f"n_{k}"])
+    resumed = sum(min(s + size, n) - s for s in complete)
+    todo = [r for r in ranges if r[0] not in complete]
+    if announce:
+        announce(resumed)
+    folder.mkdir(parents=True, exist_ok=True)
+    bar = tqdm(total=n, initial=resumed, unit="case", disable=not progress, dynamic_ncols=True)
+
+    def on_result(res: ChunkResult) -> None:
+        write_part(folder, res, p.signature)
+        counts["ok"] += res.n_ok
+        counts["kept"] += res.n_kept
+        counts["failed"] += res.n_failed
+        bar.update(res.stop - res.start)
+
+    try:
+        execute(p, todo, jobs, scheduler, on_result)
+    finally:
+        bar.close()
+    rows = read_rows(folder, [s for s, _ in ranges])
+    return rows, counts, size

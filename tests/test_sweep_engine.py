@@ -1,0 +1,217 @@
+"""The streaming batch sweep engine (driver/sweep_batch.py): same tables as case by case, on one
+process, two workers and Dask; exact resume after SIGKILL; a dying worker costs its chunk only;
+workers never outlive the driver; bad values found without validating every case."""
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from driver import sweep_batch
+from driver.cli import main
+
+BASE = """&fourbar
+  fixed_link = 12.0, crank = 3.0, coupler = 15.0, rocker = 9.0, omega = 5.0, step_deg = 10
+/
+"""
+GRID = ("&sweep key1 = 'fourbar.crank', start1 = 1, stop1 = 7, count1 = {a}\n"
+        "       key2 = 'fourbar.coupler', start2 = 6, stop2 = 20, count2 = {b}\n"
+        "       key3 = 'fourbar.rocker', start3 = 4, stop3 = 16, count3 = {c}\n"
+        "       keep = 'meets_band_40_120 and rocker_swing_deg >= 40'\n"
+        "       case_outputs = '{outputs}', summary_rows = '{rows}'{extra} /\n")
+
+
+def deck(tmp_path: Path, a=4, b=5, c=6, outputs="none", rows="all", extra="", name="sw.dat") -> Path:
+    path = tmp_path / name
+    path.write_text(BASE + GRID.format(a=a, b=b, c=c, outputs=outputs, rows=rows, extra=extra))
+    return path
+
+
+def summary(out: Path, stem: str = "sw") -> pd.DataFrame:
+    return pd.read_parquet(out / f"{stem}_summary.parquet")
+
+
+def test_batch_path_equals_case_by_case(tmp_path):
+    """The batch path (case_outputs = 'none') and the per-case path ('all') give the same rows."""
+    batch, single = tmp_path / "b", tmp_path / "s"
+    assert main([str(deck(tmp_path)), "-o", str(batch), "-q", "-j", "1"]) == 0
+    assert (batch / "sw.sweep").is_dir() and not (batch / "sw").exists()
+    assert main([str(deck(tmp_path, outputs="all")), "-o", str(single), "-q", "-j", "1"]) == 0
+    a, b = summary(batch), summary(single)
+    assert len(a) == 120 and a["kept"].sum() > 0
+    pd.testing.assert_frame_equal(a, b, check_dtype=False)
+    # the .out tables agree except for the case-output line
+    ta = (batch / "sw.out").read_text().replace("case outputs                 none", "")
+    tb = (single / "sw.out").read_text().replace("case outputs                 all", "")
+    assert ta == tb
+
+
+def test_one_process_two_workers_and_dask_agree(tmp_path):
+    path = deck(tmp_path, 5, 6, 7, rows="kept", extra=", chunk = 37")
+    one, two = tmp_path / "one", tmp_path / "two"
+    assert main([str(path), "-o", str(one), "-q", "-j", "1"]) == 0
+    assert main([str(path), "-o", str(two), "-q", "-j", "2"]) == 0
+    pd.testing.assert_frame_equal(summary(one), summary(two))
+    assert (one / "sw.out").read_text() == (two / "sw.out").read_text()
+    distributed = pytest.importorskip("distributed")
+    import dask
+    with dask.config.set({"distributed.comm.timeouts.connect": "120s", "distributed.comm.timeouts.tcp": "120s"}), \
+            distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                     dashboard_address=None) as cluster:
+        dsk = tmp_path / "dask"
+        assert main([str(path), "-o", str(dsk), "-q", "--scheduler", cluster.scheduler_address]) == 0
+    pd.testing.assert_frame_equal(summary(one), summary(dsk))
+
+
+def test_bad_values_refuse_the_sweep_before_anything_runs(tmp_path, capsys):
+    path = tmp_path / "bad.dat"
+    path.write_text(BASE + "&sweep key1 = 'fourbar.crank', values1 = 2, -1, 5\n"
+                           "       key2 = 'fourbar.start_deg', values2 = 0, 400\n"
+                           "       case_outputs = 'none' /\n")
+    out = tmp_path / "o"
+    assert main([str(path), "-o", str(out), "-q", "-j", "1"]) == 2
+    assert "is bad input" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_interior_bad_combination_of_a_large_grid_is_a_failed_case(tmp_path):
+    """Above FULL_VALIDATION cases only each value and the grid's corners are validated up
+    front; a bad combination inside the grid is found per chunk and reported as bad input."""
+    from driver import fourbar, sweep
+    from driver.deck import read_deck, validate
+    path = tmp_path / "inner.dat"
+    path.write_text(BASE + "&sweep key1 = 'fourbar.start_deg', values1 = 0, 300, 0\n"
+                           "       key2 = 'fourbar.stop_deg', values2 = 360, 200, 360\n"
+                           "       key3 = 'fourbar.crank', start3 = 1, stop3 = 3, count3 = 700\n"
+                           "       case_outputs = 'none' /\n")
+    d = read_deck(path)
+    sw = validate(d.groups["sweep"], sweep.SPEC, d.path)
+    axes = sweep._axes(sw, "fourbar", fourbar.SPEC)
+    grid = sweep_batch.Grid([a[0] for a in axes], [a[1] for a in axes], False)
+    p = sweep_batch.plan(fourbar, d.groups["fourbar"], str(path), grid, "", "all")
+    res = sweep_batch.chunk_rows(p, 0, grid.n)
+    f = res.frame
+    bad = (f["fourbar.start_deg"] == 300) & (f["fourbar.stop_deg"] == 200)
+    assert res.n_failed == bad.sum() == 700
+    assert (f.loc[bad, "status"] == "bad input").all() and f.loc[bad, "error"].str.contains("key 'step_deg'").all()
+    assert f.loc[~bad, "mu_min_deg"].notna().all()
+
+
+def _kill_after_parts(cmd: list[str], folder: Path, parts: int, timeout: float = 120.0) -> None:
+    proc = subprocess.Popen(cmd, start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.time() + timeout
+    while time.time() < deadline and proc.poll() is None:
+        if folder.exists() and len(list(folder.glob("part-*.parquet"))) >= parts:
+            break
+        time.sleep(0.02)
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait()
+
+
+def test_resume_after_sigkill_is_exact(tmp_path):
+    path = deck(tmp_path, 10, 20, 30, rows="kept", extra=", chunk = 100")   # 6000 cases, 60 chunks
+    ref = tmp_path / "ref"
+    assert main([str(path), "-o", str(ref), "-q", "-j", "2"]) == 0
+    out = tmp_path / "o"
+    cmd = [sys.executable, "-m", "driver", str(path), "-o", str(out), "-q", "-j", "2"]
+    _kill_after_parts(cmd, out / "sw.sweep", 5)
+    done = len(list((out / "sw.sweep").glob("part-*.parquet")))
+    assert not (out / "sw.out").exists() or done == 60
+    res = subprocess.run(cmd[:-3] + ["-j", "2", "--resume"], capture_output=True, text=True, timeout=300)
+    assert res.returncode == 0, res.stderr
+    assert "resume:" in res.stdout and " of 6000 cases complete" in res.stdout
+    pd.testing.assert_frame_equal(summary(ref), summary(out))
+    assert (ref / "sw.out").read_text() == (out / "sw.out").read_text()
+    assert not [p for p in (out / "sw.sweep").iterdir() if p.name.endswith(".tmp")]
+    # a changed base deck invalidates every part: nothing is resumed
+    path.write_text(path.read_text().replace("omega = 5.0", "omega = 4.0"))
+    res = subprocess.run(cmd + ["--resume"], capture_output=True, text=True, timeout=300)
+    assert res.returncode == 0
+    assert len(list((out / "sw.sweep").glob("part-*.parquet"))) == 60
+
+
+def test_resume_skips_complete_chunks(tmp_path, capsys):
+    path = deck(tmp_path, extra=", chunk = 10")   # 120 cases, 12 chunks
+    out = tmp_path / "o"
+    assert main([str(path), "-o", str(out), "-q", "-j", "1"]) == 0
+    first = summary(out)
+    parts = sorted((out / "sw.sweep").glob("part-*.parquet"))
+    parts[3].unlink()
+    (out / "sw.sweep" / ".part-x.parquet.abc.tmp").write_text("partial")
+    assert main([str(path), "-o", str(out), "-j", "1", "--resume"]) == 0
+    assert "resume: 110 of 120 cases complete, 10 to run" in capsys.readouterr().out
+    pd.testing.assert_frame_equal(first, summary(out))
+    assert not list((out / "sw.sweep").glob("*.tmp"))
+
+
+def _dies(p, start, stop, _real=sweep_batch.chunk_rows):
+    """A chunk function whose worker is SIGKILLed on the chunk starting at case 30 (always, or
+    once when DIE_ONCE names a marker file)."""
+    marker = os.environ.get("DIE_ONCE")
+    if start == 30 and (not marker or not os.path.exists(marker)):
+        if marker:
+            Path(marker).write_text("died")
+        os.kill(os.getpid(), signal.SIGKILL)
+    return _real(p, start, stop)
+
+
+@pytest.mark.parametrize("once", [True, False])
+def test_dying_worker_costs_at_most_its_chunk(tmp_path, monkeypatch, capsys, once):
+    path = deck(tmp_path, extra=", chunk = 10")
+    ref = tmp_path / "ref"
+    assert main([str(path), "-o", str(ref), "-q", "-j", "1"]) == 0
+    if once:
+        monkeypatch.setenv("DIE_ONCE", str(tmp_path / "marker"))
+    monkeypatch.setattr(sweep_batch, "chunk_rows", _dies)   # inherited by the forked workers
+    out = tmp_path / "o"
+    rc = main([str(path), "-o", str(out), "-q", "-j", "2"])
+    s, r = summary(out), summary(ref)
+    if once:   # retried once, alone: identical results
+        assert rc == 0
+        pd.testing.assert_frame_equal(s, r)
+    else:      # reported as failed cases with the reason; every other case completes
+        assert rc == 1
+        bad = s["status"] != "ok"
+        assert list(s.loc[bad, "case"]) == list(range(31, 41))
+        assert s.loc[bad, "error"].str.contains("worker process died").all()
+        pd.testing.assert_frame_equal(s[~bad].reset_index(drop=True), r[~bad].reset_index(drop=True), check_dtype=False)
+        assert "case 31" in capsys.readouterr().err
+
+
+def test_workers_exit_when_the_driver_is_killed(tmp_path):
+    psutil = pytest.importorskip("psutil")
+    path = deck(tmp_path, 40, 50, 60, extra=", chunk = 500")   # 120 000 cases
+    out = tmp_path / "o"
+    cmd = [sys.executable, "-m", "driver", str(path), "-o", str(out), "-q", "-j", "2"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    parent = psutil.Process(proc.pid)
+    deadline = time.time() + 120
+    kids = []
+    while time.time() < deadline and len(kids) < 2 and proc.poll() is None:
+        kids = parent.children(recursive=True)
+        time.sleep(0.05)
+    assert kids, "no worker processes seen"
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    gone, alive = psutil.wait_procs(kids, timeout=20)
+    assert not alive, f"workers still running after the driver died: {alive}"
+
+
+def test_grid_columns_follow_product_order():
+    import itertools
+    g = sweep_batch.Grid(["a.x", "a.y", "a.z"], [[1.0, 2.0], [3.0, 4.0, 5.0], ["u", "v"]], False)
+    combos = list(itertools.product(*g.values))
+    cols = g.columns(0, g.n)
+    assert g.n == 12 and list(zip(*cols.values())) == combos
+    part = g.columns(5, 9)
+    assert list(zip(*part.values())) == combos[5:9]
+    z = sweep_batch.Grid(["a.x", "a.y"], [[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]], True)
+    assert list(zip(*z.columns(1, 3).values())) == [(2.0, 5.0), (3.0, 6.0)]
+    assert np.asarray(z.columns(0, 3)["a.x"]).dtype == np.float64
