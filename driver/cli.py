@@ -65,6 +65,7 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool, progress:
             from driver import optimize
             return optimize.run_optimize_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))
         if "sweep" in deck.groups:
+            require("parquet")   # sweeps keep their cases in Parquet: say so before importing them
             from driver import sweep
             return sweep.run_sweep_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))
         outcome = run_study(deck, outdir, formats, plot, progress, summary_json=summary_json)

@@ -30,7 +30,8 @@ if TYPE_CHECKING:
 __all__ = ["Figure", "Result", "keyword_run", "load_study", "study_names"]
 
 _CORE = {"cli", "limits", "deck", "study", "table", "export", "plotting", "atomic", "kernels", "sweep", "runner", "expr",
-         "optimize", "synthesis", "published", "compare", "extras", "example_decks", "examples", "api"}
+         "optimize", "synthesis", "published", "compare", "extras", "example_decks", "examples", "api",
+         "sweep_batch"}
 
 
 @dataclass
