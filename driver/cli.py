@@ -22,7 +22,7 @@ from pathlib import Path
 from driver import __version__, limits
 from driver.export import FORMATS
 from driver.extras import MissingExtra, require
-from driver.study import study_names
+from driver.study import PLOT_FORMATS, study_names
 
 __all__ = ["main", "run_deck", "EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT"]
 
@@ -43,7 +43,7 @@ def _fs_error(exc: OSError) -> str:
     return f"cannot write {where}: {reason}"
 
 
-def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool, progress: bool,
+def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool | str, progress: bool,
              quiet: bool = False, sweep_options: dict | None = None, summary_json: bool = False) -> int:
     """Run one deck; returns its exit status. Errors are printed, never raised.
 
@@ -192,9 +192,10 @@ def build_parser() -> argparse.ArgumentParser:
                         help="also write the tidy table in this format (repeatable)")
     parser.add_argument("--json", action="store_true",
                         help="also write the run's summary (headline figures, warnings) as <stem>.json")
-    parser.add_argument("--plot", action="store_true", help="write figures <stem>_<name>.png")
-    parser.add_argument("--plot-format", choices=("png", "svg", "pdf"), default=None,
-                        help="figure file format (implies --plot); the same inputs give the same bytes")
+    parser.add_argument("--plot", action="store_true", help="write figures <stem>_<name>.png (see --plot-format)")
+    parser.add_argument("--plot-format", choices=PLOT_FORMATS, default=None,
+                        help="figure file format (implies --plot; default png); the same inputs give "
+                             "byte-identical files")
     parser.add_argument("-q", "--quiet", action="store_true", help="print only warnings and errors")
     parser.add_argument("--keys", metavar="GROUP", help="list the keys of a namelist group and exit")
     parser.add_argument("--examples", action="store_true",
@@ -260,9 +261,7 @@ def _main(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
     except ValueError as exc:
         parser.error(str(exc))
     formats = list(dict.fromkeys((["csv"] if args.csv else []) + args.formats))
-    if args.plot_format:
-        args.plot = args.plot_format
-    needs = ([("plot", "--plot")] if args.plot else []) + ([("parquet", "--format parquet")]
+    needs = ([("plot", "--plot")] if (args.plot or args.plot_format) else []) + ([("parquet", "--format parquet")]
              if "parquet" in formats else []) + ([("dask", "--scheduler")] if args.scheduler else [])
     for extra, option in needs:
         try:
@@ -271,13 +270,14 @@ def _main(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
             parser.error(f"{option}: {exc}")
     outdir = args.outdir or Path("outputs")
     progress = sys.stderr.isatty() and not args.quiet and not os.environ.get("CI")
+    plot: bool | str = args.plot_format or args.plot
     sweep_options = {"jobs": args.jobs, "scheduler": args.scheduler, "resume": args.resume}
     status = EXIT_OK
     handlers = _install_signals()
     try:
         for deck in args.decks:
             try:
-                status = max(status, run_deck(deck, outdir, formats, args.plot, progress, args.quiet,
+                status = max(status, run_deck(deck, outdir, formats, plot, progress, args.quiet,
                                              sweep_options, summary_json=args.json))
                 sys.stdout.flush()
             except BrokenPipeError:   # stdout closed early (e.g. piped into head): the files are

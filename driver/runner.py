@@ -81,6 +81,8 @@ def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool | s
     """Write the .out file, extra files, tidy tables, the summary as ``<stem>.json`` (when
     ``summary_json``) and figures (``plot``: True for PNG, or 'png', 'svg', 'pdf') for one case.
 
+    ``plot`` is False (no figures), True (PNG) or a format of :data:`driver.study.PLOT_FORMATS`.
+
     The files form one set (:func:`driver.atomic.output_set`): all are renamed into place
     together once every one is complete, or none is.  Stale temporaries of this stem left
     by a killed earlier run are removed first.
@@ -95,11 +97,10 @@ def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool | s
             written.append(write_tidy(result.tidy, stem, fmt))
         if summary_json:
             written.append(write_text(stem.with_name(stem.name + ".json"), summary_json_text(result)))
-        if plot and result.figures:   # plot: True (PNG) or a format name (png, svg, pdf)
-            from driver.plotting import figure_format, save_figure
-            suffix = figure_format(plot)
+        if plot and result.figures:
+            from driver.plotting import save_figure
             for fig in result.figures:
-                written.append(save_figure(fig.draw, stem.with_name(f"{stem.name}_{fig.name}.{suffix}")))
+                written.append(save_figure(fig.draw(), stem.with_name(f"{stem.name}_{fig.name}.png"), plot))
     # the set replaces an earlier run's: its tidy tables in formats not written now go
     for fmt in FORMATS:
         old = stem.with_name(f"{stem.name}.{fmt}")

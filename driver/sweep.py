@@ -49,7 +49,7 @@ from driver.deck import Deck, DeckError, GroupSpec, Key, Params, RawGroup, valid
 from driver.export import write_tidy
 from driver.extras import require
 from driver.runner import compute, output_stem, study_of, write_outputs
-from driver.study import load_study
+from driver.study import column_label, load_study
 from driver.table import Column, render_table
 
 __all__ = ["SPEC", "Case", "build_cases", "run_sweep_deck", "run_task", "auto_chunk", "MAX_KEYS"]
@@ -649,14 +649,14 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
                 write_tidy(allcases, outdir / f"{stem}_cases", fmt)
         write_text(outdir / f"{stem}.out", text)
         if plot:
-            from driver.plotting import figure_format, save_figure, sweep_summary
+            from driver.plotting import save_figure, sweep_summary
             shown = frame.copy()
             for name in [sw.plot_x, *sw.plot_y]:   # a plotted expression becomes a column
                 if name and name not in shown.columns:
                     shown[name] = expr.parse(name).evaluate(shown)
-            units = {n: _units_of(n) for n in names}
-            save_figure(lambda: sweep_summary(shown, names, sw.plot_x, sw.plot_y, stem, units),
-                        outdir / f"{stem}_summary.{figure_format(plot)}")
+            labels = {c: column_label(module, c) for c in shown.columns}
+            save_figure(sweep_summary(shown, names, sw.plot_x, sw.plot_y, stem, labels,
+                                      getattr(module, "SWEEP_PLOT", ())), outdir / f"{stem}_summary.png", plot)
     for r in done:
         for w in r.warnings:
             print(f"warning: {deck.path}: case {r.index}: {w}", file=sys.stderr)
@@ -711,14 +711,12 @@ def _run_batch(deck: Deck, sw: Params, base_params: Params, bplan, axes, outdir:
                 write_tidy(allcases, outdir / f"{stem}_cases", fmt)
         write_text(outdir / f"{stem}.out", text)
         if plot:   # the summary only (per-case figures only for case_outputs with --plot)
-            from driver.plotting import figure_format, save_figure, sweep_summary
+            from driver.plotting import save_figure, sweep_summary
             shown = rows.copy()
             for name in [sw.plot_x, *sw.plot_y]:   # a plotted expression becomes a column
                 if name and name not in shown.columns:
                     shown[name] = expr.parse(name).evaluate(shown)
-            units = {n: _units_of(n) for n in names}
-            save_figure(lambda: sweep_summary(shown, names, sw.plot_x, sw.plot_y, stem, units),
-                        outdir / f"{stem}_summary.{figure_format(plot)}")
+            save_figure(sweep_summary(shown, names, sw.plot_x, sw.plot_y, stem), outdir / f"{stem}_summary.png")
     for index, values, error in failed[:20]:
         vals = ", ".join(f"{k} = {v!r}" for k, v in values.items())
         print(f"error: {deck.path}: case {index} ({vals}): {error}", file=sys.stderr)
@@ -732,14 +730,6 @@ def _run_batch(deck: Deck, sw: Params, base_params: Params, bplan, axes, outdir:
     if failed:
         return EXIT_BAD_INPUT if (bad["status"] == "bad input").any() else EXIT_FAILED
     return EXIT_OK
-
-
-def _units_of(dotted: str) -> str:
-    """The unit a swept deck key ``group.key`` declares in its study's SPEC ('' if none)."""
-    group, _, key = dotted.partition(".")
-    module = load_study(group)
-    spec_key = module.SPEC.keys.get(key) if module is not None else None
-    return spec_key.units if spec_key is not None else ""
 
 
 def _sweep_text(deck: Deck, sw: Params, base: Params, axes: list[tuple[str, list]], n_cases: int,

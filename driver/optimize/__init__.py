@@ -222,9 +222,9 @@ def _write(oc: OptimizeOutcome, stem: Path, params, formats: list[str], plot: bo
     if "parquet" in formats:
         written.append(write_tidy(hist, stem.with_name(stem.name + "_history"), "parquet"))
     if plot:
-        from driver.plotting import figure_format, save_figure
-        written.append(save_figure(lambda: report.convergence_figure(p, hist, evals, Path(p.deck.path).stem),
-                                   stem.with_name(f"{stem.name}_convergence.{figure_format(plot)}")))
+        from driver.plotting import save_figure
+        fig = report.convergence_figure(p, hist, evals, Path(p.deck.path).stem)
+        written.append(save_figure(fig, stem.with_name(stem.name + "_convergence.png"), plot))
     return written
 
 
