@@ -3,6 +3,9 @@
 Each deck runs on its own; the exit status is 0 when every deck succeeded,
 2 when any deck had bad input (nothing written for that deck), 1 when a run
 failed otherwise (e.g. an optimiser did not converge; its outputs say so).
+Only argument parsing lives here; running is :mod:`driver.runner` and
+:mod:`driver.sweep`, :mod:`driver.optimize`, :mod:`driver.synthesis`.  Heavy modules (pandas, the kernels, the studies) are
+imported after parsing, so ``--help`` and ``--version`` answer at once.
 """
 from __future__ import annotations
 
@@ -16,12 +19,10 @@ import threading
 import traceback
 from pathlib import Path
 
-import driver
-from driver import limits
-from driver.deck import DeckError, read_deck
+from driver import __version__, limits
 from driver.export import FORMATS
-from driver.runner import CONTROL_GROUPS, available_studies, run_study
-from driver.study import PLOT_FORMATS, load_study
+from driver.extras import MissingExtra, require
+from driver.study import PLOT_FORMATS, study_names
 
 __all__ = ["main", "run_deck", "EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT"]
 
@@ -46,12 +47,17 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool | str, pro
              quiet: bool = False, sweep_options: dict | None = None, summary_json: bool = False) -> int:
     """Run one deck; returns its exit status. Errors are printed, never raised.
 
-    ``sweep_options`` (jobs, scheduler, resume) apply when the deck has a &sweep group
-    (whose cases always write their summary as JSON); ``summary_json`` writes a single
-    run's summary as ``<stem>.json``.
+    ``sweep_options`` (jobs, scheduler, resume) apply when the deck has a &sweep or an
+    &optimize group (a sweep's cases always write their summary as JSON); given for any other
+    deck, they are reported as ignored.  ``summary_json`` writes a single run's summary as
+    ``<stem>.json``.
     """
+    from driver.deck import DeckError, read_deck
+    from driver.runner import run_study
     try:
         deck = read_deck(path)
+        given = [opt for opt, key in (("-j/--jobs", "jobs"), ("--scheduler", "scheduler"), ("--resume", "resume"))
+                 if (sweep_options or {}).get(key) and not ({"sweep", "optimize"} & set(deck.groups))]
         if "synthesis" in deck.groups:
             from driver import synthesis
             return synthesis.run_synthesis_deck(deck, outdir, formats, plot, progress, quiet)
@@ -59,12 +65,16 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool | str, pro
             from driver import optimize
             return optimize.run_optimize_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))
         if "sweep" in deck.groups:
+            require("parquet")   # sweeps keep their cases in Parquet: say so before importing them
             from driver import sweep
             return sweep.run_sweep_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))
         outcome = run_study(deck, outdir, formats, plot, progress, summary_json=summary_json)
     except DeckError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except MissingExtra as exc:
+        print(f"error: {path}: {exc}", file=sys.stderr)
+        return EXIT_FAILED
     except (KeyboardInterrupt, BrokenPipeError):
         raise
     except OSError as exc:   # the file system: one line naming the path, then the next deck
@@ -79,8 +89,12 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool | str, pro
             traceback.print_exc()
         return EXIT_FAILED
     result = outcome.result
+    if given:   # reported once the deck is known to be valid (bad input gets its error line only)
+        print(f"warning: {path}: {', '.join(given)} apply to sweep and optimisation decks "
+              f"(a &sweep or &optimize group) only; ignored for this deck", file=sys.stderr)
     for w in result.warnings:
-        print(f"warning: {path}: {w}", file=sys.stderr)
+        if w != result.failure:   # a failure is printed once, as the error below
+            print(f"warning: {path}: {w}", file=sys.stderr)
     if not quiet:
         for p in outcome.written:
             print(f"wrote {p}")
@@ -98,14 +112,18 @@ def _on_sigterm(signum: int, frame: object) -> None:
     raise Terminated()
 
 
-def _keys_help(group: str) -> str:
-    module = load_study(group)
-    if module is None and group in CONTROL_GROUPS:
+def keys_help(group: str) -> str | None:
+    """Every key of namelist group ``group`` with kind, units, default and doc; None if no such group."""
+    from driver.runner import CONTROL_GROUPS
+    if group in CONTROL_GROUPS:
         import importlib
-        module = importlib.import_module(f"driver.{group}")
-    if module is None:
-        return f"no study group &{group}"
-    spec = module.SPEC
+        spec = importlib.import_module(f"driver.{group}").SPEC
+    else:
+        from driver.study import load_study
+        module = load_study(group)
+        if module is None:
+            return None
+        spec = module.SPEC
     lines = [f"&{spec.name}: {spec.doc}".rstrip(": "), ""]
     for name, key in spec.keys.items():
         req = "required" if key.required else f"default {key.default!r}"
@@ -117,19 +135,58 @@ def _keys_help(group: str) -> str:
     return "\n".join(lines)
 
 
+def _examples(args: argparse.Namespace) -> int:
+    """--examples: list the shipped decks; --example NAME: copy one out."""
+    from driver import example_decks
+    try:
+        if args.examples:
+            names = example_decks.list_examples()
+            width = max(map(len, names))
+            print(f"example decks ({example_decks.examples_dir()}); copy one with: python -m driver --example NAME")
+            for name in names:
+                text = example_decks.describe(name) or "(the listing's terminal input: p q r s, omega, increment)"
+                print(f"  {name:<{width}}  {text[:100] + ('...' if len(text) > 100 else '')}")
+        for name in args.example:
+            target = example_decks.copy_example(name, args.outdir or Path("."))
+            print(f"copied {target}; run it with: python -m driver {target}")
+    except KeyError as exc:
+        print(f"error: {exc.args[0]}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except BrokenPipeError:   # e.g. piped into head
+        sys.stderr.close()
+    except OSError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return EXIT_FAILED
+    return EXIT_OK
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number of worker processes, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"needs at least 1 worker process, got {value} "
+                                         "(leave -j out to use every core)")
+    return value
+
+
 def build_parser() -> argparse.ArgumentParser:
-    studies = ", ".join(f"&{g}" for g in sorted(available_studies()))
+    studies = ", ".join(f"&{g}" for g in study_names())
     parser = argparse.ArgumentParser(
         prog="python -m driver",
         description="Run mechanism-analysis decks (Fortran namelist files) and write "
                     "fixed-format tables to OUTDIR/<deck stem>.out.",
         epilog=f"Study groups: {studies}; a &sweep group turns a deck into a study over "
-               "several cases, an &optimize group into an optimisation. 'python -m driver --keys GROUP' lists a group's keys. "
+               "several cases, an &optimize group into an optimisation. 'python -m driver --keys GROUP' lists a "
+               "group's keys (also --keys sweep, --keys optimize); "
+               "'python -m driver --examples' lists the shipped example decks. "
                "Exit status: 0 all decks succeeded, 1 a run failed, 2 bad input.",
     )
     parser.add_argument("decks", nargs="*", type=Path, metavar="DECK", help="input deck(s), e.g. inputs/crank5.dat")
-    parser.add_argument("-o", "--outdir", type=Path, default=Path("outputs"),
-                        help="output folder (default: outputs/, created when missing)")
+    parser.add_argument("-o", "--outdir", type=Path, default=None,
+                        help="output folder (default: outputs/, created when missing); "
+                             "with --example, where the deck is copied (default: here)")
     parser.add_argument("--csv", action="store_true", help="also write the tidy table as <stem>.csv")
     parser.add_argument("--format", dest="formats", action="append", choices=FORMATS, default=[],
                         help="also write the tidy table in this format (repeatable)")
@@ -141,11 +198,15 @@ def build_parser() -> argparse.ArgumentParser:
                              "byte-identical files")
     parser.add_argument("-q", "--quiet", action="store_true", help="print only warnings and errors")
     parser.add_argument("--keys", metavar="GROUP", help="list the keys of a namelist group and exit")
+    parser.add_argument("--examples", action="store_true",
+                        help="list the example decks shipped with the package and exit")
+    parser.add_argument("--example", metavar="NAME", action="append", default=[],
+                        help="copy the shipped example deck NAME.dat here (or into -o DIR) and exit (repeatable)")
     parser.add_argument("--compare", action="store_true",
                         help="compare each deck's run with the published tables in published/ (cell by cell, "
                              "with reasons; writes nothing); exit 0 when every reproducible cell agrees")
-    parser.add_argument("-j", "--jobs", type=int, default=None,
-                        help="sweeps and optimisations: worker processes (default: all cores)")
+    parser.add_argument("-j", "--jobs", type=_positive_int, default=None,
+                        help="sweeps and optimisations: worker processes, at least 1 (default: all cores)")
     parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
                         help="sweeps: run cases on this Dask distributed scheduler")
     parser.add_argument("--resume", action="store_true",
@@ -156,21 +217,38 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--max-work", metavar="SECONDS", default=None,
                         help="refuse a deck (a sweep case) whose estimated work is longer "
                              "(e.g. 600, 30min, 2h; default: 2 min)")
-    parser.add_argument("--version", action="version", version=f"%(prog)s {driver.__version__}")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    try:
+        return _main(parser, args)
+    except ImportError as exc:   # e.g. the kernels are not built: driver.kernels says what to do
+        print(f"error: {exc}", file=sys.stderr)
+        return EXIT_FAILED
+
+
+def _main(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
     if args.keys:
+        group = args.keys.lstrip("&").lower()
+        text = keys_help(group)
+        if text is None:
+            from driver.runner import CONTROL_GROUPS
+            known = ", ".join(f"&{g}" for g in (*study_names(), *CONTROL_GROUPS))
+            print(f"error: --keys: no namelist group &{group} (known groups: {known})", file=sys.stderr)
+            return EXIT_BAD_INPUT
         try:
-            print(_keys_help(args.keys.lstrip("&").lower()))
+            print(text)
         except BrokenPipeError:  # e.g. piped into head
             sys.stderr.close()
         return EXIT_OK
+    if args.examples or args.example:
+        return _examples(args)
     if not args.decks:
-        parser.error("no deck given")
+        parser.error("no deck given (python -m driver --examples lists the shipped example decks)")
     if args.compare:
         from driver.compare import compare_decks
         try:
@@ -183,6 +261,14 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError as exc:
         parser.error(str(exc))
     formats = list(dict.fromkeys((["csv"] if args.csv else []) + args.formats))
+    needs = ([("plot", "--plot")] if (args.plot or args.plot_format) else []) + ([("parquet", "--format parquet")]
+             if "parquet" in formats else []) + ([("dask", "--scheduler")] if args.scheduler else [])
+    for extra, option in needs:
+        try:
+            require(extra)
+        except MissingExtra as exc:
+            parser.error(f"{option}: {exc}")
+    outdir = args.outdir or Path("outputs")
     progress = sys.stderr.isatty() and not args.quiet and not os.environ.get("CI")
     plot: bool | str = args.plot_format or args.plot
     sweep_options = {"jobs": args.jobs, "scheduler": args.scheduler, "resume": args.resume}
@@ -191,7 +277,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         for deck in args.decks:
             try:
-                status = max(status, run_deck(deck, args.outdir, formats, plot, progress, args.quiet,
+                status = max(status, run_deck(deck, outdir, formats, plot, progress, args.quiet,
                                              sweep_options, summary_json=args.json))
                 sys.stdout.flush()
             except BrokenPipeError:   # stdout closed early (e.g. piped into head): the files are

@@ -251,7 +251,7 @@ def _ujoint(params: Params, result: Result) -> list[dict]:
 
 
 #: relative tolerance of the Simeon (1996) comparison: the tool's linear KED model against the
-#: reference's nonlinear modal model (the slider-crank study note)
+#: reference's nonlinear modal model (docs/slidercrank.md)
 SIMEON_REL_TOL = 5e-3
 
 

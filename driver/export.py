@@ -13,14 +13,16 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
-import pyarrow as pa
-import pyarrow.compute as pc
 
 from driver.atomic import atomic_open
+from driver.extras import available, require
+
+if TYPE_CHECKING:   # annotations only: keeps `python -m driver --help` light
+    import pandas as pd
+    import pyarrow as pa
 
 __all__ = ["FORMATS", "write_tidy", "with_units", "unit_of", "json_safe", "summary_json_text"]
 
@@ -40,6 +42,8 @@ def unit_of(name: str, dtype: Any = None) -> str | None:
     for suffix, unit in SUFFIX_UNITS:
         if name.endswith(suffix):
             return unit
+    import pandas as pd
+
     if dtype is not None and not (pd.api.types.is_numeric_dtype(dtype) and not pd.api.types.is_bool_dtype(dtype)):
         return ""
     return None
@@ -63,6 +67,9 @@ def _csv_name(name: str) -> str:
 
 def _cells(col: pa.Array | pa.ChunkedArray) -> pa.Array | pa.ChunkedArray:
     """One column as CSV cell text (nulls stay null, written as empty cells)."""
+    import pyarrow as pa
+    import pyarrow.compute as pc
+
     t = col.type
     if pa.types.is_floating(t):
         values = pc.cast(col, pa.float64())
@@ -85,6 +92,8 @@ def _cells(col: pa.Array | pa.ChunkedArray) -> pa.Array | pa.ChunkedArray:
 def _write_csv_arrow(table: pa.Table, fh: Any, batch_rows: int = 1 << 16) -> None:
     """CSV rows built column-wise by Arrow compute and written from its buffers, a batch of
     rows at a time (no Python per row; memory bounded by the batch)."""
+    import pyarrow.compute as pc
+
     fh.write((",".join(_csv_name(c) for c in table.column_names) + "\n").encode())
     if table.num_columns == 0:
         return
@@ -107,12 +116,17 @@ def write_tidy(frame: pd.DataFrame, path_stem: str | Path, fmt: str) -> Path:
     if fmt not in FORMATS:
         raise ValueError(f"unknown table format {fmt!r} (choose {', '.join(FORMATS)})")
     path = Path(f"{path_stem}.{fmt}")
+    if fmt == "parquet":
+        require("parquet")
     if fmt == "csv":
-        try:   # Arrow builds the CSV about 4x faster than pandas (matters for large sweeps)
-            table = pa.Table.from_pandas(frame, preserve_index=False)
-            [_cells(table.column(i).slice(0, 0)) for i in range(table.num_columns)]
-        except (pa.ArrowInvalid, pa.ArrowTypeError, pa.ArrowNotImplementedError, TypeError):
-            table = None   # a column mixing types: let pandas stringify it
+        table = None
+        if available("parquet"):   # Arrow builds the CSV about 4x faster than pandas (large sweeps)
+            import pyarrow as pa
+            try:
+                table = pa.Table.from_pandas(frame, preserve_index=False)
+                [_cells(table.column(i).slice(0, 0)) for i in range(table.num_columns)]
+            except (pa.ArrowInvalid, pa.ArrowTypeError, pa.ArrowNotImplementedError, TypeError):
+                table = None   # a column mixing types: let pandas stringify it
         if table is not None:
             with atomic_open(path, "wb") as fh:
                 _write_csv_arrow(table, fh)

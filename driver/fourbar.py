@@ -1,4 +1,4 @@
-"""Four-bar linkage study (seed 001, Soegihardjo 2003): the ``&fourbar`` group.
+"""Four-bar linkage study [Soegihardjo 2003]: the ``&fourbar`` group.
 
 ``method = 'listing'`` runs the published Fortran 77 program (Lampiran 1), kept
 cell-for-cell, and audits it against the closed loop; ``method = 'exact'``
@@ -537,15 +537,15 @@ def _exact_columns(out: np.ndarray, status: np.ndarray, cp: np.ndarray | None = 
 
 
 def _figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> list[Figure]:
-    from driver import plotting
-
     def curves():
+        from driver import plotting   # matplotlib is the optional [plot] extra: import when drawing
         theta = np.linspace(p.start_deg, p.stop_deg, 721)
         out, st = exact_grid(p, theta)
         exact = tidy_frame("exact", theta, _exact_columns(out, st), st)
         return plotting.fourbar_curves(exact, listing, stem_title)
 
     def linkage():
+        from driver import plotting
         theta = np.linspace(0.0, 360.0, 721)
         out, st = exact_grid(p, theta)
         cp = coupler_point(p, theta, out, st)

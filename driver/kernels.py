@@ -7,9 +7,22 @@ study; each kernel's physics and units are documented in ``fortran/<study>.f90``
 """
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
-from driver import _kernels
+try:
+    from driver import _kernels
+except ImportError as _exc:
+    _root = Path(__file__).resolve().parents[1]
+    if (_root / "meson.build").is_file() and (_root / "fortran").is_dir():
+        raise ImportError(
+            f"the Fortran kernels (driver._kernels) are not built in the source checkout {_root}, and "
+            f"Python imports 'driver' from there because it is the current folder (or on sys.path). "
+            f"Run from another folder to use an installed copy, or build this checkout in place: "
+            f"bash .ci/setup (see docs/install.md)") from _exc
+    raise ImportError(f"the Fortran kernels (driver._kernels) cannot be loaded: {_exc}; reinstall "
+                      f"mechanism-driver (see docs/install.md)") from _exc
 
 __all__ = ["farray", "fourbar_listing", "fourbar_exact", "fourbar_coupler_point", "fourbar_summaries",
            "FOURBAR_SUMMARY_COLUMNS", "FOURBAR_GRASHOF", "FOURBAR_STATUS",

@@ -1,4 +1,4 @@
-"""&manipulator: robust dimensional synthesis of a planar 2R arm (seed 004, chapter 4).
+"""&manipulator: robust dimensional synthesis of a planar 2R arm ([Ma'arif 2006], chapter 4).
 
 From a workspace given as points P_i (base A at the origin) the study computes
 
@@ -13,7 +13,7 @@ From a workspace given as points P_i (base A at the origin) the study computes
 * tolerance synthesis: the largest box l +- dl whose positioning error stays within a bound
   (Caro's formulation, closed form and a corner-constrained SLSQP), checked by Monte Carlo.
 
-``mode = 'report'`` applies the report's conventions (shared/notes/manipulator.md sec. 0):
+``mode = 'report'`` applies the report's conventions (docs/manipulator.md sec. 0):
 C_rob radius rounded to 3 dp, C = radius^2 for Table 4.2 and round(radius^2, 2) for Table 4.8,
 Table 4.5 theta2 printed as the interior angle 180 - acos(c2), Table 4.7 fed with the printed
 Table 4.5 angles, Table 4.8 base angle round(atan2(y, x), 2 dp) - theta2.  ``mode = 'exact'``
@@ -701,10 +701,10 @@ def _tables(p: Params, conv: Conv) -> tuple[list[Table], dict[str, Any], dict[st
 def _header(p: Params, ws: Workspace, conv: Conv) -> list[str]:
     tx, ty = _target(p, ws)
     pts = ", ".join(f"({x:g}, {y:g})" for x, y in zip(ws.x, ws.y))
-    lines = ["2R manipulator robust design (seed 004, chapter 4)", "=" * 50]
+    lines = ["2R manipulator robust design ([Ma'arif 2006], chapter 4)", "=" * 50]
     if p.title:
         lines.append(f"case: {p.title}")
-    lines += [f"deck: {p.path.name}", f"mode: {p.mode}" + ("  (report's conventions, shared/notes/manipulator.md)"
+    lines += [f"deck: {p.path.name}", f"mode: {p.mode}" + ("  (report's conventions, docs/manipulator.md)"
                                                         if conv.report else "  (correct IK, exact constants)"),
               f"workspace points [m]: {pts}  (n = {ws.n})",
               f"target point [m]: ({tx:g}, {ty:g})   elbow branch: {p.elbow:+d}",

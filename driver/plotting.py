@@ -17,7 +17,10 @@ import textwrap
 from pathlib import Path
 from typing import Any, Callable, Iterator, Sequence, TypeVar
 
-import matplotlib
+from driver.extras import require
+
+require("plot")   # a clear message naming the [plot] extra when matplotlib is missing
+import matplotlib  # noqa: E402
 import matplotlib.ticker
 import numpy as np
 from matplotlib.figure import Figure

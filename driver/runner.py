@@ -79,7 +79,7 @@ def output_stem(outdir: str | Path, deck_path: str | Path) -> Path:
 def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool | str,
                   summary_json: bool = False, clean: bool = True) -> list[Path]:
     """Write the .out file, extra files, tidy tables, the summary as ``<stem>.json`` (when
-    ``summary_json``) and figures for one case.
+    ``summary_json``) and figures (``plot``: True for PNG, or 'png', 'svg', 'pdf') for one case.
 
     ``plot`` is False (no figures), True (PNG) or a format of :data:`driver.study.PLOT_FORMATS`.
 

@@ -1,4 +1,4 @@
-"""Slider-crank with an elastic connecting rod (seed 003, Univ. Andalas): the &slidercrank study.
+"""Slider-crank with an elastic connecting rod [Andalas]: the &slidercrank study.
 
 Rigid crank, elastic rod meshed with frame elements, slider on its guide; kineto-elastodynamic
 (KED) finite-element model integrated with Newmark's average-acceleration rule.  The physics
@@ -31,7 +31,7 @@ from driver.table import Column, render_table
 __all__ = ["SPEC", "run", "MATERIALS", "PAPER_SPEEDS", "SIMEON1996", "simeon_initial_state",
            "min_steps_per_rev", "rayleigh", "static_onset", "STATUS_TEXT"]
 
-#: Table 1a of the paper (columns re-ordered as in the study note, section 1.1); the depth is the
+#: Table 1a of the paper (columns re-ordered, docs/slidercrank.md); the depth is the
 #: in-plane section depth used for the outer-fibre strain (weak axis in plane).
 MATERIALS: dict[str, dict[str, Any]] = {
     "aluminium": dict(area=27e-6, second_moment=2.025e-11, density=2660.0, youngs_modulus=7.17e10,
@@ -504,7 +504,7 @@ def _header(params: Params, model: Model, derived: dict[str, float]) -> list[str
         ("damping ratio (Rayleigh)", "", f"{params.damping_ratio:g}"),
     ]
     out = ["Slider-crank with an elastic connecting rod: KED finite elements, Newmark average acceleration",
-           "Seed 003 (Univ. Andalas); formulation and corrections: study note slidercrank.md", "", "Inputs"]
+           "[Andalas]; formulation and corrections: docs/slidercrank.md", "", "Inputs"]
     out += [f"  {name:<46} {('[' + u + ']') if u else '':<9} {val}" for name, u, val in rows]
     out += ["", "Model",
             "  rod: planar frame elements (axial + bending), consistent mass and stiffness (eqs. 26, 29",
@@ -830,23 +830,30 @@ def run(params: Params, progress: bool = False) -> Result:
         text += ["", "Warnings"] + [f"  * {w}" for w in warnings]
     figures = []
     good = [c for c in cases if c.ok]
+    plotting = _plotting   # imported when a figure is drawn (matplotlib is the optional [plot] extra)
+    buckled = [f"{c.omega:g} rad/s" for c in cases if not c.ok]
+    over = {f"{c.omega:g} rad/s": c.euler_ratio for c in good if c.euler_ratio > 1.0 and not params.geometric_stiffness}
     if good and params.end_time <= 0:
-        from driver import plotting
         above = {f"{c.omega:g} rad/s": c.euler_ratio for c in good if c.euler_ratio > 1.0}
         missing = [f"{c.omega:g} rad/s: {_status_text(c).split(' (')[0].lower()}, not drawn" for c in cases if not c.ok]
         stiffness = "K + K_G" if params.geometric_stiffness else "linear model"
-        figures.append(Figure("strain", lambda: plotting.slidercrank_strain_figure(
+        figures.append(Figure("strain", lambda: _plotting().slidercrank_strain_figure(
             [(f"{c.omega:g} rad/s", c.angle_deg, c.eps_ax[0] * 1e6) for c in good],
             f"{params.material}: crank-end element axial strain ({stiffness})", above=above, missing=missing)))
-        figures.append(Figure("deflection", lambda: plotting.slidercrank_strain_figure(
+        figures.append(Figure("deflection", lambda: _plotting().slidercrank_strain_figure(
             [(f"{c.omega:g} rad/s", c.angle_deg, c.mid * 1e3) for c in good],
             f"{params.material}: midpoint deflection ({stiffness})", ylabel="midpoint deflection [mm]",
             above=above, missing=missing)))
     if conv:
-        from driver import plotting
         series = {f"{w:g} rad/s": ([c.n_elements for c in cs if c.ok], [c.peak(+1)[0] * 1e6 for c in cs if c.ok])
                   for w, cs in conv.items()}
-        figures.append(Figure("convergence", lambda: plotting.slidercrank_convergence_figure(
+        figures.append(Figure("convergence", lambda: plotting().slidercrank_convergence_figure(
             series, f"{params.material}: element convergence")))
     return Result(text="\n".join(text) + "\n", tidy=_tidy(params.material, list(done.values())),
                   summary=_summary(cases, model if _shape(params)[1] else None), warnings=warnings, failure=failure, figures=figures)
+
+
+def _plotting():
+    """driver.plotting, imported only when a figure is drawn (matplotlib is optional)."""
+    from driver import plotting
+    return plotting

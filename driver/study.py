@@ -29,15 +29,18 @@ from pathlib import Path
 from types import ModuleType
 from typing import TYPE_CHECKING, Any, Callable, Iterable
 
-import pandas as pd
+if TYPE_CHECKING:   # annotations only: keeps `python -m driver --help` light
+    import pandas as pd
 
 if TYPE_CHECKING:
     import matplotlib.figure
 
-__all__ = ["Figure", "PLOT_FORMATS", "Result", "column_label", "keyword_run", "load_study", "plot_format"]
+__all__ = ["Figure", "PLOT_FORMATS", "Result", "column_label", "keyword_run", "load_study", "plot_format",
+           "study_names"]
 
 _CORE = {"cli", "limits", "deck", "study", "table", "export", "plotting", "atomic", "kernels", "sweep", "runner", "expr",
-         "optimize", "synthesis", "published", "compare"}
+         "optimize", "synthesis", "published", "compare", "extras", "example_decks", "examples", "api",
+         "sweep_batch"}
 
 
 #: file formats of ``--plot`` figures (``--plot-format``); the first is the default
@@ -106,6 +109,7 @@ class Result:
     @property
     def summary_frame(self) -> pd.DataFrame:
         """The summary as a one-row DataFrame (columns in summary order; None becomes missing)."""
+        import pandas as pd
         return pd.DataFrame([self.summary])
 
     @property
@@ -179,6 +183,15 @@ def load_study(group: str) -> ModuleType | None:
     if not (hasattr(module, "SPEC") and hasattr(module, "run")):
         return None
     return module
+
+
+def study_names() -> list[str]:
+    """Group names of every study module in the package, found without importing them."""
+    import pkgutil
+
+    import driver
+    return sorted(info.name for info in pkgutil.iter_modules(driver.__path__)
+                  if info.name not in _CORE and not info.name.startswith("_"))
 
 
 #: units read off a column name's suffix when a study declares none (longest first)

@@ -47,6 +47,7 @@ from driver import expr, limits, sweep_batch
 from driver.atomic import output_set, remove_stale_temporaries, write_text
 from driver.deck import Deck, DeckError, GroupSpec, Key, Params, RawGroup, validate
 from driver.export import write_tidy
+from driver.extras import require
 from driver.runner import compute, output_stem, study_of, write_outputs
 from driver.study import column_label, load_study
 from driver.table import Column, render_table
@@ -572,8 +573,15 @@ def _summary_table(frame: pd.DataFrame, limit: int = 2000, n_cases: int | None =
 def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool,
                    quiet: bool = False, jobs: int | None = None, scheduler: Any = None,
                    resume: bool = False) -> int:
-    """Run a deck with a &sweep group; returns the exit status (see driver.cli)."""
+    """Run a deck with a &sweep group; returns the exit status (see driver.cli).
+
+    Raises :class:`~driver.extras.MissingExtra` before running anything when pyarrow (case
+    files and summaries are Parquet) or, with a scheduler, Dask is not installed.
+    """
     sw = validate(deck.groups["sweep"], SPEC, deck.path)
+    require("parquet")
+    if scheduler or sw.scheduler:
+        require("dask")
     study_raw = {n: g for n, g in deck.groups.items() if n != "sweep"}
     module, base_params = study_of(Deck(deck.path, study_raw))   # the base deck must be valid on its own
     raw = study_raw[base_params.group]
@@ -751,6 +759,7 @@ def _run_batch(deck: Deck, sw: Params, base_params: Params, bplan, axes, outdir:
 def _sweep_text(deck: Deck, sw: Params, base: Params, axes: list[tuple[str, list]], n_cases: int,
                 frame: pd.DataFrame, n_kept: int, failed: list[tuple[int, dict, str]], rows: str) -> str:
     """The sweep's fixed-format .out: axes, counts, the summary table, failed cases."""
+
     lines = [f"  sweep over &{base.group} from deck {deck.path}", ""]
     for name, values in axes:
         vals = list(dict.fromkeys(values))   # deck order

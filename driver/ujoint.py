@@ -1,6 +1,6 @@
 """Hooke-joint (universal-joint) shaft chains: the paper's SSO package, corrected and extended.
 
-Seed 000 (M. Fajar, "Optimasi kecepatan sudut keluaran kopeling universal pada poros seri"):
+[Fajar] (M. Fajar, "Optimasi kecepatan sudut keluaran kopeling universal pada poros seri"):
 three Hooke joints on four shafts, optimised with MATLAB fmincon in three options
 (1 phases free, 2 angles free, 3 both).  This study
 
@@ -16,7 +16,7 @@ three Hooke joints on four shafts, optimised with MATLAB fmincon in three option
 
 Angles in the deck are degrees; the kernel works in radians.  Phases: the paper's phi
 (90 deg = yokes on the intermediate shaft in phase) or the yoke phase delta = phi - 90 deg.
-See ../shared/notes/ujoint.md for what reproduces and what does not.
+See docs/ujoint.md for what reproduces and what does not.
 """
 from __future__ import annotations
 
@@ -637,7 +637,7 @@ def _render(params: Params, chain: Chain, beta, rho, designs: list[Design], runs
     n = beta.size
     option = params.option
     exact = params.model == "exact"
-    out = [" HOOKE-JOINT SHAFT CHAIN  (&ujoint; seed 000, Fajar: Shaft Series Optimisation, SSO)", ""]
+    out = [" HOOKE-JOINT SHAFT CHAIN  (&ujoint; [Fajar]: Shaft Series Optimisation, SSO)", ""]
     hdr = [("deck", str(params.path)),
            ("model", _model_text(params)),
            ("joints", f"{n} on {n + 1} shafts; {n - 1} intermediate shaft(s), so {n - 1} phase(s)"),
@@ -698,7 +698,7 @@ def _render(params: Params, chain: Chain, beta, rho, designs: list[Design], runs
         nfev = f", {params.paper_nfev} function evaluations" if params.paper_nfev is not None else ""
         out.append(f" The paper prints U = {params.paper_u:g}{nit}{nfev} for its optimum. That value "
                    "cannot be reproduced under any")
-        out.append(" tested definition of U (see the study notes); the row above evaluates the printed "
+        out.append(" tested definition of U (see docs/ujoint.md); the row above evaluates the printed "
                    "design under this deck's objective.")
         out.append("")
 

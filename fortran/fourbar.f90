@@ -1,4 +1,4 @@
-!> Four-bar linkage kernels (seed 001, Soegihardjo 2003).
+!> Four-bar linkage kernels [Soegihardjo 2003].
 !>
 !> Geometry: crank pivot O_A at the origin, rocker pivot O_B at (p, 0).
 !> p = fixed link, q = crank, r = coupler, s = rocker (any consistent length unit).

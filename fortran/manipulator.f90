@@ -1,4 +1,4 @@
-!> Planar 2R manipulator kernels (seed 004, robust dimensional synthesis, chapter 4).
+!> Planar 2R manipulator kernels ([Ma'arif 2006], robust dimensional synthesis, chapter 4).
 !>
 !> Geometry: base A at the origin, link lengths l1, l2, joint angles th1 (from the
 !> x axis) and th2 (relative, elbow), counter-clockwise positive, radians.  End

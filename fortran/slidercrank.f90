@@ -1,4 +1,4 @@
-!> Slider-crank with a rigid crank and an elastic connecting rod (seed 003,
+!> Slider-crank with a rigid crank and an elastic connecting rod ([Andalas],
 !> Univ. Andalas): kineto-elastodynamic (KED) finite-element model of the rod,
 !> Newmark average-acceleration time integration, banded Cholesky solver.
 !>
@@ -6,10 +6,10 @@
 !>
 !> Mechanism: crank O-A of radius r2 turning counter-clockwise at constant
 !> speed omega (theta2 = omega*t), rod A-C of length L, slider C on the +X axis.
-!> Rigid kinematics (study note eqs. 2-10, corrected):
+!> Rigid kinematics (paper eqs. 2-10, corrected: docs/slidercrank.md):
 !>   theta3 = asin(-r2 sin theta2 / L), x4 = r2 cos theta2 + L cos theta3.
 !>
-!> FE model (study note section 2.3): n equal two-node frame elements with
+!> FE model (docs/slidercrank.md): n equal two-node frame elements with
 !> nodal (u, v, theta) = axial, transverse displacement and rotation, measured
 !> from the rigid configuration in rod axes (x along A->C).  Consistent mass
 !> (eq. 26) and stiffness (eq. 29, entry (5,3) = -6EI/L^2).

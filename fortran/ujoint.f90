@@ -1,4 +1,4 @@
-!> Hooke-joint (Cardan / universal-joint) shaft chains (seed 000, Fajar: the "SSO" package).
+!> Hooke-joint (Cardan / universal-joint) shaft chains ([Fajar]: the "SSO" package).
 !>
 !> A chain of n joints joins n+1 shafts.  Joint k has the operating (bend) angle beta(k).
 !> Angles are in radians throughout; speeds are dimensionless ratios omega_out/omega_in
@@ -16,7 +16,7 @@
 !> phi and rho have n-1 entries (one per intermediate shaft; empty for a single joint).
 !> Gradients are with respect to (beta(1..n), phi(1..n-1)): 2n-1 entries.
 !>
-!> Models (see ../shared/notes/ujoint.md):
+!> Models (see docs/ujoint.md):
 !>   model_eq13        the paper's eq. 13 as printed: joint k driven at theta + phi(k-1)
 !>   model_cumulative  the paper's text: joint k driven at theta + phi(1) + ... + phi(k-1)
 !>   model_exact       exact chain: theta(k+1) = theta_out(k) + phi(k) - rho(k), with

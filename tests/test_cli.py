@@ -5,6 +5,7 @@ import subprocess
 import sys
 
 import pandas as pd
+import pytest
 
 from conftest import INPUTS
 
@@ -50,3 +51,31 @@ def test_failed_rerun_leaves_previous_output_intact(tmp_path):
     assert res.returncode == 2
     assert (tmp_path / "o" / "c.out").read_text() == before
     assert [p.name for p in (tmp_path / "o").iterdir()] == ["c.out"]   # no temporary left over
+
+
+def test_keys_of_sweep_and_unknown_group(tmp_path):
+    sweep = run(["--keys", "sweep"], tmp_path)
+    assert sweep.returncode == 0 and "key1" in sweep.stdout and "keep" in sweep.stdout
+    bogus = run(["--keys", "bogus"], tmp_path)
+    assert bogus.returncode == 2 and "no namelist group &bogus" in bogus.stderr and "&fourbar" in bogus.stderr
+
+
+@pytest.mark.parametrize("jobs", ["0", "-3", "two"])
+def test_jobs_must_be_a_positive_count(tmp_path, jobs):
+    res = run([str(INPUTS / "crank5.dat"), "-j", jobs, "-o", "o"], tmp_path)
+    assert res.returncode == 2 and "-j/--jobs" in res.stderr and not (tmp_path / "o").exists()
+
+
+def test_sweep_options_on_a_plain_deck_are_reported(tmp_path):
+    res = run([str(INPUTS / "crank5_exact.dat"), "-j", "2", "--resume", "-o", "o"], tmp_path)
+    assert res.returncode == 0
+    assert "-j/--jobs, --resume apply to sweep and optimisation decks" in res.stderr and "ignored" in res.stderr
+
+
+def test_help_and_version_import_no_study(tmp_path):
+    code = ("import sys\nfrom driver.cli import main\n"
+            "try:\n    main(['--help'])\nexcept SystemExit:\n    pass\n"
+            "heavy = [m for m in ('pandas', 'scipy', 'driver.kernels', 'driver.fourbar', 'matplotlib') if m in sys.modules]\n"
+            "print('HEAVY', heavy)")
+    res = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True)
+    assert "HEAVY []" in res.stdout, res.stdout[-300:] + res.stderr

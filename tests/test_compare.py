@@ -136,7 +136,7 @@ def test_bad_deck_gives_status_2(write_deck, capsys):
 
 # ----------------------------------------------------------------------------- manipulator and section 2.3
 
-# the printed values the report's own data and formulas do not give (study note, section 5):
+# the printed values the report's own data and formulas do not give (docs/manipulator.md):
 # case-2 dexterity 5.85/4.16 (Table 4.4), case-1 theta1 = 34.81 (printed in Tables 4.5 and 4.6),
 # the (2.12) coefficients and the last digit of two Table 2.5 std values
 FLAGGED = {"manipulator_case1_report.dat": {("Table 4.5", "1.", "theta1"), ("Table 4.6", "1.", "theta1")},
@@ -200,7 +200,7 @@ def test_cli_totals_over_the_paper_decks(capsys):
 
 def test_ujoint_printed_optima_are_flagged_and_trial_bands_agree():
     """Trial bands of options 2 and 3 agree within the figure's whole-rpm reading; option 1's band,
-    every printed optimum, U and iteration count are flagged with a reason (study note section 2)."""
+    every printed optimum, U and iteration count are flagged with a reason (docs/ujoint.md)."""
     total = {}
     for n in (1, 2, 3):
         f = compare.compare(INPUTS / f"ujoint_option{n}.dat")

@@ -1,4 +1,4 @@
-"""Large arrays cross the f2py boundary without hidden copies (shared/notes/build.md, pitfall 2.2).
+"""Large arrays cross the f2py boundary without hidden copies (docs/build.md, pitfall 2.2).
 
 numpy reports its data buffers to tracemalloc, so the peak allocation during a call shows
 whether f2py (or the wrapper) copied an input: it equals the array's size when it did.

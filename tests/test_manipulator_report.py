@@ -1,4 +1,4 @@
-"""Report decks against the printed cells of seed 004, chapter 4 (the notes' "safe exact targets").
+"""Report decks against the printed cells of [Ma'arif 2006], chapter 4 (the cells docs/manipulator.md lists as reproducible).
 
 Printed values are transcribed as text in published/manipulator_case1.txt and _case2.txt (the text
 keeps the printed number of decimals; read through driver.published, as the comparison reads
@@ -52,7 +52,7 @@ def _cells(case: str, table: str) -> pd.DataFrame:
     return wide.loc[order].reset_index()
 
 
-# case-1 Table 4.5 theta1 = 34.81 is the report's slip (not reproducible; study note section 5)
+# case-1 Table 4.5 theta1 = 34.81 is the report's slip (not reproducible; docs/manipulator.md)
 UNSAFE_THETA1 = {("1", 1)}
 
 

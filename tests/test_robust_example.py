@@ -1,5 +1,5 @@
 """Section 2.3 (Taylor's example) against the printed values of the report (published/robust_example.txt,
-read through driver.published); the printed results that do not reproduce (FLAGGED, study note
+read through driver.published); the printed results that do not reproduce (FLAGGED, docs/manipulator.md
 section 4) must be flagged."""
 from __future__ import annotations
 
@@ -96,3 +96,13 @@ def test_exact_mode_differs_only_in_rounded_inputs(tmp_path):
     res = module.run(params)
     assert value(res, "eq211", 0) == pytest.approx(-5.66833, abs=5e-6)   # unrounded means
     assert value(res, "eq213", 0) == pytest.approx(14.997, abs=5e-4)
+
+
+def test_warnings_tell_a_rounding_slip_from_a_mismatch(report):
+    """(2.12) is wrong by up to 20 %; two Table 2.5 values are one unit off in the last printed digit."""
+    real = [w for w in report.warnings if w.startswith("printed value does not reproduce")]
+    slips = [w for w in report.warnings if w.startswith("printed value differs in its last digit")]
+    assert len(real) == 3 and all("(2.12)" in w and "off by" in w for w in real)
+    assert len(slips) == 2 and all("Table 2.5 std" in w for w in slips)
+    assert "rounds to 0.1851351" in slips[1] and "rounds to 0.0038188" in slips[0]
+    assert report.text.count("LAST DIGIT") == 2 and report.text.count("NOT REPRODUCED") == 3

@@ -55,6 +55,7 @@ def test_optimiser_failure_exits_1_and_says_so(tmp_path, capsys):
     rc = main([str(deck), "-o", str(tmp_path)])
     err = capsys.readouterr().err
     assert rc == 1 and "did not converge" in err
+    assert err.count("did not converge") == 1   # printed once, as the error
     text = (tmp_path / "bad.out").read_text()
     assert "RUN FAILED" in text and "last iterate" in text
     assert "optimum " not in text.split("DESIGNS")[1].split("PERFORMANCE")[0]

@@ -1,7 +1,7 @@
 """Kernel checks of fortran/ujoint.f90 against closed forms and an independent 3-D vector model.
 
 Truth here never comes from the code under test: single-joint closed forms (Shigley; the
-study notes 5.1), the exact-cancellation condition (notes 5.2), and a numpy 3-D rotation
+docs/ujoint.md), the exact-cancellation condition (docs/ujoint.md), and a numpy 3-D rotation
 model of the Cardan cross written in this file (notes section 6, steps 1-4).
 """
 from __future__ import annotations

@@ -1,5 +1,5 @@
 """The paper's SSO options: trial bands (published/ujoint_sso_option*.txt) and optimiser outcomes
-against closed-form answers (study notes sections 2-5).  The paper's printed optima and U
+against closed-form answers (docs/ujoint.md).  The paper's printed optima and U
 values are not reproducible and are never used as targets here."""
 from __future__ import annotations
 

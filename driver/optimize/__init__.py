@@ -10,7 +10,7 @@ See :mod:`driver.optimize.problem` for the deck keys.  Outputs for a deck ``<ste
 * ``<stem>_history.csv``: the best feasible design after every generation / iteration;
 * ``<stem>_evals.parquet``: every evaluated design (variables, feasibility and reason,
   objective, margins, the study's summary columns), also as CSV with ``--csv``;
-* ``<stem>_convergence.png`` with ``--plot``.
+* ``<stem>_convergence.png`` with ``--plot`` (``.svg``/``.pdf`` with ``--plot-format``).
 
 While a run goes, each evaluation is appended to ``<stem>.journal.jsonl``; ``--resume``
 replays the (deterministic) run from the journal, or from a finished run's ``_evals``
@@ -36,6 +36,7 @@ import pandas as pd
 from driver.atomic import output_set, write_text
 from driver.deck import Deck, DeckError, read_deck
 from driver.export import write_tidy
+from driver.extras import require
 from driver.optimize.evaluate import Evaluator, Record, design_params, evaluate_cases
 from driver.optimize.methods import HistoryRow, MethodResult, run_method
 from driver.optimize.problem import SPEC, Problem, problem_of
@@ -230,7 +231,14 @@ def _write(oc: OptimizeOutcome, stem: Path, params, formats: list[str], plot: bo
 def run_optimize_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool = False,
                       quiet: bool = False, jobs: int | None = None, resume: bool = False,
                       scheduler: Any = None, **_: Any) -> int:
-    """Command-line entry: run, report written files, return the exit status (DeckError propagates)."""
+    """Command-line entry: run, report written files, return the exit status (DeckError propagates).
+
+    Raises :class:`~driver.extras.MissingExtra` before running when pyarrow is missing (the
+    evaluation journal is Parquet) or, with a scheduler, Dask.
+    """
+    require("parquet")
+    if scheduler:
+        require("dask")
     oc = optimize(deck, outdir, formats, plot, jobs, resume, scheduler or None)
     if oc.study_result is not None:
         for w in oc.study_result.warnings:
