@@ -244,6 +244,11 @@ def _cross_check(params: Params) -> None:
                                            "crank_radius must be < rod_length")
     w_bend, _, _ = model.frequencies()
     for omega in params.speeds:
+        ratio = MIN_STEPS_PER_BENDING_PERIOD * w_bend / omega
+        if not math.isfinite(ratio) or ratio > 1e9:   # e.g. speeds = 4.9e-324: refused before ceil() overflows
+            raise params.error("speeds", f"crank speed {omega:g} rad/s is too slow to integrate: one revolution "
+                                         f"would need more than 10^9 time steps ({MIN_STEPS_PER_BENDING_PERIOD} "
+                                         f"per period of the first bending mode, {w_bend:.1f} rad/s)")
         need = min_steps_per_rev(omega, w_bend)
         if params.steps_per_rev < need:
             per = params.steps_per_rev * omega / w_bend

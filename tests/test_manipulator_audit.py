@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from conftest import INPUTS
+from driver import manipulator
 from driver.cli import main
 from driver.deck import read_deck
 from driver.runner import run_study
@@ -58,8 +59,8 @@ def test_horizontal_arm_gravity_zero(write_deck):
     gravity terms."""
     res = _run(write_deck, "manipulator", CASE1 + "  gravity = 0, joint_rates = 1.5, -0.5, "
                                                   "joint_accels = 2, 1")
-    t45 = res.tidy[res.tidy["table"] == "4.5"]
-    t47 = res.tidy[res.tidy["table"] == "4.7"]
+    t45 = manipulator.table_frame(res.tidy, "4.5")
+    t47 = manipulator.table_frame(res.tidy, "4.7")
     for (_, a), (_, b) in zip(t45.iterrows(), t47.iterrows()):
         l1, l2, m1, m2 = a["l1_m"], a["l2_m"], a["m1_kg"], a["m2_kg"]
         q2 = math.radians(a["theta2_deg"])
