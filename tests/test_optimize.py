@@ -241,3 +241,45 @@ def test_slidercrank_lightest_rod_is_bound_by_the_euler_constraint(tmp_path):
     h = brentq(ratio, 4e-3, 8e-3, xtol=1e-12)
     assert oc.x["slidercrank.section_depth"] == pytest.approx(h, rel=1e-5)
     assert oc.fun == pytest.approx(2660 * 6e-3 * h * 0.505, rel=1e-5)     # rho w h L
+
+
+def test_grid_started_local_search_and_partial_journal_resume(tmp_path):
+    """start = 'grid': the best grid points start SLSQP; an interrupted run's journal is replayed."""
+    body = ("var1 = 'fourbar.coupler', lower1 = 10, upper1 = 20\n"
+            "minimize = '(mu_min_deg - 45)**2'\nmethod = 'slsqp', start = 'grid', grid_count = 6, starts = 2")
+    path = _deck(tmp_path, body)
+    out = tmp_path / "out"
+    oc = optimize(path, out, jobs=1)
+    assert oc.success
+    c = math.cos(math.radians(45))
+    assert oc.x["fourbar.coupler"] == pytest.approx(9 * c + math.sqrt(81 * c * c - 81 + 81), abs=1e-4)
+    # the grid's six points were evaluated first
+    evals = pd.read_parquet(out / "opt_evals.parquet")
+    assert list(evals["fourbar.coupler"].iloc[:6]) == pytest.approx(list(np.linspace(10, 20, 6)))
+    # an interrupted run: a journal holding the first half of the evaluations (as the run appends them)
+    import json
+    half = evals.iloc[: len(evals) // 2]
+    lines = [json.dumps({"base": oc.problem.fingerprint(), "x": [float(v)], "status": "ok", "reason": "",
+                         "summary": {k[len("summary."):]: (None if isinstance(row[k], float) and math.isnan(row[k])
+                                                           else (row[k].item() if hasattr(row[k], "item") else row[k]))
+                                     for k in evals.columns if k.startswith("summary.")}})
+             for v, (_, row) in zip(half["fourbar.coupler"], half.iterrows())]
+    (out / "opt_evals.parquet").unlink()
+    (out / "opt.journal.jsonl").write_text("\n".join(lines) + "\n{\"cut by an interrupt")
+    again = optimize(path, out, jobs=1, resume=True)
+    assert again.evaluator.computed == len(evals) - len(half)
+    assert again.x == oc.x and again.nfev == oc.nfev
+    assert not (out / "opt.journal.jsonl").exists()
+
+
+def test_dask_scheduler_gives_the_same_run(tmp_path):
+    distributed = pytest.importorskip("distributed")
+    body = ("var1 = 'fourbar.coupler', lower1 = 10, upper1 = 20\nvar2 = 'fourbar.rocker', lower2 = 5, upper2 = 12\n"
+            "maximize = 'mu_min_deg'\nconstraint1 = 'rocker_swing_deg >= 40'\nmethod = 'grid', grid_count = 5")
+    path = _deck(tmp_path, body)
+    local = optimize(path, None, jobs=1)
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+        on_dask = optimize(path, None, scheduler=client)
+        assert on_dask.evaluator.scheduler is client
+    assert on_dask.x == local.x and on_dask.fun == local.fun and on_dask.nfev == 25

@@ -153,8 +153,12 @@ def _resumed(problem: Problem, stem: Path) -> list[dict]:
 
 
 def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[str] | None = None,
-             plot: bool = False, jobs: int | None = None, resume: bool = False) -> OptimizeOutcome:
+             plot: bool = False, jobs: int | None = None, resume: bool = False,
+             scheduler: Any = None) -> OptimizeOutcome:
     """Run an optimisation deck; write its outputs to ``outdir`` (None: write nothing).
+
+    ``scheduler``: a Dask scheduler address or Client (from the command line or Dask's
+    configuration, never from the deck): each batch of designs is spread over its workers.
 
     Raises DeckError for bad input before anything is computed or written.
     """
@@ -170,7 +174,10 @@ def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[
         journal.unlink()
     njobs = jobs if jobs is not None else problem.opts.jobs
     history: list[HistoryRow] = []
-    with Evaluator(problem, njobs, journal, resumed) as ev:
+    if scheduler is None:
+        from driver.sweep import _configured_scheduler
+        scheduler = _configured_scheduler() or None
+    with Evaluator(problem, njobs, journal, resumed, scheduler) as ev:
         mres = run_method(ev, history)
     best = ev.best()
     check, result, params = None, None, None
@@ -216,14 +223,15 @@ def _write(oc: OptimizeOutcome, stem: Path, params, formats: list[str], plot: bo
     if plot:
         from driver.plotting import save_figure
         fig = report.convergence_figure(p, hist, evals, Path(p.deck.path).stem)
-        written.append(save_figure(fig, stem.with_name(stem.name + "_convergence.png")))
+        written.append(save_figure(fig, stem.with_name(stem.name + "_convergence.png"), plot))
     return written
 
 
 def run_optimize_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool = False,
-                      quiet: bool = False, jobs: int | None = None, resume: bool = False, **_: Any) -> int:
+                      quiet: bool = False, jobs: int | None = None, resume: bool = False,
+                      scheduler: Any = None, **_: Any) -> int:
     """Command-line entry: run, report written files, return the exit status (DeckError propagates)."""
-    oc = optimize(deck, outdir, formats, plot, jobs, resume)
+    oc = optimize(deck, outdir, formats, plot, jobs, resume, scheduler or None)
     if oc.study_result is not None:
         for w in oc.study_result.warnings:
             print(f"warning: {deck.path}: optimum: {w}", file=sys.stderr)
@@ -236,7 +244,8 @@ def run_optimize_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, 
                   + ", ".join(f"{k} = {v:.6g}" for k, v in oc.x.items()))
         ev = oc.evaluator
         if ev.computed:
-            how = "batch path" if hasattr(oc.problem.study, "summarise_batch") else f"{ev.jobs} process(es)"
+            how = ("batch path" if hasattr(oc.problem.study, "summarise_batch") else
+                   f"dask {ev.scheduler}" if ev.scheduler else f"{ev.jobs} process(es)")
             print(f"{deck.path}: {ev.computed} designs computed ({len(ev.records) - ev.computed} replayed), "
                   f"{1e3 * ev.compute_seconds / ev.computed:.3f} ms per design ({how})")
     if not oc.success:

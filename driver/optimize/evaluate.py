@@ -4,7 +4,8 @@ Every design the optimiser asks for goes through :class:`Evaluator`, which
 
 * validates the design as a complete deck (the study group with the variables replaced) and
   computes the study's summary: in one batched call where the study has a batch path
-  (``summarise_batch``), otherwise case by case, in worker processes when that pays;
+  (``summarise_batch``), otherwise case by case, on a Dask cluster (``--scheduler``) or in
+  worker processes when that pays;
 * never raises for a bad design: a case that cannot be validated, fails, or leaves the
   objective undefined is *infeasible*, with its reason recorded and counted;
 * evaluates the objective and constraints (deck expression language) over the whole batch
@@ -112,8 +113,10 @@ class Evaluator:
     """Evaluates designs for one :class:`Problem`; keeps every evaluation in order."""
 
     def __init__(self, problem: Problem, jobs: int = 1, journal: Path | None = None,
-                 resumed: list[dict] | None = None):
+                 resumed: list[dict] | None = None, scheduler: Any = None):
         self.problem = problem
+        self.scheduler = scheduler      # a Dask scheduler address or Client: batches go to its workers
+        self._client = None
         self.jobs = jobs if jobs > 0 else (os.cpu_count() or 1)
         self.records: list[Record] = []
         self.cache: dict[tuple[float, ...], int] = {}
@@ -131,6 +134,9 @@ class Evaluator:
 
     # ------------------------------------------------------------------ lifecycle
     def close(self) -> None:
+        if self._client is not None and isinstance(self.scheduler, str):
+            self._client.close()
+        self._client = None
         if self._pool is not None:
             self._pool.shutdown(wait=True, cancel_futures=True)
             self._pool = None
@@ -152,7 +158,17 @@ class Evaluator:
         if out is None:
             args = (self.problem.raw.name, str(self.problem.deck.path), self.problem.raw, self.keys, self.kinds)
             slow = self.seconds_per_case is not None and self.seconds_per_case * len(xs) > 0.2
-            if self.jobs > 1 and len(xs) > 1 and slow:
+            if self.scheduler and len(xs) > 1:
+                if self._client is None:
+                    from dask.distributed import Client
+                    self._client = self.scheduler if not isinstance(self.scheduler, str) else \
+                        Client(self.scheduler, timeout="60s")
+                workers = max(1, len(self._client.scheduler_info().get("workers", {})))
+                size = max(1, math.ceil(len(xs) / (2 * workers)))
+                parts = [list(map(list, xs[i:i + size])) for i in range(0, len(xs), size)]
+                futures = [self._client.submit(evaluate_cases, *args, part, pure=False) for part in parts]
+                out = [r for part in self._client.gather(futures) for r in part]
+            elif self.jobs > 1 and len(xs) > 1 and slow:
                 if self._pool is None:
                     self._pool = cf.ProcessPoolExecutor(self.jobs, initializer=_ignore_sigint)
                 size = max(1, math.ceil(len(xs) / self.jobs))
