@@ -550,7 +550,10 @@ def validate(raw: RawGroup, spec: GroupSpec, path: str | Path) -> Params:
                                     f"{x!r} is not one of {', '.join(map(repr, k.choices))}")
             val = norm if isinstance(val, list) else norm[0]
         if k.check is not None:
-            msg = k.check(val)
+            try:
+                msg = k.check(val)
+            except (ArithmeticError, ValueError) as exc:   # a check overflowing on an extreme value
+                msg = f"value out of the range this key can take ({exc.__class__.__name__}: {exc})"
             if msg:
                 raise DeckError(path, line, key, msg)
         values[key] = val
@@ -562,7 +565,14 @@ def validate(raw: RawGroup, spec: GroupSpec, path: str | Path) -> Params:
             values[key] = k.default
     params = Params(spec.name, path, values, raw.lines, raw.line, given)
     if spec.check is not None:
-        spec.check(params)
+        try:
+            spec.check(params)
+        except (ArithmeticError, ValueError) as exc:   # a cross-key check overflowing on extreme values
+            if isinstance(exc, DeckError):
+                raise
+            given = ", ".join(sorted(given)) or "none"
+            raise DeckError(path, raw.line, None, f"the values of &{spec.name} are out of the range its checks "
+                            f"can compute ({exc}); look for extreme values among: {given}") from None
     return params
 
 
