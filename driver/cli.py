@@ -147,7 +147,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("-j", "--jobs", type=int, default=None,
                         help="sweeps and optimisations: worker processes (default: all cores)")
     parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
-                        help="sweeps: run cases on this Dask distributed scheduler")
+                        help="sweeps and optimisations: run cases on this Dask distributed scheduler")
     parser.add_argument("--resume", action="store_true",
                         help="sweeps: skip cases whose outputs are already complete; optimisations: replay the run's journal and compute only new designs")
     parser.add_argument("--max-memory", metavar="SIZE", default=None,
