@@ -444,6 +444,7 @@ contains
     m = min(maxscan, max(2, ceiling((hie - lo)/scan_step) + 1))
     h = (hie - lo)/(m - 1)
     ! the whole scan in one (vectorised) kernel call
+    ! hot-loop: fourbar_summary scan angles
     do k = 1, m
       th(k) = (lo + (k - 1)*h)*rad
     end do
