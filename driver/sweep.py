@@ -740,7 +740,10 @@ def _run_batch(deck: Deck, sw: Params, base_params: Params, bplan, axes, outdir:
             for name in [sw.plot_x, *sw.plot_y]:   # a plotted expression becomes a column
                 if name and name not in shown.columns:
                     shown[name] = expr.parse(name).evaluate(shown)
-            save_figure(sweep_summary(shown, names, sw.plot_x, sw.plot_y, stem), outdir / f"{stem}_summary.png")
+            module = load_study(base_params.group)
+            labels = {c: column_label(module, c) for c in shown.columns}
+            save_figure(sweep_summary(shown, names, sw.plot_x, sw.plot_y, stem, labels,
+                                      getattr(module, "SWEEP_PLOT", ())), outdir / f"{stem}_summary.png", plot)
     for index, values, error in failed[:20]:
         vals = ", ".join(f"{k} = {v!r}" for k, v in values.items())
         print(f"error: {deck.path}: case {index} ({vals}): {error}", file=sys.stderr)
