@@ -21,7 +21,7 @@ from driver import limits
 from driver.deck import DeckError, read_deck
 from driver.export import FORMATS
 from driver.runner import CONTROL_GROUPS, available_studies, run_study
-from driver.study import load_study
+from driver.study import PLOT_FORMATS, load_study
 
 __all__ = ["main", "run_deck", "EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT"]
 
@@ -42,7 +42,7 @@ def _fs_error(exc: OSError) -> str:
     return f"cannot write {where}: {reason}"
 
 
-def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool, progress: bool,
+def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool | str, progress: bool,
              quiet: bool = False, sweep_options: dict | None = None, summary_json: bool = False) -> int:
     """Run one deck; returns its exit status. Errors are printed, never raised.
 
@@ -135,7 +135,10 @@ def build_parser() -> argparse.ArgumentParser:
                         help="also write the tidy table in this format (repeatable)")
     parser.add_argument("--json", action="store_true",
                         help="also write the run's summary (headline figures, warnings) as <stem>.json")
-    parser.add_argument("--plot", action="store_true", help="write PNG figures <stem>_<name>.png")
+    parser.add_argument("--plot", action="store_true", help="write figures <stem>_<name>.png (see --plot-format)")
+    parser.add_argument("--plot-format", choices=PLOT_FORMATS, default=None,
+                        help="figure file format (implies --plot; default png); the same inputs give "
+                             "byte-identical files")
     parser.add_argument("-q", "--quiet", action="store_true", help="print only warnings and errors")
     parser.add_argument("--keys", metavar="GROUP", help="list the keys of a namelist group and exit")
     parser.add_argument("--compare", action="store_true",
@@ -144,7 +147,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("-j", "--jobs", type=int, default=None,
                         help="sweeps and optimisations: worker processes (default: all cores)")
     parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
-                        help="sweeps: run cases on this Dask distributed scheduler")
+                        help="sweeps and optimisations: run cases on this Dask distributed scheduler")
     parser.add_argument("--resume", action="store_true",
                         help="sweeps: skip cases whose outputs are already complete; optimisations: replay the run's journal and compute only new designs")
     parser.add_argument("--max-memory", metavar="SIZE", default=None,
@@ -181,13 +184,14 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(str(exc))
     formats = list(dict.fromkeys((["csv"] if args.csv else []) + args.formats))
     progress = sys.stderr.isatty() and not args.quiet and not os.environ.get("CI")
+    plot: bool | str = args.plot_format or args.plot
     sweep_options = {"jobs": args.jobs, "scheduler": args.scheduler, "resume": args.resume}
     status = EXIT_OK
     handlers = _install_signals()
     try:
         for deck in args.decks:
             try:
-                status = max(status, run_deck(deck, args.outdir, formats, args.plot, progress, args.quiet,
+                status = max(status, run_deck(deck, args.outdir, formats, plot, progress, args.quiet,
                                              sweep_options, summary_json=args.json))
                 sys.stdout.flush()
             except BrokenPipeError:   # stdout closed early (e.g. piped into head): the files are

@@ -62,6 +62,19 @@ def _check(p: Params) -> None:
             raise p.error("branch", "the listing computes one assembly only; branch applies to method='exact'")
 
 
+#: axis labels of summary columns and deck keys (driver.study.column_label): name -> (words, units)
+LABELS = {"crank": ("crank length", "length units"), "coupler": ("coupler length", "length units"),
+          "rocker": ("rocker length", "length units"),
+          "fixed_link": ("ground link length", "length units"), "omega": ("crank speed", ""),
+          "mu_min_deg": ("minimum transmission angle", "deg"), "mu_max_deg": ("maximum transmission angle", "deg"),
+          "rocker_swing_deg": ("rocker swing", "deg"), "omega3_peak_rad_s": ("peak rocker speed", "rad/s"),
+          "omega2_peak_rad_s": ("peak coupler speed", "rad/s"),
+          "assembled_fraction": ("fraction of the turn assembled", "-")}
+#: what a sweep summary plots when its deck names no plot_y
+SWEEP_PLOT = ("mu_min_deg", "mu_max_deg", "rocker_swing_deg", "omega3_peak_rad_s", "omega2_peak_rad_s",
+              "assembled_fraction")
+
+
 SPEC = GroupSpec(
     name="fourbar",
     doc="planar four-bar linkage driven by its crank at constant speed",

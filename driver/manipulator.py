@@ -98,6 +98,20 @@ def _cross_check(p: Params) -> None:
         raise p.error("sweep_count", f"must not be negative (got {p.sweep_count}); 0 = up to the C_rob radius")
 
 
+#: axis labels of summary columns and deck keys (driver.study.column_label): name -> (words, units)
+LABELS = {"r_m": ("inner workspace radius r", "m"), "R_m": ("outer workspace radius R", "m"),
+          "mean_d2_m2": ("mean squared point distance", "m^2"), "crob_radius_m": ("C_rob radius", "m"),
+          "crob_c_m2": ("C_rob l1^2 + l2^2", "m^2"), "ri2_min": ("minimum RI2", "-"),
+          "dexterity_l1_m": ("dexterity optimum l1", "m"), "dexterity_l2_m": ("dexterity optimum l2", "m"),
+          "manipulability_l1_m": ("manipulability optimum l1", "m"),
+          "manipulability_l2_m": ("manipulability optimum l2", "m"),
+          "sweep_min_total_torque_Nm": ("least tau1 + tau2 along C_rob", "N m"),
+          "sweep_min_l1_m": ("l1 of the least torque", "m"), "sweep_min_l2_m": ("l2 of the least torque", "m"),
+          "mass_per_length": ("link mass per length", "kg/m"), "gravity": ("gravity", "m/s^2")}
+#: what a sweep summary plots when its deck names no plot_y
+SWEEP_PLOT = ("crob_radius_m", "sweep_min_total_torque_Nm", "sweep_min_l1_m", "dexterity_l1_m", "manipulability_l1_m")
+
+
 SPEC = GroupSpec(
     name="manipulator",
     doc="2R manipulator robust design: C_rob, RI2, dexterity/manipulability optima, torques, tolerances",
@@ -805,7 +819,7 @@ def run(params: Params, progress: bool = False) -> Result:
         lines += ["Warnings", "--------"] + [f"  {w}" for w in warnings] + [""]
     tidy = _tidy(tables, tol, sweep, used)
     figures = [Figure("design_space", lambda: _fig_design(p, ws, conv, used)),
-               Figure("torque_crob", lambda: _fig_torque(sweep, conv))]
+               Figure("torque_crob", lambda: _fig_torque(sweep, conv, p.title or p.path.stem))]
     return Result(text="\n".join(lines).rstrip() + "\n", tidy=tidy, summary=_summary(p, ws, conv, used, sweep, tol),
                   warnings=warnings, figures=figures)
 
@@ -883,7 +897,8 @@ def _fig_design(p: Params, ws: Workspace, conv: Conv, used: dict):
                                     title=p.title or p.path.stem)
 
 
-def _fig_torque(sweep: dict, conv: Conv):
+def _fig_torque(sweep: dict, conv: Conv, title: str = ""):
     from driver.plotting import manipulator_torque_crob
     return manipulator_torque_crob(sweep["l1"], np.where(sweep["ok"], sweep["tau"][:, 0], np.nan),
-                                   np.where(sweep["ok"], sweep["tau"][:, 1], np.nan), conv.c_sweep)
+                                   np.where(sweep["ok"], sweep["tau"][:, 1], np.nan), conv.c_sweep,
+                                   violates=sweep["ok"] & ~sweep["reach_all"], title=title)

@@ -3,7 +3,7 @@
 Shared helpers first; then one section per study with its figure builders.
 Every builder returns a :class:`matplotlib.figure.Figure` drawn inside
 :func:`style` (an ``rc_context``), and :func:`save_figure` writes it atomically
-as PNG.  Nothing here selects a backend or changes the global ``rcParams``:
+as PNG, SVG or PDF, byte for byte the same for the same inputs.  Nothing here selects a backend or changes the global ``rcParams``:
 importing this module or drawing a figure leaves a user's own matplotlib
 settings (e.g. Jupyter's inline backend) exactly as they were.  Studies wrap
 builders in :class:`driver.study.Figure` so nothing is drawn unless asked.
@@ -12,14 +12,18 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import math
+import textwrap
 from pathlib import Path
 from typing import Any, Callable, Iterator, Sequence, TypeVar
 
 import matplotlib
+import matplotlib.ticker
 import numpy as np
 from matplotlib.figure import Figure
 
 from driver.atomic import atomic_open
+from driver.study import PLOT_FORMATS, plot_format
 
 __all__ = ["STYLE", "style", "styled", "new_figure", "save_figure", "line_panels"]
 
@@ -53,11 +57,30 @@ def new_figure(nrows: int = 1, ncols: int = 1, **kw) -> tuple[Figure, np.ndarray
     return fig, axes.ravel()
 
 
-def save_figure(fig: Figure, path: str | Path) -> Path:
-    """Write ``fig`` as PNG to ``path`` atomically (in the house style's resolution)."""
+#: metadata written into every figure file: no dates, no software versions, so the same
+#: inputs give byte-identical files (PNG, SVG and PDF alike)
+_METADATA = {"png": {"Software": None},
+             "svg": {"Date": None, "Creator": None},
+             "pdf": {"Creator": None, "Producer": None, "CreationDate": None}}
+#: fixed seed for the ids matplotlib writes into SVG files (otherwise random per run)
+_SVG_SALT = "driver-figures"
+
+
+def save_figure(fig: Figure, path: str | Path, fmt: bool | str | None = None) -> Path:
+    """Write ``fig`` to ``path`` atomically and reproducibly (no dates or versions inside), in the
+    house style's resolution.
+
+    ``fmt`` is a format of :data:`driver.study.PLOT_FORMATS` (``True`` or None: PNG, or the
+    format of ``path``'s suffix when that is one); ``path``'s suffix is replaced by it.
+    Returns the path written.
+    """
     path = Path(path)
-    with style(), atomic_open(path, "wb") as fh:
-        fig.savefig(fh, format="png")
+    if fmt is None or fmt is True:
+        fmt = path.suffix.lstrip(".").lower() if path.suffix.lstrip(".").lower() in PLOT_FORMATS else "png"
+    fmt = plot_format(fmt)
+    path = path.with_suffix(f".{fmt}")
+    with style(**{"svg.hashsalt": _SVG_SALT}), atomic_open(path, "wb") as fh:
+        fig.savefig(fh, format=fmt, metadata=_METADATA[fmt])
     return path
 
 
@@ -80,28 +103,67 @@ def line_panels(x: np.ndarray, panels: Sequence[tuple[str, dict[str, np.ndarray]
 
 # ----------------------------------------------------------------------------- fourbar
 
+def break_wraps(x: np.ndarray, y: np.ndarray, period: float = 360.0) -> tuple[np.ndarray, np.ndarray]:
+    """``x``, ``y`` with a NaN inserted wherever ``y`` (an angle wrapped into one period) jumps
+    by more than half a period between neighbours, so the drawn line breaks at the wrap
+    instead of running vertically across the panel."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    jumps = np.flatnonzero(np.abs(np.diff(y)) > 0.5 * period) + 1
+    return np.insert(x, jumps, np.nan), np.insert(y, jumps, np.nan)
+
+
+def _unassembled_spans(theta: np.ndarray, ok: np.ndarray) -> list[tuple[float, float]]:
+    """Crank-angle intervals [deg] where ``ok`` is False (the linkage cannot be assembled)."""
+    spans, start = [], None
+    for t, good in zip(theta, ok):
+        if not good and start is None:
+            start = t
+        elif good and start is not None:
+            spans.append((start, t))
+            start = None
+    if start is not None:
+        spans.append((start, theta[-1]))
+    return spans
+
+
+#: legend words of the four-bar curves
+_FOURBAR_NAMES = {"coupler_deg": "coupler angle", "rocker_deg": "rocker angle", "transmission_deg": "transmission angle",
+                  "omega2_rad_s": "coupler speed omega2", "omega3_rad_s": "rocker speed omega3"}
+
+
 @styled
 def fourbar_curves(exact, listing, title: str) -> Figure:
     """Angles, angular velocities and transmission angle against crank angle.
 
     ``exact`` and ``listing`` are tidy frames from driver.fourbar; listing rows are
-    drawn as markers over the exact curves so the listing's defect is visible.
+    drawn as markers over the exact curves so the listing's defect is visible.  Angles
+    wrapped into 0-360 deg break at the wrap (no vertical line); crank angles where the
+    linkage cannot be assembled are shaded and said so.
     """
-    panels = [("coupler, rocker [deg]", ["coupler_deg", "rocker_deg"]),
-              ("transmission [deg]", ["transmission_deg"]),
+    panels = [("link angle [deg]", ["coupler_deg", "rocker_deg"]),
+              ("transmission angle [deg]", ["transmission_deg"]),
               ("angular velocity [rad/s]", ["omega2_rad_s", "omega3_rad_s"])]
-    fig, axes = new_figure(3, 1, sharex=True, figsize=(7.0, 7.4))
+    fig, axes = new_figure(3, 1, sharex=True, figsize=(7.0, 7.6))
     colors = {"coupler_deg": "C0", "rocker_deg": "C1", "transmission_deg": "C2",
               "omega2_rad_s": "C0", "omega3_rad_s": "C1"}
+    theta = exact["theta_deg"].to_numpy(dtype=float)
+    spans = _unassembled_spans(theta, np.isfinite(exact["transmission_deg"].to_numpy(dtype=float)))
     for ax, (label, keys) in zip(axes, panels):
+        for j, (lo, hi) in enumerate(spans):
+            ax.axvspan(lo, hi, color="0.85", alpha=0.6, lw=0, label="cannot be assembled" if j == 0 else None)
         for k in keys:
-            ax.plot(exact["theta_deg"], exact[k], color=colors[k], label=f"{k.split('_')[0]} (exact)")
+            wrap = k.endswith("_deg")
+            ax.plot(*(break_wraps(theta, exact[k]) if wrap else (theta, exact[k])), color=colors[k],
+                    label=f"{_FOURBAR_NAMES[k]} (exact)")
             if listing is not None:
                 ax.plot(listing["theta_deg"], listing[k], "o", ms=4, mfc="none", color=colors[k],
-                        label=f"{k.split('_')[0]} (listing)")
+                        label=f"{_FOURBAR_NAMES[k]} (listing)")
         ax.set_ylabel(label)
-        ax.legend(fontsize=7, ncol=2)
-    axes[1].axhspan(40, 120, color="C2", alpha=0.08, label="40-120 deg")
+    axes[0].set_ylim(-5, 365)
+    axes[0].set_yticks(np.arange(0, 361, 90))
+    axes[1].axhspan(40, 120, color="C2", alpha=0.08, label="40-120 deg band")
+    for ax in axes:
+        ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
     axes[-1].set_xlabel("crank angle [deg]")
     fig.suptitle(f"{title}: four-bar kinematics")
     return fig
@@ -109,10 +171,13 @@ def fourbar_curves(exact, listing, title: str) -> Figure:
 
 @styled
 def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.ndarray,
-                    listing, title: str, n_poses: int = 6, point: np.ndarray | None = None) -> Figure:
+                    listing, title: str, n_poses: int = 6, point: np.ndarray | None = None,
+                    units: str = "length units") -> Figure:
     """The linkage drawn at a few crank angles with the paths of A and B (exact), and the
-    path of a coupler point (``point``: (n, 2) positions) when the deck defines one."""
-    fig, (ax,) = new_figure(1, 1, figsize=(7.0, 5.0))
+    path of a coupler point (``point``: (n, 2) positions) when the deck defines one.
+    Coordinates are in the deck's length ``units``, the crank pivot at the origin and the
+    ground link along +x; the legend sits beside the drawing, never on it."""
+    fig, (ax,) = new_figure(1, 1, figsize=(8.2, 5.0))
     ax.plot(out[:, 3], out[:, 4], color="0.6", lw=0.8, label="path of A")
     bx = np.where(ok, out[:, 5], np.nan)
     by = np.where(ok, out[:, 6], np.nan)
@@ -123,20 +188,45 @@ def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.nd
     if listing is not None:
         ax.plot(listing["xb"], listing["yb"], "x", color="k", ms=5, label="B (listing)")
     idx = np.flatnonzero(ok)
+    cmap = matplotlib.colormaps["viridis"]
     for j, k in enumerate(idx[np.linspace(0, len(idx) - 1, n_poses, endpoint=False).astype(int)] if len(idx) else []):
         xs = [0.0, out[k, 3], out[k, 5], ground]
         ys = [0.0, out[k, 4], out[k, 6], 0.0]
-        ax.plot(xs, ys, "-o", color=matplotlib.colormaps["viridis"](j / max(1, n_poses - 1)), ms=3, lw=1.4,
+        ax.plot(xs, ys, "-o", color=cmap(j / max(1, n_poses - 1)), ms=3, lw=1.4,
                 label=f"theta = {theta[k]:.0f} deg")
     ax.plot([0.0, ground], [0.0, 0.0], color="k", lw=2.5)
-    ax.plot([0.0, ground], [0.0, 0.0], "^", color="k", ms=9)
+    ax.plot([0.0, ground], [0.0, 0.0], "^", color="k", ms=9, label="ground pivots")
     ax.set_aspect("equal")
-    ax.legend(fontsize=7, loc="best")
+    ax.set_xlabel(f"x [{units}]")
+    ax.set_ylabel(f"y [{units}]")
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
     ax.set_title(f"{title}: linkage positions")
     return fig
 
 
 # ----------------------------------------------------------------------------- manipulator
+
+def _ellipse_levels(levels: Sequence[float], n: int) -> list[float]:
+    """The RI2 values whose ellipses the design-space figure draws: the deck's (its Table 4.1
+    rows) and, as RI2 = sqrt(n) is the C_rob circle itself, three more so the family shows."""
+    lo, hi = math.sqrt(n), math.sqrt(2 * n)
+    extra = [lo + f * (hi - lo) for f in (0.05, 0.2, 0.5)]
+    return sorted({round(float(v), 12) for v in [*levels, *extra] if 0.0 < v < hi})
+
+
+def ri2_ellipses(ri2: float, n: int, c: float, samples: int = 721) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The two iso-RI2 ellipses (the report's eqs 4.14-4.17) as (l1, l2) [m] point arrays, cut to
+    l1, l2 >= 0: in the 45-deg frame L1 = (l1 + l2)/sqrt2, L2 = (l1 - l2)/sqrt2 they are
+    RI2^2 L1^2 + (2n - RI2^2) L2^2 = c and the same with the coefficients swapped (c = sum d^2 [m^2])."""
+    phi = np.linspace(0.0, 2.0 * np.pi, samples)
+    out = []
+    for ca, cb in ((ri2 * ri2, 2 * n - ri2 * ri2), (2 * n - ri2 * ri2, ri2 * ri2)):
+        P, Q = math.sqrt(c / ca) * np.cos(phi), math.sqrt(c / cb) * np.sin(phi)
+        x, y = (P + Q) / math.sqrt(2.0), (P - Q) / math.sqrt(2.0)
+        keep = (x >= -1e-9) & (y >= -1e-9)
+        out.append((np.where(keep, x, np.nan), np.where(keep, y, np.nan)))
+    return out
+
 
 @styled
 def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, L2: np.ndarray,
@@ -161,14 +251,10 @@ def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, 
             ax.plot(g, g - r, "b-", lw=0.8, label="|l1 - l2| = r")
             ax.plot(g, g + r, "b-", lw=0.8)
             ax.plot(g, R - g, "g-", lw=0.8, label="l1 + l2 = R")
-            for v in levels:  # ellipses in the 45-deg frame; both branches
-                for ca, cb in ((v * v, 2 * n - v * v), (2 * n - v * v, v * v)):
-                    phi = np.linspace(0, 2 * np.pi, 400)
-                    A, B = np.sqrt(sum_d2 / ca), np.sqrt(sum_d2 / cb)
-                    P, Q = A * np.cos(phi), B * np.sin(phi)
-                    keep = np.abs(P) >= np.abs(Q)
-                    x, y = (P + Q) / np.sqrt(2), (P - Q) / np.sqrt(2)
-                    ax.plot(np.where(keep, x, np.nan), np.where(keep, y, np.nan), ":", lw=0.8, color="gray")
+            for j, v in enumerate(_ellipse_levels(levels, n)):
+                for k2, (x, y) in enumerate(ri2_ellipses(v, n, sum_d2)):
+                    ax.plot(x, y, ":", lw=1.0, color=matplotlib.colormaps["viridis"](j / 4), gid=f"iso-RI2 ellipse {v!r}",
+                            label=f"iso-RI2 ellipse, RI2 = {v:.3g}" if k2 == 0 else None)
         else:
             cs = ax.contour(L1, L2, ri2, levels=np.sqrt(n) + np.array([0.001, 0.01, 0.05, 0.1, 0.2, 0.4, 0.8]),
                             linewidths=0.7, cmap="viridis")
@@ -188,95 +274,166 @@ def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, 
         ax.set_ylabel("l2 [m]")
     axes[0].set_title("reach region, C_rob, iso-RI2 ellipses")
     axes[1].set_title("RI2 over the design plane")
-    axes[0].legend(fontsize=7, loc="upper right")
+    fig.legend(*axes[0].get_legend_handles_labels(), fontsize=7, loc="outside lower center", ncol=4, frameon=False)
     if title:
         fig.suptitle(title)
     return fig
 
 
 @styled
-def manipulator_torque_crob(l1: np.ndarray, tau1: np.ndarray, tau2: np.ndarray, c: float) -> Figure:
-    """Motor torques tau1, tau2 and their sum [N m] against l1 [m] along C_rob (Table 4.8)."""
-    return line_panels(l1, [("torque [N m]", {"tau1": tau1, "tau2": tau2, "tau1 + tau2": tau1 + tau2})],
-                       xlabel="l1 [m] (l2 = sqrt(%g - l1^2))" % c, title="Motor torques along C_rob")
+def manipulator_torque_crob(l1: np.ndarray, tau1: np.ndarray, tau2: np.ndarray, c: float,
+                            violates: np.ndarray | None = None, title: str = "") -> Figure:
+    """Motor torques tau1, tau2 and their sum [N m] against l1 [m] along C_rob (Table 4.8).
+
+    Rows where the target is out of reach are gaps; ``violates`` marks the rows (a boolean
+    per row) whose design does not reach the whole workspace (the reach conditions
+    |l1 - l2| <= r, l1 + l2 >= R fail): their points are crossed and named in the legend."""
+    fig, (ax,) = new_figure(1, 1, figsize=(7.4, 3.8))
+    total = tau1 + tau2
+    for label, y in (("tau1", tau1), ("tau2", tau2), ("tau1 + tau2", total)):
+        ax.plot(l1, y, "-o", ms=2.5, lw=1.2, label=label)
+    if violates is not None and np.any(violates):
+        bad = np.asarray(violates, dtype=bool)
+        for k, y in enumerate((tau1, tau2, total)):
+            ax.plot(l1[bad], y[bad], "x", color="C3", ms=7, mew=1.5,
+                    label="violates the workspace reach conditions" if k == 0 else None)
+    ax.set_ylabel("motor torque [N m]")
+    ax.set_xlabel("l1 [m]  (l2 = sqrt(%g - l1^2) [m])" % c)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    fig.suptitle(f"{title}: motor torques along C_rob" if title else "Motor torques along C_rob")
+    return fig
 
 
 # ----------------------------------------------------------------------------- sweep
 
-@styled
-def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (), title: str = "") -> Figure:
-    """Summary of a sweep: chosen (or all numeric) headline figures against a swept key.
+def _trivial(y, x, chosen) -> bool:
+    """A panel that shows nothing: a constant column, the x column again, or a column already shown."""
+    import pandas as pd
+    v = pd.to_numeric(y, errors="coerce").to_numpy(dtype=float)
+    fin = v[np.isfinite(v)]
+    if fin.size == 0 or np.ptp(fin) <= 1e-12 * max(1.0, float(np.max(np.abs(fin)))):
+        return True
+    for other in [x, *chosen]:
+        w = pd.to_numeric(other, errors="coerce").to_numpy(dtype=float)
+        if w.shape == v.shape and np.array_equal(np.isfinite(w), np.isfinite(v)) and \
+                np.allclose(w[np.isfinite(w)], fin, rtol=1e-12, atol=0.0):
+            return True
+    return False
 
-    With one numeric x the figures are drawn as lines over the cases; a boolean
-    ``kept`` column, when some cases are not kept, is shown as filled vs hollow markers.
+
+@styled
+def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (), title: str = "",
+                  labels: dict[str, str] | None = None, preferred: Sequence[str] = ()) -> Figure:
+    """Summary of a sweep: chosen (or the study's headline) figures against a swept key.
+
+    ``labels`` maps column names to axis labels with units (driver.study.column_label);
+    ``preferred`` are the study's headline columns, plotted when ``ys`` is empty.  Panels
+    chosen automatically never repeat x, a constant or another panel.  With one numeric x
+    the figures are drawn as lines over the cases, one line per value of the other keys;
+    when some cases are not kept, kept cases are circled.
     """
     import pandas as pd
+    labels = labels or {}
+    label = lambda c: textwrap.fill(labels.get(c, c), 28)  # noqa: E731  (two lines fit a panel)
     x = x or next((k for k in keys if pd.api.types.is_numeric_dtype(frame[k])), "case")
-    numeric = [c for c in frame.columns if c not in (x, "case") and pd.api.types.is_numeric_dtype(frame[c])
-               and not pd.api.types.is_bool_dtype(frame[c]) and c not in keys]
-    ys = list(ys) or numeric[:6]
-    fig, axes = new_figure(len(ys), 1, sharex=True, figsize=(7.0, 1.9 * len(ys) + 0.8))
+    if ys:
+        ys = list(ys)
+    else:
+        numeric = [c for c in frame.columns if c not in (x, "case") and pd.api.types.is_numeric_dtype(frame[c])
+                   and not pd.api.types.is_bool_dtype(frame[c]) and c not in keys]
+        ordered = [c for c in preferred if c in numeric] + [c for c in numeric if c not in preferred]
+        ys = []
+        for c in ordered:
+            if len(ys) < 6 and not _trivial(frame[c], frame[x], [frame[k] for k in ys]):
+                ys.append(c)
+        ys = ys or ordered[:1]
+    fig, axes = new_figure(len(ys), 1, sharex=True, figsize=(7.0, 1.9 * len(ys) + 0.9))
     kept = frame["kept"].astype(bool) if "kept" in frame else pd.Series(True, index=frame.index)
     others = [k for k in keys if k != x]
-    many = len(frame) > 2000 or (others and frame.groupby(others).ngroups > 12)
+    many = len(frame) > 2000 or bool(others and frame.groupby(others).ngroups > 12)
     groups = [("", frame)] if (many or not others) else frame.groupby(others, sort=False)
     if many:
         others = []
     for ax, y in zip(axes, ys):
         if many:   # a design-space search: every case as a dot, kept cases circled
-            ax.plot(frame[x], frame[y], ".", ms=1, color="0.6", alpha=0.3, rasterized=True)
+            ax.plot(frame[x], frame[y], ".", ms=1, color="0.6", alpha=0.3, rasterized=True, label="all cases")
             if not kept.all():
                 ax.plot(frame.loc[kept, x], frame.loc[kept, y], "o", ms=3, mfc="none", color="C3", label="kept")
-            ax.set_ylabel(y, fontsize=7)
+            ax.set_ylabel(label(y))
             continue
-        for label, g in groups:
+        for key, g in groups:
             g = g.sort_values(x)
             style = "-" if len(frame) <= 2000 else ""
             ax.plot(g[x], g[y], style, marker="o" if len(frame) <= 200 else ".", ms=3, lw=1,
-                    label=", ".join(f"{k}={v}" for k, v in zip(others, label if isinstance(label, tuple) else (label,))) or None)
+                    label=", ".join(f"{labels.get(k, k).split(' [')[0]} = {v}"
+                                    for k, v in zip(others, key if isinstance(key, tuple) else (key,))) or None)
         if not kept.all():
             ax.plot(frame.loc[kept, x], frame.loc[kept, y], "o", ms=4, mfc="none", color="k", label="kept")
-        ax.set_ylabel(y, fontsize=7)
+        ax.set_ylabel(label(y))
     if others or not kept.all():
-        axes[0].legend(fontsize=6, ncol=2)
-    axes[-1].set_xlabel(x)
+        axes[0].legend(fontsize=7, ncol=min(3, max(1, len(frame.groupby(others)) if others else 1)),
+                       loc="lower left", bbox_to_anchor=(0.0, 1.02), frameon=False)
+    axes[-1].set_xlabel(label(x))
     fig.suptitle(f"{title}: sweep summary" if title else "sweep summary")
     return fig
 
 
 # ---- ujoint
 
+#: line styles of the Hooke-joint designs, by the label driver.ujoint gives them
+_UJOINT_STYLES = {"trial": dict(color="C1", lw=1.4), "design": dict(color="C1", lw=1.4),
+                  "optimum": dict(color="C0", lw=2.0), "last iterate": dict(color="C3", lw=1.6, ls="-."),
+                  "paper printed": dict(color="C2", lw=1.2, ls=":")}
+
+
 @styled
 def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.ndarray],
-                        polar: bool = False) -> Figure:
-    """Input and output shaft speed [rpm] against the input angle [deg], one panel per design
-    (the paper's Figures 6-11: trial and optimum), cartesian or polar."""
-    n = len(curves)
+                        polar: bool = False, band: Sequence[float] | None = None, title: str = "") -> Figure:
+    """Input and output shaft speed [rpm] against the input angle [deg], every design (trial,
+    optimum, the paper's printed optimum) overlaid on one panel as in the paper's Figures 6-11,
+    with the paper's trial band ``band`` = (min, max) [rpm] shaded when given.
+
+    Cartesian or polar (angle = input angle, radius = speed); the polar radius starts near
+    the slowest speed, not at 0, so a fluctuation of a fraction of an rpm stays visible (the
+    empty centre says the radius does not start at 0)."""
     if polar:
-        fig = Figure(figsize=(3.6 * n, 3.8), layout="constrained")
-        axes = [fig.add_subplot(1, n, k + 1, projection="polar") for k in range(n)]
+        fig = Figure(figsize=(7.4, 5.2), layout="constrained")
+        ax = fig.add_subplot(1, 1, 1, projection="polar")
     else:
-        fig, axes = new_figure(n, 1, sharex=True, figsize=(7.0, 2.3 * n + 0.6))
-    top = max(float(np.max(w)) for w in curves.values())
-    low = min(float(np.min(w)) for w in curves.values())
-    for ax, (label, w) in zip(axes, curves.items()):
-        x = np.radians(theta_deg) if polar else theta_deg
-        ax.plot(x, np.full_like(theta_deg, rpm), "k--", lw=1.0, label="input shaft")
-        ax.plot(x, w, lw=1.5, label="output shaft")
-        ax.set_title(f"{label}: output {w.min():.2f}-{w.max():.2f} rpm", fontsize=9, pad=14 if polar else 4)
+        fig, (ax,) = new_figure(1, 1, figsize=(7.4, 4.0))
+    x = np.radians(theta_deg) if polar else theta_deg
+    values = [rpm, *(float(v) for w in curves.values() for v in (np.min(w), np.max(w)))] + list(band or [])
+    low, top = min(values), max(values)
+    pad = 0.08 * max(top - low, 1e-3 * rpm)
+    if band is not None:
+        lo, hi = band
+        text = f"paper's trial band {lo:g}-{hi:g} rpm (read off its plot)"
         if polar:
-            ax.set_ylim(0.0, 1.05 * top)
+            ax.fill_between(x, lo, hi, color="0.5", alpha=0.15, lw=0, label=text)
         else:
-            pad = 0.05 * max(top - low, 1e-3 * rpm)
-            ax.set_ylim(low - pad, top + pad)
-            ax.set_ylabel("speed [rpm]")
-            ax.legend(fontsize=7, loc="upper right")
-    if not polar:
-        axes[-1].set_xlabel("input angle [deg]")
-        axes[-1].set_xlim(0.0, 360.0)
+            ax.axhspan(lo, hi, color="0.5", alpha=0.15, lw=0, label=text)
+    ax.plot(x, np.full_like(theta_deg, rpm, dtype=float), "k--", lw=0.9, label=f"input shaft {rpm:g} rpm")
+    for k, (label, w) in enumerate(curves.items()):
+        style = _UJOINT_STYLES.get(label, dict(color=f"C{k + 4}", lw=1.4))
+        ax.plot(x, w, label=f"{label}: output {np.min(w):.2f}-{np.max(w):.2f} rpm", **style)
+    if polar:
+        ax.set_rlim(low - pad, top + pad)
+        ax.set_rorigin(low - pad - 0.6 * (top - low + 2 * pad))
+        ax.set_rlabel_position(100.0)
+        ax.yaxis.set_major_locator(matplotlib.ticker.MaxNLocator(4))
+        ax.yaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g} rpm"))
+        ax.tick_params(axis="y", labelsize=7)
+        ax.set_xlabel("input angle [deg]; radius: shaft speed [rpm], not starting at 0", fontsize=8)
+        fig.legend(loc="outside lower center", fontsize=7, ncol=2, frameon=False)
     else:
-        axes[0].legend(fontsize=7, loc="lower left", bbox_to_anchor=(-0.1, -0.15))
-    fig.suptitle("Hooke-joint chain: input and output shaft speed")
+        ax.set_ylim(low - pad, top + pad)
+        ax.set_ylabel("shaft speed [rpm]")
+        ax.set_xlabel("input angle [deg]")
+        ax.set_xlim(0.0, 360.0)
+        ax.set_xticks(np.arange(0, 361, 45))
+        fig.legend(loc="outside lower center", fontsize=7, ncol=2, frameon=False)
+    fig.suptitle(f"{title}: Hooke-joint chain, input and output shaft speed" if title
+                 else "Hooke-joint chain: input and output shaft speed")
     return fig
 
 
@@ -285,18 +442,32 @@ def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.
 
 @styled
 def slidercrank_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray]], title: str,
-                              ylabel: str = "axial strain [microstrain]") -> Figure:
-    """A quantity against crank angle [deg], one line per case (label, angle, value): Figure 10."""
-    fig, axes = new_figure(1, 1, figsize=(7.0, 3.6))
+                              ylabel: str = "axial strain [microstrain]", above: dict[str, float] | None = None,
+                              missing: Sequence[str] = ()) -> Figure:
+    """A quantity against crank angle [deg], one line per case (label, angle, value): Figure 10.
+
+    ``above`` maps the labels of cases whose rod compression exceeds the Euler load to that
+    ratio N/P_E: their curves are dashed and flagged in the legend (a linear model draws
+    them although the rod would buckle).  ``missing`` are one-line texts of cases not drawn (e.g. a speed that
+    buckled): they are listed in the legend, so no speed silently disappears.
+    """
+    from matplotlib.lines import Line2D
+    above = above or {}
+    fig, axes = new_figure(1, 1, figsize=(7.4, 4.4))
     ax = axes[0]
     for label, x, y in series:
-        ax.plot(x, y, label=label, lw=1.2)
+        flagged = label in above
+        ax.plot(x, y, label=f"{label}: N = {above[label]:.2f} P_E, above the Euler load" if flagged else label,
+                lw=1.2, ls="--" if flagged else "-")
+    for text in missing:
+        ax.add_line(Line2D([], [], ls="none", marker="x", color="C3", label=text))
     ax.axhline(0.0, color="k", lw=0.6)
     ax.set_xlim(0, 360)
     ax.set_xticks(np.arange(0, 361, 45))
     ax.set_xlabel("crank angle theta2 [deg]")
     ax.set_ylabel(ylabel)
-    ax.legend(fontsize=7, loc="best")
+    fig.legend(fontsize=7, loc="outside lower center", ncol=3 if len(series) + len(missing) > 4 else 2,
+               frameon=False, title="crank speed", title_fontsize=7)
     ax.set_title(title)
     return fig
 

@@ -76,10 +76,12 @@ def output_stem(outdir: str | Path, deck_path: str | Path) -> Path:
     return candidate
 
 
-def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool,
+def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool | str,
                   summary_json: bool = False) -> list[Path]:
     """Write the .out file, extra files, tidy tables, the summary as ``<stem>.json`` (when
     ``summary_json``) and figures for one case.
+
+    ``plot`` is False (no figures), True (PNG) or a format of :data:`driver.study.PLOT_FORMATS`.
 
     The files form one set (:func:`driver.atomic.output_set`): all are renamed into place
     together once every one is complete, or none is.  Stale temporaries of this stem left
@@ -98,7 +100,7 @@ def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool,
         if plot and result.figures:
             from driver.plotting import save_figure
             for fig in result.figures:
-                written.append(save_figure(fig.draw(), stem.with_name(f"{stem.name}_{fig.name}.png")))
+                written.append(save_figure(fig.draw(), stem.with_name(f"{stem.name}_{fig.name}.png"), plot))
     # the set replaces an earlier run's: its tidy tables in formats not written now go
     for fmt in FORMATS:
         old = stem.with_name(f"{stem.name}.{fmt}")

@@ -259,6 +259,24 @@ def _cross_check(params: Params) -> None:
                                            "set end_time = 0.1")
 
 
+#: axis labels of summary columns and deck keys (driver.study.column_label): name -> (words, units);
+#: {i} is the number of a crank speed in the deck's list
+LABELS = {"speeds": ("crank speed", "rad/s"), "n_elements": ("rod elements", "-"),
+          "omega_{i}_rad_s": ("crank speed {i}", "rad/s"), "euler_ratio_{i}": ("peak compression / Euler load, speed {i}", "-"),
+          "peak_tensile_{i}_microstrain": ("peak tensile strain, speed {i}", "microstrain"),
+          "peak_tensile_{i}_deg": ("crank angle of peak tension, speed {i}", "deg"),
+          "peak_compressive_{i}_microstrain": ("peak compressive strain, speed {i}", "microstrain"),
+          "peak_compressive_{i}_deg": ("crank angle of peak compression, speed {i}", "deg"),
+          "peak_tensile_microstrain": ("peak tensile strain", "microstrain"),
+          "peak_tensile_deg": ("crank angle of peak tension", "deg"),
+          "peak_compressive_microstrain": ("peak compressive strain", "microstrain"),
+          "peak_compressive_deg": ("crank angle of peak compression", "deg"),
+          "euler_ratio_max": ("peak compression / Euler load", "-"), "n_buckled": ("speeds buckled", "-")}
+#: what a sweep summary plots when its deck names no plot_y
+SWEEP_PLOT = ("peak_tensile_microstrain", "peak_compressive_microstrain", "euler_ratio_max", "peak_tensile_deg",
+              "peak_compressive_deg", "n_buckled")
+
+
 SPEC = GroupSpec("slidercrank", _KEYS,
                  "slider-crank with a rigid crank and an elastic connecting rod (KED finite elements, Newmark)",
                  check=_cross_check)
@@ -677,12 +695,16 @@ def run(params: Params, progress: bool = False) -> Result:
     good = [c for c in cases if c.ok]
     if good and params.end_time <= 0:
         from driver import plotting
+        above = {f"{c.omega:g} rad/s": c.euler_ratio for c in good if c.euler_ratio > 1.0}
+        missing = [f"{c.omega:g} rad/s: {_status_text(c).split(' (')[0].lower()}, not drawn" for c in cases if not c.ok]
+        stiffness = "K + K_G" if params.geometric_stiffness else "linear model"
         figures.append(Figure("strain", lambda: plotting.slidercrank_strain_figure(
             [(f"{c.omega:g} rad/s", c.angle_deg, c.eps_ax[0] * 1e6) for c in good],
-            f"{params.material}: crank-end element axial strain")))
+            f"{params.material}: crank-end element axial strain ({stiffness})", above=above, missing=missing)))
         figures.append(Figure("deflection", lambda: plotting.slidercrank_strain_figure(
             [(f"{c.omega:g} rad/s", c.angle_deg, c.mid * 1e3) for c in good],
-            f"{params.material}: midpoint deflection", ylabel="midpoint deflection [mm]")))
+            f"{params.material}: midpoint deflection ({stiffness})", ylabel="midpoint deflection [mm]",
+            above=above, missing=missing)))
     if conv:
         from driver import plotting
         series = {f"{w:g} rad/s": ([c.n_elements for c in cs if c.ok], [c.peak(+1)[0] * 1e6 for c in cs if c.ok])

@@ -48,7 +48,7 @@ from driver.atomic import output_set, remove_stale_temporaries, write_text
 from driver.deck import Deck, DeckError, GroupSpec, Key, Params, RawGroup, validate
 from driver.export import write_tidy
 from driver.runner import compute, output_stem, study_of, write_outputs
-from driver.study import load_study
+from driver.study import column_label, load_study
 from driver.table import Column, render_table
 
 __all__ = ["SPEC", "Case", "build_cases", "run_sweep_deck", "run_task", "auto_chunk", "MAX_KEYS"]
@@ -646,7 +646,9 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
             for name in [sw.plot_x, *sw.plot_y]:   # a plotted expression becomes a column
                 if name and name not in shown.columns:
                     shown[name] = expr.parse(name).evaluate(shown)
-            save_figure(sweep_summary(shown, names, sw.plot_x, sw.plot_y, stem), outdir / f"{stem}_summary.png")
+            labels = {c: column_label(module, c) for c in shown.columns}
+            save_figure(sweep_summary(shown, names, sw.plot_x, sw.plot_y, stem, labels,
+                                      getattr(module, "SWEEP_PLOT", ())), outdir / f"{stem}_summary.png", plot)
     for r in done:
         for w in r.warnings:
             print(f"warning: {deck.path}: case {r.index}: {w}", file=sys.stderr)

@@ -352,6 +352,19 @@ def cross_check(params: Params) -> None:
         raise params.error("paper_band", f"needs two values (min, max rpm); got {len(params.paper_band)}")
 
 
+#: axis labels of summary columns and deck keys (driver.study.column_label): name -> (words, units);
+#: {i} is the number of a joint in the chain
+LABELS = {"rpm": ("input shaft speed", "rpm"), "objective": ("objective (optimum)", "-"),
+          "objective_trial": ("objective (trial)", "-"), "pp_ratio": ("peak-to-peak speed ratio", "-"),
+          "omega_out_min_rpm": ("minimum output speed", "rpm"), "omega_out_max_rpm": ("maximum output speed", "rpm"),
+          "beta_e_deg": ("equivalent joint angle", "deg"), "beta_res_deg": ("resultant joint angle", "deg"),
+          "peak_accel_rad_s2": ("peak output acceleration", "rad/s^2"), "iterations": ("iterations", "-"),
+          "evaluations": ("objective evaluations", "-"), "beta_{i}_deg": ("joint angle beta{i}", "deg"),
+          "phi_{i}_deg": ("phase angle phi{i}", "deg")}
+#: what a sweep summary plots when its deck names no plot_y
+SWEEP_PLOT = ("omega_out_min_rpm", "omega_out_max_rpm", "pp_ratio", "beta_e_deg", "peak_accel_rad_s2", "objective")
+
+
 SPEC = GroupSpec("ujoint", _KEYS, check=cross_check,
                  doc="Hooke-joint shaft chain: speed fluctuation, exact 3-D kinematics, SSO options 0-3")
 
@@ -473,8 +486,9 @@ def run(params: Params, progress: bool = False) -> Result:
     tidy = _tidy(chain, designs)
     summary = _summary(trial, best, runs, failure)
     extra = {".result.dat": _result_dat(params, chain, designs, best, runs)} if best is not None else {}
-    figures = [Figure("speed", lambda: _figure(chain, designs, polar=False)),
-               Figure("polar", lambda: _figure(chain, designs, polar=True))]
+    title = params.path.stem if getattr(params, "path", None) else ""
+    figures = [Figure("speed", lambda: _figure(chain, designs, False, params.paper_band, title)),
+               Figure("polar", lambda: _figure(chain, designs, True, params.paper_band, title))]
     return Result(text=text, tidy=tidy, summary=summary, warnings=warnings, failure=failure,
                   figures=figures, extra=extra)
 
@@ -750,8 +764,9 @@ def _result_dat(params: Params, chain: Chain, designs: list[Design], best: Desig
     return "\n".join(lines) + "\n"
 
 
-def _figure(chain: Chain, designs: list[Design], polar: bool):
+def _figure(chain: Chain, designs: list[Design], polar: bool, band: list[float] | None = None, title: str = ""):
+    """The speed figure: every design overlaid, the paper's trial band (``paper_band``) shaded."""
     from driver.plotting import ujoint_speed_figure
     theta = np.arange(0.0, 360.0 + 1e-9, 1.0)
     curves = {d.label: _speed(chain, d, theta)[0] for d in designs}
-    return ujoint_speed_figure(theta, chain.rpm, curves, polar=polar)
+    return ujoint_speed_figure(theta, chain.rpm, curves, polar=polar, band=band, title=title)

@@ -223,7 +223,7 @@ def _write(oc: OptimizeOutcome, stem: Path, params, formats: list[str], plot: bo
     if plot:
         from driver.plotting import save_figure
         fig = report.convergence_figure(p, hist, evals, Path(p.deck.path).stem)
-        written.append(save_figure(fig, stem.with_name(stem.name + "_convergence.png")))
+        written.append(save_figure(fig, stem.with_name(stem.name + "_convergence.png"), plot))
     return written
 
 

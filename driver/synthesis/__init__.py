@@ -412,7 +412,7 @@ def synthesise(deck: Deck | str | Path) -> Synthesis:
     return syn
 
 
-def _path_figure(syn: Synthesis, path: Path, title: str) -> Path:
+def _path_figure(syn: Synthesis, path: Path, title: str, fmt: bool | str = True) -> Path:
     """The linkage, its coupler curve and the target points, in the linkage deck's frame."""
     from driver import plotting
     from driver.synthesis import path as pg
@@ -427,8 +427,8 @@ def _path_figure(syn: Synthesis, path: Path, title: str) -> Path:
     tk = pg._to_kernel(pp, syn.design.x)
     ax = fig.axes[0]
     ax.plot(tk[:, 0], tk[:, 1], "s", mfc="none", mec="k", ms=7, label="target points")
-    ax.legend(fontsize=7, loc="best")
-    return plotting.save_figure(fig, path)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)   # beside the drawing
+    return plotting.save_figure(fig, path, fmt)
 
 
 def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool = False,
@@ -456,9 +456,9 @@ def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool,
             fig = plotting.line_panels(fd.x, [("y", {"desired y(x)": fd.y_desired, "generated": fd.y_generated}),
                                               ("structural error", {"error": fd.y_generated - fd.y_desired})],
                                        "x", title=f"{Path(deck.path).stem}: function generation")
-            written.append(plotting.save_figure(fig, stem.with_name(stem.name + "_error.png")))
+            written.append(plotting.save_figure(fig, stem.with_name(stem.name + "_error.png"), plot))
     if plot and syn.params.task == "path" and syn.design is not None:
-        written.append(_path_figure(syn, stem.with_name(stem.name + "_path.png"), Path(deck.path).stem))
+        written.append(_path_figure(syn, stem.with_name(stem.name + "_path.png"), Path(deck.path).stem, plot))
     if not quiet:
         for w in written:
             print(f"wrote {w}")
