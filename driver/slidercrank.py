@@ -289,7 +289,9 @@ LABELS = {"speeds": ("crank speed", "rad/s"), "n_elements": ("rod elements", "-"
           "peak_tensile_deg": ("crank angle of peak tension", "deg"),
           "peak_compressive_microstrain": ("peak compressive strain", "microstrain"),
           "peak_compressive_deg": ("crank angle of peak compression", "deg"),
-          "euler_ratio_max": ("peak compression / Euler load", "-"), "n_buckled": ("speeds buckled", "-")}
+          "euler_ratio_max": ("peak compression / Euler load", "-"), "n_buckled": ("speeds buckled", "-"),
+          "rod_mass_kg": ("rod mass", "kg"), "section_area_m2": ("rod section area", "m^2"),
+          "section_width": ("section width", "m"), "section_depth": ("section depth", "m")}
 #: what a sweep summary plots when its deck names no plot_y
 SWEEP_PLOT = ("peak_tensile_microstrain", "peak_compressive_microstrain", "euler_ratio_max", "peak_tensile_deg",
               "peak_compressive_deg", "n_buckled")

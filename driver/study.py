@@ -196,7 +196,7 @@ def study_names() -> list[str]:
 
 #: units read off a column name's suffix when a study declares none (longest first)
 _SUFFIX_UNITS = (("_rad_s2", "rad/s^2"), ("_rad_s", "rad/s"), ("_microstrain", "microstrain"), ("_deg", "deg"),
-                 ("_rpm", "rpm"), ("_Nm", "N m"), ("_m2", "m^2"), ("_mm", "mm"), ("_m", "m"), ("_N", "N"),
+                 ("_rpm", "rpm"), ("_Nm", "N m"), ("_kg", "kg"), ("_m2", "m^2"), ("_mm", "mm"), ("_m", "m"), ("_N", "N"),
                  ("_s", "s"))
 
 

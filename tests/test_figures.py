@@ -71,6 +71,7 @@ def test_column_labels_have_words_and_units():
     assert column_label(sc, "slidercrank.speeds") == "crank speed [rad/s]"
     assert column_label(sc, "peak_tensile_2_deg") == "crank angle of peak tension, speed 2 [deg]"
     assert column_label(sc, "peak_compressive_microstrain") == "peak compressive strain [microstrain]"
+    assert column_label(sc, "rod_mass_kg") == "rod mass [kg]"          # an optimisation objective
     assert column_label(fb, "fourbar.omega") == "crank speed [rad/s]"          # units from the key's SPEC
     assert column_label(fb, "mu_min_deg") == "minimum transmission angle [deg]"
     assert column_label(None, "something_rad_s") == "something [rad/s]"       # units read off the suffix
@@ -317,3 +318,21 @@ def test_manipulator_torque_curves_mark_rows_violating_the_reach_conditions():
         assert np.allclose(np.sort(ln.get_xdata()), np.sort(l1[violating]))
     assert "[N m]" in ax.get_ylabel() and "[m]" in ax.get_xlabel()
     assert _inside_figure(fig, ax.get_legend())
+
+
+# ----------------------------------------------------------------------------- optimisation
+
+
+def test_optimisation_convergence_figure_names_its_objective_with_units(tmp_path):
+    from driver.optimize import optimize
+    deck = tmp_path / "opt.dat"
+    deck.write_text("&fourbar fixed_link = 12, crank = 3, coupler = 15, rocker = 9, omega = 5, step_deg = 10 /\n"
+                    "&optimize\nvar1 = 'fourbar.coupler', lower1 = 10, upper1 = 20\n"
+                    "maximize = 'rocker_swing_deg'\nmethod = 'slsqp', starts = 1\n/\n")
+    oc = optimize(deck, tmp_path / "out", plot="svg", jobs=1)
+    svg = [p for p in oc.written if p.suffix == ".svg"]
+    assert [p.name for p in svg] == ["opt.optimum_curves.svg", "opt.optimum_linkage.svg", "opt_convergence.svg"]
+    from driver.optimize import report
+    fig = report.convergence_figure(oc.problem, report.history_frame(oc.problem, oc.history),
+                                    oc.evaluator.frame(), "opt")
+    assert fig.axes[0].get_ylabel() == "rocker swing [deg]"
