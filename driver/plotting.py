@@ -162,8 +162,10 @@ def fourbar_curves(exact, listing, title: str) -> Figure:
                 ax.plot(listing["theta_deg"], listing[k], "o", ms=4, mfc="none", color=colors[k],
                         label=f"{_FOURBAR_NAMES[k]} (listing)")
         ax.set_ylabel(label)
-    axes[0].set_ylim(-5, 365)
-    axes[0].set_yticks(np.arange(0, 361, 90))
+    angles = exact[["coupler_deg", "rocker_deg"]].to_numpy(dtype=float)
+    if np.isfinite(angles).any() and np.ptp(angles[np.isfinite(angles)]) > 180.0:   # wrapped: the whole turn
+        axes[0].set_ylim(-5, 365)
+        axes[0].set_yticks(np.arange(0, 361, 90))
     axes[1].axhspan(40, 120, color="C2", alpha=0.08, label="40-120 deg band")
     for ax in axes:
         ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
