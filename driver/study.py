@@ -194,12 +194,6 @@ def study_names() -> list[str]:
                   if info.name not in _CORE and not info.name.startswith("_"))
 
 
-#: units read off a column name's suffix when a study declares none (longest first)
-_SUFFIX_UNITS = (("_rad_s2", "rad/s^2"), ("_rad_s", "rad/s"), ("_microstrain", "microstrain"), ("_deg", "deg"),
-                 ("_rpm", "rpm"), ("_Nm", "N m"), ("_kg", "kg"), ("_m2", "m^2"), ("_mm", "mm"), ("_m", "m"), ("_N", "N"),
-                 ("_s", "s"))
-
-
 def column_label(module: ModuleType | None, name: str) -> str:
     """The axis label of summary column or deck key ``name`` (``group.key`` or ``key``) of
     study ``module``: words and units from its ``LABELS``, else the key's ``SPEC`` units, else
@@ -219,7 +213,9 @@ def column_label(module: ModuleType | None, name: str) -> str:
     spec_key = getattr(module.SPEC, "keys", {}).get(key) if module is not None else None
     if entry is None:
         words, units = key, ""
-        for suffix, u in _SUFFIX_UNITS:
+        from driver.export import SUFFIX_UNITS   # the one suffix table (tidy units and labels)
+
+        for suffix, u in SUFFIX_UNITS:
             if key.endswith(suffix) and len(key) > len(suffix):
                 words, units = key[: -len(suffix)], u
                 break
