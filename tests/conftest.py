@@ -8,6 +8,16 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 INPUTS = ROOT / "inputs"
 
+#: a small valid four-bar deck that deck-reading tests mutate one change at a time
+GOOD_DECK = """! a good deck
+&fourbar
+  fixed_link = 12.0, crank = 5.0
+  coupler = 15.0
+  rocker = 9.0
+  omega = 5.0
+  step_deg = 20
+/
+"""
 
 
 @pytest.fixture

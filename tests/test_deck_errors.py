@@ -3,17 +3,8 @@ from __future__ import annotations
 
 import pytest
 
+from conftest import GOOD_DECK as GOOD
 from driver.cli import main
-
-GOOD = """! a good deck
-&fourbar
-  fixed_link = 12.0, crank = 5.0
-  coupler = 15.0
-  rocker = 9.0
-  omega = 5.0
-  step_deg = 20
-/
-"""
 
 
 @pytest.mark.parametrize("change,line,key,words", [

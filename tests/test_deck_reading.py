@@ -7,18 +7,9 @@ import warnings
 
 import pytest
 
+from conftest import GOOD_DECK as GOOD
 from driver.cli import main
 from driver.deck import MAX_DECK_BYTES, MAX_VALUES, DeckError, read_deck
-
-GOOD = """! a good deck
-&fourbar
-  fixed_link = 12.0, crank = 5.0
-  coupler = 15.0
-  rocker = 9.0
-  omega = 5.0
-  step_deg = 20
-/
-"""
 
 
 def _raw(text, tmp_path, name="d.dat", mode="w"):
