@@ -24,13 +24,15 @@ Physics (IK, Jacobian, indices, torques, positioning errors) is in fortran/manip
 
 The package splits the study by job: :mod:`.spec` (deck keys and checks), :mod:`.analysis`
 (conventions, optima, joint angles, tolerance synthesis), :mod:`.tables` (the tables and the
-report/exact differences) and :mod:`.report` (the run: text, tidy table, summary, figures).
+report/exact differences), :mod:`.report` (the run: text, tidy table, summary, figures) and
+:mod:`.batch` (the design summary of many designs in one kernel call).
 """
 from __future__ import annotations
 
 from driver.deck import Params
-from driver.manipulator.analysis import (SIGNIFICANT, STATUS, Conv, Workspace, _sensitivity_blocks, optima,
-                                         round_half_up, tolerance_box)
+from driver.manipulator.analysis import (DESIGN_STATUS, SIGNIFICANT, STATUS, Conv, Workspace, _sensitivity_blocks,
+                                         optima, round_half_up, tolerance_box)
+from driver.manipulator.batch import BATCH_IGNORED, BATCH_INDEPENDENT, BATCH_KEYS, summarise, summarise_batch
 from driver.manipulator import report as _report
 from driver.manipulator.report import TIDY_UNITS, table_frame
 from driver.manipulator.spec import LABELS, SPEC, SWEEP_PLOT, estimate
@@ -38,7 +40,8 @@ from driver.manipulator.tables import NOT_REPRODUCIBLE, REASONS, TEXT_REASONS, T
 from driver.study import Result, keyword_run
 
 __all__ = ["SPEC", "run", "Workspace", "tolerance_box", "round_half_up", "REASONS", "NOT_REPRODUCIBLE", "TEXT_REASONS",
-           "TIDY_NAMES", "TIDY_UNITS", "table_frame", "LABELS", "SWEEP_PLOT", "estimate", "optima"]
+           "TIDY_NAMES", "TIDY_UNITS", "table_frame", "LABELS", "SWEEP_PLOT", "estimate", "optima",
+           "summarise", "summarise_batch", "BATCH_KEYS", "BATCH_IGNORED", "BATCH_INDEPENDENT", "DESIGN_STATUS"]
 
 
 @keyword_run

@@ -17,7 +17,8 @@ from scipy.optimize import minimize
 from driver import kernels
 from driver.deck import Params
 
-__all__ = ["STATUS", "SIGNIFICANT", "round_half_up", "Workspace", "Conv", "optima", "tolerance_box"]
+__all__ = ["STATUS", "SIGNIFICANT", "DESIGN_STATUS", "round_half_up", "Workspace", "Conv", "optima", "tolerance_box",
+           "design_status"]
 
 STATUS = kernels.MANIPULATOR_STATUS
 #: significant digits of every number column outside report mode (the report's fixed decimals
@@ -99,6 +100,19 @@ def _design_list(p: Params, conv: Conv) -> tuple[list[str], np.ndarray, np.ndarr
         l1 = np.array([round_half_up(v, 2) for v in l1])
         l2 = np.array([round_half_up(v, 2) for v in l2])
     return ["Dexterity", "Workspace"], l1, l2
+
+
+#: values of the summary column ``design_status`` (the first design's), and what they mean
+DESIGN_STATUS = {"ok": "reaches every workspace point and the target; RI1 defined",
+                 "unreachable": "violates the reach conditions (4.4) at some workspace point",
+                 "target_unreachable": "reaches the workspace but not the torque target point (no torques)",
+                 "singular": "sigma_min of the sensitivity Jacobian is 0: RI1 undefined"}
+
+
+def design_status(reach: bool, target_ok: bool, ri1: float) -> str:
+    """The first design's status (a DESIGN_STATUS key): the first problem in that order."""
+    return "unreachable" if not reach else "target_unreachable" if not target_ok else \
+        "singular" if not ri1 > 0 else "ok"
 
 
 def optima(c: float) -> dict[str, tuple[float, float]]:

@@ -12,7 +12,8 @@ import pandas as pd
 from driver import kernels
 from driver.deck import Params
 from driver.export import with_units
-from driver.manipulator.analysis import SIGNIFICANT, Conv, Workspace, _design_list, _target, optima, round_half_up
+from driver.manipulator.analysis import (SIGNIFICANT, Conv, Workspace, _design_list, _target, design_status, optima,
+                                         round_half_up)
 from driver.manipulator.tables import TIDY_NAMES, Table, _differences, _tables, _tolerance
 from driver.study import Figure, Result
 from driver.table import fortran_f
@@ -144,7 +145,8 @@ def _summary(p: Params, ws: Workspace, conv: Conv, used: dict, sweep: dict, tol:
               "design_ri2": float(ri[0, 1]), "design_ri3": float(ri[0, 2]),
               "design_ri2_excess": float(ri[0, 1]) - math.sqrt(ws.n),
               "design_reaches_all": bool(reach[0]), "design_crob_residual_m2": l1 * l1 + l2 * l2 - ws.mean_d2,
-              "design_total_torque_Nm": float(used["tau"][0].sum()) if used["ok"][0] else None})
+              "design_total_torque_Nm": float(used["tau"][0].sum()) if used["ok"][0] else None,
+              "design_status": design_status(bool(reach[0]), bool(used["ok"][0]), float(ri[0, 0]))})
     s.update(sweep_columns(sweep))
     return s
 
