@@ -158,11 +158,12 @@ def check_finite(result: Result, params: Params) -> Result:
     return result
 
 
-def compute(module: ModuleType, params: Params, progress: bool = False) -> Result:
-    """``module.run(params)`` within the budget (:mod:`driver.limits`), with numerical failures
-    turned into deck errors and the result checked for non-finite numbers (no NaN, inf or '****'
-    ever reaches a table)."""
-    limits.check(module, params)   # absurd requests are refused before anything is allocated
+def compute(module: ModuleType, params: Params, progress: bool = False,
+            budget: limits.Budget | None = None) -> Result:
+    """``module.run(params)`` within the budget (:mod:`driver.limits`; ``budget`` default this
+    process's), with numerical failures turned into deck errors and the result checked for
+    non-finite numbers (no NaN, inf or '****' ever reaches a table)."""
+    limits.check(module, params, lim=budget)   # absurd requests are refused before anything is allocated
     try:
         with np.errstate(all="ignore"):
             result = module.run(params, progress=progress)
