@@ -31,7 +31,7 @@ from driver import expr, limits
 from driver.deck import DeckError, Params, RawGroup, validate
 from driver.study import load_study
 from driver.optimize.problem import Problem
-from driver.runner import NUMERICAL, compute, numerical_error
+from driver.runner import NUMERICAL, CaseFailure, compute, numerical_error
 
 __all__ = ["Evaluator", "evaluate_cases", "FAILED_VIOLATION"]
 
@@ -69,8 +69,9 @@ def evaluate_cases(group: str, deck_path: str, raw: RawGroup, keys: list[str], k
                    xs: list[list[float]], budget: limits.Budget | None = None) -> list[tuple[str, str, dict]]:
     """Summaries of designs ``xs`` case by case: [(status, reason, summary)] (worker entry point).
 
-    status is 'ok', 'bad_input' (the design is not a valid deck), 'refused' (over the work or
-    memory ``budget`` of one run, :mod:`driver.limits`; default this process's) or 'failed'.
+    status is 'ok', 'bad_input' (the design is not a valid deck, or the study refuses it),
+    'refused' (over the work or memory ``budget`` of one run, :mod:`driver.limits`; default this
+    process's) or 'failed' (the run failed, numerically or by the study's own verdict).
     Every case goes through the runner's checks (:func:`driver.runner.compute`): the budget
     before it runs, numerical failures in words, no NaN/inf/'****' in what it would write.
     """
@@ -99,8 +100,10 @@ def evaluate_cases(group: str, deck_path: str, raw: RawGroup, keys: list[str], k
                 result = compute(module, params, budget=budget)
                 out.append(("failed", str(result.failure), dict(result.summary)) if result.failure
                            else ("ok", "", dict(result.summary)))
-        except DeckError as exc:   # a numerical failure, or a non-finite number bound for a table
+        except CaseFailure as exc:   # a numerical failure, or a non-finite number bound for a table
             out.append(("failed", _deck_reason(exc), {}))
+        except DeckError as exc:     # the study refuses the design (e.g. an arm that cannot reach)
+            out.append(("bad_input", _deck_reason(exc), {}))
         except Exception as exc:   # a failing design is infeasible, never the end of the run
             out.append(("failed", f"{exc.__class__.__name__}: {exc}", {}))
     return out
