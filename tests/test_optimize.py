@@ -303,8 +303,16 @@ def test_differential_evolution_same_run_in_one_process_worker_processes_and_on_
     Dask LocalCluster (submitted at once, gathered in order); the run is the same design for
     design, generation for generation, as in one process."""
     distributed = pytest.importorskip("distributed")
+    import os
     from driver.optimize import evaluate
     from driver import slidercrank
+    # a LocalCluster with worker processes sets OMP/MKL/OPENBLAS_NUM_THREADS=1 in this process's
+    # environment; later tests' subprocesses must not inherit that (SLSQP results follow OpenBLAS's
+    # thread count in the last bits, and the committed outputs are compared byte for byte)
+    for name in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MALLOC_TRIM_THRESHOLD_"):
+        monkeypatch.setenv(name, os.environ.get(name, ""))   # recorded: undone after the test
+        if not os.environ[name]:
+            monkeypatch.delenv(name)
     assert not hasattr(slidercrank, "summarise_batch")
     path = tmp_path / "sc.dat"
     path.write_text(SC_SMALL)
