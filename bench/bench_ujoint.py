@@ -7,7 +7,11 @@ Measures, in the same run, for a 3-joint chain on a 360-point input-angle grid:
   * one objective + gradient, kernel (analytic) vs numpy (central finite differences, what
     an optimiser without the kernel's gradient pays);
   * the wall time of a 64-start option-3 search (SLSQP, analytic gradient) vs the same
-    search with the numpy objective and scipy's finite-difference gradient.
+    search with the numpy objective and scipy's finite-difference gradient;
+  * the batch path of sweeps and &optimize (ujoint.summarise_batch: many designs in one
+    kernel call) against the per-case loops it replaces, in designs/s (CPU time): the
+    single-design kernel calls of ujoint.evaluate, and validate + run per design (what a
+    sweep or an optimiser pays without the batch path).
 Prints medians over repeats, ratios, the issue's targets and whether they are met.
 """
 from __future__ import annotations
@@ -24,6 +28,8 @@ from scipy.optimize import minimize
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from driver.kernels import UJOINT_MODELS, UJOINT_OBJECTIVES, ujoint_objective  # noqa: E402
+from driver import ujoint  # noqa: E402
+from driver.deck import RawGroup, validate  # noqa: E402
 from driver.ujoint import Chain, optimise  # noqa: E402
 
 D = math.pi / 180.0
@@ -98,6 +104,40 @@ def search_numpy(model: str, n_starts: int) -> tuple[float, float]:
     return time.perf_counter() - t0, best
 
 
+def batch_designs(nd: int, seed: int = 5) -> tuple[object, np.ndarray]:
+    """The base deck (exact 3-joint chain, plane angles RHO) and nd random phase pairs [deg]."""
+    raw = RawGroup("ujoint", {"beta": list(BETA / D), "phi": list(PHI / D), "rho": list(RHO / D)}, {}, 1)
+    base = validate(raw, ujoint.SPEC, "bench.dat")
+    return base, np.random.default_rng(seed).uniform(0.0, 180.0, (nd, 2))
+
+
+def batch_rates(nd: int, n_run: int, repeat: int) -> dict[str, float]:
+    """Designs per CPU second: the batch path, the per-design kernel calls, validate + run."""
+    base, phis = batch_designs(nd)
+    chain = Chain(UJOINT_MODELS["exact"], UJOINT_OBJECTIVES["mean_square"], np.asarray(base["rho"]) * D, M, 25.0)
+    beta = np.asarray(base["beta"])
+    frame = ujoint.summarise_batch(base, {"phi": phis})
+    for i in range(3):   # the batch rows are the per-case figures (tests/test_ujoint_batch.py: all of them)
+        d = ujoint.evaluate(chain, "x", beta, phis[i])
+        assert (frame["objective"][i], frame["peak_accel_rad_s2"][i]) == (d.objective, d.peak_acc)
+
+    def cpu(fn) -> float:
+        times = []
+        for _ in range(repeat):
+            t0 = time.process_time()
+            fn()
+            times.append(time.process_time() - t0)
+        return float(np.median(times))
+
+    def runs() -> None:
+        for ph in phis[:n_run]:
+            raw = RawGroup("ujoint", {"beta": base["beta"], "phi": list(ph), "rho": base["rho"]}, {}, 1)
+            ujoint.run(validate(raw, ujoint.SPEC, "bench.dat")).summary
+    return {"batch": nd / cpu(lambda: ujoint.summarise_batch(base, {"phi": phis})),
+            "evaluate": nd / cpu(lambda: [ujoint.evaluate(chain, "x", beta, ph) for ph in phis]),
+            "run": n_run / cpu(runs)}
+
+
 def main() -> None:
     quick = "--quick" in sys.argv
     rep = 5 if quick else 9
@@ -132,6 +172,14 @@ def main() -> None:
     ws = max(results["search_exact"], results["search_cumulative"])
     print(f"target: 64-start option-3 search < {TARGET_SEARCH_S} s: worst {ws:.3f} s -> "
           f"{'MET' if ws < TARGET_SEARCH_S else 'NOT MET'}")
+    nd = 2000 if quick else 20000
+    r = batch_rates(nd, 50 if quick else 200, 3 if quick else 5)
+    print(f"\nbatch path (exact chain, 3 joints x {M} angles, {nd} designs; CPU time, median):")
+    print(f"  summarise_batch (one kernel call)        {r['batch']:12,.0f} designs/s")
+    print(f"  per-design kernel calls (evaluate)       {r['evaluate']:12,.0f} designs/s   "
+          f"batch {r['batch'] / r['evaluate']:.1f}x")
+    print(f"  validate + run per design (per-case path){r['run']:12,.0f} designs/s   "
+          f"batch {r['batch'] / r['run']:.0f}x")
 
 
 if __name__ == "__main__":

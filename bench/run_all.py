@@ -33,6 +33,7 @@ import bench_manipulator  # noqa: E402
 import bench_slidercrank  # noqa: E402
 import bench_ujoint  # noqa: E402
 from driver import kernels  # noqa: E402
+from driver import ujoint as ujoint_study  # noqa: E402
 from driver.slidercrank import MATERIALS, rayleigh  # noqa: E402
 
 
@@ -166,9 +167,24 @@ def ujoint(repeat: int) -> list[Row]:
     tk, tb = interleaved(lambda: kernels.ujoint_objective(code, 0, beta, phi, rho, m, grad=False),
                          lambda: bench_ujoint.numpy_objective("exact", beta, phi, rho), repeat,
                          kernel_per_round=200, baseline_per_round=20)
-    return [Row("Hooke joint: objective, 3 joints x 360 angles", "us/objective", tk, tb, 5e-6, None,
+    rows = [Row("Hooke joint: objective, 3 joints x 360 angles", "us/objective", tk, tb, 5e-6, None,
                 "180 points (period pi) x 3 joints: 1 division + 1 sqrt per point and joint; "
                 "Python call overhead ~1 us")]
+    # the batch path of sweeps and &optimize against the per-design kernel calls it replaces
+    nd = 64 if repeat <= 2 else 2000
+    base, phis = bench_ujoint.batch_designs(nd)
+    chain = ujoint_study.Chain(code, kernels.UJOINT_OBJECTIVES["mean_square"],
+                               np.asarray(base["rho"]) * ujoint_study.DEG, m, 25.0)
+    bdeg = np.asarray(base["beta"])
+    frame = ujoint_study.summarise_batch(base, {"phi": phis})
+    d = ujoint_study.evaluate(chain, "x", bdeg, phis[-1])
+    assert (frame["objective"].iloc[-1], frame["pp_ratio"].iloc[-1]) == (d.objective, d.pp)
+    tk, tb = interleaved(lambda: ujoint_study.summarise_batch(base, {"phi": phis}),
+                         lambda: [ujoint_study.evaluate(chain, "x", bdeg, ph) for ph in phis], repeat)
+    rows.append(Row("Hooke joint batch: summary vs per-design calls", "us/design", tk / nd, tb / nd, None, 3.0,
+                    "per design: 180 + 360 points x 3 joints (objective grid, then ratio and dR/dtheta) and "
+                    "the closed-form angles; the baseline makes 4 kernel calls per design"))
+    return rows
 
 
 def slidercrank(n_el: int, spr: int, base_steps: int, repeat: int) -> list[Row]:
@@ -192,7 +208,8 @@ def slidercrank(n_el: int, spr: int, base_steps: int, repeat: int) -> list[Row]:
                 100e-3, 10.0, "sequential banded triangular solves (latency of 2 x 6 multiply-adds per unknown)")]
 
 
-SCALE = {"ns/position": 1e9, "ns/sample": 1e9, "us/config": 1e6, "us/objective": 1e6, "ms/revolution": 1e3}
+SCALE = {"ns/position": 1e9, "ns/sample": 1e9, "us/config": 1e6, "us/objective": 1e6, "us/design": 1e6,
+         "ms/revolution": 1e3}
 
 
 def print_table(rows: list[Row]) -> None:

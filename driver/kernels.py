@@ -29,7 +29,7 @@ __all__ = ["farray", "fourbar_listing", "fourbar_exact", "fourbar_coupler_point"
            "MANIPULATOR_STATUS", "manipulator_arm_states", "manipulator_torques", "manipulator_ik",
            "manipulator_design_indices", "manipulator_position_errors",
            "UJOINT_MODELS", "UJOINT_OBJECTIVES", "ujoint_speed", "ujoint_objective",
-           "ujoint_equivalent", "ujoint_geometry",
+           "ujoint_equivalent", "ujoint_geometry", "ujoint_summaries", "UJOINT_SUMMARY_COLUMNS",
            "SLIDERCRANK_STATUS", "slidercrank_simulate", "slidercrank_matrices", "slidercrank_rigid",
            "slidercrank_axial_force", "slidercrank_frequencies"]
 
@@ -290,6 +290,37 @@ def ujoint_equivalent(model: int, beta, phi, rho, tol: float = 1e-7) -> tuple[fl
     b, ph, rh = _ujoint_chain(beta, phi, rho)
     be, br, st = _kernels.ujoint.chain_equivalent(int(model), b, ph, rh, float(tol))
     return float(be), (float(br) if st == int(_kernels.ujoint.st_ok) else None)
+
+
+#: columns of ujoint_summaries (fortran/ujoint.f90 chain_summaries)
+UJOINT_SUMMARY_COLUMNS = ("objective", "ratio_min", "ratio_max", "dratio_abs_max", "beta_e", "beta_res",
+                          "beta_res_status")
+
+
+def ujoint_summaries(model: int, kind: int, beta, phi, rho, m: int, tol: float = 1e-7) -> np.ndarray:
+    """Headline figures of many designs of one chain layout in one kernel call: (nd, 7) array.
+
+    beta (nd, n) joint angles [rad]; phi (nd, n-1) the paper's phases [rad]; rho (nd, n-1)
+    plane angles [rad] or None (coplanar).  Every design shares ``model``, the objective
+    ``kind`` and the grid of ``m`` input angles per revolution.  Columns
+    (UJOINT_SUMMARY_COLUMNS): the objective (as :func:`ujoint_objective` without gradient),
+    min and max of R = omega_out/omega_in and max |dR/dtheta| [1/rad] on the grid
+    theta_j = 2 pi j/m (as :func:`ujoint_speed` there), beta_e and beta_res [rad] and the
+    status of beta_res (0: defined; as :func:`ujoint_equivalent` with ``tol`` [rad]).
+    Each row has the same bits as those single-design calls.
+    """
+    beta = np.asarray(beta, dtype=np.float64)
+    if beta.ndim != 2 or beta.shape[1] < 1:
+        raise ValueError(f"beta must be (designs, joints), got shape {beta.shape}")
+    nd, n = beta.shape
+    if nd == 0:
+        return np.empty((0, len(UJOINT_SUMMARY_COLUMNS)))
+    x = np.empty((nd, 3 * n - 2), dtype=np.float64, order="F")
+    x[:, :n] = beta
+    x[:, n:2 * n - 1] = phi
+    x[:, 2 * n - 1:] = 0.0 if rho is None else rho
+    return _kernels.ujoint.chain_summaries(model=int(model), kind=int(kind), n=n, nd=nd, x=x, m=int(m),
+                                           tol=float(tol))
 
 
 def ujoint_geometry(axes) -> tuple[np.ndarray, np.ndarray, int]:

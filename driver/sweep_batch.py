@@ -132,6 +132,9 @@ def batchable(module, names: list[str], keep: str, case_outputs: str) -> bool:
 
 def plan(module, raw: RawGroup, deck_path: str, grid: Grid, keep: str, rows: str) -> BatchPlan | None:
     """A batch plan for this sweep (see :func:`batchable`), or None when it must run case by case."""
+    applies = getattr(module, "batch_applies", None)   # e.g. not for a base deck that optimises per case
+    if applies is not None and not applies(validate(raw, module.SPEC, deck_path)):
+        return None
     keys = [n.partition(".")[2] for n in grid.names]
     independent = set(getattr(module, "BATCH_INDEPENDENT", ()))
     single: dict[str, dict[int, str]] = {}

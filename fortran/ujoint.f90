@@ -23,6 +23,9 @@
 !>                     tan(theta_out(k)) = cos(beta(k)) tan(theta(k)); exact for
 !>                     non-coplanar chains too (agrees with a 3-D vector model).
 !>
+!> chain_summaries evaluates many designs of one chain layout in one call (the batch path of
+!> sweeps and optimisers) with the same procedures, so each row has a single design's bits.
+!>
 !> Internally the driving angle of each joint is carried as a unit complex number
 !> (cos, sin), so the exact transfer needs one square root and no trigonometric call.
 module ujoint
@@ -30,7 +33,7 @@ module ujoint
   use vecmath, only: sincos_array, atan2_array
   implicit none
   private
-  public :: chain_speed, chain_objective, chain_equivalent, chain_geometry
+  public :: chain_speed, chain_objective, chain_equivalent, chain_geometry, chain_summaries
 
   !> model codes
   integer, parameter, public :: model_eq13 = 0, model_cumulative = 1, model_exact = 2
@@ -38,6 +41,8 @@ module ujoint
   integer, parameter, public :: obj_mean_square = 0, obj_rms = 1, obj_peak_to_peak = 2
   !> status codes of chain_equivalent (beta_res) and chain_geometry
   integer, parameter, public :: st_ok = 0, st_res_undefined = 1, st_zero_axis = 2, st_right_angle = 3
+  !> result columns of chain_summaries
+  integer, parameter, public :: nsum = 7
 
   real(dp), parameter :: pi = 3.14159265358979323846264338327950288_dp
 
@@ -71,7 +76,7 @@ contains
 
   !> Values (and optionally gradients) of ln R at m points given by (c, s) = (cos, sin) of
   !> the input angle.  rat(j) = R, dlth(j) = d ln R / d theta; if want_grad /= 0 also
-  !> dlp(j, :) = d ln R / d(beta(1..n), phi(1..n-1)).
+  !> dlp(j, :) = d ln R / d(beta(1..n), phi(1..n-1)) (dlp is not set when want_grad = 0).
   !> thout(j): output angle of the last joint (exact model only; 0 otherwise) if want_out.
   subroutine propagate(model, n, beta, phi, rho, m, c0, s0, want_grad, want_out, &
                        rat, dlth, dlp, thout)
@@ -187,7 +192,6 @@ contains
         end do
       end if
     end do
-    if (want_grad == 0) dlp = 0.0_dp
   end subroutine propagate
 
   !> Speed ratio R = omega_out/omega_in, dR/dtheta (output angular acceleration per
@@ -242,29 +246,91 @@ contains
       call propagate_nograd(model, n, beta, phi, rho, mh, c, s, rat)
     end if
     grad = 0.0_dp
-    select case (kind)
-    case (obj_peak_to_peak)
+    f = objective_value(kind, mh, rat)
+    if (want_grad == 0) return
+    if (kind == obj_peak_to_peak) then
       jmax = maxloc(rat, 1)
       jmin = minloc(rat, 1)
-      f = rat(jmax) - rat(jmin)
-      if (want_grad /= 0) call p2p_grad(model, n, beta, phi, rho, c(jmax), s(jmax), c(jmin), s(jmin), grad)
-    case default
-      f = sum((rat - 1.0_dp)**2)/real(mh, dp)
-      if (g == 1) then
-        do j = 1, 2*n - 1
-          grad(j) = 2.0_dp*sum((rat - 1.0_dp)*rat*dlp(:, j))/real(mh, dp)
-        end do
+      call p2p_grad(model, n, beta, phi, rho, c(jmax), s(jmax), c(jmin), s(jmin), grad)
+      return
+    end if
+    do j = 1, 2*n - 1
+      grad(j) = 2.0_dp*sum((rat - 1.0_dp)*rat*dlp(:, j))/real(mh, dp)
+    end do
+    if (kind == obj_rms) then
+      if (f > 0.0_dp) then
+        grad = grad/(2.0_dp*f)
+      else
+        grad = 0.0_dp
       end if
-      if (kind == obj_rms) then
-        f = sqrt(f)
-        if (f > 0.0_dp) then
-          grad = grad/(2.0_dp*f)
-        else
-          grad = 0.0_dp
-        end if
-      end if
-    end select
+    end if
   end subroutine chain_objective
+
+  !> Headline figures of nd designs of one chain layout in one call: the batch path of sweeps
+  !> and optimisers (driver/ujoint summarise_batch).  The designs share the joint count n, the
+  !> model, the objective kind and the grid of m input angles; design i is
+  !> x(i, :) = beta(1..n), phi(1..n-1), rho(1..n-1) [rad] (3n-2 columns; phi and rho as in
+  !> chain_speed).  Each row holds exactly what chain_objective (without gradient),
+  !> chain_speed on theta_j = 2 pi (j-1)/m (j = 1..m) and chain_equivalent give for that
+  !> design alone: the same procedures on the same grid, so the same bits.
+  !>   res(i, 1)  objective of kind (dimensionless; over the first m/2 angles for even m)
+  !>   res(i, 2:3) min and max of R = omega_out/omega_in on the grid
+  !>   res(i, 4)  max |dR/dtheta| on the grid [1/rad] (times omega_in**2: peak output
+  !>              angular acceleration at constant input speed)
+  !>   res(i, 5)  beta_e [rad]; res(i, 6) beta_res [rad], 0 unless res(i, 7) = st_ok
+  !>   res(i, 7)  status of beta_res (chain_equivalent with tolerance tol [rad])
+  !> The sines and cosines of the grid are taken once for all designs.
+  subroutine chain_summaries(model, kind, n, nd, x, m, tol, res)
+    integer, intent(in) :: model, kind, n, nd, m
+    real(dp), intent(in) :: x(nd, 3*n - 2), tol
+    real(dp), intent(out) :: res(nd, 7)                ! nsum columns (literal for f2py)
+    real(dp), allocatable :: th(:), c(:), s(:), rat(:), ratf(:), dlth(:), dlp(:, :), thout(:), acc(:)
+    real(dp) :: beta(n), phi(n - 1), rho(n - 1), be, br
+    integer :: i, j, mh, st
+    !f2py threadsafe
+    mh = m
+    if (mod(m, 2) == 0) mh = m/2
+    allocate (th(m), c(m), s(m), rat(mh), ratf(m), dlth(m), dlp(m, 2*n - 1), thout(m), acc(m))
+    ! the grid of chain_objective (its first mh angles) and of the speed table
+    ! hot-loop: ujoint summaries grid
+    do j = 1, m
+      th(j) = (2.0_dp*pi/real(m, dp))*real(j - 1, dp)
+    end do
+    call sincos_array(m, th, s, c)
+    do i = 1, nd
+      beta = x(i, 1:n)
+      phi = x(i, n + 1:2*n - 1)
+      rho = x(i, 2*n:3*n - 2)
+      call propagate_nograd(model, n, beta, phi, rho, mh, c(1:mh), s(1:mh), rat)
+      res(i, 1) = objective_value(kind, mh, rat)
+      call propagate(model, n, beta, phi, rho, m, c, s, 0, 0, ratf, dlth, dlp, thout)
+      ! hot-loop: ujoint summaries acceleration
+      do j = 1, m
+        acc(j) = abs(ratf(j)*dlth(j))
+      end do
+      res(i, 2) = minval(ratf)
+      res(i, 3) = maxval(ratf)
+      res(i, 4) = maxval(acc)
+      call chain_equivalent(model, n, beta, phi, rho, tol, be, br, st)
+      res(i, 5) = be
+      res(i, 6) = br
+      res(i, 7) = real(st, dp)
+    end do
+  end subroutine chain_summaries
+
+  !> The objective of kind ``kind`` from the ratios rat(1..m) of a uniform grid: mean (R-1)**2,
+  !> its root, or max R - min R (the one place both chain_objective and chain_summaries take it).
+  pure function objective_value(kind, m, rat) result(f)
+    integer, intent(in) :: kind, m
+    real(dp), intent(in) :: rat(m)
+    real(dp) :: f
+    if (kind == obj_peak_to_peak) then
+      f = maxval(rat) - minval(rat)
+    else
+      f = sum((rat - 1.0_dp)**2)/real(m, dp)
+      if (kind == obj_rms) f = sqrt(f)
+    end if
+  end function objective_value
 
   !> Gradient of max R - min R from the two extreme grid points (ca, sa) and (cb, sb).
   subroutine p2p_grad(model, n, beta, phi, rho, ca, sa, cb, sb, grad)

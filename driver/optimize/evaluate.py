@@ -382,9 +382,13 @@ def _slots(problem: Problem) -> list[str]:
 def _batch_summaries(problem: Problem, xs: list[tuple[float, ...]]) -> list[tuple[str, str, dict]] | None:
     """The study's batch path (``summarise_batch``), when it has one; None otherwise."""
     fn = getattr(problem.study, "summarise_batch", None)
-    if fn is None or not xs or any(v.index is not None for v in problem.variables):
+    elements = getattr(problem.study, "BATCH_ELEMENTS", ())   # list keys whose elements a batch may set
+    if fn is None or not xs or any(v.index is not None and v.key not in elements for v in problem.variables):
         return None
-    columns = {v.key: np.array([x[i] for x in xs]) for i, v in enumerate(problem.variables)}
+    applies = getattr(problem.study, "batch_applies", None)
+    if applies is not None and not applies(problem.base):
+        return None
+    columns = {slot: np.array([x[i] for x in xs]) for i, slot in enumerate(_slots(problem))}
     try:
         frame = fn(problem.base, columns)
     except DeckError:
