@@ -1,6 +1,7 @@
 """What a study is, and how the driver finds one.
 
-A study is a module ``driver/<group>.py`` named after its namelist group.  It
+A study is a module ``driver/<group>.py`` (or a package ``driver/<group>/``, split by job
+when it grows: spec, analysis, report, batch) named after its namelist group.  It
 defines
 
 * ``SPEC``: a :class:`driver.deck.GroupSpec` for its keys, and

@@ -108,7 +108,10 @@ def _signature(raw: RawGroup, grid: Grid, keep: str, rows: str, module) -> str:
     h = hashlib.sha256()
     h.update(json.dumps([raw.name, raw.values, grid.names, grid.values, grid.zipped, keep, rows, driver.__version__],
                         sort_keys=True, default=str).encode())
-    for path in (getattr(module, "__file__", None), getattr(sys.modules.get("driver._kernels"), "__file__", None)):
+    sources = [getattr(module, "__file__", None)]
+    if sources[0] and Path(sources[0]).name == "__init__.py":   # a study package: every module of it
+        sources = sorted(str(f) for f in Path(sources[0]).parent.glob("*.py"))
+    for path in (*sources, getattr(sys.modules.get("driver._kernels"), "__file__", None)):
         if path:
             with contextlib.suppress(OSError):
                 h.update(Path(path).read_bytes())
