@@ -5,17 +5,26 @@
    Target: at most 0.04 us per configuration (issue 12; was 0.05).
 2. Monte Carlo tolerance check with 10^6 samples (sampling + positioning errors at the 4
    workspace points + max and 99th percentile): kernel vs numpy.  Target: under 1 s.
+3. Design summaries (issue 13): manipulator.summarise_batch over 10^4 designs of the
+   least-torque deck (inputs/optimize_manipulator_torque.dat, 1000 Monte Carlo samples) in one
+   kernel call vs the per-case loop a sweep or an optimiser ran before (one run() per design
+   deck, its summary), both in this process: designs/s and the ratio (CPU time, medians).
 
 Run: .venv/bin/python bench/bench_manipulator.py [--repeat N]
 """
 from __future__ import annotations
 
 import argparse
+import statistics
+import time
+from pathlib import Path
 
 import numpy as np
 
 from driver import kernels
 from timing import median_time as timeit
+
+DECK = Path(__file__).resolve().parents[1] / "inputs" / "optimize_manipulator_torque.dat"
 
 
 def numpy_arm_states(l1, l2, th1, th2, qd, qdd, m1, m2, g):
@@ -44,6 +53,41 @@ def numpy_position_errors(th1, th2, dl):
     e = dl[:, 0, None, None] * u1[None] + dl[:, 1, None, None] * u2[None]   # (ns, k, 2)
     e2 = (e * e).sum(2)
     return np.stack([np.sqrt(e2.sum(1)), np.sqrt(e2.max(1))], 1)
+
+
+def design_batch(n: int, n_case: int, repeat: int) -> tuple[float, float]:
+    """CPU seconds per design: (batch summaries of n designs in one call, one run() per design
+    deck for n_case of them), medians of ``repeat`` interleaved rounds; the batch rows are
+    checked against the runs first."""
+    from driver import manipulator
+    from driver.deck import Params, read_deck, validate
+    d = read_deck(DECK)
+    base = validate(d.groups["manipulator"], manipulator.SPEC, d.path)
+    rng = np.random.default_rng(3)
+    l1, l2 = rng.uniform(4.5, 6.5, n), rng.uniform(3.8, 5.0, n)    # designs that reach the workspace
+    cols = {"designs_l1": l1, "designs_l2": l2}
+    def deck(i: int):
+        return Params(base.group, base.path, {**base, "designs_l1": [float(l1[i])], "designs_l2": [float(l2[i])]},
+                      {}, base.line)
+
+    frame = manipulator.summarise_batch(base, cols)
+    for i in range(min(n_case, 5)):
+        s = manipulator.run(deck(i)).summary
+        assert s["design_total_torque_Nm"] == frame["design_total_torque_Nm"].iloc[i]
+
+    def per_case():
+        for i in range(n_case):
+            manipulator.run(deck(i)).summary
+
+    tb, tc = [], []
+    for _ in range(repeat):
+        t0 = time.process_time()
+        manipulator.summarise_batch(base, cols)
+        tb.append((time.process_time() - t0) / n)
+        t0 = time.process_time()
+        per_case()
+        tc.append((time.process_time() - t0) / n_case)
+    return statistics.median(tb), statistics.median(tc)
 
 
 def main() -> None:
@@ -102,6 +146,13 @@ def main() -> None:
     print(f"  numpy baseline : {mn * 1e3:8.1f} ms")
     print(f"  speed-up       : {mn / mk:.2f}x")
     print(f"  target < 1 s: {'MET' if mk < 1.0 else 'NOT MET'}")
+
+    nb, nc = 10_000, 100
+    tb, tc = design_batch(nb, nc, max(3, args.repeat // 3))
+    print(f"Design summaries, {DECK.name} (1000 Monte Carlo samples per design), CPU time, medians:")
+    print(f"  batch, {nb} designs in one call : {tb * 1e6:9.2f} us/design  {1 / tb:10.0f} designs/s")
+    print(f"  one run() per design ({nc})      : {tc * 1e6:9.2f} us/design  {1 / tc:10.0f} designs/s")
+    print(f"  ratio                           : {tc / tb:.0f}x")
 
 
 if __name__ == "__main__":

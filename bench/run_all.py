@@ -155,6 +155,11 @@ def manipulator(n: int, samples: int, repeat: int) -> list[Row]:
                          lambda: bench_manipulator.numpy_position_errors(a1, a2, dl), repeat)
     rows.append(Row("2R manipulator: position errors, 4 points", "ns/sample", tk / samples, tb / samples,
                     None, None, "reads 16 B, writes 16 B/sample; 4 x 10 flops"))
+    nb = max(64, n // 10)
+    tb, tc = bench_manipulator.design_batch(nb, max(4, min(100, nb // 100)), max(3, repeat // 3))
+    rows.append(Row("2R manipulator: design summaries (batch)", "us/design", tb, tc, None, 100.0,
+                    f"baseline: one run() per design deck (the per-case path); {1 / tb:.0f} designs/s; "
+                    "1000 Monte Carlo samples x 4 flops per design dominate"))
     return rows
 
 

@@ -27,7 +27,8 @@ except ImportError as _exc:
 __all__ = ["farray", "fourbar_listing", "fourbar_exact", "fourbar_coupler_point", "fourbar_summaries",
            "FOURBAR_SUMMARY_COLUMNS", "FOURBAR_GRASHOF", "FOURBAR_STATUS",
            "MANIPULATOR_STATUS", "manipulator_arm_states", "manipulator_torques", "manipulator_ik",
-           "manipulator_design_indices", "manipulator_position_errors",
+           "manipulator_design_indices", "manipulator_position_errors", "manipulator_design_summaries",
+           "MANIPULATOR_SUMMARY_PARAMS", "MANIPULATOR_SUMMARY_COLUMNS",
            "UJOINT_MODELS", "UJOINT_OBJECTIVES", "ujoint_speed", "ujoint_objective",
            "ujoint_equivalent", "ujoint_geometry", "ujoint_summaries", "UJOINT_SUMMARY_COLUMNS",
            "SLIDERCRANK_STATUS", "slidercrank_simulate", "slidercrank_matrices", "slidercrank_rigid",
@@ -95,7 +96,7 @@ FOURBAR_SUMMARY_COLUMNS = ("grashof", "assemblable", "assembled_fraction", "mu_m
                            "mu_max_deg", "mu_max_at_deg", "rocker_min_deg", "rocker_min_at_deg",
                            "rocker_max_deg", "rocker_max_at_deg", "rocker_swing_deg", "rocker_turns",
                            "toggles_in_range", "omega3_peak_rad_s", "omega3_peak_at_deg",
-                           "omega2_peak_rad_s", "omega2_peak_at_deg")
+                           "omega2_peak_rad_s", "omega2_peak_at_deg", "time_ratio")
 #: Grashof class codes of fourbar_summaries
 FOURBAR_GRASHOF = {int(getattr(_kernels.fourbar_summary, f"gr_{k}")): k for k in
                    ("double_crank", "crank_rocker", "rocker_crank", "double_rocker", "change_point",
@@ -103,7 +104,7 @@ FOURBAR_GRASHOF = {int(getattr(_kernels.fourbar_summary, f"gr_{k}")): k for k in
 
 
 def fourbar_summaries(params: np.ndarray) -> np.ndarray:
-    """Headline figures of many four-bars in one kernel call: (n, 18) array.
+    """Headline figures of many four-bars in one kernel call: (n, 19) array.
 
     ``params`` (n, 8): fixed link p, crank q, coupler r, rocker s [length], crank speed
     [rad/s], first and last crank angle of the range [deg], branch (+1 open, -1 crossed).
@@ -222,6 +223,40 @@ def manipulator_position_errors(th1, th2, dl) -> np.ndarray:
     """
     th1, th2 = farray(np.atleast_1d(th1), 1), farray(np.atleast_1d(th2), 1)
     return _kernels.manipulator.position_errors(th1, th2, farray(dl, 2))
+
+
+#: columns of the parameter matrix of :func:`manipulator_design_summaries`
+MANIPULATOR_SUMMARY_PARAMS = ("l1", "l2", "target_x", "target_y", "mass_per_length", "gravity", "tolerance_bound")
+#: columns of its result (fortran/manipulator_summary.f90)
+MANIPULATOR_SUMMARY_COLUMNS = ("ri1", "ri2", "ri3", "sum_c2", "reach", "target_status", "theta1_deg", "theta2_deg",
+                               "tau1", "tau2", "reaches_points", "dl1", "dl2", "mc_max")
+
+
+def manipulator_design_summaries(x, y, params, branch: int = 1, rates=(1.0, 1.0, 1.0, 1.0),
+                                 measure: str = "global", unit=None) -> np.ndarray:
+    """Design summaries of nd 2R arms for workspace points (x, y) [m] in one call: (nd, 14).
+
+    ``params`` (nd, 7): columns MANIPULATOR_SUMMARY_PARAMS -- l1, l2 [m] (positive), the
+    target point x, y [m], mass per length [kg/m], g [m/s^2] along -y, tolerance bound [m].
+    ``branch`` the IK elbow branch (+1/-1), ``rates`` = (th1', th2' [rad/s], th1'', th2''
+    [rad/s^2]), ``measure`` 'global' or 'per_point', ``unit`` (ns, 2) Monte Carlo samples in
+    [-1, 1]^2 (the box is unit * dl; default one sample at (1, 1)).
+    Result columns MANIPULATOR_SUMMARY_COLUMNS: RI1 (0 where sigma_min = 0), RI2, RI3, sum c2,
+    reach (1/0, conditions 4.4), IK status at the target (MANIPULATOR_STATUS), theta1, theta2
+    there [deg], tau1, tau2 [N m] (0 unless the status is ok), reaches_points (1 when the IK
+    reaches every workspace point), tolerance half-widths dl1, dl2 [m] and the Monte Carlo
+    maximum error [m] (the last three 0 unless reaches_points).
+    """
+    x, y = farray(np.atleast_1d(x), 1), farray(np.atleast_1d(y), 1)
+    params = farray(params, 2)
+    if params.shape[1] != len(MANIPULATOR_SUMMARY_PARAMS):
+        raise ValueError(f"params must have {len(MANIPULATOR_SUMMARY_PARAMS)} columns, got {params.shape[1]}")
+    unit = farray(np.ones((1, 2)) if unit is None else unit, 2)
+    if unit.shape[1] != 2 or unit.shape[0] < 1:
+        raise ValueError(f"unit must have shape (ns >= 1, 2), got {unit.shape}")
+    return _kernels.manipulator_summary.design_summaries(
+        x, y, params, int(branch), farray(np.asarray(rates, dtype=np.float64).ravel(), 1),
+        {"global": 0, "per_point": 1}[measure], unit)
 
 
 

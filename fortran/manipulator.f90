@@ -19,6 +19,7 @@ module manipulator
   implicit none
   private
   public :: arm_states, craig_torques, inverse_kin, design_indices, position_errors
+  public :: block_trig, torque_block   ! blocks of the batch routines (fortran/manipulator_summary.f90)
 
   !> status codes shared with driver/manipulator.py
   integer, parameter, public :: st_ok = 0, st_unreachable = 1, st_degenerate = 2
@@ -39,9 +40,10 @@ contains
     real(dp), intent(inout) :: jac(n, 4), w(n), kappa(n), tau(n, 2)   ! overwritten (reusable buffers)
     !f2py intent(in,out) :: jac, w, kappa, tau
     integer, parameter :: nb = 256
-    real(dp) :: sc(nb, 4), s12, c12, a, b, c, d, t, det, disc
+    real(dp) :: sc(nb, 4), s12, c12, a, b, c, d, t, det, disc, gb(nb)
     integer :: k, k0, m, i
     !f2py threadsafe
+    gb = g
     do k0 = 1, n, nb
       m = min(nb, n - k0 + 1)
       call block_trig(m, th1(k0:k0 + m - 1), th2(k0:k0 + m - 1), sc)
@@ -60,7 +62,7 @@ contains
         kappa(k) = merge((t + disc)/(2.0_dp*merge(det, 1.0_dp, det > 0.0_dp)), 0.0_dp, det > 0.0_dp)
       end do
       call torque_block(m, l1(k0:k0 + m - 1), l2(k0:k0 + m - 1), m1(k0:k0 + m - 1), m2(k0:k0 + m - 1), &
-                        g, sc, qd(k0:k0 + m - 1, 1), qd(k0:k0 + m - 1, 2), qdd(k0:k0 + m - 1, 1), &
+                        gb(1:m), sc, qd(k0:k0 + m - 1, 1), qd(k0:k0 + m - 1, 2), qdd(k0:k0 + m - 1, 1), &
                         qdd(k0:k0 + m - 1, 2), tau(k0:k0 + m - 1, 1), tau(k0:k0 + m - 1, 2))
     end do
   end subroutine arm_states
@@ -71,14 +73,15 @@ contains
     real(dp), intent(in) :: l1(n), l2(n), th1(n), th2(n), qd(n, 2), qdd(n, 2), m1(n), m2(n), g
     real(dp), intent(out) :: tau(n, 2)
     integer, parameter :: nb = 256
-    real(dp) :: sc(nb, 4)
+    real(dp) :: sc(nb, 4), gb(nb)
     integer :: k0, m
     !f2py threadsafe
+    gb = g
     do k0 = 1, n, nb
       m = min(nb, n - k0 + 1)
       call block_trig(m, th1(k0:k0 + m - 1), th2(k0:k0 + m - 1), sc)
       call torque_block(m, l1(k0:k0 + m - 1), l2(k0:k0 + m - 1), m1(k0:k0 + m - 1), m2(k0:k0 + m - 1), &
-                        g, sc, qd(k0:k0 + m - 1, 1), qd(k0:k0 + m - 1, 2), qdd(k0:k0 + m - 1, 1), &
+                        gb(1:m), sc, qd(k0:k0 + m - 1, 1), qd(k0:k0 + m - 1, 2), qdd(k0:k0 + m - 1, 1), &
                         qdd(k0:k0 + m - 1, 2), tau(k0:k0 + m - 1, 1), tau(k0:k0 + m - 1, 2))
     end do
   end subroutine craig_torques
@@ -93,10 +96,11 @@ contains
   end subroutine block_trig
 
   !> Report eqs (2.52)/(2.53) = Craig (1989) eq. 6.60, point masses at the link ends, for
-  !> one block of m <= 256 configurations with sines and cosines sc from block_trig.
+  !> one block of m <= 256 configurations with sines and cosines sc from block_trig
+  !> (g(m) per configuration: the batch summaries vary it by design).
   subroutine torque_block(m, l1, l2, m1, m2, g, sc, qd1, qd2, qdd1, qdd2, tau1, tau2)
     integer, intent(in) :: m
-    real(dp), intent(in) :: l1(m), l2(m), m1(m), m2(m), g, sc(256, 4), qd1(m), qd2(m), qdd1(m), qdd2(m)
+    real(dp), intent(in) :: l1(m), l2(m), m1(m), m2(m), g(m), sc(256, 4), qd1(m), qd2(m), qdd1(m), qdd2(m)
     real(dp), intent(out) :: tau1(m), tau2(m)
     real(dp) :: m2l1l2, c1, s2, c2, c12
     integer :: k
@@ -109,8 +113,8 @@ contains
       m2l1l2 = m2(k)*l1(k)*l2(k)
       tau1(k) = m2(k)*l2(k)*l2(k)*(qdd1(k) + qdd2(k)) + m2l1l2*c2*(2.0_dp*qdd1(k) + qdd2(k)) &
                 + (m1(k) + m2(k))*l1(k)*l1(k)*qdd1(k) - m2l1l2*s2*qd2(k)*qd2(k) &
-                - 2.0_dp*m2l1l2*s2*qd1(k)*qd2(k) + m2(k)*l2(k)*g*c12 + (m1(k) + m2(k))*l1(k)*g*c1
-      tau2(k) = m2l1l2*c2*qdd1(k) + m2l1l2*s2*qd1(k)*qd1(k) + m2(k)*l2(k)*g*c12 &
+                - 2.0_dp*m2l1l2*s2*qd1(k)*qd2(k) + m2(k)*l2(k)*g(k)*c12 + (m1(k) + m2(k))*l1(k)*g(k)*c1
+      tau2(k) = m2l1l2*c2*qdd1(k) + m2l1l2*s2*qd1(k)*qd1(k) + m2(k)*l2(k)*g(k)*c12 &
                 + m2(k)*l2(k)*l2(k)*(qdd1(k) + qdd2(k))
     end do
   end subroutine torque_block

@@ -1,0 +1,51 @@
+"""&manipulator: robust dimensional synthesis of a planar 2R arm ([Ma'arif 2006], chapter 4).
+
+From a workspace given as points P_i (base A at the origin) the study computes
+
+* the reach conditions |l1 - l2| <= r, l1 + l2 >= R (r, R = min, max d(A, P_i)), the robust
+  circle C_rob: l1^2 + l2^2 = mean d^2 (RI2 = sqrt(n) on it), RI1/RI2/RI3 of any design,
+  the iso-RI2 ellipse variables (Tables 4.1/4.3) and (l1, l2) pairs on C_rob (Table 4.2);
+* the dexterity optimum (l2 = l1 sqrt(2)/2) and manipulability optimum (l1 = l2) on C_rob
+  (Table 4.4);
+* joint angles and Craig point-mass motor torques at a target point for the chosen designs
+  (Tables 4.5-4.7) and along C_rob (Table 4.8; rows where the target is out of reach blank,
+  with a note);
+* tolerance synthesis: the largest box l +- dl whose positioning error stays within a bound
+  (Caro's formulation, closed form and a corner-constrained SLSQP), checked by Monte Carlo.
+
+``mode = 'report'`` applies the report's conventions (docs/manipulator.md sec. 0):
+C_rob radius rounded to 3 dp, C = radius^2 for Table 4.2 and round(radius^2, 2) for Table 4.8,
+Table 4.5 theta2 printed as the interior angle 180 - acos(c2), Table 4.7 fed with the printed
+Table 4.5 angles, Table 4.8 base angle round(atan2(y, x), 2 dp) - theta2.  ``mode = 'exact'``
+uses mean d^2 itself, the IK joint angles on the chosen elbow branch at full precision.  In
+report mode the .out lists every cell where the two modes differ, and why.
+
+Physics (IK, Jacobian, indices, torques, positioning errors) is in fortran/manipulator.f90.
+
+The package splits the study by job: :mod:`.spec` (deck keys and checks), :mod:`.analysis`
+(conventions, optima, joint angles, tolerance synthesis), :mod:`.tables` (the tables and the
+report/exact differences), :mod:`.report` (the run: text, tidy table, summary, figures) and
+:mod:`.batch` (the design summary of many designs in one kernel call).
+"""
+from __future__ import annotations
+
+from driver.deck import Params
+from driver.manipulator.analysis import (DESIGN_STATUS, SIGNIFICANT, STATUS, Conv, Workspace, _sensitivity_blocks,
+                                         optima, round_half_up, tolerance_box)
+from driver.manipulator.batch import BATCH_IGNORED, BATCH_INDEPENDENT, BATCH_KEYS, summarise, summarise_batch
+from driver.manipulator import report as _report
+from driver.manipulator.report import TIDY_UNITS, table_frame
+from driver.manipulator.spec import LABELS, SPEC, SWEEP_PLOT, estimate
+from driver.manipulator.tables import NOT_REPRODUCIBLE, REASONS, TEXT_REASONS, TIDY_NAMES, Table
+from driver.study import Result, keyword_run
+
+__all__ = ["SPEC", "run", "Workspace", "tolerance_box", "round_half_up", "REASONS", "NOT_REPRODUCIBLE", "TEXT_REASONS",
+           "TIDY_NAMES", "TIDY_UNITS", "table_frame", "LABELS", "SWEEP_PLOT", "estimate", "optima",
+           "summarise", "summarise_batch", "BATCH_KEYS", "BATCH_IGNORED", "BATCH_INDEPENDENT", "DESIGN_STATUS"]
+
+
+@keyword_run
+def run(params: Params, progress: bool = False) -> Result:
+    """Run one &manipulator deck (see the package docstring): validated Params, or the deck's
+    keys as keyword arguments (``driver.manipulator.run(points_x=[...], points_y=[...])``)."""
+    return _report.run(params, progress=progress)

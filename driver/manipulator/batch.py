@@ -1,0 +1,252 @@
+"""Design summaries of many &manipulator designs in one kernel call: the batch path of sweeps
+(driver.sweep_batch) and optimisations (driver.optimize.evaluate).
+
+:func:`summarise_batch` returns, one row per design deck, the columns of the single run's
+summary (``run(...).summary``) plus nothing else: the workspace and C_rob figures, the torques
+at the target and the tolerance box of every design, the first design's indices and status,
+and the least torque along C_rob.  The per-design figures come from
+fortran/manipulator_summary.f90 (RI1-RI3, the reach conditions, the IK and Craig torques at the
+target, the closed-form tolerance box and its Monte Carlo check over the deck's samples), for
+all designs in one call; the C_rob walk (Table 4.8) depends on none of the designs and is
+computed once for every distinct target, mass per length and g.
+
+A design that cannot reach the workspace or the target is a row like any other, with its
+``design_status`` and missing figures (NaN here, None in :func:`summarise`): a sweep lists it,
+an optimiser sees its constraint ``design_reaches_all`` violated.  (A single run refuses such a
+deck design: its tables need a design that reaches.)
+"""
+from __future__ import annotations
+
+import math
+from typing import Any, Mapping
+
+import numpy as np
+import pandas as pd
+
+from driver import kernels
+from driver.deck import Params
+from driver.manipulator.analysis import STATUS, Conv, Workspace, _design_list, design_status, round_half_up
+from driver.manipulator.report import sweep_columns, workspace_columns
+from driver.manipulator.tables import _t48
+
+__all__ = ["BATCH_KEYS", "BATCH_IGNORED", "BATCH_INDEPENDENT", "summarise_batch", "summarise"]
+
+#: deck keys a batch may vary (one value per design deck; designs_l1/designs_l2 one length, or
+#: an (n, k) array for k designs per deck); every other key is the base deck's
+BATCH_KEYS = ("designs_l1", "designs_l2", "mass_per_length", "gravity", "target_x", "target_y", "tolerance_bound")
+#: keys that change tables but not the summary (accepted and ignored)
+BATCH_IGNORED = ("title", "ri2_levels", "crob_l1", "text_optimum_decimals")
+#: keys whose deck checks do not involve other keys (a sweep validates each of their values once)
+BATCH_INDEPENDENT = ("mass_per_length", "gravity", "tolerance_bound", "title", "crob_l1")
+
+#: C_rob walks cached per distinct (target, mass per length, g) and base deck: an optimiser
+#: asks for the same one at every population
+_WALKS: dict[tuple, dict[str, Any]] = {}
+
+
+def _bad(base: Mapping[str, Any], key: str | None, message: str) -> Exception:
+    """A DeckError at the key's deck line when ``base`` is a deck's Params, else a ValueError."""
+    if isinstance(base, Params):
+        return base.error(key, message)
+    return ValueError(f"{key}: {message}" if key else message)
+
+
+def _as_params(base: Mapping[str, Any]) -> Params:
+    if isinstance(base, Params):
+        return base
+    from pathlib import Path
+    return Params("manipulator", Path("batch"), dict(base), {}, 1)
+
+
+def _with(p: Params, **values: Any) -> Params:
+    """``p`` with some values replaced (same deck lines)."""
+    return Params(p.group, p.path, {**p, **values}, p._lines, p.line, p.given)
+
+
+def _column(base: Mapping[str, Any], key: str, v: Any, n: int, check) -> np.ndarray:
+    a = np.broadcast_to(np.asarray(v, dtype=np.float64), (n,))
+    bad = ~np.isfinite(a) | ~check(a)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise _bad(base, key, f"design {i} has {float(a[i])!r}")
+    return a
+
+
+def _lengths(base: Mapping[str, Any], columns: dict[str, Any], n: int, conv: Conv
+             ) -> tuple[list[str], np.ndarray, np.ndarray]:
+    """Design names and lengths l1, l2 (n, k) [m]: swept, the base deck's, or the optima on C_rob."""
+    if "designs_l1" not in columns and "designs_l2" not in columns:
+        names, l1, l2 = _design_list(_as_params(base), conv)
+        return names, np.broadcast_to(l1, (n, l1.size)), np.broadcast_to(l2, (n, l2.size))
+    out = []
+    for key in ("designs_l1", "designs_l2"):
+        v = columns[key] if key in columns else base[key]
+        if v is None:
+            raise _bad(base, key, "designs_l1 and designs_l2 must be given together")
+        a = np.asarray(v, dtype=np.float64)
+        a = a.reshape(n, -1) if key in columns else np.broadcast_to(a.ravel(), (n, a.size))
+        bad = ~np.isfinite(a) | ~(a > 0)
+        if bad.any():
+            i = int(np.argmax(bad.any(1)))
+            raise _bad(base, key, f"design {i} has {a[i].tolist()!r} (lengths must be positive and finite)")
+        out.append(a)
+    l1, l2 = out
+    if l1.shape != l2.shape:
+        raise _bad(base, "designs_l2", f"gives {l2.shape[1]} lengths per design but designs_l1 gives {l1.shape[1]}")
+    k = l1.shape[1]
+    names = base["design_names"]
+    if names is not None and len(names) != k:
+        raise _bad(base, "design_names", f"gives {len(names)} names for {k} designs")
+    return list(names or [f"Design {i + 1}" for i in range(k)]), l1, l2
+
+
+def _walk(p: Params, conv: Conv, tx: float, ty: float, mpl: float, g: float) -> dict[str, Any]:
+    """Summary columns of the C_rob walk (Table 4.8) for one target, mass per length and g."""
+    key = (p.path, tuple(sorted((k, repr(v)) for k, v in p.items() if k != "title")), tx, ty, mpl, g)
+    if key not in _WALKS:
+        if len(_WALKS) > 4096:
+            _WALKS.clear()
+        _, sweep = _t48(_with(p, target_x=tx, target_y=ty, mass_per_length=mpl, gravity=g), conv)
+        _WALKS[key] = sweep_columns(sweep)
+    return _WALKS[key]
+
+
+def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None = None) -> pd.DataFrame:
+    """Summaries of many &manipulator design decks in one Fortran call: one row per deck.
+
+    ``base``: a validated ``&manipulator`` Params.  ``columns``: {key: n values} for keys in
+    BATCH_KEYS (``'manipulator.gravity'`` is accepted for ``'gravity'``); scalars broadcast;
+    ``designs_l1``/``designs_l2`` n lengths [m] (one design per deck) or an (n, k) array.
+    Lengths [m], ``mass_per_length`` [kg/m], ``gravity`` [m/s^2], target [m], tolerance bound [m].
+    Returns the columns of the single run's summary with its values (to the last printed
+    digit; the first design's torque and indices to the last bit), missing figures as NaN,
+    and ``design_status`` (analysis.DESIGN_STATUS) saying why a figure is missing.
+    A bad value raises DeckError (deck, line and key of the base deck; the design's index in the
+    message) or ValueError for a plain mapping.  About 2 us per design with the deck's 1000
+    Monte Carlo samples (bench/bench_manipulator.py).
+    """
+    p = _as_params(base)
+    columns = {k.partition(".")[2] if k.startswith("manipulator.") else k: v for k, v in (columns or {}).items()}
+    unknown = [k for k in columns if k not in BATCH_KEYS and k not in BATCH_IGNORED]
+    if unknown:
+        raise _bad(base, unknown[0], f"not a &manipulator key the summary takes per design ({', '.join(BATCH_KEYS)})")
+    columns = {k: v for k, v in columns.items() if k in BATCH_KEYS}
+    sizes = {np.shape(v)[0] for v in columns.values() if np.ndim(v) > 0}
+    if len(sizes) > 1:
+        raise _bad(base, None, f"batch columns have different lengths {sorted(sizes)}")
+    n = sizes.pop() if sizes else 1
+    if n == 0:
+        return _empty(base)
+    ws = Workspace(np.asarray(p.points_x, dtype=np.float64), np.asarray(p.points_y, dtype=np.float64))
+    conv = Conv(p.mode == "report", ws)
+    names, l1, l2 = _lengths(base, columns, n, conv)
+    k = l1.shape[1]
+    if ("target_x" in columns or "target_y" in columns) and \
+            (columns.get("target_x", p.target_x) is None or columns.get("target_y", p.target_y) is None):
+        raise _bad(base, "target_y" if "target_x" in columns else "target_x",
+                   "target_x and target_y must be given together")
+    tx0, ty0 = (p.target_x, p.target_y) if p.target_x is not None else (float(ws.x[0]), float(ws.y[0]))
+    finite = lambda a: np.ones(a.shape, bool)
+    tx = _column(base, "target_x", columns.get("target_x", tx0), n, finite)
+    ty = _column(base, "target_y", columns.get("target_y", ty0), n, finite)
+    if ((tx == 0.0) & (ty == 0.0)).any():
+        i = int(np.argmax((tx == 0.0) & (ty == 0.0)))
+        raise _bad(base, "target_x", f"design {i}: the target point is the base (0, 0)")
+    mpl = _column(base, "mass_per_length", columns.get("mass_per_length", p.mass_per_length), n, lambda a: a > 0)
+    g = _column(base, "gravity", columns.get("gravity", p.gravity), n, lambda a: a >= 0)
+    eps = _column(base, "tolerance_bound", columns.get("tolerance_bound", p.tolerance_bound), n, lambda a: a >= 1e-9)
+
+    # every design of every deck in one kernel call (rows deck-major: deck i, design j -> i k + j)
+    prm = np.empty((n * k, 7), dtype=np.float64, order="F")
+    prm[:, 0], prm[:, 1] = l1.ravel(), l2.ravel()
+    for j, v in enumerate((tx, ty, mpl, g, eps), start=2):
+        prm[:, j] = np.repeat(v, k)
+    rates = [*p.joint_rates, *p.joint_accels]
+    unit = np.random.default_rng(p.mc_seed).uniform(-1.0, 1.0, size=(p.mc_samples, 2))
+    res = kernels.manipulator_design_summaries(ws.x, ws.y, prm, p.elbow, rates, p.error_measure, unit)
+    r = {c: res[:, i].reshape(n, k) for i, c in enumerate(kernels.MANIPULATOR_SUMMARY_COLUMNS)}
+    ok = r["target_status"] == STATUS["ok"]
+    tau1, tau2 = r["tau1"], r["tau2"]
+    if conv.report:
+        tau1, tau2 = _report_torques(p, prm, r, n, k)
+
+    out: dict[str, Any] = {c: np.full(n, v, dtype=object if isinstance(v, str) else None)
+                           for c, v in workspace_columns(p, ws, conv).items()}
+    nan = lambda v, m: np.where(m, v, np.nan)
+    for j, name in enumerate(names):
+        key = name.lower().replace(" ", "_")
+        out[f"{key}_tau1_Nm"] = nan(tau1[:, j], ok[:, j])
+        out[f"{key}_tau2_Nm"] = nan(tau2[:, j], ok[:, j])
+    reached = r["reaches_points"] > 0
+    for j, name in enumerate(names):
+        key = name.lower().replace(" ", "_")
+        out[f"{key}_dl_m"] = nan(r["dl1"][:, j], reached[:, j])
+        out[f"{key}_mc_max_m"] = nan(r["mc_max"][:, j], reached[:, j])
+        out[f"{key}_reaches_workspace"] = reached[:, j].copy()
+    d1, d2 = l1[:, 0].copy(), l2[:, 0].copy()
+    ri1, ri2, reach = r["ri1"][:, 0], r["ri2"][:, 0], r["reach"][:, 0] > 0
+    out.update({"design_l1_m": d1, "design_l2_m": d2, "design_ri1": nan(ri1, ri1 > 0), "design_ri2": ri2.copy(),
+                "design_ri3": r["ri3"][:, 0].copy(), "design_ri2_excess": ri2 - math.sqrt(ws.n),
+                "design_reaches_all": reach, "design_crob_residual_m2": d1 * d1 + d2 * d2 - ws.mean_d2,
+                "design_total_torque_Nm": nan(tau1[:, 0] + tau2[:, 0], ok[:, 0]),
+                "design_status": np.array([design_status(a, b, c) for a, b, c in zip(reach, ok[:, 0], ri1)],
+                                          dtype=object)})
+    # the C_rob walk: once per distinct target, mass per length and g
+    combos = np.stack([tx, ty, mpl, g], 1)
+    uniq, inv = np.unique(combos, axis=0, return_inverse=True)
+    walks = [_walk(p, conv, *map(float, u)) for u in uniq]
+    for c in ("sweep_min_total_torque_Nm", "sweep_min_l1_m", "sweep_min_l2_m", "sweep_min_row",
+              "sweep_min_reaches_workspace"):
+        vals = [w.get(c) for w in walks]
+        if all(v is None for v in vals):
+            continue
+        kind = object if any(v is None for v in vals) else type(vals[0])
+        out[c] = np.array(vals, dtype=kind)[inv.ravel()]
+    return pd.DataFrame(out)
+
+
+def _empty(base: Mapping[str, Any]) -> pd.DataFrame:
+    return summarise_batch(base).iloc[:0]
+
+
+def _report_torques(p: Params, prm: np.ndarray, r: dict[str, np.ndarray], n: int, k: int
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """mode = 'report': the torques of the report's Table 4.7 -- the printed Table 4.5 angles
+    (printed_angles_deg, or the IK angles rounded to 2 dp with theta2 the interior angle)."""
+    t1, t2 = r["theta1_deg"].ravel(), r["theta2_deg"].ravel()
+    if p.printed_angles_deg is not None and len(p.printed_angles_deg) == 2 * k:
+        used = np.tile(np.asarray(p.printed_angles_deg, dtype=np.float64).reshape(-1, 2), (n, 1))
+    else:
+        used = np.array([[round_half_up(a, 2), round_half_up(180.0 - abs(b), 2)] for a, b in zip(t1, t2)])
+        used = used.reshape(-1, 2)
+    tau = np.empty((n * k, 2))
+    for gv in np.unique(prm[:, 5]):      # the torque kernel takes one g per call
+        m = prm[:, 5] == gv
+        tau[m] = kernels.manipulator_torques(prm[m, 0], prm[m, 1], np.radians(used[m, 0]), np.radians(used[m, 1]),
+                                             p.joint_rates, p.joint_accels, prm[m, 4] * prm[m, 0],
+                                             prm[m, 4] * prm[m, 1], float(gv))
+    return tau[:, 0].reshape(n, k), tau[:, 1].reshape(n, k)
+
+
+def summarise(params: Params) -> dict[str, Any]:
+    """The design summary of one deck (one row of :func:`summarise_batch`; missing -> None):
+    what a sweep or an optimiser needs when it writes no per-case files.  Equals
+    ``run(params).summary`` wherever a run succeeds, and also answers for a design the run
+    refuses (one that cannot reach the workspace or the target), with its ``design_status``."""
+    row = summarise_batch(params).iloc[0].to_dict()
+    out = {}
+    for key, v in row.items():
+        if isinstance(v, float) and math.isnan(v):
+            v = None
+        elif isinstance(v, np.bool_):
+            v = bool(v)
+        elif isinstance(v, np.integer):
+            v = int(v)
+        elif isinstance(v, np.floating):
+            v = float(v)
+        out[key] = v
+    if out.get("sweep_min_total_torque_Nm") is None:   # as a run: no C_rob row reaches the target
+        for key in ("sweep_min_total_torque_Nm", "sweep_min_l1_m", "sweep_min_l2_m", "sweep_min_row",
+                    "sweep_min_reaches_workspace"):
+            out.pop(key, None)
+    return out
