@@ -139,7 +139,11 @@ def _alive(pid: int) -> bool:
         return False
     except PermissionError:
         return True
-    return True
+    try:   # a killed process stays a zombie until reaped (its parent may be dead too): not alive
+        with open(f"/proc/{pid}/stat") as fh:
+            return fh.read().rpartition(")")[2].split()[0] not in ("Z", "X")
+    except (OSError, IndexError):
+        return True
 
 
 def remove_stale_temporaries(folder: str | Path, stem: str) -> list[Path]:

@@ -69,7 +69,8 @@ LABELS = {"crank": ("crank length", "length units"), "coupler": ("coupler length
           "mu_min_deg": ("minimum transmission angle", "deg"), "mu_max_deg": ("maximum transmission angle", "deg"),
           "rocker_swing_deg": ("rocker swing", "deg"), "omega3_peak_rad_s": ("peak rocker speed", "rad/s"),
           "omega2_peak_rad_s": ("peak coupler speed", "rad/s"),
-          "assembled_fraction": ("fraction of the turn assembled", "-")}
+          "assembled_fraction": ("fraction of the turn assembled", "-"),
+          "time_ratio": ("time ratio (slow / quick stroke)", "-")}
 #: what a sweep summary plots when its deck names no plot_y
 SWEEP_PLOT = ("mu_min_deg", "mu_max_deg", "rocker_swing_deg", "omega3_peak_rad_s", "omega2_peak_rad_s",
               "assembled_fraction")
@@ -284,7 +285,9 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     Returns the columns of the single-case summary (``summarise``) with identical values
     (missing figures as NaN): grashof_class, full_crank_rotation, assemblable, mu_min_deg,
     mu_max_deg, meets_band_40_120, rocker_turns_fully, rocker_swing_deg, toggle_in_range,
-    omega3_peak_rad_s, omega2_peak_rad_s, assembled_fraction; with ``detail`` also the crank
+    omega3_peak_rad_s, omega2_peak_rad_s, assembled_fraction, time_ratio (crank angle of the
+    rocker's slower stroke over its quicker one, >= 1; missing unless the range holds a full
+    turn, assembled throughout, without a toggle, with the rocker oscillating); with ``detail`` also the crank
     angles [deg] of those extremes, the rocker extreme positions [deg] and the number of
     toggle positions in the range.  A bad value raises DeckError (``base`` a deck's Params:
     deck, line and key of the base deck, the design's index in the message) or ValueError.
@@ -321,7 +324,8 @@ def _frame(res: np.ndarray, detail: bool = False) -> pd.DataFrame:
            "rocker_turns_fully": turns, "rocker_swing_deg": has(c["rocker_swing_deg"]),
            "toggle_in_range": tog, "omega3_peak_rad_s": has(c["omega3_peak_rad_s"], ok & ~tog),
            "omega2_peak_rad_s": has(c["omega2_peak_rad_s"], ok & ~tog),
-           "assembled_fraction": np.where(ok, c["assembled_fraction"], 0.0)}
+           "assembled_fraction": np.where(ok, c["assembled_fraction"], 0.0),
+           "time_ratio": np.where(ok & (c["time_ratio"] > 0), c["time_ratio"], np.nan)}
     if detail:
         out |= {"mu_min_at_deg": has(c["mu_min_at_deg"]), "mu_max_at_deg": has(c["mu_max_at_deg"]),
                 "rocker_min_deg": has(c["rocker_min_deg"]), "rocker_min_at_deg": has(c["rocker_min_at_deg"]),

@@ -96,7 +96,7 @@ FOURBAR_SUMMARY_COLUMNS = ("grashof", "assemblable", "assembled_fraction", "mu_m
                            "mu_max_deg", "mu_max_at_deg", "rocker_min_deg", "rocker_min_at_deg",
                            "rocker_max_deg", "rocker_max_at_deg", "rocker_swing_deg", "rocker_turns",
                            "toggles_in_range", "omega3_peak_rad_s", "omega3_peak_at_deg",
-                           "omega2_peak_rad_s", "omega2_peak_at_deg")
+                           "omega2_peak_rad_s", "omega2_peak_at_deg", "time_ratio")
 #: Grashof class codes of fourbar_summaries
 FOURBAR_GRASHOF = {int(getattr(_kernels.fourbar_summary, f"gr_{k}")): k for k in
                    ("double_crank", "crank_rocker", "rocker_crank", "double_rocker", "change_point",
@@ -104,7 +104,7 @@ FOURBAR_GRASHOF = {int(getattr(_kernels.fourbar_summary, f"gr_{k}")): k for k in
 
 
 def fourbar_summaries(params: np.ndarray) -> np.ndarray:
-    """Headline figures of many four-bars in one kernel call: (n, 18) array.
+    """Headline figures of many four-bars in one kernel call: (n, 19) array.
 
     ``params`` (n, 8): fixed link p, crank q, coupler r, rocker s [length], crank speed
     [rad/s], first and last crank angle of the range [deg], branch (+1 open, -1 crossed).

@@ -158,12 +158,17 @@ def _time(s: float) -> str:
     return f"{s:.3g} s"
 
 
-def check(module: Any, params: Params, what: str = "") -> Estimate | None:
-    """Raise DeckError when the study's estimate for ``params`` exceeds the budget."""
+def check(module: Any, params: Params, what: str = "", lim: Budget | None = None) -> Estimate | None:
+    """Raise DeckError when the study's estimate for ``params`` exceeds the budget.
+
+    ``lim``: the budget to apply (default :func:`budget`, this process's); a caller that sends
+    cases to other machines (a Dask cluster does not inherit this process's environment) passes
+    its own.
+    """
     if not hasattr(module, "estimate"):
         return None
     est = module.estimate(params)
-    lim = budget()
+    lim = lim or budget()
     detail = f" ({est.detail})" if est.detail else ""
     if est.bytes > lim.memory:
         raise params.error(est.memory_key, f"{what}needs about {_size(est.bytes)} of memory{detail}, beyond the "

@@ -23,7 +23,7 @@ from driver.export import FORMATS, summary_json_text, write_tidy
 from driver.study import Result, load_study
 from driver.table import TableValueError
 
-__all__ = ["CONTROL_GROUPS", "Outcome", "available_studies", "study_of", "run_study", "write_outputs",
+__all__ = ["CONTROL_GROUPS", "CaseFailure", "Outcome", "available_studies", "study_of", "run_study", "write_outputs",
            "output_stem", "check_finite", "compute", "numerical_error"]
 
 #: groups handled by the driver itself rather than by a study module
@@ -125,7 +125,13 @@ _WORDS = [(TableValueError, "a result that is not a finite number"),
 _NON_FINITE = re.compile(r"(?<![A-Za-z_])(nan|[+-]?inf(inity)?)(?![A-Za-z_])|\*\*\*\*", re.IGNORECASE)
 
 
-def numerical_error(params: Params, exc: BaseException) -> DeckError:
+class CaseFailure(DeckError):
+    """A deck error for a case that was accepted and computed but failed: a numerical failure,
+    or a non-finite number bound for a table (an optimiser counts such a design as failed, one
+    the study refuses as input as not a valid design)."""
+
+
+def numerical_error(params: Params, exc: BaseException) -> CaseFailure:
     """The deck error for a numerical failure reached from ``params``.
 
     A study may define ``blame(params, exc) -> (key, message) | None`` to name the key; otherwise
@@ -134,12 +140,14 @@ def numerical_error(params: Params, exc: BaseException) -> DeckError:
     module = load_study(params.group)
     blamed = module.blame(params, exc) if module is not None and hasattr(module, "blame") else None
     if blamed:
-        return params.error(*blamed)
-    words = next(w for cls, w in _WORDS if isinstance(exc, cls))
-    detail = str(exc).strip().splitlines()[0][:120] if str(exc).strip() else exc.__class__.__name__
-    given = ", ".join(sorted(params.given)) or "none"
-    return params.error(None, f"the values of &{params.group} lead to {words} ({detail}); this case cannot "
-                        f"be computed (keys given: {given})")
+        e = params.error(*blamed)
+    else:
+        words = next(w for cls, w in _WORDS if isinstance(exc, cls))
+        detail = str(exc).strip().splitlines()[0][:120] if str(exc).strip() else exc.__class__.__name__
+        given = ", ".join(sorted(params.given)) or "none"
+        e = params.error(None, f"the values of &{params.group} lead to {words} ({detail}); this case cannot "
+                         f"be computed (keys given: {given})")
+    return CaseFailure(e.path, e.line, e.key, e.message)
 
 
 def check_finite(result: Result, params: Params) -> Result:
@@ -158,11 +166,12 @@ def check_finite(result: Result, params: Params) -> Result:
     return result
 
 
-def compute(module: ModuleType, params: Params, progress: bool = False) -> Result:
-    """``module.run(params)`` within the budget (:mod:`driver.limits`), with numerical failures
-    turned into deck errors and the result checked for non-finite numbers (no NaN, inf or '****'
-    ever reaches a table)."""
-    limits.check(module, params)   # absurd requests are refused before anything is allocated
+def compute(module: ModuleType, params: Params, progress: bool = False,
+            budget: limits.Budget | None = None) -> Result:
+    """``module.run(params)`` within the budget (:mod:`driver.limits`; ``budget`` default this
+    process's), with numerical failures turned into deck errors and the result checked for
+    non-finite numbers (no NaN, inf or '****' ever reaches a table)."""
+    limits.check(module, params, lim=budget)   # absurd requests are refused before anything is allocated
     try:
         with np.errstate(all="ignore"):
             result = module.run(params, progress=progress)

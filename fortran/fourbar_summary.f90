@@ -19,7 +19,10 @@
 !> * peak speeds (no toggle in the range): a 1 deg scan of the whole range in one vectorised
 !>   kernel call, then each sign change of the angular acceleration (crank speed constant,
 !>   so alpha = d omega / dt vanishes at a speed extremum) refined by Illinois regula falsi
-!>   to 1e-12 rad, all brackets of a linkage in one kernel call per iteration.
+!>   to 1e-12 rad, all brackets of a linkage in one kernel call per iteration;
+!> * time ratio (a full turn, assembled throughout, no toggle, rocker oscillating): the crank
+!>   turns a = (crank angle of the upper rocker extreme - that of the lower) mod 360 on one
+!>   stroke and 360 - a on the other; the ratio is the slower over the quicker, >= 1.
 !>
 !> Velocities are evaluated for a unit crank speed and scaled by omega (they are linear in it).
 module fourbar_summary
@@ -32,7 +35,7 @@ module fourbar_summary
   !> params columns
   integer, parameter, public :: npar = 8
   !> result columns (see summaries)
-  integer, parameter, public :: ncol = 18
+  integer, parameter, public :: ncol = 19
   !> Grashof class codes shared with driver/fourbar.py
   integer, parameter, public :: gr_double_crank = 0, gr_crank_rocker = 1, gr_rocker_crank = 2, &
                                 gr_double_rocker = 3, gr_change_point = 4, gr_triple_rocker = 5
@@ -60,12 +63,15 @@ contains
   !> res(:, 14) number of toggle (limit) crank angles in the range
   !> res(:, 15:16) peak rocker angular velocity [rad/s] (signed) and its crank angle [deg]
   !> res(:, 17:18) peak coupler angular velocity and its crank angle (peaks 0 when res(:, 14) > 0)
+  !> res(:, 19) time ratio of the rocker's strokes (crank angle of the slower over the quicker, >= 1);
+  !>            0 unless the range holds a full turn, assembled throughout, without a toggle, and
+  !>            the rocker oscillates
   !> Figures that do not exist (not assemblable) are 0; the caller masks them with res(:, 2) / res(:, 14).
   subroutine summaries(n, params, res)
     !f2py threadsafe
     integer, intent(in) :: n
     real(dp), intent(in) :: params(n, 8)      ! npar columns (literal for f2py)
-    real(dp), intent(out) :: res(n, 18)        ! ncol columns
+    real(dp), intent(out) :: res(n, 19)        ! ncol columns
     real(dp) :: row(ncol)
     integer :: i
     do i = 1, n
@@ -367,6 +373,13 @@ contains
       row(12) = 360.0_dp
     else
       row(12) = (umax - umin)/rad
+    end if
+
+    ! ---- time ratio: a full turn without toggles, the rocker oscillating
+    if (hie - lo >= 360.0_dp .and. row(3) >= 1.0_dp .and. niv == 1 .and. ntog == 0 .and. &
+        row(13) == 0.0_dp) then
+      t = modulo(tumax - tumin, 360.0_dp)
+      if (t > 0.0_dp .and. t < 360.0_dp) row(19) = max(t, 360.0_dp - t)/min(t, 360.0_dp - t)
     end if
 
     ! ---- peak speeds: only without a toggle in the range (then the range is one interval)

@@ -62,6 +62,10 @@ def oracle(p, q, r, s, lo=0.0, hi=360.0, branch=1, omega=1.0, step=0.01):
         for name, col in (("omega3_peak_rad_s", 8), ("omega2_peak_rad_s", 7)):
             k = np.argmax(np.abs(out[:, col]))
             res[name] = out[k, col]
+        if hi - lo == 360.0 and res["rocker_swing_deg"] < 359.0:
+            # crank angles of the rocker's extremes on the grid: the strokes' shares of the turn
+            turn = (grid[runs[0][np.argmax(u)]] - grid[runs[0][np.argmin(u)]]) % 360.0
+            res["time_ratio"] = max(turn, 360.0 - turn) / min(turn, 360.0 - turn)
     res["assembled_fraction"] = placed.mean()
     return res
 
@@ -106,6 +110,28 @@ def test_batch_against_brute_force(lengths, branch):
             assert abs(f[name]) >= abs(o[name]) * (1 - 1e-12)
     else:
         assert f["toggle_in_range"] and math.isnan(f["omega3_peak_rad_s"])
+    if "time_ratio" in o:   # a full turn with the rocker oscillating: strokes of 180 +- alpha
+        assert f["time_ratio"] >= 1.0
+        assert f["time_ratio"] == pytest.approx(o["time_ratio"], abs=2e-4)
+    else:
+        assert math.isnan(f["time_ratio"])
+
+
+def test_time_ratio_of_the_closed_form_crank_rocker_family():
+    """Every crank-rocker of the textbook family (driver/synthesis/crank_rocker.py, built for a
+    swing and a time ratio in closed form) has exactly that time ratio in the batch summary."""
+    from driver.synthesis import crank_rocker as cr
+    for swing, q in ((60.0, 1.25), (45.0, 1.0), (80.0, 1.6)):
+        members = [m for m in cr.family(swing, q, 25) if m.crank_rocker]
+        assert len(members) > 10
+        f = summarise_batch(params(fixed_link=1.0, crank=1.0, coupler=1.0, rocker=1.0),
+                            {"fixed_link": [m.ground for m in members], "crank": [m.crank for m in members],
+                             "coupler": [m.coupler for m in members], "rocker": [m.rocker for m in members]})
+        assert f["rocker_swing_deg"].to_numpy() == pytest.approx(swing, abs=1e-7)
+        assert f["time_ratio"].to_numpy() == pytest.approx(q, abs=1e-7)
+    # a range short of a full turn has no time ratio
+    f = summarise_batch(params(fixed_link=12.0, crank=5.0, coupler=15.0, rocker=9.0, stop_deg=350.0))
+    assert math.isnan(f["time_ratio"].iloc[0])
 
 
 def test_partial_ranges_and_long_ranges():

@@ -8,6 +8,7 @@
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 
@@ -272,14 +273,136 @@ def test_grid_started_local_search_and_partial_journal_resume(tmp_path):
     assert not (out / "opt.journal.jsonl").exists()
 
 
-def test_dask_scheduler_gives_the_same_run(tmp_path):
+#: a small slider-crank problem (no batch path: every design is one integration, case by case)
+SC_SMALL = """&slidercrank
+  material = 'aluminium'
+  section_width = 9e-3, section_depth = 3e-3
+  speeds = 29.32
+  n_elements = 4, steps_per_rev = 720, revolutions = 1
+  geometric_stiffness = .true.
+/
+&optimize
+  var1 = 'slidercrank.section_width', lower1 = 6e-3, upper1 = 20e-3
+  var2 = 'slidercrank.section_depth', lower2 = 2e-3, upper2 = 20e-3
+  minimize = 'rod_mass_kg'
+  constraint1 = 'euler_ratio_max <= 1/3'
+  method = 'differential_evolution', seed = 3, popsize = 4, maxiter = 3, tol = 0, atol = 0
+/
+"""
+
+
+def _trace(oc) -> tuple:
+    """Everything a run decided: designs in evaluation order with their results, and the history."""
+    recs = [(r.x, r.status, r.feasible, r.objective, r.margins) for r in oc.evaluator.records]
+    hist = [(h.step, h.evals, h.objective, h.x, h.feasible) for h in oc.history]
+    return oc.x, oc.fun, oc.nfev, recs, hist
+
+
+def test_differential_evolution_same_run_in_one_process_worker_processes_and_on_dask(tmp_path, monkeypatch):
+    """A study without a batch path: each generation goes case by case to worker processes or a
+    Dask LocalCluster (submitted at once, gathered in order); the run is the same design for
+    design, generation for generation, as in one process."""
     distributed = pytest.importorskip("distributed")
-    body = ("var1 = 'fourbar.coupler', lower1 = 10, upper1 = 20\nvar2 = 'fourbar.rocker', lower2 = 5, upper2 = 12\n"
-            "maximize = 'mu_min_deg'\nconstraint1 = 'rocker_swing_deg >= 40'\nmethod = 'grid', grid_count = 5")
-    path = _deck(tmp_path, body)
-    local = optimize(path, None, jobs=1)
-    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
-                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
-        on_dask = optimize(path, None, scheduler=client)
-        assert on_dask.evaluator.scheduler is client
-    assert on_dask.x == local.x and on_dask.fun == local.fun and on_dask.nfev == 25
+    import os
+    from driver.optimize import evaluate
+    from driver import slidercrank
+    # a LocalCluster with worker processes sets OMP/MKL/OPENBLAS_NUM_THREADS=1 in this process's
+    # environment; later tests' subprocesses must not inherit that (SLSQP results follow OpenBLAS's
+    # thread count in the last bits, and the committed outputs are compared byte for byte)
+    for name in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MALLOC_TRIM_THRESHOLD_"):
+        monkeypatch.setenv(name, os.environ.get(name, ""))   # recorded: undone after the test
+        if not os.environ[name]:
+            monkeypatch.delenv(name)
+    assert not hasattr(slidercrank, "summarise_batch")
+    path = tmp_path / "sc.dat"
+    path.write_text(SC_SMALL)
+    serial = optimize(path, None, jobs=1)
+    assert set(serial.evaluator.routes) == {"serial"}
+    assert serial.nfev == 4 * 2 * (3 + 1) and len(serial.history) == 3
+    monkeypatch.setattr(evaluate, "POOL_MIN_SECONDS", 0.0)   # every batch after the first to the pool
+    pooled = optimize(path, None, jobs=2)
+    assert pooled.evaluator.routes.get("processes", 0) >= 3 * 8
+    assert _trace(pooled) == _trace(serial)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=":0") as cluster:
+        with distributed.Client(cluster) as client:
+            on_dask = optimize(path, None, scheduler=client)
+            routes = on_dask.evaluator.routes     # (a lone design is computed here, not shipped)
+            assert set(routes) <= {"dask", "serial"} and routes["dask"] >= 3 * 8
+            assert _trace(on_dask) == _trace(serial)
+        # --scheduler on the command line is the one used (an address: the run connects itself)
+        out = tmp_path / "cli"
+        main([str(path), "-o", str(out), "-q", "--scheduler", cluster.scheduler_address])
+    ref = tmp_path / "ref"
+    main([str(path), "-o", str(ref), "-q", "-j", "1"])
+    for name in ("sc.out", "sc_history.csv", "sc.optimum.dat"):
+        assert (out / name).read_text() == (ref / name).read_text()
+    a, b = pd.read_parquet(out / "sc_evals.parquet"), pd.read_parquet(ref / "sc_evals.parquet")
+    pd.testing.assert_frame_equal(a, b)
+
+
+def test_a_deck_never_names_the_scheduler(tmp_path, capsys):
+    path = tmp_path / "sc.dat"
+    path.write_text(SC_SMALL.replace("  method = ", "  scheduler = 'tcp://10.0.0.1:8786'\n  method = "))
+    assert main([str(path), "-o", str(tmp_path / "out")]) == 2
+    assert "scheduler" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
+
+
+def test_over_budget_and_non_finite_designs_are_infeasible_with_reasons(tmp_path, monkeypatch):
+    """Per-design runs go through the runner: a design over the work budget is refused before it
+    runs, counted by reason, and never ends the run (a Dask worker gets the budget with the cases)."""
+    from driver import limits, slidercrank
+    path = tmp_path / "sc.dat"
+    path.write_text(SC_SMALL.replace("var2 = 'slidercrank.section_depth', lower2 = 2e-3, upper2 = 20e-3",
+                             "var2 = 'slidercrank.section_depth', lower2 = 2e-3, upper2 = 20e-3\n"
+                             "  var3 = 'slidercrank.speeds', lower3 = 10, upper3 = 30"))
+    real = slidercrank.estimate
+
+    def estimate(params):   # a fast design counts as an absurd one above 25 rad/s
+        est = real(params)
+        return limits.Estimate(est.bytes, 1e9 if params.speeds[0] > 25 else est.seconds, est.memory_key,
+                               "speeds", "a test's stand-in")
+    run = slidercrank.run
+
+    def run_nan(params, progress=False):   # a slow design writes a NaN into its table
+        result = run(params, progress)
+        return dataclasses.replace(result, text=result.text + "   nan\n") if params.speeds[0] < 12 else result
+    monkeypatch.setattr(slidercrank, "estimate", estimate)
+    monkeypatch.setattr(slidercrank, "run", run_nan)
+    oc = optimize(path, tmp_path / "out", jobs=1)
+    nan = [r for r in oc.evaluator.records if r.x[2] < 12 and r.status != "bad_input"]
+    assert nan and all(r.status == "failed" and "not a finite number" in r.reason for r in nan)
+    refused = [r for r in oc.evaluator.records if r.status == "refused"]
+    assert refused and all(r.x[2] > 25 for r in refused)
+    assert all(r.status != "refused" for r in oc.evaluator.records if r.x[2] <= 25)
+    assert all(not r.feasible and r.why.startswith("refused, over the budget") for r in refused)
+    text = (tmp_path / "out" / "sc.out").read_text()
+    assert f"{len(refused):>8}  refused, over the budget of one run: speeds:" in text
+
+
+def test_crank_rocker_through_optimize_agrees_with_the_closed_form_family(tmp_path):
+    """inputs/optimize_crank_rocker.dat states the textbook problem of
+    inputs/synthesis_crank_rocker.dat (swing 60 deg, time ratio 1.25, ground 10, best
+    transmission angle) over the four-bar keys; SLSQP from seeded starts, knowing nothing of the
+    construction, must land on the closed-form family's best member.  Tolerances: swing and time
+    ratio are held within 1e-6 by the deck's constraint pairs, which moves the optimum along the
+    family by about 1e-5 (lengths) and its objective by < 1e-4 deg."""
+    from driver.synthesis import crank_rocker as cr, synthesise
+    oc = optimize(ROOT / "inputs" / "optimize_crank_rocker.dat", None, jobs=1)
+    assert oc.success
+    syn = synthesise(ROOT / "inputs" / "synthesis_crank_rocker.dat")
+    best = syn.design
+    crank, coupler, rocker = best.scaled(10.0)
+    assert oc.fun == pytest.approx(best.quality_deg, abs=1e-4)
+    assert oc.x["fourbar.crank"] == pytest.approx(crank, rel=1e-5)
+    assert oc.x["fourbar.coupler"] == pytest.approx(coupler, rel=1e-5)
+    assert oc.x["fourbar.rocker"] == pytest.approx(rocker, rel=1e-5)
+    # the optimum, re-run by the full study: swing and time ratio as asked, a crank-rocker
+    s = oc.check.summary
+    assert oc.check.feasible and s["grashof_class"] == "crank-rocker"
+    assert s["rocker_swing_deg"] == pytest.approx(60.0, abs=1.01e-6)
+    assert s["time_ratio"] == pytest.approx(1.25, abs=1.01e-6)
+    # no family member (a fine scan of both arcs, closed form) beats it beyond the band's slack
+    fine = [m for m in cr.family(60.0, 1.25, 4001) if m.crank_rocker]
+    assert oc.fun >= max(m.quality_deg for m in fine) - 1e-4

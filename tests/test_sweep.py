@@ -163,20 +163,21 @@ def test_resume_runs_only_missing_cases(tmp_path, capsys):
 def test_interrupt_keeps_finished_cases_and_leaves_no_partial_file(tmp_path, monkeypatch):
     path = deck(tmp_path, SWEEP_GRID)
     out = tmp_path / "o"
-    real = sweep._compute
+    from driver.sweep import engine
+    real = engine._compute
 
     def interrupted(task, case, module):
         if case.index == 6:
             raise KeyboardInterrupt
         return real(task, case, module)
 
-    monkeypatch.setattr(sweep, "_compute", interrupted)
+    monkeypatch.setattr(engine, "_compute", interrupted)
     assert main([str(path), "-o", str(out), "-q", "-j", "1"]) == 130
     names = sorted(p.name for p in (out / "sw").iterdir())
     assert [n for n in names if n.endswith(".json")] == [f"case_{k:04d}.json" for k in range(1, 6)]
     assert not any(n.startswith(".") or n.endswith(".tmp") for n in names)
     assert not (out / "sw.out").exists() and not (out / "sw_summary.csv").exists()
-    monkeypatch.setattr(sweep, "_compute", real)
+    monkeypatch.setattr(engine, "_compute", real)
     assert main([str(path), "-o", str(out), "-q", "-j", "1", "--resume"]) == 0
     assert len(pd.read_csv(out / "sw_summary.csv")) == 15
 

@@ -225,3 +225,193 @@ def test_a_warning_every_case_repeats_is_printed_once(tmp_path, capsys):
     assert main([str(path), "-o", str(tmp_path / "o"), "-q", "-j", "1"]) == 0
     err = [l for l in capsys.readouterr().err.splitlines() if l.startswith("warning:")]
     assert len(err) == 1 and "all 8 cases: the linkage cannot be assembled" in err[0], err
+
+
+# ----------------------------------------------------------------------------- the per-case engine
+
+PER_CASE = ("&sweep key1 = 'fourbar.crank', start1 = 1.5, stop1 = 5, count1 = {a}\n"
+            "       key2 = 'fourbar.rocker', values2 = {rockers}\n"
+            "       key3 = 'fourbar.method', values3 = 'exact'{extra} /\n")
+
+
+def per_case_deck(tmp_path: Path, a=6, rockers="8, 9, 10", extra="", name="pc.dat") -> Path:
+    path = tmp_path / name
+    path.write_text(BASE + PER_CASE.format(a=a, rockers=rockers, extra=extra))
+    return path
+
+
+def tree(folder: Path) -> dict[str, bytes]:
+    """Every file under ``folder`` (relative name -> bytes)."""
+    return {p.relative_to(folder).as_posix(): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def same_outputs(a: Path, b: Path, stem: str = "pc") -> None:
+    pd.testing.assert_frame_equal(summary(a, stem), summary(b, stem))
+    assert (a / f"{stem}.out").read_text() == (b / f"{stem}.out").read_text()
+    assert (a / f"{stem}_cases.csv").read_bytes() == (b / f"{stem}_cases.csv").read_bytes()
+    ta, tb = tree(a / stem), tree(b / stem)
+    assert sorted(ta) == sorted(tb)
+    assert [k for k in ta if ta[k] != tb[k]] == []
+
+
+def test_per_case_resume_after_sigkill_is_exact(tmp_path):
+    """SIGKILL of the driver in the middle of a per-case sweep (case_outputs = 'all'), then
+    --resume: the summary, the .out and every case file equal an uninterrupted run, no
+    temporary file is left, and only the missing cases run again."""
+    path = per_case_deck(tmp_path, a=10, extra=", chunk = 2")   # 30 cases, 15 chunks
+    ref = tmp_path / "ref"
+    assert main([str(path), "-o", str(ref), "-q", "-j", "2"]) == 0
+    out = tmp_path / "o"
+    cmd = [sys.executable, "-m", "driver", str(path), "-o", str(out), "-j", "2"]
+    _kill_after_parts(cmd, out / "pc.sweep", 4)
+    assert not (out / "pc.out").exists()
+    res = subprocess.run(cmd + ["--resume"], capture_output=True, text=True, timeout=300)
+    assert res.returncode == 0, res.stderr
+    line = next(l for l in res.stdout.splitlines() if l.startswith("resume:"))
+    complete = int(line.split()[1])
+    assert 8 <= complete < 30, line
+    same_outputs(ref, out)
+    assert not [p for p in out.rglob("*") if p.name.endswith(".tmp")]
+
+
+def test_deleted_out_file_reruns_its_case(tmp_path, capsys):
+    path = per_case_deck(tmp_path, a=3)
+    out = tmp_path / "o"
+    assert main([str(path), "-o", str(out), "-q", "-j", "1"]) == 0
+    first = tree(out / "pc")
+    (out / "pc" / "case_0005.out").unlink()          # the .json marker stays: not trusted alone
+    capsys.readouterr()
+    assert main([str(path), "-o", str(out), "-j", "1", "--resume"]) == 0
+    assert "resume: 8 of 9 cases complete, 1 to run" in capsys.readouterr().out
+    assert tree(out / "pc") == first
+
+
+def test_shrunken_grid_removes_the_old_cases_files(tmp_path):
+    path = per_case_deck(tmp_path, a=4)                       # 12 cases
+    out = tmp_path / "o"
+    assert main([str(path), "-o", str(out), "-q", "-j", "1"]) == 0
+    (out / "pc" / "notes.txt").write_text("mine")            # not a case file: left alone
+    path = per_case_deck(tmp_path, a=2)                       # 6 cases
+    assert main([str(path), "-o", str(out), "-q", "-j", "1", "--resume"]) == 0
+    names = sorted(p.name for p in (out / "pc").iterdir())
+    assert {n.split(".")[0] for n in names if n.startswith("case_")} == {f"case_{k:04d}" for k in range(1, 7)}
+    assert "notes.txt" in names
+    assert len(summary(out, "pc")) == 6
+    # no case files at all any more: the folder keeps only what is not the sweep's
+    path = per_case_deck(tmp_path, a=2, extra=", case_outputs = 'none'")
+    assert main([str(path), "-o", str(out), "-q", "-j", "1"]) == 0
+    assert sorted(p.name for p in (out / "pc").iterdir()) == ["notes.txt"]
+
+
+def test_large_sweeps_shard_their_case_files(tmp_path, monkeypatch):
+    from driver.sweep import store
+    path = per_case_deck(tmp_path, a=3)                       # 9 cases
+    flat = tmp_path / "flat"
+    assert main([str(path), "-o", str(flat), "-q", "-j", "1"]) == 0
+    monkeypatch.setattr(store, "FLAT_MAX", 4)
+    monkeypatch.setattr(store, "SHARD", 4)
+    out = tmp_path / "o"
+    assert main([str(path), "-o", str(out), "-q", "-j", "1"]) == 0
+    assert sorted(p.name for p in (out / "pc").iterdir()) == ["0001-0004", "0005-0008", "0009-0012"]
+    assert (out / "pc" / "0009-0012" / "case_0009.out").read_bytes() == (flat / "pc" / "case_0009.out").read_bytes()
+    pd.testing.assert_frame_equal(summary(flat, "pc"), summary(out, "pc"))
+    assert (flat / "pc_cases.csv").read_bytes() == (out / "pc_cases.csv").read_bytes()
+    # back to the flat layout: the shards go
+    monkeypatch.setattr(store, "FLAT_MAX", 1000)
+    assert main([str(path), "-o", str(out), "-q", "-j", "1", "--resume"]) == 0
+    assert sorted(p.name for p in (out / "pc").iterdir()) == sorted(p.name for p in (flat / "pc").iterdir())
+
+
+def _die_on_case(task, case, module, _real=None):
+    """A case computation whose worker is SIGKILLed on case 7 (always, or once with DIE_ONCE)."""
+    from driver.sweep import engine
+    marker = os.environ.get("DIE_ONCE")
+    if case.index == 7 and (not marker or not os.path.exists(marker)):
+        if marker:
+            Path(marker).write_text("died")
+        os.kill(os.getpid(), signal.SIGKILL)
+    return engine._real_compute(task, case, module)
+
+
+@pytest.mark.parametrize("once", [True, False])
+def test_per_case_dying_worker_is_retried_then_isolated(tmp_path, monkeypatch, capsys, once):
+    from driver.sweep import engine
+    path = per_case_deck(tmp_path, a=4, extra=", chunk = 4")   # 12 cases; case 7 in chunk 5-8
+    ref = tmp_path / "ref"
+    assert main([str(path), "-o", str(ref), "-q", "-j", "1"]) == 0
+    if once:
+        monkeypatch.setenv("DIE_ONCE", str(tmp_path / "marker"))
+    monkeypatch.setattr(engine, "_real_compute", engine._compute, raising=False)
+    monkeypatch.setattr(engine, "_compute", _die_on_case)   # inherited by the forked workers
+    out = tmp_path / "o"
+    rc = main([str(path), "-o", str(out), "-q", "-j", "2"])
+    s, r = summary(out, "pc"), summary(ref, "pc")
+    if once:   # retried once, alone: identical results
+        assert rc == 0
+        same_outputs(ref, out)
+    else:      # the chunk is split down to the case that kills its worker; that case alone fails
+        assert rc == 1
+        bad = s["status"] != "ok"
+        assert list(s.loc[bad, "case"]) == [7]
+        assert s.loc[bad, "error"].str.contains("worker process died").all()
+        keep = [c for c in s.columns if c in r.columns]
+        pd.testing.assert_frame_equal(s.loc[~bad, keep].reset_index(drop=True),
+                                      r.loc[~bad, keep].reset_index(drop=True), check_dtype=False)
+        assert "case 7 (" in capsys.readouterr().err
+        assert not (out / "pc" / "case_0007.out").exists() and (out / "pc" / "case_0008.out").exists()
+
+
+def test_chunk_size_comes_from_a_warm_case(tmp_path, monkeypatch, capsys):
+    """A worker's first case pays its cold imports: the chunk is sized from a later one."""
+    from driver.sweep import engine
+    real, calls = engine._compute, []
+
+    def cold_first(task, case, module):
+        calls.append(case.index)
+        if len(calls) == 1:
+            time.sleep(0.5)   # 'cold imports'
+        return real(task, case, module)
+
+    monkeypatch.setattr(engine, "_compute", cold_first)
+    path = per_case_deck(tmp_path, a=6)   # 18 cases
+    assert main([str(path), "-o", str(tmp_path / "o"), "-j", "1"]) == 0
+    chunk = int(capsys.readouterr().out.split("chunk ")[1].split(")")[0])
+    assert chunk > 1      # from the first case alone it would be 1
+
+
+def test_dask_sizes_by_the_cluster_and_probes_its_file_system(tmp_path):
+    """The first single-case batch is sized by the cluster's threads (not this machine's
+    cores); workers that cannot see the output folder are found before anything runs."""
+    from driver.sweep import engine
+
+    class Client:   # the parts of a dask.distributed.Client the engine uses
+        def __init__(self, root: Path | None = None):
+            self.root = root
+
+        def scheduler_info(self):
+            return {"workers": {"tcp://10.0.0.7:4000": {"nthreads": 8}, "tcp://10.0.0.8:4000": {"nthreads": 4}}}
+
+        def run(self, fn, folder, token):
+            if self.root is not None:   # a worker on another machine: same path, its own disk
+                folder = str(self.root / Path(folder).relative_to("/"))
+            return {w: fn(folder, token) for w in self.scheduler_info()["workers"]}
+
+    assert engine.cluster_workers(Client()) == 12
+    feed = engine._Feed(iter(range(1, 101)), 100, engine.cluster_workers(Client()), 0)
+    assert len(feed.probes) == 24
+    engine.check_shared_folder(Client(), tmp_path / "shared")   # same file system: fine
+    assert not list((tmp_path / "shared").iterdir())             # probes removed
+    with pytest.raises(OSError) as err:
+        engine.check_shared_folder(Client(tmp_path / "elsewhere"), tmp_path / "o")
+    msg = str(err.value)
+    assert "do not share this output folder" in msg and "tcp://10.0.0.7:4000" in msg and "1 more" in msg
+
+
+def test_plot_draws_the_summary_and_case_figures_only_when_asked(tmp_path):
+    path = per_case_deck(tmp_path, a=1, rockers="9")   # one case
+    out = tmp_path / "o"
+    assert main([str(path), "-o", str(out), "-q", "-j", "1", "--plot"]) == 0
+    assert (out / "pc_summary.png").exists() and not list((out / "pc").glob("*.png"))
+    path = per_case_deck(tmp_path, a=1, rockers="9", extra=", case_plots = .true.")
+    assert main([str(path), "-o", str(out), "-q", "-j", "1", "--plot"]) == 0
+    assert list((out / "pc").glob("case_0001_*.png"))

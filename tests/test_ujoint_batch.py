@@ -181,9 +181,17 @@ def _sweep(tmp_path: Path, outputs: str, option: int = 0) -> Path:
     return out
 
 
+def _path_taken(out: Path) -> str:
+    """'batch' or 'case': the parts of the resume record <stem>.sweep/ say which engine ran
+    (driver.sweep_batch: part-<first case>.parquet; driver.sweep: part-r<run>-<seq>.parquet)."""
+    parts = [p.name for p in (out / "usw.sweep").glob("part-*.parquet")]
+    assert parts
+    return "case" if all(n.startswith("part-r") for n in parts) else "batch"
+
+
 def test_sweep_takes_the_batch_path_and_equals_case_by_case(tmp_path):
     batch, single_ = _sweep(tmp_path, "none"), _sweep(tmp_path, "all")
-    assert (batch / "usw.sweep").is_dir() and not (single_ / "usw.sweep").exists()
+    assert _path_taken(batch) == "batch" and _path_taken(single_) == "case"
     a = pd.read_parquet(batch / "usw_summary.parquet")
     b = pd.read_parquet(single_ / "usw_summary.parquet")
     assert len(a) == 28 and 0 < a["kept"].sum() < 28
@@ -193,7 +201,7 @@ def test_sweep_takes_the_batch_path_and_equals_case_by_case(tmp_path):
     assert ta == tb
     # a base deck that optimises per case (option 1) runs case by case
     opt = _sweep(tmp_path, "none", option=1)
-    assert not (opt / "usw.sweep").exists() and len(pd.read_parquet(opt / "usw_summary.parquet")) == 28
+    assert _path_taken(opt) == "case" and len(pd.read_parquet(opt / "usw_summary.parquet")) == 28
 
 
 def test_optimize_evaluates_populations_in_one_call_and_finds_option_1(tmp_path, monkeypatch):

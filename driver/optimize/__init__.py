@@ -87,8 +87,8 @@ def _probe(problem: Problem) -> None:
         params = design_params(problem, np.array(x))
         if hasattr(problem.study, "summarise"):
             summary, clean = dict(problem.study.summarise(params)), True
-        else:
-            result = problem.study.run(params, progress=False)
+        else:       # through the runner: the budget and the finite-number checks apply here too
+            result = compute(problem.study, params)
             summary, clean = dict(result.summary), not (result.failure or result.warnings)
     except Exception:    # the deck's design fails; names are checked per design (missing -> infeasible)
         return
@@ -252,8 +252,9 @@ def run_optimize_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, 
                   + ", ".join(f"{k} = {v:.6g}" for k, v in oc.x.items()))
         ev = oc.evaluator
         if ev.computed:
-            how = ("batch path" if hasattr(oc.problem.study, "summarise_batch") else
-                   f"dask {ev.scheduler}" if ev.scheduler else f"{ev.jobs} process(es)")
+            names = {"batch": "batch path", "dask": f"dask {ev.scheduler}", "processes": f"{ev.jobs} processes",
+                     "serial": "this process"}
+            how = ", ".join(f"{names[r]}: {n}" if len(ev.routes) > 1 else names[r] for r, n in ev.routes.items())
             print(f"{deck.path}: {ev.computed} designs computed ({len(ev.records) - ev.computed} replayed), "
                   f"{1e3 * ev.compute_seconds / ev.computed:.3f} ms per design ({how})")
     if not oc.success:

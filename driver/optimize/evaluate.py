@@ -27,10 +27,11 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from driver import expr
+from driver import expr, limits
 from driver.deck import DeckError, Params, RawGroup, validate
 from driver.study import load_study
 from driver.optimize.problem import Problem
+from driver.runner import NUMERICAL, CaseFailure, compute, numerical_error
 
 __all__ = ["Evaluator", "evaluate_cases", "FAILED_VIOLATION"]
 
@@ -38,6 +39,9 @@ __all__ = ["Evaluator", "evaluate_cases", "FAILED_VIOLATION"]
 FAILED_VIOLATION = 1e6
 #: objective given to failed designs in the local methods (which need a finite number)
 FAILED_OBJECTIVE = 1e12
+#: a batch of designs goes to worker processes (-j) when it is estimated to take longer than
+#: this [s] in this process (the first batch is timed here); the route never changes a result
+POOL_MIN_SECONDS = 0.2
 
 
 def _design_raw(raw: RawGroup, keys: list[str], kinds: list[str], x: np.ndarray) -> RawGroup:
@@ -62,29 +66,68 @@ def design_params(problem: Problem, x: np.ndarray) -> Params:
 
 
 def evaluate_cases(group: str, deck_path: str, raw: RawGroup, keys: list[str], kinds: list[str],
-                   xs: list[list[float]]) -> list[tuple[str, str, dict]]:
+                   xs: list[list[float]], budget: limits.Budget | None = None) -> list[tuple[str, str, dict]]:
     """Summaries of designs ``xs`` case by case: [(status, reason, summary)] (worker entry point).
 
-    status is 'ok', 'bad_input' (the design is not a valid deck) or 'failed'.
+    status is 'ok', 'bad_input' (the design is not a valid deck, or the study refuses it),
+    'refused' (over the work or memory ``budget`` of one run, :mod:`driver.limits`; default this
+    process's) or 'failed' (the run failed, numerically or by the study's own verdict).
+    Every case goes through the runner's checks (:func:`driver.runner.compute`): the budget
+    before it runs, numerical failures in words, no NaN/inf/'****' in what it would write.
     """
     module = load_study(group)
-    out = []
+    out: list[tuple[str, str, dict]] = []
     for x in xs:
         try:
             params = validate(_design_raw(raw, keys, kinds, np.asarray(x)), module.SPEC, deck_path)
-            if hasattr(module, "summarise"):
-                out.append(("ok", "", dict(module.summarise(params))))
-            else:
-                result = module.run(params, progress=False)
-                if result.failure:
-                    out.append(("failed", str(result.failure), dict(result.summary)))
-                else:
-                    out.append(("ok", "", dict(result.summary)))
         except DeckError as exc:
-            out.append(("bad_input", exc.message if exc.key is None else f"{exc.key}: {exc.message}", {}))
+            out.append(("bad_input", _deck_reason(exc), {}))
+            continue
+        try:
+            limits.check(module, params, lim=budget)
+        except DeckError as exc:
+            out.append(("refused", _deck_reason(exc), {}))
+            continue
+        try:
+            if hasattr(module, "summarise"):
+                try:
+                    with np.errstate(all="ignore"):
+                        summary = dict(module.summarise(params))
+                except NUMERICAL as exc:
+                    raise numerical_error(params, exc) from None
+                out.append(("ok", "", summary))
+            else:
+                result = compute(module, params, budget=budget)
+                out.append(("failed", str(result.failure), dict(result.summary)) if result.failure
+                           else ("ok", "", dict(result.summary)))
+        except CaseFailure as exc:   # a numerical failure, or a non-finite number bound for a table
+            out.append(("failed", _deck_reason(exc), {}))
+        except DeckError as exc:     # the study refuses the design (e.g. an arm that cannot reach)
+            out.append(("bad_input", _deck_reason(exc), {}))
         except Exception as exc:   # a failing design is infeasible, never the end of the run
             out.append(("failed", f"{exc.__class__.__name__}: {exc}", {}))
     return out
+
+
+def _deck_reason(exc: DeckError) -> str:
+    return exc.message if exc.key is None else f"{exc.key}: {exc.message}"
+
+
+def _non_finite(row: tuple[str, str, dict]) -> tuple[str, str, dict]:
+    """A summary value NaN is a missing figure (None); an infinite one fails the design, with its
+    column named: no such number is ranked or reaches the evaluations table."""
+    status, reason, summary = row
+    if not summary:
+        return row
+    clean = {}
+    for k, v in summary.items():
+        if isinstance(v, (float, np.floating)) and not math.isfinite(v):
+            if math.isnan(v):
+                v = None
+            elif status == "ok":
+                return ("failed", f"a result that is not a finite number ({k} = {float(v)})", {})
+        clean[k] = v
+    return (status, reason, clean)
 
 
 def _ignore_sigint() -> None:
@@ -129,6 +172,10 @@ class Evaluator:
         self.seconds_per_case: float | None = None
         self.compute_seconds = 0.0
         self.computed = 0
+        #: designs computed by route: 'batch', 'dask', 'processes', 'serial'
+        self.routes: dict[str, int] = {}
+        #: the budget of one design's run, this process's (Dask workers do not inherit it)
+        self.budget = limits.budget()
         for row in resumed or []:
             self.replayed[tuple(float(v) for v in row["x"])] = row
 
@@ -152,34 +199,48 @@ class Evaluator:
 
     # ------------------------------------------------------------------ computing
     def _compute(self, xs: list[tuple[float, ...]]) -> list[tuple[str, str, dict]]:
-        """Summaries of new designs: the study's batch path, worker processes, or serially."""
+        """Summaries of new designs: the study's batch path, else case by case on the Dask cluster,
+        in worker processes (when a batch costs enough to pay for them) or in this process.
+
+        Whatever the route, the same designs give the same rows (cases are independent and
+        deterministic), so a run's optimum and history do not depend on where it ran.
+        """
         t0 = time.perf_counter()
         out = _batch_summaries(self.problem, xs)
+        route = "batch"
         if out is None:
             args = (self.problem.raw.name, str(self.problem.deck.path), self.problem.raw, self.keys, self.kinds)
-            slow = self.seconds_per_case is not None and self.seconds_per_case * len(xs) > 0.2
+            slow = self.seconds_per_case is not None and self.seconds_per_case * len(xs) > POOL_MIN_SECONDS
             if self.scheduler and len(xs) > 1:
+                route = "dask"
                 if self._client is None:
                     from dask.distributed import Client
                     self._client = self.scheduler if not isinstance(self.scheduler, str) else \
                         Client(self.scheduler, timeout="60s")
-                workers = max(1, len(self._client.scheduler_info().get("workers", {})))
+                workers = max(1, sum(w.get("nthreads", 1) for w in
+                                     self._client.scheduler_info().get("workers", {}).values()))
                 size = max(1, math.ceil(len(xs) / (2 * workers)))
                 parts = [list(map(list, xs[i:i + size])) for i in range(0, len(xs), size)]
-                futures = [self._client.submit(evaluate_cases, *args, part, pure=False) for part in parts]
+                # the whole generation is submitted at once and gathered in order
+                futures = [self._client.submit(evaluate_cases, *args, part, self.budget, pure=False)
+                           for part in parts]
                 out = [r for part in self._client.gather(futures) for r in part]
             elif self.jobs > 1 and len(xs) > 1 and slow:
+                route = "processes"
                 if self._pool is None:
                     self._pool = cf.ProcessPoolExecutor(self.jobs, initializer=_ignore_sigint)
                 size = max(1, math.ceil(len(xs) / self.jobs))
                 parts = [list(map(list, xs[i:i + size])) for i in range(0, len(xs), size)]
-                out = [r for part in self._pool.map(evaluate_cases, *zip(*[args + (p,) for p in parts]))
+                out = [r for part in self._pool.map(evaluate_cases, *zip(*[args + (p, self.budget) for p in parts]))
                        for r in part]
             else:
-                out = evaluate_cases(*args, [list(x) for x in xs])
+                route = "serial"
+                out = evaluate_cases(*args, [list(x) for x in xs], self.budget)
+        out = [_non_finite(row) for row in out]
         dt = time.perf_counter() - t0
         self.compute_seconds += dt
         self.computed += len(xs)
+        self.routes[route] = self.routes.get(route, 0) + len(xs)
         if self.seconds_per_case is None and xs:
             self.seconds_per_case = dt / len(xs)
         return out
@@ -226,7 +287,8 @@ class Evaluator:
         ok = [r for r in recs if r.status == "ok"]
         for r in recs:
             if r.status != "ok":
-                r.why = f"{'not a valid design' if r.status == 'bad_input' else 'case failed'}: {_short(r.reason)}"
+                word = {"bad_input": "not a valid design", "refused": "refused, over the budget of one run"}
+                r.why = f"{word.get(r.status, 'case failed')}: {_short(r.reason)}"
                 r.violation = FAILED_VIOLATION
                 r.margins = tuple(-math.inf for _ in p.constraints)
                 r.met = tuple(False for _ in p.constraints)

@@ -1,0 +1,289 @@
+"""Sweeps: a ``&sweep`` group turns a deck into a study over many cases.
+
+    &fourbar  fixed_link = 12, crank = 2, coupler = 15, rocker = 9, omega = 5, step_deg = 20 /
+    &sweep
+      key1 = 'fourbar.crank',   values1 = 2, 3, 4, 5          ! a list ...
+      key2 = 'fourbar.coupler', start2 = 14, stop2 = 16, count2 = 3   ! ... or start/stop/count
+      zip  = .false.            ! .false.: full grid; .true.: keys varied together
+      keep = 'meets_band_40_120 and rocker_swing_deg > 60'   ! optional filter on the summary
+      case_outputs = 'all'      ! per-case files for 'all', 'kept' or 'none' of the cases
+    /
+
+Every case is a complete deck (the study group with the swept values), validated
+and run exactly as a single run would be.  Outputs, for a deck ``<stem>.dat``:
+
+* ``<stem>/case_0001.{dat,out,parquet,json}``: the case deck, its ``.out``, its tidy
+  table and its summary (sweeps of more than 1000 cases: in folders of 1000 cases,
+  ``<stem>/000001-001000/case_000001.*``);
+* ``<stem>.out``: a fixed-format summary table (one row per case) and failed cases;
+* ``<stem>_summary.{csv,parquet}``: one row per case (swept keys + headline figures);
+* ``<stem>_cases.{csv,parquet}``: the tidy tables of the written cases, with a
+  column for every swept key (up to :data:`CASES_TABLE_MAX` written cases);
+* ``<stem>.sweep/``: the resume record (:mod:`driver.sweep.store`).
+
+Cases run in worker processes (``--jobs``, default all cores) or on a Dask
+cluster (``--scheduler ADDRESS`` or Dask's ``scheduler-address`` configuration; never
+the deck: a deck naming a scheduler is refused), in chunks sized so that scheduling
+costs little (:mod:`driver.sweep.engine`); results are ordered by case whatever the
+scheduling.  ``--resume`` skips cases whose row is in the resume record and whose files
+are all there.  A study with a batch path runs its summary-only sweeps on
+:mod:`driver.sweep_batch`.
+
+The package: :mod:`~driver.sweep.spec` (the &sweep keys, the grid, cases, validation),
+:mod:`~driver.sweep.engine` (workers and scheduling), :mod:`~driver.sweep.store` (case
+files and the resume record), :mod:`~driver.sweep.report` (summary tables and text).
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from driver import expr, sweep_batch
+from driver.atomic import remove_stale_temporaries
+from driver.deck import Deck, Params, RawGroup, validate
+from driver.extras import require
+from driver.runner import compute, output_stem, study_of
+from driver.study import load_study
+from driver.sweep import engine, store
+from driver.sweep.engine import Task, auto_chunk, run_task
+from driver.sweep.report import Warnings, summary_frame, sweep_text, write_sweep_files
+from driver.sweep.spec import (EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, FULL_VALIDATION, MAX_CASES, MAX_KEYS, SPEC, Case,
+                               CaseResult, _axes, _configured_scheduler, build_cases, case_count, grid_of,
+                               validate_sweep)
+
+__all__ = ["SPEC", "Case", "build_cases", "run_sweep_deck", "run_task", "auto_chunk", "MAX_KEYS", "MAX_CASES",
+           "summary_frame", "case_count", "CASES_TABLE_MAX"]
+
+#: the combined ``<stem>_cases`` tables are written up to this many written cases (above, the
+#: cases' own Parquet files are the table: ``pyarrow.dataset.dataset(<stem>/, format="parquet")``)
+CASES_TABLE_MAX = 2000
+#: the sweep's .out lists every case up to this many cases (above: the kept and failed ones)
+TABLE_ALL_MAX = 2000
+
+
+def _base_hash(raw: RawGroup) -> str:
+    text = json.dumps(raw.values, sort_keys=True, default=str)
+    return hashlib.sha256(f"{raw.name}:{text}".encode()).hexdigest()[:16]
+
+
+def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool,
+                   quiet: bool = False, jobs: int | None = None, scheduler: Any = None,
+                   resume: bool = False) -> int:
+    """Run a deck with a &sweep group; returns the exit status (see driver.cli).
+
+    Raises :class:`~driver.extras.MissingExtra` before running anything when pyarrow (case
+    files and summaries are Parquet) or, with a scheduler, Dask is not installed.
+    """
+    sw = validate(deck.groups["sweep"], SPEC, deck.path)
+    require("parquet")
+    if scheduler or sw.scheduler:
+        require("dask")
+    study_raw = {n: g for n, g in deck.groups.items() if n != "sweep"}
+    module, base_params = study_of(Deck(deck.path, study_raw))   # the base deck must be valid on its own
+    raw = study_raw[base_params.group]
+    grid = grid_of(sw, base_params.group, module.SPEC)
+    names = grid.names
+    axes = list(zip(grid.names, grid.values))
+    batchable = sweep_batch.batchable(module, names, sw.keep, sw.case_outputs)
+    limit = sweep_batch.MAX_CASES if batchable else MAX_CASES
+    if grid.n > limit:
+        sizes = " x ".join(f"{len(v)} ({n})" for n, v in axes)
+        raise sw.error("key1", f"{grid.n} cases ({sizes}) is beyond the {limit} cases one sweep deck "
+                       "may have; split the sweep into several decks or coarsen the grid")
+    estimates = validate_sweep(sw, raw, module, grid)
+    named = [(k, v) for k, v in [("keep", sw.keep), ("plot_x", sw.plot_x)] + [("plot_y", y) for y in sw.plot_y] if v]
+    if named:   # check the filter and plotted columns on the base deck's summary before running anything
+        probe = (module.summarise(base_params) if hasattr(module, "summarise")
+                 else compute(module, base_params).summary)
+        columns = [*names, *probe, "case"]
+        for key, text in named:
+            try:
+                expr.parse(text, columns)
+            except expr.ExprError as exc:
+                raise sw.error(key, f"{exc.message}" + (f" (at '{exc.token}')" if exc.token else "")
+                               + ("" if key == "keep" else f"; summary columns: {', '.join(columns)}")) from None
+    stem_path = output_stem(outdir, deck.path)
+    scheduler = scheduler or _configured_scheduler()
+    jobs = jobs or os.cpu_count() or 1
+    layout = store.layout_for(stem_path, grid.n)
+    case_plot = plot if sw.case_plots else False
+
+    def task_of(indices: list[int], case_outputs: str = sw.case_outputs) -> Task:
+        return Task(str(deck.path), raw, grid, indices, layout, sw.keep, case_outputs, formats, case_plot,
+                    _base_hash(raw))
+
+    run = _Run(deck, sw, base_params, module, grid, outdir, stem_path.name, layout, task_of, plot, progress, quiet,
+               jobs, scheduler, resume)
+    if batchable:
+        bplan = sweep_batch.plan(module, raw, str(deck.path), grid, sw.keep, sw.summary_rows)
+        if bplan is not None:
+            return run.batch(bplan)
+    sig = store.signature(raw, names, str(deck.path), sw.keep, sw.case_outputs, formats, case_plot, module)
+    return run.cases(sig, estimates)
+
+
+class _Run:
+    """One sweep run: the per-case path (:meth:`cases`) or the batch path (:meth:`batch`)."""
+
+    def __init__(self, deck: Deck, sw: Params, base: Params, module, grid, outdir: Path, stem: str,
+                 layout: store.Layout, task_of, plot, progress: bool, quiet: bool, jobs: int, scheduler: Any,
+                 resume: bool):
+        self.deck, self.sw, self.base, self.module, self.grid = deck, sw, base, module, grid
+        self.outdir, self.stem, self.layout, self.task_of = outdir, stem, layout, task_of
+        self.plot, self.progress, self.quiet, self.jobs, self.scheduler, self.resume = (
+            plot, progress, quiet, jobs, scheduler, resume)
+        self.axes = list(zip(grid.names, grid.values))
+
+    def _where(self) -> str:
+        return f"dask {self.scheduler}" if self.scheduler else f"{self.jobs} worker(s)"
+
+    def _check_workers_see(self, writes_files: bool) -> None:
+        """On Dask, when workers write case files: they must see this output folder."""
+        if not (self.scheduler and writes_files):
+            return
+        from dask.distributed import Client
+        client = self.scheduler if not isinstance(self.scheduler, str) else Client(self.scheduler)
+        try:
+            engine.check_shared_folder(client, Path(self.layout.root))
+        finally:
+            if isinstance(self.scheduler, str):
+                client.close()
+
+    # ------------------------------------------------------------------ per case
+    def cases(self, signature: str, estimates: dict[int, float]) -> int:
+        sw, grid, layout, n = self.sw, self.grid, self.layout, self.grid.n
+        names = grid.names
+        store.clean_temporaries(layout)   # left by a killed earlier run of this deck
+        remove_stale_temporaries(self.outdir, self.stem)
+        record = store.Record(self.outdir / f"{self.stem}.sweep", signature, n)
+        record.start(self.resume)
+        done = record.scan(grid, layout) if self.resume else np.zeros(n + 1, dtype=bool)
+        n_done = int(done[1:].sum())
+        if self.resume and not self.quiet:
+            print(f"resume: {n_done} of {n} cases complete, {n - n_done} to run")
+        self._check_workers_see(sw.case_outputs != "none" and n_done < n)
+        if estimates and len(set(estimates.values())) > 1:   # longest first: the last case to start is short
+            order: Any = [i for i in sorted(estimates, key=lambda i: -estimates[i]) if not done[i]]
+        else:
+            order = (i for i in range(1, n + 1) if not done[i])
+        from tqdm import tqdm
+        bar = tqdm(total=n, initial=n_done, unit="case", disable=not self.progress, dynamic_ncols=True)
+
+        def on_result(results: list[CaseResult]) -> None:
+            record.append(results, layout)
+            bar.update(len(results))
+
+        t_start = time.perf_counter()
+        try:
+            chunk = engine.execute(order, n - n_done, self.task_of, self.jobs, self.scheduler, sw.chunk, on_result)
+        finally:
+            bar.close()
+        elapsed = time.perf_counter() - t_start
+
+        # the tables, from the resume record (memory: the rows shown, not every case's result)
+        retain_all = sw.summary_rows == "all" or n <= TABLE_ALL_MAX
+        shown: list[CaseResult] = []
+        has_files = np.zeros(n + 1, dtype=bool)
+        warnings = Warnings()
+        n_ok = n_kept = 0
+        written: list[int] = []
+        for r in record.results():
+            has_files[r.index] = bool(r.files)
+            if r.files:
+                written.append(r.index)
+            warnings.add(r)
+            n_ok += r.status == EXIT_OK
+            n_kept += bool(r.kept and r.status == EXIT_OK)
+            if retain_all or r.kept or r.status != EXIT_OK:
+                shown.append(r)
+        shown.sort(key=lambda r: r.index)
+        written.sort()
+        frame = summary_frame(shown, names)
+        table = frame if sw.summary_rows == "all" else frame[frame["kept"] | (frame["status"] != "ok")]
+        failed = [r for r in shown if r.status != EXIT_OK]
+        text = sweep_text(self.deck, sw, self.base, self.axes, n, frame, n_kept,
+                          [(r.index, r.values, r.error) for r in failed], sw.summary_rows)
+        cases = None
+        if written and len(written) <= CASES_TABLE_MAX:
+            cases = pd.concat([pd.read_parquet(layout.stem(k).with_suffix(".parquet")) for k in written],
+                              ignore_index=True)
+        write_sweep_files(self.outdir, self.stem, table, cases, text, self.plot, sw, names, self.module, frame)
+        store.remove_stale_case_files(layout, has_files)
+        store.clean_temporaries(layout)   # of workers of a killed earlier run that outlived its start
+        if cases is None and written:
+            old = [self.outdir / f"{self.stem}_cases.{fmt}" for fmt in ("csv", "parquet")]
+            for p in old:   # an earlier, smaller run's table would no longer match the cases
+                p.unlink(missing_ok=True)
+        for line in warnings.lines(self.deck.path, n):
+            print(line, file=sys.stderr)
+        self._print_failed([(r.index, r.values, r.error) for r in failed])
+        if not self.quiet:
+            print(f"sweep {self.deck.path}: {n_ok} of {n} cases ok, {n_kept} kept, "
+                  f"{elapsed:.2f} s ({self._where()}, chunk {chunk})")
+            print(f"wrote {self.outdir / (self.stem + '.out')} and {self.outdir / self.stem}_summary.{{csv,parquet}}")
+        return max([EXIT_OK] + [r.status for r in failed])
+
+    def _print_failed(self, failed: list[tuple[int, dict, str]], most: int = 20) -> None:
+        for index, values, error in failed[:most]:
+            vals = ", ".join(f"{k} = {v!r}" for k, v in values.items())
+            print(f"error: {self.deck.path}: case {index} ({vals}): {error}", file=sys.stderr)
+        if len(failed) > most:
+            print(f"error: {self.deck.path}: ... and {len(failed) - most} more failed cases (see {self.stem}.out)",
+                  file=sys.stderr)
+
+    # ------------------------------------------------------------------ batch path
+    def batch(self, bplan) -> int:
+        """A sweep on the study's batch path (driver.sweep_batch); same outputs as case by case."""
+        sw, names, n = self.sw, self.grid.names, bplan.grid.n
+        t_start = time.perf_counter()
+
+        def announce(resumed: int) -> None:
+            if self.resume and not self.quiet:
+                print(f"resume: {resumed} of {n} cases complete, {n - resumed} to run")
+
+        rows, counts, chunk = sweep_batch.run(bplan, self.outdir / f"{self.stem}.sweep", self.jobs, self.scheduler,
+                                              self.resume, self.progress, sw.chunk, announce)
+        elapsed = time.perf_counter() - t_start
+        if rows.empty:
+            rows = pd.DataFrame(columns=["case", *names, "status", "kept", "error"])
+        cases = None
+        has_files = np.zeros(n + 1, dtype=bool) if n <= 10 * store.SHARD * store.SHARD else None
+        if sw.case_outputs == "kept" and counts["kept"]:   # the kept cases' own files, case by case
+            kept = [int(c) for c in rows.loc[rows["kept"], "case"]]
+            self._check_workers_see(True)
+            results: list[CaseResult] = []
+            engine.execute(kept, len(kept), self.task_of, self.jobs, self.scheduler, 0, results.extend)
+            results.sort(key=lambda r: r.index)
+            written = [r.index for r in results if r.files]
+            if has_files is not None:
+                has_files[written] = True
+            if written and len(written) <= CASES_TABLE_MAX:
+                cases = pd.concat([pd.read_parquet(self.layout.stem(k).with_suffix(".parquet")) for k in written],
+                                  ignore_index=True)
+            for r in results:
+                if r.status != EXIT_OK:
+                    rows.loc[rows["case"] == r.index, ["status", "kept", "error"]] = ["failed", False, r.error]
+        bad = rows[rows["status"] != "ok"]
+        failed = [(int(r["case"]), {k: r[k] for k in names}, r["error"]) for _, r in bad.iterrows()]
+        text = sweep_text(self.deck, sw, self.base, self.axes, n, rows, int(rows["kept"].sum()), failed,
+                          sw.summary_rows)
+        remove_stale_temporaries(self.outdir, self.stem)
+        write_sweep_files(self.outdir, self.stem, rows, cases, text, self.plot, sw, names, self.module, rows)
+        if has_files is not None:
+            store.remove_stale_case_files(self.layout, has_files)
+        self._print_failed(failed)
+        if not self.quiet:
+            print(f"sweep {self.deck.path}: {n - len(failed)} of {n} cases ok, {int(rows['kept'].sum())} kept, "
+                  f"{elapsed:.2f} s, {n / max(elapsed, 1e-9):.0f} cases/s ({self._where()}, batch path, chunk {chunk})")
+            print(f"wrote {self.outdir / (self.stem + '.out')} and {self.outdir / self.stem}_summary.{{csv,parquet}}")
+        if failed:
+            return EXIT_BAD_INPUT if (bad["status"] == "bad input").any() else EXIT_FAILED
+        return EXIT_OK

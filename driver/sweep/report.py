@@ -1,0 +1,144 @@
+"""What a sweep reports: the summary frame (one row per case), the fixed-format ``.out``, the
+warnings many cases repeat (printed once), and the sweep's own files written as one set."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from driver import expr
+from driver.atomic import output_set, write_text
+from driver.deck import Deck, Params
+from driver.export import write_tidy
+from driver.study import column_label
+from driver.sweep.spec import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, CaseResult
+from driver.table import Column, render_table
+
+__all__ = ["summary_frame", "sweep_text", "Warnings", "write_sweep_files"]
+
+
+def summary_frame(results: list[CaseResult], names: list[str]) -> pd.DataFrame:
+    """One row per case: case, swept keys, status, error, kept, headline figures."""
+    rows = []
+    for r in results:
+        row = {"case": r.index, **{n: r.values[n] for n in names},
+               "status": {EXIT_OK: "ok", EXIT_FAILED: "failed", EXIT_BAD_INPUT: "bad input"}[r.status],
+               "kept": bool(r.kept and r.status == EXIT_OK)}
+        row.update(r.summary)
+        row["error"] = r.error
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def _summary_table(frame: pd.DataFrame, limit: int = 2000, n_cases: int | None = None,
+                   rows: str = "all") -> list[str]:
+    """Fixed-format rendering of the summary frame (kept and failed cases only above ``limit``
+    cases; ``frame`` may hold only those already, then ``n_cases`` is the study's total)."""
+    n_cases = len(frame) if n_cases is None else n_cases
+    show = frame if n_cases <= limit else frame[frame["kept"] | (frame["status"] != "ok")]
+    cols, keys = [], []
+    for name in frame.columns:
+        if name in ("error",):
+            continue
+        s = frame[name]
+        if pd.api.types.is_bool_dtype(s) or s.map(lambda v: isinstance(v, (bool, np.bool_))).all():
+            cols.append(Column(name, "s", max(4, len(name)), 0))
+        elif pd.api.types.is_integer_dtype(s):
+            cols.append(Column(name, "i", max(5, len(name)), 0))
+        elif pd.api.types.is_numeric_dtype(s):
+            cols.append(Column(name, "f", max(10, len(name)), 4))
+        else:
+            cols.append(Column(name, "s", max(6, len(name)), 0))
+        keys.append(name)
+    rows = []
+    for _, r in show.iterrows():
+        row = []
+        for c, k in zip(cols, keys):
+            v = r[k]
+            if v is None or (isinstance(v, float) and not math.isfinite(v)):
+                row.append("-")
+            elif isinstance(v, (bool, np.bool_)):
+                row.append("yes" if v else "no")
+            elif c.kind == "s":
+                row.append(str(v))
+            else:
+                row.append(v)
+        rows.append(row)
+    lines = render_table(cols, rows)
+    if len(show) < n_cases:
+        where = "are in the _summary table only" if rows == "all" else "are not listed (summary_rows = 'kept')"
+        lines.append(f"  ({n_cases - len(show)} cases not kept {where})")
+    return lines
+
+
+class Warnings:
+    """The cases' warnings, counted as they arrive: a warning many cases repeat is printed once,
+    with how many cases gave it and their range (not 31 identical lines for a 31-case sweep)."""
+
+    def __init__(self) -> None:
+        self.by_text: dict[str, list[int]] = {}   # text -> [count, first case, last case]
+
+    def add(self, r: CaseResult) -> None:
+        for w in dict.fromkeys(r.warnings):
+            c = self.by_text.setdefault(w, [0, r.index, r.index])
+            c[0] += 1
+            c[1], c[2] = min(c[1], r.index), max(c[2], r.index)
+
+    def lines(self, path: Path, n_cases: int) -> list[str]:
+        out = []
+        for w, (count, lo, hi) in self.by_text.items():
+            where = (f"case {lo}" if count == 1 else
+                     f"{count} cases ({lo}..{hi})" if count < n_cases else f"all {count} cases")
+            out.append(f"warning: {path}: {where}: {w}")
+        return out
+
+
+def write_sweep_files(outdir: Path, stem: str, table: pd.DataFrame, cases: pd.DataFrame | None, text: str,
+                      plot: bool | str, sw: Params, names: list[str], module: Any, shown: pd.DataFrame) -> None:
+    """The sweep's own files, all renamed into place together or none: ``<stem>_summary`` tables,
+    ``<stem>_cases`` tables (when given), ``<stem>.out`` and, with ``plot``, the summary figure."""
+    with output_set(outdir):
+        for fmt in ("csv", "parquet"):
+            write_tidy(table, outdir / f"{stem}_summary", fmt)
+        if cases is not None:
+            for fmt in ("csv", "parquet"):
+                write_tidy(cases, outdir / f"{stem}_cases", fmt)
+        write_text(outdir / f"{stem}.out", text)
+        if plot:   # the summary only (the cases' own figures with case_plots = .true.)
+            from driver.plotting import save_figure, sweep_summary
+            shown = shown.copy()
+            for name in [sw.plot_x, *sw.plot_y]:   # a plotted expression becomes a column
+                if name and name not in shown.columns:
+                    shown[name] = expr.parse(name).evaluate(shown)
+            labels = {c: column_label(module, c) for c in shown.columns}
+            save_figure(sweep_summary(shown, names, sw.plot_x, sw.plot_y, stem, labels,
+                                      getattr(module, "SWEEP_PLOT", ())), outdir / f"{stem}_summary.png", plot)
+
+
+def sweep_text(deck: Deck, sw: Params, base: Params, axes: list[tuple[str, list]], n_cases: int,
+                frame: pd.DataFrame, n_kept: int, failed: list[tuple[int, dict, str]], rows: str) -> str:
+    """The sweep's fixed-format .out: axes, counts, the summary table, failed cases."""
+
+    lines = [f"  sweep over &{base.group} from deck {deck.path}", ""]
+    for name, values in axes:
+        vals = list(dict.fromkeys(values))   # deck order
+        fmt = lambda v: v if isinstance(v, str) else f"{v:.6g}"
+        shown = (", ".join(map(fmt, vals[:8])) if len(vals) <= 8 else
+                 f"{fmt(vals[0])}, {fmt(vals[1])}, ..., {fmt(vals[-1])} ({len(vals)} values)")
+        lines.append(f"    {name:<28} {shown}")
+    lines += [f"    {'cases':<28} {n_cases} ({'zipped' if sw.zip else 'full grid'})",
+              f"    {'case outputs':<28} {sw.case_outputs}" + (f"   keep: {sw.keep}" if sw.keep else ""),
+              f"    {'kept':<28} {n_kept}",
+              f"    {'failed':<28} {len(failed)}", ""]
+    lines += _summary_table(frame, n_cases=n_cases, rows=rows)
+    if failed:
+        lines += ["", "  Failed cases"]
+        for index, values, error in failed[:1000]:
+            vals = ", ".join(f"{k} = {v!r}" for k, v in values.items())
+            lines.append(f"    case {index} ({vals}): {error}")
+        if len(failed) > 1000:
+            lines.append(f"    ... and {len(failed) - 1000} more (status column of the _summary table)")
+    return "\n".join(lines) + "\n"

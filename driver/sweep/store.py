@@ -1,0 +1,290 @@
+"""A per-case sweep's records on disk: where each case's files go (one folder, or sharded
+folders for large sweeps), the resume record (a Parquet dataset of summary rows, appended as
+chunks complete), and the removal of case files that are no longer part of the sweep.
+
+The resume record is ``<outdir>/<stem>.sweep/part-r<run>-<seq>.parquet``: one part per
+completed chunk, written atomically by the driver, one row per case (case number, status,
+kept, the swept values, the files the case wrote, and its summary, error and warnings as
+JSON).  Each part carries the sweep's *signature* in its metadata: a hash of the base deck's
+study group (without the swept keys), the deck path, keep, case_outputs, the table formats,
+whether case figures are drawn, the package version, and the bytes of the study module, the
+runner, table and export modules and the kernel extension.  On ``--resume`` a case is
+complete when the newest row for its number is in a part of the same signature, has status
+ok, holds the values the grid now gives that number, and every file it wrote is still there
+in this sweep's layout; every other case runs again.  So a changed base deck or tool build
+re-runs every case, a changed grid re-runs the cases whose values changed, and a deleted
+``.out`` re-runs its case.
+"""
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+import os
+import re
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Iterator
+
+import numpy as np
+
+import driver
+from driver.atomic import atomic_open, remove_stale_temporaries
+from driver.deck import RawGroup
+from driver.sweep.spec import CaseResult, case_at
+from driver.sweep_batch import Grid
+
+__all__ = ["Layout", "layout_for", "Record", "signature", "json_default", "remove_stale_case_files",
+           "clean_temporaries", "SHARD", "FLAT_MAX"]
+
+#: sweeps up to this many cases keep every case's files in one folder <stem>/
+FLAT_MAX = 1000
+#: cases per sub-folder <stem>/<first>-<last>/ of a larger sweep
+SHARD = 1000
+
+_CASE_FILE = re.compile(r"^case_(\d+)[._]")
+_SHARD_DIR = re.compile(r"^(\d+)-(\d+)$")
+_PART = re.compile(r"^part-r(\d+)-(\d+)\.parquet$")
+
+
+def json_default(o: Any) -> Any:
+    """JSON for numpy scalars (values and summaries of cases)."""
+    if isinstance(o, np.bool_):
+        return bool(o)
+    if isinstance(o, (np.floating, np.integer)):
+        return o.item()
+    return str(o)
+
+
+@dataclass(frozen=True)
+class Layout:
+    """Where case ``index`` writes its files: ``root/case_0001.*`` (flat) or
+    ``root/<first>-<last>/case_000001.*`` with ``shard`` cases per folder."""
+
+    root: str
+    width: int
+    shard: int = 0
+
+    def name(self, index: int) -> str:
+        return f"case_{index:0{self.width}d}"
+
+    def folder(self, index: int) -> str:
+        """The folder of case ``index`` relative to the root ('' when flat)."""
+        if not self.shard:
+            return ""
+        lo = (index - 1) // self.shard * self.shard + 1
+        return f"{lo:0{self.width}d}-{lo + self.shard - 1:0{self.width}d}"
+
+    def stem(self, index: int) -> Path:
+        return Path(self.root) / self.folder(index) / self.name(index)
+
+
+def layout_for(case_dir: str | Path, n_cases: int) -> Layout:
+    """The layout of a sweep of ``n_cases``: flat up to :data:`FLAT_MAX` cases, else sharded."""
+    return Layout(str(case_dir), max(4, len(str(n_cases))), SHARD if n_cases > FLAT_MAX else 0)
+
+
+def signature(raw: RawGroup, swept: list[str], deck_path: str, keep: str, case_outputs: str,
+              formats: list[str], case_plot: bool | str, module: Any) -> str:
+    """The hash that a part of the resume record must carry to count (module docstring)."""
+    keys = {n.partition(".")[2] for n in swept}
+    h = hashlib.sha256()
+    h.update(json.dumps(["per-case", raw.name, {k: v for k, v in raw.values.items() if k not in keys}, deck_path,
+                         keep, case_outputs, sorted(formats), str(case_plot), driver.__version__],
+                        sort_keys=True, default=str).encode())
+    from driver import export, runner, table
+    for mod in (module, runner, table, export, sys.modules.get("driver._kernels")):
+        path = getattr(mod, "__file__", None)
+        if path:
+            with contextlib.suppress(OSError):
+                h.update(Path(path).read_bytes())
+    return h.hexdigest()[:20]
+
+
+def clean_temporaries(layout: Layout) -> None:
+    """Remove the temporaries of case files whose writer died (SIGKILL), in every case folder."""
+    root = Path(layout.root)
+    remove_stale_temporaries(root, "case_")
+    with contextlib.suppress(OSError):
+        for e in os.scandir(root):
+            if e.is_dir(follow_symlinks=False) and _SHARD_DIR.match(e.name):
+                remove_stale_temporaries(e.path, "case_")
+
+
+class Record:
+    """The resume record ``<folder>`` of one sweep run (module docstring)."""
+
+    def __init__(self, folder: Path, signature: str, n_cases: int):
+        self.folder = Path(folder)
+        self.signature = signature
+        self.parts: list[Path] = []
+        #: per case number, the index in ``parts`` of its newest row (-1: none)
+        self.winner = np.full(n_cases + 1, -1, dtype=np.int32)
+        self.run = time.time_ns()
+        self.seq = 0
+
+    # -- start: clean and find what is complete
+    def start(self, resume: bool) -> None:
+        """Remove stray temporaries, and parts of another signature (all parts without ``resume``)."""
+        kept = []
+        if self.folder.exists():
+            remove_stale_temporaries(self.folder, "part-")   # of a driver killed while writing a part
+            for f in self.folder.iterdir():
+                if not f.name.startswith("part-"):
+                    continue
+                m = _PART.match(f.name)
+                meta = self._meta(f) if (resume and m) else None
+                if meta and meta.get("signature") == self.signature:
+                    kept.append(((int(m.group(1)), int(m.group(2))), f))
+                else:
+                    f.unlink(missing_ok=True)
+        self.parts = [f for _, f in sorted(kept)]
+
+    @staticmethod
+    def _meta(path: Path) -> dict | None:
+        import pyarrow.parquet as pq
+        try:
+            raw = pq.read_schema(path).metadata or {}
+            return json.loads(raw.get(b"sweep", b"{}"))
+        except Exception:
+            return None
+
+    def scan(self, grid: Grid, layout: Layout) -> np.ndarray:
+        """Cases complete in the record (bool array indexed by case number, [0] unused)."""
+        import pyarrow.parquet as pq
+        n = grid.n
+        listing: dict[str, set[str]] = {}
+
+        def present(rel: str) -> bool:
+            parent, _, name = rel.rpartition("/")
+            if parent not in listing:
+                try:
+                    listing[parent] = {e.name for e in os.scandir(Path(layout.root) / parent)}
+                except OSError:
+                    listing[parent] = set()
+            return name in listing[parent]
+
+        good: list[Path] = []
+        for part in self.parts:
+            try:
+                t = pq.read_table(part, columns=["case", "status", "values", "files"]).to_pydict()
+            except Exception:   # an unreadable part: its cases run again
+                continue
+            k = len(good)
+            good.append(part)
+            for case, status, values, files in zip(t["case"], t["status"], t["values"], t["files"]):
+                if not 1 <= case <= n:
+                    continue
+                ok = status == "ok"
+                if ok:
+                    ok = values == json.dumps(case_at(grid, case).values, default=json_default)
+                if ok:
+                    stem = self._rel(layout, case)
+                    names = json.loads(files)
+                    ok = all(f.startswith(stem) and f[len(stem):len(stem) + 1] in (".", "_") and present(f) for f in names)
+                self.winner[case] = k if ok else -1
+        self.parts = good
+        return self.winner >= 0
+
+    @staticmethod
+    def _rel(layout: Layout, case: int) -> str:
+        folder = layout.folder(case)
+        return f"{folder}/{layout.name(case)}" if folder else layout.name(case)
+
+    # -- during the run
+    def append(self, results: list[CaseResult], layout: Layout) -> None:
+        """Write the rows of a completed chunk as one part (atomically)."""
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+        if not results:
+            return
+        status = {0: "ok", 1: "failed", 2: "bad input"}
+        table = pa.table({
+            "case": pa.array([r.index for r in results], pa.int64()),
+            "status": [status.get(r.status, "failed") for r in results],
+            "kept": pa.array([bool(r.kept and r.status == 0) for r in results], pa.bool_()),
+            "values": [json.dumps(r.values, default=json_default) for r in results],
+            "files": [json.dumps(r.files) for r in results],
+            "seconds": pa.array([float(r.seconds) for r in results], pa.float64()),
+            "cpu": pa.array([float(r.cpu) for r in results], pa.float64()),
+            "record": [json.dumps({"status": r.status, "error": r.error, "summary": r.summary,
+                                   "warnings": r.warnings}, default=json_default) for r in results],
+        })
+        self.seq += 1
+        meta = {"signature": self.signature, "run": self.run, "seq": self.seq}
+        table = table.replace_schema_metadata({b"sweep": json.dumps(meta).encode()})
+        self.folder.mkdir(parents=True, exist_ok=True)
+        path = self.folder / f"part-r{self.run}-{self.seq:06d}.parquet"
+        with atomic_open(path, "wb") as fh:
+            pq.write_table(table, fh)
+        self.parts.append(path)
+        k = len(self.parts) - 1
+        for r in results:
+            self.winner[r.index] = k
+
+    # -- at the end
+    def results(self, wanted: np.ndarray | None = None) -> Iterator[CaseResult]:
+        """The newest row of every case (or of the cases ``wanted[case]``), as CaseResults,
+        part by part (memory: one part at a time plus what the caller keeps)."""
+        import pyarrow.parquet as pq
+        codes = {"ok": 0, "failed": 1, "bad input": 2}
+        for k, part in enumerate(self.parts):
+            t = pq.read_table(part).to_pydict()
+            for i, case in enumerate(t["case"]):
+                if case >= len(self.winner) or self.winner[case] != k or (wanted is not None and not wanted[case]):
+                    continue
+                rec = json.loads(t["record"][i])
+                yield CaseResult(case, json.loads(t["values"][i]), codes[t["status"][i]], rec["error"], rec["summary"],
+                                 bool(t["kept"][i]), warnings=rec["warnings"], seconds=t["seconds"][i],
+                                 files=json.loads(t["files"][i]), cpu=t["cpu"][i])
+
+    def columns(self, names: list[str]) -> dict[str, np.ndarray]:
+        """Columns ``names`` (of 'case', 'status', 'kept', 'seconds', 'cpu') of every case's newest row, by case."""
+        import pyarrow.parquet as pq
+        out: dict[str, list] = {c: [] for c in names}
+        for k, part in enumerate(self.parts):
+            t = pq.read_table(part, columns=sorted({"case", *names})).to_pydict()
+            sel = [i for i, c in enumerate(t["case"]) if c < len(self.winner) and self.winner[c] == k]
+            for c in names:
+                out[c] += [t[c][i] for i in sel]
+        return {c: np.asarray(v) for c, v in out.items()}
+
+
+def remove_stale_case_files(layout: Layout, has_files: np.ndarray) -> int:
+    """Remove case files (``case_<n>.*``, ``case_<n>_*``) in the case folder that are not this
+    sweep's: beyond its last case (a shrunken grid), of a case that writes no files now, or in
+    another layout (numbering width, sharding); then empty shard folders and an empty case
+    folder.  Other files are left alone.  Returns the number of files removed."""
+    root = Path(layout.root)
+    n = len(has_files) - 1
+    removed = 0
+
+    def sweep_folder(path: Path, folder: str) -> None:
+        nonlocal removed
+        with contextlib.suppress(OSError):
+            for e in os.scandir(path):
+                m = _CASE_FILE.match(e.name)
+                if not m or not e.is_file(follow_symlinks=False):
+                    continue
+                k = int(m.group(1))
+                ours = (len(m.group(1)) == layout.width and 1 <= k <= n and bool(has_files[k])
+                        and layout.folder(k) == folder)
+                if not ours:
+                    with contextlib.suppress(OSError):
+                        os.unlink(e.path)
+                        removed += 1
+
+    if not root.is_dir():
+        return 0
+    sweep_folder(root, "")
+    with contextlib.suppress(OSError):
+        for e in os.scandir(root):
+            if e.is_dir(follow_symlinks=False) and _SHARD_DIR.match(e.name):
+                sweep_folder(Path(e.path), e.name)
+                with contextlib.suppress(OSError):
+                    os.rmdir(e.path)   # only when empty
+    with contextlib.suppress(OSError):
+        os.rmdir(root)
+    return removed
