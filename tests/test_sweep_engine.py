@@ -432,3 +432,15 @@ def test_dask_is_imported_only_when_configured(tmp_path):
     (tmp_path / ".config" / "dask").mkdir(parents=True)
     (tmp_path / ".config" / "dask" / "site.yaml").write_text("scheduler-address: tcp://10.9.9.9:8786\n")
     assert run(env) == ["'tcp://10.9.9.9:8786'", "True"]
+
+
+def test_cases_table_is_bounded_in_the_drivers_memory(tmp_path, monkeypatch):
+    import driver.sweep as sweep_pkg
+    path = per_case_deck(tmp_path, a=1)   # 3 cases
+    out = tmp_path / "o"
+    assert main([str(path), "-o", str(out), "-q", "-j", "1"]) == 0
+    assert len(pd.read_csv(out / "pc_cases.csv")) == 3 * len(pd.read_parquet(out / "pc" / "case_0001.parquet"))
+    monkeypatch.setattr(sweep_pkg, "CASES_TABLE_BYTES", 1000)   # smaller than one case's table
+    assert main([str(path), "-o", str(out), "-q", "-j", "1"]) == 0
+    assert not (out / "pc_cases.csv").exists() and not (out / "pc_cases.parquet").exists()
+    assert len(list((out / "pc").glob("case_*.parquet"))) == 3

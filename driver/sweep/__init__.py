@@ -18,7 +18,8 @@ and run exactly as a single run would be.  Outputs, for a deck ``<stem>.dat``:
 * ``<stem>.out``: a fixed-format summary table (one row per case) and failed cases;
 * ``<stem>_summary.{csv,parquet}``: one row per case (swept keys + headline figures);
 * ``<stem>_cases.{csv,parquet}``: the tidy tables of the written cases, with a
-  column for every swept key (up to :data:`CASES_TABLE_MAX` written cases);
+  column for every swept key (up to :data:`CASES_TABLE_MAX` written cases and
+  :data:`CASES_TABLE_BYTES`);
 * ``<stem>.sweep/``: the resume record (:mod:`driver.sweep.store`).
 
 Cases run in worker processes (``--jobs``, default all cores) or on a Dask
@@ -65,6 +66,8 @@ __all__ = ["SPEC", "Case", "build_cases", "run_sweep_deck", "run_task", "auto_ch
 #: the combined ``<stem>_cases`` tables are written up to this many written cases (above, the
 #: cases' own Parquet files are the table: ``pyarrow.dataset.dataset(<stem>/, format="parquet")``)
 CASES_TABLE_MAX = 2000
+#: ... and up to this many bytes of them in the driver's memory
+CASES_TABLE_BYTES = 256 * 2**20
 #: the sweep's .out lists every case up to this many cases (above: the kept and failed ones)
 TABLE_ALL_MAX = 2000
 #: CPU-time accounting of the last per-case sweep run in this process [s] (bench/bench_sweep.py):
@@ -144,12 +147,14 @@ class _CasesTable:
     def __init__(self, layout: store.Layout):
         self.layout = layout
         self.pieces: dict[int, tuple[Any, bytes | None]] = {}
+        self.nbytes = 0
+        self.full = False   # beyond CASES_TABLE_MAX cases or CASES_TABLE_BYTES: no combined table
 
     def add(self, indices: list[int]) -> None:
         import pyarrow.parquet as pq
         from driver.export import csv_bytes
         for k in indices:
-            if len(self.pieces) >= CASES_TABLE_MAX:
+            if self.full:
                 return
             t = pq.read_table(self.layout.stem(k).with_suffix(".parquet"))
             try:
@@ -157,13 +162,19 @@ class _CasesTable:
             except TypeError:
                 body = None
             self.pieces[k] = (t, body)
+            self.nbytes += t.nbytes + len(body or b"")
+            if len(self.pieces) > CASES_TABLE_MAX or self.nbytes > CASES_TABLE_BYTES:
+                self.full, self.pieces = True, {}   # the driver's memory stays bounded
 
     def table(self, written: list[int]) -> Any:
         """The combined table of cases ``written`` (in order): a DataFrame, or an (Arrow table, CSV
-        bytes) pair when every case has the same columns; None above CASES_TABLE_MAX cases."""
-        if not written or len(written) > CASES_TABLE_MAX:
+        bytes) pair when every case has the same columns; None above CASES_TABLE_MAX cases or
+        CASES_TABLE_BYTES."""
+        if not written or len(written) > CASES_TABLE_MAX or self.full:
             return None
         self.add([k for k in written if k not in self.pieces])
+        if self.full:
+            return None
         import pyarrow as pa
         from driver.export import csv_bytes
         parts = [self.pieces[k] for k in written]
