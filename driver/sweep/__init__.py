@@ -131,11 +131,11 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
 
     run = _Run(deck, sw, base_params, module, grid, outdir, stem_path.name, layout, task_of, plot, progress, quiet,
                jobs, scheduler, resume)
+    sig = store.signature(raw, names, str(deck.path), sw.keep, sw.case_outputs, formats, case_plot, module)
     if batchable:
         bplan = sweep_batch.plan(module, raw, str(deck.path), grid, sw.keep, sw.summary_rows)
         if bplan is not None:
-            return run.batch(bplan)
-    sig = store.signature(raw, names, str(deck.path), sw.keep, sw.case_outputs, formats, case_plot, module)
+            return run.batch(bplan, sig)
     return run.cases(sig, estimates)
 
 
@@ -298,8 +298,10 @@ class _Run:
                   file=sys.stderr)
 
     # ------------------------------------------------------------------ batch path
-    def batch(self, bplan) -> int:
-        """A sweep on the study's batch path (driver.sweep_batch); same outputs as case by case."""
+    def batch(self, bplan, signature: str) -> int:
+        """A sweep on the study's batch path (driver.sweep_batch); same outputs as case by case.
+        With case_outputs = 'kept' the kept cases then run case by case for their files, with
+        their own resume record ``<stem>.sweep/cases/`` (:mod:`driver.sweep.store`)."""
         sw, names, n = self.sw, self.grid.names, bplan.grid.n
         t_start = time.perf_counter()
 
@@ -316,10 +318,19 @@ class _Run:
         has_files = np.zeros(n + 1, dtype=bool) if n <= 10 * store.SHARD * store.SHARD else None
         if sw.case_outputs == "kept" and counts["kept"]:   # the kept cases' own files, case by case
             kept = [int(c) for c in rows.loc[rows["kept"], "case"]]
-            self._check_workers_see(True)
-            results: list[CaseResult] = []
-            engine.execute(kept, len(kept), self.task_of, self.jobs, self.scheduler, 0, results.extend)
-            results.sort(key=lambda r: r.index)
+            record = store.Record(self.outdir / f"{self.stem}.sweep" / "cases", signature, n)
+            store.clean_temporaries(self.layout)
+            record.start(self.resume)
+            if self.resume:
+                record.scan(self.grid, self.layout)
+            todo = [k for k in kept if not record.complete(k)]
+            if self.resume and not self.quiet:
+                print(f"resume: {len(kept) - len(todo)} of {len(kept)} kept cases' files complete, {len(todo)} to write")
+            self._check_workers_see(bool(todo))
+            engine.execute(todo, len(todo), self.task_of, self.jobs, self.scheduler, 0,
+                           lambda res: record.append(res, self.layout))
+            wanted = set(kept)
+            results = sorted((r for r in record.results() if r.index in wanted), key=lambda r: r.index)
             written = [r.index for r in results if r.files]
             if has_files is not None:
                 has_files[written] = True
