@@ -460,3 +460,20 @@ def test_batch_kept_cases_files_resume(tmp_path, capsys):
     assert main([str(path), "-o", str(out), "-j", "1", "--resume"]) == 0
     assert f"resume: {len(kept) - 1} of {len(kept)} kept cases' files complete, 1 to write" in capsys.readouterr().out
     assert tree(out / "sw") == first
+
+
+def test_per_case_workers_exit_when_the_driver_is_killed(tmp_path):
+    psutil = pytest.importorskip("psutil")
+    path = per_case_deck(tmp_path, a=200, rockers="8, 9")   # 400 cases with their files
+    cmd = [sys.executable, "-m", "driver", str(path), "-o", str(tmp_path / "o"), "-q", "-j", "2"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    parent = psutil.Process(proc.pid)
+    deadline, kids = time.time() + 120, []
+    while time.time() < deadline and len(kids) < 2 and proc.poll() is None:
+        kids = parent.children(recursive=True)
+        time.sleep(0.05)
+    assert kids, "no worker processes seen"
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    gone, alive = psutil.wait_procs(kids, timeout=20)
+    assert not alive, f"workers still running after the driver died: {alive}"
