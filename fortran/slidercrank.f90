@@ -42,7 +42,7 @@ module slidercrank
 
   !> half bandwidth of the banded matrices in q ordering
   integer, parameter, public :: kd = 5
-  !> status codes shared with driver/slidercrank.py
+  !> status codes shared with driver/kernels.py (SLIDERCRANK_STATUS) and driver/slidercrank/
   integer, parameter, public :: st_ok = 0, st_buckled = 1, st_diverged = 2, st_not_spd = 3, &
                                 st_bad_args = 4
   real(dp), parameter :: pi = 3.14159265358979323846_dp

@@ -77,9 +77,16 @@ LABELS = {"r_m": ("inner workspace radius r", "m"), "R_m": ("outer workspace rad
           "manipulability_l2_m": ("manipulability optimum l2", "m"),
           "sweep_min_total_torque_Nm": ("least tau1 + tau2 along C_rob", "N m"),
           "sweep_min_l1_m": ("l1 of the least torque", "m"), "sweep_min_l2_m": ("l2 of the least torque", "m"),
-          "mass_per_length": ("link mass per length", "kg/m"), "gravity": ("gravity", "m/s^2")}
+          "mass_per_length": ("link mass per length", "kg/m"), "gravity": ("gravity", "m/s^2"),
+          "design_l1_m": ("design l1", "m"), "design_l2_m": ("design l2", "m"), "design_ri1": ("design RI1", "-"),
+          "design_ri2": ("design RI2", "-"), "design_ri3": ("design RI3", "-"),
+          "design_ri2_excess": ("design RI2 - sqrt(n)", "-"),
+          "design_crob_residual_m2": ("design l1^2 + l2^2 - mean d^2", "m^2"),
+          "design_total_torque_Nm": ("design tau1 + tau2 at the target", "N m")}
 #: what a sweep summary plots when its deck names no plot_y
-SWEEP_PLOT = ("crob_radius_m", "sweep_min_total_torque_Nm", "sweep_min_l1_m", "dexterity_l1_m", "manipulability_l1_m")
+#: (a design sweep's constant columns are skipped: its plot shows the design_* columns)
+SWEEP_PLOT = ("design_total_torque_Nm", "design_ri2", "crob_radius_m", "sweep_min_total_torque_Nm", "sweep_min_l1_m",
+              "dexterity_l1_m", "manipulability_l1_m")
 
 
 SPEC = GroupSpec(
