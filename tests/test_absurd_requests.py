@@ -124,6 +124,19 @@ def test_sweep_too_many_cases_is_refused_before_building_them(tmp_path, capsys):
     assert "1000000000 cases" in err and "key 'key1'" in err
 
 
+def test_sweep_axis_of_too_many_values_is_refused_before_allocating(tmp_path, capsys):
+    """count1 = 1e8 would build 10^8 Python floats (about 3 GB) before the grid's size is checked."""
+    deck = tmp_path / "axis.dat"
+    deck.write_text((INPUTS / "crank5_exact.dat").read_text() +
+                    "&sweep key1 = 'fourbar.crank', start1 = 1, stop1 = 5, count1 = 1e8, case_outputs = 'none' /\n")
+    t0 = time.perf_counter()
+    assert main([str(deck), "-o", str(tmp_path / "o"), "-q"]) == 2
+    assert time.perf_counter() - t0 < 20
+    err = capsys.readouterr().err
+    assert "key 'count1'" in err and "100000000 values on one axis" in err
+    assert not (tmp_path / "o").exists()
+
+
 def test_sweep_case_beyond_budget_refuses_the_sweep(tmp_path, capsys):
     deck = tmp_path / "sw.dat"
     deck.write_text((INPUTS / "crank5_exact.dat").read_text()
