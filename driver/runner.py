@@ -15,7 +15,7 @@ from types import ModuleType
 import numpy as np
 
 import driver
-from driver import limits
+from driver import blas, limits
 from driver.atomic import inside, output_set, remove_stale_temporaries, write_text
 from driver.deck import Deck, DeckError, Params
 from driver.deck import validate
@@ -173,7 +173,7 @@ def compute(module: ModuleType, params: Params, progress: bool = False,
     non-finite numbers (no NaN, inf or '****' ever reaches a table)."""
     limits.check(module, params, lim=budget)   # absurd requests are refused before anything is allocated
     try:
-        with np.errstate(all="ignore"):
+        with np.errstate(all="ignore"), blas.one_thread():   # one BLAS thread: the same digits on any machine
             result = module.run(params, progress=progress)
     except DeckError:
         raise

@@ -34,6 +34,7 @@ import numpy as np
 import pandas as pd
 
 from driver.atomic import output_set, write_text
+from driver import blas
 from driver.deck import Deck, DeckError, read_deck
 from driver.export import write_tidy
 from driver.extras import require
@@ -153,6 +154,7 @@ def _resumed(problem: Problem, stem: Path) -> list[dict]:
     return rows
 
 
+@blas.one_thread()
 def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[str] | None = None,
              plot: bool = False, jobs: int | None = None, resume: bool = False,
              scheduler: Any = None) -> OptimizeOutcome:

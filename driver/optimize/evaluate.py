@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from driver import expr, limits
+from driver import blas, expr, limits
 from driver.deck import DeckError, Params, RawGroup, validate
 from driver.study import load_study
 from driver.optimize.problem import Problem
@@ -65,6 +65,7 @@ def design_params(problem: Problem, x: np.ndarray) -> Params:
     return validate(raw, problem.study.SPEC, problem.deck.path)
 
 
+@blas.one_thread()
 def evaluate_cases(group: str, deck_path: str, raw: RawGroup, keys: list[str], kinds: list[str],
                    xs: list[list[float]], budget: limits.Budget | None = None) -> list[tuple[str, str, dict]]:
     """Summaries of designs ``xs`` case by case: [(status, reason, summary)] (worker entry point).

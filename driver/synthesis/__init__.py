@@ -31,7 +31,7 @@ import f90nml
 import numpy as np
 import pandas as pd
 
-from driver import expr, fourbar, kernels
+from driver import blas, expr, fourbar, kernels
 from driver.atomic import output_set, write_text
 from driver.deck import Deck, DeckError, GroupSpec, Key, Params, RawGroup, positive, read_deck, validate
 from driver.export import write_tidy
@@ -393,6 +393,7 @@ def _path(p: Params) -> Synthesis:
 
 # ----------------------------------------------------------------------------- run
 
+@blas.one_thread()
 def synthesise(deck: Deck | str | Path) -> Synthesis:
     """Run a &synthesis deck: design the linkage, check it, and run its &fourbar deck."""
     if not isinstance(deck, Deck):
