@@ -41,7 +41,7 @@ __all__ = ["Figure", "PLOT_FORMATS", "Result", "column_label", "keyword_run", "l
 
 _CORE = {"cli", "limits", "deck", "study", "table", "export", "plotting", "atomic", "kernels", "sweep", "runner", "expr",
          "optimize", "synthesis", "published", "compare", "extras", "example_decks", "examples", "api",
-         "sweep_batch"}
+         "sweep_batch", "blas"}
 
 
 #: file formats of ``--plot`` figures (``--plot-format``); the first is the default
