@@ -24,7 +24,7 @@ if TYPE_CHECKING:   # annotations only: keeps `python -m driver --help` light
     import pandas as pd
     import pyarrow as pa
 
-__all__ = ["FORMATS", "write_tidy", "with_units", "unit_of", "json_safe", "summary_json_text"]
+__all__ = ["FORMATS", "write_tidy", "csv_bytes", "with_units", "unit_of", "json_safe", "summary_json_text"]
 
 FORMATS = ("csv", "parquet")
 
@@ -89,12 +89,13 @@ def _cells(col: pa.Array | pa.ChunkedArray) -> pa.Array | pa.ChunkedArray:
     raise TypeError(f"no CSV form for {t}")
 
 
-def _write_csv_arrow(table: pa.Table, fh: Any, batch_rows: int = 1 << 16) -> None:
+def _write_csv_arrow(table: pa.Table, fh: Any, batch_rows: int = 1 << 16, header: bool = True) -> None:
     """CSV rows built column-wise by Arrow compute and written from its buffers, a batch of
     rows at a time (no Python per row; memory bounded by the batch)."""
     import pyarrow.compute as pc
 
-    fh.write((",".join(_csv_name(c) for c in table.column_names) + "\n").encode())
+    if header:
+        fh.write((",".join(_csv_name(c) for c in table.column_names) + "\n").encode())
     if table.num_columns == 0:
         return
     for batch in table.to_batches(max_chunksize=batch_rows):
@@ -137,6 +138,16 @@ def write_tidy(frame: pd.DataFrame, path_stem: str | Path, fmt: str) -> Path:
         with atomic_open(path, "wb") as fh:
             frame.to_parquet(fh, index=False)
     return path
+
+
+def csv_bytes(table: pa.Table, header: bool = True) -> bytes:
+    """The CSV that :func:`write_tidy` writes for a frame whose Arrow form is ``table`` (with the
+    header line, or only the rows: pieces of one CSV built as they arrive, e.g. a sweep's
+    ``_cases`` table).  TypeError for a column type without a CSV form here."""
+    import io
+    buf = io.BytesIO()
+    _write_csv_arrow(table, buf, header=header)
+    return buf.getvalue()
 
 
 def json_safe(value: Any) -> Any:

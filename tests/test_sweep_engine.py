@@ -415,3 +415,20 @@ def test_plot_draws_the_summary_and_case_figures_only_when_asked(tmp_path):
     path = per_case_deck(tmp_path, a=1, rockers="9", extra=", case_plots = .true.")
     assert main([str(path), "-o", str(out), "-q", "-j", "1", "--plot"]) == 0
     assert list((out / "pc").glob("case_0001_*.png"))
+
+
+def test_dask_is_imported_only_when_configured(tmp_path):
+    """Reading Dask's scheduler-address costs a 0.2 s import of Dask, serial before every sweep:
+    it is done only when some Dask configuration exists (environment or configuration file)."""
+    code = ("import sys; from driver.sweep.spec import _configured_scheduler as c; "
+            "print(repr(c()), 'dask' in sys.modules)")
+    env = {k: v for k, v in os.environ.items() if not k.startswith("DASK_")}
+    env["HOME"] = str(tmp_path)
+    run = lambda e: subprocess.run([sys.executable, "-c", code], env=e, capture_output=True, text=True,
+                                   check=True).stdout.split()
+    if not any(Path(p).is_dir() for p in ("/etc/dask", Path(sys.prefix) / "etc" / "dask")):
+        assert run(env) == ["''", "False"]
+    assert run({**env, "DASK_SCHEDULER_ADDRESS": "tcp://10.1.2.3:8786"}) == ["'tcp://10.1.2.3:8786'", "True"]
+    (tmp_path / ".config" / "dask").mkdir(parents=True)
+    (tmp_path / ".config" / "dask" / "site.yaml").write_text("scheduler-address: tcp://10.9.9.9:8786\n")
+    assert run(env) == ["'tcp://10.9.9.9:8786'", "True"]

@@ -67,6 +67,10 @@ __all__ = ["SPEC", "Case", "build_cases", "run_sweep_deck", "run_task", "auto_ch
 CASES_TABLE_MAX = 2000
 #: the sweep's .out lists every case up to this many cases (above: the kept and failed ones)
 TABLE_ALL_MAX = 2000
+#: CPU-time accounting of the last per-case sweep run in this process [s] (bench/bench_sweep.py):
+#: prepare_cpu (deck, validation, imports, resume scan), run_cpu (the driver's CPU while the
+#: cases ran; with one worker, the cases themselves), run_wall, finish_cpu (tables and files)
+LAST_RUN: dict[str, float] = {}
 
 
 def _base_hash(raw: RawGroup) -> str:
@@ -82,6 +86,8 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
     Raises :class:`~driver.extras.MissingExtra` before running anything when pyarrow (case
     files and summaries are Parquet) or, with a scheduler, Dask is not installed.
     """
+    LAST_RUN.clear()
+    LAST_RUN["start_cpu"] = time.process_time()
     sw = validate(deck.groups["sweep"], SPEC, deck.path)
     require("parquet")
     if scheduler or sw.scheduler:
@@ -130,6 +136,44 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
     return run.cases(sig, estimates)
 
 
+class _CasesTable:
+    """The ``<stem>_cases`` tables, built from the written cases' Parquet files as the cases
+    arrive (while the workers compute, off the critical path): their Arrow tables and CSV rows,
+    up to :data:`CASES_TABLE_MAX` cases."""
+
+    def __init__(self, layout: store.Layout):
+        self.layout = layout
+        self.pieces: dict[int, tuple[Any, bytes | None]] = {}
+
+    def add(self, indices: list[int]) -> None:
+        import pyarrow.parquet as pq
+        from driver.export import csv_bytes
+        for k in indices:
+            if len(self.pieces) >= CASES_TABLE_MAX:
+                return
+            t = pq.read_table(self.layout.stem(k).with_suffix(".parquet"))
+            try:
+                body = csv_bytes(t, header=False)
+            except TypeError:
+                body = None
+            self.pieces[k] = (t, body)
+
+    def table(self, written: list[int]) -> Any:
+        """The combined table of cases ``written`` (in order): a DataFrame, or an (Arrow table, CSV
+        bytes) pair when every case has the same columns; None above CASES_TABLE_MAX cases."""
+        if not written or len(written) > CASES_TABLE_MAX:
+            return None
+        self.add([k for k in written if k not in self.pieces])
+        import pyarrow as pa
+        from driver.export import csv_bytes
+        parts = [self.pieces[k] for k in written]
+        first = parts[0][0].schema
+        if all(t.schema.equals(first, check_metadata=False) and body is not None for t, body in parts):
+            table = pa.concat_tables([t for t, _ in parts])
+            return table, csv_bytes(table.slice(0, 0)) + b"".join(body for _, body in parts)
+        return pd.concat([t.to_pandas() for t, _ in parts], ignore_index=True)
+
+
 class _Run:
     """One sweep run: the per-case path (:meth:`cases`) or the batch path (:meth:`batch`)."""
 
@@ -176,17 +220,22 @@ class _Run:
             order = (i for i in range(1, n + 1) if not done[i])
         from tqdm import tqdm
         bar = tqdm(total=n, initial=n_done, unit="case", disable=not self.progress, dynamic_ncols=True)
+        pieces = _CasesTable(layout)
 
         def on_result(results: list[CaseResult]) -> None:
             record.append(results, layout)
             bar.update(len(results))
+            pieces.add([r.index for r in results if r.files])   # while the workers compute
 
-        t_start = time.perf_counter()
+        t_start, c_start = time.perf_counter(), time.process_time()
+        LAST_RUN["prepare_cpu"] = c_start - LAST_RUN.get("start_cpu", c_start)
         try:
             chunk = engine.execute(order, n - n_done, self.task_of, self.jobs, self.scheduler, sw.chunk, on_result)
         finally:
             bar.close()
         elapsed = time.perf_counter() - t_start
+        c_end = time.process_time()
+        LAST_RUN.update(run_wall=elapsed, run_cpu=c_end - c_start, chunk=chunk)
 
         # the tables, from the resume record (memory: the rows shown, not every case's result)
         retain_all = sw.summary_rows == "all" or n <= TABLE_ALL_MAX
@@ -211,13 +260,11 @@ class _Run:
         failed = [r for r in shown if r.status != EXIT_OK]
         text = sweep_text(self.deck, sw, self.base, self.axes, n, frame, n_kept,
                           [(r.index, r.values, r.error) for r in failed], sw.summary_rows)
-        cases = None
-        if written and len(written) <= CASES_TABLE_MAX:
-            cases = pd.concat([pd.read_parquet(layout.stem(k).with_suffix(".parquet")) for k in written],
-                              ignore_index=True)
+        cases = pieces.table(written)
         write_sweep_files(self.outdir, self.stem, table, cases, text, self.plot, sw, names, self.module, frame)
         store.remove_stale_case_files(layout, has_files)
         store.clean_temporaries(layout)   # of workers of a killed earlier run that outlived its start
+        LAST_RUN["finish_cpu"] = time.process_time() - c_end
         if cases is None and written:
             old = [self.outdir / f"{self.stem}_cases.{fmt}" for fmt in ("csv", "parquet")]
             for p in old:   # an earlier, smaller run's table would no longer match the cases
@@ -265,9 +312,7 @@ class _Run:
             written = [r.index for r in results if r.files]
             if has_files is not None:
                 has_files[written] = True
-            if written and len(written) <= CASES_TABLE_MAX:
-                cases = pd.concat([pd.read_parquet(self.layout.stem(k).with_suffix(".parquet")) for k in written],
-                                  ignore_index=True)
+            cases = _CasesTable(self.layout).table(written)
             for r in results:
                 if r.status != EXIT_OK:
                     rows.loc[rows["case"] == r.index, ["status", "kept", "error"]] = ["failed", False, r.error]

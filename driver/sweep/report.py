@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 
 from driver import expr
-from driver.atomic import output_set, write_text
+from driver.atomic import atomic_open, output_set, write_text
 from driver.deck import Deck, Params
 from driver.export import write_tidy
 from driver.study import column_label
@@ -96,14 +96,22 @@ class Warnings:
         return out
 
 
-def write_sweep_files(outdir: Path, stem: str, table: pd.DataFrame, cases: pd.DataFrame | None, text: str,
+def write_sweep_files(outdir: Path, stem: str, table: pd.DataFrame, cases: Any, text: str,
                       plot: bool | str, sw: Params, names: list[str], module: Any, shown: pd.DataFrame) -> None:
     """The sweep's own files, all renamed into place together or none: ``<stem>_summary`` tables,
-    ``<stem>_cases`` tables (when given), ``<stem>.out`` and, with ``plot``, the summary figure."""
+    ``<stem>_cases`` tables (``cases``: a DataFrame, an (Arrow table, CSV bytes) pair, or None),
+    ``<stem>.out`` and, with ``plot``, the summary figure."""
     with output_set(outdir):
         for fmt in ("csv", "parquet"):
             write_tidy(table, outdir / f"{stem}_summary", fmt)
-        if cases is not None:
+        if isinstance(cases, tuple):   # (Arrow table, its CSV): built while the cases ran
+            import pyarrow.parquet as pq
+            table, csv = cases
+            with atomic_open(outdir / f"{stem}_cases.csv", "wb") as fh:
+                fh.write(csv)
+            with atomic_open(outdir / f"{stem}_cases.parquet", "wb") as fh:
+                pq.write_table(table, fh)
+        elif cases is not None:
             for fmt in ("csv", "parquet"):
                 write_tidy(cases, outdir / f"{stem}_cases", fmt)
         write_text(outdir / f"{stem}.out", text)

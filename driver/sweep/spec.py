@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import itertools
 import math
+import os
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Iterable, Iterator
@@ -33,8 +35,27 @@ def _no_scheduler_in_deck(value: str) -> str:
             "(scheduler-address, e.g. the environment variable DASK_SCHEDULER_ADDRESS)")
 
 
+def _dask_configured() -> bool:
+    """Whether any Dask configuration exists: a DASK_* environment variable or a configuration
+    file in one of the folders Dask reads (dask.config.paths and $DASK_CONFIG)."""
+    if "dask" in sys.modules or any(k.startswith("DASK_") for k in os.environ):
+        return True
+    folders = [os.environ.get("DASK_ROOT_CONFIG", "/etc/dask"), os.path.join(sys.prefix, "etc", "dask"),
+               os.path.join(os.path.expanduser("~"), ".config", "dask")]
+    for folder in folders:
+        try:
+            if any(e.name.endswith((".yaml", ".yml", ".json")) for e in os.scandir(folder)):
+                return True
+        except OSError:
+            continue
+    return False
+
+
 def _configured_scheduler() -> str:
-    """The scheduler address from Dask's own configuration/environment, or ''."""
+    """The scheduler address from Dask's own configuration/environment, or ''.  Dask is imported
+    (0.2 s) only when some Dask configuration exists."""
+    if not _dask_configured():
+        return ""
     try:
         import dask.config
     except ImportError:
