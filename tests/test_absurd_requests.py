@@ -151,3 +151,15 @@ def test_numerical_failure_is_a_deck_error_in_words(base, edits, add, words, tmp
     for bad in ("Traceback", "run failed", "nan", "LinAlgError", "ZeroDivisionError"):
         assert bad not in err[0].replace("finite number", ""), err[0]
     assert not out.exists()
+
+
+def test_sweep_axis_count_beyond_limit_is_refused_before_allocating(tmp_path, capsys):
+    """count2 = 1e8 would list 10^8 axis values (gigabytes) before the case count is checked."""
+    deck = tmp_path / "big.dat"
+    deck.write_text((INPUTS / "fourbar_design_search.dat").read_text().replace("count2 = 64", "count2 = 1e8"))
+    t0 = time.perf_counter()
+    assert main([str(deck), "-o", str(tmp_path / "o"), "-q", "-j", "1"]) == 2
+    assert time.perf_counter() - t0 < 5.0
+    err = capsys.readouterr().err
+    assert f"{deck}:" in err and "key 'count2'" in err and "100000000 values on one axis" in err
+    assert not (tmp_path / "o").exists()
