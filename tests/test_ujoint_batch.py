@@ -163,11 +163,12 @@ def test_refusals_name_the_key():
 
 
 SWEEP = """&ujoint
-  model = 'exact', beta = 12.0, 24.0, option = {option}, n_starts = 2, table_step = 30
+  beta = 12.0, 24.0, option = {option}, n_starts = 2, table_step = 30
 /
 &sweep key1 = 'ujoint.phi', start1 = 60, stop1 = 120, count1 = 7
        key2 = 'ujoint.rpm', values2 = 25, 1500
        key3 = 'ujoint.objective', values3 = 'mean_square', 'peak_to_peak'
+       key4 = 'ujoint.model', values4 = 'exact', 'paper'
        keep = 'pp_ratio < 0.145'
        case_outputs = '{outputs}' /
 """
@@ -175,16 +176,17 @@ SWEEP = """&ujoint
 
 def _sweep(tmp_path: Path, outputs: str, option: int = 0) -> Path:
     path = tmp_path / "usw.dat"
-    path.write_text(SWEEP.format(outputs=outputs, option=option))
+    text = SWEEP.format(outputs=outputs, option=option)
+    path.write_text(text if option == 0 else text.replace("count1 = 7", "count1 = 2"))   # 16 optimisations
     out = tmp_path / f"{outputs}{option}"
     assert main([str(path), "-o", str(out), "-q", "-j", "1"]) == 0
     return out
 
 
-def _path_taken(out: Path) -> str:
+def _path_taken(out: Path, stem: str = "usw") -> str:
     """'batch' or 'case': the parts of the resume record <stem>.sweep/ say which engine ran
     (driver.sweep_batch: part-<first case>.parquet; driver.sweep: part-r<run>-<seq>.parquet)."""
-    parts = [p.name for p in (out / "usw.sweep").glob("part-*.parquet")]
+    parts = [p.name for p in (out / f"{stem}.sweep").glob("part-*.parquet")]
     assert parts
     return "case" if all(n.startswith("part-r") for n in parts) else "batch"
 
@@ -194,14 +196,26 @@ def test_sweep_takes_the_batch_path_and_equals_case_by_case(tmp_path):
     assert _path_taken(batch) == "batch" and _path_taken(single_) == "case"
     a = pd.read_parquet(batch / "usw_summary.parquet")
     b = pd.read_parquet(single_ / "usw_summary.parquet")
-    assert len(a) == 28 and 0 < a["kept"].sum() < 28
+    assert len(a) == 56 and 0 < a["kept"].sum() < 56
     pd.testing.assert_frame_equal(a, b, check_dtype=False)
     ta = (batch / "usw.out").read_text().replace("case outputs                 none", "")
     tb = (single_ / "usw.out").read_text().replace("case outputs                 all", "")
     assert ta == tb
     # a base deck that optimises per case (option 1) runs case by case
     opt = _sweep(tmp_path, "none", option=1)
-    assert _path_taken(opt) == "case" and len(pd.read_parquet(opt / "usw_summary.parquet")) == 28
+    assert _path_taken(opt) == "case" and len(pd.read_parquet(opt / "usw_summary.parquet")) == 16
+
+
+def test_shipped_phasing_sweep_finds_the_cancelling_phases(tmp_path):
+    """inputs/ujoint_phasing_sweep.dat: two equal joints run at constant velocity exactly when the
+    yokes on the intermediate shaft lie in their joints' planes, phi = rho + 90 deg (mod 180)."""
+    assert main([str(ROOT / "inputs" / "ujoint_phasing_sweep.dat"), "-o", str(tmp_path), "-q", "-j", "1"]) == 0
+    assert _path_taken(tmp_path, "ujoint_phasing_sweep") == "batch"
+    kept = pd.read_parquet(tmp_path / "ujoint_phasing_sweep_summary.parquet")
+    kept = kept[kept["kept"]]
+    got = sorted(zip(kept["ujoint.rho"], kept["ujoint.phi"]))
+    assert got == [(rho, (rho + 90) % 180) for rho in (0, 30, 60, 90)]
+    assert (kept["pp_ratio"] < 1e-14).all() and (kept["beta_res_deg"].abs() < 1e-6).all()
 
 
 def test_optimize_evaluates_populations_in_one_call_and_finds_option_1(tmp_path, monkeypatch):

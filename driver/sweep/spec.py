@@ -23,8 +23,8 @@ __all__ = ["SPEC", "Case", "CaseResult", "MAX_KEYS", "MAX_CASES", "FULL_VALIDATI
 MAX_KEYS = 9
 #: most cases one per-case sweep deck may have (a batch sweep lists no case: driver.sweep_batch.MAX_CASES)
 MAX_CASES = 1_000_000
-#: most values of one swept axis (its values are listed; 10^6 floats are ~30 MB)
-MAX_AXIS_VALUES = 1_000_000
+#: most values one start/stop/count axis may have (about 0.3 GB as Python floats)
+MAX_AXIS_VALUES = 10_000_000
 #: sweeps up to this many cases have every case validated before anything runs
 FULL_VALIDATION = 5_000
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
@@ -154,9 +154,9 @@ def _axes(sw: Params, study_group: str, study_spec: GroupSpec) -> list[tuple[str
                 raise sw.error(f"{missing[0]}{k}", f"start{k}, stop{k} and count{k} go together")
             if sw[f"count{k}"] < 1:
                 raise sw.error(f"count{k}", "must be at least 1")
-            if sw[f"count{k}"] > MAX_AXIS_VALUES:   # refused before the values are held in memory
+            if sw[f"count{k}"] > MAX_AXIS_VALUES:   # refused before the values are allocated
                 raise sw.error(f"count{k}", f"{sw[f'count{k}']} values on one axis is beyond the {MAX_AXIS_VALUES} "
-                                            "one axis may have; a larger grid takes more keys or several decks")
+                                            "one axis may have; a grid multiplies its axes")
             values = [float(v) for v in np.linspace(sw[f"start{k}"], sw[f"stop{k}"], sw[f"count{k}"])]
         else:
             raise sw.error(f"key{k}", f"needs values{k} or start{k}/stop{k}/count{k}")
