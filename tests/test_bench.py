@@ -38,3 +38,20 @@ def test_run_all_smoke(run_all, capsys):
         assert r.kernel_s > 0 and r.baseline_s > 0 and r.limit
         assert r.name in text
     assert "limits (floor" in text
+
+
+def test_bench_optimize_times_the_kernels_the_optimiser_calls(capsys):
+    """bench/bench_optimize.py (one seed): its kernel clock sees the batch summary kernel the
+    population goes through, and the optimum's check run; the targets are printed, not asserted."""
+    sys.path.insert(0, str(BENCH))
+    try:
+        import bench_optimize
+        rows = bench_optimize.main(["--seeds", "1"])
+    finally:
+        sys.path.remove(str(BENCH))
+    (seed, converged, fun, designs, reach, kernel, wall, by_kernel), = rows
+    assert converged and fun >= 55.2846 and designs <= 0.05 * bench_optimize.GRID_EVALS
+    assert set(by_kernel) >= {"fourbar_summaries", "fourbar_exact"}
+    assert 0 < kernel == pytest.approx(sum(by_kernel.values())) and kernel < wall
+    text = capsys.readouterr().out
+    assert "kernel time < 1 s:" in text and "evaluations <= 5 % of the grid's (5120):" in text

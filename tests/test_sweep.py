@@ -63,6 +63,7 @@ def test_case_counts(tmp_path, text, n):
     ("&sweep\n key1 = 'fourbar.crank' /\n", 6, "key1", "needs values1"),
     ("&sweep\n values1 = 2, 3 /\n", 6, "values1", "without key1"),
     ("&sweep\n key1 = 'fourbar.crank', start1 = 1, stop1 = 2 /\n", 5, "count1", "go together"),
+    ("&sweep\n key1 = 'fourbar.crank', start1 = 1, stop1 = 2, count1 = 1e8 /\n", 6, "count1", "beyond the 10000000"),
     ("&sweep\n key1 = 'fourbar.crank', values1 = 2\n keep = 'no_such_column > 1' /\n", 7, "keep", "unknown column 'no_such_column'"),
 ])
 def test_sweep_deck_errors(tmp_path, capsys, text, line, key, words):

@@ -432,3 +432,48 @@ def test_dask_is_imported_only_when_configured(tmp_path):
     (tmp_path / ".config" / "dask").mkdir(parents=True)
     (tmp_path / ".config" / "dask" / "site.yaml").write_text("scheduler-address: tcp://10.9.9.9:8786\n")
     assert run(env) == ["'tcp://10.9.9.9:8786'", "True"]
+
+
+def test_cases_table_is_bounded_in_the_drivers_memory(tmp_path, monkeypatch):
+    import driver.sweep as sweep_pkg
+    path = per_case_deck(tmp_path, a=1)   # 3 cases
+    out = tmp_path / "o"
+    assert main([str(path), "-o", str(out), "-q", "-j", "1"]) == 0
+    assert len(pd.read_csv(out / "pc_cases.csv")) == 3 * len(pd.read_parquet(out / "pc" / "case_0001.parquet"))
+    monkeypatch.setattr(sweep_pkg, "CASES_TABLE_BYTES", 1000)   # smaller than one case's table
+    assert main([str(path), "-o", str(out), "-q", "-j", "1"]) == 0
+    assert not (out / "pc_cases.csv").exists() and not (out / "pc_cases.parquet").exists()
+    assert len(list((out / "pc").glob("case_*.parquet"))) == 3
+
+
+def test_batch_kept_cases_files_resume(tmp_path, capsys):
+    """On the batch path with case_outputs = 'kept' the kept cases' files have their own resume
+    record: --resume writes only the missing ones (a deleted .out), identical to the first run."""
+    path = deck(tmp_path, 5, 6, 7, outputs="kept")
+    out = tmp_path / "o"
+    assert main([str(path), "-o", str(out), "-q", "-j", "1"]) == 0
+    first = tree(out / "sw")
+    kept = sorted(p.name for p in (out / "sw").glob("case_*.out"))
+    assert len(kept) >= 2
+    (out / "sw" / kept[1]).unlink()
+    capsys.readouterr()
+    assert main([str(path), "-o", str(out), "-j", "1", "--resume"]) == 0
+    assert f"resume: {len(kept) - 1} of {len(kept)} kept cases' files complete, 1 to write" in capsys.readouterr().out
+    assert tree(out / "sw") == first
+
+
+def test_per_case_workers_exit_when_the_driver_is_killed(tmp_path):
+    psutil = pytest.importorskip("psutil")
+    path = per_case_deck(tmp_path, a=200, rockers="8, 9")   # 400 cases with their files
+    cmd = [sys.executable, "-m", "driver", str(path), "-o", str(tmp_path / "o"), "-q", "-j", "2"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    parent = psutil.Process(proc.pid)
+    deadline, kids = time.time() + 120, []
+    while time.time() < deadline and len(kids) < 2 and proc.poll() is None:
+        kids = parent.children(recursive=True)
+        time.sleep(0.05)
+    assert kids, "no worker processes seen"
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    gone, alive = psutil.wait_procs(kids, timeout=20)
+    assert not alive, f"workers still running after the driver died: {alive}"

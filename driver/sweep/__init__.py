@@ -18,7 +18,8 @@ and run exactly as a single run would be.  Outputs, for a deck ``<stem>.dat``:
 * ``<stem>.out``: a fixed-format summary table (one row per case) and failed cases;
 * ``<stem>_summary.{csv,parquet}``: one row per case (swept keys + headline figures);
 * ``<stem>_cases.{csv,parquet}``: the tidy tables of the written cases, with a
-  column for every swept key (up to :data:`CASES_TABLE_MAX` written cases);
+  column for every swept key (up to :data:`CASES_TABLE_MAX` written cases and
+  :data:`CASES_TABLE_BYTES`);
 * ``<stem>.sweep/``: the resume record (:mod:`driver.sweep.store`).
 
 Cases run in worker processes (``--jobs``, default all cores) or on a Dask
@@ -65,6 +66,8 @@ __all__ = ["SPEC", "Case", "build_cases", "run_sweep_deck", "run_task", "auto_ch
 #: the combined ``<stem>_cases`` tables are written up to this many written cases (above, the
 #: cases' own Parquet files are the table: ``pyarrow.dataset.dataset(<stem>/, format="parquet")``)
 CASES_TABLE_MAX = 2000
+#: ... and up to this many bytes of them in the driver's memory
+CASES_TABLE_BYTES = 256 * 2**20
 #: the sweep's .out lists every case up to this many cases (above: the kept and failed ones)
 TABLE_ALL_MAX = 2000
 #: CPU-time accounting of the last per-case sweep run in this process [s] (bench/bench_sweep.py):
@@ -128,11 +131,11 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
 
     run = _Run(deck, sw, base_params, module, grid, outdir, stem_path.name, layout, task_of, plot, progress, quiet,
                jobs, scheduler, resume)
+    sig = store.signature(raw, names, str(deck.path), sw.keep, sw.case_outputs, formats, case_plot, module)
     if batchable:
         bplan = sweep_batch.plan(module, raw, str(deck.path), grid, sw.keep, sw.summary_rows)
         if bplan is not None:
-            return run.batch(bplan)
-    sig = store.signature(raw, names, str(deck.path), sw.keep, sw.case_outputs, formats, case_plot, module)
+            return run.batch(bplan, sig)
     return run.cases(sig, estimates)
 
 
@@ -144,12 +147,14 @@ class _CasesTable:
     def __init__(self, layout: store.Layout):
         self.layout = layout
         self.pieces: dict[int, tuple[Any, bytes | None]] = {}
+        self.nbytes = 0
+        self.full = False   # beyond CASES_TABLE_MAX cases or CASES_TABLE_BYTES: no combined table
 
     def add(self, indices: list[int]) -> None:
         import pyarrow.parquet as pq
         from driver.export import csv_bytes
         for k in indices:
-            if len(self.pieces) >= CASES_TABLE_MAX:
+            if self.full:
                 return
             t = pq.read_table(self.layout.stem(k).with_suffix(".parquet"))
             try:
@@ -157,13 +162,19 @@ class _CasesTable:
             except TypeError:
                 body = None
             self.pieces[k] = (t, body)
+            self.nbytes += t.nbytes + len(body or b"")
+            if len(self.pieces) > CASES_TABLE_MAX or self.nbytes > CASES_TABLE_BYTES:
+                self.full, self.pieces = True, {}   # the driver's memory stays bounded
 
     def table(self, written: list[int]) -> Any:
         """The combined table of cases ``written`` (in order): a DataFrame, or an (Arrow table, CSV
-        bytes) pair when every case has the same columns; None above CASES_TABLE_MAX cases."""
-        if not written or len(written) > CASES_TABLE_MAX:
+        bytes) pair when every case has the same columns; None above CASES_TABLE_MAX cases or
+        CASES_TABLE_BYTES."""
+        if not written or len(written) > CASES_TABLE_MAX or self.full:
             return None
         self.add([k for k in written if k not in self.pieces])
+        if self.full:
+            return None
         import pyarrow as pa
         from driver.export import csv_bytes
         parts = [self.pieces[k] for k in written]
@@ -287,8 +298,10 @@ class _Run:
                   file=sys.stderr)
 
     # ------------------------------------------------------------------ batch path
-    def batch(self, bplan) -> int:
-        """A sweep on the study's batch path (driver.sweep_batch); same outputs as case by case."""
+    def batch(self, bplan, signature: str) -> int:
+        """A sweep on the study's batch path (driver.sweep_batch); same outputs as case by case.
+        With case_outputs = 'kept' the kept cases then run case by case for their files, with
+        their own resume record ``<stem>.sweep/cases/`` (:mod:`driver.sweep.store`)."""
         sw, names, n = self.sw, self.grid.names, bplan.grid.n
         t_start = time.perf_counter()
 
@@ -305,10 +318,19 @@ class _Run:
         has_files = np.zeros(n + 1, dtype=bool) if n <= 10 * store.SHARD * store.SHARD else None
         if sw.case_outputs == "kept" and counts["kept"]:   # the kept cases' own files, case by case
             kept = [int(c) for c in rows.loc[rows["kept"], "case"]]
-            self._check_workers_see(True)
-            results: list[CaseResult] = []
-            engine.execute(kept, len(kept), self.task_of, self.jobs, self.scheduler, 0, results.extend)
-            results.sort(key=lambda r: r.index)
+            record = store.Record(self.outdir / f"{self.stem}.sweep" / "cases", signature, n)
+            store.clean_temporaries(self.layout)
+            record.start(self.resume)
+            if self.resume:
+                record.scan(self.grid, self.layout)
+            todo = [k for k in kept if not record.complete(k)]
+            if self.resume and not self.quiet:
+                print(f"resume: {len(kept) - len(todo)} of {len(kept)} kept cases' files complete, {len(todo)} to write")
+            self._check_workers_see(bool(todo))
+            engine.execute(todo, len(todo), self.task_of, self.jobs, self.scheduler, 0,
+                           lambda res: record.append(res, self.layout))
+            wanted = set(kept)
+            results = sorted((r for r in record.results() if r.index in wanted), key=lambda r: r.index)
             written = [r.index for r in results if r.files]
             if has_files is not None:
                 has_files[written] = True

@@ -113,6 +113,33 @@ def clean_temporaries(layout: Layout) -> None:
                 remove_stale_temporaries(e.path, "case_")
 
 
+class _Winners:
+    """Per case number, the index of the part holding its newest row (-1: none): an array up
+    to :data:`DENSE_MAX` cases, else a dict (a batch sweep's kept cases among 10^10)."""
+
+    def __init__(self, n: int):
+        self.n = n
+        self.a = np.full(n + 1, -1, dtype=np.int32) if n <= DENSE_MAX else None
+        self.d: dict[int, int] = {}
+
+    def get(self, case: int) -> int:
+        if not 1 <= case <= self.n:
+            return -1
+        return int(self.a[case]) if self.a is not None else self.d.get(case, -1)
+
+    def set(self, case: int, k: int) -> None:
+        if self.a is not None:
+            self.a[case] = k
+        elif k < 0:
+            self.d.pop(case, None)
+        else:
+            self.d[case] = k
+
+
+#: case numbers up to which the record keeps an array (4 bytes a case) rather than a dict
+DENSE_MAX = 10_000_000
+
+
 class Record:
     """The resume record ``<folder>`` of one sweep run (module docstring)."""
 
@@ -121,7 +148,7 @@ class Record:
         self.signature = signature
         self.parts: list[Path] = []
         #: per case number, the index in ``parts`` of its newest row (-1: none)
-        self.winner = np.full(n_cases + 1, -1, dtype=np.int32)
+        self.winner = _Winners(n_cases)
         self.run = time.time_ns()
         self.seq = 0
 
@@ -152,7 +179,8 @@ class Record:
             return None
 
     def scan(self, grid: Grid, layout: Layout) -> np.ndarray:
-        """Cases complete in the record (bool array indexed by case number, [0] unused)."""
+        """Cases complete in the record (bool array indexed by case number, [0] unused; empty
+        above DENSE_MAX cases: ask :meth:`complete`)."""
         import pyarrow.parquet as pq
         n = grid.n
         listing: dict[str, set[str]] = {}
@@ -184,9 +212,13 @@ class Record:
                     stem = self._rel(layout, case)
                     names = json.loads(files)
                     ok = all(f.startswith(stem) and f[len(stem):len(stem) + 1] in (".", "_") and present(f) for f in names)
-                self.winner[case] = k if ok else -1
+                self.winner.set(case, k if ok else -1)
         self.parts = good
-        return self.winner >= 0
+        return self.winner.a >= 0 if self.winner.a is not None else np.zeros(0, dtype=bool)
+
+    def complete(self, case: int) -> bool:
+        """Whether case ``case`` has a valid row (after :meth:`scan` and :meth:`append`)."""
+        return self.winner.get(case) >= 0
 
     @staticmethod
     def _rel(layout: Layout, case: int) -> str:
@@ -222,7 +254,7 @@ class Record:
         self.parts.append(path)
         k = len(self.parts) - 1
         for r in results:
-            self.winner[r.index] = k
+            self.winner.set(r.index, k)
 
     # -- at the end
     def results(self, wanted: np.ndarray | None = None) -> Iterator[CaseResult]:
@@ -233,7 +265,7 @@ class Record:
         for k, part in enumerate(self.parts):
             t = pq.read_table(part).to_pydict()
             for i, case in enumerate(t["case"]):
-                if case >= len(self.winner) or self.winner[case] != k or (wanted is not None and not wanted[case]):
+                if self.winner.get(case) != k or (wanted is not None and not wanted[case]):
                     continue
                 rec = json.loads(t["record"][i])
                 yield CaseResult(case, json.loads(t["values"][i]), codes[t["status"][i]], rec["error"], rec["summary"],
@@ -246,7 +278,7 @@ class Record:
         out: dict[str, list] = {c: [] for c in names}
         for k, part in enumerate(self.parts):
             t = pq.read_table(part, columns=sorted({"case", *names})).to_pydict()
-            sel = [i for i, c in enumerate(t["case"]) if c < len(self.winner) and self.winner[c] == k]
+            sel = [i for i, c in enumerate(t["case"]) if self.winner.get(c) == k]
             for c in names:
                 out[c] += [t[c][i] for i in sel]
         return {c: np.asarray(v) for c, v in out.items()}
