@@ -271,3 +271,20 @@ def test_optimiser_evaluates_populations_in_one_call(tmp_path, monkeypatch):
     assert len(calls) < len(evals)            # populations, not designs, per call
     committed = pd.read_parquet(ROOT / "outputs" / "optimize_manipulator_torque_evals.parquet")
     pd.testing.assert_frame_equal(evals, committed)
+
+
+def test_per_case_summaries_equal_runs(tmp_path, capsys):
+    """A key the batch does not take (elbow) sends the sweep case by case: with case_outputs
+    'none' each case is ``summarise`` (one batch row), with 'all' a full run: the same rows."""
+    text = ("&manipulator points_x = 1, 2, 3, 4, points_y = 5, 7, 7, 6, designs_l1 = 5.0, designs_l2 = 4.5,\n"
+            "  mc_samples = 300 /\n&sweep key1 = 'manipulator.elbow', values1 = 1, -1\n"
+            "  key2 = 'manipulator.designs_l1', values2 = 4.8, 5.2, 5.6\n  case_outputs = '{o}' /\n")
+    frames = []
+    for o in ("none", "all"):
+        path = tmp_path / f"{o}.dat"
+        path.write_text(text.format(o=o))
+        assert main([str(path), "-o", str(tmp_path / o), "-j", "1"]) == 0
+        assert "batch path" not in capsys.readouterr().out
+        frames.append(pd.read_parquet(tmp_path / o / f"{o}_summary.parquet"))
+    pd.testing.assert_frame_equal(frames[0], frames[1], check_dtype=False, rtol=1e-12)
+    assert frames[0]["design_total_torque_Nm"].nunique() == 6     # both elbows differ

@@ -125,6 +125,11 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     message) or ValueError for a plain mapping.  About 0.5 us per design on one core
     (bench/bench_manipulator.py), a tenth of it in the kernel.
     """
+    return pd.DataFrame(_arrays(base, columns))
+
+
+def _arrays(base: Mapping[str, Any], columns: Mapping[str, Any] | None) -> dict[str, np.ndarray]:
+    """The columns of :func:`summarise_batch` as numpy arrays (what :func:`summarise` reads)."""
     p = _as_params(base)
     columns = {k.partition(".")[2] if k.startswith("manipulator.") else k: v for k, v in (columns or {}).items()}
     unknown = [k for k in columns if k not in BATCH_KEYS and k not in BATCH_IGNORED]
@@ -136,7 +141,7 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
         raise _bad(base, None, f"batch columns have different lengths {sorted(sizes)}")
     n = sizes.pop() if sizes else 1
     if n == 0:
-        return _empty(base)
+        return {k: v[:0] for k, v in _arrays(base, None).items()}
     ws = Workspace(np.asarray(p.points_x, dtype=np.float64), np.asarray(p.points_y, dtype=np.float64))
     conv = Conv(p.mode == "report", ws)
     names, l1, l2 = _lengths(base, columns, n, conv)
@@ -202,7 +207,7 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
             continue
         kind = object if any(v is None for v in vals) else type(vals[0])
         out[c] = np.array(vals, dtype=kind)[inv.ravel()]
-    return pd.DataFrame(out)
+    return out
 
 
 #: Monte Carlo samples that can be a box's worst, per (seed, count)
@@ -241,10 +246,6 @@ def _status(reach: np.ndarray, target_ok: np.ndarray, ri1: np.ndarray) -> np.nda
     return out
 
 
-def _empty(base: Mapping[str, Any]) -> pd.DataFrame:
-    return summarise_batch(base).iloc[:0]
-
-
 def _report_torques(p: Params, prm: np.ndarray, r: dict[str, np.ndarray], n: int, k: int
                     ) -> tuple[np.ndarray, np.ndarray]:
     """mode = 'report': the torques of the report's Table 4.7 -- the printed Table 4.5 angles
@@ -269,9 +270,9 @@ def summarise(params: Params) -> dict[str, Any]:
     what a sweep or an optimiser needs when it writes no per-case files.  Equals
     ``run(params).summary`` wherever a run succeeds, and also answers for a design the run
     refuses (one that cannot reach the workspace or the target), with its ``design_status``."""
-    row = summarise_batch(params).iloc[0].to_dict()
     out = {}
-    for key, v in row.items():
+    for key, col in _arrays(params, None).items():
+        v = col[0]
         if isinstance(v, float) and math.isnan(v):
             v = None
         elif isinstance(v, np.bool_):
