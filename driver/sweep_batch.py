@@ -45,7 +45,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 import driver
-from driver import blas, expr
+from driver import expr
 from driver.atomic import atomic_open
 from driver.deck import DeckError, RawGroup, validate
 from driver.study import load_study
@@ -187,7 +187,6 @@ class ChunkResult:
     errors: list[str] = field(default_factory=list)
 
 
-@blas.one_thread()
 def chunk_rows(p: BatchPlan, start: int, stop: int) -> ChunkResult:
     """Summaries of cases start+1..stop (the unit of work of a worker)."""
     t0 = time.perf_counter()
