@@ -37,7 +37,7 @@ import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any, Callable, Iterator
 
 import numpy as np
 import pandas as pd
@@ -327,42 +327,56 @@ def execute(p: BatchPlan, todo: list[tuple[int, int]], jobs: int, scheduler: Any
         for s, e in todo:
             on_result(chunk_rows(p, s, e))
         return
-    limit = in_flight or 2 * jobs
     queue: Iterator[tuple[int, int]] = iter(todo)
+    run_pool(lambda: next(queue, None), lambda pool, rng: pool.submit(chunk_rows, p, *rng),
+             lambda rng: _alone(p, *rng), lambda rng, res, pending: on_result(res), jobs, in_flight or 2 * jobs,
+             "chunks")
+
+
+def run_pool(source: Callable[[], Any], submit: Callable[[cf.ProcessPoolExecutor, Any], cf.Future],
+             alone: Callable[[Any], Any], on_result: Callable[[Any, Any, int], None], jobs: int, limit: int,
+             what: str, order: Callable[[Any], Any] = lambda t: t) -> None:
+    """The local worker pool of both sweep engines, with a bounded number of tasks in flight.
+
+    ``source()`` gives the next task (None: none now; with nothing in flight, the end);
+    ``submit(pool, task)`` sends it; ``on_result(task, result, n_in_flight)`` takes each result as it
+    comes.  When a worker dies every task in flight is suspect: each is retried once, alone, by
+    ``alone(task)`` (in ``order``), and a fresh pool takes over.  Workers exit with the driver
+    (:func:`worker_init`)."""
     pool = cf.ProcessPoolExecutor(max_workers=jobs, initializer=worker_init)
-    pending: dict[cf.Future, tuple[int, int]] = {}
+    pending: dict[cf.Future, Any] = {}
     try:
         while True:
-            suspects: list[tuple[int, int]] = []
+            suspects: list[Any] = []
             while len(pending) < limit and not suspects:
-                nxt = next(queue, None)
-                if nxt is None:
+                task = source()
+                if task is None:
                     break
                 try:
-                    pending[pool.submit(chunk_rows, p, *nxt)] = nxt
+                    pending[submit(pool, task)] = task
                 except cf.process.BrokenProcessPool:   # a worker died since the last wait
-                    suspects.append(nxt)
-            if not pending and not suspects:
+                    suspects.append(task)
+            if not pending and not suspects:   # every task sent and returned
                 break
             if not suspects:
                 done, _ = cf.wait(pending, return_when=cf.FIRST_COMPLETED)
                 for fut in done:
-                    rng = pending.pop(fut)
+                    task = pending.pop(fut)
                     try:
                         res = fut.result()
                     except cf.process.BrokenProcessPool:
-                        suspects.append(rng)
+                        suspects.append(task)
                         continue
-                    on_result(res)
-            if suspects:   # every chunk in flight is suspect: retry each once, alone
+                    on_result(task, res, len(pending))
+            if suspects:   # every task in flight is suspect: each is retried once, alone
                 suspects += list(pending.values())
                 pending.clear()
                 pool.shutdown(wait=False, cancel_futures=True)
-                for rng in sorted(set(suspects)):
-                    on_result(_alone(p, *rng))
+                for task in sorted(suspects, key=order):
+                    on_result(task, alone(task), 0)
                 pool = cf.ProcessPoolExecutor(max_workers=jobs, initializer=worker_init)
     except KeyboardInterrupt:
-        print("interrupt: cancelling queued chunks, finishing the running ones", file=sys.stderr)
+        print(f"interrupt: cancelling queued {what}, finishing the running ones", file=sys.stderr)
         pool.shutdown(wait=True, cancel_futures=True)
         raise
     finally:

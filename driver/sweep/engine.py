@@ -43,7 +43,7 @@ from driver.runner import compute, write_outputs
 from driver.study import load_study
 from driver.sweep.spec import EXIT_FAILED, EXIT_OK, Case, CaseResult, _case_deck_text, _case_raw, iter_cases
 from driver.sweep.store import Layout, json_default
-from driver.sweep_batch import Grid, worker_init
+from driver.sweep_batch import Grid, run_pool, worker_init
 
 __all__ = ["Task", "run_task", "auto_chunk", "execute", "cluster_workers", "check_shared_folder", "DIED"]
 
@@ -313,49 +313,17 @@ class _Feed:
 
 def _execute_pool(it, n_todo: int, task_of, jobs: int, chunk: int, on_result, in_flight: int) -> int:
     feed = _Feed(it, n_todo, jobs, chunk)
-    limit = in_flight or 2 * jobs
-    pool = cf.ProcessPoolExecutor(max_workers=jobs, initializer=worker_init)
-    pending: dict[cf.Future, Task] = {}
-    try:
-        while True:
-            suspects: list[Task] = []
-            while len(pending) < limit and not suspects:
-                cs = feed.next()
-                if cs is None:
-                    break
-                task = task_of(cs)
-                try:
-                    pending[pool.submit(run_task, task)] = task
-                except cf.process.BrokenProcessPool:   # a worker died since the last wait
-                    suspects.append(task)
-            if not pending and not suspects:   # every case sent and returned
-                break
-            if not suspects:
-                done, _ = cf.wait(pending, return_when=cf.FIRST_COMPLETED)
-                for fut in done:
-                    task = pending.pop(fut)
-                    try:
-                        res = fut.result()
-                    except cf.process.BrokenProcessPool:
-                        suspects.append(task)
-                        continue
-                    on_result(res)
-                    feed.returned(task, res, len(pending))
-            if suspects:   # every chunk in flight is suspect: each is retried once, alone
-                suspects += list(pending.values())
-                pending.clear()
-                pool.shutdown(wait=False, cancel_futures=True)
-                for task in sorted(suspects, key=lambda t: t.indices[0]):
-                    res = _alone(task)
-                    on_result(res)
-                    feed.returned(task, res, 0)
-                pool = cf.ProcessPoolExecutor(max_workers=jobs, initializer=worker_init)
-    except KeyboardInterrupt:
-        print("interrupt: cancelling queued cases, finishing the running ones", file=sys.stderr)
-        pool.shutdown(wait=True, cancel_futures=True)
-        raise
-    finally:
-        pool.shutdown(wait=True)
+
+    def source() -> Task | None:
+        cs = feed.next()
+        return None if cs is None else task_of(cs)
+
+    def took(task: Task, res: list[CaseResult], in_flight: int) -> None:
+        on_result(res)
+        feed.returned(task, res, in_flight)
+
+    run_pool(source, lambda pool, task: pool.submit(run_task, task), _alone, took, jobs,
+             in_flight or 2 * jobs, "cases", order=lambda t: t.indices[0])
     return feed.chunk or 1
 
 
