@@ -189,19 +189,7 @@ def test_workers_exit_when_the_driver_is_killed(tmp_path):
     psutil = pytest.importorskip("psutil")
     path = deck(tmp_path, 40, 50, 60, extra=", chunk = 500")   # 120 000 cases
     out = tmp_path / "o"
-    cmd = [sys.executable, "-m", "driver", str(path), "-o", str(out), "-q", "-j", "2"]
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    parent = psutil.Process(proc.pid)
-    deadline = time.time() + 120
-    kids = []
-    while time.time() < deadline and len(kids) < 2 and proc.poll() is None:
-        kids = parent.children(recursive=True)
-        time.sleep(0.05)
-    assert kids, "no worker processes seen"
-    proc.send_signal(signal.SIGKILL)
-    proc.wait()
-    gone, alive = psutil.wait_procs(kids, timeout=20)
-    assert not alive, f"workers still running after the driver died: {alive}"
+    _kill_driver_and_check_workers(psutil, path, out)
 
 
 def test_grid_columns_follow_product_order():
@@ -465,7 +453,12 @@ def test_batch_kept_cases_files_resume(tmp_path, capsys):
 def test_per_case_workers_exit_when_the_driver_is_killed(tmp_path):
     psutil = pytest.importorskip("psutil")
     path = per_case_deck(tmp_path, a=200, rockers="8, 9")   # 400 cases with their files
-    cmd = [sys.executable, "-m", "driver", str(path), "-o", str(tmp_path / "o"), "-q", "-j", "2"]
+    _kill_driver_and_check_workers(psutil, path, tmp_path / "o")
+
+
+def _kill_driver_and_check_workers(psutil, path: Path, out: Path) -> None:
+    """SIGKILL a 2-worker sweep's driver once its workers run; every worker must exit by itself."""
+    cmd = [sys.executable, "-m", "driver", str(path), "-o", str(out), "-q", "-j", "2"]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     parent = psutil.Process(proc.pid)
     deadline, kids = time.time() + 120, []
