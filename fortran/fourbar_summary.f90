@@ -84,23 +84,14 @@ contains
   !> Grashof class from the link lengths (same rule and tolerance as driver/fourbar.py grashof()).
   pure integer function grashof_code(p, q, r, s) result(code)
     real(dp), intent(in) :: p, q, r, s
-    real(dp) :: l(4), lhs, rhs, tol, t
-    integer :: i, j, ishort
+    real(dp) :: l(4), lhs, rhs, tol
+    integer :: i, ishort
     l = [p, q, s, r]                   ! tie order of the Python rule: ground, crank, rocker, coupler
     ishort = 1
     do i = 2, 4
       if (l(i) < l(ishort)) ishort = i
     end do
-    do i = 2, 4                        ! sort a copy
-      t = l(i)
-      j = i - 1
-      do while (j >= 1)
-        if (l(j) <= t) exit
-        l(j + 1) = l(j)
-        j = j - 1
-      end do
-      l(j + 1) = t
-    end do
+    call sort(l, 4)                    ! a sorted copy
     lhs = l(1) + l(4)
     rhs = l(2) + l(3)
     tol = 1.0e-12_dp*rhs
