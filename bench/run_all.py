@@ -218,7 +218,7 @@ SCALE = {"ns/position": 1e9, "ns/sample": 1e9, "us/config": 1e6, "us/objective":
 
 
 def print_table(rows: list[Row]) -> None:
-    print(f"{'benchmark':<46}{'unit':>14}{'kernel':>10}{'numpy':>11}{'ratio':>8}   target")
+    print(f"{'benchmark':<46}{'unit':>14}{'kernel':>10}{'numpy':>12}{'ratio':>10}   target")
     for r in rows:
         k = SCALE[r.unit]
         tgt = []
@@ -227,7 +227,7 @@ def print_table(rows: list[Row]) -> None:
         if r.target_ratio is not None:
             tgt.append(f">= {r.target_ratio:g}x")
         verdict = ("met" if r.met() else "NOT met") if tgt else "-"
-        print(f"{r.name:<46}{r.unit:>14}{r.kernel_s * k:10.3f}{r.baseline_s * k:11.3f}{r.ratio:7.1f}x   "
+        print(f"{r.name:<46}{r.unit:>14}{r.kernel_s * k:10.3f}{r.baseline_s * k:12.3f}{r.ratio:9.1f}x   "
               f"{', '.join(tgt) or '-'} {verdict if tgt else ''}")
     print("\nlimits (floor: numpy writing the same output bytes in the same run):")
     for r in rows:
