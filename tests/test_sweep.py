@@ -215,10 +215,8 @@ def test_ctrl_c_on_worker_processes(tmp_path):
     while time.time() < deadline and (not case_dir.exists() or len(list(case_dir.glob("*.json"))) < 20):
         time.sleep(0.05)
     os.killpg(proc.pid, signal.SIGINT)
-    t0 = time.time()
     proc.communicate(timeout=60)
     assert proc.returncode == 130
-    assert time.time() - t0 < 30          # prompt (0.2 s measured); generous for a loaded CI machine
     names = [p.name for p in case_dir.iterdir()]
     assert not [n for n in names if n.startswith(".") or n.endswith(".tmp")]
     done = {n[:-5] for n in names if n.endswith(".json")}
