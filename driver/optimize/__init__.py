@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -35,10 +34,10 @@ import pandas as pd
 
 from driver.atomic import output_set, write_text
 from driver import blas
-from driver.deck import Deck, DeckError, read_deck
+from driver.deck import Deck, read_deck
 from driver.export import write_tidy
 from driver.extras import require
-from driver.optimize.evaluate import Evaluator, Record, design_params, evaluate_cases
+from driver.optimize.evaluate import Evaluator, Record, design_params
 from driver.optimize.methods import HistoryRow, MethodResult, run_method
 from driver.optimize.problem import SPEC, Problem, problem_of
 from driver.optimize import report
@@ -81,8 +80,6 @@ def _probe(problem: Problem) -> None:
     Only a clean run (no failure, no warning) proves a column does not exist; otherwise (a buckled
     rod has no strain peaks) a design whose summary lacks a column is infeasible, with that reason.
     """
-    from driver.optimize.evaluate import _slots
-    kinds = [problem.study.SPEC.keys[v.key].kind for v in problem.variables]
     x = [base_value(problem, v) for v in problem.variables]
     try:
         params = design_params(problem, np.array(x))

@@ -236,7 +236,7 @@ def _local(ev: Evaluator, history: list[HistoryRow]) -> MethodResult:
     converged = p.sense * (top["objective"] - best.objective) <= tol
     msg = (f"{len(good)} of {len(runs)} starts converged to feasible designs; best from start {top['start']}"
            if converged else
-           f"the best design evaluated is better than every converged start by more than the tolerance")
+           "the best design evaluated is better than every converged start by more than the tolerance")
     return MethodResult(bool(converged), msg, nit, nfev, runs)
 
 

@@ -31,7 +31,6 @@ import numpy as np
 
 from driver import expr
 from driver.deck import Deck, DeckError, GroupSpec, Key, Params, RawGroup, validate
-from driver.study import load_study
 
 __all__ = ["SPEC", "MAX_VARS", "MAX_CONSTRAINTS", "METHODS", "Variable", "Constraint", "Problem", "problem_of"]
 

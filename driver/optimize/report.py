@@ -90,7 +90,7 @@ def report_text(p: Problem, ev: Evaluator, mres: MethodResult, history: list[His
         least = ev.least_infeasible()
         L += ["    no feasible design was evaluated; nothing is reported as an optimum."]
         if least is not None:
-            L += [f"    least infeasible design: " + ", ".join(f"{n} = {_g(x)}" for n, x in zip(p.names, least.x))
+            L += ["    least infeasible design: " + ", ".join(f"{n} = {_g(x)}" for n, x in zip(p.names, least.x))
                   + f" ({least.why})"]
     else:
         what = "optimum" if mres.converged else "best feasible design evaluated (not an optimum: the method did not converge)"

@@ -59,7 +59,6 @@ class PathDesign:
 
 def bounds(pp: PathProblem) -> list[tuple[float, float]]:
     lo, hi = pp.targets.min(0), pp.targets.max(0)
-    ext = float(max(hi - lo)) or 1.0
     pad = pp.length_max
     b = [(lo[0] - pad, hi[0] + pad), (lo[1] - pad, hi[1] + pad), (-180.0, 180.0)]
     b += [(pp.length_min, pp.length_max)] * 4
