@@ -103,18 +103,26 @@ FOURBAR_GRASHOF = {int(getattr(_kernels.fourbar_summary, f"gr_{k}")): k for k in
                     "triple_rocker")}
 
 
-def fourbar_summaries(params: np.ndarray) -> np.ndarray:
+#: pass bits of fourbar_summaries (fortran/fourbar_summary.f90 pass_*); 'dense_scan' with
+#: 'peaks' is the previous peak search (every 1 deg grid point), the baseline of bench and tests
+FOURBAR_PASSES = {k: int(getattr(_kernels.fourbar_summary, f"pass_{k}")) for k in
+                  ("transmission", "rocker", "peaks", "dense_scan")}
+
+
+def fourbar_summaries(params: np.ndarray, passes: int = 7) -> np.ndarray:
     """Headline figures of many four-bars in one kernel call: (n, 19) array.
 
     ``params`` (n, 8): fixed link p, crank q, coupler r, rocker s [length], crank speed
     [rad/s], first and last crank angle of the range [deg], branch (+1 open, -1 crossed).
     Columns: FOURBAR_SUMMARY_COLUMNS (angles in degrees, speeds in rad/s; flags 0/1;
     figures that do not exist are 0 -- mask them with 'assemblable' and 'toggles_in_range').
+    ``passes``: sum of FOURBAR_PASSES bits; the columns of a pass not asked for are 0 (not
+    computed), the others have the same bits whichever passes run (default: all three).
     """
     params = farray(params, 2)
     if params.shape[1] != 8:
         raise ValueError(f"params must have 8 columns, got {params.shape[1]}")
-    return _kernels.fourbar_summary.summaries(params)
+    return _kernels.fourbar_summary.summaries(params, int(passes))
 
 
 def fourbar_coupler_point(theta: np.ndarray, states: np.ndarray, status: np.ndarray, q: float,
@@ -232,8 +240,13 @@ MANIPULATOR_SUMMARY_COLUMNS = ("ri1", "ri2", "ri3", "sum_c2", "reach", "target_s
                                "tau1", "tau2", "reaches_points", "dl1", "dl2", "mc_max")
 
 
+#: pass bits of manipulator_design_summaries (fortran/manipulator_summary.f90 ds_*)
+MANIPULATOR_PASSES = {k: int(getattr(_kernels.manipulator_summary, f"ds_{k}")) for k in
+                      ("indices", "target", "tolerance")}
+
+
 def manipulator_design_summaries(x, y, params, branch: int = 1, rates=(1.0, 1.0, 1.0, 1.0),
-                                 measure: str = "global", unit=None) -> np.ndarray:
+                                 measure: str = "global", unit=None, passes: int = 7) -> np.ndarray:
     """Design summaries of nd 2R arms for workspace points (x, y) [m] in one call: (nd, 14).
 
     ``params`` (nd, 7): columns MANIPULATOR_SUMMARY_PARAMS -- l1, l2 [m] (positive), the
@@ -245,7 +258,9 @@ def manipulator_design_summaries(x, y, params, branch: int = 1, rates=(1.0, 1.0,
     reach (1/0, conditions 4.4), IK status at the target (MANIPULATOR_STATUS), theta1, theta2
     there [deg], tau1, tau2 [N m] (0 unless the status is ok), reaches_points (1 when the IK
     reaches every workspace point), tolerance half-widths dl1, dl2 [m] and the Monte Carlo
-    maximum error [m] (the last three 0 unless reaches_points).
+    maximum error [m] (the last three 0 unless reaches_points).  ``passes``: sum of
+    MANIPULATOR_PASSES bits (indices: columns 0-4, target: 5-9, tolerance: 10-13); the
+    columns of a pass not asked for are 0 (not computed).
     """
     x, y = farray(np.atleast_1d(x), 1), farray(np.atleast_1d(y), 1)
     params = farray(params, 2)
@@ -256,7 +271,7 @@ def manipulator_design_summaries(x, y, params, branch: int = 1, rates=(1.0, 1.0,
         raise ValueError(f"unit must have shape (ns >= 1, 2), got {unit.shape}")
     return _kernels.manipulator_summary.design_summaries(
         x, y, params, int(branch), farray(np.asarray(rates, dtype=np.float64).ravel(), 1),
-        {"global": 0, "per_point": 1}[measure], unit)
+        {"global": 0, "per_point": 1}[measure], unit, int(passes))
 
 
 
@@ -332,7 +347,11 @@ UJOINT_SUMMARY_COLUMNS = ("objective", "ratio_min", "ratio_max", "dratio_abs_max
                           "beta_res_status")
 
 
-def ujoint_summaries(model: int, kind: int, beta, phi, rho, m: int, tol: float = 1e-7) -> np.ndarray:
+#: pass bits of ujoint_summaries (fortran/ujoint.f90 sum_*)
+UJOINT_PASSES = {k: int(getattr(_kernels.ujoint, f"sum_{k}")) for k in ("objective", "speed", "equivalent")}
+
+
+def ujoint_summaries(model: int, kind: int, beta, phi, rho, m: int, tol: float = 1e-7, passes: int = 7) -> np.ndarray:
     """Headline figures of many designs of one chain layout in one kernel call: (nd, 7) array.
 
     beta (nd, n) joint angles [rad]; phi (nd, n-1) the paper's phases [rad]; rho (nd, n-1)
@@ -342,7 +361,9 @@ def ujoint_summaries(model: int, kind: int, beta, phi, rho, m: int, tol: float =
     min and max of R = omega_out/omega_in and max |dR/dtheta| [1/rad] on the grid
     theta_j = 2 pi j/m (as :func:`ujoint_speed` there), beta_e and beta_res [rad] and the
     status of beta_res (0: defined; as :func:`ujoint_equivalent` with ``tol`` [rad]).
-    Each row has the same bits as those single-design calls.
+    Each row has the same bits as those single-design calls.  ``passes``: sum of
+    UJOINT_PASSES bits (objective: column 0, speed: 1-3, equivalent: 4-6); the columns of a
+    pass not asked for are 0 (not computed).
     """
     beta = np.asarray(beta, dtype=np.float64)
     if beta.ndim != 2 or beta.shape[1] < 1:
@@ -355,7 +376,7 @@ def ujoint_summaries(model: int, kind: int, beta, phi, rho, m: int, tol: float =
     x[:, n:2 * n - 1] = phi
     x[:, 2 * n - 1:] = 0.0 if rho is None else rho
     return _kernels.ujoint.chain_summaries(model=int(model), kind=int(kind), n=n, nd=nd, x=x, m=int(m),
-                                           tol=float(tol))
+                                           tol=float(tol), passes=int(passes))
 
 
 def ujoint_geometry(axes) -> tuple[np.ndarray, np.ndarray, int]:

@@ -102,12 +102,16 @@ class BatchPlan:
     coupled: list[int]                          # axes validated together
     coupled_errors: dict[tuple, str]            # value-index tuple of the coupled axes -> error
     signature: str = ""
+    #: summary columns computed for every case (those the filter reads); None: all
+    filter_columns: list[str] | None = None
+    #: summary columns of the rows the tables show (kept rows with rows = 'kept'); None: all
+    shown_columns: list[str] | None = None
 
 
-def _signature(raw: RawGroup, grid: Grid, keep: str, rows: str, module) -> str:
+def _signature(raw: RawGroup, grid: Grid, keep: str, rows: str, module, shown: list[str] | None = None) -> str:
     h = hashlib.sha256()
-    h.update(json.dumps([raw.name, raw.values, grid.names, grid.values, grid.zipped, keep, rows, driver.__version__],
-                        sort_keys=True, default=str).encode())
+    h.update(json.dumps([raw.name, raw.values, grid.names, grid.values, grid.zipped, keep, rows, driver.__version__]
+                        + ([shown] if shown is not None else []), sort_keys=True, default=str).encode())
     sources = [getattr(module, "__file__", None)]
     if sources[0] and Path(sources[0]).name == "__init__.py":   # a study package: every module of it
         sources = sorted(str(f) for f in Path(sources[0]).parent.glob("*.py"))
@@ -133,8 +137,29 @@ def batchable(module, names: list[str], keep: str, case_outputs: str) -> bool:
     return all(n.partition(".")[2] in batch_keys for n in names)
 
 
-def plan(module, raw: RawGroup, deck_path: str, grid: Grid, keep: str, rows: str) -> BatchPlan | None:
-    """A batch plan for this sweep (see :func:`batchable`), or None when it must run case by case."""
+def wanted_columns(module, keep: str, plotted: list[str], shown: list[str] | None
+                   ) -> tuple[list[str] | None, list[str] | None]:
+    """(columns every case needs, columns the shown rows need) of the study's batch summary,
+    from its column -> pass table ``BATCH_PASSES``: the filter's columns for every case; the
+    shown rows also the plotted ones and ``shown`` (summary_columns; None: every column).
+    (None, None) when the study declares no table (everything is computed)."""
+    table = getattr(module, "BATCH_PASSES", None)
+    if table is None:
+        return None, None
+    def names(text: str) -> set[str]:   # summary columns an expression reads (not swept keys, not 'case')
+        return {n for n in expr.parse(text).names if "." not in n and n != "case"} if text else set()
+
+    order = lambda cols: [c for c in table if c in cols] + sorted(c for c in cols if c not in table)
+    filt = order(names(keep))
+    if shown is None:
+        return filt, None
+    return filt, order(set(filt).union(*(names(t) for t in plotted)) | set(shown))
+
+
+def plan(module, raw: RawGroup, deck_path: str, grid: Grid, keep: str, rows: str,
+         plotted: list[str] | None = None, shown: list[str] | None = None) -> BatchPlan | None:
+    """A batch plan for this sweep (see :func:`batchable`), or None when it must run case by case.
+    ``plotted``: the plot_x/plot_y expressions; ``shown``: summary_columns (None: all)."""
     applies = getattr(module, "batch_applies", None)   # e.g. not for a base deck that optimises per case
     if applies is not None and not applies(validate(raw, module.SPEC, deck_path)):
         return None
@@ -167,7 +192,8 @@ def plan(module, raw: RawGroup, deck_path: str, grid: Grid, keep: str, rows: str
             except DeckError as exc:
                 coupled_errors[combo] = str(exc)
     p = BatchPlan(deck_path, raw, grid, keep, rows, single, coupled, coupled_errors)
-    p.signature = _signature(raw, grid, keep, rows, module)
+    p.filter_columns, p.shown_columns = wanted_columns(module, keep, plotted or [], shown)
+    p.signature = _signature(raw, grid, keep, rows, module, p.shown_columns)
     return p
 
 
@@ -187,8 +213,28 @@ class ChunkResult:
     errors: list[str] = field(default_factory=list)
 
 
+def _summaries(module, base, cols: dict[str, np.ndarray], rows: np.ndarray, wanted: list[str] | None,
+               bad: np.ndarray | None) -> pd.DataFrame:
+    """The study's batch summary of cases ``rows`` (indices into ``cols``; ``bad[rows]`` True
+    where the case is bad input: a row of None), columns ``wanted`` (None: all)."""
+    good = rows if bad is None else rows[~bad[rows]]
+    sub = {k.partition(".")[2]: v[good] for k, v in cols.items()}
+    summ = module.summarise_batch(base, sub) if wanted is None else module.summarise_batch(base, sub, wanted=wanted)
+    if bad is not None and bad[rows].any():
+        summ = summ.astype(object)
+        full = pd.DataFrame(None, index=range(len(rows)), columns=summ.columns, dtype=object)
+        full.iloc[np.flatnonzero(~bad[rows])] = summ.to_numpy()
+        summ = full
+    return summ
+
+
 def chunk_rows(p: BatchPlan, start: int, stop: int) -> ChunkResult:
-    """Summaries of cases start+1..stop (the unit of work of a worker)."""
+    """Summaries of cases start+1..stop (the unit of work of a worker).
+
+    With a filter and ``rows = 'kept'`` in two steps: the columns the filter reads for every
+    case (``p.filter_columns``), then the columns the tables show (``p.shown_columns``) for the
+    kept cases only; so a column nobody asks for is never computed, and the kept rows hold
+    the same values as a single summary of every column would give."""
     t0 = time.perf_counter()
     module = load_study(p.raw.name)
     n = stop - start
@@ -206,20 +252,15 @@ def chunk_rows(p: BatchPlan, start: int, stop: int) -> ChunkResult:
                 err[k] = msg
     bad = err != ""
     base = validate(p.raw, module.SPEC, p.deck_path)
-    frame = pd.DataFrame({"case": np.arange(start + 1, stop + 1, dtype=np.int64), **cols})
-    good = np.flatnonzero(~bad)
-    summ = module.summarise_batch(base, {k.partition(".")[2]: v[good] for k, v in cols.items()})
-    if bad.any():
-        summ = summ.astype(object)
-        full = pd.DataFrame(None, index=range(n), columns=summ.columns, dtype=object)
-        full.iloc[good] = summ.to_numpy()
-        summ = full
-    summ.index = frame.index
-    status = np.where(bad, "bad input", "ok").astype(object)
-    frame["status"] = status
-    frame["kept"] = False
-    frame = pd.concat([frame, summ], axis=1)
-    frame["error"] = err
+    every = np.arange(n)
+    two_step = bool(p.keep) and p.rows == "kept" and p.filter_columns is not None
+    if two_step:
+        first = _summaries(module, base, cols, every, p.filter_columns, bad)
+    else:
+        wanted = None if p.shown_columns is None else list(dict.fromkeys([*(p.filter_columns or []),
+                                                                          *p.shown_columns]))
+        first = _summaries(module, base, cols, every, wanted, bad)
+    frame = _frame(start, stop, cols, bad, err, first)
     mask = ~bad
     if p.keep:
         try:
@@ -229,9 +270,32 @@ def chunk_rows(p: BatchPlan, start: int, stop: int) -> ChunkResult:
     frame["kept"] = mask
     res = ChunkResult(start, stop, frame, int((~bad).sum()), int(mask.sum()), int(bad.sum()))
     if p.rows == "kept":
-        res.frame = frame[mask | bad].reset_index(drop=True)
+        shown = np.flatnonzero(mask | bad)
+        if two_step:   # the shown rows' columns, for those rows only
+            summ = _summaries(module, base, cols, shown, p.shown_columns, bad)
+            out = _frame(start, stop, cols, bad, err, summ, shown)
+            out["kept"] = mask[shown]
+            res.frame = out
+        else:
+            res.frame = frame.iloc[shown].reset_index(drop=True)
+    elif p.shown_columns is not None:   # the filter's columns that are not shown go
+        res.frame = frame[[c for c in frame.columns if c not in set(p.filter_columns or ()) - set(p.shown_columns)]]
     res.seconds = time.perf_counter() - t0
     return res
+
+
+def _frame(start: int, stop: int, cols: dict[str, np.ndarray], bad: np.ndarray, err: np.ndarray,
+           summ: pd.DataFrame, rows: np.ndarray | None = None) -> pd.DataFrame:
+    """The rows of a chunk (all, or ``rows``): case, swept values, status, kept, summary, error."""
+    case = np.arange(start + 1, stop + 1, dtype=np.int64)
+    pick = (lambda a: a) if rows is None else (lambda a: a[rows])
+    frame = pd.DataFrame({"case": pick(case), **{k: pick(v) for k, v in cols.items()}})
+    frame["status"] = np.where(pick(bad), "bad input", "ok").astype(object)
+    frame["kept"] = False
+    summ.index = frame.index
+    frame = pd.concat([frame, summ], axis=1)
+    frame["error"] = pick(err)
+    return frame
 
 
 def _watch_parent(ppid: int) -> None:

@@ -18,7 +18,7 @@ deck design: its tables need a design that reaches.)
 from __future__ import annotations
 
 import math
-from typing import Any, Mapping
+from typing import Any, Collection, Mapping
 
 import numpy as np
 import pandas as pd
@@ -29,7 +29,8 @@ from driver.manipulator.analysis import STATUS, Conv, Workspace, _design_list, d
 from driver.manipulator.report import sweep_columns, workspace_columns
 from driver.manipulator.tables import _t48
 
-__all__ = ["BATCH_KEYS", "BATCH_IGNORED", "BATCH_INDEPENDENT", "summarise_batch", "summarise"]
+__all__ = ["BATCH_KEYS", "BATCH_IGNORED", "BATCH_INDEPENDENT", "BATCH_PASSES", "BATCH_PASS_SUFFIXES", "summarise_batch",
+           "summarise"]
 
 #: deck keys a batch may vary (one value per design deck; designs_l1/designs_l2 one length, or
 #: an (n, k) array for k designs per deck); every other key is the base deck's
@@ -38,6 +39,38 @@ BATCH_KEYS = ("designs_l1", "designs_l2", "mass_per_length", "gravity", "target_
 BATCH_IGNORED = ("title", "ri2_levels", "crob_l1", "text_optimum_decimals")
 #: keys whose deck checks do not involve other keys (a sweep validates each of their values once)
 BATCH_INDEPENDENT = ("mass_per_length", "gravity", "tolerance_bound", "title", "crob_l1")
+
+#: The column -> pass dependency table of the batch summary: the passes each column of
+#: :func:`summarise_batch` needs -- the kernel's (fortran/manipulator_summary.f90 ds_*):
+#: 'indices' (RI1-RI3, reach conditions), 'target' (IK and torques at the target),
+#: 'tolerance' (the tolerance box and its Monte Carlo check), and 'walk' (the C_rob walk of
+#: Table 4.8, in Python).  The workspace figures and the design's own lengths need none.
+#: Per-design columns ``<design>_<suffix>`` are in :data:`BATCH_PASS_SUFFIXES`.
+BATCH_PASSES: dict[str, tuple[str, ...]] = {
+    "design_l1_m": (), "design_l2_m": (), "design_ri1": ("indices",), "design_ri2": ("indices",),
+    "design_ri3": ("indices",), "design_ri2_excess": ("indices",), "design_reaches_all": ("indices",),
+    "design_crob_residual_m2": (), "design_total_torque_Nm": ("target",),
+    "design_status": ("indices", "target"), "sweep_min_total_torque_Nm": ("walk",), "sweep_min_l1_m": ("walk",),
+    "sweep_min_l2_m": ("walk",), "sweep_min_row": ("walk",), "sweep_min_reaches_workspace": ("walk",),
+}
+BATCH_PASS_SUFFIXES: dict[str, tuple[str, ...]] = {
+    "_tau1_Nm": ("target",), "_tau2_Nm": ("target",), "_dl_m": ("tolerance",), "_mc_max_m": ("tolerance",),
+    "_reaches_workspace": ("tolerance",),
+}
+
+
+def _passes(wanted: Collection[str] | None) -> set[str]:
+    """The passes columns ``wanted`` need (None: all)."""
+    if wanted is None:
+        return {"indices", "target", "tolerance", "walk"}
+    out: set[str] = set()
+    for c in wanted:
+        if c in BATCH_PASSES:
+            out.update(BATCH_PASSES[c])
+        else:
+            out.update(*(p for sfx, p in BATCH_PASS_SUFFIXES.items() if c.endswith(sfx)))
+    return out
+
 
 #: C_rob walks cached per distinct (target, mass per length, g) and base deck: an optimiser
 #: asks for the same one at every population
@@ -111,7 +144,8 @@ def _walk(p: Params, conv: Conv, tx: float, ty: float, mpl: float, g: float) -> 
     return _WALKS[key]
 
 
-def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None = None) -> pd.DataFrame:
+def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None = None,
+                    wanted: Collection[str] | None = None) -> pd.DataFrame:
     """Summaries of many &manipulator design decks in one Fortran call: one row per deck.
 
     ``base``: a validated ``&manipulator`` Params.  ``columns``: {key: n values} for keys in
@@ -123,13 +157,22 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     and ``design_status`` (analysis.DESIGN_STATUS) saying why a figure is missing.
     A bad value raises DeckError (deck, line and key of the base deck; the design's index in the
     message) or ValueError for a plain mapping.  About 0.5 us per design on one core
-    (bench/bench_manipulator.py), a tenth of it in the kernel.
+    (bench/bench_manipulator.py), a tenth of it in the kernel.  ``wanted``: only these
+    columns, computed by only the passes they need (:data:`BATCH_PASSES`; the same values as
+    in a full summary); None: all.
     """
-    return pd.DataFrame(_arrays(base, columns))
+    out = _arrays(base, columns, wanted)
+    if wanted is not None:
+        names = set(wanted)
+        out = {k: v for k, v in out.items() if k in names}
+    return pd.DataFrame(out)
 
 
-def _arrays(base: Mapping[str, Any], columns: Mapping[str, Any] | None) -> dict[str, np.ndarray]:
-    """The columns of :func:`summarise_batch` as numpy arrays (what :func:`summarise` reads)."""
+def _arrays(base: Mapping[str, Any], columns: Mapping[str, Any] | None,
+            wanted: Collection[str] | None = None) -> dict[str, np.ndarray]:
+    """The columns of :func:`summarise_batch` as numpy arrays (what :func:`summarise` reads);
+    the passes ``wanted`` needs only (None: all)."""
+    passes = _passes(wanted)
     p = _as_params(base)
     columns = {k.partition(".")[2] if k.startswith("manipulator.") else k: v for k, v in (columns or {}).items()}
     unknown = [k for k in columns if k not in BATCH_KEYS and k not in BATCH_IGNORED]
@@ -168,11 +211,12 @@ def _arrays(base: Mapping[str, Any], columns: Mapping[str, Any] | None) -> dict[
         prm[:, j] = np.repeat(v, k)
     rates = [*p.joint_rates, *p.joint_accels]
     unit = _mc_samples(p.mc_seed, p.mc_samples)
-    res = kernels.manipulator_design_summaries(ws.x, ws.y, prm, p.elbow, rates, p.error_measure, unit)
+    bits = sum(b for k, b in kernels.MANIPULATOR_PASSES.items() if k in passes)
+    res = kernels.manipulator_design_summaries(ws.x, ws.y, prm, p.elbow, rates, p.error_measure, unit, passes=bits)
     r = {c: res[:, i].reshape(n, k) for i, c in enumerate(kernels.MANIPULATOR_SUMMARY_COLUMNS)}
     ok = r["target_status"] == STATUS["ok"]
     tau1, tau2 = r["tau1"], r["tau2"]
-    if conv.report:
+    if conv.report and "target" in passes:
         tau1, tau2 = _report_torques(p, prm, r, n, k)
 
     out: dict[str, Any] = {c: np.full(n, v, dtype=object if isinstance(v, str) else None)
@@ -195,6 +239,8 @@ def _arrays(base: Mapping[str, Any], columns: Mapping[str, Any] | None) -> dict[
                 "design_reaches_all": reach, "design_crob_residual_m2": d1 * d1 + d2 * d2 - ws.mean_d2,
                 "design_total_torque_Nm": nan(tau1[:, 0] + tau2[:, 0], ok[:, 0]),
                 "design_status": _status(reach, ok[:, 0], ri1)})
+    if "walk" not in passes:
+        return out
     # the C_rob walk: once per distinct target, mass per length and g
     codes = [np.unique(v, return_inverse=True) for v in (tx, ty, mpl, g)]
     flat = np.ravel_multi_index([c[1].ravel() for c in codes], [len(c[0]) for c in codes])
