@@ -134,3 +134,22 @@ def test_manipulator_wanted_columns_have_the_full_bits_and_run_their_passes(monk
         pd.testing.assert_series_equal(part[c], full[c])
         need = manipulator.batch._passes([c]) - {"walk"}
         assert seen == [sum(kernels.MANIPULATOR_PASSES[p] for p in need)], c
+
+
+def test_optimize_runs_only_the_passes_of_its_objective_constraints_and_summary_columns(tmp_path, spy, monkeypatch):
+    """&optimize with summary_columns: the batch path computes what the objective, the
+    constraints and summary_columns read (no peak speeds here), and finds the optimum of the
+    committed run (outputs/optimize_fourbar_design.out, every column computed)."""
+    text = (ROOT / "inputs" / "optimize_fourbar_design.dat").read_text()
+    (tmp_path / "opt.dat").write_text(text.replace("method = 'differential_evolution'",
+                                                   "summary_columns = 'time_ratio', method = 'differential_evolution'"))
+    assert main([str(tmp_path / "opt.dat"), "-o", str(tmp_path / "o"), "-q"]) == 0
+    assert spy and all(not bits & P["peaks"] for n, bits in spy if n > 1)
+    evals = pd.read_parquet(tmp_path / "o" / "opt_evals.parquet")
+    summ = sorted(c for c in evals.columns if c.startswith("summary."))
+    assert summ == ["summary." + c for c in sorted(("meets_band_40_120", "mu_max_deg", "mu_min_deg",
+                                                     "rocker_swing_deg", "time_ratio"))]
+    ref = pd.read_parquet(ROOT / "outputs" / "optimize_fourbar_design_evals.parquet")
+    assert len(evals) == len(ref)
+    for c in ["fourbar.crank", "fourbar.coupler", "fourbar.rocker", "objective", "feasible", *summ]:
+        pd.testing.assert_series_equal(evals[c], ref[c], check_names=False)

@@ -98,6 +98,10 @@ def _probe(problem: Problem) -> None:
     exprs = [("minimize" if problem.sense > 0 else "maximize", problem.objective)]
     nums = [n for n in range(1, 10) if o[f"constraint{n}"] is not None]
     exprs += [(f"constraint{n}", c.whole) for n, c in zip(nums, problem.constraints)]
+    unknown = [c for c in o.summary_columns if c not in frame]
+    if unknown and clean:
+        raise o.error("summary_columns", f"unknown summary column '{unknown[0]}' of &{problem.raw.name} "
+                                         f"(columns: {', '.join(frame.columns)})")
     for key, e in exprs:
         missing = [name for name in sorted(e.names) if name not in frame]
         if missing and clean:   # a clean run of the deck's design has every column its study writes

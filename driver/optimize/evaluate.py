@@ -390,8 +390,12 @@ def _batch_summaries(problem: Problem, xs: list[tuple[float, ...]]) -> list[tupl
     if applies is not None and not applies(problem.base):
         return None
     columns = {slot: np.array([x[i] for x in xs]) for i, slot in enumerate(_slots(problem))}
+    wanted = None
+    if problem.opts.summary_columns and hasattr(problem.study, "BATCH_PASSES"):
+        # only what the objective, the constraints and summary_columns read: only their passes run
+        wanted = sorted(_names(problem) | set(problem.opts.summary_columns))
     try:
-        frame = fn(problem.base, columns)
+        frame = fn(problem.base, columns) if wanted is None else fn(problem.base, columns, wanted=wanted)
     except DeckError:
         return None                     # some design is not a valid deck: case by case says which
     rows = frame.to_dict("records") if hasattr(frame, "to_dict") else list(frame)

@@ -82,6 +82,10 @@ def _spec() -> GroupSpec:
                          doc="refuse a run that could need more design evaluations than this"),
         "jobs": Key("int", default=0, check=lambda v: None if v >= 0 else "must not be negative",
                     doc="worker processes for studies without a batch path (0: all cores, 1: serial)"),
+        "summary_columns": Key("strs", default=[],
+                               doc="the summary columns the evaluations table records besides those the objective "
+                                   "and constraints read (default: all); on a study's batch path only the kernel "
+                                   "passes these columns need run"),
     })
     return GroupSpec("optimize", keys, doc="optimise a study's design over bounded deck keys")
 
@@ -148,7 +152,10 @@ class Problem:
         """Hash of everything that changes an evaluation's result (study group minus the variables)."""
         whole = {v.key for v in self.variables if v.index is None}
         fixed = {k: v for k, v in self.raw.values.items() if k not in whole}
-        blob = json.dumps([self.raw.name, sorted(fixed.items(), key=lambda kv: kv[0])], default=str)
+        parts: list[Any] = [self.raw.name, sorted(fixed.items(), key=lambda kv: kv[0])]
+        if self.opts.summary_columns:   # fewer columns recorded: another set of evaluations
+            parts.append(sorted(self.opts.summary_columns))
+        blob = json.dumps(parts, default=str)
         return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 
