@@ -54,6 +54,9 @@ __all__ = ["Grid", "BatchPlan", "batchable", "plan", "run", "worker_init", "chun
 
 #: cases per task: ~0.3-0.6 s of kernel time on one core for the four-bar
 CHUNK = 16384
+#: above CHUNK * MAX_CHUNKS cases the chunks grow instead of multiplying: the driver's work (a
+#: result to merge, a part in the record) is per chunk, so 10^9 cases are 4096 chunks, not 61 035
+MAX_CHUNKS = 4096
 #: largest batch sweep (no case is listed, so only the grid's size is limited)
 MAX_CASES = 10**10
 #: largest number of combinations of coupled swept keys validated one by one
@@ -106,6 +109,14 @@ class BatchPlan:
     filter_columns: list[str] | None = None
     #: summary columns of the rows the tables show (kept rows with rows = 'kept'); None: all
     shown_columns: list[str] | None = None
+
+
+def chunk_size(n: int) -> int:
+    """Cases per chunk of a batch sweep of ``n`` cases: a function of ``n`` only (not of the
+    workers), so ``--resume`` works with any ``-j``; at most :data:`MAX_CHUNKS` chunks."""
+    if n > CHUNK * MAX_CHUNKS:
+        return -(-n // MAX_CHUNKS)
+    return min(CHUNK, max(64, -(-n // 16)))
 
 
 def _signature(raw: RawGroup, grid: Grid, keep: str, rows: str, module, shown: list[str] | None = None) -> str:
@@ -205,6 +216,7 @@ class ChunkResult:
     n_failed: int = 0
     seconds: float = 0.0
     errors: list[str] = field(default_factory=list)
+    written: bool = False       # its part is in the record already (the worker wrote it)
 
 
 def _summaries(module, base, cols: dict[str, np.ndarray], rows: np.ndarray, wanted: list[str] | None,
@@ -222,8 +234,10 @@ def _summaries(module, base, cols: dict[str, np.ndarray], rows: np.ndarray, want
     return summ
 
 
-def chunk_rows(p: BatchPlan, start: int, stop: int) -> ChunkResult:
-    """Summaries of cases start+1..stop (the unit of work of a worker).
+def chunk_rows(p: BatchPlan, start: int, stop: int, folder: str = "") -> ChunkResult:
+    """Summaries of cases start+1..stop (the unit of work of a worker); with ``folder`` the
+    worker also writes the chunk's part of the resume record there (the driver then only merges
+    the rows it returns: the kept and failed ones with ``rows = 'kept'``).
 
     With a filter and ``rows = 'kept'`` in two steps: the columns the filter reads for every
     case (``p.filter_columns``), then the columns the tables show (``p.shown_columns``) for the
@@ -234,20 +248,41 @@ def chunk_rows(p: BatchPlan, start: int, stop: int) -> ChunkResult:
     n = stop - start
     cols = p.grid.columns(start, stop)
     idx = p.grid.indices(start, stop)
-    err = np.full(n, "", dtype=object)
+    bad = np.zeros(n, dtype=bool)
+    err = None
     for i, name in enumerate(p.grid.names):
         for j, msg in p.single_errors.get(name, {}).items():
-            err[(idx[i] == j) & (err == "")] = msg
+            hit = idx[i] == j
+            if hit.any():
+                err = np.full(n, "", dtype=object) if err is None else err
+                err[hit & ~bad] = msg
+                bad |= hit
     if p.coupled_errors:
         keys = list(zip(*(idx[i] for i in p.coupled)))
         for k, key in enumerate(keys):
             msg = p.coupled_errors.get(tuple(int(x) for x in key))
-            if msg and not err[k]:
+            if msg and not bad[k]:
+                err = np.full(n, "", dtype=object) if err is None else err
                 err[k] = msg
-    bad = err != ""
+                bad[k] = True
+    if err is None:
+        err = np.full(n, "", dtype=object)
     base = validate(p.raw, module.SPEC, p.deck_path)
     every = np.arange(n)
     two_step = bool(p.keep) and p.rows == "kept" and p.filter_columns is not None
+    if two_step and not bad.any():   # the common case: the filter on plain arrays, no full frame
+        first = _summaries(module, base, cols, every, p.filter_columns, None)
+        data = {"case": np.arange(start + 1, stop + 1, dtype=np.int64), **cols,
+                **{c: first[c].to_numpy() for c in first.columns}}
+        try:
+            mask = np.asarray(expr.parse(p.keep).mask(data), dtype=bool)
+        except expr.ExprError:
+            mask = np.zeros(n, dtype=bool)
+        shown = np.flatnonzero(mask)
+        out = _frame(start, stop, cols, bad, err, _summaries(module, base, cols, shown, p.shown_columns, None), shown)
+        out["kept"] = True
+        res = ChunkResult(start, stop, out, n, len(shown), 0)
+        return _finish(res, p, folder, t0)
     if two_step:
         first = _summaries(module, base, cols, every, p.filter_columns, bad)
     else:
@@ -274,6 +309,14 @@ def chunk_rows(p: BatchPlan, start: int, stop: int) -> ChunkResult:
             res.frame = frame.iloc[shown].reset_index(drop=True)
     elif p.shown_columns is not None:   # the filter's columns that are not shown go
         res.frame = frame[[c for c in frame.columns if c not in set(p.filter_columns or ()) - set(p.shown_columns)]]
+    return _finish(res, p, folder, t0)
+
+
+def _finish(res: ChunkResult, p: BatchPlan, folder: str, t0: float) -> ChunkResult:
+    """Write the chunk's part when the worker owns the record's folder; time the chunk."""
+    if folder:
+        write_part(Path(folder), res, p.signature)
+        res.written = True
     res.seconds = time.perf_counter() - t0
     return res
 
@@ -346,9 +389,12 @@ def write_part(folder: Path, res: ChunkResult, signature: str) -> None:
         pq.write_table(table, fh)
 
 
+def _read_parts(folder: Path, starts: list[int]) -> list[pd.DataFrame]:
+    return [pq.read_table(folder / _part_name(s)).to_pandas() for s in starts]
+
+
 def read_rows(folder: Path, starts: list[int]) -> pd.DataFrame:
-    frames = [pq.read_table(folder / _part_name(s)).to_pandas() for s in sorted(starts)]
-    frames = [f for f in frames if len(f)]
+    frames = [f for f in _read_parts(folder, sorted(starts)) if len(f)]
     if not frames:
         return pd.DataFrame()
     return pd.concat(frames, ignore_index=True) if len(frames) > 1 else frames[0]
@@ -364,31 +410,33 @@ def _died(p: BatchPlan, start: int, stop: int) -> ChunkResult:
     return ChunkResult(start, stop, frame, 0, 0, stop - start)
 
 
-def _alone(p: BatchPlan, start: int, stop: int) -> ChunkResult:
+def _alone(p: BatchPlan, start: int, stop: int, folder: str = "") -> ChunkResult:
     """Retry of a chunk whose worker died: alone in a fresh process."""
     with cf.ProcessPoolExecutor(max_workers=1, initializer=worker_init) as pool:
         try:
-            return pool.submit(chunk_rows, p, start, stop).result()
+            return pool.submit(chunk_rows, p, start, stop, folder).result()
         except cf.process.BrokenProcessPool:
             return _died(p, start, stop)
 
 
 def execute(p: BatchPlan, todo: list[tuple[int, int]], jobs: int, scheduler: Any,
-            on_result, in_flight: int = 0) -> None:
-    """Run chunks ``todo`` [(start, stop)]; ``on_result(ChunkResult)`` as each completes."""
+            on_result, in_flight: int = 0, folder: str = "") -> None:
+    """Run chunks ``todo`` [(start, stop)]; ``on_result(ChunkResult)`` as each completes.
+    ``folder``: the record's folder, where the workers write their chunks' parts (on Dask only
+    when every worker sees it; otherwise the result comes back unwritten)."""
     if not todo:
         return
     if scheduler:
-        _execute_dask(p, todo, scheduler, on_result, in_flight)
+        _execute_dask(p, todo, scheduler, on_result, in_flight, folder)
         return
     if jobs <= 1:
         for s, e in todo:
-            on_result(chunk_rows(p, s, e))
+            on_result(chunk_rows(p, s, e, folder))
         return
     queue: Iterator[tuple[int, int]] = iter(todo)
-    run_pool(lambda: next(queue, None), lambda pool, rng: pool.submit(chunk_rows, p, *rng),
-             lambda rng: _alone(p, *rng), lambda rng, res, pending: on_result(res), jobs, in_flight or 2 * jobs,
-             "chunks")
+    run_pool(lambda: next(queue, None), lambda pool, rng: pool.submit(chunk_rows, p, *rng, folder),
+             lambda rng: _alone(p, *rng, folder), lambda rng, res, pending: on_result(res), jobs,
+             in_flight or 2 * jobs, "chunks")
 
 
 def run_pool(source: Callable[[], Any], submit: Callable[[cf.ProcessPoolExecutor, Any], cf.Future],
@@ -441,11 +489,18 @@ def run_pool(source: Callable[[], Any], submit: Callable[[cf.ProcessPoolExecutor
         pool.shutdown(wait=True)
 
 
-def _execute_dask(p: BatchPlan, todo: list[tuple[int, int]], scheduler: Any, on_result, in_flight: int) -> None:
+def _execute_dask(p: BatchPlan, todo: list[tuple[int, int]], scheduler: Any, on_result, in_flight: int,
+                  folder: str = "") -> None:
     from dask.distributed import Client, as_completed
     from distributed.scheduler import KilledWorker
     client = scheduler if not isinstance(scheduler, str) else Client(scheduler)
     try:
+        if folder:   # workers write their parts only where this machine reads them back
+            from driver.sweep.engine import check_shared_folder
+            try:
+                check_shared_folder(client, Path(folder))
+            except OSError:
+                folder = ""
         workers = max(1, len(client.scheduler_info().get("workers", {})))
         limit = in_flight or 2 * workers
         queue = iter(todo)
@@ -453,7 +508,7 @@ def _execute_dask(p: BatchPlan, todo: list[tuple[int, int]], scheduler: Any, on_
         pdata = client.scatter(p, broadcast=True)
 
         def submit(rng):
-            fut = client.submit(chunk_rows, pdata, *rng, pure=False, retries=1)
+            fut = client.submit(chunk_rows, pdata, *rng, folder, pure=False, retries=1)
             ranges[fut] = rng
             return fut
 
@@ -479,11 +534,11 @@ def run(p: BatchPlan, folder: Path, jobs: int, scheduler: Any, resume: bool, pro
     from tqdm import tqdm
     n = p.grid.n
     # the layout depends on the grid only (not on the workers), so --resume works with any -j
-    size = chunk or min(CHUNK, max(64, -(-n // 16)))
+    size = chunk or chunk_size(n)
     done = clean(folder, p.signature, resume)
     # a resumed chunk counts only if it covers exactly one chunk of this run's layout
     ranges = [(s, min(s + size, n)) for s in range(0, n, size)]
-    complete = {s for s, m in done.items() if (s, m["stop"]) in ranges}
+    complete = {s for s, m in done.items() if s % size == 0 and m["stop"] == min(s + size, n)}
     for s in set(done) - complete:
         (folder / _part_name(s)).unlink(missing_ok=True)
     counts = {"ok": 0, "kept": 0, "failed": 0}
@@ -497,16 +552,24 @@ def run(p: BatchPlan, folder: Path, jobs: int, scheduler: Any, resume: bool, pro
     folder.mkdir(parents=True, exist_ok=True)
     bar = tqdm(total=n, initial=resumed, unit="case", disable=not progress, dynamic_ncols=True)
 
+    merged: dict[int, pd.DataFrame] = {}   # the rows each chunk returned (kept and failed with rows = 'kept')
+
     def on_result(res: ChunkResult) -> None:
-        write_part(folder, res, p.signature)
+        if not res.written:   # a chunk whose worker died, or Dask workers that do not see the folder
+            write_part(folder, res, p.signature)
+        merged[res.start] = res.frame
         counts["ok"] += res.n_ok
         counts["kept"] += res.n_kept
         counts["failed"] += res.n_failed
         bar.update(res.stop - res.start)
 
     try:
-        execute(p, todo, jobs, scheduler, on_result)
+        execute(p, todo, jobs, scheduler, on_result, folder=str(folder))
     finally:
         bar.close()
-    rows = read_rows(folder, [s for s, _ in ranges])
+    # the rows: those of the resumed chunks from the record, the others as the workers returned them
+    frames = {s: f for s, f in zip(sorted(complete), _read_parts(folder, sorted(complete)))}
+    frames.update(merged)
+    parts = [frames[s] for s in sorted(frames) if len(frames[s])]
+    rows = pd.DataFrame() if not parts else parts[0] if len(parts) == 1 else pd.concat(parts, ignore_index=True)
     return rows, counts, size
