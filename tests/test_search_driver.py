@@ -81,3 +81,27 @@ def test_chunk_layout_depends_on_the_case_count_only_and_is_capped():
     for n in (10**8, 10**9, 10**10):
         size = sweep_batch.chunk_size(n)
         assert -(-n // size) <= sweep_batch.MAX_CHUNKS and size >= sweep_batch.CHUNK
+
+
+def _decimal_half_up(value: float, decimals: int) -> str:
+    """The reference: the exact binary value rounded half away from zero by Decimal."""
+    from decimal import ROUND_HALF_UP, Context, Decimal, localcontext
+    with localcontext(Context(prec=330 + decimals)):
+        return format(Decimal(value).quantize(Decimal(1).scaleb(-decimals), rounding=ROUND_HALF_UP), "f")
+
+
+def test_fast_fixed_point_text_equals_decimal_half_up():
+    """The table writer's fast path (Python's correctly rounded 'f' text unless the double is an
+    exact tie) gives Decimal's half-up text for every value: ties, negative zero, huge and tiny."""
+    from hypothesis import given, settings, strategies as st
+    from driver.table import _round_half_up
+    for v in (0.5, 1.5, 2.5, -2.5, 0.125, -0.125, 2.675, 0.045, 0.0, -0.0, 1e-5, -1e-5, 1e20, 1e300, 5e-324):
+        for d in range(0, 9):
+            assert _round_half_up(v, d) == _decimal_half_up(v, d), (v, d)
+
+    @settings(max_examples=3000, deadline=None)
+    @given(st.one_of(st.floats(allow_nan=False, allow_infinity=False),
+                     st.integers(-10**7, 10**7).map(lambda k: k / 2 ** 9)), st.integers(0, 10))
+    def same(v, d):
+        assert _round_half_up(v, d) == _decimal_half_up(v, d)
+    same()

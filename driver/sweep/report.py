@@ -44,7 +44,8 @@ def _summary_table(frame: pd.DataFrame, limit: int = 2000, n_cases: int | None =
         if name in ("error",):
             continue
         s = frame[name]
-        if pd.api.types.is_bool_dtype(s) or s.map(lambda v: isinstance(v, (bool, np.bool_))).all():
+        if pd.api.types.is_bool_dtype(s) or len(s) == 0 or (
+                s.dtype == object and s.map(lambda v: isinstance(v, (bool, np.bool_))).all()):
             cols.append(Column(name, "s", max(4, len(name)), 0))
         elif pd.api.types.is_integer_dtype(s):
             cols.append(Column(name, "i", max(5, len(name)), 0))
