@@ -16,9 +16,11 @@ baselines measured in the same run:
    * ``--big``: 10^7 linkages on 2 workers (target < 15 s wall on two idle cores);
    * ``--huge``: 10^8 linkages on 2 workers (target < 3 min, driver memory flat < 300 MiB).
 3. ``--dask``: a 10^7-linkage search on a loopback Dask cluster (bench_dask_cluster.py's
-   scheduler and 2 single-threaded workers): the driver's CPU time per part it merges, and
-   from it the driver time of a 10^9-linkage search (the number of parts the chunk layout
-   gives at 10^9 times the measured per-part cost, plus the fixed cost; target < 5 min).
+   scheduler and 2 single-threaded workers): the driver's CPU time per phase (sweep.LAST_RUN:
+   preparing, receiving and merging the chunks, writing the tables), and from it the driver
+   time of a 10^9-linkage search: the preparation, plus the measured cost per chunk times the
+   chunks the layout gives at 10^9, plus the measured cost per kept row times the kept rows
+   10^9 linkages would give at the same rate (target < 5 min).
 
 The machine is shared: the load average is printed with every figure; CPU time per linkage
 is the figure that load disturbs least (wall times are those of the moment).
@@ -116,7 +118,7 @@ def report(label: str, n: int, r: dict) -> float:
 
 
 def dask_estimate(tmp: Path, linkages: int) -> None:
-    """Driver CPU per merged part on a loopback Dask cluster, and the 10^9 estimate."""
+    """The driver's CPU per phase on a loopback Dask cluster, and the 10^9 estimate."""
     sys.path.insert(0, str(ROOT / "bench"))
     import bench_dask_cluster as bdc
     from driver import sweep_batch
@@ -132,22 +134,24 @@ def dask_estimate(tmp: Path, linkages: int) -> None:
                 "t0, c0 = time.perf_counter(), time.process_time()\n"
                 "s = sweep.run_sweep_deck(d, Path(sys.argv[2]), [], False, False, quiet=True, scheduler=sys.argv[3])\n"
                 "print(json.dumps({'status': s, 'wall': time.perf_counter() - t0, 'cpu': time.process_time() - c0,"
-                " 'rss': resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))")
+                " 'rss': resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 'phases': sweep.LAST_RUN}))")
         res = subprocess.run([sys.executable, "-c", code, str(deck), str(tmp / "dask_out"), address],
                              capture_output=True, text=True, cwd=ROOT, check=True)
         r = json.loads(res.stdout.strip().splitlines()[-1])
     finally:
         bdc.stop(procs)
-    size = sweep_batch.chunk_size(n)
-    parts = -(-n // size)
-    per_part = r["cpu"] / parts
+    ph = r["phases"]
+    per_part = ph["run_cpu"] / ph["chunks"]           # receiving and merging a chunk (its part: the worker's)
+    per_row = ph["finish_cpu"] / max(ph["rows"], 1)   # the tables and the .out, per kept row
     big = 10**9
-    parts_big = -(-big // sweep_batch.chunk_size(big))
-    print(f"  loopback Dask, 2 workers: {n:,d} linkages, wall {r['wall']:.1f} s, driver CPU {r['cpu']:.2f} s over "
-          f"{parts} parts = {per_part * 1e3:.1f} ms per part (all of the driver's work, fixed costs included), "
-          f"driver RSS {r['rss']:.0f} MiB   [{load()}]")
-    print(f"  10^9 linkages: {parts_big} parts of {sweep_batch.chunk_size(big):,d} -> driver time about "
-          f"{per_part * parts_big / 60:.1f} min (target < 5 min); the workers' time scales with their number")
+    parts_big, rows_big = -(-big // sweep_batch.chunk_size(big)), ph["rows"] * big / n
+    est = ph["prepare_cpu"] + per_part * parts_big + per_row * rows_big
+    print(f"  loopback Dask, 2 workers: {n:,d} linkages, wall {r['wall']:.1f} s, driver CPU {r['cpu']:.2f} s: "
+          f"prepare {ph['prepare_cpu']:.2f} s, {ph['chunks']} chunks merged in {ph['run_cpu']:.2f} s "
+          f"({per_part * 1e3:.2f} ms each), tables of {ph['rows']:,d} kept rows in {ph['finish_cpu']:.2f} s "
+          f"({per_row * 1e6:.1f} us each); driver RSS {r['rss']:.0f} MiB   [{load()}]")
+    print(f"  10^9 linkages: {parts_big} chunks of {sweep_batch.chunk_size(big):,d} and ~{rows_big:,.0f} kept rows -> "
+          f"driver CPU about {est:.0f} s = {est / 60:.1f} min (target < 5 min); the workers' time divides by their number")
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -323,7 +323,8 @@ class _Run:
         With case_outputs = 'kept' the kept cases then run case by case for their files, with
         their own resume record ``<stem>.sweep/cases/`` (:mod:`driver.sweep.store`)."""
         sw, names, n = self.sw, self.grid.names, bplan.grid.n
-        t_start = time.perf_counter()
+        t_start, c_start = time.perf_counter(), time.process_time()
+        LAST_RUN["prepare_cpu"] = c_start - LAST_RUN.get("start_cpu", c_start)
 
         def announce(resumed: int) -> None:
             if self.resume and not self.quiet:
@@ -331,6 +332,9 @@ class _Run:
 
         rows, counts, chunk = sweep_batch.run(bplan, self.outdir / f"{self.stem}.sweep", self.jobs, self.scheduler,
                                               self.resume, self.progress, sw.chunk, announce)
+        c_run = time.process_time()
+        # the driver's CPU per phase (bench/bench_search.py): merging the chunks, then the tables
+        LAST_RUN.update(run_cpu=c_run - c_start, chunk=chunk, chunks=-(-n // chunk), rows=len(rows))
         elapsed = time.perf_counter() - t_start
         if rows.empty:
             rows = pd.DataFrame(columns=["case", *names, "status", "kept", "error"])
@@ -366,6 +370,7 @@ class _Run:
         write_sweep_files(self.outdir, self.stem, rows, cases, text, self.plot, sw, names, self.module, rows)
         if has_files is not None:
             store.remove_stale_case_files(self.layout, has_files)
+        LAST_RUN["finish_cpu"] = time.process_time() - c_run
         self._print_failed(failed)
         if not self.quiet:
             print(f"sweep {self.deck.path}: {n - len(failed)} of {n} cases ok, {int(rows['kept'].sum())} kept, "
