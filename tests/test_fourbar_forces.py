@@ -25,7 +25,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
-from driver import _fourbar_forces as forces
+from driver.fourbar import forces
 from driver import kernels
 from driver.api import run
 from driver.cli import main

@@ -17,7 +17,7 @@ from typing import Any, Mapping
 import numpy as np
 import pandas as pd
 
-from driver import _fourbar_forces as forces
+from driver.fourbar import forces
 from driver import kernels
 from driver.limits import Estimate
 from driver.deck import GroupSpec, Key, Params, positive
@@ -100,7 +100,7 @@ SPEC = GroupSpec(
                              doc="a point P on the coupler: u along A->B, v to its left; adds its path, "
                                  "velocity and acceleration (exact method)"),
         "title": Key("str", default="", doc="free text echoed in the output"),
-        **forces.KEYS,   # the force analysis (driver/_fourbar_forces.py), run when 'mass' is given
+        **forces.KEYS,   # the force analysis (driver/fourbar/forces.py), run when 'mass' is given
     },
     check=_check,
 )
@@ -308,7 +308,7 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     n = sizes.pop() if sizes else 1
     res = kernels.fourbar_summaries(_param_matrix(base, columns, n))
     frame = _frame(res, detail)
-    if forces.active(base):   # force columns (driver/_fourbar_forces.py) when the deck gives masses
+    if forces.active(base):   # force columns (driver/fourbar/forces.py) when the deck gives masses
         frame = pd.concat([frame, forces.summarise_force_batch(base, force_columns)], axis=1)
     return frame
 
