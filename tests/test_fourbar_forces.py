@@ -449,3 +449,43 @@ def test_bad_force_input_exits_2_naming_the_key(change, key, words, tmp_path, ca
     err = capsys.readouterr().err
     assert f"key '{key}'" in err and words in err, err
     assert not out.exists() or not any(out.iterdir())
+
+
+def test_sweeps_carry_the_force_columns():
+    """A sweep over link lengths (batch path) and one over a force key (case by case) both report
+    the force summary of each case, equal to single runs."""
+    from driver.api import run_sweep
+    base = open(INPUTS / "fourbar_forces.dat").read()
+    lengths = run_sweep(base, grid={"coupler": [0.33, 0.37]}, jobs=1)
+    loads = run_sweep(base, grid={"load_torque": [0.0, 9.0]}, jobs=1)
+    for res, key, vals, fmt in ((lengths, "coupler", [0.33, 0.37], "coupler = {}"),
+                                (loads, "load_torque", [0.0, 9.0], "load_torque = {}")):
+        frame = res.summary
+        assert "torque_peak_Nm" in frame.columns and "flywheel_inertia_kgm2" in frame.columns
+        for i, v in enumerate(vals):
+            one = run(base.replace(fmt.format("0.35" if key == "coupler" else "5.0"), fmt.format(v), 1)).summary
+            assert frame["torque_peak_Nm"].iloc[i] == pytest.approx(one["torque_peak_Nm"], rel=1e-12)
+            assert frame["energy_fluctuation_J"].iloc[i] == pytest.approx(one["energy_fluctuation_J"], rel=1e-12)
+
+
+def test_force_figures_draw_with_units_and_accept_ax():
+    """The three force figures of the balanced deck: labelled axes with units, the mean and dE on
+    the torque plot, four polar pin-force panels, the balanced shaking force flat at zero; the
+    drawing functions draw into axes they are given (ax=)."""
+    from matplotlib.figure import Figure as MplFigure
+    res = run(open(INPUTS / "fourbar_forces_balanced.dat").read())
+    figs = {f.name: f.draw() for f in res.figures}
+    assert {"torque", "pin_forces", "shaking"} <= set(figs)
+    ax = figs["torque"].axes[0]
+    assert "[N m]" in ax.get_ylabel() and "[deg]" in ax.get_xlabel()
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert any(l.startswith("mean") for l in labels) and any(l.startswith("dE =") for l in labels)
+    assert sum(a.name == "polar" for a in figs["pin_forces"].axes) == 4
+    sh = figs["shaking"].axes[0]
+    balanced = [l for l in sh.get_lines() if "balanced (" in l.get_label()][0]
+    assert np.nanmax(np.abs(balanced.get_ydata())) < 1e-9 * np.nanmax([l.get_ydata() for l in sh.get_lines()])
+    fig = MplFigure()
+    own = fig.add_subplot()
+    theta = np.linspace(0, 360, 37)
+    fa = forces.ForceAnalysis(np.ones((37, 12)), np.ones(37, bool))
+    assert forces.plot_torque(theta, fa, {}, ax=own) is own and len(own.get_lines()) >= 2

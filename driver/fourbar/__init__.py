@@ -300,7 +300,7 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     unknown = [k for k in columns if k not in BATCH_KEYS and k not in BATCH_IGNORED]
     if unknown:
         raise _bad(base, unknown[0], f"not a &fourbar key the summary depends on ({', '.join(BATCH_KEYS)})")
-    force_columns = columns
+    force_columns = {k: v for k, v in columns.items() if k in forces.BATCH_KEYS}
     columns = {k: v for k, v in columns.items() if k in BATCH_KEYS}
     sizes = {np.size(v) for v in columns.values() if np.ndim(v) > 0}
     if len(sizes) > 1:
@@ -578,7 +578,8 @@ def estimate(params: Params) -> Estimate:
     n = max(n, 1.0)
     span = min(abs(p.stop_deg - p.start_deg), 360.0) / 1.0 + 1.0
     range_key = "start_deg" if "start_deg" in p.given else ("stop_deg" if "stop_deg" in p.given else "step_deg")
-    rows = Estimate(2000.0 * n + 5e6, 5e-5 * n + 0.05, "step_deg", "step_deg", f"{n:.4g} crank angles")
+    k = 2.5 if forces.active(p) else 1.0   # the force table and columns: 13 more cells and 24 columns per row
+    rows = Estimate(k * 2000.0 * n + 5e6, k * 5e-5 * n + 0.05, "step_deg", "step_deg", f"{n:.4g} crank angles")
     grid = Estimate(500.0 * span, 1e-6 * span, range_key, range_key,
                     f"a {span:.4g}-point scan of one turn for the summary")
     return rows + grid

@@ -60,18 +60,21 @@ KEYS: dict[str, Key] = {
                             "(default: mid-link)"),
     "com_angle_deg": Key("floats", default=None, units="deg", check=lambda v: _three(v) or _finite(v),
                          doc="centre of mass off the line to the link's second pin (A, B, B), ccw + (default 0)"),
-    "gravity": Key("float", default=9.81, units="m/s^2", check=_finite, doc="gravitational acceleration along -y"),
-    "load_torque": Key("float", default=0.0, units="N m", check=_finite,
-                       doc="external torque on the rocker, ccw +"),
-    "load_force_x": Key("float", default=0.0, units="N", check=_finite,
-                        doc="external force on the coupler at coupler_point, x"),
-    "load_force_y": Key("float", default=0.0, units="N", check=_finite,
-                        doc="external force on the coupler at coupler_point, y"),
-    "speed_fluctuation": Key("float", default=0.02, units="1",
+    "gravity": Key("float", default=None, units="m/s^2", check=_finite,
+                   doc="gravitational acceleration along -y (default 9.81)"),
+    "load_torque": Key("float", default=None, units="N m", check=_finite,
+                       doc="external torque on the rocker, ccw + (default 0)"),
+    "load_force_x": Key("float", default=None, units="N", check=_finite,
+                        doc="external force on the coupler at coupler_point, x (default 0)"),
+    "load_force_y": Key("float", default=None, units="N", check=_finite,
+                        doc="external force on the coupler at coupler_point, y (default 0)"),
+    "speed_fluctuation": Key("float", default=None, units="1",
                              check=lambda v: None if v > 0 and math.isfinite(v) else f"must be positive (got {v})",
-                             doc="coefficient of speed fluctuation C_s for the flywheel inertia dE / (C_s omega^2)"),
-    "balance": Key("str", default="none", choices=("none", "force"),
-                   doc="'force': Berkof-Lowen counterweights on crank and rocker, balanced analysis reported too"),
+                             doc="coefficient of speed fluctuation C_s for the flywheel inertia dE / (C_s omega^2) "
+                                 "(default 0.02)"),
+    "balance": Key("str", default=None, choices=("none", "force"),
+                   doc="'force': Berkof-Lowen counterweights on crank and rocker, balanced analysis reported too "
+                       "(default 'none')"),
     "counterweight_radius": Key("floats", default=None, units="m",
                                 check=lambda v: (None if len(v) == 2 else f"give two values: crank, rocker (got {len(v)})")
                                 or (None if all(x > 0 for x in v) else "must be positive"),
@@ -80,6 +83,16 @@ KEYS: dict[str, Key] = {
 }
 #: keys that mean nothing without ``mass``
 DEPENDENT = tuple(k for k in KEYS if k != "mass")
+#: the values of keys left out (their deck default is None, so a case deck written out by a sweep
+#: carries only the keys a deck gave, and a deck without masses none of these)
+DEFAULTS: dict[str, Any] = {"gravity": 9.81, "load_torque": 0.0, "load_force_x": 0.0, "load_force_y": 0.0,
+                            "speed_fluctuation": 0.02, "balance": "none"}
+
+
+def value(p: Mapping[str, Any], key: str) -> Any:
+    """The value of force key ``key``: the deck's, or its default (DEFAULTS)."""
+    v = p.get(key)
+    return DEFAULTS.get(key) if v is None else v
 
 
 def active(p: Mapping[str, Any]) -> bool:
@@ -94,7 +107,7 @@ def _lengths(p: Mapping[str, Any]) -> tuple[float, float, float]:
 def check(p: Params) -> None:
     """Cross-key checks of the force keys (called by the four-bar SPEC's check)."""
     if not active(p):
-        for key in DEPENDENT:
+        for key in sorted((k for k in DEPENDENT if k in p.given), key=p.line_of):
             if key in p.given:
                 raise p.error(key, "belongs to the force analysis, which runs only when 'mass' is given "
                                    "(mass = crank, coupler, rocker in kg)")
@@ -119,14 +132,15 @@ def check(p: Params) -> None:
                                          f"is over {MAX_GYRATION_RATIO:g} times its length {L:g} m: inertia and the "
                                          "lengths look like different units (kg m^2 and m expected)")
     if p.counterweight_radius is not None:
-        if p.balance != "force":
+        if value(p, "balance") != "force":
             raise p.error("counterweight_radius", "is used only with balance = 'force'")
         for i, (rc, L) in enumerate(zip(p.counterweight_radius, (lengths[0], lengths[2]))):
             if rc > MAX_COM_RATIO * L:
                 raise p.error("counterweight_radius", f"{rc:g} m is {rc / L:.0f} times the "
                                                       f"{('crank', 'rocker')[i]} length: a length unit mismatch?")
-    if (p.load_force_x != 0.0 or p.load_force_y != 0.0) and not p.coupler_point:
-        key = "load_force_x" if p.load_force_x != 0.0 else "load_force_y"
+    fx, fy = value(p, "load_force_x"), value(p, "load_force_y")
+    if (fx != 0.0 or fy != 0.0) and not p.coupler_point:
+        key = "load_force_x" if fx != 0.0 else "load_force_y"
         raise p.error(key, "a load force acts at the coupler point: give coupler_point = u, v (m) to place it")
 
 
@@ -139,8 +153,8 @@ def props(p: Mapping[str, Any]) -> np.ndarray:
                else m * lengths ** 2 / 12.0)
     ang = np.radians(p["com_angle_deg"]) if p.get("com_angle_deg") is not None else np.zeros(3)
     u, v = p.get("coupler_point") or (0.0, 0.0)
-    return np.concatenate([m, inertia, d, ang, [p.get("gravity", 9.81), p.get("load_torque", 0.0),
-                                                p.get("load_force_x", 0.0), p.get("load_force_y", 0.0), u, v]])
+    return np.concatenate([m, inertia, d, ang, [value(p, "gravity"), value(p, "load_torque"),
+                                                value(p, "load_force_x"), value(p, "load_force_y"), u, v]])
 
 
 def cw_radii(p: Mapping[str, Any]) -> tuple[float, float]:
@@ -198,7 +212,7 @@ def forces_at(p: Mapping[str, Any], out: np.ndarray, status: np.ndarray, pr: np.
 def analyse(p: Params, out: np.ndarray, status: np.ndarray) -> ForceAnalysis:
     """Force analysis at the deck's crank angles (``out``, ``status`` of its exact grid)."""
     given = forces_at(p, out, status, props(p))
-    if p.balance != "force":
+    if value(p, "balance") != "force":
         return ForceAnalysis(given, status == ST_OK)
     cw = counterweights(p)
     return ForceAnalysis(forces_at(p, out, status, cw.props), status == ST_OK, given, cw)
@@ -261,11 +275,11 @@ BATCH_KEYS = ("fixed_link", "crank", "coupler", "rocker", "omega", "alpha", "sta
 def _row(p: Mapping[str, Any]) -> np.ndarray:
     """One row of the batch kernel's (31) parameters from a deck-like mapping."""
     pr = props(p)
-    bal = 1.0 if p.get("balance", "none") == "force" else 0.0
+    bal = 1.0 if value(p, "balance") == "force" else 0.0
     return np.concatenate([[p["fixed_link"], p["crank"], p["coupler"], p["rocker"], p["omega"], p.get("alpha", 0.0),
                             p.get("start_deg", 0.0), p.get("stop_deg", 360.0),
                             1.0 if p.get("branch", "open") == "open" else -1.0],
-                           pr, [p.get("speed_fluctuation", 0.02), bal, *cw_radii(p)]])
+                           pr, [value(p, "speed_fluctuation"), bal, *cw_radii(p)]])
 
 
 #: summary columns and what they are
@@ -362,7 +376,7 @@ def summary_lines(p: Params, s: dict[str, Any], fa: ForceAnalysis) -> list[str]:
             f"peak |shaking moment| {fmt(s['shaking_moment_peak_Nm'], 'N m')}",
             f"    energy fluctuation ... dE = {fmt(s['energy_fluctuation_J'], 'J', '.5f')}",
             f"    flywheel inertia ..... dE / (C_s omega^2) = {fmt(s['flywheel_inertia_kgm2'], 'kg m^2', '.6g')} "
-            f"(C_s = {p.speed_fluctuation:g}, omega = {p.omega:g} rad/s)"]
+            f"(C_s = {value(p, 'speed_fluctuation'):g}, omega = {p.omega:g} rad/s)"]
     if s["torque_mean_Nm"] is None:
         out.append("    mean, RMS and dE need the forces everywhere in the range (a toggle or an unassembled "
                    "position lies in it)")
