@@ -72,7 +72,7 @@ LABELS = {"crank": ("crank length", "length units"), "coupler": ("coupler length
           "rocker_swing_deg": ("rocker swing", "deg"), "omega3_peak_rad_s": ("peak rocker speed", "rad/s"),
           "omega2_peak_rad_s": ("peak coupler speed", "rad/s"),
           "assembled_fraction": ("fraction of the turn assembled", "-"),
-          "time_ratio": ("time ratio (slow / quick stroke)", "-")}
+          "time_ratio": ("time ratio (slow / quick stroke)", "-"), **forces.LABELS}
 #: what a sweep summary plots when its deck names no plot_y
 SWEEP_PLOT = ("mu_min_deg", "mu_max_deg", "rocker_swing_deg", "omega3_peak_rad_s", "omega2_peak_rad_s",
               "assembled_fraction")

@@ -296,6 +296,10 @@ SUMMARY_DOC = {
 }
 
 
+#: axis labels of the summary columns (driver.study.column_label): name -> (words, units)
+LABELS = {name: (doc.rsplit(" [", 1)[0], doc.rsplit(" [", 1)[1].rstrip("]")) for name, doc in SUMMARY_DOC.items()}
+
+
 def frame_from_kernel(res: np.ndarray, prefix: str = "") -> pd.DataFrame:
     """Kernel rows -> summary columns (NaN where a figure does not exist)."""
     c = dict(zip(kernels.FOURBAR_FORCE_SUMMARY_COLUMNS, res.T))
