@@ -368,7 +368,10 @@ def summary_lines(p: Params, s: dict[str, Any], fa: ForceAnalysis) -> list[str]:
             return "n/a"
         return (fortran_f(v, None, int(spec[1:-1])) if spec.endswith("f") else f"{v:{spec}}") + f" {unit}"
 
-    out = ["", "  Force summary (a scan of the crank range at most 0.1 deg apart)"]
+    span = abs(p.stop_deg - p.start_deg)
+    npts = min(36001, max(2, math.ceil(span / 0.1 - 1e-9) + 1))
+    out = ["", f"  Force summary (a scan of the crank range in {span / (npts - 1):.4g} deg steps)" if span > 0
+           else "  Force summary (the one crank angle of the range)"]
     if s["torque_peak_Nm"] is None:
         out.append("    the forces are not defined anywhere in the range (no assembly, or toggle throughout)")
         return out
