@@ -22,6 +22,7 @@ from driver.extras import require
 require("plot")   # a clear message naming the [plot] extra when matplotlib is missing
 import matplotlib  # noqa: E402
 import matplotlib.ticker
+import matplotlib.colors
 import numpy as np
 from matplotlib.figure import Figure
 
@@ -492,4 +493,233 @@ def slidercrank_convergence_figure(series: dict[str, tuple[list[int], list[float
     axes[1].set_xlabel("number of elements")
     axes[0].legend(fontsize=7)
     fig.suptitle(title)
+    return fig
+
+
+# ----------------------------------------------------------------------------- design spaces and convergence
+
+def _numeric_axis(values) -> np.ndarray:
+    """Sorted distinct finite values of a swept key."""
+    import pandas as pd
+    v = pd.to_numeric(pd.Series(values), errors="coerce").to_numpy(dtype=float)
+    return np.unique(v[np.isfinite(v)])
+
+
+def _grid_of(frame, kx: str, ky: str, col: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Values of ``col`` on the (kx, ky) grid of the rows of ``frame`` (NaN where no row)."""
+    import pandas as pd
+    xs, ys = _numeric_axis(frame[kx]), _numeric_axis(frame[ky])
+    z = np.full((len(ys), len(xs)), np.nan)
+    ix = np.searchsorted(xs, pd.to_numeric(frame[kx], errors="coerce").to_numpy(dtype=float))
+    iy = np.searchsorted(ys, pd.to_numeric(frame[ky], errors="coerce").to_numpy(dtype=float))
+    vals = pd.to_numeric(frame[col], errors="coerce").to_numpy(dtype=float)
+    ok = (ix < len(xs)) & (iy < len(ys))
+    z[iy[ok], ix[ok]] = vals[ok]
+    return xs, ys, z
+
+
+def _edges(v: np.ndarray) -> np.ndarray:
+    """Cell edges around grid values (midpoints; half a step beyond the ends)."""
+    if len(v) == 1:
+        return np.array([v[0] - 0.5, v[0] + 0.5])
+    mid = 0.5 * (v[1:] + v[:-1])
+    return np.concatenate([[2 * v[0] - mid[0]], mid, [2 * v[-1] - mid[-1]]])
+
+
+def _plain_numbers(ax) -> None:
+    """No offset or scientific notation on either axis (a reader sees the numbers themselves)."""
+    for axis in (ax.xaxis, ax.yaxis):
+        fmt = axis.get_major_formatter()
+        if isinstance(fmt, matplotlib.ticker.ScalarFormatter):
+            fmt.set_useOffset(False)
+            fmt.set_scientific(False)
+
+
+@styled
+def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, str] | None = None,
+                     best: int | None = None, best_text: str = "", title: str = "", panels: int = 6,
+                     cmap: str = "viridis", only_kept: bool = False, ax=None) -> Figure:
+    """A metric over the design space of a sweep, as a textbook prints it.
+
+    ``frame`` has one row per case (the sweep summary: swept keys, ``kept``, the metric);
+    ``keys`` are the 1-3 swept keys.  One key: the metric against it as a line, kept cases
+    as filled markers.  Two keys: the metric as an image over the two keys (cells without a
+    row left blank), the kept designs outlined in black.  Three keys: small multiples of
+    that image over up to ``panels`` values of the third key (the best's value always among
+    them), one shared colour scale.  ``only_kept``: the frame holds the kept designs only (blank
+    cells are designs not kept, not missing ones).  ``best`` is the frame index of the design to mark (a
+    star labelled ``best_text``); ``labels`` maps columns to axis words with units.  With
+    ``ax`` (one key or two) the map is drawn into that axes and its figure returned.
+    """
+    import pandas as pd
+    labels = labels or {}
+    lab = lambda c: labels.get(c, c)  # noqa: E731
+    keys = [k for k in keys if k in frame.columns][:3]
+    kept = frame["kept"].astype(bool) if "kept" in frame else pd.Series(True, index=frame.index)
+    z_all = pd.to_numeric(frame[metric], errors="coerce").to_numpy(dtype=float)
+    fin = z_all[np.isfinite(z_all)]
+    vmin, vmax = (float(fin.min()), float(fin.max())) if fin.size else (0.0, 1.0)
+    if vmax - vmin <= 1e-12 * max(1.0, abs(vmax)):
+        vmin, vmax = vmin - 0.5, vmax + 0.5
+    norm = matplotlib.colors.Normalize(vmin, vmax)
+    brow = frame.loc[best] if best is not None and best in frame.index else None
+
+    if len(keys) <= 1:
+        if ax is None:
+            fig, (ax,) = new_figure(1, 1, figsize=(6.4, 3.6))
+        else:
+            fig = ax.figure
+        x = keys[0] if keys else "case"
+        order = frame.sort_values(x)
+        ax.plot(order[x], order[metric], "-", color="C0", lw=1.2, label="all cases")
+        ax.plot(order.loc[kept, x], order.loc[kept, metric], "o", ms=4, color="C0", label="kept")
+        if brow is not None:
+            ax.plot([brow[x]], [brow[metric]], "*", ms=14, color="C3", mec="k", label=best_text or "best")
+        ax.set_xlabel(lab(x))
+        ax.set_ylabel(lab(metric))
+        _plain_numbers(ax)
+        ax.legend(loc="best")
+        if title:
+            ax.set_title(title)
+        return fig
+
+    kx, ky = keys[0], keys[1]
+    if len(keys) == 3:
+        kz = keys[2]
+        zs = _numeric_axis(frame[kz])
+        pick = np.unique(np.linspace(0, len(zs) - 1, min(panels, len(zs))).round().astype(int))
+        if brow is not None:
+            bz = int(np.argmin(np.abs(zs - float(brow[kz]))))
+            if bz not in pick:
+                pick[np.argmin(np.abs(pick - bz))] = bz
+            pick = np.unique(pick)
+        slices = [(zs[i], frame[np.isclose(pd.to_numeric(frame[kz], errors="coerce"), zs[i])]) for i in pick]
+    else:
+        kz, slices = "", [(None, frame)]
+    n = len(slices)
+    if ax is not None and n == 1:
+        fig, axes = ax.figure, [ax]
+    else:
+        ncols = min(3, n)
+        nrows = int(math.ceil(n / ncols))
+        fig, axes = new_figure(nrows, ncols, sharex=True, sharey=True,
+                               figsize=(3.3 * ncols + 1.2, 2.9 * nrows + 0.8))
+        for extra in axes[n:]:
+            extra.set_visible(False)
+    xs_all, ys_all = _numeric_axis(frame[kx]), _numeric_axis(frame[ky])
+    image = None
+    for a, (zval, part) in zip(axes, slices):
+        xs, ys, z = _grid_of(part, kx, ky, metric)
+        _, _, keep = _grid_of(part.assign(_kept=kept[part.index].astype(float)), kx, ky, "_kept")
+        a.grid(False)
+        a.set_facecolor("0.93")
+        image = a.pcolormesh(_edges(xs), _edges(ys), np.ma.masked_invalid(z), cmap=cmap, norm=norm,
+                             shading="flat", rasterized=True)
+        if np.nansum(keep) and not np.all(keep[np.isfinite(keep)] == 1):
+            k = np.nan_to_num(keep, nan=0.0)
+            a.contour(xs, ys, k, levels=[0.5], colors="k", linewidths=1.2)
+        if brow is not None and (zval is None or np.isclose(float(brow[kz]), zval)):
+            a.plot([brow[kx]], [brow[ky]], "*", ms=15, color="C3", mec="k", mew=0.8, zorder=5)
+            if best_text:
+                right = float(brow[kx]) > 0.5 * (xs_all[0] + xs_all[-1])
+                a.annotate(textwrap.fill(best_text, 24), (brow[kx], brow[ky]), xytext=(-8 if right else 8, 8),
+                           textcoords="offset points", ha="right" if right else "left", fontsize=8, color="k",
+                           bbox=dict(boxstyle="round,pad=0.2", fc="w", ec="0.5", alpha=0.9))
+        a.set_xlim(_edges(xs_all)[[0, -1]])
+        a.set_ylim(_edges(ys_all)[[0, -1]])
+        if zval is not None:
+            a.set_title(f"{lab(kz).split(' [')[0]} = {zval:.4g}", fontsize=9)
+        _plain_numbers(a)
+    for a in axes[:n]:
+        if a.get_subplotspec() is None or a.get_subplotspec().is_last_row() or n == 1:
+            a.set_xlabel(lab(kx))
+        if a.get_subplotspec() is None or a.get_subplotspec().is_first_col() or n == 1:
+            a.set_ylabel(lab(ky))
+    cb = fig.colorbar(image, ax=list(axes[:n]), shrink=0.9, pad=0.02)
+    cb.set_label(lab(metric))
+    _plain_numbers(cb.ax)
+    note = ("kept designs outlined in black" if not kept.all() else
+            "only kept designs tabulated (blank: not kept)" if only_kept else "every design kept")
+    if title:
+        fig.suptitle(f"{title}\n{note}" if n > 1 else title)
+    if n == 1 and not title:
+        axes[0].set_title(note, fontsize=8)
+    return fig
+
+
+@styled
+def convergence_plot(history, evals, objective: str, sense: str = "minimize", title: str = "",
+                     axes=None) -> Figure:
+    """How an optimisation converged, as an engineer reads it: three panels against the number
+    of designs evaluated.
+
+    Left: the best feasible objective so far (a step line), every feasible design as a grey
+    dot; the axis shows plain numbers (no offset).  Middle: the gap between the best so far
+    and the final best on a log axis (zero gaps left out), so the last digits gained are
+    visible without a 1e-7 change looking like a big step.  Right: the constraint violation
+    of every design on a log axis (feasible designs, violation 0, are not drawn) and its
+    running minimum.  ``history`` has columns evals, feasible, objective; ``evals`` eval,
+    feasible, objective, violation.  ``objective`` is the axis label (words and unit);
+    ``sense`` 'minimize' or 'maximize'.  ``axes``: three axes to draw into.
+    """
+    import pandas as pd
+    if axes is None:
+        fig, axes = new_figure(1, 3, sharex=True, figsize=(11.0, 3.8))
+    else:
+        fig = axes[0].figure
+    a1, a2, a3 = axes
+    objective = textwrap.fill(objective, 40)
+    ev = evals.sort_values("eval")
+    feas = ev[ev["feasible"].astype(bool)]
+    sign = -1.0 if sense.startswith("max") else 1.0
+    obj = pd.to_numeric(feas["objective"], errors="coerce").to_numpy(dtype=float)
+    a1.plot(feas["eval"], obj, ".", ms=2.5, color="0.65", label="feasible designs", rasterized=len(obj) > 2000)
+    if len(obj):
+        best = sign * np.minimum.accumulate(sign * obj)
+        x = np.concatenate([feas["eval"].to_numpy(dtype=float), [float(ev["eval"].max())]])
+        y = np.concatenate([best, best[-1:]])
+        a1.step(x, y, where="post", color="C3", lw=1.8, label="best so far")
+        final = best[-1]
+        gap = np.abs(best - final)
+        pos = gap > 0
+        if pos.any():
+            a2.step(x[:-1][pos], gap[pos], where="post", color="C3", lw=1.6)
+            a2.set_yscale("log")
+        else:
+            a2.text(0.5, 0.5, "the first feasible design\nwas already the best", transform=a2.transAxes,
+                    ha="center", va="center")
+        a2.axvline(float(feas["eval"].iloc[int(np.argmax(best == final))]), color="0.4", ls=":", lw=1,
+                   label="final best found")
+        a2.legend(loc="upper right")
+        lo, hi = np.nanmin(obj), np.nanmax(obj)
+        pad = 0.05 * (hi - lo) if hi > lo else max(1e-6, 0.05 * abs(hi))
+        a1.set_ylim(lo - pad, hi + pad)
+    else:
+        a1.text(0.5, 0.5, "no feasible design", transform=a1.transAxes, ha="center", va="center")
+    a1.set_ylabel(objective)
+    a1.set_title(f"best feasible ({'largest' if sign < 0 else 'smallest'})")
+    a1.legend(loc="best")
+    a2.set_ylabel("|best so far - final best|")
+    a2.set_title("gap to the final best")
+    viol = pd.to_numeric(ev["violation"], errors="coerce").to_numpy(dtype=float) if "violation" in ev else np.array([])
+    if viol.size and np.nanmax(viol) > 0:
+        pos = viol > 0
+        a3.plot(ev["eval"].to_numpy()[pos], viol[pos], ".", ms=2.5, color="C0", alpha=0.6,
+                label="violation of each design", rasterized=pos.sum() > 2000)
+        run = np.minimum.accumulate(np.where(np.isfinite(viol), viol, np.inf))
+        shown = run > 0
+        a3.step(ev["eval"].to_numpy()[shown], run[shown], where="post", color="k", lw=1.4,
+                label="smallest so far (0 once feasible)")
+        a3.set_yscale("log")
+        a3.legend(loc="best")
+    else:
+        a3.text(0.5, 0.5, "every design feasible", transform=a3.transAxes, ha="center", va="center")
+    a3.set_ylabel("constraint violation")
+    a3.set_title("constraint violation")
+    for a in axes:
+        a.set_xlabel("designs evaluated")
+    _plain_numbers(a1)
+    _plain_numbers(a3) if a3.get_yscale() == "linear" else None
+    if title:
+        fig.suptitle(title)
     return fig
