@@ -136,7 +136,7 @@ _FOURBAR_NAMES = {"coupler_deg": "coupler angle", "rocker_deg": "rocker angle", 
 
 
 @styled
-def fourbar_curves(exact, listing, title: str) -> Figure:
+def fourbar_curves(exact, listing, title: str, band: Sequence[float] = (40.0, 120.0)) -> Figure:
     """Angles, angular velocities and transmission angle against crank angle.
 
     ``exact`` and ``listing`` are tidy frames from driver.fourbar; listing rows are
@@ -167,7 +167,7 @@ def fourbar_curves(exact, listing, title: str) -> Figure:
     if np.isfinite(angles).any() and np.ptp(angles[np.isfinite(angles)]) > 180.0:   # wrapped: the whole turn
         axes[0].set_ylim(-5, 365)
         axes[0].set_yticks(np.arange(0, 361, 90))
-    axes[1].axhspan(40, 120, color="C2", alpha=0.08, label="40-120 deg band")
+    axes[1].axhspan(band[0], band[1], color="C2", alpha=0.08, label=f"{band[0]:g}-{band[1]:g} deg band")
     for ax in axes:
         ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
     axes[-1].set_xlabel("crank angle [deg]")

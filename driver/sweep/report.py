@@ -137,6 +137,13 @@ def sweep_text(deck: Deck, sw: Params, base: Params, axes: list[tuple[str, list]
         shown = (", ".join(map(fmt, vals[:8])) if len(vals) <= 8 else
                  f"{fmt(vals[0])}, {fmt(vals[1])}, ..., {fmt(vals[-1])} ({len(vals)} values)")
         lines.append(f"    {name:<28} {shown}")
+    from driver.study import load_study   # settings of the base deck the summary columns depend on
+    swept = {name.partition(".")[2] for name, _ in axes}
+    for key in getattr(load_study(base.group), "SUMMARY_SETTINGS", ()):
+        if key in base and key not in swept:
+            v = base[key]
+            lines.append(f"    {key:<28} " + (", ".join(f"{x:g}" for x in v) if isinstance(v, (list, tuple)) else f"{v}")
+                         + "   (base deck; used by the summary columns)")
     lines += [f"    {'cases':<28} {n_cases} ({'zipped' if sw.zip else 'full grid'})",
               f"    {'case outputs':<28} {sw.case_outputs}" + (f"   keep: {sw.keep}" if sw.keep else ""),
               f"    {'kept':<28} {n_kept}",

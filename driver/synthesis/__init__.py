@@ -373,7 +373,9 @@ def _path(p: Params) -> Synthesis:
                    "the best design found passes near, not through, the points")
     linkage = {"fixed_link": q["ground"], "crank": q["crank"], "coupler": q["coupler"], "rocker": q["rocker"],
                "omega": p.omega, "step_deg": p.step_deg, "branch": p.branch,
-               "coupler_point": [q["u"], q["v"]]}
+               "coupler_point": [q["u"], q["v"]],
+               # the band the synthesis asked for: the linkage's summary and figures judge it by it
+               "transmission_band_deg": [p.transmission_min_deg, p.transmission_max_deg]}
     # the full turn by the exact kernel: assembly, Grashof class, transmission band
     fp = validate(RawGroup("fourbar", dict(linkage), {}, p.line), fourbar.SPEC, p.path)
     g = fourbar.grashof(fp.fixed_link, fp.crank, fp.coupler, fp.rocker)
@@ -406,7 +408,7 @@ def synthesise(deck: Deck | str | Path) -> Synthesis:
     p = validate(deck.groups["synthesis"], SPEC, deck.path)
     syn = {"function": _function, "crank_rocker": _crank_rocker, "path": _path}[p.task](p)
     if syn.linkage is not None:
-        fp = validate(RawGroup("fourbar", dict(syn.linkage, title=p.title or f"synthesised by {deck.path}"),
+        fp = validate(RawGroup("fourbar", dict(syn.linkage, title=p.title or f"{Path(deck.path).stem} ({p.task} synthesis)"),
                                {}, p.line), fourbar.SPEC, deck.path)
         syn.study_result = compute(fourbar, fp)
         syn.linkage = {k: v for k, v in fp.items() if v is not None and v != [] and v != ""}
