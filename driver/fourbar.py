@@ -87,6 +87,9 @@ LABELS = {"crank": ("crank length", "length units"), "coupler": ("coupler length
           "omega2_peak_rad_s": ("peak coupler speed", "rad/s"),
           "assembled_fraction": ("fraction of the turn assembled", "-"),
           "time_ratio": ("time ratio (slow / quick stroke)", "-")}
+#: which way a summary column is better (the design-space maps star the best kept design)
+SWEEP_BEST = {"mu_min_deg": "max", "mu_max_deg": "min", "rocker_swing_deg": "max", "omega3_peak_rad_s": "min",
+              "omega2_peak_rad_s": "min"}
 #: keys of the base deck a sweep's .out states because summary columns depend on them
 SUMMARY_SETTINGS = ("transmission_band_deg",)
 #: what a sweep summary plots when its deck names no plot_y

@@ -32,8 +32,9 @@ from driver.study import PLOT_FORMATS, plot_format
 __all__ = ["STYLE", "style", "styled", "new_figure", "save_figure", "line_panels"]
 
 #: the house style, applied only inside :func:`style` (never written to the global rcParams)
-STYLE: dict[str, Any] = {"figure.dpi": 110, "savefig.dpi": 110, "axes.grid": True, "grid.alpha": 0.3,
-                         "axes.spines.top": False, "axes.spines.right": False, "font.size": 9}
+STYLE: dict[str, Any] = {"figure.dpi": 150, "savefig.dpi": 150, "axes.grid": True, "grid.alpha": 0.3,
+                         "axes.spines.top": False, "axes.spines.right": False, "font.size": 9,
+                         "legend.fontsize": 8.5, "axes.formatter.useoffset": False}
 
 _F = TypeVar("_F", bound=Callable[..., Any])
 
@@ -98,7 +99,7 @@ def line_panels(x: np.ndarray, panels: Sequence[tuple[str, dict[str, np.ndarray]
             ax.plot(x, y, label=label, **(styles or {}).get(label, {}))
         ax.set_ylabel(ylabel)
         if len(series) > 1:
-            ax.legend(fontsize=7, loc="best")
+            ax.legend(loc="best")
     axes[-1].set_xlabel(xlabel)
     if title:
         fig.suptitle(title)
@@ -169,7 +170,7 @@ def fourbar_curves(exact, listing, title: str, band: Sequence[float] = (40.0, 12
         axes[0].set_yticks(np.arange(0, 361, 90))
     axes[1].axhspan(band[0], band[1], color="C2", alpha=0.08, label=f"{band[0]:g}-{band[1]:g} deg band")
     for ax in axes:
-        ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
+        ax.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
     axes[-1].set_xlabel("crank angle [deg]")
     fig.suptitle(f"{title}: four-bar kinematics")
     return fig
@@ -205,7 +206,7 @@ def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.nd
     ax.set_aspect("equal")
     ax.set_xlabel(f"x [{units}]")
     ax.set_ylabel(f"y [{units}]")
-    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
     ax.set_title(f"{title}: linkage positions")
     return fig
 
@@ -280,7 +281,7 @@ def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, 
         ax.set_ylabel("l2 [m]")
     axes[0].set_title("reach region, C_rob, iso-RI2 ellipses")
     axes[1].set_title("RI2 over the design plane")
-    fig.legend(*axes[0].get_legend_handles_labels(), fontsize=7, loc="outside lower center", ncol=4, frameon=False)
+    fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncol=4, frameon=False)
     if title:
         fig.suptitle(title)
     return fig
@@ -305,19 +306,22 @@ def manipulator_torque_crob(l1: np.ndarray, tau1: np.ndarray, tau2: np.ndarray, 
                     label="violates the workspace reach conditions" if k == 0 else None)
     ax.set_ylabel("motor torque [N m]")
     ax.set_xlabel("l1 [m]  (l2 = sqrt(%g - l1^2) [m])" % c)
-    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     fig.suptitle(f"{title}: motor torques along C_rob" if title else "Motor torques along C_rob")
     return fig
 
 
 # ----------------------------------------------------------------------------- sweep
 
-def _trivial(y, x, chosen) -> bool:
-    """A panel that shows nothing: a constant column, the x column again, or a column already shown."""
+def _trivial(y, x, chosen, unit: str = "") -> bool:
+    """A panel that shows nothing: a constant column, round-off (angles all below 1e-5 deg), the
+    x column or a swept key again, or a column already shown."""
     import pandas as pd
     v = pd.to_numeric(y, errors="coerce").to_numpy(dtype=float)
     fin = v[np.isfinite(v)]
     if fin.size == 0 or np.ptp(fin) <= 1e-12 * max(1.0, float(np.max(np.abs(fin)))):
+        return True
+    if unit == "deg" and float(np.max(np.abs(fin))) < 1e-5:
         return True
     for other in [x, *chosen]:
         w = pd.to_numeric(other, errors="coerce").to_numpy(dtype=float)
@@ -340,6 +344,7 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
     """
     import pandas as pd
     labels = labels or {}
+    only_points = False
     label = lambda c: textwrap.fill(labels.get(c, c), 28)  # noqa: E731  (two lines fit a panel)
     x = x or next((k for k in keys if pd.api.types.is_numeric_dtype(frame[k])), "case")
     if ys:
@@ -349,10 +354,14 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
                    and not pd.api.types.is_bool_dtype(frame[c]) and c not in keys]
         ordered = [c for c in preferred if c in numeric] + [c for c in numeric if c not in preferred]
         ys = []
+        unit = lambda c: labels.get(c, "").rpartition("[")[2].rstrip("]")  # noqa: E731
         for c in ordered:
-            if len(ys) < 6 and not _trivial(frame[c], frame[x], [frame[k] for k in ys]):
+            if len(ys) < 6 and not _trivial(frame[c], frame[x], [frame[k] for k in [*ys, *keys]], unit(c)):
                 ys.append(c)
-        ys = ys or ordered[:1]
+        if not ys:   # every figure constant or round-off: show how the kept designs' other keys vary with x
+            ys = [k for k in keys if k != x and pd.api.types.is_numeric_dtype(frame[k])] or ordered[:1]
+            keys = [k for k in keys if k not in ys]
+            only_points = True   # a key against a key: points, no line (angles may wrap between them)
     fig, axes = new_figure(len(ys), 1, sharex=True, figsize=(7.0, 1.9 * len(ys) + 0.9))
     kept = frame["kept"].astype(bool) if "kept" in frame else pd.Series(True, index=frame.index)
     others = [k for k in keys if k != x]
@@ -369,7 +378,7 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
             continue
         for key, g in groups:
             g = g.sort_values(x)
-            style = "-" if len(frame) <= 2000 else ""
+            style = "-" if len(frame) <= 2000 and not only_points else ""
             ax.plot(g[x], g[y], style, marker="o" if len(frame) <= 200 else ".", ms=3, lw=1,
                     label=", ".join(f"{labels.get(k, k).split(' [')[0]} = {v}"
                                     for k, v in zip(others, key if isinstance(key, tuple) else (key,))) or None)
@@ -377,7 +386,7 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
             ax.plot(frame.loc[kept, x], frame.loc[kept, y], "o", ms=4, mfc="none", color="k", label="kept")
         ax.set_ylabel(label(y))
     if others or not kept.all():
-        axes[0].legend(fontsize=7, ncol=min(3, max(1, len(frame.groupby(others)) if others else 1)),
+        axes[0].legend(ncol=min(3, max(1, len(frame.groupby(others)) if others else 1)),
                        loc="lower left", bbox_to_anchor=(0.0, 1.02), frameon=False)
     axes[-1].set_xlabel(label(x))
     fig.suptitle(f"{title}: sweep summary" if title else "sweep summary")
@@ -418,26 +427,30 @@ def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.
             ax.fill_between(x, lo, hi, color="0.5", alpha=0.15, lw=0, label=text)
         else:
             ax.axhspan(lo, hi, color="0.5", alpha=0.15, lw=0, label=text)
-    ax.plot(x, np.full_like(theta_deg, rpm, dtype=float), "k--", lw=0.9, label=f"input shaft {rpm:g} rpm")
     for k, (label, w) in enumerate(curves.items()):
         style = _UJOINT_STYLES.get(label, dict(color=f"C{k + 4}", lw=1.4))
         ax.plot(x, w, label=f"{label}: output {np.min(w):.2f}-{np.max(w):.2f} rpm", **style)
+    # the input speed last and on top: an optimum close to it must not hide it
+    ax.plot(x, np.full_like(theta_deg, rpm, dtype=float), "k--", lw=1.1, zorder=5, label=f"input shaft {rpm:g} rpm")
     if polar:
         ax.set_rlim(low - pad, top + pad)
         ax.set_rorigin(low - pad - 0.6 * (top - low + 2 * pad))
-        ax.set_rlabel_position(100.0)
-        ax.yaxis.set_major_locator(matplotlib.ticker.MaxNLocator(4))
-        ax.yaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g} rpm"))
-        ax.tick_params(axis="y", labelsize=7)
+        ticks = [t for t in matplotlib.ticker.MaxNLocator(4).tick_values(low - pad, top + pad)
+                 if low - pad <= t <= top + pad]
+        ax.set_yticks(ticks)
+        ax.set_yticklabels([])
+        for t in ticks:   # radial labels cross the curves: drawn on a white patch, above them
+            ax.text(np.radians(112.5), t, f"{t:g} rpm", fontsize=7.5, ha="center", va="center", zorder=6,
+                    bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.85))
         ax.set_xlabel("input angle [deg]; radius: shaft speed [rpm], not starting at 0", fontsize=8)
-        fig.legend(loc="outside lower center", fontsize=7, ncol=2, frameon=False)
+        fig.legend(loc="outside lower center", ncol=2, frameon=False)
     else:
         ax.set_ylim(low - pad, top + pad)
         ax.set_ylabel("shaft speed [rpm]")
         ax.set_xlabel("input angle [deg]")
         ax.set_xlim(0.0, 360.0)
         ax.set_xticks(np.arange(0, 361, 45))
-        fig.legend(loc="outside lower center", fontsize=7, ncol=2, frameon=False)
+        fig.legend(loc="outside lower center", ncol=2, frameon=False)
     fig.suptitle(f"{title}: Hooke-joint chain, input and output shaft speed" if title
                  else "Hooke-joint chain: input and output shaft speed")
     return fig
@@ -472,8 +485,8 @@ def slidercrank_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray
     ax.set_xticks(np.arange(0, 361, 45))
     ax.set_xlabel("crank angle theta2 [deg]")
     ax.set_ylabel(ylabel)
-    fig.legend(fontsize=7, loc="outside lower center", ncol=3 if len(series) + len(missing) > 4 else 2,
-               frameon=False, title="crank speed", title_fontsize=7)
+    fig.legend(loc="outside lower center", ncol=3 if len(series) + len(missing) > 4 else 2,
+               frameon=False, title="crank speed")
     ax.set_title(title)
     return fig
 
@@ -491,7 +504,7 @@ def slidercrank_convergence_figure(series: dict[str, tuple[list[int], list[float
     axes[0].set_ylabel("peak tensile strain [microstrain]")
     axes[1].set_ylabel("change from previous count [%]")
     axes[1].set_xlabel("number of elements")
-    axes[0].legend(fontsize=7)
+    axes[0].legend()
     fig.suptitle(title)
     return fig
 
@@ -603,7 +616,7 @@ def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, 
         ncols = min(3, n)
         nrows = int(math.ceil(n / ncols))
         fig, axes = new_figure(nrows, ncols, sharex=True, sharey=True,
-                               figsize=(3.3 * ncols + 1.2, 2.9 * nrows + 0.8))
+                               figsize=(6.4, 5.0) if n == 1 else (3.3 * ncols + 1.2, 2.9 * nrows + 1.0))
         for extra in axes[n:]:
             extra.set_visible(False)
     xs_all, ys_all = _numeric_axis(frame[kx]), _numeric_axis(frame[ky])
@@ -620,11 +633,10 @@ def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, 
             a.contour(xs, ys, k, levels=[0.5], colors="k", linewidths=1.2)
         if brow is not None and (zval is None or np.isclose(float(brow[kz]), zval)):
             a.plot([brow[kx]], [brow[ky]], "*", ms=15, color="C3", mec="k", mew=0.8, zorder=5)
-            if best_text:
-                right = float(brow[kx]) > 0.5 * (xs_all[0] + xs_all[-1])
-                a.annotate(textwrap.fill(best_text, 24), (brow[kx], brow[ky]), xytext=(-8 if right else 8, 8),
-                           textcoords="offset points", ha="right" if right else "left", fontsize=8, color="k",
-                           bbox=dict(boxstyle="round,pad=0.2", fc="w", ec="0.5", alpha=0.9))
+            right = float(brow[kx]) > 0.5 * (xs_all[0] + xs_all[-1])
+            a.annotate("best", (brow[kx], brow[ky]), xytext=(-9 if right else 9, 7), textcoords="offset points",
+                       ha="right" if right else "left", fontsize=9, fontweight="bold", color="k",
+                       bbox=dict(boxstyle="round,pad=0.15", fc="w", ec="none", alpha=0.8))
         a.set_xlim(_edges(xs_all)[[0, -1]])
         a.set_ylim(_edges(ys_all)[[0, -1]])
         if zval is not None:
@@ -635,14 +647,16 @@ def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, 
             a.set_xlabel(lab(kx))
         if a.get_subplotspec() is None or a.get_subplotspec().is_first_col() or n == 1:
             a.set_ylabel(lab(ky))
+    if brow is not None and best_text:   # the best design's values, under the panels
+        fig.supxlabel("\u2605 " + textwrap.fill(best_text, 110), fontsize=8.5, color="0.15")
     cb = fig.colorbar(image, ax=list(axes[:n]), shrink=0.9, pad=0.02)
     cb.set_label(lab(metric))
     _plain_numbers(cb.ax)
     note = ("kept designs outlined in black" if not kept.all() else
             "only kept designs tabulated (blank: not kept)" if only_kept else "every design kept")
     if title:
-        fig.suptitle(f"{title}\n{note}" if n > 1 else title)
-    if n == 1 and not title:
+        fig.suptitle(f"{title}\n{note}" if (n > 1 or not kept.all() or only_kept) else title)
+    elif not kept.all() or only_kept:
         axes[0].set_title(note, fontsize=8)
     return fig
 
@@ -723,3 +737,61 @@ def convergence_plot(history, evals, objective: str, sense: str = "minimize", ti
     if title:
         fig.suptitle(title)
     return fig
+
+
+def best_index(frame, metric: str, sense: str | None):
+    """The frame index of the kept, ok design with the best ``metric`` (``sense`` 'min' or 'max'),
+    or None (no sense known, or no such design)."""
+    import pandas as pd
+    if sense not in ("min", "max") or metric not in frame:
+        return None
+    ok = frame
+    if "status" in ok:
+        ok = ok[ok["status"] == "ok"]
+    if "kept" in ok:
+        ok = ok[ok["kept"].astype(bool)]
+    m = pd.to_numeric(ok[metric], errors="coerce")
+    if not m.notna().any():
+        return None
+    return m.idxmax() if sense == "max" else m.idxmin()
+
+
+def is_grid(frame, keys: Sequence[str]) -> bool:
+    """Whether 2-3 numeric swept ``keys`` span a grid worth a map (several values on each of two)."""
+    import pandas as pd
+    numeric = [k for k in keys if k in frame and pd.api.types.is_numeric_dtype(frame[k])
+               and not pd.api.types.is_bool_dtype(frame[k])]
+    if not (2 <= len(numeric) <= 3 and len(numeric) == len(keys)):
+        return False
+    counts = [len(_numeric_axis(frame[k])) for k in numeric[:2]]
+    # a map needs cells: at least 3 values on each axis and two designs per value on average
+    return min(counts) >= 3 and len(frame) >= 2 * max(counts)
+
+
+def _words_value(label: str, value: float, name: bool = True) -> str:
+    """``'crank length [length units]', 4.0`` -> ``'crank length 4 length units'`` (``name``
+    False: the value and unit only)."""
+    words, _, unit = label.partition(" [")
+    unit = unit.rstrip("]")
+    text = f"{value:.4g}" + (f" {unit}" if unit and unit != "-" else "")
+    return f"{words} {text}" if name else text
+
+
+def sweep_maps(frame, keys: Sequence[str], ys: Sequence[str], labels: dict[str, str], senses: dict[str, str],
+               title: str = "", only_kept: bool = False) -> list[Figure]:
+    """Design-space maps of a 2-3-key grid sweep, one per plotted column ``ys``: the best kept
+    design (by ``senses[y]``, 'min' or 'max', when the study knows which is better) starred and
+    labelled with its key values."""
+    figs = []
+    for y in ys:
+        best = best_index(frame, y, senses.get(y))
+        text = ""
+        if best is not None:
+            word = "largest" if senses[y] == "max" else "smallest"
+            text = f"best ({word} {labels.get(y, y).split(' [')[0]}): " + ", ".join(
+                f"{_words_value(labels.get(k, k), frame.loc[best, k])}" for k in keys) + \
+                f"; {labels.get(y, y).split(' [')[0]} {_words_value(labels.get(y, y), frame.loc[best, y], name=False)}"
+        figs.append(design_space_map(frame, keys, y, labels, best=best, best_text=text,
+                                     title=f"{title}: {labels.get(y, y)}" if title else labels.get(y, y),
+                                     only_kept=only_kept))
+    return figs

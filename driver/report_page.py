@@ -516,8 +516,9 @@ def _namelist(group: str, values: dict[str, Any]) -> str:
 
 def page_for_sweep(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> str:
     """The page of a sweep deck, from the files the sweep wrote: the design-space maps of the
-    plotted summary columns (kept designs outlined, the kept design with the largest first
-    plotted column marked), that design's drawing and animation, the summary .out, the deck."""
+    plotted summary columns (kept designs outlined; the best kept design by the first plotted
+    column marked where the study says which way is better, its ``SWEEP_BEST``, else the first
+    kept design), that design's drawing and animation, the summary .out, the deck."""
     import pandas as pd
 
     from driver import plotting
@@ -539,30 +540,27 @@ def page_for_sweep(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> st
     labels = _labels(module, list(summary.columns))
     ok = summary[summary["status"] == "ok"] if "status" in summary else summary
     kept = ok[ok["kept"].astype(bool)] if "kept" in ok else ok
-    best = None
+    senses = getattr(module, "SWEEP_BEST", {})
     sections: list[Section] = []
     notes: list[str] = []
-    if wanted and len(kept):
-        m = pd.to_numeric(kept[wanted[0]], errors="coerce")
-        if m.notna().any():
-            best = m.idxmax()
-    best_text = ""
-    if best is not None:
-        best_text = f"largest {labels[wanted[0]].split(' [')[0]}: " + ", ".join(
-            f"{k.split('.')[-1]} {summary.loc[best, k]:.4g}" for k in keys if pd.api.types.is_numeric_dtype(summary[k]))
     numeric_keys = [k for k in keys if pd.api.types.is_numeric_dtype(summary[k])]
+    best = plotting.best_index(ok, wanted[0], senses.get(wanted[0])) if wanted else None
+    if best is not None:
+        best_text = ("largest " if senses[wanted[0]] == "max" else "smallest ") + labels[wanted[0]].split(" [")[0]
+    elif len(kept):
+        best, best_text = kept.index[0], "the first kept design"
+    else:
+        best_text = ""
     maps = []
-    for y in wanted[:3]:
-        try:
-            fig = plotting.design_space_map(ok, numeric_keys, y, labels, best=best,
-                                            best_text=best_text if y == wanted[0] else "",
-                                            only_kept=sw.summary_rows == "kept", title=f"{stem}: {labels[y]}")
-            maps.append(_figure_block(fig, f"{labels[y]} over the swept keys"))
-        except Exception as exc:
-            notes.append(f"design-space map of {y} could not be drawn: {exc.__class__.__name__}: {exc}")
-    if len(summary) and "kept" in summary and summary["kept"].astype(bool).all() and sw.summary_rows == "kept":
-        maps.insert(0, '<p class="note">The summary keeps only the kept designs (summary_rows = \'kept\'): cells '
-                       "without a kept design are blank.</p>")
+    try:
+        if plotting.is_grid(ok, keys) and not sw.zip:
+            figs = plotting.sweep_maps(ok, keys, wanted[:3], labels, senses, stem, sw.summary_rows == "kept")
+        else:
+            figs = [plotting.design_space_map(ok, numeric_keys[:1], y, labels, best=best, best_text=best_text,
+                                              title=f"{stem}: {labels[y]}") for y in wanted[:3]]
+        maps += [_figure_block(f, f"{labels[y]} over the swept keys") for f, y in zip(figs, wanted)]
+    except Exception as exc:
+        notes.append(f"the design-space maps could not be drawn: {exc.__class__.__name__}: {exc}")
     sections.append(Section("design-space", "design space", "\n".join(maps) or "<p>No numeric summary column to map.</p>"))
     if best is not None:
         values = dict(deck.groups[base_params.group].values)
@@ -572,7 +570,8 @@ def page_for_sweep(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> st
         try:
             result, params = _case_result(Path(f"{stem}_case{int(summary.loc[best, 'case'])}.dat"),
                                           _namelist(base_params.group, values))
-            body = f'<p>Case {int(summary.loc[best, "case"])}: {esc(best_text)}.</p>'
+            body = (f'<p>Case {int(summary.loc[best, "case"])}, {esc(best_text)}: ' + ", ".join(
+                f"{esc(k)} = {summary.loc[best, k]:.6g}" for k in numeric_keys) + ".</p>")
             anim = mechanism_animation(params, "anim-best", "The marked design over one crank turn.")
             body += anim or ""
             figs, failed = _figures_html(result)
@@ -604,32 +603,6 @@ def _objective(deck: "Deck") -> tuple[str, str]:
     return "objective", "minimize"
 
 
-def objective_label(module: Any, text: str) -> str:
-    """The axis words of an objective: a summary column's words and unit, or for an expression
-    the expression in words with the unit its columns share (``min(mu_min_deg, ...) [deg]``)."""
-    from driver.export import SUFFIX_UNITS
-    from driver.study import column_label
-    if re.fullmatch(r"[A-Za-z_][A-Za-z0-9_.]*", text.strip()):
-        return column_label(module, text.strip())
-    names = set(re.findall(r"[A-Za-z_][A-Za-z0-9_]*", text)) - {"min", "max", "abs", "sqrt", "and", "or", "not"}
-    units = set()
-    for n in names:
-        for suffix, u in SUFFIX_UNITS:
-            if n.endswith(suffix):
-                units.add(u)
-                break
-        else:
-            labels = getattr(module, "LABELS", {})
-            if n in labels:
-                units.add(labels[n][1])
-    words = text.strip()
-    for n in sorted(names, key=len, reverse=True):
-        entry = getattr(module, "LABELS", {}).get(n)
-        if entry:
-            words = re.sub(rf"\b{re.escape(n)}\b", entry[0], words)
-    return f"{words} [{units.pop()}]" if len(units) == 1 and "" not in units else words
-
-
 def page_for_optimize(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> str:
     """The page of an optimisation deck, from the files it wrote: the convergence plot, the map
     of the designs evaluated over the first two design variables (coloured by the objective,
@@ -640,13 +613,14 @@ def page_for_optimize(deck: "Deck", outdir: Path, stem: str, status: int = 0) ->
     from driver import plotting
     from driver.deck import Deck as _Deck
     from driver.runner import study_of
+    from driver.study import expression_label
     outdir = Path(outdir)
     text = (outdir / f"{stem}.out").read_text()
     history = pd.read_csv(outdir / f"{stem}_history.csv")
     evals = pd.read_parquet(outdir / f"{stem}_evals.parquet")
     module, _ = study_of(_Deck(deck.path, {g: r for g, r in deck.groups.items() if g != "optimize"}))
     obj_text, sense = _objective(deck)
-    label = objective_label(module, obj_text)
+    label = expression_label(module, obj_text)
     sections: list[Section] = []
     notes: list[str] = []
     figs = []

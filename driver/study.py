@@ -36,7 +36,7 @@ if TYPE_CHECKING:   # annotations only: keeps `python -m driver --help` light
 if TYPE_CHECKING:
     import matplotlib.figure
 
-__all__ = ["Figure", "PLOT_FORMATS", "Result", "code_digest", "column_label", "keyword_run", "load_study", "plot_format",
+__all__ = ["Figure", "PLOT_FORMATS", "Result", "code_digest", "column_label", "expression_label", "keyword_run", "load_study", "plot_format",
            "study_names"]
 
 _CORE = {"cli", "limits", "deck", "study", "table", "export", "plotting", "atomic", "kernels", "sweep", "runner", "expr",
@@ -263,3 +263,28 @@ def column_label(module: ModuleType | None, name: str) -> str:
     if not units and spec_key is not None:
         units = spec_key.units
     return f"{words} [{units}]" if units else words
+
+
+def expression_label(module: ModuleType | None, text: str) -> str:
+    """The axis words of an objective: a summary column's words and unit, or for an expression
+    the expression in words with the unit its columns share (``min(mu_min_deg, ...) [deg]``)."""
+    from driver.export import SUFFIX_UNITS
+    if re.fullmatch(r"[A-Za-z_][A-Za-z0-9_.]*", text.strip()):
+        return column_label(module, text.strip())
+    names = set(re.findall(r"[A-Za-z_][A-Za-z0-9_]*", text)) - {"min", "max", "abs", "sqrt", "and", "or", "not"}
+    units = set()
+    for n in names:
+        for suffix, u in SUFFIX_UNITS:
+            if n.endswith(suffix):
+                units.add(u)
+                break
+        else:
+            labels = getattr(module, "LABELS", {})
+            if n in labels:
+                units.add(labels[n][1])
+    words = text.strip()
+    for n in sorted(names, key=len, reverse=True):
+        entry = getattr(module, "LABELS", {}).get(n)
+        if entry:
+            words = re.sub(rf"\b{re.escape(n)}\b", entry[0], words)
+    return f"{words} [{units.pop()}]" if len(units) == 1 and "" not in units else words

@@ -122,8 +122,16 @@ def write_sweep_files(outdir: Path, stem: str, table: pd.DataFrame, cases: Any, 
                 if name and name not in shown.columns:
                     shown[name] = expr.parse(name).evaluate(shown)
             labels = {c: column_label(module, c) for c in shown.columns}
-            save_figure(sweep_summary(shown, names, sw.plot_x, sw.plot_y, stem, labels,
-                                      getattr(module, "SWEEP_PLOT", ())), outdir / f"{stem}_summary.png", plot)
+            from driver.plotting import is_grid, sweep_maps
+            if is_grid(shown, names) and not sw.zip:   # a design space: maps over the keys, not strips
+                ys = [y for y in sw.plot_y if y in shown] or [c for c in getattr(module, "SWEEP_PLOT", ())
+                                                             if c in shown][:1]
+                for k, fig in enumerate(sweep_maps(shown, names, ys[:3], labels, getattr(module, "SWEEP_BEST", {}),
+                                                   stem, sw.summary_rows == "kept")):
+                    save_figure(fig, outdir / f"{stem}_summary{'' if k == 0 else f'_{k + 1}'}.png", plot)
+            else:
+                save_figure(sweep_summary(shown, names, sw.plot_x, sw.plot_y, stem, labels,
+                                          getattr(module, "SWEEP_PLOT", ())), outdir / f"{stem}_summary.png", plot)
 
 
 def sweep_text(deck: Deck, sw: Params, base: Params, axes: list[tuple[str, list]], n_cases: int,

@@ -430,7 +430,7 @@ def _path_figure(syn: Synthesis, path: Path, title: str, fmt: bool | str = True)
     tk = pg._to_kernel(pp, syn.design.x)
     ax = fig.axes[0]
     ax.plot(tk[:, 0], tk[:, 1], "s", mfc="none", mec="k", ms=7, label="target points")
-    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)   # beside the drawing
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)   # beside the drawing
     return plotting.save_figure(fig, path, fmt)
 
 
