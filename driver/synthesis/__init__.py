@@ -459,6 +459,14 @@ def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool,
             fig = plotting.line_panels(fd.x, [("y", {"desired y(x)": fd.y_desired, "generated": fd.y_generated}),
                                               ("structural error", {"error": fd.y_generated - fd.y_desired})],
                                        "x", title=f"{Path(deck.path).stem}: function generation")
+            # the precision points: where the generated function meets y(x) (zero structural error)
+            top, err = fig.axes
+            top.plot(fd.x_points, fd.y_points, "o", ms=6, mfc="white", mec="k", zorder=5, label="precision points")
+            err.plot(fd.x_points, np.zeros_like(fd.x_points), "o", ms=6, mfc="white", mec="k", zorder=5,
+                     label="precision points")
+            err.axhline(0.0, color="0.5", lw=0.8)
+            top.legend()
+            err.legend()
             written.append(plotting.save_figure(fig, stem.with_name(stem.name + "_error.png"), plot))
     if plot and syn.params.task == "path" and syn.design is not None:
         written.append(_path_figure(syn, stem.with_name(stem.name + "_path.png"), Path(deck.path).stem, plot))
