@@ -45,7 +45,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 DECK = ROOT / "inputs" / "fourbar_design_search.dat"
 PER_CRANK = 64 * 64              # linkages per crank value of the shipped grid
-PEAK_KEEP = "meets_band_40_120 and rocker_swing_deg >= 60 and abs(omega3_peak_rad_s) <= 3"
+PEAK_KEEP = "meets_transmission_band and rocker_swing_deg >= 60 and abs(omega3_peak_rad_s) <= 3"
 
 
 def load() -> str:
@@ -55,7 +55,7 @@ def load() -> str:
 def deck_text(cranks: int, keep: str | None = None) -> str:
     text = DECK.read_text().replace("count1 = 25", f"count1 = {cranks}")
     if keep:
-        text = text.replace("keep = 'meets_band_40_120 and rocker_swing_deg >= 60'", f"keep = '{keep}'")
+        text = text.replace("keep = 'meets_transmission_band and rocker_swing_deg >= 60'", f"keep = '{keep}'")
     return text
 
 

@@ -27,7 +27,7 @@ SWEEP = """&fourbar fixed_link = 12.0, crank = 3.0, coupler = 15.0, rocker = 9.0
   key1 = 'fourbar.crank',   start1 = 1.0, stop1 = 7.0,  count1 = 21
   key2 = 'fourbar.coupler', start2 = 6.0, stop2 = 20.0, count2 = 40
   key3 = 'fourbar.rocker',  start3 = 4.0, stop3 = 16.0, count3 = 40
-  keep = 'meets_band_40_120 and rocker_swing_deg >= 50'
+  keep = 'meets_transmission_band and rocker_swing_deg >= 50'
   case_outputs = 'none', summary_rows = 'kept'
 /
 """

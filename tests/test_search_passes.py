@@ -147,7 +147,7 @@ def test_optimize_runs_only_the_passes_of_its_objective_constraints_and_summary_
     assert spy and all(not bits & P["peaks"] for n, bits in spy if n > 1)
     evals = pd.read_parquet(tmp_path / "o" / "opt_evals.parquet")
     summ = sorted(c for c in evals.columns if c.startswith("summary."))
-    assert summ == ["summary." + c for c in sorted(("meets_band_40_120", "mu_max_deg", "mu_min_deg",
+    assert summ == ["summary." + c for c in sorted(("meets_transmission_band", "mu_max_deg", "mu_min_deg",
                                                      "rocker_swing_deg", "time_ratio"))]
     ref = pd.read_parquet(ROOT / "outputs" / "optimize_fourbar_design_evals.parquet")
     assert len(evals) == len(ref)

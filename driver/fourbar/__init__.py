@@ -17,6 +17,7 @@ from typing import Any, Callable, Collection, Mapping
 import numpy as np
 import pandas as pd
 
+from driver.fourbar import forces
 from driver import kernels
 from driver.limits import Estimate
 from driver.deck import GroupSpec, Key, Params, positive
@@ -29,7 +30,23 @@ __all__ = ["SPEC", "run", "summarise", "summarise_batch", "BATCH_KEYS", "grashof
 
 ST = kernels.FOURBAR_STATUS
 MAX_ANGLE = 1.0e6   # |crank angle| [deg] a deck may give (ulp of 1e6 is 1.2e-10 deg)
-BAND = (40.0, 120.0)  # transmission-angle band recommended by the paper [deg]
+BAND = (40.0, 120.0)  # transmission-angle band recommended by the paper [deg]: transmission_band_deg's default
+
+
+def _band_check(v: Any) -> str | None:
+    """Key check of ``transmission_band_deg``: two angles 0 <= min < max <= 180 [deg]."""
+    if len(v) != 2:
+        return f"give two angles, the band's minimum and maximum in deg (got {len(v)} values)"
+    lo, hi = v
+    if not (0.0 <= lo < hi <= 180.0):
+        return f"the band needs 0 <= min < max <= 180 deg (got {lo:g}, {hi:g})"
+    return None
+
+
+def band_of(p: Mapping[str, Any]) -> tuple[float, float]:
+    """The deck's transmission-angle band (min, max) [deg] (the paper's 40-120 deg by default)."""
+    v = p.get("transmission_band_deg") if hasattr(p, "get") else None
+    return (float(v[0]), float(v[1])) if v is not None and len(v) == 2 else BAND
 
 #: why the published listing's rows for crank angles in (180, 360) deg are wrong (see :func:`audit`)
 LISTING_DEFECT = ("the listing's quadrant test sends sigy > 0, sigx > 0 to sigma = 2 pi - |atan| (meant |atan|), "
@@ -60,6 +77,7 @@ def _check(p: Params) -> None:
                                    f"(got {p[key]:g}); use method='exact' for fractional angles")
         if "branch" in p.given and p.branch != "open":
             raise p.error("branch", "the listing computes one assembly only; branch applies to method='exact'")
+    forces.check(p)
 
 
 #: axis labels of summary columns and deck keys (driver.study.column_label): name -> (words, units)
@@ -70,7 +88,12 @@ LABELS = {"crank": ("crank length", "length units"), "coupler": ("coupler length
           "rocker_swing_deg": ("rocker swing", "deg"), "omega3_peak_rad_s": ("peak rocker speed", "rad/s"),
           "omega2_peak_rad_s": ("peak coupler speed", "rad/s"),
           "assembled_fraction": ("fraction of the turn assembled", "-"),
-          "time_ratio": ("time ratio (slow / quick stroke)", "-")}
+          "time_ratio": ("time ratio (slow / quick stroke)", "-"), **forces.LABELS}
+#: which way a summary column is better (the design-space maps star the best kept design)
+SWEEP_BEST = {"mu_min_deg": "max", "mu_max_deg": "min", "rocker_swing_deg": "max", "omega3_peak_rad_s": "min",
+              "omega2_peak_rad_s": "min"}
+#: keys of the base deck a sweep's .out states because summary columns depend on them
+SUMMARY_SETTINGS = ("transmission_band_deg",)
 #: what a sweep summary plots when its deck names no plot_y
 SWEEP_PLOT = ("mu_min_deg", "mu_max_deg", "rocker_swing_deg", "omega3_peak_rad_s", "omega2_peak_rad_s",
               "assembled_fraction")
@@ -93,11 +116,16 @@ SPEC = GroupSpec(
                       doc="'listing' = published program cell for cell; 'exact' = closed loop"),
         "branch": Key("str", default="open", choices=("open", "crossed"),
                       doc="'open': B left of the line A->O_B; 'crossed': mirror assembly"),
+        "transmission_band_deg": Key("floats", default=list(BAND), units="deg", check=_band_check,
+                                     doc="the transmission-angle band a design should keep to (min, max): the "
+                                         "summary's meets_transmission_band, the .out and the figures use it; "
+                                         "default the paper's 40, 120"),
         "coupler_point": Key("floats", default=None, units="length",
                              check=lambda v: None if len(v) == 2 else f"give two numbers u, v (got {len(v)})",
                              doc="a point P on the coupler: u along A->B, v to its left; adds its path, "
                                  "velocity and acceleration (exact method)"),
         "title": Key("str", default="", doc="free text echoed in the output"),
+        **forces.KEYS,   # the force analysis (driver/fourbar/forces.py), run when 'mass' is given
     },
     check=_check,
 )
@@ -242,13 +270,15 @@ BATCH_INDEPENDENT = ("fixed_link", "crank", "coupler", "rocker", "omega", "alpha
 #: scans the range for the speed extremes (about 80 % of the kernel time when asked).
 BATCH_PASSES: dict[str, tuple[str, ...]] = {
     "grashof_class": (), "full_crank_rotation": (), "assemblable": (),
-    "mu_min_deg": ("transmission",), "mu_max_deg": ("transmission",), "meets_band_40_120": ("transmission",),
+    "mu_min_deg": ("transmission",), "mu_max_deg": ("transmission",), "meets_transmission_band": ("transmission",),
     "rocker_turns_fully": ("rocker",), "rocker_swing_deg": ("rocker",), "toggle_in_range": (),
     "omega3_peak_rad_s": ("peaks",), "omega2_peak_rad_s": ("peaks",), "assembled_fraction": (),
     "time_ratio": ("rocker",),
     "mu_min_at_deg": ("transmission",), "mu_max_at_deg": ("transmission",), "rocker_min_deg": ("rocker",),
     "rocker_min_at_deg": ("rocker",), "rocker_max_deg": ("rocker",), "rocker_max_at_deg": ("rocker",),
     "omega3_peak_at_deg": ("peaks",), "omega2_peak_at_deg": ("peaks",), "toggles_in_range": (),
+    # decks that give masses: the force summary (driver/fourbar/forces.py), a pass of its own
+    **{f"{pre}{c}": ("forces",) for pre in ("", "unbalanced_") for c in forces.SUMMARY_DOC},
 }
 #: the kernel's pass bits (fortran/fourbar_summary.f90 pass_*)
 PASS_BITS = {"transmission": kernels.FOURBAR_PASSES["transmission"], "rocker": kernels.FOURBAR_PASSES["rocker"],
@@ -259,7 +289,7 @@ def _pass_mask(wanted: Collection[str] | None) -> int:
     """The kernel's pass bits for summary columns ``wanted`` (None: every pass)."""
     if wanted is None:
         return sum(PASS_BITS.values())
-    return sum({PASS_BITS[p] for c in wanted for p in BATCH_PASSES.get(c, ())})
+    return sum({PASS_BITS[p] for c in wanted for p in BATCH_PASSES.get(c, ()) if p in PASS_BITS})
 
 
 #: kernel Grashof codes -> (class name as grashof() prints it, full crank rotation)
@@ -312,7 +342,7 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     [rad/s], ``start_deg``/``stop_deg`` [deg], ``branch`` 'open'/'crossed' or +1/-1.
     Returns the columns of the single-case summary (``summarise``) with identical values
     (missing figures as NaN): grashof_class, full_crank_rotation, assemblable, mu_min_deg,
-    mu_max_deg, meets_band_40_120, rocker_turns_fully, rocker_swing_deg, toggle_in_range,
+    mu_max_deg, meets_transmission_band (mu within the base deck's ``transmission_band_deg``), rocker_turns_fully, rocker_swing_deg, toggle_in_range,
     omega3_peak_rad_s, omega2_peak_rad_s, assembled_fraction, time_ratio (crank angle of the
     rocker's slower stroke over its quicker one, >= 1; missing unless the range holds a full
     turn, assembled throughout, without a toggle, with the rocker oscillating); with ``detail`` also the crank
@@ -328,13 +358,21 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     unknown = [k for k in columns if k not in BATCH_KEYS and k not in BATCH_IGNORED]
     if unknown:
         raise _bad(base, unknown[0], f"not a &fourbar key the summary depends on ({', '.join(BATCH_KEYS)})")
+    force_columns = {k: v for k, v in columns.items() if k in forces.BATCH_KEYS}
     columns = {k: v for k, v in columns.items() if k in BATCH_KEYS}
     sizes = {np.size(v) for v in columns.values() if np.ndim(v) > 0}
     if len(sizes) > 1:
         raise _bad(base, None, f"batch columns have different lengths {sorted(sizes)}")
     n = sizes.pop() if sizes else 1
     res = kernels.fourbar_summaries(_param_matrix(base, columns, n), _pass_mask(wanted))
-    return _frame(res, detail or (wanted is not None and any(c in _DETAIL for c in wanted)), wanted)
+    frame = _frame(res, detail or (wanted is not None and any(c in _DETAIL for c in wanted)), band_of(base), wanted)
+    if forces.active(base) and (wanted is None or any(BATCH_PASSES.get(c) == ("forces",) for c in wanted)):
+        # force columns (driver/fourbar/forces.py) when the deck gives masses, and someone reads one
+        more = forces.summarise_force_batch(base, force_columns)
+        if wanted is not None:
+            more = more[[c for c in more.columns if c in set(wanted)]]
+        frame = pd.concat([frame, more], axis=1)
+    return frame
 
 
 #: the columns of summarise_batch(detail=True) only
@@ -342,7 +380,8 @@ _DETAIL = ("mu_min_at_deg", "mu_max_at_deg", "rocker_min_deg", "rocker_min_at_de
            "rocker_max_at_deg", "omega3_peak_at_deg", "omega2_peak_at_deg", "toggles_in_range")
 
 
-def _frame(res: np.ndarray, detail: bool = False, wanted: Collection[str] | None = None) -> pd.DataFrame:
+def _frame(res: np.ndarray, detail: bool = False, band: tuple[float, float] = BAND,
+           wanted: Collection[str] | None = None) -> pd.DataFrame:
     """Kernel rows -> the summary columns (vectorised; the one place both paths go through);
     with ``wanted``, only those columns are built."""
     c = dict(zip(kernels.FOURBAR_SUMMARY_COLUMNS, res.T))
@@ -350,13 +389,13 @@ def _frame(res: np.ndarray, detail: bool = False, wanted: Collection[str] | None
     lut = [GRASHOF_NAMES[kernels.FOURBAR_GRASHOF[k]] for k in range(len(GRASHOF_NAMES))]
     tog = lambda: ok & (c["toggles_in_range"] > 0)
     has = lambda v, m=None: np.where(ok if m is None else m, v, np.nan)
-    lo, hi = BAND
+    lo, hi = band
     build: dict[str, Callable[[], Any]] = {
         "grashof_class": lambda: np.array([n for n, _ in lut], dtype=object)[c["grashof"].astype(int)],
         "full_crank_rotation": lambda: np.array([f for _, f in lut])[c["grashof"].astype(int)],
         "assemblable": lambda: ok,
         "mu_min_deg": lambda: has(c["mu_min_deg"]), "mu_max_deg": lambda: has(c["mu_max_deg"]),
-        "meets_band_40_120": lambda: ok & (c["mu_min_deg"] >= lo) & (c["mu_max_deg"] <= hi),
+        "meets_transmission_band": lambda: ok & (c["mu_min_deg"] >= lo) & (c["mu_max_deg"] <= hi),
         "rocker_turns_fully": lambda: ok & (c["rocker_turns"] > 0),
         "rocker_swing_deg": lambda: has(c["rocker_swing_deg"]),
         "toggle_in_range": tog,
@@ -467,7 +506,7 @@ def summary_lines(p: Params, g: Grashof, ex: Extremes | None) -> list[str]:
     if ex is None:
         out.append("    the linkage cannot be assembled anywhere in the requested range")
         return out
-    lo, hi = BAND
+    lo, hi = band_of(p)
     meets = lo <= ex.mu_min and ex.mu_max <= hi
     out += [f"    transmission angle ... min {ex.mu_min:.2f} deg at theta = {ex.mu_min_at:.2f}, "
             f"max {ex.mu_max:.2f} deg at theta = {ex.mu_max_at:.2f}",
@@ -581,21 +620,37 @@ def _exact_columns(out: np.ndarray, status: np.ndarray, cp: np.ndarray | None = 
     return vals
 
 
+def output_name(p: Params) -> str:
+    """What the output link is called in figures: 'output crank' when it turns fully (a
+    double-crank, a drag link), 'rocker' otherwise."""
+    g = grashof(p.fixed_link, p.crank, p.coupler, p.rocker)
+    return "output crank" if g.name.startswith("double-crank") else "rocker"
+
+
 def _figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> list[Figure]:
     def curves():
         from driver import plotting   # matplotlib is the optional [plot] extra: import when drawing
         theta = np.linspace(p.start_deg, p.stop_deg, 721)
         out, st = exact_grid(p, theta)
         exact = tidy_frame("exact", theta, _exact_columns(out, st), st)
-        return plotting.fourbar_curves(exact, listing, stem_title)
+        return plotting.fourbar_curves(exact, listing, stem_title, band=band_of(p), output=output_name(p))
 
     def linkage():
         from driver import plotting
-        theta = np.linspace(0.0, 360.0, 721)
+        lo, hi = sorted((p.start_deg, p.stop_deg))
+        # the deck's crank range when it is less than a turn (a function generator's design range)
+        theta = np.linspace(lo, hi, 721) if hi - lo < 360.0 else np.linspace(0.0, 360.0, 721)
         out, st = exact_grid(p, theta)
         cp = coupler_point(p, theta, out, st)
+        limits = []
+        for a in limit_angles(p.fixed_link, p.crank, p.coupler, p.rocker):
+            if theta[0] - 1e-9 <= a <= theta[-1] + 1e-9 or hi - lo >= 360.0:
+                row, rst = exact_grid(p, np.array([a]))
+                if rst[0] != ST["no_assembly"] and np.all(np.isfinite(row[0, 3:7])):
+                    limits.append((a, row[0]))
         return plotting.fourbar_linkage(p.fixed_link, theta, out, st == ST["ok"], listing, stem_title,
-                                        point=None if cp is None else cp[:, :2])
+                                        point=None if cp is None else cp[:, :2], output=output_name(p),
+                                        limits=limits)
 
     return [Figure("curves", curves), Figure("linkage", linkage)]
 
@@ -612,7 +667,8 @@ def estimate(params: Params) -> Estimate:
     n = max(n, 1.0)
     span = min(abs(p.stop_deg - p.start_deg), 360.0) / 1.0 + 1.0
     range_key = "start_deg" if "start_deg" in p.given else ("stop_deg" if "stop_deg" in p.given else "step_deg")
-    rows = Estimate(2000.0 * n + 5e6, 5e-5 * n + 0.05, "step_deg", "step_deg", f"{n:.4g} crank angles")
+    k = 2.5 if forces.active(p) else 1.0   # the force table and columns: 13 more cells and 24 columns per row
+    rows = Estimate(k * 2000.0 * n + 5e6, k * 5e-5 * n + 0.05, "step_deg", "step_deg", f"{n:.4g} crank angles")
     grid = Estimate(500.0 * span, 1e-6 * span, range_key, range_key,
                     f"a {span:.4g}-point scan of one turn for the summary")
     return rows + grid
@@ -663,13 +719,29 @@ def run(params: Params, progress: bool = False) -> Result:
         if cp is not None:
             lines += [f"    coupler point P ...... u = {p.coupler_point[0]:g} along A->B, v = {p.coupler_point[1]:g} "
                       "to its left; xp, yp its position, vp its speed [length/s]"]
+        if forces.active(p):
+            lines += _force_section(p, theta, out, status, exact_frame)
         for k in np.flatnonzero(status == ST["no_assembly"])[:1]:
             warnings.append(f"the linkage cannot be assembled at {int((status == ST['no_assembly']).sum())} "
                             f"of {len(theta)} crank angles (first at {theta[k]:g} deg)")
         tidy = exact_frame
     summary = _summary(p)
-    return Result(text="\n".join(lines) + "\n", tidy=tidy, summary=summary, warnings=warnings,
-                  figures=_figures(p, title, listing_frame))
+    figs = _figures(p, title, listing_frame) + (forces.figures(p, title, exact_grid) if forces.active(p) else [])
+    return Result(text="\n".join(lines) + "\n", tidy=tidy, summary=summary, warnings=warnings, figures=figs)
+
+
+def _force_section(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarray,
+                   frame: pd.DataFrame) -> list[str]:
+    """The force analysis's lines of the .out; its columns are added to ``frame`` (in place)."""
+    fa = forces.analyse(p, out, status)
+    for name, values in forces.tidy_columns(fa).items():
+        frame[name] = values
+    with_units(frame, TIDY_UNITS)
+    words = ["toggle: forces unbounded" if s == ST["toggle"] else "not placed" for s in status]
+    title = ("Force analysis (Newton-Euler, closed form; " +
+             ("with the Berkof-Lowen counterweights" if fa.cw is not None else "links as given") + ")")
+    return (forces.echo_lines(p) + forces.table_lines(theta, fa.forces, fa.ok, words, title)
+            + forces.summary_lines(p, forces.summary(p), fa))
 
 
 def summarise(params: Params) -> dict:
