@@ -44,8 +44,12 @@ def test_arithmetic_is_float64_and_vectorised():
     assert e.names == {"fourbar.crank", "mu_min_deg", "n"}
 
 
-def test_overflow_and_division_give_inf_not_hangs():
-    out = parse("10 ** 10 ** 10 + n / 0").evaluate(FRAME)
+def test_overflow_is_refused_when_parsed_and_division_gives_inf_not_hangs():
+    # a constant part that is not a finite float64 is a deck error before anything runs
+    for text in ("10 ** 10 ** 10 + n / 0", "9**9**9**9", "log(0.0) / n", "1e308 * 10 + n", "n + 1e400"):
+        with pytest.raises(ExprError, match="finite"):
+            parse(text)
+    out = parse("n / 0").evaluate(FRAME)   # what depends on a column is evaluated case by case
     assert np.isinf(out).all()
 
 
