@@ -46,6 +46,13 @@ from driver.runner import compute, output_stem, write_outputs
 __all__ = ["SPEC", "OptimizeOutcome", "optimize", "run_optimize_deck", "problem_of"]
 
 EXIT_OK, EXIT_FAILED = 0, 1
+#: methods whose every step is free of BLAS (their evaluations are the deterministic kernel's): the
+#: best design they evaluated is the same on every machine
+DETERMINISTIC = ("differential_evolution", "grid")
+
+
+def o_method(problem: Problem) -> str:
+    return problem.opts.method
 
 
 @dataclass
@@ -179,7 +186,12 @@ def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[
         scheduler = _configured_scheduler() or None
     with Evaluator(problem, njobs, journal, resumed, scheduler) as ev:
         mres = run_method(ev, history)
-    best = ev.best()
+    best = mres.best if mres.best is not None else (ev.best() if o_method(problem) in DETERMINISTIC else None)
+    if best is None and o_method(problem) not in DETERMINISTIC and mres.starts:
+        # no start settled on a feasible design: the best feasible design evaluated, on the lattice
+        cand = ev.best()
+        best = None if cand is None else ev.evaluate(problem.snap(cand.x)[None, :])[0]
+        best = best if best is not None and best.feasible else None
     check, result, params = None, None, None
     if best is not None:
         params = design_params(problem, np.array(best.x))

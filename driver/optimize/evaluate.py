@@ -151,6 +151,10 @@ class Record:
     margins: tuple[float, ...] = ()
     met: tuple[bool, ...] = ()
     why: str = ""                   # infeasibility reason (counted in the report)
+    tols: tuple[float, ...] = ()    # feasibility tolerance of each constraint (its units; 0: a condition)
+    values: tuple[float, ...] = ()  # left side of each numeric constraint (NaN for a condition)
+    signed: tuple[float, ...] = ()  # a - b of each numeric constraint (NaN for a condition)
+    terms: tuple[float, ...] = ()   # epigraph terms of the objective (Problem.terms), if any
 
 
 class Evaluator:
@@ -311,20 +315,42 @@ class Evaluator:
             if name not in frame:
                 frame[name] = np.nan
         f = _values(p.objective, frame)
-        margins, met = [], []
+        terms = [_values(t, frame) for t in p.terms]
+        ctol = p.opts.constraint_tol
+        margins, met, tols, lefts, diffs = [], [], [], [], []
+        nan = np.full(len(frame), math.nan)
         for c in p.constraints:
-            truth = c.whole.mask(frame)
-            if c.sense:
-                m = c.sense * (_values(c.left, frame) - _values(c.right, frame))
+            numeric = c.numeric
+            if numeric:
+                try:
+                    a, b = _values(c.left, frame), _values(c.right, frame)
+                except expr.ExprError:      # 'a == b' over text columns: a condition after all
+                    numeric = False
+            if numeric:
+                # met within constraint_tol x max(1, |a|, |b|): the scale of the constraint's own numbers
+                tol = ctol * np.fmax(1.0, np.fmax(np.abs(a), np.abs(b)))
+                m = -np.abs(a - b) if c.equality else c.sense * (a - b)
                 m = np.where(np.isnan(m), -math.inf, m)
+                truth = m >= -tol
+                tol = np.where(np.isfinite(tol), tol, 0.0)
+                left, diff = a, a - b
             else:
+                truth = c.whole.mask(frame)
                 m = np.where(truth, 0.0, -1.0)
+                tol, left, diff = np.zeros(len(frame)), nan, nan
             margins.append(m)
             met.append(truth)
+            tols.append(tol)
+            lefts.append(left)
+            diffs.append(diff)
         for i, r in enumerate(ok):
             r.objective = float(f[i])
+            r.terms = tuple(float(t[i]) for t in terms)
             r.margins = tuple(float(m[i]) for m in margins)
             r.met = tuple(bool(t[i]) for t in met)
+            r.tols = tuple(float(t[i]) for t in tols)
+            r.values = tuple(float(v[i]) for v in lefts)
+            r.signed = tuple(float(v[i]) for v in diffs)
             viol = [0.0 if t else (min(-m, FAILED_VIOLATION) if math.isfinite(m) and m < 0 else
                                    (1.0 if math.isfinite(m) else FAILED_VIOLATION))
                     for m, t in zip(r.margins, r.met)]
