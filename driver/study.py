@@ -36,7 +36,7 @@ if TYPE_CHECKING:   # annotations only: keeps `python -m driver --help` light
 if TYPE_CHECKING:
     import matplotlib.figure
 
-__all__ = ["Figure", "PLOT_FORMATS", "Result", "column_label", "keyword_run", "load_study", "plot_format",
+__all__ = ["Figure", "PLOT_FORMATS", "Result", "code_digest", "column_label", "keyword_run", "load_study", "plot_format",
            "study_names"]
 
 _CORE = {"cli", "limits", "deck", "study", "table", "export", "plotting", "atomic", "kernels", "sweep", "runner", "expr",
@@ -184,6 +184,35 @@ def load_study(group: str) -> ModuleType | None:
     if not (hasattr(module, "SPEC") and hasattr(module, "run")):
         return None
     return module
+
+
+def code_digest(module: ModuleType | None, *others: ModuleType | None) -> bytes:
+    """SHA-256 of the source of study ``module`` -- every ``.py`` file of its package when it
+    is one, so an edit to any module of the study counts -- of the other modules ``others``,
+    and of the compiled kernels.  Both kinds of sweep resume record (batch and per-case) carry
+    it in their signature: a record made by other code is redone, never believed."""
+    import hashlib
+    import sys
+
+    def files(mod: ModuleType | None) -> list[Path]:
+        path = getattr(mod, "__file__", None)
+        if not path:
+            return []
+        p = Path(path)
+        if p.name == "__init__.py":
+            return sorted(p.parent.rglob("*.py"))
+        return [p]
+
+    h = hashlib.sha256()
+    kernels = sys.modules.get("driver._kernels")
+    for mod in (module, *others, kernels):
+        for f in files(mod):
+            h.update(str(f.name).encode())
+            try:
+                h.update(f.read_bytes())
+            except OSError:
+                h.update(b"<unreadable>")
+    return h.digest()
 
 
 def study_names() -> list[str]:
