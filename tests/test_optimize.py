@@ -108,7 +108,7 @@ def _deck(tmp_path, body: str, study: str | None = None) -> Path:
 def test_local_methods_reach_the_closed_form(tmp_path, method):
     """mu_min of a crank-rocker = 45 deg: coupler r from r^2 - 2 s cos45 r + s^2 - (p - q)^2 = 0."""
     path = _deck(tmp_path, f"var1 = 'fourbar.coupler', lower1 = 10, upper1 = 20\n"
-                           f"minimize = '(mu_min_deg - 45)**2'\nmethod = '{method}', starts = 3")
+                           f"minimize = '(mu_min_deg - 45)**2'\nmethod = '{method}', starts = 3, tol = 1e-6")
     oc = optimize(path, tmp_path / "out", jobs=1)
     p, q, s = 12.0, 3.0, 9.0
     c = math.cos(math.radians(45))

@@ -431,12 +431,10 @@ def _verdict(p, runs: list[dict]) -> tuple[dict | None, list[dict]]:
     reached = [r for r in good if p.sense * (r["objective"] - top["objective"]) <= tol]
     for r in runs:
         r["reached"] = r in reached
-    # reported: the first start whose polished end is within polish_tol of the best one (equal
-    # lattice ends tie exactly; the first start wins)
-    fine = polish_tol(p, top["objective"])
-    first = min((r for r in reached if p.sense * (r["objective"] - top["objective"]) <= fine),
-                key=lambda r: r["start"])
-    return first, reached
+    # reported: the first start that reached the optimum.  Not the very best end: ends within tol
+    # of each other are equally optima at the stated precision, and which of them is best can
+    # follow the last bits (a start that stopped elsewhere on a tolerance band's ridge)
+    return min(reached, key=lambda r: r["start"]), reached
 
 
 def _local(ev: Evaluator, history: list[HistoryRow]) -> MethodResult:
