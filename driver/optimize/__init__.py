@@ -107,6 +107,10 @@ def _probe(problem: Problem) -> None:
     exprs += [(f"constraint{n}", c.whole) for n, c in zip(nums, problem.constraints)]
     for key, e in exprs:
         missing = [name for name in sorted(e.names) if name not in frame]
+        renamed = getattr(problem.study, "RENAMED", {})
+        if missing and missing[0] in renamed:
+            raise o.error(key, f"summary column '{missing[0]}' of &{problem.raw.name} is now "
+                               f"{renamed[missing[0]]}")
         if missing and clean:   # a clean run of the deck's design has every column its study writes
             raise o.error(key, f"unknown summary column '{missing[0]}' of &{problem.raw.name} "
                                f"(columns: {', '.join(frame.columns)})")
@@ -225,7 +229,7 @@ def _write(oc: OptimizeOutcome, stem: Path, params, formats: list[str], plot: bo
     evals.insert(1, "base", p.fingerprint())
     hist = report.history_frame(p, oc.history)
     text = report.report_text(p, ev, oc.method, oc.history, oc.best, oc.check, files,
-                              ev.jobs)
+                              ev.jobs, list(oc.study_result.warnings) if oc.study_result is not None else [])
     written.append(write_text(stem.with_name(stem.name + ".out"), text))
     written.append(write_tidy(hist, stem.with_name(stem.name + "_history"), "csv"))
     for fmt in dict.fromkeys(["parquet"] + formats):

@@ -37,6 +37,9 @@ __all__ = ["Evaluator", "evaluate_cases", "FAILED_VIOLATION"]
 
 #: constraint violation given to a design whose case failed (ranks below every evaluated design)
 FAILED_VIOLATION = 1e6
+#: violation of a design whose constraints are met but the study's own run refuses (ranks it just
+#: below the feasible designs, so the polish steps back to one the study accepts)
+REFUSED_VIOLATION = 1e-300
 #: objective given to failed designs in the local methods (which need a finite number)
 FAILED_OBJECTIVE = 1e12
 #: a batch of designs goes to worker processes (-j) when it is estimated to take longer than
@@ -361,6 +364,9 @@ class Evaluator:
             elif not all(r.met):
                 k = r.met.index(False)
                 r.why = f"violates constraint{_constraint_number(p, k)}"
+            elif r.reason:      # the study's own run refuses it (a batch row's verdict)
+                r.why = f"not a valid design: {_short(r.reason)}"
+                r.violation = max(r.violation, REFUSED_VIOLATION)
             r.feasible = not r.why
 
     # ------------------------------------------------------------------ views for the methods
@@ -421,11 +427,17 @@ def _batch_summaries(problem: Problem, xs: list[tuple[float, ...]]) -> list[tupl
     except DeckError:
         return None                     # some design is not a valid deck: case by case says which
     rows = frame.to_dict("records") if hasattr(frame, "to_dict") else list(frame)
+    # a design the study's own run refuses (DeckError case by case, e.g. an arm that cannot reach) is
+    # a batch row with a status: infeasible here too, so the optimum is a design the study accepts
+    refusal = getattr(problem.study, "batch_refusal", None)
     out = []
     for row in rows:
         row = {k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in row.items()}
         err = row.pop("error", None) or row.pop("case_error", None)
-        out.append(("failed", str(err), row) if err else ("ok", "", row))
+        why = refusal(row) if (refusal is not None and not err) else None
+        # the row keeps its summary (its margins stay smooth for a gradient method) and its reason:
+        # _score makes it infeasible
+        out.append(("failed", str(err), row) if err else ("ok", why or "", row))
     return out
 
 

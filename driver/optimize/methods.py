@@ -123,7 +123,7 @@ def _de_polish(ev: Evaluator, best, history: list[HistoryRow]) -> dict:
     runs, _, _ = _local_runs(ev, u0[None, :], history, "SLSQP", label="polish")
     r = runs[0]
     rec = r["record"]
-    word = "run"    # its own stopping message depends on the path (the BLAS kernel): in the JSON only
+    word = "from the best feasible member"   # SLSQP's own message follows the path (the BLAS kernel)
     if not rec.feasible:
         return {"record": None, "text": f"failed: SLSQP {word}; its lattice-polished end is infeasible "
                                         f"({rec.why}); the evolution's best member is reported"}
@@ -194,6 +194,9 @@ POLISH_LEVELS = (64, 16, 4, 1)
 POLISH_MOVES = 100
 #: up to this many variables the polish looks at all 3^n - 1 neighbours, beyond at the 2n compass ones
 POLISH_FULL_N = 4
+#: a polish stuck on an infeasible point searches the whole box of +-POLISH_BOX[n] steps around it
+#: (n variables: 25^2 - 1 = 624, 9^3 - 1 = 728 designs; not beyond 3 variables)
+POLISH_BOX = {1: 64, 2: 12, 3: 4}
 
 
 def _rank(p, r) -> tuple:
@@ -240,17 +243,31 @@ def lattice_polish(ev: Evaluator, x: np.ndarray, history: list[HistoryRow], labe
         dirs = [np.array(d, dtype=np.float64) for d in itertools.product((-1, 0, 1), repeat=n) if any(d)]
     else:                    # compass directions
         dirs = [sgn * np.eye(n)[i] for i in range(n) for sgn in (-1.0, 1.0)]
-    for m in POLISH_LEVELS:
-        for _ in range(POLISH_MOVES):
-            X = [p.snap(np.array(cur.x, dtype=np.float64) + m * h * d) for d in dirs]
-            recs = ev.evaluate(np.array(X))
-            top = min(recs, key=lambda r: _rank(p, r))     # min is stable: the first of equals
-            if _better(p, top, cur):
-                cur = top
+    def descend(cur, levels):
+        ok = True
+        for m in levels:
+            for _ in range(POLISH_MOVES):
+                X = [p.snap(np.array(cur.x, dtype=np.float64) + m * h * d) for d in dirs]
+                recs = ev.evaluate(np.array(X))
+                top = min(recs, key=lambda r: _rank(p, r))     # min is stable: the first of equals
+                if _better(p, top, cur):
+                    cur = top
+                else:
+                    break
             else:
-                break
-        else:
-            settled = False
+                ok = False
+        return cur, ok
+
+    cur, settled = descend(cur, POLISH_LEVELS)
+    if not cur.feasible and n in POLISH_BOX:
+        # stuck infeasible: a thin feasible wedge (an equality band against a bound) runs in a direction
+        # no single cube step follows; every lattice point of the box +-POLISH_BOX steps, in one batch
+        r = np.arange(-POLISH_BOX[n], POLISH_BOX[n] + 1, dtype=np.float64)
+        box = [np.array(d) for d in itertools.product(r, repeat=n) if any(d)]
+        recs = ev.evaluate(np.array([p.snap(np.array(cur.x, dtype=np.float64) + h * d) for d in box]))
+        top = min(recs, key=lambda q: _rank(p, q))
+        if _better(p, top, cur):
+            cur, settled = descend(top, (1,))
     _snapshot(ev, f"{label} lattice polish", history)
     return cur, settled
 
@@ -396,8 +413,7 @@ def _local_runs(ev: Evaluator, starts: np.ndarray, history: list[HistoryRow], me
         end = one(res.x)
         # the end and the best feasible design this start evaluated: the polish starts from the
         # better one (an iterate can beat the method's last point), on the lattice
-        near = end.feasible or (end.status == "ok" and end.tols and
-                                end.violation <= 100.0 * max(sum(end.tols), 1e-300))
+        near = end.feasible or _near(p, end)
         if near:    # feasible, or within a few tolerances of it: polished (restored first) on the lattice
             rec, settled = lattice_polish(ev, np.array(end.x), history, f"{label} {s}")
         else:       # far from feasible: not polished; its end follows the floating-point path
@@ -411,6 +427,23 @@ def _local_runs(ev: Evaluator, starts: np.ndarray, history: list[HistoryRow], me
         nfev += int(getattr(res, "nfev", 0))
         _snapshot(ev, f"{label} {s} end", history)
     return runs, nit, nfev
+
+
+def _near(p, r) -> bool:
+    """A method's end within a few tolerances of the constraints (conditions met; the objective may
+    be undefined there, e.g. just across a reach boundary): worth polishing back to feasibility."""
+    if r.status != "ok" or not r.margins:
+        return False
+    excess = 0.0
+    for c, m, t, ok in zip(p.constraints, r.margins, r.tols, r.met):
+        if not c.numeric:
+            if not ok:
+                return False
+            continue
+        if not math.isfinite(m):
+            return False
+        excess += max(0.0, -m - t)
+    return excess <= 100.0 * max(sum(r.tols), 1e-300)
 
 
 def objective_tol(p, best: float) -> float:

@@ -74,7 +74,8 @@ def x_text(p: Problem, i: int, v: float, on_lattice: bool) -> str:
 
 
 def report_text(p: Problem, ev: Evaluator, mres: MethodResult, history: list[HistoryRow],
-                best: Record | None, check: Record | None, files: list[str], jobs: int) -> str:
+                best: Record | None, check: Record | None, files: list[str], jobs: int,
+                warnings: list[str] | None = None) -> str:
     """The optimisation's .out file.
 
     Everything printed is the same on every machine (BLAS kernel, thread count, CPU): designs
@@ -125,6 +126,10 @@ def report_text(p: Problem, ev: Evaluator, mres: MethodResult, history: list[His
     L += render_table(cols, rows) + [""]
     status = "CONVERGED" if mres.converged else "NOT CONVERGED"
     L += [f"  Result: {status} -- {mres.message}"]
+    unsettled = [w for w in (warnings or []) if "not settled" in w.lower()]
+    if best is not None and unsettled:
+        L += ["    BUT NOT SETTLED: the optimum's full run has not settled (its values are those of a run "
+              "that needs more revolutions; see the warnings below)"]
     if best is None:
         least = ev.least_infeasible()
         L += ["    no feasible design was found; nothing is reported as an optimum."]
@@ -158,7 +163,8 @@ def report_text(p: Problem, ev: Evaluator, mres: MethodResult, history: list[His
               f"    {files[0] if files else ''}",
               f"    objective {_g(check.objective)}, feasible {_g(check.feasible)}, margins "
               + (", ".join(_g(m) for m in check.margins) or "-")
-              + ("  -- agrees with the evaluation" if same else "  -- DIFFERS from the evaluation"), ""]
+              + ("  -- agrees with the evaluation" if same else "  -- DIFFERS from the evaluation")]
+        L += [f"    warning: {w}" for w in (warnings or [])] + [""]
     if mres.starts:
         top = mres.best.objective if mres.best is not None else None
         L += ["  Local starts (where each ended follows the method's floating-point path: the _history table has it)",
