@@ -60,14 +60,22 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool | str, pro
                  if (sweep_options or {}).get(key) and not ({"sweep", "optimize"} & set(deck.groups))]
         if "synthesis" in deck.groups:
             from driver import synthesis
-            return synthesis.run_synthesis_deck(deck, outdir, formats, plot, progress, quiet)
+            return synthesis.run_synthesis_deck(deck, outdir, formats, plot, progress, quiet,
+                                                summary_json=summary_json)
         if "optimize" in deck.groups:
             from driver import optimize
-            return optimize.run_optimize_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))
+            return optimize.run_optimize_deck(deck, outdir, formats, plot, progress, quiet,
+                                              summary_json=summary_json, **(sweep_options or {}))
         if "sweep" in deck.groups:
             require("parquet")   # sweeps keep their cases in Parquet: say so before importing them
             from driver import sweep
-            return sweep.run_sweep_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))
+            rc = sweep.run_sweep_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))
+            if summary_json:
+                from driver.sweep.record import write_sweep_json
+                path_ = write_sweep_json(deck, outdir, rc)
+                if not quiet:
+                    print(f"wrote {path_}")
+            return rc
         outcome = run_study(deck, outdir, formats, plot, progress, summary_json=summary_json)
     except DeckError as exc:
         print(f"error: {exc}", file=sys.stderr)
@@ -191,7 +199,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--format", dest="formats", action="append", choices=FORMATS, default=[],
                         help="also write the tidy table in this format (repeatable)")
     parser.add_argument("--json", action="store_true",
-                        help="also write the run's summary (headline figures, warnings) as <stem>.json")
+                        help="also write the run's summary (headline figures, warnings) as <stem>.json; for an "
+                             "optimisation its result (x, fun, success, status, message, nit, nfev, constraints), "
+                             "for a synthesis its linkage and checks, for a sweep its cases and summary table")
     parser.add_argument("--plot", action="store_true", help="write figures <stem>_<name>.png (see --plot-format)")
     parser.add_argument("--plot-format", choices=PLOT_FORMATS, default=None,
                         help="figure file format (implies --plot; default png); the same inputs give "

@@ -142,3 +142,67 @@ def test_every_crank_rocker_start_reaches_the_optimum_of_the_shipped_deck(tmp_pa
     s = oc.check.summary
     assert abs(s["rocker_swing_deg"] - 60.0) <= 1e-7 * 60.0
     assert abs(s["time_ratio"] - 1.25) <= 1e-7 * 1.25
+
+
+def _crank_rocker_deck(tmp_path, swing: float, q: float):
+    path = tmp_path / "cr.dat"
+    path.write_text(f"&synthesis\n task = 'crank_rocker', swing_deg = {swing}, time_ratio = {q}\n fixed_link = 10.0\n/\n")
+    return path
+
+
+def _mu_deg(a: float, b: float, c: float, d: float) -> tuple[float, float]:
+    """Transmission-angle extremes of a crank-rocker by the law of cosines (crank along the ground)."""
+    mu = lambda x: math.degrees(math.acos((b * b + c * c - x * x) / (2 * b * c)))
+    return mu(d - a), mu(d + a)
+
+
+def _swing_deg(a: float, b: float, c: float, d: float) -> float:
+    """Rocker swing between the folded and extended dead centres (law of cosines at O_B)."""
+    ang = lambda x: math.acos((c * c + d * d - x * x) / (2 * c * d))
+    return math.degrees(ang(b + a) - ang(b - a))
+
+
+def test_time_ratio_one_has_no_interior_optimum_and_a_usable_member_is_returned(tmp_path):
+    from driver.synthesis import synthesise
+    syn = synthesise(_crank_rocker_deck(tmp_path, 30.0, 1.0))
+    assert syn.failure is None
+    assert any("no interior optimum" in w and "75.000000" in w for w in syn.warnings)   # 90 - swing/2
+    a, b, c, d = (syn.linkage[k] for k in ("crank", "coupler", "rocker", "fixed_link"))
+    assert min(a, b, c) >= 0.05 * d * (1 - 1e-9)                 # usable: every link >= 5 % of the ground
+    assert _swing_deg(a, b, c, d) == pytest.approx(30.0, abs=1e-6)
+    lo, hi = _mu_deg(a, b, c, d)
+    q = min(lo, 180 - hi)
+    assert 70.0 < q < 75.0                                         # below the limit, approaching it
+    assert "WARNING: no interior optimum" in syn.text
+
+
+@pytest.mark.parametrize("swing, q", [(60.0, 3.5), (170.0, 1.2)])
+def test_a_poor_best_transmission_angle_is_named(tmp_path, swing, q):
+    from driver.synthesis import synthesise
+    syn = synthesise(_crank_rocker_deck(tmp_path, swing, q))
+    a, b, c, d = (syn.linkage[k] for k in ("crank", "coupler", "rocker", "fixed_link"))
+    lo, hi = _mu_deg(a, b, c, d)
+    assert min(lo, 180 - hi) < 30.0                                # by hand: the design is poor
+    assert any(w.startswith("poor design: transmission angle") for w in syn.warnings)
+    assert "WARNING: poor design" in syn.text
+
+
+def test_json_records_of_optimisation_synthesis_and_sweep(tmp_path):
+    import json
+    from driver.cli import main
+    decks = [ROOT / "inputs" / n for n in ("optimize_manipulator_torque.dat", "synthesis_crank_rocker.dat",
+                                           "fourbar_paper_sweep.dat")]
+    assert main([*map(str, decks), "-o", str(tmp_path), "-q", "--json"]) == 0
+    opt = json.loads((tmp_path / "optimize_manipulator_torque.json").read_text())
+    assert opt["success"] is True and opt["status"] == 0 and opt["nfev"] > 0 and opt["nit"] > 0
+    assert opt["x_names"] == ["manipulator.designs_l1", "manipulator.designs_l2"]
+    l1, l2 = opt["x"]
+    eq = opt["constraints"][1]
+    assert eq["kind"] == "equality" and eq["met"] is True
+    assert eq["value"] == pytest.approx(l1 * l1 + l2 * l2, rel=1e-12)          # its left side, recomputed
+    assert abs(eq["value"] - 47.25) <= eq["tolerance"] == pytest.approx(1e-7 * 47.25)
+    assert eq["margin"] == pytest.approx(-abs(l1 * l1 + l2 * l2 - 47.25), abs=1e-12)
+    syn = json.loads((tmp_path / "synthesis_crank_rocker.json").read_text())
+    assert syn["ok"] is True and syn["linkage"]["crank"] == pytest.approx(4.126, abs=1e-3)
+    sw = json.loads((tmp_path / "fourbar_paper_sweep.json").read_text())
+    assert sw["kind"] == "sweep" and sw["rows"] == 4 and sw["swept_keys"] == ["fourbar.crank"]
