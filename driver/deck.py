@@ -657,6 +657,10 @@ def _coerce(kind: str, v: Any) -> tuple[Any, str | None]:
         return None, f"not a logical (.true./.false.): {v!r}"
     if kind == "str":
         if isinstance(v, str):
+            bad = next((ch for ch in v if not ch.isprintable()), None)
+            if bad is not None:   # ESC, NUL, line breaks: text from a deck is printed in tables
+                return None, (f"text holds the control character U+{ord(bad):04X} "
+                              f"({unicodedata.name(bad, 'control')}); text is printable characters only")
             return v, None
         return None, f"not a quoted string: {v!r}"
     raise AssertionError(kind)

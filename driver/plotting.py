@@ -14,6 +14,7 @@ import contextlib
 import functools
 import math
 import textwrap
+import warnings
 from pathlib import Path
 from typing import Any, Callable, Iterator, Sequence, TypeVar
 
@@ -28,7 +29,7 @@ from matplotlib.figure import Figure
 from driver.atomic import atomic_open
 from driver.study import PLOT_FORMATS, plot_format
 
-__all__ = ["STYLE", "style", "styled", "new_figure", "save_figure", "line_panels"]
+__all__ = ["STYLE", "style", "styled", "new_figure", "save_figure", "line_panels", "plain_text"]
 
 #: the house style, applied only inside :func:`style` (never written to the global rcParams)
 STYLE: dict[str, Any] = {"figure.dpi": 110, "savefig.dpi": 110, "axes.grid": True, "grid.alpha": 0.3,
@@ -37,10 +38,23 @@ STYLE: dict[str, Any] = {"figure.dpi": 110, "savefig.dpi": 110, "axes.grid": Tru
 _F = TypeVar("_F", bound=Callable[..., Any])
 
 
+def plain_text(text: Any) -> str:
+    """Text from a deck (a title, a design name, the deck's file name, a value, an expression)
+    as matplotlib draws it literally: never mathtext (every ``$`` escaped, so ``'$\\frac$'`` or
+    nested braces cannot raise a parse error), control characters dropped.  Every figure
+    builder passes deck text through this one function."""
+    text = "".join(ch for ch in str(text) if ch.isprintable() or ch == "\n")
+    return text.replace("$", r"\$")
+
+
 @contextlib.contextmanager
 def style(**overrides: Any) -> Iterator[None]:
-    """Draw inside this context to get the house style; rcParams are restored on exit."""
-    with matplotlib.rc_context({**STYLE, **overrides}):
+    """Draw inside this context to get the house style; rcParams are restored on exit.
+
+    matplotlib's warnings (a glyph missing from the font, identical axis limits) are dropped
+    here: they name package paths and say nothing a user of the tool can act on."""
+    with matplotlib.rc_context({**STYLE, **overrides}), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
         yield
 
 
@@ -100,7 +114,7 @@ def line_panels(x: np.ndarray, panels: Sequence[tuple[str, dict[str, np.ndarray]
             ax.legend(fontsize=7, loc="best")
     axes[-1].set_xlabel(xlabel)
     if title:
-        fig.suptitle(title)
+        fig.suptitle(plain_text(title))
     return fig
 
 
@@ -170,7 +184,7 @@ def fourbar_curves(exact, listing, title: str) -> Figure:
     for ax in axes:
         ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
     axes[-1].set_xlabel("crank angle [deg]")
-    fig.suptitle(f"{title}: four-bar kinematics")
+    fig.suptitle(f"{plain_text(title)}: four-bar kinematics")
     return fig
 
 
@@ -205,7 +219,7 @@ def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.nd
     ax.set_xlabel(f"x [{units}]")
     ax.set_ylabel(f"y [{units}]")
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
-    ax.set_title(f"{title}: linkage positions")
+    ax.set_title(f"{plain_text(title)}: linkage positions")
     return fig
 
 
@@ -271,7 +285,7 @@ def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, 
             ax.plot(*optima[key], mk, ms=5, mfc="none")
         ax.plot(l1, l2, "r*", ms=9, label="chosen designs")
         for name, a, b in zip(names, l1, l2):
-            ax.annotate(name, (a, b), textcoords="offset points", xytext=(4, 4), fontsize=7)
+            ax.annotate(plain_text(name), (a, b), textcoords="offset points", xytext=(4, 4), fontsize=7)
         ax.set_xlim(0, top)
         ax.set_ylim(0, top)
         ax.set_aspect("equal")
@@ -281,7 +295,7 @@ def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, 
     axes[1].set_title("RI2 over the design plane")
     fig.legend(*axes[0].get_legend_handles_labels(), fontsize=7, loc="outside lower center", ncol=4, frameon=False)
     if title:
-        fig.suptitle(title)
+        fig.suptitle(plain_text(title))
     return fig
 
 
@@ -305,7 +319,7 @@ def manipulator_torque_crob(l1: np.ndarray, tau1: np.ndarray, tau2: np.ndarray, 
     ax.set_ylabel("motor torque [N m]")
     ax.set_xlabel("l1 [m]  (l2 = sqrt(%g - l1^2) [m])" % c)
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
-    fig.suptitle(f"{title}: motor torques along C_rob" if title else "Motor torques along C_rob")
+    fig.suptitle(f"{plain_text(title)}: motor torques along C_rob" if title else "Motor torques along C_rob")
     return fig
 
 
@@ -339,7 +353,7 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
     """
     import pandas as pd
     labels = labels or {}
-    label = lambda c: textwrap.fill(labels.get(c, c), 28)  # noqa: E731  (two lines fit a panel)
+    label = lambda c: plain_text(textwrap.fill(labels.get(c, c), 28))  # noqa: E731  (two lines fit a panel)
     x = x or next((k for k in keys if pd.api.types.is_numeric_dtype(frame[k])), "case")
     if ys:
         ys = list(ys)
@@ -370,8 +384,8 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
             g = g.sort_values(x)
             style = "-" if len(frame) <= 2000 else ""
             ax.plot(g[x], g[y], style, marker="o" if len(frame) <= 200 else ".", ms=3, lw=1,
-                    label=", ".join(f"{labels.get(k, k).split(' [')[0]} = {v}"
-                                    for k, v in zip(others, key if isinstance(key, tuple) else (key,))) or None)
+                    label=plain_text(", ".join(f"{labels.get(k, k).split(' [')[0]} = {v}"
+                                    for k, v in zip(others, key if isinstance(key, tuple) else (key,)))) or None)
         if not kept.all():
             ax.plot(frame.loc[kept, x], frame.loc[kept, y], "o", ms=4, mfc="none", color="k", label="kept")
         ax.set_ylabel(label(y))
@@ -379,7 +393,7 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
         axes[0].legend(fontsize=7, ncol=min(3, max(1, len(frame.groupby(others)) if others else 1)),
                        loc="lower left", bbox_to_anchor=(0.0, 1.02), frameon=False)
     axes[-1].set_xlabel(label(x))
-    fig.suptitle(f"{title}: sweep summary" if title else "sweep summary")
+    fig.suptitle(f"{plain_text(title)}: sweep summary" if title else "sweep summary")
     return fig
 
 
@@ -437,7 +451,7 @@ def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.
         ax.set_xlim(0.0, 360.0)
         ax.set_xticks(np.arange(0, 361, 45))
         fig.legend(loc="outside lower center", fontsize=7, ncol=2, frameon=False)
-    fig.suptitle(f"{title}: Hooke-joint chain, input and output shaft speed" if title
+    fig.suptitle(f"{plain_text(title)}: Hooke-joint chain, input and output shaft speed" if title
                  else "Hooke-joint chain: input and output shaft speed")
     return fig
 
@@ -473,7 +487,7 @@ def slidercrank_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray
     ax.set_ylabel(ylabel)
     fig.legend(fontsize=7, loc="outside lower center", ncol=3 if len(series) + len(missing) > 4 else 2,
                frameon=False, title="crank speed", title_fontsize=7)
-    ax.set_title(title)
+    ax.set_title(plain_text(title))
     return fig
 
 
@@ -491,5 +505,5 @@ def slidercrank_convergence_figure(series: dict[str, tuple[list[int], list[float
     axes[1].set_ylabel("change from previous count [%]")
     axes[1].set_xlabel("number of elements")
     axes[0].legend(fontsize=7)
-    fig.suptitle(title)
+    fig.suptitle(plain_text(title))
     return fig

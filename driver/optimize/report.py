@@ -174,7 +174,7 @@ def convergence_figure(p: Problem, history: pd.DataFrame, evals: pd.DataFrame, t
         if len(h):
             ax.step(h["evals"], h["objective"], where="post", color="C3", lw=1.5, label="best so far")
         ax.set_xlabel("designs evaluated")
-        ax.set_ylabel(column_label(p.study, p.objective.text))   # words and units when it is one summary column
+        ax.set_ylabel(plotting.plain_text(column_label(p.study, p.objective.text)))   # deck text: never mathtext
         ax.legend(fontsize=7)
-        ax.set_title(f"{title}: {p.objective_text}", fontsize=9)
+        ax.set_title(plotting.plain_text(f"{title}: {p.objective_text}"), fontsize=9)
     return fig
