@@ -392,3 +392,20 @@ def test_degenerate_syntheses_are_deck_errors(tmp_path, capsys, change, key):
     text = (INPUTS / "synthesis_function_log.dat").read_text().replace(*change)
     line = next(i for i, l in enumerate(text.splitlines(), 1) if change[1] in l)
     _refused(tmp_path, capsys, text, line, key)
+
+
+def test_unknown_keys_refused_before_the_namelist_reader(monkeypatch):
+    """A group of 12 000 unknown keys: refused in the pre-scan, linear in the deck's size (the
+    namelist library's work grows with the square of a group's keys: it is never reached)."""
+    import driver.deck as deck_module
+
+    def never(text):
+        raise AssertionError("f90nml reached")
+    monkeypatch.setattr(deck_module, "_f90nml_reads", never)
+    keys = "".join(f"  k{i} = 1\n" for i in range(12_000))
+    with pytest.raises(DeckError, match="unknown key in &fourbar") as exc:
+        read_deck("big.dat", text="&fourbar\n  fixed_link = 12, crank = 5, coupler = 15, rocker = 9\n" + keys + "/\n")
+    assert (exc.value.line, exc.value.key) == (3, "k0")
+    with pytest.raises(DeckError, match="more than 200 keys") as exc:
+        read_deck("big.dat", text="&nosuchgroup\n" + keys + "/\n")
+    assert exc.value.line == 202
