@@ -2,7 +2,7 @@
 
 A deck may name a computation over a table's columns, e.g. a sweep's ``keep`` filter::
 
-    keep = 'meets_band_40_120 and rocker_swing_deg >= 60 and abs(mu_min_deg - 45) < 10'
+    keep = 'meets_transmission_band and rocker_swing_deg >= 60 and abs(mu_min_deg - 45) < 10'
 
 The text is parsed with :mod:`ast` and checked against a whitelist; nothing in it is ever
 evaluated by Python.  Allowed:

@@ -13,14 +13,14 @@ FRAME = pd.DataFrame({
     "fourbar.crank": [2.0, 3.0, 4.0, 5.0],
     "mu_min_deg": [40.5, 35.9, 30.1, 25.0],
     "rocker_swing_deg": [61.0, 59.0, 70.0, None],
-    "meets_band_40_120": [True, False, False, None],
+    "meets_transmission_band": [True, False, False, None],
     "grashof_class": ["crank-rocker", "crank-rocker", "double-rocker", None],
     "n": [1, 2, 3, 4],
 })
 
 
 @pytest.mark.parametrize("text, expected", [
-    ("meets_band_40_120 and rocker_swing_deg >= 60", [True, False, False, False]),
+    ("meets_transmission_band and rocker_swing_deg >= 60", [True, False, False, False]),
     ("rocker_swing_deg >= 60", [True, False, True, False]),          # None is missing: false
     ("not rocker_swing_deg >= 60", [False, True, False, True]),
     ("`fourbar.crank` > 2 and fourbar.crank < 5", [False, True, True, False]),

@@ -5,7 +5,7 @@
       key1 = 'fourbar.crank',   values1 = 2, 3, 4, 5          ! a list ...
       key2 = 'fourbar.coupler', start2 = 14, stop2 = 16, count2 = 3   ! ... or start/stop/count
       zip  = .false.            ! .false.: full grid; .true.: keys varied together
-      keep = 'meets_band_40_120 and rocker_swing_deg > 60'   ! optional filter on the summary
+      keep = 'meets_transmission_band and rocker_swing_deg > 60'   ! optional filter on the summary
       case_outputs = 'all'      ! per-case files for 'all', 'kept' or 'none' of the cases
     /
 
