@@ -435,7 +435,8 @@ def compare_decks(decks: list[Path], out=None) -> int:
     out = sys.stdout if out is None else out
     if not published.PUBLISHED_DIR.is_dir():
         print(f"error: the published tables are not installed ({published.PUBLISHED_DIR} is missing); "
-              "--compare needs the source tree (pip install -e .)", file=sys.stderr)
+              "the install is incomplete: reinstall it (pip install --force-reinstall PATH-TO-THE-SOURCE-OR-WHEEL; "
+              "in a clone: bash .ci/setup)", file=sys.stderr)
         return 1
     status, done = 0, []
     for deck in decks:
@@ -454,8 +455,11 @@ def compare_decks(decks: list[Path], out=None) -> int:
         if not c.ok:
             status = max(status, 1)
     if len(done) > 1:
+        totals = totals_text(done)
         print("Total", file=out)
-        print("\n".join(totals_text(done)), file=out)
+        print("\n".join(totals) if totals else
+              f"  no published cells among these {len(done)} decks (sweep, optimisation and synthesis decks "
+              "have none: compare the single-case decks a sweep writes instead)", file=out)
     return status
 
 
