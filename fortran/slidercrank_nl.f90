@@ -8,9 +8,11 @@
 !> as the linear KED model (fortran/slidercrank.f90, docs/slidercrank.md): nodal (u, v, th)
 !> are displacements from the rigid configuration in the rod frame (x along A->C), the
 !> crank pin has u = v = 0, the slider node moves on the guide (u_n = cos(th3) U_X,
-!> v_n = -sin(th3) U_X) with the slider mass on U_X, Rayleigh damping C = alpha M + beta K0
-!> (K0 the linear stiffness), load Q = -M u_r'' - msl A_h e_X.  Only the elastic forces
-!> differ: each element's internal force and tangent come from the co-rotational
+!> v_n = -sin(th3) U_X) with the slider mass on U_X, Rayleigh damping alpha M + beta K, load
+!> Q = -M u_r'' - msl A_h e_X.  The elastic forces differ, and so does the stiffness-
+!> proportional damping, which acts on each element's deformation rates (co-rotational,
+!> beta B^T K_l B p'; the linear model's beta K0 q' would damp the finite rotations of a
+!> buckled rod's elements, docs/slidercrank.md): each element's internal force and tangent come from the co-rotational
 !> formulation (Crisfield 1991, ch. 7): the element chord from node a at (s_a + u_a, v_a)
 !> to node b has length l and angle beta; local deformations
 !>   ubar = l - le,  th1 = th_a - beta,  th2 = th_b - beta,
@@ -23,9 +25,11 @@
 !>
 !> Time step t_n -> t_n+1, HHT-alpha with parameter a in [-1/3, 0] (a = 0: Newmark average
 !> acceleration, the linear model's rule): solve for q
-!>   R(q) = M qdd + (1 + a) [C qd + f_int(q) - Q(t_n+1)] - a [C qd_n + f_int(q_n) - Q(t_n)] = 0,
+!>   R(q) = M qdd + (1 + a) [alpha M qd + f(q, qd) - Q(t_n+1)] - a [same at t_n] = 0,
+!>   f = f_int + the damping force of the deformation rates,
 !>   Newmark beta_N = (1 - a)^2/4, gamma = 1/2 - a relating qdd, qd to q,
-!> by Newton with S = M/(beta_N h^2) + (1 + a) [gamma/(beta_N h) C + K_T(q)].  a < 0 damps the
+!> by Newton with S = (1/(beta_N h^2) + (1 + a) gamma alpha/(beta_N h)) M
+!>   + (1 + a) [K_T(q) + gamma beta/(beta_N h) B^T K_l B].  a < 0 damps the
 !> unresolved high frequencies (axial waves, the nearly massless end rotations) that the
 !> average-acceleration rule keeps forever and the nonlinear coupling can feed.  Converged when
 !> ||R||_2 <= tol (||Q||_2 + ||f_int||_2 + EI/L^2).  A step whose Newton iteration fails
@@ -52,8 +56,21 @@ contains
     real(dp), intent(in) :: le, ea, ei, p(6)
     logical, intent(in) :: want_k
     real(dp), intent(out) :: f(6), kt(6, 6), eps, kap, en
+    call element_corot_d(le, ea, ei, p, [0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp], 0.0_dp, 0.0_dp, &
+                         want_k, f, kt, eps, kap, en)
+  end subroutine element_corot
+
+  !> element_corot with stiffness-proportional damping of the element's deformation rates:
+  !> f adds bd B^T K_l B pd for the nodal velocities pd (rod frame) -- the co-rotational form
+  !> of beta K0 q', which damps stretching and bending but not the element's rotation -- and kt
+  !> adds cd B^T K_l B (cd = bd dpd/dp of the time rule; the variation of B with p in the
+  !> damping force, O(rates), is left out of the tangent).
+  pure subroutine element_corot_d(le, ea, ei, p, pd, bd, cd, want_k, f, kt, eps, kap, en)
+    real(dp), intent(in) :: le, ea, ei, p(6), pd(6), bd, cd
+    logical, intent(in) :: want_k
+    real(dp), intent(out) :: f(6), kt(6, 6), eps, kap, en
     real(dp) :: dx, dy, l, ubar, c, s, beta, t1, t2, n, m1, m2, r(6), z(6), b2(6), b3(6)
-    real(dp) :: g, ka, kb, nl, k22, k23, k33
+    real(dp) :: g, ka, kb, nl, k23, d1, d2, d3, cm
     integer :: i, j
     dx = le + p(4) - p(1)
     dy = p(5) - p(2)
@@ -79,21 +96,44 @@ contains
     b3 = b2
     b2(3) = 1
     b3(6) = 1
+    if (bd /= 0) then                ! deformation rates D = B pd, damping stresses bd K_l D
+      d1 = dot_product(r, pd)
+      d2 = dot_product(b2, pd)
+      d3 = dot_product(b3, pd)
+      n = n + bd*ka*d1
+      m1 = m1 + bd*kb*(4*d2 + 2*d3)
+      m2 = m2 + bd*kb*(2*d2 + 4*d3)
+    end if
     f = n*r + m1*b2 + m2*b3
     kt = 0
     if (.not. want_k) return
+    ka = (1 + cd)*ka                 ! material part (1 + cd) B^T K_l B; geometric part from N, M1 + M2
+    cm = (1 + cd)*kb
+    ! K_T = B^T K_l B + N/l z z^T + g (r z^T + z r^T), written out with r and z zero on the
+    ! rotations: translations ka r r^T + (12 kb/l^2 + N/l) z z^T + g (r z^T + z r^T); rotation
+    ! columns -6 kb/l z + kb (4 e3 + 2 e6) and -6 kb/l z + kb (2 e3 + 4 e6).  Lower triangle
+    ! only (the assembly reads i >= j).
     g = (m1 + m2)/(l*l)
-    nl = n/l
-    k22 = 4*kb
-    k23 = 2*kb
-    k33 = 4*kb
-    do j = 1, 6                      ! lower triangle: the assembly reads i >= j only
-      do i = j, 6
-        kt(i, j) = ka*r(i)*r(j) + k22*b2(i)*b2(j) + k23*(b2(i)*b3(j) + b3(i)*b2(j)) + k33*b3(i)*b3(j) &
-                   + nl*z(i)*z(j) + g*(r(i)*z(j) + z(i)*r(j))
+    nl = n/l + 12*cm/(l*l)
+    k23 = -6*cm/l
+    do j = 1, 5
+      if (j == 3) cycle
+      do i = j, 5
+        if (i == 3) cycle
+        kt(i, j) = ka*r(i)*r(j) + nl*z(i)*z(j) + g*(r(i)*z(j) + z(i)*r(j))
       end do
     end do
-  end subroutine element_corot
+    kt(3, 1) = k23*z(1)
+    kt(3, 2) = k23*z(2)
+    kt(4, 3) = k23*z(4)
+    kt(5, 3) = k23*z(5)
+    do i = 1, 5
+      if (i /= 3) kt(6, i) = k23*z(i)
+    end do
+    kt(3, 3) = 4*cm
+    kt(6, 6) = 4*cm
+    kt(6, 3) = 2*cm
+  end subroutine element_corot_d
 
   !> Element displacements p(6) of element e from q (crank pin u = v = 0, slider node
   !> u = c3 U_X, v = -s3 U_X).
@@ -143,35 +183,48 @@ contains
     end do
   end subroutine element_map_p
 
-  !> Internal force fint(nq) and, if want_k, the tangent added into the band ab (lower,
-  !> kd = 5); also the total strain energy [J].  Interior elements (2 .. nel-1) map onto
+  !> Internal force fint(nq), with the co-rotational stiffness-proportional damping force of the
+  !> rates qd (coefficient bd [s]; the slider node's rod-frame rate includes the frame's turn at
+  !> th3d [rad/s]), and, if want_k, the tangent (cd weighting the damping part) added into the
+  !> band ab (lower, kd = 5) times kscale; also the total strain energy [J] and each element's axial strain epse and mean
+  !> curvature kape [1/m].  Interior elements (2 .. nel-1) map onto
   !> six consecutive q entries 3e-4 .. 3e+1 with unit coefficients; the two end elements go
   !> through element_map_p.
-  subroutine internal_forces(nel, nq, q, c3, s3, le, ea, ei, want_k, fint, ab, energy)
+  subroutine internal_forces(nel, nq, q, qd, th3d, bd, cd, c3, s3, le, ea, ei, want_k, kscale, fint, ab, &
+                             energy, epse, kape)
     integer, intent(in) :: nel, nq
-    real(dp), intent(in) :: q(nq), c3, s3, le, ea, ei
+    real(dp), intent(in) :: q(nq), qd(nq), th3d, bd, cd, c3, s3, le, ea, ei, kscale
     logical, intent(in) :: want_k
-    real(dp), intent(out) :: fint(nq), energy
+    real(dp), intent(out) :: fint(nq), energy, epse(nel), kape(nel)
     real(dp), intent(inout) :: ab(kd + 1, nq)
-    real(dp) :: p(6), cf(6), f(6), kt(6, 6), eps, kap, en
+    real(dp) :: p(6), pd(6), cf(6), f(6), kt(6, 6), eps, kap, en
     integer :: e, a, b, idx(6), o
     fint = 0
     energy = 0
     do e = 2, nel - 1
       o = 3*e - 5                       ! q index of the element's first entry, minus one
-      call element_corot(le, ea, ei, q(o + 1:o + 6), want_k, f, kt, eps, kap, en)
+      call element_corot_d(le, ea, ei, q(o + 1:o + 6), qd(o + 1:o + 6), bd, cd, want_k, f, kt, eps, kap, en)
+      epse(e) = eps
+      kape(e) = kap
       energy = energy + en
       fint(o + 1:o + 6) = fint(o + 1:o + 6) + f
       if (.not. want_k) cycle
       do b = 1, 6
         do a = b, 6
-          ab(1 + a - b, o + b) = ab(1 + a - b, o + b) + kt(a, b)
+          ab(1 + a - b, o + b) = ab(1 + a - b, o + b) + kscale*kt(a, b)
         end do
       end do
     end do
     do e = 1, nel, nel - 1
       call gather(e, nel, nq, q, c3, s3, p, idx, cf)
-      call element_corot(le, ea, ei, p, want_k, f, kt, eps, kap, en)
+      call gather(e, nel, nq, qd, c3, s3, pd, idx, cf)
+      if (e == nel) then               ! the slider node moves in the turning rod frame at fixed U_X too
+        pd(4) = pd(4) - s3*th3d*q(nq)
+        pd(5) = pd(5) - c3*th3d*q(nq)
+      end if
+      call element_corot_d(le, ea, ei, p, pd, bd, cd, want_k, f, kt, eps, kap, en)
+      epse(e) = eps
+      kape(e) = kap
       do b = 2, 6                     ! full matrix: the slider node's map reorders entries
         do a = 1, b - 1
           kt(a, b) = kt(b, a)
@@ -186,32 +239,11 @@ contains
         if (idx(b) == 0) cycle
         do a = 1, 6
           if (idx(a) == 0 .or. idx(a) < idx(b)) cycle
-          ab(1 + idx(a) - idx(b), idx(b)) = ab(1 + idx(a) - idx(b), idx(b)) + cf(a)*cf(b)*kt(a, b)
+          ab(1 + idx(a) - idx(b), idx(b)) = ab(1 + idx(a) - idx(b), idx(b)) + kscale*cf(a)*cf(b)*kt(a, b)
         end do
       end do
     end do
   end subroutine internal_forces
-
-  !> Adds scale * T^T Ke (Tdot q) to r: the stiffness-proportional damping of the slider node's
-  !> rod-frame velocity that comes from the rod frame turning, d/dt (c3, -s3) U_X at fixed U_X =
-  !> th3' (-s3, -c3) U_X.  T q' alone misses it; it is negligible in the linear model (U_X ~ the
-  !> rod's elongation) but not once a buckled rod pulls the slider in by millimetres, where
-  !> K0 ~ EI/le^3 would turn the missing rate into a spurious force that grows with the mesh.
-  !> (Left out of the Newton matrix: its column is U_X alone, unsymmetric, and O(th3' h) of the
-  !> damping term there.)
-  subroutine frame_rate_damping(nel, nq, q, c3, s3, th3d, ke, scale, r)
-    integer, intent(in) :: nel, nq
-    real(dp), intent(in) :: q(nq), c3, s3, th3d, ke(6, 6), scale
-    real(dp), intent(inout) :: r(nq)
-    real(dp) :: du, dv, cf(6)
-    integer :: a, idx(6)
-    du = -s3*th3d*q(nq)
-    dv = -c3*th3d*q(nq)
-    call element_map_p(nel, nel, c3, s3, idx, cf)
-    do a = 1, 6
-      if (idx(a) /= 0) r(idx(a)) = r(idx(a)) + scale*cf(a)*(ke(a, 4)*du + ke(a, 5)*dv)
-    end do
-  end subroutine frame_rate_damping
 
   !> Banded (lower) assembly of sum_e T^T (cm me + ck ke) T + cm msl e_X e_X^T.
   subroutine assemble_linear(nel, nq, me, ke, cm, ck, msl, c3, s3, ab)
@@ -235,20 +267,19 @@ contains
     ab(1, nq) = ab(1, nq) + cm*msl
   end subroutine assemble_linear
 
-  !> Element strains, lateral deflections from the chord A-C and the slider-node values.
-  !> eps(nel) axial strain, eof(nel) outer-fibre strain |eps| + c |kappa|, lat(0:nel) nodal
-  !> lateral deflection from the chord [m].
-  subroutine measures(nel, nq, q, c3, s3, le, ea, ei, half_depth, eps, eof, lat)
+  !> Element strains and lateral deflections from the chord A-C, from the element strains epse
+  !> and curvatures kape of internal_forces at q: eps(nel) axial strain, eof(nel) outer-fibre
+  !> strain |eps| + c |kappa|, lat(0:nel) nodal lateral deflection from the chord [m].
+  subroutine measures(nel, nq, q, c3, s3, le, half_depth, epse, kape, eps, eof, lat)
     integer, intent(in) :: nel, nq
-    real(dp), intent(in) :: q(nq), c3, s3, le, ea, ei, half_depth
+    real(dp), intent(in) :: q(nq), c3, s3, le, half_depth, epse(nel), kape(nel)
     real(dp), intent(out) :: eps(nel), eof(nel), lat(0:nel)
-    real(dp) :: p(6), cf(6), f(6), kt(6, 6), ep, kap, en, xn, yn, ln, cc, ss
-    integer :: e, idx(6)
+    real(dp) :: xn, yn, ln, cc, ss
+    integer :: e
+    eps = epse
+    ! hot-loop: slidercrank_nl outer-fibre strain
     do e = 1, nel
-      call gather(e, nel, nq, q, c3, s3, p, idx, cf)
-      call element_corot(le, ea, ei, p, .false., f, kt, ep, kap, en)
-      eps(e) = ep
-      eof(e) = abs(ep) + half_depth*abs(kap)
+      eof(e) = abs(epse(e)) + half_depth*abs(kape(e))
     end do
     xn = nel*le + c3*q(nq)
     yn = -s3*q(nq)
@@ -317,7 +348,7 @@ contains
     integer, intent(out) :: shape_step(2), stats(5), status, fail_step, fail_iter
 
     real(dp), allocatable :: q(:), qd(:), qdd(:), qn(:), qdn(:), qddn(:), fint(:), r(:), w1(:), w2(:)
-    real(dp), allocatable :: qprev(:), gn(:), gnew(:), gsave(:)
+    real(dp), allocatable :: qprev(:), gn(:), gnew(:), gsave(:), epse(:), kape(:), epsx(:), kapx(:)
     real(dp), allocatable :: ab(:, :), ab0(:, :), qm(:), zero(:), qs(:), eps(:), eof(:), lat(:)
     real(dp) :: me(6, 6), ke(6, 6), kg1(6, 6), kin(7), nb(nel), le, t, tn, h, a0, a1, a2, cm, ck
     real(dp) :: en, ekin, wext, wdamp, wold, best_lat, best_cmp, lv, rref, rnorm, c3, s3, kmax, hprev
@@ -342,7 +373,7 @@ contains
     nb = 0
     mid_node = nel/2
     allocate (q(nq), qd(nq), qdd(nq), qn(nq), qdn(nq), qddn(nq), fint(nq), r(nq), w1(nq), w2(nq))
-    allocate (qprev(nq), gn(nq), gnew(nq), gsave(nq))
+    allocate (qprev(nq), gn(nq), gnew(nq), gsave(nq), epse(nel), kape(nel), epsx(nel), kapx(nel))
     allocate (ab(kd + 1, nq), ab0(kd + 1, nq), qm(nq), zero(nq), qs(nq), eps(nel), eof(nel), lat(0:nel))
     zero = 0
     call element_matrices(le, rhoa, ea, ei, me, ke, kg1)
@@ -369,13 +400,13 @@ contains
         status = nl_not_spd; fail_step = 0; return
       end if
     end if
-    ! qdd from the equation of motion: M qdd = Q - C qd - f_int(q)
+    ! qdd from the equation of motion: M qdd = Q - alpha M qd - f_int(q, qd) (with damping)
     call rigid_kin(0.0_dp, omega, r2, rl, kin)
     c3 = cos(kin(1)); s3 = sin(kin(1))
     w1 = -alpha*qd
-    w2 = -beta*qd
-    call apply_ops(nel, nq, w1, w2, zero, .false., 1.0_dp, kin, le, me, ke, kg1, nb, msl, r)
-    call internal_forces(nel, nq, q, c3, s3, le, ea, ei, .false., fint, ab, en)
+    call apply_ops(nel, nq, w1, zero, zero, .false., 1.0_dp, kin, le, me, ke, kg1, nb, msl, r)
+    call internal_forces(nel, nq, q, qd, kin(2), beta, 0.0_dp, c3, s3, le, ea, ei, .false., 1.0_dp, fint, ab, &
+                         en, epse, kape)
     qdd = r - fint
     call assemble_linear(nel, nq, me, ke, 1.0_dp, 0.0_dp, msl, c3, s3, ab)
     call band_cholesky(nq, ab, info)
@@ -434,9 +465,9 @@ contains
       if (status /= nl_ok) exit
       call rigid_kin(omega*k*dt, omega, r2, rl, kin)
       c3 = cos(kin(1)); s3 = sin(kin(1))
-      call measures(nel, nq, q, c3, s3, le, ea, ei, half_depth, eps, eof, lat)
+      call measures(nel, nq, q, c3, s3, le, half_depth, epse, kape, eps, eof, lat)
       lv = maxval(abs(lat))
-      if (.not. (lv <= rl/4) .or. any(q /= q)) then
+      if (.not. (lv <= rl/2) .or. any(q /= q)) then
         status = nl_limit
         fail_step = k
         exit
@@ -445,7 +476,8 @@ contains
       rev_lat(revi) = max(rev_lat(revi), lv)
       rev_eps(revi) = max(rev_eps(revi), maxval(abs(eps)))
       if (k >= rec_start .and. k < rec_start + nrec) then
-        if (want_energy /= 0) call internal_forces(nel, nq, q, c3, s3, le, ea, ei, .false., fint, ab, en)
+        if (want_energy /= 0) call internal_forces(nel, nq, q, zero, 0.0_dp, 0.0_dp, 0.0_dp, c3, s3, le, ea, ei, &
+                                                   .false., 1.0_dp, fint, ab, en, epsx, kapx)
         call record(k - rec_start + 1, k, q, c3, s3, kin, en)
       end if
       stats(5) = k
@@ -461,6 +493,7 @@ contains
       integer, intent(out) :: nit
       real(dp) :: kt_(7), cc, ss, e_, qnorm
       integer :: jj, inf
+      logical :: first
       success = .false.
       nit = 0
       call rigid_kin(omega*tt, omega, r2, rl, kt_)
@@ -470,8 +503,8 @@ contains
       a0 = 1/(bn*hh**2)
       a1 = gn_/(bn*hh)
       cm = a0 + (1 + hht)*a1*alpha
-      ck = (1 + hht)*a1*beta
-      call assemble_linear(nel, nq, me, ke, cm, ck, msl, cc, ss, ab0)
+      ck = a1*beta                    ! weight of the damping tangent B^T K_l B (times 1 + a below)
+      call assemble_linear(nel, nq, me, ke, cm, 0.0_dp, msl, cc, ss, ab0)
       ! predictor: secant extrapolation of the displacements, q_n + (h/h_prev)(q_n - q_n-1)
       ! (displacements are smooth; rates and accelerations of the end rotations, which carry
       ! almost no inertia, are not)
@@ -481,13 +514,20 @@ contains
       end do
       call apply_ops(nel, nq, zero, zero, zero, .false., 1.0_dp, kt_, le, me, ke, kg1, nb, msl, r)
       qnorm = sqrt(dot_product(r, r))
+      first = .true.
       do
-        call newmark_rates(nq, q, qn, qdn, qddn, bn, gn_, hh, (1 + hht)*alpha, (1 + hht)*beta, qdd, qd, w1, w2)
-        ! r = M (qdd + (1+a) alpha qd) + (1+a) beta K0 qd - (1+a) Q + (1+a) f(q) - a g_n,
-        ! g_n = C qd_n + f(q_n) - Q_n (apply_ops' load scales -Q)
-        call apply_ops(nel, nq, w1, w2, zero, .false., -(1 + hht), kt_, le, me, ke, kg1, nb, msl, r)
-        call frame_rate_damping(nel, nq, q, cc, ss, kt_(2), ke, (1 + hht)*beta, r)
-        call internal_forces(nel, nq, q, cc, ss, le, ea, ei, .false., fint, ab, e_)
+        call newmark_rates(nq, q, qn, qdn, qddn, bn, gn_, hh, (1 + hht)*alpha, 0.0_dp, qdd, qd, w1, w2)
+        ! r = M (qdd + (1+a) alpha qd) - (1+a) Q + (1+a) f(q, qd) - a g_n, f with the damping of
+        ! the deformation rates, g_n = alpha M qd_n + f(q_n, qd_n) - Q_n (apply_ops' load scales -Q)
+        call apply_ops(nel, nq, w1, zero, zero, .false., -(1 + hht), kt_, le, me, ke, kg1, nb, msl, r)
+        if (first) then               ! the predictor rarely converges: force and tangent at once
+          ab = ab0
+          call internal_forces(nel, nq, q, qd, kt_(2), beta, ck, cc, ss, le, ea, ei, .true., 1 + hht, fint, ab, &
+                               e_, epse, kape)
+        else
+          call internal_forces(nel, nq, q, qd, kt_(2), beta, ck, cc, ss, le, ea, ei, .false., 1.0_dp, fint, ab, &
+                               e_, epse, kape)
+        end if
         ! tolerance, and the round-off floor of a residual whose stiffest rows (12 EI/le^3,
         ! EA/le) multiply displacements of size max|q|
         rref = max(tol*(qnorm + sqrt(dot_product(fint, fint)) + ei/rl**2), &
@@ -497,9 +537,12 @@ contains
         if (.not. (rnorm == rnorm) .or. any(q /= q)) return
         if (rnorm <= rref) exit
         if (nit >= maxit) return
-        ab = 0
-        call internal_forces(nel, nq, q, cc, ss, le, ea, ei, .true., fint, ab, e_)
-        ab = ab0 + (1 + hht)*ab
+        if (.not. first) then
+          ab = ab0
+          call internal_forces(nel, nq, q, qd, kt_(2), beta, ck, cc, ss, le, ea, ei, .true., 1 + hht, fint, ab, &
+                               e_, epsx, kapx)
+        end if
+        first = .false.
         call band_cholesky(nq, ab, inf)
         if (inf /= 0) return
         r = -r
@@ -508,9 +551,8 @@ contains
         nit = nit + 1
       end do
       success = .true.
-      ! g_n+1 = C qd + f(q) - Q for the next step (fint holds f(q) of the converged q)
-      call apply_ops(nel, nq, alpha*qd, beta*qd, zero, .false., -1.0_dp, kt_, le, me, ke, kg1, nb, msl, gnew)
-      call frame_rate_damping(nel, nq, q, cc, ss, kt_(2), ke, beta, gnew)
+      ! g_n+1 = alpha M qd + f(q, qd) - Q for the next step (fint holds f of the converged state)
+      call apply_ops(nel, nq, alpha*qd, zero, zero, .false., -1.0_dp, kt_, le, me, ke, kg1, nb, msl, gnew)
       gnew = gnew + fint
       if (want_energy /= 0) then
         ! trapezoidal work of the loads Q over the step, damping dissipation, and the work of
@@ -528,16 +570,20 @@ contains
         ! and of the guide turning with the rod frame: the strain energy depends on time through
         ! the slider node's map (u_n, v_n) = (c3, -s3) U_X; its change at fixed q (midpoint)
         w2 = 0.5_dp*(q + qn)
-        call internal_forces(nel, nq, w2, cc, ss, le, ea, ei, .false., fint, ab, e_)
+        call internal_forces(nel, nq, w2, zero, 0.0_dp, 0.0_dp, 0.0_dp, cc, ss, le, ea, ei, .false., 1.0_dp, &
+                             fint, ab, e_, epsx, kapx)
         wext = wext + e_
-        call internal_forces(nel, nq, w2, cos(kin(1)), sin(kin(1)), le, ea, ei, .false., fint, ab, e_)
+        ! (the damping force at the midpoint state: f(q_mid, qd_mid) - f(q_mid, 0), kept in qs)
+        call internal_forces(nel, nq, w2, w1, kt_(2), beta, 0.0_dp, cc, ss, le, ea, ei, .false., 1.0_dp, &
+                             qs, ab, e_, epsx, kapx)
+        qs = qs - fint
+        call internal_forces(nel, nq, w2, zero, 0.0_dp, 0.0_dp, 0.0_dp, cos(kin(1)), sin(kin(1)), le, ea, ei, &
+                             .false., 1.0_dp, fint, ab, e_, epsx, kapx)
         wext = wext - e_
         w2 = q - qn
-        ! damping: C qd_mid . dq
-        call apply_ops(nel, nq, alpha*w1, beta*w1, zero, .false., 0.0_dp, kt_, le, me, ke, kg1, nb, &
-                       msl, r)
-        call frame_rate_damping(nel, nq, 0.5_dp*(q + qn), cc, ss, kt_(2), ke, beta, r)
-        wdamp = wdamp + dot_product(r, w2)
+        ! damping: (alpha M qd_mid + damping force at the midpoint) . dq
+        call apply_ops(nel, nq, alpha*w1, zero, zero, .false., 0.0_dp, kt_, le, me, ke, kg1, nb, msl, r)
+        wdamp = wdamp + dot_product(r + qs, w2)
         call apply_ops(nel, nq, qd, zero, zero, .false., 0.0_dp, kt_, le, me, ke, kg1, nb, msl, r)
         ekin = 0.5_dp*dot_product(qd, r)
       end if
@@ -558,7 +604,8 @@ contains
       inf = 0
       do i = 1, 50
         ab = 0
-        call internal_forces(nel, nq, qq, cc, ss, le, ea, ei, .true., fint, ab, e_)
+        call internal_forces(nel, nq, qq, zero, 0.0_dp, 0.0_dp, 0.0_dp, cc, ss, le, ea, ei, .true., 1.0_dp, fint, &
+                             ab, e_, epsx, kapx)
         rr = qload - fint
         if (sqrt(dot_product(rr, rr)) <= 1e-12_dp*(sqrt(dot_product(qload, qload)) + ei/rl**2) &
             .and. i > 1) return
@@ -574,7 +621,7 @@ contains
       integer, intent(in) :: jj, kk
       real(dp), intent(in) :: qq(nq), cc, ss, kq(7), estrain
       real(dp) :: lv_
-      call measures(nel, nq, qq, cc, ss, le, ea, ei, half_depth, eps, eof, lat)
+      call measures(nel, nq, qq, cc, ss, le, half_depth, epse, kape, eps, eof, lat)
       eps_ax(:, jj) = eps
       eps_of(:, jj) = eof
       lv_ = maxval(abs(lat))
@@ -609,7 +656,7 @@ contains
     real(dp), intent(in) :: rl, ea, ei, p, amp, tol
     real(dp), intent(out) :: q(nq), mid, shortening
     integer, intent(out) :: iters, status
-    real(dp), allocatable :: fint(:), r(:), d(:), qt(:), ab(:, :), ab0(:, :), k0(:, :)
+    real(dp), allocatable :: fint(:), r(:), d(:), qt(:), ab(:, :), ab0(:, :), k0(:, :), epsx(:), kapx(:), zero(:)
     real(dp) :: me(6, 6), ke(6, 6), kg1(6, 6), le, pi, en, pot, pot_t, mu, step, rn, slope
     integer :: j, info, ls
     q = 0
@@ -621,7 +668,9 @@ contains
     status = nl_no_convergence
     pi = 4*atan(1.0_dp)
     le = rl/nel
-    allocate (fint(nq), r(nq), d(nq), qt(nq), ab(kd + 1, nq), ab0(kd + 1, nq), k0(kd + 1, nq))
+    allocate (fint(nq), r(nq), d(nq), qt(nq), ab(kd + 1, nq), ab0(kd + 1, nq), k0(kd + 1, nq), epsx(nel), kapx(nel))
+    allocate (zero(nq))
+    zero = 0
     call element_matrices(le, 1.0_dp, ea, ei, me, ke, kg1)
     call assemble_linear(nel, nq, me, ke, 0.0_dp, 1.0_dp, 0.0_dp, 1.0_dp, 0.0_dp, k0)
     q(1) = amp*pi/rl
@@ -633,7 +682,8 @@ contains
     mu = 0
     do while (iters < maxit)
       ab0 = 0
-      call internal_forces(nel, nq, q, 1.0_dp, 0.0_dp, le, ea, ei, .true., fint, ab0, en)
+      call internal_forces(nel, nq, q, zero, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, 0.0_dp, le, ea, ei, .true., 1.0_dp, &
+                           fint, ab0, en, epsx, kapx)
       pot = en + p*q(nq)
       r = fint
       r(nq) = r(nq) + p
@@ -659,7 +709,8 @@ contains
       step = 1
       do ls = 1, 40
         qt = q + step*d
-        call internal_forces(nel, nq, qt, 1.0_dp, 0.0_dp, le, ea, ei, .false., fint, ab, en)
+        call internal_forces(nel, nq, qt, zero, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, 0.0_dp, le, ea, ei, .false., &
+                             1.0_dp, fint, ab, en, epsx, kapx)
         pot_t = en + p*qt(nq)
         if (pot_t <= pot + 1e-4_dp*step*slope .or. mu == 0 .and. ls == 1 .and. rn < 1e-6_dp*abs(p)) exit
         step = step/2

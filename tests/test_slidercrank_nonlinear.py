@@ -175,7 +175,7 @@ def test_newton_failure_is_reported_with_step_and_iterations(tmp_path):
 
 def test_step_cuts_rescue_a_coarse_step(tmp_path):
     deck = _deck(tmp_path, "  speeds = 29.32\n  n_elements = 10\n  steps_per_rev = 360, revolutions = 4\n"
-                           "  newton_max_iterations = 2, max_step_cuts = 8\n")
+                           "  newton_max_iterations = 4, max_step_cuts = 8\n")
     res = _run(deck, tmp_path / "out")
     assert res.returncode == 0, res.stderr
     text = (tmp_path / "out" / "nl.out").read_text()
@@ -194,7 +194,10 @@ def test_linear_only_options_are_refused(tmp_path, line, key):
 
 
 def test_growth_ratio_definition():
-    from driver.slidercrank.nonlinear import growth_ratio
-    assert growth_ratio(np.array([1.0, 1.0, 1.0, 1.0])) == 0.0
-    assert growth_ratio(np.array([2.0, 1.0, 2.0, 1.0])) == 0.0          # period 2: steady
-    assert growth_ratio(np.array([1.0, 1.0, 1.1, 1.2])) == pytest.approx(0.2)
+    from driver.slidercrank.nonlinear import growth_ratio, scatter
+    assert growth_ratio(np.ones(8)) == 0.0
+    assert growth_ratio(np.array([2.0, 1.0] * 6)) == 0.0                 # period 2: steady
+    assert growth_ratio(1.1 ** np.arange(12)) == pytest.approx(0.1)      # 10 % a revolution
+    assert growth_ratio(np.array([1.0] * 10 + [3.0, 1.0])) == 0.0        # one large revolution is no trend
+    assert growth_ratio(1.1 ** np.arange(4)) == pytest.approx(0.1)       # the fewest revolutions allowed
+    assert scatter(np.array([9.0] * 4 + [1.0, 2.0, 1.0, 1.5] * 2)) == pytest.approx(1.0)

@@ -4,11 +4,15 @@ kernel (fortran/slidercrank_nl.f90), the growth criterion, and the dynamic-buckl
 SI units; strains dimensionless here (the report prints microstrain), deflections in m.
 
 Growth criterion (docs/slidercrank.md, "Does the rod buckle?"): with d_k the peak |lateral
-deflection from the chord A-C| in revolution k of N, the response *grows* when
-max(d_N-1, d_N) > (1 + growth_tolerance) max(d_N-3, d_N-2), or when the run stops because the
-deflection passed L/4.  Two-revolution windows make a period-2 (subharmonic) response, which
-alternates between two levels, count as steady.  The rod counts as *buckled* when its peak
-lateral deflection in the last revolution exceeds ``large_deflection`` x L.
+deflection from the chord A-C| in revolution k of N, compare the median of the last h
+revolutions with the median of the h before them, h = 2 max(1, N // 6) (2 for 4 to 11
+revolutions, 4 for 12 to 17): the mean growth per revolution (ratio)^(1/h) - 1 above
+``growth_tolerance`` means the response *grows*, and so does a run stopped because the
+deflection passed L/2.  Medians of even-length windows, not the last two values: a buckled
+rod's response can be irregular from one revolution to the next (period 2, or no period at
+all), and one large revolution is no trend.  The response is *irregular* when max/min - 1 of
+the d_k over those 2h revolutions exceeds 5 %.  The rod counts as *buckled* when its peak lateral deflection in
+the last revolution exceeds ``large_deflection`` x L.
 """
 from __future__ import annotations
 
@@ -49,6 +53,7 @@ class NLCase:
     fail_step: int = -1
     fail_iter: int = 0
     growth: float = 0.0
+    scatter: float = 0.0
 
     @property
     def ok(self) -> bool:
@@ -56,7 +61,7 @@ class NLCase:
 
     @property
     def collapsed(self) -> bool:
-        """The run stopped because the lateral deflection passed L/4 (or turned NaN)."""
+        """The run stopped because the lateral deflection passed L/2 (or turned NaN)."""
         return self.status == "limit"
 
     @property
@@ -86,11 +91,31 @@ class NLCase:
         return self.grows(tol) or (self.ok and self.peak_lateral > limit)
 
 
-def growth_ratio(rev_lat: np.ndarray) -> float:
-    """max(d_N-1, d_N) / max(d_N-3, d_N-2) - 1 for the per-revolution peaks d (at least 4)."""
+IRREGULAR = 0.05
+
+
+def _half(n: int) -> int:
+    return 2 * max(1, n // 6)
+
+
+def _window(rev_lat: np.ndarray) -> np.ndarray:
     d = np.asarray(rev_lat, dtype=float)
-    before = float(d[-4:-2].max())
-    return float(d[-2:].max()) / before - 1.0 if before > 0 else 0.0
+    return d[-2 * _half(len(d)):]
+
+
+def growth_ratio(rev_lat: np.ndarray) -> float:
+    """Mean growth per revolution of the per-revolution peaks d (at least 4 values):
+    (median of the last h / median of the h before)^(1/h) - 1, h = 2 max(1, len(d) // 6)."""
+    d = np.asarray(rev_lat, dtype=float)
+    h = _half(len(d))
+    before, last = float(np.median(d[-2 * h:-h])), float(np.median(d[-h:]))
+    return (last / before) ** (1.0 / h) - 1.0 if before > 0 else 0.0
+
+
+def scatter(rev_lat: np.ndarray) -> float:
+    """max/min - 1 of the per-revolution peaks over the growth window (0: periodic)."""
+    d = _window(rev_lat)
+    return float(d.max() / d.min() - 1.0) if d.min() > 0 else 0.0
 
 
 def run_nl_case(model: Model, params: Params, omega: float, n_el: int, alpha: float, beta: float,
@@ -120,6 +145,7 @@ def run_nl_case(model: Model, params: Params, omega: float, n_el: int, alpha: fl
     case.shapes = res["shapes"]
     case.shape_deg = tuple(float(math.degrees(omega * dt * k) % 360.0) for k in res["shape_step"])
     case.growth = growth_ratio(case.rev_lat)
+    case.scatter = scatter(case.rev_lat)
     return case
 
 

@@ -15,14 +15,14 @@ from tqdm import tqdm
 from driver.deck import Params
 from driver.export import with_units
 from driver.slidercrank.analysis import Case, _run_case, static_onset
-from driver.slidercrank.nonlinear import NLCase, onset_search, run_nl_case
+from driver.slidercrank.nonlinear import IRREGULAR, NLCase, onset_search, run_nl_case
 from driver.slidercrank.report import _header, _plotting, _status_text
 from driver.slidercrank.spec import _model, rayleigh
 from driver.study import Figure, Result
 from driver.table import Column, render_table
 
 NL_STATUS_TEXT = {
-    "limit": ("COLLAPSE", "the lateral deflection passed L/4: the rod has collapsed"),
+    "limit": ("COLLAPSE", "the lateral deflection passed L/2: the rod has folded up"),
     "no_convergence": ("NO CONVERGENCE", "Newton did not converge even after the allowed step cuts; "
                                          "reduce the time step (steps_per_rev) or raise max_step_cuts"),
     "not_spd": ("NOT SPD", "the Newton matrix is not positive definite"),
@@ -45,14 +45,15 @@ def verdict(c: NLCase, tol: float, limit: float) -> str:
         return "FAILED"
     if c.grows(tol):
         return "GROWS"
-    return "BUCKLED, bounded" if c.buckled(tol, limit) else "bounded"
+    kind = "irregular" if c.scatter > IRREGULAR else "bounded"
+    return f"BUCKLED, {kind}" if c.buckled(tol, limit) else kind
 
 
 def _side_by_side(pairs: list[tuple[Case, NLCase]], tol: float, limit: float) -> list[str]:
     cols = [Column("omega", "f", 7, 2), Column("lin tens", "f", 9, 2), Column("nl tens", "f", 9, 2),
             Column("lin comp", "f", 9, 2), Column("nl comp", "f", 9, 2), Column("lin outer", "f", 9, 1),
             Column("nl outer", "f", 9, 1), Column("lin lat", "f", 8, 3), Column("nl lat", "f", 8, 3),
-            Column("N/P_E", "f", 6, 3), Column("growth%", "f", 8, 2)]
+            Column("N/P_E", "f", 6, 3), Column("growth%", "f", 8, 2), Column("spread%", "f", 8, 1)]
     rows, trailers = [], []
     for lin, nl in pairs:
         row: list[Any] = [nl.omega]
@@ -62,16 +63,17 @@ def _side_by_side(pairs: list[tuple[Case, NLCase]], tol: float, limit: float) ->
                     nl.peak_lateral * 1e3] if nl.ok else ["-"] * 4)
         for a, b in zip(lin_vals, nl_vals):
             row += [a, b]
-        row += [lin.euler_ratio, 100 * nl.growth if nl.ok else "-"]
+        row += [lin.euler_ratio, 100 * nl.growth if nl.ok else "-", 100 * nl.scatter if nl.ok else "-"]
         rows.append(row)
         trailers.append(verdict(nl, tol, limit))
     return ["Table 5  Linear (the paper's KED model) and geometrically nonlinear rod, last revolution",
             "         omega [rad/s]; tens/comp = peak tensile/compressive axial strain, outer = peak outer-fibre",
             "         strain |eps| + c|kappa| (microstrain); lat = peak lateral deflection [mm] (linear: midpoint",
             "         from the chord; nonlinear: largest over the rod); N/P_E = peak rigid-body compression / Euler",
-            "         load; growth% = peak lateral deflection of the last two revolutions over the two before,",
-            f"         minus 1 (GROWS above {100 * tol:g} %); BUCKLED = lateral deflection above "
-            f"{1e3 * limit:.1f} mm ({limit:.4g} m)", ""] + render_table(cols, rows, trailers)
+            "         load; growth% = mean growth per revolution of the per-revolution peak lateral deflection",
+            f"         (Table 6; medians of the last revolutions against those before; GROWS above {100 * tol:g} %);",
+            "         spread% = max/min - 1 of those peaks (irregular above "
+            f"{100 * IRREGULAR:g} %); BUCKLED = lateral deflection above {1e3 * limit:.1f} mm", ""] + render_table(cols, rows, trailers)
 
 
 def _per_revolution(cases: list[NLCase]) -> list[str]:
@@ -207,8 +209,8 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
              f"  time integration: HHT-alpha, alpha = {params.hht_alpha:g}"
              + (" (Newmark average acceleration)" if params.hht_alpha == 0 else
                 " (damps the unresolved high frequencies; 0 = Newmark average acceleration)"),
-             f"  growth tolerance {tol:g} per two revolutions; buckled above {params.large_deflection:g} L lateral "
-             "deflection", ""]
+             f"  growth tolerance {tol:g} per revolution (medians of the last revolutions); buckled",
+             f"  above {params.large_deflection:g} L lateral deflection", ""]
     text += _side_by_side(pairs, tol, limit) + [""] + _per_revolution(nls) + [""] + _newton_table(nls, params) + \
         [""] + _strain_curves(pairs) + [""]
     if onset is not None:

@@ -151,9 +151,9 @@ _KEYS: dict[str, Key] = {
                          doc="nonlinear model: halvings of a time step allowed (0: none) before the run "
                              "stops with NO CONVERGENCE"),
     "growth_tolerance": Key("float", default=0.01, check=positive, units="-",
-                            doc="nonlinear model: the response grows when the peak lateral deflection of "
-                                "the last two revolutions exceeds that of the two before by more than "
-                                "this fraction"),
+                            doc="nonlinear model: the response grows when the median per-revolution peak "
+                                "lateral deflection of the last revolutions exceeds that of those before by more "
+                                "than this fraction per revolution (docs/slidercrank.md)"),
     "large_deflection": Key("float", default=0.02, check=positive, units="-",
                             doc="nonlinear model: peak lateral deflection, as a fraction of the rod "
                                 "length, counted as a buckled (large-deflection) rod"),
