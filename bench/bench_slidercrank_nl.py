@@ -33,6 +33,7 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--smoke", action="store_true", help="tiny case (40 elements, 2 revolutions, 1 repeat)")
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--omega", type=float, default=OMEGA, help="crank speed [rad/s] (default: the buckled 29.32)")
     args = ap.parse_args(argv)
     n_el, revs, repeat = (40, 2, 1) if args.smoke else (700, 4, args.repeat)
     spr = 1440
@@ -41,15 +42,16 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     ei, half = mat["youngs_modulus"] * mat["second_moment"], mat["section_depth"] / 2
     wb, wa, _ = kernels.slidercrank_frequencies(rho_a, ea, ei, LEN, M_S)
     alpha, beta = rayleigh(0.02, wb, wa)
-    dt = 2 * math.pi / (OMEGA * spr)
+    omega = args.omega
+    dt = 2 * math.pi / (omega * spr)
     steps, rec = revs * spr, (revs - 1) * spr
 
     def linear() -> dict:
-        return kernels.slidercrank_simulate(n_el, R2, LEN, rho_a, ea, ei, half, M_S, OMEGA, dt, steps, rec, spr + 1,
+        return kernels.slidercrank_simulate(n_el, R2, LEN, rho_a, ea, ei, half, M_S, omega, dt, steps, rec, spr + 1,
                                             alpha, beta)
 
     def nonlinear() -> dict:
-        return kernels.slidercrank_nl_simulate(n_el, R2, LEN, rho_a, ea, ei, half, M_S, OMEGA, dt, steps, spr, rec,
+        return kernels.slidercrank_nl_simulate(n_el, R2, LEN, rho_a, ea, ei, half, M_S, omega, dt, steps, spr, rec,
                                                spr + 1, alpha, beta, hht=-0.05)
 
     check = nonlinear()
@@ -59,7 +61,7 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     ratio = t_nl / t_lin
     solves = int(check["stats"][0]) / steps
     load = os.getloadavg()[0]
-    print(f"slider-crank nonlinear vs linear rod: {n_el} elements, {revs} revolutions x {spr} steps at {OMEGA} rad/s "
+    print(f"slider-crank nonlinear vs linear rod: {n_el} elements, {revs} revolutions x {spr} steps at {omega} rad/s "
           f"(median of {repeat}; load {load:.2f})")
     print(f"  linear KED kernel      {1e3 * t_lin:10.1f} ms  ({1e3 * t_lin / revs:.1f} ms per revolution)")
     print(f"  nonlinear kernel       {1e3 * t_nl:10.1f} ms  ({1e3 * t_nl / revs:.1f} ms per revolution, "

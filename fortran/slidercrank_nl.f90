@@ -293,6 +293,30 @@ contains
     end do
   end subroutine measures
 
+  !> Secant predictor q = qn + ratio (qn - qprev).
+  pure subroutine secant_predict(nq, qn, qprev, ratio, q)
+    integer, intent(in) :: nq
+    real(dp), intent(in) :: qn(nq), qprev(nq), ratio
+    real(dp), intent(out) :: q(nq)
+    integer :: j
+    ! hot-loop: slidercrank_nl predictor
+    do j = 1, nq
+      q(j) = qn(j) + ratio*(qn(j) - qprev(j))
+    end do
+  end subroutine secant_predict
+
+  !> Quadratic extrapolation over three equal steps, q = 3 qn - 3 qprev + qprev2.
+  pure subroutine quadratic_predict(nq, qn, qprev, qprev2, q)
+    integer, intent(in) :: nq
+    real(dp), intent(in) :: qn(nq), qprev(nq), qprev2(nq)
+    real(dp), intent(out) :: q(nq)
+    integer :: j
+    ! hot-loop: slidercrank_nl quadratic predictor
+    do j = 1, nq
+      q(j) = 3*(qn(j) - qprev(j)) + qprev2(j)
+    end do
+  end subroutine quadratic_predict
+
   !> Newmark rates (parameters bn, gn) of the trial state q over a step h from (qn, qdn, qddn):
   !> qdd = (q - qn - h qdn)/(bn h^2) - (1/(2 bn) - 1) qddn, qd = qdn + h ((1 - gn) qddn + gn qdd);
   !> and the inertia and damping operands w1 = qdd + ca qd (for M), w2 = cb qd (for K0).
@@ -348,11 +372,12 @@ contains
     integer, intent(out) :: shape_step(2), stats(5), status, fail_step, fail_iter
 
     real(dp), allocatable :: q(:), qd(:), qdd(:), qn(:), qdn(:), qddn(:), fint(:), r(:), w1(:), w2(:)
-    real(dp), allocatable :: qprev(:), gn(:), gnew(:), gsave(:), epse(:), kape(:), epsx(:), kapx(:)
+    real(dp), allocatable :: qprev2(:), qprev(:), gn(:), gnew(:), gsave(:), epse(:), kape(:), epsx(:), kapx(:)
     real(dp), allocatable :: ab(:, :), ab0(:, :), qm(:), zero(:), qs(:), eps(:), eof(:), lat(:)
     real(dp) :: me(6, 6), ke(6, 6), kg1(6, 6), kin(7), nb(nel), le, t, tn, h, a0, a1, a2, cm, ck
     real(dp) :: en, ekin, wext, wdamp, wold, best_lat, best_cmp, lv, rref, rnorm, c3, s3, kmax, hprev
-    real(dp) :: bn, gn_
+    real(dp) :: bn, gn_, hprev2
+    integer :: nhist
     integer :: k, info, it, level, piece, revi, mid_node
     logical :: ok
 
@@ -373,7 +398,7 @@ contains
     nb = 0
     mid_node = nel/2
     allocate (q(nq), qd(nq), qdd(nq), qn(nq), qdn(nq), qddn(nq), fint(nq), r(nq), w1(nq), w2(nq))
-    allocate (qprev(nq), gn(nq), gnew(nq), gsave(nq), epse(nel), kape(nel), epsx(nel), kapx(nel))
+    allocate (qprev2(nq), qprev(nq), gn(nq), gnew(nq), gsave(nq), epse(nel), kape(nel), epsx(nel), kapx(nel))
     allocate (ab(kd + 1, nq), ab0(kd + 1, nq), qm(nq), zero(nq), qs(nq), eps(nel), eof(nel), lat(0:nel))
     zero = 0
     call element_matrices(le, rhoa, ea, ei, me, ke, kg1)
@@ -431,6 +456,7 @@ contains
       if (k == 1) then
         qprev = q
         hprev = dt
+        nhist = 0
       end if
       do while (piece < 2**level)
         h = dt/2**level
@@ -440,8 +466,11 @@ contains
         stats(2) = max(stats(2), it)
         if (ok) then
           piece = piece + 1
+          qprev2 = qprev
+          hprev2 = hprev
           qprev = qn
           hprev = h
+          nhist = nhist + 1
           qn = q; qdn = qd; qddn = qdd
           gn = gnew
           gsave = gn
@@ -449,6 +478,7 @@ contains
           q = qn; qd = qdn; qdd = qddn
           gn = gsave
           qprev = qn                     ! restart the predictor after a cut
+          nhist = 0
           if (level >= max_cuts) then
             status = nl_no_convergence
             fail_step = k
@@ -505,13 +535,14 @@ contains
       cm = a0 + (1 + hht)*a1*alpha
       ck = a1*beta                    ! weight of the damping tangent B^T K_l B (times 1 + a below)
       call assemble_linear(nel, nq, me, ke, cm, 0.0_dp, msl, cc, ss, ab0)
-      ! predictor: secant extrapolation of the displacements, q_n + (h/h_prev)(q_n - q_n-1)
-      ! (displacements are smooth; rates and accelerations of the end rotations, which carry
-      ! almost no inertia, are not)
-      ! hot-loop: slidercrank_nl predictor
-      do jj = 1, nq
-        q(jj) = qn(jj) + (hh/hprev)*(qn(jj) - qprev(jj))
-      end do
+      ! predictor: extrapolation of the displacements, quadratic over three equal steps, else
+      ! secant q_n + (h/h_prev)(q_n - q_n-1) (displacements are smooth; rates and accelerations
+      ! of the end rotations, which carry almost no inertia, are not)
+      if (nhist >= 2 .and. hh == hprev .and. hh == hprev2) then
+        call quadratic_predict(nq, qn, qprev, qprev2, q)
+      else
+        call secant_predict(nq, qn, qprev, hh/hprev, q)
+      end if
       call apply_ops(nel, nq, zero, zero, zero, .false., 1.0_dp, kt_, le, me, ke, kg1, nb, msl, r)
       qnorm = sqrt(dot_product(r, r))
       first = .true.
@@ -520,7 +551,7 @@ contains
         ! r = M (qdd + (1+a) alpha qd) - (1+a) Q + (1+a) f(q, qd) - a g_n, f with the damping of
         ! the deformation rates, g_n = alpha M qd_n + f(q_n, qd_n) - Q_n (apply_ops' load scales -Q)
         call apply_ops(nel, nq, w1, zero, zero, .false., -(1 + hht), kt_, le, me, ke, kg1, nb, msl, r)
-        if (first) then               ! the predictor rarely converges: force and tangent at once
+        if (first) then               ! far from convergence: force and tangent at once
           ab = ab0
           call internal_forces(nel, nq, q, qd, kt_(2), beta, ck, cc, ss, le, ea, ei, .true., 1 + hht, fint, ab, &
                                e_, epse, kape)
@@ -542,7 +573,10 @@ contains
           call internal_forces(nel, nq, q, qd, kt_(2), beta, ck, cc, ss, le, ea, ei, .true., 1 + hht, fint, ab, &
                                e_, epsx, kapx)
         end if
-        first = .false.
+        ! the next evaluation: the residual alone when this correction should converge (Newton
+        ! squares the residual: from below 1e4 times the tolerance it lands below it), else the
+        ! residual and the tangent at once
+        first = rnorm > 1e4_dp*rref
         call band_cholesky(nq, ab, inf)
         if (inf /= 0) return
         r = -r

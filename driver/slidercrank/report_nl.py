@@ -235,6 +235,12 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
              "  * Growth: per-revolution peaks of Table 6; a bounded response may still be buckled (a large",
              "    lateral deflection every revolution that the tension half of the turn straightens again).",
              "  * The answer for the paper's rods, with numbers: docs/slidercrank.md, 'Does the rod buckle?'."]
+    irregular = [f"{nl.omega:g}" for nl in nls if nl.ok and nl.scatter > IRREGULAR]
+    if irregular:
+        text += [f"  * Irregular ({', '.join(irregular)} rad/s): the buckled rod's motion does not repeat from one",
+                 "    revolution to the next, so its last revolution is one sample of a range (Table 6), and anything",
+                 "    that perturbs the motion (Newton tolerance, time step, mesh) changes its numbers within that",
+                 "    range: read them as magnitudes, not to their last digit."]
     if warnings:
         text += ["", "Warnings"] + [f"  * {w}" for w in warnings]
     figures = []
