@@ -28,7 +28,7 @@ from typing import Any, Iterable, Sequence, Union
 import numpy as np
 import pandas as pd
 
-from driver.deck import Deck, DeckError, RawGroup, read_deck
+from driver.deck import MAX_DECK_BYTES, MAX_VALUES, Deck, DeckError, RawGroup, shown_value, read_deck
 from driver.runner import available_studies, run_study
 from driver.study import Result
 
@@ -40,19 +40,36 @@ DeckSource = Union[str, os.PathLike, Mapping[str, Mapping[str, Any]]]
 
 # ----------------------------------------------------------------------------- decks from Python
 
-def _plain(value: Any, where: str) -> Any:
-    """A Python/numpy value as the deck reader's plain types (lists for sequences)."""
+def _plain(value: Any, where: str, key: str | None = None, depth: int = 0) -> Any:
+    """A Python/numpy value as the deck reader's plain types (lists for sequences).
+
+    Sizes are checked from ``len()`` and ``shape`` before anything is converted (a
+    ``range(10**9)`` is refused, not materialised); a list of lists is one level deep at most
+    (a deck value is a number, a string, a logical or a list of them)."""
     if isinstance(value, np.ndarray):
-        return [_plain(v, where) for v in value.tolist()]
+        if value.ndim == 0:
+            return _plain(value.item(), where, key, depth)
+        if value.size > MAX_VALUES or value.ndim > 1:
+            raise DeckError(where, None, key, f"array of shape {value.shape}: a deck value is at most a flat "
+                            f"list of {MAX_VALUES} values")
+        value = value.tolist()
     if isinstance(value, (list, tuple, range)):
-        return [_plain(v, where) for v in value]
+        if len(value) > MAX_VALUES:
+            raise DeckError(where, None, key, f"{len(value)} values; at most {MAX_VALUES} are read per key "
+                            "(checked before anything is converted)")
+        if depth >= 1:
+            raise DeckError(where, None, key, "a list inside a list: a deck value is a number, a string, "
+                            "a logical or a flat list of them")
+        return [_plain(v, where, key, depth + 1) for v in value]
     if isinstance(value, np.generic):
-        return value.item()
+        return _plain(value.item(), where, key, depth)
     if isinstance(value, Path):
         return str(value)
+    if isinstance(value, str) and len(value) > MAX_DECK_BYTES:
+        raise DeckError(where, None, key, f"a text of {len(value)} characters; a deck is at most {MAX_DECK_BYTES}")
     if value is None or isinstance(value, (bool, int, float, str)):
         return value
-    raise DeckError(where, None, None, f"value {value!r} of type {type(value).__name__} is not a deck value "
+    raise DeckError(where, None, key, f"value {shown_value(value)} of type {type(value).__name__} is not a deck value "
                                        "(give numbers, strings, logicals or lists of them)")
 
 
@@ -63,7 +80,7 @@ def _group_from_dict(group: str, values: Mapping[str, Any], label: str) -> RawGr
     for k, v in values.items():
         if not isinstance(k, str):
             raise DeckError(label, None, None, f"key {k!r} of &{group} is not a name")
-        plain[k.lower()] = _plain(v, label)
+        plain[k.lower()] = _plain(v, label, k.lower())
     return RawGroup(group, plain, {}, 0)
 
 
@@ -190,9 +207,9 @@ def _sweep_group(grid: Mapping[str, Any], study: str, label: str, options: dict[
     for k, (key, vals) in enumerate(grid.items(), start=1):
         key = str(key).lower()
         values[f"key{k}"] = key if "." in key else f"{study}.{key}"
-        vals = _plain(vals, label)
+        vals = _plain(vals, label, key)
         values[f"values{k}"] = vals if isinstance(vals, list) else [vals]
-    values.update({k: _plain(v, label) for k, v in options.items() if v is not None})
+    values.update({k: _plain(v, label, k) for k, v in options.items() if v is not None})
     return RawGroup("sweep", values, {}, 0)
 
 
@@ -232,8 +249,15 @@ def run_sweep(source: DeckSource, grid: Mapping[str, Sequence[Any]] | None = Non
         given = ", ".join(k for k, v in options.items() if v is not None)
         raise DeckError(deck.path, deck.groups["sweep"].line or None, None,
                         f"the deck's &sweep group sets the sweep; {given} apply only with grid=")
-    if jobs is not None and jobs < 1:
-        raise ValueError(f"jobs must be at least 1 (got {jobs})")
+    if jobs is not None and (isinstance(jobs, bool) or not isinstance(jobs, (int, np.integer)) or jobs < 1):
+        raise ValueError(f"jobs must be a whole number of at least 1 (got {jobs!r})")
+    from driver.export import FORMATS
+    if isinstance(formats, str):
+        formats = [formats]
+    formats = list(formats)
+    bad = [f for f in formats if f not in FORMATS]
+    if bad:   # checked before any case runs
+        raise ValueError(f"unknown table format {bad[0]!r} (choose {', '.join(FORMATS)})")
     from driver import sweep
 
     stem = Path(deck.path).stem

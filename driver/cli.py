@@ -44,13 +44,15 @@ def _fs_error(exc: OSError) -> str:
 
 
 def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool | str, progress: bool,
-             quiet: bool = False, sweep_options: dict | None = None, summary_json: bool = False) -> int:
+             quiet: bool = False, sweep_options: dict | None = None, summary_json: bool = False,
+             report: bool = False) -> int:
     """Run one deck; returns its exit status. Errors are printed, never raised.
 
     ``sweep_options`` (jobs, scheduler, resume) apply when the deck has a &sweep or an
     &optimize group (a sweep's cases always write their summary as JSON); given for any other
     deck, they are reported as ignored.  ``summary_json`` writes a single run's summary as
-    ``<stem>.json``.
+    ``<stem>.json``.  ``report`` also writes the deck's report page ``<stem>.html``
+    (:mod:`driver.report_page`) once its run has written its outputs.
     """
     from driver.deck import DeckError, read_deck
     from driver.runner import run_study
@@ -60,15 +62,20 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool | str, pro
                  if (sweep_options or {}).get(key) and not ({"sweep", "optimize"} & set(deck.groups))]
         if "synthesis" in deck.groups:
             from driver import synthesis
-            return synthesis.run_synthesis_deck(deck, outdir, formats, plot, progress, quiet)
+            status = synthesis.run_synthesis_deck(deck, outdir, formats, plot, progress, quiet)
+            return _report(deck, outdir, "synthesis", status, quiet) if report else status
         if "optimize" in deck.groups:
             from driver import optimize
-            return optimize.run_optimize_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))
+            status = optimize.run_optimize_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))
+            return _report(deck, outdir, "optimize", status, quiet) if report else status
         if "sweep" in deck.groups:
             require("parquet")   # sweeps keep their cases in Parquet: say so before importing them
             from driver import sweep
-            return sweep.run_sweep_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))
+            status = sweep.run_sweep_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))
+            return _report(deck, outdir, "sweep", status, quiet) if report else status
         outcome = run_study(deck, outdir, formats, plot, progress, summary_json=summary_json)
+        if report:
+            outcome.written.append(_report_page(deck, outdir, outcome.result))
     except DeckError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -102,6 +109,40 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool | str, pro
         print(f"error: {path}: {result.failure}", file=sys.stderr)
         return EXIT_FAILED
     return EXIT_OK
+
+
+def _report_page(deck, outdir: Path, result) -> Path:
+    """Write the report page of a single-case run (``<stem>.html``); returns its path."""
+    from driver import report_page
+    from driver.runner import output_stem, study_of
+    _, params = study_of(deck)
+    stem = output_stem(outdir, deck.path)
+    page = report_page.page_for_result(result, deck, params)
+    return report_page.write_report(stem.with_name(stem.name + ".html"), page)
+
+
+def _report(deck, outdir: Path, kind: str, status: int, quiet: bool) -> int:
+    """Write the report page of a sweep, optimisation or synthesis deck after its run (not after
+    bad input: nothing is written then); a page that cannot be built is an error line, and the
+    deck's status becomes 1."""
+    if status == EXIT_BAD_INPUT:
+        return status
+    from driver import report_page
+    from driver.runner import output_stem
+    stem = output_stem(outdir, deck.path)
+    build = {"sweep": report_page.page_for_sweep, "optimize": report_page.page_for_optimize,
+             "synthesis": report_page.page_for_synthesis}[kind]
+    try:
+        path = report_page.write_report(stem.with_name(stem.name + ".html"), build(deck, outdir, stem.name, status))
+    except (KeyboardInterrupt, BrokenPipeError):
+        raise
+    except Exception as exc:
+        print(f"error: {deck.path}: the report page could not be written: {exc.__class__.__name__}: {exc}",
+              file=sys.stderr)
+        return max(status, EXIT_FAILED)
+    if not quiet:
+        print(f"wrote {path}")
+    return status
 
 
 class Terminated(KeyboardInterrupt):
@@ -196,6 +237,10 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--plot-format", choices=PLOT_FORMATS, default=None,
                         help="figure file format (implies --plot; default png); the same inputs give "
                              "byte-identical files")
+    parser.add_argument("--report", action="store_true",
+                        help="also write a self-contained report page <stem>.html (figures, tables, the deck, "
+                             "warnings, the comparison with the published tables, an animation of the mechanism; "
+                             "opens offline in any browser and prints)")
     parser.add_argument("-q", "--quiet", action="store_true", help="print only warnings and errors")
     parser.add_argument("--keys", metavar="GROUP", help="list the keys of a namelist group and exit")
     parser.add_argument("--examples", action="store_true",
@@ -261,7 +306,8 @@ def _main(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
     except ValueError as exc:
         parser.error(str(exc))
     formats = list(dict.fromkeys((["csv"] if args.csv else []) + args.formats))
-    needs = ([("plot", "--plot")] if (args.plot or args.plot_format) else []) + ([("parquet", "--format parquet")]
+    needs = ([("plot", "--plot")] if (args.plot or args.plot_format) else []) + \
+        ([("plot", "--report")] if args.report else []) + ([("parquet", "--format parquet")]
              if "parquet" in formats else []) + ([("dask", "--scheduler")] if args.scheduler else [])
     for extra, option in needs:
         try:
@@ -278,7 +324,7 @@ def _main(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
         for deck in args.decks:
             try:
                 status = max(status, run_deck(deck, outdir, formats, plot, progress, args.quiet,
-                                             sweep_options, summary_json=args.json))
+                                             sweep_options, summary_json=args.json, report=args.report))
                 sys.stdout.flush()
             except BrokenPipeError:   # stdout closed early (e.g. piped into head): the files are
                 _quiet_stdout()       # written; go on with the other decks without printing

@@ -39,7 +39,7 @@ from driver.deck import Params, read_deck
 from driver.runner import study_of
 from driver.study import Result
 
-__all__ = ["COLUMNS", "OK", "Comparison", "agrees_printed", "compare", "compare_decks", "compare_text",
+__all__ = ["COLUMNS", "OK", "Comparison", "agrees_printed", "compare", "compare_decks", "compare_result", "compare_text",
            "run_comparison", "totals_text"]
 
 COLUMNS = ["deck", "table", "row", "column", "printed", "computed", "status", "reason"]
@@ -366,6 +366,16 @@ def run_comparison(deck: str | Path) -> Comparison:
     frame = pd.DataFrame.from_records(rows, columns=COLUMNS[1:])
     frame.insert(0, "deck", str(path))
     return Comparison(path, group, frame, params)
+
+
+def compare_result(deck: str | Path, params: Params, result: Result) -> pd.DataFrame:
+    """The comparison of a run already made (``params`` validated, ``result`` computed from
+    them) with the published record: the frame of :func:`compare`, without running again."""
+    comparer = _COMPARERS.get(params.group)
+    rows = comparer(params, result) if comparer is not None else []
+    frame = pd.DataFrame.from_records(rows, columns=COLUMNS[1:])
+    frame.insert(0, "deck", str(deck))
+    return frame
 
 
 def compare(deck: str | Path) -> pd.DataFrame:

@@ -15,6 +15,8 @@ the line and the key.  The four-bar listing's own terminal input (three lines
 """
 from __future__ import annotations
 
+import contextlib
+import io
 import math
 import os
 import re
@@ -227,6 +229,93 @@ def _code_mask(path: Path, n: int, line: str) -> tuple[str, str]:
     return "".join(code), line
 
 
+#: what Fortran list-directed input reads as one value (ASCII only): an integer, a real with an
+#: optional E/D exponent, a logical; optionally after a repeat count ``r*`` (r >= 1)
+_INTEGER = r"[+-]?[0-9]+"
+_REAL = r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eEdD][+-]?[0-9]+)?"
+_LOGICAL = r"\.(?:true|false|t|f)\.|true|false|t|f"
+_NUMBER_RE = re.compile(rf"(?:{_REAL})", re.ASCII)
+_VALUE_RE = re.compile(rf"(?:{_REAL}|{_LOGICAL})", re.ASCII | re.IGNORECASE)
+_COUNT_RE = re.compile(r"([0-9]+)\*(.*)", re.ASCII | re.DOTALL)
+#: digits a number may have: more is no measurement, and only overflows (a 400-digit integer)
+MAX_DIGITS = 40
+
+
+def is_number(text: str) -> bool:
+    """True when ``text`` (surrounding blanks allowed) is a number as Fortran list-directed input
+    reads one: ``5``, ``-5.``, ``.5``, ``5.0e-3``, ``5d0``; never ``5_0``, ``5.0_8``, ``4+1``,
+    ``0x10``, ``inf``, ``nan`` or digits other than ASCII 0-9."""
+    t = text.strip(" \t")
+    return bool(_NUMBER_RE.fullmatch(t)) and sum(c.isdigit() for c in t) <= MAX_DIGITS
+
+
+def _value_tokens(text: str) -> Iterator[str]:
+    """The values of a value text, separated by commas and blanks; quoted strings (with their
+    doubled-quote escapes and a repeat count glued in front) kept whole."""
+    i, n = 0, len(text)
+    while i < n:
+        ch = text[i]
+        if ch in " \t\n,":
+            i += 1
+            continue
+        j = i
+        while j < n and text[j] not in " \t\n,'\"":
+            j += 1
+        if j < n and text[j] in "'\"" and (j == i or text[j - 1] == "*"):
+            q = text[j]
+            j += 1
+            while j < n:
+                if text[j] == q:
+                    if j + 1 < n and text[j + 1] == q:
+                        j += 2
+                        continue
+                    break
+                j += 1
+            j += 1
+        yield text[i:j]
+        i = j
+
+
+def _check_values(path: Path, it: "_Item") -> None:
+    """Every value of ``it`` is a number, a logical or a quoted string as Fortran list-directed
+    input reads them, with at most one repeat count; anything else is a DeckError naming the
+    token (f90nml would read ``5.0_8`` as 5.08, ``4+1`` as 40 and ``2*1*4.0`` as 1, 1, 4)."""
+    for tok in _value_tokens(it.text):
+        value = tok
+        m = _COUNT_RE.fullmatch(tok)
+        if m:
+            if int(m.group(1)[:7]) == 0:
+                raise DeckError(path, it.line, it.key, f"repeat count 0 in {tok[:40]!r}: a count is at least 1")
+            value = m.group(2)
+            if not value:
+                continue                      # r* : r empty entries
+        if value[:1] in "'\"":
+            if len(value) < 2 or value[-1] != value[0]:
+                raise DeckError(path, it.line, it.key, f"text after a quoted string in {tok[:40]!r}")
+            continue
+        if _VALUE_RE.fullmatch(value):
+            digits = sum(c.isdigit() for c in value)
+            if digits > MAX_DIGITS:
+                raise DeckError(path, it.line, it.key, f"number with {digits} digits: not a value any study "
+                                f"takes (at most {MAX_DIGITS} digits)")
+            continue
+        if "*" in value and _COUNT_RE.fullmatch(value):
+            why = "a repeat count applied to a repeat count"
+        elif "_" in value:
+            why = "a kind suffix or '_' inside a number (write the number itself: 5.0, 15)"
+        elif re.fullmatch(r"[+-]?[0-9.]+[eEdD]?[0-9]*[+-][0-9.]+", value):
+            why = "arithmetic is not read in a deck (write the number itself; '4+1' would be read as 4e+1)"
+        elif value[:1] == "(":
+            why = "complex numbers and parentheses are not read"
+        elif re.fullmatch(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)[eEdD][+-]?", value):
+            why = "an exponent without digits"
+        elif re.fullmatch(r"[A-Za-z_]\w*", value):
+            why = "not a number, a logical (.true./.false.) or a 'quoted string' (quote text values)"
+        else:
+            why = "not a number as Fortran reads one (digits, '.', an E or D exponent), a logical or a 'quoted string'"
+        raise DeckError(path, it.line, it.key, f"not a number: {tok[:40]!r}: {why}")
+
+
 _DASHES = "\u2212\u2010\u2011\u2012\u2013\u2014\ufe63\uff0d"
 _NAME_EQ = re.compile(r"(?<![\w.%])([A-Za-z_]\w*)\s*(\([^)]*\)|%\s*\w+)?\s*=")
 _REPEAT = re.compile(r"(?<![\w.])(\d+)\s*\*")
@@ -241,6 +330,31 @@ def _count_values(text: str) -> int:
         m = re.match(r"(\d+)\s*\*", tok)
         n += (int(m.group(1)) if len(m.group(1)) <= 6 else 10**6) if m else 1
     return max(n, 1)
+
+
+#: keys one group may have (the largest group has under 60): more is refused in the pre-scan
+MAX_KEYS_PER_GROUP = 200
+_KNOWN: dict[str, frozenset[str] | None] = {}
+
+
+def _known_keys(group: str) -> frozenset[str] | None:
+    """The keys of group ``group`` (a study's or &sweep, &optimize, &synthesis), or None when
+    no module declares it (the runner then refuses the group itself)."""
+    if group not in _KNOWN:
+        import importlib
+        keys = None
+        try:
+            if group in ("sweep", "optimize", "synthesis"):
+                module = importlib.import_module(f"driver.{group}")
+            else:
+                from driver.study import load_study
+                module = load_study(group)
+            spec = getattr(module, "SPEC", None)
+            keys = frozenset(spec.keys) if isinstance(spec, GroupSpec) else None
+        except Exception:   # noqa: BLE001 - a module that fails to import declares no keys here
+            keys = None
+        _KNOWN[group] = keys
+    return _KNOWN[group]
 
 
 def _prescan(path: Path, text: str) -> tuple[list[tuple[str, int]], list[_Item]]:
@@ -304,6 +418,13 @@ def _prescan(path: Path, text: str) -> tuple[list[tuple[str, int]], list[_Item]]
                     what = "array subscripts" if km.group(2).startswith("(") else "derived-type components"
                     raise DeckError(path, n, key, f"{what} are not supported ('{km.group(0).rstrip('= ')}'): "
                                     "give the whole list, e.g. key = 1, 2, 4")
+                known = _known_keys(current)
+                if known is not None and key not in known:
+                    raise DeckError(path, n, key, f"unknown key in &{current} (known keys: {', '.join(sorted(known))})")
+                if len(seen[current]) >= MAX_KEYS_PER_GROUP:
+                    raise DeckError(path, n, key, f"more than {MAX_KEYS_PER_GROUP} keys in &{current}; no group "
+                                    "has that many (refused before the namelist reader, whose work grows with "
+                                    "the square of a group's keys)")
                 if key in seen[current]:
                     raise DeckError(path, n, key, f"given twice in &{current}: on line {seen[current][key]} "
                                     f"and on line {n} (keep one)")
@@ -329,6 +450,7 @@ def _prescan(path: Path, text: str) -> tuple[list[tuple[str, int]], list[_Item]]
     if current is not None:
         raise DeckError(path, group_line, None, f"group &{current} is not closed (end it with '/')")
     for it in items:
+        _check_values(path, it)
         blank, _ = _code_mask(path, it.line, it.text)
         big = [m.group(1) for m in _REPEAT.finditer(blank) if len(m.group(1)) > 6 or int(m.group(1)) > MAX_VALUES]
         if big:
@@ -382,10 +504,10 @@ def _read_legacy(path: Path, text: str) -> Deck:
             raise DeckError(path, n, keys[min(len(tokens), len(keys) - 1)],
                             f"expected {len(keys)} value(s) ({' '.join(keys)}), found {len(tokens)}")
         for key, tok in zip(keys, tokens):
-            try:
-                values[key] = float(tok.replace("d", "e").replace("D", "e"))
-            except ValueError:
-                raise DeckError(path, n, key, f"not a number: {tok!r}") from None
+            f = _as_float(tok)
+            if f is None:
+                raise DeckError(path, n, key, f"not a number: {tok!r}")
+            values[key] = f
             lines[key] = n
     return Deck(path, {"fourbar": RawGroup("fourbar", values, lines, content[0][0])}, legacy=True)
 
@@ -399,8 +521,8 @@ def _plain(value: Any) -> Any:
 
 def _f90nml_reads(text: str) -> tuple[Any, list[str]]:
     """f90nml's parse of ``text`` with its warnings captured (never printed)."""
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
+    with warnings.catch_warnings(record=True) as caught, contextlib.redirect_stdout(io.StringIO()):
+        warnings.simplefilter("always")   # and f90nml's debug prints (its state table) go nowhere
         nml = f90nml.reads(text)
     return nml, [str(w.message) for w in caught]
 
@@ -466,16 +588,29 @@ def read_deck(path: str | Path, text: str | None = None) -> Deck:
 # --------------------------------------------------------------------------- validation
 
 def _as_float(v: Any) -> float | None:
+    """A number as a float; a string only when it spells a Fortran number (:func:`is_number`:
+    not '5_0', not fullwidth or Arabic-Indic digits); None otherwise.  A Python int beyond a
+    float is returned as inf (refused by the caller as not finite)."""
     if isinstance(v, bool) or v is None:
         return None
-    if isinstance(v, (int, float)):
-        return float(v)
-    if isinstance(v, str):
+    if isinstance(v, int):
         try:
-            return float(v.strip().replace("d", "e").replace("D", "e"))
-        except ValueError:
+            return float(v)
+        except OverflowError:
+            return math.inf if v > 0 else -math.inf
+    if isinstance(v, float):
+        return v
+    if isinstance(v, str):
+        if not is_number(v):
             return None
+        return float(v.strip(" \t").replace("d", "e").replace("D", "e"))
     return None
+
+
+def shown_value(v: Any) -> str:
+    """A value in a message: its repr, cut to 40 characters (a 400-digit integer is not echoed)."""
+    r = repr(v)
+    return r if len(r) <= 40 else r[:37] + "..."
 
 
 def _coerce(kind: str, v: Any) -> tuple[Any, str | None]:
@@ -502,21 +637,19 @@ def _coerce(kind: str, v: Any) -> tuple[Any, str | None]:
         return None, "no value given"
     if isinstance(v, list):
         return None, f"expected one value, got a list of {len(v)}"
-    if kind == "float":
+    if kind in ("float", "int"):
         f = _as_float(v)
         if f is None:
-            return None, f"not a number: {v!r}"
+            return None, f"not a number: {shown_value(v)}"
         if not math.isfinite(f):
-            return None, f"not a finite number: {v!r}"
-        if abs(f) > MAX_FLOAT:
-            return None, f"{f:g} is beyond +-{MAX_FLOAT:g}, outside what any study here computes"
-        return f, None
-    if kind == "int":
-        f = _as_float(v)
-        if f is None or not f.is_integer():
-            return None, f"not a whole number: {v!r}"
-        if abs(f) > MAX_INT:
-            return None, f"{f:g} is beyond +-{MAX_INT:g}"
+            return None, f"not a finite number: {shown_value(v)}"
+        if abs(f) > (MAX_FLOAT if kind == "float" else MAX_INT):
+            limit = MAX_FLOAT if kind == "float" else MAX_INT
+            return None, f"{f:g} is beyond +-{limit:g}, outside what any study here computes"
+        if kind == "float":
+            return f, None
+        if not f.is_integer():
+            return None, f"not a whole number: {shown_value(v)}"
         return int(f), None
     if kind == "bool":
         if isinstance(v, bool):

@@ -2,7 +2,7 @@
 
 A deck may name a computation over a table's columns, e.g. a sweep's ``keep`` filter::
 
-    keep = 'meets_band_40_120 and rocker_swing_deg >= 60 and abs(mu_min_deg - 45) < 10'
+    keep = 'meets_transmission_band and rocker_swing_deg >= 60 and abs(mu_min_deg - 45) < 10'
 
 The text is parsed with :mod:`ast` and checked against a whitelist; nothing in it is ever
 evaluated by Python.  Allowed:
@@ -26,16 +26,20 @@ from __future__ import annotations
 import ast
 import math
 import re
+import unicodedata
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any, Callable
 
 import numpy as np
 
-__all__ = ["Expr", "ExprError", "FUNCTIONS", "parse", "MAX_LENGTH", "MAX_NODES"]
+__all__ = ["Expr", "ExprError", "FUNCTIONS", "parse", "kinds_of", "MAX_LENGTH", "MAX_NODES"]
 
 #: longest expression text accepted (characters) and largest syntax tree (nodes)
 MAX_LENGTH, MAX_NODES = 2000, 500
+#: digits a number in an expression may have
+MAX_DIGITS = 40
+_DECIMAL = re.compile(r"(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?", re.ASCII)
 
 
 class ExprError(ValueError):
@@ -101,6 +105,8 @@ def _prepare(text: str) -> tuple[str, dict[str, str]]:
             name = piece[1:-1].strip()
             if not name:
                 raise ExprError("empty name in backticks", piece)
+            if not name.isascii() or not name.isprintable():
+                raise ExprError("a name in backticks is printable ASCII", piece)
             ident = f"_bq{len(names)}_"
             names[ident] = name
             pieces.append(f" {ident} ")
@@ -109,6 +115,14 @@ def _prepare(text: str) -> tuple[str, dict[str, str]]:
         else:
             if "@" in piece:
                 raise ExprError("'@' references are not allowed in a deck expression", "@")
+            if "#" in piece:
+                raise ExprError("'#' is not a comment inside an expression (the whole text is the "
+                                "expression); remove it and what follows, or quote it", piece[piece.index("#"):][:40])
+            for ch in piece:
+                if not (" " <= ch <= "~" or ch == "\t"):
+                    raise ExprError(f"character {ch!r} (U+{ord(ch):04X} {unicodedata.name(ch, 'control')}) is "
+                                    "not allowed outside quotes: names and numbers are ASCII (a fullwidth or "
+                                    "accented look-alike would read another column)", ch)
             for word, repl in _FORTRAN.items():
                 piece = re.sub(re.escape(word), repl, piece, flags=re.IGNORECASE)
             pieces.append(piece)
@@ -151,10 +165,22 @@ class Expr:
         """The expression over every row of ``data`` (DataFrame or mapping of columns)."""
         n = _length(data)
         columns = {name: _column(data, name, n) for name in self.names}
+        _Kinds(_kinds_of_columns(columns), dict(self._aliases), self._source).of(self._tree.body)
         with np.errstate(all="ignore"):
             out = _Evaluator(columns, dict(self._aliases), self._source).visit(self._tree.body)
         out = np.asarray(out)
         return np.broadcast_to(out, (n,)).copy() if out.ndim == 0 else out
+
+    def check_kinds(self, kinds: Mapping[str, str]) -> str:
+        """Check the expression against column kinds (``{'mu_min_deg': 'number', 'grashof_class':
+        'text'}``, see :func:`kinds_of`) before anything is evaluated: arithmetic, functions and
+        order on numbers and logicals only, text compared with text only, and the result one
+        number or logical per row.  Returns the result's kind ('number' or 'bool'); raises
+        :class:`ExprError` naming the offending token."""
+        result = _Kinds(kinds, dict(self._aliases), self._source).of(self._tree.body)
+        if result == "text":
+            raise ExprError(f"'{self._source[:60]}' gives text, not a number or a logical", self._source[:60])
+        return result
 
     def mask(self, data: Any) -> np.ndarray:
         """Truth of the expression for every row: a boolean array (NaN/None count as false)."""
@@ -187,6 +213,8 @@ def parse(text: str, columns: Iterable[str] | None = None) -> Expr:
         raise ExprError(f"expression too large ({len(nodes)} syntax nodes; at most {MAX_NODES})")
     names: set[str] = set()
     _check(tree.body, source, aliases, names)
+    _Kinds({}, aliases, source, "any").of(tree.body)   # text constants in arithmetic ('x' * 10**9)
+    _fold(tree.body, source, aliases)
     if columns is not None:
         known = set(columns)
         for name in sorted(names):
@@ -222,6 +250,15 @@ def _check(node: ast.AST, source: str, aliases: dict[str, str], names: set[str])
     elif isinstance(node, ast.Constant):
         if not isinstance(node.value, (bool, int, float, str)) or isinstance(node.value, complex):
             raise ExprError("only numbers, strings and True/False are allowed as constants", tok(node))
+        if isinstance(node.value, (int, float)) and not isinstance(node.value, bool):
+            spelt = tok(node)
+            if not _DECIMAL.fullmatch(spelt):
+                raise ExprError(f"'{spelt[:40]}' is not a number as a deck writes one (decimal digits, '.', "
+                                "an e exponent; no '_', 0x, 0o, 0b or j)", spelt[:40])
+            if sum(c.isdigit() for c in spelt) > MAX_DIGITS:
+                raise ExprError(f"number with more than {MAX_DIGITS} digits", spelt[:40] + "...")
+            if not math.isfinite(float(node.value)):
+                raise ExprError(f"'{spelt[:40]}' is not a finite float64 number", spelt[:40])
     elif isinstance(node, ast.Name):
         name = aliases.get(node.id, node.id)
         if node.id not in aliases and (node.id.startswith("__") or node.id.startswith("_bq")):
@@ -244,6 +281,9 @@ def _check(node: ast.AST, source: str, aliases: dict[str, str], names: set[str])
         nargs = FUNCTIONS[fname][1]
         if nargs is not None and len(node.args) != nargs:
             raise ExprError(f"{fname}() takes {nargs} argument(s)", tok(node))
+        if nargs is None and len(node.args) < 2:
+            raise ExprError(f"{fname}() takes two or more arguments: it is element-wise over the columns of "
+                            "one case (one value per case), not a reduction over the cases", tok(node))
         for a in node.args:
             if isinstance(a, ast.Starred):
                 raise ExprError("'*' arguments are not allowed", tok(a))
@@ -256,6 +296,118 @@ def _check(node: ast.AST, source: str, aliases: dict[str, str], names: set[str])
                 ast.Tuple: "tuples", ast.Dict: "dicts", ast.Set: "sets", ast.Await: "await",
                 ast.Yield: "yield", ast.Starred: "'*'", ast.Slice: "slices"}.get(type(node), type(node).__name__)
         raise ExprError(f"{what} are not allowed in a deck expression", tok(node))
+
+
+def _reads_columns(node: ast.AST) -> bool:
+    """Whether the part reads a column (a function's own name is not one)."""
+    if isinstance(node, ast.Attribute):
+        return True
+    if isinstance(node, ast.Name):
+        return node.id not in ("True", "False")
+    if isinstance(node, ast.Call):
+        return any(_reads_columns(a) for a in node.args)
+    return any(_reads_columns(c) for c in ast.iter_child_nodes(node))
+
+
+def _fold(node: ast.AST, source: str, aliases: dict[str, str]) -> None:
+    """Evaluate every largest part that reads no column (a constant) now: it must be a finite
+    number, a logical or a text (``9**9**9**9``, ``log(0.0)``, ``'x' * 10**9`` are refused here)."""
+    if _reads_columns(node):
+        for child in ast.iter_child_nodes(node):
+            if isinstance(child, ast.expr):
+                _fold(child, source, aliases)
+        return
+    if isinstance(node, ast.Constant):
+        return
+    with np.errstate(all="ignore"):
+        value = np.asarray(_Evaluator({}, aliases, source).visit(node))
+    if value.dtype.kind in "iuf" and not np.all(np.isfinite(value)):
+        raise ExprError(f"'{_segment(source, node)[:60]}' is {value.item()!r}, not a finite number",
+                        _segment(source, node)[:60])
+
+
+#: the kinds of value a column holds, for :meth:`Expr.check_kinds`
+KINDS = ("number", "bool", "text")
+
+
+def kinds_of(sample: Mapping[str, Any]) -> dict[str, str]:
+    """Column kinds from one row (a case's summary): text for strings, bool for logicals,
+    number otherwise (None/NaN included)."""
+    out = {}
+    for k, v in sample.items():
+        if isinstance(v, (bool, np.bool_)):
+            out[k] = "bool"
+        elif isinstance(v, str):
+            out[k] = "text"
+        else:
+            out[k] = "number"
+    return out
+
+
+def _kinds_of_columns(columns: Mapping[str, np.ndarray]) -> dict[str, str]:
+    out = {}
+    for k, a in columns.items():
+        if a.dtype.kind == "b":
+            out[k] = "bool"
+        elif a.dtype.kind in "iuf":
+            out[k] = "number"
+        else:
+            out[k] = "text" if any(isinstance(v, str) for v in a.ravel()) else "number"
+    return out
+
+
+class _Kinds:
+    """Static type check of a tree against column kinds (number, bool, text)."""
+
+    def __init__(self, kinds: Mapping[str, str], aliases: dict[str, str], source: str, unknown: str = "number"):
+        self.kinds, self.aliases, self.source = kinds, aliases, source
+        self.unknown = unknown   # the kind of a column not in ``kinds`` ('any': not known yet)
+
+    def tok(self, node: ast.AST) -> str:
+        return _segment(self.source, node)[:60]
+
+    def numeric(self, node: ast.AST, what: str) -> None:
+        if self.of(node) == "text":
+            raise ExprError(f"{what} on text ('{self.tok(node)}' is text, not a number)", self.tok(node))
+
+    def of(self, node: ast.AST) -> str:
+        if isinstance(node, ast.Constant):
+            return "bool" if isinstance(node.value, bool) else ("text" if isinstance(node.value, str) else "number")
+        if isinstance(node, ast.Name):
+            if node.id in ("True", "False"):
+                return "bool"
+            return self.kinds.get(self.aliases.get(node.id, node.id), self.unknown)
+        if isinstance(node, ast.Attribute):
+            return self.kinds.get(_dotted(node) or "", self.unknown)
+        if isinstance(node, ast.BoolOp):
+            for v in node.values:
+                self.of(v)
+            return "bool"
+        if isinstance(node, ast.UnaryOp):
+            if isinstance(node.op, ast.Not):
+                self.of(node.operand)
+                return "bool"
+            self.numeric(node.operand, "arithmetic")
+            return "number"
+        if isinstance(node, ast.BinOp):
+            self.numeric(node.left, "arithmetic")
+            self.numeric(node.right, "arithmetic")
+            return "number"
+        if isinstance(node, ast.Compare):
+            left = node.left
+            for op, right in zip(node.ops, node.comparators):
+                a, b = self.of(left), self.of(right)
+                if "any" not in (a, b) and (a == "text") != (b == "text"):
+                    txt, num = (left, right) if a == "text" else (right, left)
+                    raise ExprError(f"'{self.tok(txt)}' is text and '{self.tok(num)}' a number: comparing them "
+                                    "is always false (compare text with 'quoted text')", self.tok(txt))
+                left = right
+            return "bool"
+        if isinstance(node, ast.Call):
+            for a in node.args:
+                self.numeric(a, f"{node.func.id}()")   # type: ignore[attr-defined]
+            return "number"
+        raise ExprError(f"{type(node).__name__} is not allowed", self.tok(node))
 
 
 def _length(data: Any) -> int:

@@ -22,6 +22,7 @@ from driver.extras import require
 require("plot")   # a clear message naming the [plot] extra when matplotlib is missing
 import matplotlib  # noqa: E402
 import matplotlib.ticker
+import matplotlib.colors
 import numpy as np
 from matplotlib.figure import Figure
 
@@ -31,8 +32,9 @@ from driver.study import PLOT_FORMATS, plot_format
 __all__ = ["STYLE", "style", "styled", "new_figure", "save_figure", "line_panels"]
 
 #: the house style, applied only inside :func:`style` (never written to the global rcParams)
-STYLE: dict[str, Any] = {"figure.dpi": 110, "savefig.dpi": 110, "axes.grid": True, "grid.alpha": 0.3,
-                         "axes.spines.top": False, "axes.spines.right": False, "font.size": 9}
+STYLE: dict[str, Any] = {"figure.dpi": 150, "savefig.dpi": 150, "axes.grid": True, "grid.alpha": 0.3,
+                         "axes.spines.top": False, "axes.spines.right": False, "font.size": 9,
+                         "legend.fontsize": 8.5, "axes.formatter.useoffset": False}
 
 _F = TypeVar("_F", bound=Callable[..., Any])
 
@@ -97,7 +99,7 @@ def line_panels(x: np.ndarray, panels: Sequence[tuple[str, dict[str, np.ndarray]
             ax.plot(x, y, label=label, **(styles or {}).get(label, {}))
         ax.set_ylabel(ylabel)
         if len(series) > 1:
-            ax.legend(fontsize=7, loc="best")
+            ax.legend(loc="best")
     axes[-1].set_xlabel(xlabel)
     if title:
         fig.suptitle(title)
@@ -129,24 +131,35 @@ def _unassembled_spans(theta: np.ndarray, ok: np.ndarray) -> list[tuple[float, f
     return spans
 
 
-#: legend words of the four-bar curves
-_FOURBAR_NAMES = {"coupler_deg": "coupler angle", "rocker_deg": "rocker angle", "transmission_deg": "transmission angle",
-                  "omega2_rad_s": "coupler speed omega2", "omega3_rad_s": "rocker speed omega3"}
+#: legend words of the four-bar curves: words first, textbook link numbers (2 crank, 3 coupler,
+#: 4 output link) as symbols; the tidy columns keep the paper's names (omega2 = coupler)
+def _fourbar_names(output: str = "rocker") -> dict[str, str]:
+    return {"coupler_deg": r"coupler angle $\theta_3$", "rocker_deg": rf"{output} angle $\theta_4$",
+            "transmission_deg": r"transmission angle $\mu$",
+            "omega2_rad_s": r"coupler angular velocity $\omega_3$",
+            "omega3_rad_s": rf"{output} angular velocity $\omega_4$"}
 
 
 @styled
-def fourbar_curves(exact, listing, title: str) -> Figure:
+def fourbar_curves(exact, listing, title: str, band: Sequence[float] = (40.0, 120.0), output: str = "rocker",
+                   axes=None) -> Figure:
     """Angles, angular velocities and transmission angle against crank angle.
 
     ``exact`` and ``listing`` are tidy frames from driver.fourbar; listing rows are
     drawn as markers over the exact curves so the listing's defect is visible.  Angles
     wrapped into 0-360 deg break at the wrap (no vertical line); crank angles where the
-    linkage cannot be assembled are shaded and said so.
+    linkage cannot be assembled are shaded and said so; the transmission-angle ``band``
+    [deg] is shaded.  ``output`` names the output link ('rocker', 'output crank').
+    ``axes``: three axes to draw into.
     """
+    names = _fourbar_names(output)
     panels = [("link angle [deg]", ["coupler_deg", "rocker_deg"]),
               ("transmission angle [deg]", ["transmission_deg"]),
               ("angular velocity [rad/s]", ["omega2_rad_s", "omega3_rad_s"])]
-    fig, axes = new_figure(3, 1, sharex=True, figsize=(7.0, 7.6))
+    if axes is None:
+        fig, axes = new_figure(3, 1, sharex=True, figsize=(7.4, 7.6))
+    else:
+        fig = axes[0].figure
     colors = {"coupler_deg": "C0", "rocker_deg": "C1", "transmission_deg": "C2",
               "omega2_rad_s": "C0", "omega3_rad_s": "C1"}
     theta = exact["theta_deg"].to_numpy(dtype=float)
@@ -157,55 +170,94 @@ def fourbar_curves(exact, listing, title: str) -> Figure:
         for k in keys:
             wrap = k.endswith("_deg")
             ax.plot(*(break_wraps(theta, exact[k]) if wrap else (theta, exact[k])), color=colors[k],
-                    label=f"{_FOURBAR_NAMES[k]} (exact)")
+                    label=f"{names[k]} (exact)")
             if listing is not None:
                 ax.plot(listing["theta_deg"], listing[k], "o", ms=4, mfc="none", color=colors[k],
-                        label=f"{_FOURBAR_NAMES[k]} (listing)")
+                        label=f"{names[k]} (listing)")
         ax.set_ylabel(label)
     angles = exact[["coupler_deg", "rocker_deg"]].to_numpy(dtype=float)
     if np.isfinite(angles).any() and np.ptp(angles[np.isfinite(angles)]) > 180.0:   # wrapped: the whole turn
         axes[0].set_ylim(-5, 365)
         axes[0].set_yticks(np.arange(0, 361, 90))
-    axes[1].axhspan(40, 120, color="C2", alpha=0.08, label="40-120 deg band")
+    axes[1].axhspan(band[0], band[1], color="C2", alpha=0.08, label=f"{band[0]:g}-{band[1]:g} deg band")
     for ax in axes:
-        ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
-    axes[-1].set_xlabel("crank angle [deg]")
-    fig.suptitle(f"{title}: four-bar kinematics")
+        ax.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
+    axes[-1].set_xlabel(r"crank angle $\theta_2$ [deg]")
+    if title:
+        fig.suptitle(f"{title}: four-bar kinematics")
     return fig
+
+
+def _runs(ok: np.ndarray) -> list[np.ndarray]:
+    """Index runs where ``ok`` holds (a run wrapping past the end of a full turn is joined)."""
+    idx = np.arange(len(ok))
+    runs = [r for r in np.split(idx, np.flatnonzero(np.diff(ok.astype(int))) + 1) if len(r) and ok[r[0]]]
+    return runs
 
 
 @styled
 def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.ndarray,
                     listing, title: str, n_poses: int = 6, point: np.ndarray | None = None,
-                    units: str = "length units") -> Figure:
+                    units: str = "length units", output: str = "rocker",
+                    limits: Sequence[tuple[float, np.ndarray]] = (), ax=None) -> Figure:
     """The linkage drawn at a few crank angles with the paths of A and B (exact), and the
-    path of a coupler point (``point``: (n, 2) positions) when the deck defines one.
-    Coordinates are in the deck's length ``units``, the crank pivot at the origin and the
-    ground link along +x; the legend sits beside the drawing, never on it."""
-    fig, (ax,) = new_figure(1, 1, figsize=(8.2, 5.0))
-    ax.plot(out[:, 3], out[:, 4], color="0.6", lw=0.8, label="path of A")
-    bx = np.where(ok, out[:, 5], np.nan)
-    by = np.where(ok, out[:, 6], np.nan)
-    ax.plot(bx, by, color="C3", lw=1.2, label="path of B (exact)")
-    if point is not None:
-        ax.plot(np.where(ok, point[:, 0], np.nan), np.where(ok, point[:, 1], np.nan), color="C4", lw=1.2,
-                ls="--", label="coupler point P")
+    path of a coupler point (``point``: (n, 2) positions) when the deck defines one, the
+    coupler then drawn as the plate A-B-P in every pose.
+
+    ``theta`` [deg] is the drawn crank range (a function generator's design range, or a whole
+    turn); the crank pin's path is drawn only where the linkage assembles, so a crank that
+    cannot turn shows the arc it swings through, not a circle.  Separate assembly intervals
+    are drawn and named as separate motions.  ``limits``: (crank angle [deg], kernel row)
+    of the limit (toggle) positions, drawn dashed and labelled.  ``output`` names the output
+    link.  Coordinates in the deck's length ``units``, crank pivot at the origin, ground along
+    +x; the legend sits beside the drawing.
+    """
+    if ax is None:
+        fig, (ax,) = new_figure(1, 1, figsize=(8.6, 5.2))
+    else:
+        fig = ax.figure
+    runs = _runs(ok)
+    full = bool(ok.all()) and np.ptp(theta) >= 359.0
+    for j, r in enumerate(runs if not full else [np.arange(len(ok))]):
+        ax.plot(out[r, 3], out[r, 4], color="0.55", lw=0.9, label="path of A (crank pin)" if j == 0 else None)
+        ax.plot(out[r, 5], out[r, 6], color="C3", lw=1.3, label=f"path of B ({output} pin)" if j == 0 else None)
+        if point is not None:
+            ax.plot(point[r, 0], point[r, 1], color="C4", lw=1.3, ls="--",
+                    label="path of coupler point P" if j == 0 else None)
     if listing is not None:
         ax.plot(listing["xb"], listing["yb"], "x", color="k", ms=5, label="B (listing)")
-    idx = np.flatnonzero(ok)
     cmap = matplotlib.colormaps["viridis"]
-    for j, k in enumerate(idx[np.linspace(0, len(idx) - 1, n_poses, endpoint=False).astype(int)] if len(idx) else []):
+    # poses spread over the assembled samples (every run gets some)
+    idx = np.flatnonzero(ok)
+    picks = idx[np.linspace(0, len(idx) - 1, n_poses, endpoint=not full).astype(int)] if len(idx) else []
+    for j, k in enumerate(picks):
+        c = cmap(j / max(1, n_poses - 1))
         xs = [0.0, out[k, 3], out[k, 5], ground]
         ys = [0.0, out[k, 4], out[k, 6], 0.0]
-        ax.plot(xs, ys, "-o", color=cmap(j / max(1, n_poses - 1)), ms=3, lw=1.4,
-                label=f"theta = {theta[k]:.0f} deg")
+        ax.plot(xs, ys, "-o", color=c, ms=3, lw=1.5, label=rf"$\theta_2$ = {theta[k]:.0f}°")
+        if point is not None:
+            tri = np.array([[out[k, 3], out[k, 4]], [out[k, 5], out[k, 6]], point[k], [out[k, 3], out[k, 4]]])
+            ax.fill(tri[:, 0], tri[:, 1], color=c, alpha=0.15, lw=0)
+            ax.plot(tri[:, 0], tri[:, 1], color=c, lw=1.0)
+            ax.plot(*point[k], "o", color=c, ms=3.5)
+    for j, (angle, row) in enumerate(limits):
+        xs = [0.0, row[3], row[5], ground]
+        ys = [0.0, row[4], row[6], 0.0]
+        ax.plot(xs, ys, "--", color="k", lw=1.1, label="limit (toggle) positions" if j == 0 else None)
+        ax.annotate(rf"$\theta_2$ = {angle:.1f}°", (row[3], row[4]), xytext=(4, -10), textcoords="offset points",
+                    fontsize=8)
     ax.plot([0.0, ground], [0.0, 0.0], color="k", lw=2.5)
-    ax.plot([0.0, ground], [0.0, 0.0], "^", color="k", ms=9, label="ground pivots")
+    ax.plot([0.0, ground], [0.0, 0.0], "^", color="k", ms=9, label="ground pivots $O_2$, $O_4$")
     ax.set_aspect("equal")
     ax.set_xlabel(f"x [{units}]")
     ax.set_ylabel(f"y [{units}]")
-    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
-    ax.set_title(f"{title}: linkage positions")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
+    lo, hi = float(np.min(theta)), float(np.max(theta))
+    what = "linkage positions" + ("" if full or (hi - lo) >= 359.0 else f" over the crank range {lo:g}-{hi:g}°")
+    if len(runs) > 1:
+        spans = ", ".join(f"{theta[r[0]]:.0f}-{theta[r[-1]]:.0f}°" for r in runs)
+        what += f"\nassembles over {len(runs)} separate crank intervals ({spans}): separate motions"
+    ax.set_title(f"{title}: {what}" if title else what)
     return fig
 
 
@@ -279,7 +331,7 @@ def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, 
         ax.set_ylabel("l2 [m]")
     axes[0].set_title("reach region, C_rob, iso-RI2 ellipses")
     axes[1].set_title("RI2 over the design plane")
-    fig.legend(*axes[0].get_legend_handles_labels(), fontsize=7, loc="outside lower center", ncol=4, frameon=False)
+    fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncol=4, frameon=False)
     if title:
         fig.suptitle(title)
     return fig
@@ -304,19 +356,22 @@ def manipulator_torque_crob(l1: np.ndarray, tau1: np.ndarray, tau2: np.ndarray, 
                     label="violates the workspace reach conditions" if k == 0 else None)
     ax.set_ylabel("motor torque [N m]")
     ax.set_xlabel("l1 [m]  (l2 = sqrt(%g - l1^2) [m])" % c)
-    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     fig.suptitle(f"{title}: motor torques along C_rob" if title else "Motor torques along C_rob")
     return fig
 
 
 # ----------------------------------------------------------------------------- sweep
 
-def _trivial(y, x, chosen) -> bool:
-    """A panel that shows nothing: a constant column, the x column again, or a column already shown."""
+def _trivial(y, x, chosen, unit: str = "") -> bool:
+    """A panel that shows nothing: a constant column, round-off (angles all below 1e-5 deg), the
+    x column or a swept key again, or a column already shown."""
     import pandas as pd
     v = pd.to_numeric(y, errors="coerce").to_numpy(dtype=float)
     fin = v[np.isfinite(v)]
     if fin.size == 0 or np.ptp(fin) <= 1e-12 * max(1.0, float(np.max(np.abs(fin)))):
+        return True
+    if unit == "deg" and float(np.max(np.abs(fin))) < 1e-5:
         return True
     for other in [x, *chosen]:
         w = pd.to_numeric(other, errors="coerce").to_numpy(dtype=float)
@@ -339,6 +394,7 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
     """
     import pandas as pd
     labels = labels or {}
+    only_points = False
     label = lambda c: textwrap.fill(labels.get(c, c), 28)  # noqa: E731  (two lines fit a panel)
     x = x or next((k for k in keys if pd.api.types.is_numeric_dtype(frame[k])), "case")
     if ys:
@@ -348,10 +404,14 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
                    and not pd.api.types.is_bool_dtype(frame[c]) and c not in keys]
         ordered = [c for c in preferred if c in numeric] + [c for c in numeric if c not in preferred]
         ys = []
+        unit = lambda c: labels.get(c, "").rpartition("[")[2].rstrip("]")  # noqa: E731
         for c in ordered:
-            if len(ys) < 6 and not _trivial(frame[c], frame[x], [frame[k] for k in ys]):
+            if len(ys) < 6 and not _trivial(frame[c], frame[x], [frame[k] for k in [*ys, *keys]], unit(c)):
                 ys.append(c)
-        ys = ys or ordered[:1]
+        if not ys:   # every figure constant or round-off: show how the kept designs' other keys vary with x
+            ys = [k for k in keys if k != x and pd.api.types.is_numeric_dtype(frame[k])] or ordered[:1]
+            keys = [k for k in keys if k not in ys]
+            only_points = True   # a key against a key: points, no line (angles may wrap between them)
     fig, axes = new_figure(len(ys), 1, sharex=True, figsize=(7.0, 1.9 * len(ys) + 0.9))
     kept = frame["kept"].astype(bool) if "kept" in frame else pd.Series(True, index=frame.index)
     others = [k for k in keys if k != x]
@@ -368,7 +428,7 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
             continue
         for key, g in groups:
             g = g.sort_values(x)
-            style = "-" if len(frame) <= 2000 else ""
+            style = "-" if len(frame) <= 2000 and not only_points else ""
             ax.plot(g[x], g[y], style, marker="o" if len(frame) <= 200 else ".", ms=3, lw=1,
                     label=", ".join(f"{labels.get(k, k).split(' [')[0]} = {v}"
                                     for k, v in zip(others, key if isinstance(key, tuple) else (key,))) or None)
@@ -376,7 +436,7 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
             ax.plot(frame.loc[kept, x], frame.loc[kept, y], "o", ms=4, mfc="none", color="k", label="kept")
         ax.set_ylabel(label(y))
     if others or not kept.all():
-        axes[0].legend(fontsize=7, ncol=min(3, max(1, len(frame.groupby(others)) if others else 1)),
+        axes[0].legend(ncol=min(3, max(1, len(frame.groupby(others)) if others else 1)),
                        loc="lower left", bbox_to_anchor=(0.0, 1.02), frameon=False)
     axes[-1].set_xlabel(label(x))
     fig.suptitle(f"{title}: sweep summary" if title else "sweep summary")
@@ -417,26 +477,30 @@ def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.
             ax.fill_between(x, lo, hi, color="0.5", alpha=0.15, lw=0, label=text)
         else:
             ax.axhspan(lo, hi, color="0.5", alpha=0.15, lw=0, label=text)
-    ax.plot(x, np.full_like(theta_deg, rpm, dtype=float), "k--", lw=0.9, label=f"input shaft {rpm:g} rpm")
     for k, (label, w) in enumerate(curves.items()):
         style = _UJOINT_STYLES.get(label, dict(color=f"C{k + 4}", lw=1.4))
         ax.plot(x, w, label=f"{label}: output {np.min(w):.2f}-{np.max(w):.2f} rpm", **style)
+    # the input speed last and on top: an optimum close to it must not hide it
+    ax.plot(x, np.full_like(theta_deg, rpm, dtype=float), "k--", lw=1.1, zorder=5, label=f"input shaft {rpm:g} rpm")
     if polar:
         ax.set_rlim(low - pad, top + pad)
         ax.set_rorigin(low - pad - 0.6 * (top - low + 2 * pad))
-        ax.set_rlabel_position(100.0)
-        ax.yaxis.set_major_locator(matplotlib.ticker.MaxNLocator(4))
-        ax.yaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g} rpm"))
-        ax.tick_params(axis="y", labelsize=7)
+        ticks = [t for t in matplotlib.ticker.MaxNLocator(4).tick_values(low - pad, top + pad)
+                 if low - pad <= t <= top + pad]
+        ax.set_yticks(ticks)
+        ax.set_yticklabels([])
+        for t in ticks:   # radial labels cross the curves: drawn on a white patch, above them
+            ax.text(np.radians(112.5), t, f"{t:g} rpm", fontsize=7.5, ha="center", va="center", zorder=6,
+                    bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.85))
         ax.set_xlabel("input angle [deg]; radius: shaft speed [rpm], not starting at 0", fontsize=8)
-        fig.legend(loc="outside lower center", fontsize=7, ncol=2, frameon=False)
+        fig.legend(loc="outside lower center", ncol=2, frameon=False)
     else:
         ax.set_ylim(low - pad, top + pad)
         ax.set_ylabel("shaft speed [rpm]")
         ax.set_xlabel("input angle [deg]")
         ax.set_xlim(0.0, 360.0)
         ax.set_xticks(np.arange(0, 361, 45))
-        fig.legend(loc="outside lower center", fontsize=7, ncol=2, frameon=False)
+        fig.legend(loc="outside lower center", ncol=2, frameon=False)
     fig.suptitle(f"{title}: Hooke-joint chain, input and output shaft speed" if title
                  else "Hooke-joint chain: input and output shaft speed")
     return fig
@@ -471,8 +535,8 @@ def slidercrank_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray
     ax.set_xticks(np.arange(0, 361, 45))
     ax.set_xlabel("crank angle theta2 [deg]")
     ax.set_ylabel(ylabel)
-    fig.legend(fontsize=7, loc="outside lower center", ncol=3 if len(series) + len(missing) > 4 else 2,
-               frameon=False, title="crank speed", title_fontsize=7)
+    fig.legend(loc="outside lower center", ncol=3 if len(series) + len(missing) > 4 else 2,
+               frameon=False, title="crank speed")
     ax.set_title(title)
     return fig
 
@@ -490,9 +554,297 @@ def slidercrank_convergence_figure(series: dict[str, tuple[list[int], list[float
     axes[0].set_ylabel("peak tensile strain [microstrain]")
     axes[1].set_ylabel("change from previous count [%]")
     axes[1].set_xlabel("number of elements")
-    axes[0].legend(fontsize=7)
+    axes[0].legend()
     fig.suptitle(title)
     return fig
+
+
+# ----------------------------------------------------------------------------- design spaces and convergence
+
+def _numeric_axis(values) -> np.ndarray:
+    """Sorted distinct finite values of a swept key."""
+    import pandas as pd
+    v = pd.to_numeric(pd.Series(values), errors="coerce").to_numpy(dtype=float)
+    return np.unique(v[np.isfinite(v)])
+
+
+def _grid_of(frame, kx: str, ky: str, col: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Values of ``col`` on the (kx, ky) grid of the rows of ``frame`` (NaN where no row)."""
+    import pandas as pd
+    xs, ys = _numeric_axis(frame[kx]), _numeric_axis(frame[ky])
+    z = np.full((len(ys), len(xs)), np.nan)
+    ix = np.searchsorted(xs, pd.to_numeric(frame[kx], errors="coerce").to_numpy(dtype=float))
+    iy = np.searchsorted(ys, pd.to_numeric(frame[ky], errors="coerce").to_numpy(dtype=float))
+    vals = pd.to_numeric(frame[col], errors="coerce").to_numpy(dtype=float)
+    ok = (ix < len(xs)) & (iy < len(ys))
+    z[iy[ok], ix[ok]] = vals[ok]
+    return xs, ys, z
+
+
+def _edges(v: np.ndarray) -> np.ndarray:
+    """Cell edges around grid values (midpoints; half a step beyond the ends)."""
+    if len(v) == 1:
+        return np.array([v[0] - 0.5, v[0] + 0.5])
+    mid = 0.5 * (v[1:] + v[:-1])
+    return np.concatenate([[2 * v[0] - mid[0]], mid, [2 * v[-1] - mid[-1]]])
+
+
+def _plain_numbers(ax) -> None:
+    """No offset or scientific notation on either axis (a reader sees the numbers themselves)."""
+    for axis in (ax.xaxis, ax.yaxis):
+        fmt = axis.get_major_formatter()
+        if isinstance(fmt, matplotlib.ticker.ScalarFormatter):
+            fmt.set_useOffset(False)
+            fmt.set_scientific(False)
+
+
+@styled
+def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, str] | None = None,
+                     best: int | None = None, best_text: str = "", title: str = "", panels: int = 6,
+                     cmap: str = "viridis", only_kept: bool = False, ax=None) -> Figure:
+    """A metric over the design space of a sweep, as a textbook prints it.
+
+    ``frame`` has one row per case (the sweep summary: swept keys, ``kept``, the metric);
+    ``keys`` are the 1-3 swept keys.  One key: the metric against it as a line, kept cases
+    as filled markers.  Two keys: the metric as an image over the two keys (cells without a
+    row left blank), the kept designs outlined in black.  Three keys: small multiples of
+    that image over up to ``panels`` values of the third key (the best's value always among
+    them), one shared colour scale.  ``only_kept``: the frame holds the kept designs only (blank
+    cells are designs not kept, not missing ones).  ``best`` is the frame index of the design to mark (a
+    star labelled ``best_text``); ``labels`` maps columns to axis words with units.  With
+    ``ax`` (one key or two) the map is drawn into that axes and its figure returned.
+    """
+    import pandas as pd
+    labels = labels or {}
+    lab = lambda c: labels.get(c, c)  # noqa: E731
+    keys = [k for k in keys if k in frame.columns][:3]
+    kept = frame["kept"].astype(bool) if "kept" in frame else pd.Series(True, index=frame.index)
+    z_all = pd.to_numeric(frame[metric], errors="coerce").to_numpy(dtype=float)
+    fin = z_all[np.isfinite(z_all)]
+    vmin, vmax = (float(fin.min()), float(fin.max())) if fin.size else (0.0, 1.0)
+    if vmax - vmin <= 1e-12 * max(1.0, abs(vmax)):
+        vmin, vmax = vmin - 0.5, vmax + 0.5
+    norm = matplotlib.colors.Normalize(vmin, vmax)
+    brow = frame.loc[best] if best is not None and best in frame.index else None
+
+    if len(keys) <= 1:
+        if ax is None:
+            fig, (ax,) = new_figure(1, 1, figsize=(6.4, 3.6))
+        else:
+            fig = ax.figure
+        x = keys[0] if keys else "case"
+        order = frame.sort_values(x)
+        ax.plot(order[x], order[metric], "-", color="C0", lw=1.2, label="all cases")
+        ax.plot(order.loc[kept, x], order.loc[kept, metric], "o", ms=4, color="C0", label="kept")
+        if brow is not None:
+            ax.plot([brow[x]], [brow[metric]], "*", ms=14, color="C3", mec="k", label=best_text or "best")
+        ax.set_xlabel(lab(x))
+        ax.set_ylabel(lab(metric))
+        _plain_numbers(ax)
+        ax.legend(loc="best")
+        if title:
+            ax.set_title(title)
+        return fig
+
+    kx, ky = keys[0], keys[1]
+    if len(keys) == 3:
+        kz = keys[2]
+        zs = _numeric_axis(frame[kz])
+        pick = np.unique(np.linspace(0, len(zs) - 1, min(panels, len(zs))).round().astype(int))
+        if brow is not None:
+            bz = int(np.argmin(np.abs(zs - float(brow[kz]))))
+            if bz not in pick:
+                pick[np.argmin(np.abs(pick - bz))] = bz
+            pick = np.unique(pick)
+        slices = [(zs[i], frame[np.isclose(pd.to_numeric(frame[kz], errors="coerce"), zs[i])]) for i in pick]
+    else:
+        kz, slices = "", [(None, frame)]
+    n = len(slices)
+    if ax is not None and n == 1:
+        fig, axes = ax.figure, [ax]
+    else:
+        ncols = min(3, n)
+        nrows = int(math.ceil(n / ncols))
+        fig, axes = new_figure(nrows, ncols, sharex=True, sharey=True,
+                               figsize=(6.4, 5.0) if n == 1 else (3.3 * ncols + 1.2, 2.9 * nrows + 1.0))
+        for extra in axes[n:]:
+            extra.set_visible(False)
+    xs_all, ys_all = _numeric_axis(frame[kx]), _numeric_axis(frame[ky])
+    image = None
+    for a, (zval, part) in zip(axes, slices):
+        xs, ys, z = _grid_of(part, kx, ky, metric)
+        _, _, keep = _grid_of(part.assign(_kept=kept[part.index].astype(float)), kx, ky, "_kept")
+        a.grid(False)
+        a.set_facecolor("0.93")
+        image = a.pcolormesh(_edges(xs), _edges(ys), np.ma.masked_invalid(z), cmap=cmap, norm=norm,
+                             shading="flat", rasterized=True)
+        if np.nansum(keep) and not np.all(keep[np.isfinite(keep)] == 1):
+            k = np.nan_to_num(keep, nan=0.0)
+            a.contour(xs, ys, k, levels=[0.5], colors="k", linewidths=1.2)
+        if brow is not None and (zval is None or np.isclose(float(brow[kz]), zval)):
+            a.plot([brow[kx]], [brow[ky]], "*", ms=15, color="C3", mec="k", mew=0.8, zorder=5)
+            right = float(brow[kx]) > 0.5 * (xs_all[0] + xs_all[-1])
+            a.annotate("best", (brow[kx], brow[ky]), xytext=(-9 if right else 9, 7), textcoords="offset points",
+                       ha="right" if right else "left", fontsize=9, fontweight="bold", color="k",
+                       bbox=dict(boxstyle="round,pad=0.15", fc="w", ec="none", alpha=0.8))
+        a.set_xlim(_edges(xs_all)[[0, -1]])
+        a.set_ylim(_edges(ys_all)[[0, -1]])
+        if zval is not None:
+            a.set_title(f"{lab(kz).split(' [')[0]} = {zval:.4g}", fontsize=9)
+        _plain_numbers(a)
+    for a in axes[:n]:
+        if a.get_subplotspec() is None or a.get_subplotspec().is_last_row() or n == 1:
+            a.set_xlabel(lab(kx))
+        if a.get_subplotspec() is None or a.get_subplotspec().is_first_col() or n == 1:
+            a.set_ylabel(lab(ky))
+    if brow is not None and best_text:   # the best design's values, under the panels
+        fig.supxlabel("\u2605 " + textwrap.fill(best_text, 110), fontsize=8.5, color="0.15")
+    cb = fig.colorbar(image, ax=list(axes[:n]), shrink=0.9, pad=0.02)
+    cb.set_label(lab(metric))
+    _plain_numbers(cb.ax)
+    note = ("kept designs outlined in black" if not kept.all() else
+            "only kept designs tabulated (blank: not kept)" if only_kept else "every design kept")
+    if title:
+        fig.suptitle(f"{title}\n{note}" if (n > 1 or not kept.all() or only_kept) else title)
+    elif not kept.all() or only_kept:
+        axes[0].set_title(note, fontsize=8)
+    return fig
+
+
+@styled
+def convergence_plot(history, evals, objective: str, sense: str = "minimize", title: str = "",
+                     axes=None) -> Figure:
+    """How an optimisation converged, as an engineer reads it: three panels against the number
+    of designs evaluated.
+
+    Left: the best feasible objective so far (a step line), every feasible design as a grey
+    dot; the axis shows plain numbers (no offset).  Middle: the gap between the best so far
+    and the final best on a log axis (zero gaps left out), so the last digits gained are
+    visible without a 1e-7 change looking like a big step.  Right: the constraint violation
+    of every design on a log axis (feasible designs, violation 0, are not drawn) and its
+    running minimum.  ``history`` has columns evals, feasible, objective; ``evals`` eval,
+    feasible, objective, violation.  ``objective`` is the axis label (words and unit);
+    ``sense`` 'minimize' or 'maximize'.  ``axes``: three axes to draw into.
+    """
+    import pandas as pd
+    if axes is None:
+        fig, axes = new_figure(1, 3, sharex=True, figsize=(11.0, 3.8))
+    else:
+        fig = axes[0].figure
+    a1, a2, a3 = axes
+    objective = textwrap.fill(objective, 40)
+    ev = evals.sort_values("eval")
+    feas = ev[ev["feasible"].astype(bool)]
+    sign = -1.0 if sense.startswith("max") else 1.0
+    obj = pd.to_numeric(feas["objective"], errors="coerce").to_numpy(dtype=float)
+    a1.plot(feas["eval"], obj, ".", ms=2.5, color="0.65", label="feasible designs", rasterized=len(obj) > 2000)
+    if len(obj):
+        best = sign * np.minimum.accumulate(sign * obj)
+        x = np.concatenate([feas["eval"].to_numpy(dtype=float), [float(ev["eval"].max())]])
+        y = np.concatenate([best, best[-1:]])
+        a1.step(x, y, where="post", color="C3", lw=1.8, label="best so far")
+        final = best[-1]
+        gap = np.abs(best - final)
+        pos = gap > 0
+        if pos.any():
+            a2.step(x[:-1][pos], gap[pos], where="post", color="C3", lw=1.6)
+            a2.set_yscale("log")
+        else:
+            a2.text(0.5, 0.5, "the first feasible design\nwas already the best", transform=a2.transAxes,
+                    ha="center", va="center")
+        a2.axvline(float(feas["eval"].iloc[int(np.argmax(best == final))]), color="0.4", ls=":", lw=1,
+                   label="final best found")
+        a2.legend(loc="upper right")
+        lo, hi = np.nanmin(obj), np.nanmax(obj)
+        pad = 0.05 * (hi - lo) if hi > lo else max(1e-6, 0.05 * abs(hi))
+        a1.set_ylim(lo - pad, hi + pad)
+    else:
+        a1.text(0.5, 0.5, "no feasible design", transform=a1.transAxes, ha="center", va="center")
+    a1.set_ylabel(objective)
+    a1.set_title(f"best feasible ({'largest' if sign < 0 else 'smallest'})")
+    a1.legend(loc="best")
+    a2.set_ylabel("|best so far - final best|")
+    a2.set_title("gap to the final best")
+    viol = pd.to_numeric(ev["violation"], errors="coerce").to_numpy(dtype=float) if "violation" in ev else np.array([])
+    if viol.size and np.nanmax(viol) > 0:
+        pos = viol > 0
+        a3.plot(ev["eval"].to_numpy()[pos], viol[pos], ".", ms=2.5, color="C0", alpha=0.6,
+                label="violation of each design", rasterized=pos.sum() > 2000)
+        run = np.minimum.accumulate(np.where(np.isfinite(viol), viol, np.inf))
+        shown = run > 0
+        a3.step(ev["eval"].to_numpy()[shown], run[shown], where="post", color="k", lw=1.4,
+                label="smallest so far (0 once feasible)")
+        a3.set_yscale("log")
+        a3.legend(loc="best")
+    else:
+        a3.text(0.5, 0.5, "every design feasible", transform=a3.transAxes, ha="center", va="center")
+    a3.set_ylabel("constraint violation")
+    a3.set_title("constraint violation")
+    for a in axes:
+        a.set_xlabel("designs evaluated")
+    _plain_numbers(a1)
+    _plain_numbers(a3) if a3.get_yscale() == "linear" else None
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+def best_index(frame, metric: str, sense: str | None):
+    """The frame index of the kept, ok design with the best ``metric`` (``sense`` 'min' or 'max'),
+    or None (no sense known, or no such design)."""
+    import pandas as pd
+    if sense not in ("min", "max") or metric not in frame:
+        return None
+    ok = frame
+    if "status" in ok:
+        ok = ok[ok["status"] == "ok"]
+    if "kept" in ok:
+        ok = ok[ok["kept"].astype(bool)]
+    m = pd.to_numeric(ok[metric], errors="coerce")
+    if not m.notna().any():
+        return None
+    return m.idxmax() if sense == "max" else m.idxmin()
+
+
+def is_grid(frame, keys: Sequence[str]) -> bool:
+    """Whether 2-3 numeric swept ``keys`` span a grid worth a map (several values on each of two)."""
+    import pandas as pd
+    numeric = [k for k in keys if k in frame and pd.api.types.is_numeric_dtype(frame[k])
+               and not pd.api.types.is_bool_dtype(frame[k])]
+    if not (2 <= len(numeric) <= 3 and len(numeric) == len(keys)):
+        return False
+    counts = [len(_numeric_axis(frame[k])) for k in numeric[:2]]
+    # a map needs cells: at least 3 values on each axis and two designs per value on average
+    return min(counts) >= 3 and len(frame) >= 2 * max(counts)
+
+
+def _words_value(label: str, value: float, name: bool = True) -> str:
+    """``'crank length [length units]', 4.0`` -> ``'crank length 4 length units'`` (``name``
+    False: the value and unit only)."""
+    words, _, unit = label.partition(" [")
+    unit = unit.rstrip("]")
+    text = f"{value:.4g}" + (f" {unit}" if unit and unit != "-" else "")
+    return f"{words} {text}" if name else text
+
+
+def sweep_maps(frame, keys: Sequence[str], ys: Sequence[str], labels: dict[str, str], senses: dict[str, str],
+               title: str = "", only_kept: bool = False) -> list[Figure]:
+    """Design-space maps of a 2-3-key grid sweep, one per plotted column ``ys``: the best kept
+    design (by ``senses[y]``, 'min' or 'max', when the study knows which is better) starred and
+    labelled with its key values."""
+    figs = []
+    for y in ys:
+        best = best_index(frame, y, senses.get(y))
+        text = ""
+        if best is not None:
+            word = "largest" if senses[y] == "max" else "smallest"
+            text = f"best ({word} {labels.get(y, y).split(' [')[0]}): " + ", ".join(
+                f"{_words_value(labels.get(k, k), frame.loc[best, k])}" for k in keys) + \
+                f"; {labels.get(y, y).split(' [')[0]} {_words_value(labels.get(y, y), frame.loc[best, y], name=False)}"
+        figs.append(design_space_map(frame, keys, y, labels, best=best, best_text=text,
+                                     title=f"{title}: {labels.get(y, y)}" if title else labels.get(y, y),
+                                     only_kept=only_kept))
+    return figs
 
 
 # ----------------------------------------------------------------------------- slidercrank, nonlinear rod

@@ -179,6 +179,7 @@ def compute(module: ModuleType, params: Params, progress: bool = False,
         raise
     except NUMERICAL as exc:
         raise numerical_error(params, exc) from None
+    result.params = params
     return check_finite(result, params)
 
 

@@ -36,12 +36,12 @@ if TYPE_CHECKING:   # annotations only: keeps `python -m driver --help` light
 if TYPE_CHECKING:
     import matplotlib.figure
 
-__all__ = ["Figure", "PLOT_FORMATS", "Result", "column_label", "keyword_run", "load_study", "plot_format",
+__all__ = ["Figure", "PLOT_FORMATS", "Result", "code_digest", "column_label", "expression_label", "keyword_run", "load_study", "plot_format",
            "study_names"]
 
 _CORE = {"cli", "limits", "deck", "study", "table", "export", "plotting", "atomic", "kernels", "sweep", "runner", "expr",
          "optimize", "synthesis", "published", "compare", "extras", "example_decks", "examples", "api",
-         "sweep_batch", "blas"}
+         "sweep_batch", "blas", "report_page"}
 
 
 #: file formats of ``--plot`` figures (``--plot-format``); the first is the default
@@ -96,6 +96,9 @@ class Result:
     extra: dict[str, str] = field(default_factory=dict)
     name: str = ""
     study: str = ""
+    #: the validated deck keys the run was made from (set by the runner; the report page's
+    #: animation and comparison use them)
+    params: Any = field(default=None, repr=False, compare=False)
 
     @property
     def out(self) -> str:
@@ -134,16 +137,22 @@ class Result:
         raise LookupError(f"no figure {name!r}; this result draws {', '.join(self.figure_names)}")
 
     def write(self, outdir: str | Path, formats: Iterable[str] = (), plot: bool = False,
-              json: bool = False, name: str | None = None) -> list[Path]:
+              json: bool = False, name: str | None = None, report: bool = False) -> list[Path]:
         """Write the outputs the command line writes: ``<outdir>/<name>.out`` and extra files,
-        tidy tables in ``formats`` ('csv', 'parquet'), PNG figures with ``plot``, and the
-        summary as ``<name>.json`` with ``json``.  Every file is written atomically;
-        ``outdir`` is created when missing.  Returns the paths written."""
+        tidy tables in ``formats`` ('csv', 'parquet'), PNG figures with ``plot``, the
+        summary as ``<name>.json`` with ``json``, and the self-contained report page
+        ``<name>.html`` with ``report`` (:mod:`driver.report_page`, as ``--report``).  Every
+        file is written atomically; ``outdir`` is created when missing.  Returns the paths written."""
         from driver.runner import write_outputs
         stem = name or self.name or self.study or "result"
         if Path(stem).name != stem or stem in ("", ".", ".."):
             raise ValueError(f"output name {stem!r} must be a plain file stem, not a path")
-        return write_outputs(self, Path(outdir) / stem, list(formats), plot, summary_json=json)
+        written = write_outputs(self, Path(outdir) / stem, list(formats), plot, summary_json=json)
+        if report:
+            from driver import report_page
+            page = report_page.page_for_result(self, None, self.params)
+            written.append(report_page.write_report(Path(outdir) / f"{stem}.html", page))
+        return written
 
     def __repr__(self) -> str:
         state = "ok" if self.ok else f"failed: {self.failure}"
@@ -186,6 +195,35 @@ def load_study(group: str) -> ModuleType | None:
     return module
 
 
+def code_digest(module: ModuleType | None, *others: ModuleType | None) -> bytes:
+    """SHA-256 of the source of study ``module`` -- every ``.py`` file of its package when it
+    is one, so an edit to any module of the study counts -- of the other modules ``others``,
+    and of the compiled kernels.  Both kinds of sweep resume record (batch and per-case) carry
+    it in their signature: a record made by other code is redone, never believed."""
+    import hashlib
+    import sys
+
+    def files(mod: ModuleType | None) -> list[Path]:
+        path = getattr(mod, "__file__", None)
+        if not path:
+            return []
+        p = Path(path)
+        if p.name == "__init__.py":
+            return sorted(p.parent.rglob("*.py"))
+        return [p]
+
+    h = hashlib.sha256()
+    kernels = sys.modules.get("driver._kernels")
+    for mod in (module, *others, kernels):
+        for f in files(mod):
+            h.update(str(f.name).encode())
+            try:
+                h.update(f.read_bytes())
+            except OSError:
+                h.update(b"<unreadable>")
+    return h.digest()
+
+
 def study_names() -> list[str]:
     """Group names of every study module in the package, found without importing them."""
     import pkgutil
@@ -225,3 +263,28 @@ def column_label(module: ModuleType | None, name: str) -> str:
     if not units and spec_key is not None:
         units = spec_key.units
     return f"{words} [{units}]" if units else words
+
+
+def expression_label(module: ModuleType | None, text: str) -> str:
+    """The axis words of an objective: a summary column's words and unit, or for an expression
+    the expression in words with the unit its columns share (``min(mu_min_deg, ...) [deg]``)."""
+    from driver.export import SUFFIX_UNITS
+    if re.fullmatch(r"[A-Za-z_][A-Za-z0-9_.]*", text.strip()):
+        return column_label(module, text.strip())
+    names = set(re.findall(r"[A-Za-z_][A-Za-z0-9_]*", text)) - {"min", "max", "abs", "sqrt", "and", "or", "not"}
+    units = set()
+    for n in names:
+        for suffix, u in SUFFIX_UNITS:
+            if n.endswith(suffix):
+                units.add(u)
+                break
+        else:
+            labels = getattr(module, "LABELS", {})
+            if n in labels:
+                units.add(labels[n][1])
+    words = text.strip()
+    for n in sorted(names, key=len, reverse=True):
+        entry = getattr(module, "LABELS", {}).get(n)
+        if entry:
+            words = re.sub(rf"\b{re.escape(n)}\b", entry[0], words)
+    return f"{words} [{units.pop()}]" if len(units) == 1 and "" not in units else words

@@ -48,7 +48,7 @@ import driver
 from driver import expr
 from driver.atomic import atomic_open
 from driver.deck import DeckError, RawGroup, validate
-from driver.study import load_study
+from driver.study import code_digest, load_study
 
 __all__ = ["Grid", "BatchPlan", "batchable", "plan", "run", "worker_init", "chunk_rows", "MAX_CASES"]
 
@@ -108,13 +108,7 @@ def _signature(raw: RawGroup, grid: Grid, keep: str, rows: str, module) -> str:
     h = hashlib.sha256()
     h.update(json.dumps([raw.name, raw.values, grid.names, grid.values, grid.zipped, keep, rows, driver.__version__],
                         sort_keys=True, default=str).encode())
-    sources = [getattr(module, "__file__", None)]
-    if sources[0] and Path(sources[0]).name == "__init__.py":   # a study package: every module of it
-        sources = sorted(str(f) for f in Path(sources[0]).parent.glob("*.py"))
-    for path in (*sources, getattr(sys.modules.get("driver._kernels"), "__file__", None)):
-        if path:
-            with contextlib.suppress(OSError):
-                h.update(Path(path).read_bytes())
+    h.update(code_digest(module))
     return h.hexdigest()[:20]
 
 

@@ -24,7 +24,7 @@ def main(outdir: Path):
           .to_string(index=False))
     base = {"fixed_link": 12.0, "crank": 5.0, "coupler": 15.0, "rocker": 9.0, "omega": 5.0, "step_deg": 10.0}
     grid = driver.run_sweep({"fourbar": base}, grid={"crank": np.linspace(2.0, 6.0, 5), "rocker": [8.0, 9.0, 10.0]},
-                            keep="meets_band_40_120 or mu_min_deg > 30", case_outputs="none",
+                            keep="meets_transmission_band or mu_min_deg > 30", case_outputs="none",
                             jobs=1, outdir=outdir)
     table = grid.summary.pivot(index="fourbar.crank", columns="fourbar.rocker", values="mu_min_deg")
     print("minimum transmission angle [deg], crank (rows) x rocker (columns):")

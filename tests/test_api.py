@@ -145,7 +145,7 @@ def test_figures_on_demand_and_write(tmp_path):
     r = driver.fourbar.run(**CRANK5)
     assert r.figure_names == ["curves", "linkage"]
     fig = r.figure("linkage")
-    assert type(fig).__name__ == "Figure" and fig.get_dpi() == 110
+    assert type(fig).__name__ == "Figure" and fig.get_dpi() == 150
     with pytest.raises(LookupError):
         r.figure("nope")
     written = r.write(tmp_path / "new", formats=["csv", "parquet"], plot=True, json=True, name="c5")
@@ -263,7 +263,7 @@ def test_plotting_leaves_the_users_backend_and_rcparams_alone(tmp_path):
         assert not changed, changed
         assert "matplotlib.pyplot" not in sys.modules
         assert figs[0].axes[0].xaxis.get_gridlines()[0].get_visible()   # house style inside the figure
-        assert figs[0].get_dpi() == 110
+        assert figs[0].get_dpi() == 150
         print("ok")
     """)
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)

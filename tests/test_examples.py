@@ -61,5 +61,5 @@ def test_sweep_example_dataframes_match_the_closed_form(tmp_path):
     assert len(crank_rocker) >= 8
     for _, row in crank_rocker.iterrows():
         assert row["mu_min_deg"] == pytest.approx(_mu(row["fourbar.crank"], row["fourbar.rocker"], 0.0), abs=1e-9)
-    kept = (grid.summary["meets_band_40_120"] | (grid.summary["mu_min_deg"] > 30)) & (grid.summary["status"] == "ok")
+    kept = (grid.summary["meets_transmission_band"] | (grid.summary["mu_min_deg"] > 30)) & (grid.summary["status"] == "ok")
     assert np.array_equal(grid.summary["kept"].to_numpy(), kept.to_numpy())

@@ -135,8 +135,12 @@ def test_ujoint_trial_and_optimum_on_one_panel_with_the_paper_band():
     lo, hi = polar.get_ylim()
     assert 20.0 < lo < 23.0 and 27.17 < hi < 28.0          # not from 0: the fluctuation fills the radius
     assert polar.get_rorigin() < lo                         # an empty centre says so
-    ticks = [t.get_text() for t in polar.get_yticklabels() if t.get_text()]
+    ticks = [t.get_text() for t in polar.texts if t.get_text()]   # radial labels on white patches
     assert ticks and all(t.endswith(" rpm") for t in ticks)
+    assert all(t.get_bbox_patch() is not None and t.get_zorder() > 5 for t in polar.texts)
+    # the input speed on top of every curve (an optimum close to it must not hide it)
+    inp = [ln for ln in polar.lines if ln.get_label().startswith("input shaft")][0]
+    assert inp.get_zorder() > max(ln.get_zorder() for ln in polar.lines if ln is not inp)
 
 
 def test_ujoint_small_fluctuation_fills_the_polar_radius():

@@ -67,7 +67,7 @@ EXPRESSIONS = [
     '{{"a": 1}}',
     'rocker_swing_deg is None',
     'rocker_swing_deg in (1, 2)',
-    '~meets_band_40_120',
+    '~meets_transmission_band',
     'rocker_swing_deg << 2',
     'no_such_column > 1',
     '1' * 2001,

@@ -32,7 +32,7 @@ def _fourbar_summary(crank: float, coupler: float, rocker: float) -> dict:
 
 
 def _feasible(s: dict) -> bool:
-    return bool(s["meets_band_40_120"]) and s["rocker_swing_deg"] is not None and s["rocker_swing_deg"] >= 60
+    return bool(s["meets_transmission_band"]) and s["rocker_swing_deg"] is not None and s["rocker_swing_deg"] >= 60
 
 
 @pytest.fixture(scope="module")

@@ -34,7 +34,7 @@ def test_paper_study_in_one_run_reproduces_all_published_cells(tmp_path):
     assert list(summary["fourbar.crank"]) == [2, 3, 4, 5]
     # the paper's conclusion: only crank 2 keeps the transmission angle within 40-120 deg,
     # and the lower bounds it quotes (36, 26, 17 deg, truncated) are the closed-loop minima
-    assert list(summary["meets_band_40_120"]) == [True, False, False, False]
+    assert list(summary["meets_transmission_band"]) == [True, False, False, False]
     assert [int(v) for v in summary["mu_min_deg"]] == [40, 33, 26, 17]
     cases = pd.read_parquet(out / "fourbar_paper_sweep_cases.parquet")
     assert len(cases) == 4 * 2 * 19 and "fourbar.crank" in cases
@@ -186,7 +186,7 @@ def test_interrupt_keeps_finished_cases_and_leaves_no_partial_file(tmp_path, mon
 def test_design_search_filter_and_kept_rows(tmp_path):
     text = ("&sweep key1 = 'fourbar.crank', start1 = 1, stop1 = 6, count1 = 6\n"
             "       key2 = 'fourbar.method', values2 = 'exact'\n"
-            "       keep = 'meets_band_40_120 and rocker_swing_deg > 30'\n"
+            "       keep = 'meets_transmission_band and rocker_swing_deg > 30'\n"
             "       case_outputs = 'kept', summary_rows = 'kept' /\n")
     out = tmp_path / "o"
     assert main([str(deck(tmp_path, text)), "-o", str(out), "-q", "-j", "1"]) == 0

@@ -24,7 +24,7 @@ BASE = """&fourbar
 GRID = ("&sweep key1 = 'fourbar.crank', start1 = 1, stop1 = 7, count1 = {a}\n"
         "       key2 = 'fourbar.coupler', start2 = 6, stop2 = 20, count2 = {b}\n"
         "       key3 = 'fourbar.rocker', start3 = 4, stop3 = 16, count3 = {c}\n"
-        "       keep = 'meets_band_40_120 and rocker_swing_deg >= 40'\n"
+        "       keep = 'meets_transmission_band and rocker_swing_deg >= 40'\n"
         "       case_outputs = '{outputs}', summary_rows = '{rows}'{extra} /\n")
 
 

@@ -8,7 +8,7 @@ from typing import Any
 from driver.deck import GroupSpec, Key, Params, non_empty, non_negative, positive
 from driver.limits import Estimate
 
-__all__ = ["SPEC", "LABELS", "SWEEP_PLOT", "estimate"]
+__all__ = ["SPEC", "LABELS", "SWEEP_PLOT", "SWEEP_BEST", "estimate"]
 
 
 def _pair_check(v: Any) -> str | None:
@@ -82,7 +82,11 @@ LABELS = {"r_m": ("inner workspace radius r", "m"), "R_m": ("outer workspace rad
           "design_ri2": ("design RI2", "-"), "design_ri3": ("design RI3", "-"),
           "design_ri2_excess": ("design RI2 - sqrt(n)", "-"),
           "design_crob_residual_m2": ("design l1^2 + l2^2 - mean d^2", "m^2"),
-          "design_total_torque_Nm": ("design tau1 + tau2 at the target", "N m")}
+          "design_total_torque_Nm": ("design tau1 + tau2 at the target", "N m"),
+          "designs_l1": ("design link length l1", "m"), "designs_l2": ("design link length l2", "m")}
+#: which way a summary column is better (the design-space maps star the best kept design)
+SWEEP_BEST = {"design_total_torque_Nm": "min", "design_ri2": "min", "design_ri2_excess": "min",
+              "sweep_min_total_torque_Nm": "min"}
 #: what a sweep summary plots when its deck names no plot_y
 #: (a design sweep's constant columns are skipped: its plot shows the design_* columns)
 SWEEP_PLOT = ("design_total_torque_Nm", "design_ri2", "crob_radius_m", "sweep_min_total_torque_Nm", "sweep_min_l1_m",

@@ -366,7 +366,8 @@ class Evaluator:
         for r in self.records:
             row: dict[str, Any] = {"eval": r.index + 1, **dict(zip(p.names, r.x)), "status": r.status,
                                    "feasible": r.feasible, "infeasible_reason": r.why,
-                                   "objective": r.objective, "violation": r.violation}
+                                   "objective": r.objective if math.isfinite(r.objective) else np.nan,
+                                   "violation": r.violation}   # inf never reaches a table: null, reason given
             for k, m in enumerate(r.margins):
                 row[f"margin{_constraint_number(p, k)}"] = m if math.isfinite(m) else np.nan
             row["case_error"] = r.reason

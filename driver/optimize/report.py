@@ -162,19 +162,11 @@ def history_frame(p: Problem, history: list[HistoryRow]) -> pd.DataFrame:
 
 
 def convergence_figure(p: Problem, history: pd.DataFrame, evals: pd.DataFrame, title: str):
-    """Best feasible objective against evaluations, over every feasible evaluation (house style)."""
+    """How the search converged (driver.plotting.convergence_plot): best feasible objective, its
+    gap to the final best on a log axis, and the constraint violation, against designs evaluated;
+    the objective named in words with its unit."""
     from driver import plotting
-    from driver.study import column_label
-    with plotting.style():
-        fig, (ax,) = plotting.new_figure(1, 1, figsize=(6.4, 3.6))
-        feas = evals[evals["feasible"]]
-        if len(feas):
-            ax.plot(feas["eval"], feas["objective"], ".", ms=2, color="0.6", alpha=0.5, label="feasible designs")
-        h = history[history["feasible"]]
-        if len(h):
-            ax.step(h["evals"], h["objective"], where="post", color="C3", lw=1.5, label="best so far")
-        ax.set_xlabel("designs evaluated")
-        ax.set_ylabel(column_label(p.study, p.objective.text))   # words and units when it is one summary column
-        ax.legend(fontsize=7)
-        ax.set_title(f"{title}: {p.objective_text}", fontsize=9)
-    return fig
+    from driver.study import expression_label
+    return plotting.convergence_plot(history, evals, expression_label(p.study, p.objective.text),
+                                     "minimize" if p.sense > 0 else "maximize",
+                                     title=f"{title}: {p.objective_text}")

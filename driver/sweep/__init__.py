@@ -5,7 +5,7 @@
       key1 = 'fourbar.crank',   values1 = 2, 3, 4, 5          ! a list ...
       key2 = 'fourbar.coupler', start2 = 14, stop2 = 16, count2 = 3   ! ... or start/stop/count
       zip  = .false.            ! .false.: full grid; .true.: keys varied together
-      keep = 'meets_band_40_120 and rocker_swing_deg > 60'   ! optional filter on the summary
+      keep = 'meets_transmission_band and rocker_swing_deg > 60'   ! optional filter on the summary
       case_outputs = 'all'      ! per-case files for 'all', 'kept' or 'none' of the cases
     /
 
@@ -113,9 +113,14 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
         probe = (module.summarise(base_params) if hasattr(module, "summarise")
                  else compute(module, base_params).summary)
         columns = [*names, *probe, "case"]
+        kinds = {**expr.kinds_of({n: v[0] for n, v in axes if len(v)}), **expr.kinds_of(probe), "case": "number"}
         for key, text in named:
             try:
-                expr.parse(text, columns)
+                e = expr.parse(text, columns)
+                e.check_kinds(kinds)   # one number or logical per case, before any case runs
+                if key != "keep" and not e.names:
+                    raise expr.ExprError("reads no column: a plot shows a column or an expression of columns",
+                                         text[:60])
             except expr.ExprError as exc:
                 raise sw.error(key, f"{exc.message}" + (f" (at '{exc.token}')" if exc.token else "")
                                + ("" if key == "keep" else f"; summary columns: {', '.join(columns)}")) from None

@@ -14,7 +14,7 @@ import f90nml
 import numpy as np
 
 from driver import limits
-from driver.deck import DeckError, GroupSpec, Key, Params, RawGroup, validate
+from driver.deck import DeckError, GroupSpec, Key, Params, RawGroup, shown_value, validate
 from driver.sweep_batch import Grid
 
 __all__ = ["SPEC", "Case", "CaseResult", "MAX_KEYS", "MAX_CASES", "FULL_VALIDATION", "build_cases", "grid_of", "case_at", "iter_cases",
@@ -259,7 +259,7 @@ def validate_sweep(sw: Params, raw: RawGroup, module: Any, grid: Grid) -> dict[i
             name = next((n for n in values if n.partition(".")[2] == exc.key), next(iter(values)))
             key, line = _axis_line(sw, name)
             where = f"case {case_no} (" if case_no else "the value "
-            vals = ", ".join(f"{k} = {v!r}" for k, v in values.items())
+            vals = ", ".join(f"{k} = {shown_value(v)}" for k, v in values.items())
             raise DeckError(sw.path, line, key, f"{where}{vals}{')' if case_no else ''} is bad input: "
                             f"{exc.key + ': ' if exc.key else ''}{exc.message}; nothing was run") from None
     estimates: dict[int, float] = {}

@@ -22,7 +22,6 @@ import hashlib
 import json
 import os
 import re
-import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -95,11 +94,8 @@ def signature(raw: RawGroup, swept: list[str], deck_path: str, keep: str, case_o
                          keep, case_outputs, sorted(formats), str(case_plot), driver.__version__],
                         sort_keys=True, default=str).encode())
     from driver import export, runner, table
-    for mod in (module, runner, table, export, sys.modules.get("driver._kernels")):
-        path = getattr(mod, "__file__", None)
-        if path:
-            with contextlib.suppress(OSError):
-                h.update(Path(path).read_bytes())
+    from driver.study import code_digest
+    h.update(code_digest(module, runner, table, export))
     return h.hexdigest()[:20]
 
 

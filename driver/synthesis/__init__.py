@@ -373,7 +373,9 @@ def _path(p: Params) -> Synthesis:
                    "the best design found passes near, not through, the points")
     linkage = {"fixed_link": q["ground"], "crank": q["crank"], "coupler": q["coupler"], "rocker": q["rocker"],
                "omega": p.omega, "step_deg": p.step_deg, "branch": p.branch,
-               "coupler_point": [q["u"], q["v"]]}
+               "coupler_point": [q["u"], q["v"]],
+               # the band the synthesis asked for: the linkage's summary and figures judge it by it
+               "transmission_band_deg": [p.transmission_min_deg, p.transmission_max_deg]}
     # the full turn by the exact kernel: assembly, Grashof class, transmission band
     fp = validate(RawGroup("fourbar", dict(linkage), {}, p.line), fourbar.SPEC, p.path)
     g = fourbar.grashof(fp.fixed_link, fp.crank, fp.coupler, fp.rocker)
@@ -406,7 +408,7 @@ def synthesise(deck: Deck | str | Path) -> Synthesis:
     p = validate(deck.groups["synthesis"], SPEC, deck.path)
     syn = {"function": _function, "crank_rocker": _crank_rocker, "path": _path}[p.task](p)
     if syn.linkage is not None:
-        fp = validate(RawGroup("fourbar", dict(syn.linkage, title=p.title or f"synthesised by {deck.path}"),
+        fp = validate(RawGroup("fourbar", dict(syn.linkage, title=p.title or f"{Path(deck.path).stem} ({p.task} synthesis)"),
                                {}, p.line), fourbar.SPEC, deck.path)
         syn.study_result = compute(fourbar, fp)
         syn.linkage = {k: v for k, v in fp.items() if v is not None and v != [] and v != ""}
@@ -428,7 +430,7 @@ def _path_figure(syn: Synthesis, path: Path, title: str, fmt: bool | str = True)
     tk = pg._to_kernel(pp, syn.design.x)
     ax = fig.axes[0]
     ax.plot(tk[:, 0], tk[:, 1], "s", mfc="none", mec="k", ms=7, label="target points")
-    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)   # beside the drawing
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)   # beside the drawing
     return plotting.save_figure(fig, path, fmt)
 
 
@@ -457,6 +459,14 @@ def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool,
             fig = plotting.line_panels(fd.x, [("y", {"desired y(x)": fd.y_desired, "generated": fd.y_generated}),
                                               ("structural error", {"error": fd.y_generated - fd.y_desired})],
                                        "x", title=f"{Path(deck.path).stem}: function generation")
+            # the precision points: where the generated function meets y(x) (zero structural error)
+            top, err = fig.axes
+            top.plot(fd.x_points, fd.y_points, "o", ms=6, mfc="white", mec="k", zorder=5, label="precision points")
+            err.plot(fd.x_points, np.zeros_like(fd.x_points), "o", ms=6, mfc="white", mec="k", zorder=5,
+                     label="precision points")
+            err.axhline(0.0, color="0.5", lw=0.8)
+            top.legend()
+            err.legend()
             written.append(plotting.save_figure(fig, stem.with_name(stem.name + "_error.png"), plot))
     if plot and syn.params.task == "path" and syn.design is not None:
         written.append(_path_figure(syn, stem.with_name(stem.name + "_path.png"), Path(deck.path).stem, plot))

@@ -228,8 +228,10 @@ LABELS = {"rpm": ("input shaft speed", "rpm"), "objective": ("objective (optimum
           "omega_out_min_rpm": ("minimum output speed", "rpm"), "omega_out_max_rpm": ("maximum output speed", "rpm"),
           "beta_e_deg": ("equivalent joint angle", "deg"), "beta_res_deg": ("resultant joint angle", "deg"),
           "peak_accel_rad_s2": ("peak output acceleration", "rad/s^2"), "iterations": ("iterations", "-"),
-          "evaluations": ("objective evaluations", "-"), "beta_{i}_deg": ("joint angle beta{i}", "deg"),
-          "phi_{i}_deg": ("phase angle phi{i}", "deg")}
+          "evaluations": ("objective evaluations", "-"),
+          "phi_{i}_deg": ("phase angle $\\varphi_{{i}}$", "deg"), "beta_{i}_deg": ("joint angle $\\beta_{{i}}$", "deg"),
+          "beta": ("joint angle $\\beta$", "deg"), "phi": ("phase angle $\\varphi$", "deg"),
+          "delta": ("yoke phase $\\delta$", "deg"), "rho": ("angle between the joint planes $\\rho$", "deg")}
 #: what a sweep summary plots when its deck names no plot_y
 SWEEP_PLOT = ("omega_out_min_rpm", "omega_out_max_rpm", "pp_ratio", "beta_e_deg", "peak_accel_rad_s2", "objective")
 

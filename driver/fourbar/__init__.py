@@ -17,6 +17,7 @@ from typing import Any, Mapping
 import numpy as np
 import pandas as pd
 
+from driver.fourbar import forces
 from driver import kernels
 from driver.limits import Estimate
 from driver.deck import GroupSpec, Key, Params, positive
@@ -29,7 +30,23 @@ __all__ = ["SPEC", "run", "summarise", "summarise_batch", "BATCH_KEYS", "grashof
 
 ST = kernels.FOURBAR_STATUS
 MAX_ANGLE = 1.0e6   # |crank angle| [deg] a deck may give (ulp of 1e6 is 1.2e-10 deg)
-BAND = (40.0, 120.0)  # transmission-angle band recommended by the paper [deg]
+BAND = (40.0, 120.0)  # transmission-angle band recommended by the paper [deg]: transmission_band_deg's default
+
+
+def _band_check(v: Any) -> str | None:
+    """Key check of ``transmission_band_deg``: two angles 0 <= min < max <= 180 [deg]."""
+    if len(v) != 2:
+        return f"give two angles, the band's minimum and maximum in deg (got {len(v)} values)"
+    lo, hi = v
+    if not (0.0 <= lo < hi <= 180.0):
+        return f"the band needs 0 <= min < max <= 180 deg (got {lo:g}, {hi:g})"
+    return None
+
+
+def band_of(p: Mapping[str, Any]) -> tuple[float, float]:
+    """The deck's transmission-angle band (min, max) [deg] (the paper's 40-120 deg by default)."""
+    v = p.get("transmission_band_deg") if hasattr(p, "get") else None
+    return (float(v[0]), float(v[1])) if v is not None and len(v) == 2 else BAND
 
 #: why the published listing's rows for crank angles in (180, 360) deg are wrong (see :func:`audit`)
 LISTING_DEFECT = ("the listing's quadrant test sends sigy > 0, sigx > 0 to sigma = 2 pi - |atan| (meant |atan|), "
@@ -60,6 +77,7 @@ def _check(p: Params) -> None:
                                    f"(got {p[key]:g}); use method='exact' for fractional angles")
         if "branch" in p.given and p.branch != "open":
             raise p.error("branch", "the listing computes one assembly only; branch applies to method='exact'")
+    forces.check(p)
 
 
 #: axis labels of summary columns and deck keys (driver.study.column_label): name -> (words, units)
@@ -70,7 +88,12 @@ LABELS = {"crank": ("crank length", "length units"), "coupler": ("coupler length
           "rocker_swing_deg": ("rocker swing", "deg"), "omega3_peak_rad_s": ("peak rocker speed", "rad/s"),
           "omega2_peak_rad_s": ("peak coupler speed", "rad/s"),
           "assembled_fraction": ("fraction of the turn assembled", "-"),
-          "time_ratio": ("time ratio (slow / quick stroke)", "-")}
+          "time_ratio": ("time ratio (slow / quick stroke)", "-"), **forces.LABELS}
+#: which way a summary column is better (the design-space maps star the best kept design)
+SWEEP_BEST = {"mu_min_deg": "max", "mu_max_deg": "min", "rocker_swing_deg": "max", "omega3_peak_rad_s": "min",
+              "omega2_peak_rad_s": "min"}
+#: keys of the base deck a sweep's .out states because summary columns depend on them
+SUMMARY_SETTINGS = ("transmission_band_deg",)
 #: what a sweep summary plots when its deck names no plot_y
 SWEEP_PLOT = ("mu_min_deg", "mu_max_deg", "rocker_swing_deg", "omega3_peak_rad_s", "omega2_peak_rad_s",
               "assembled_fraction")
@@ -93,11 +116,16 @@ SPEC = GroupSpec(
                       doc="'listing' = published program cell for cell; 'exact' = closed loop"),
         "branch": Key("str", default="open", choices=("open", "crossed"),
                       doc="'open': B left of the line A->O_B; 'crossed': mirror assembly"),
+        "transmission_band_deg": Key("floats", default=list(BAND), units="deg", check=_band_check,
+                                     doc="the transmission-angle band a design should keep to (min, max): the "
+                                         "summary's meets_transmission_band, the .out and the figures use it; "
+                                         "default the paper's 40, 120"),
         "coupler_point": Key("floats", default=None, units="length",
                              check=lambda v: None if len(v) == 2 else f"give two numbers u, v (got {len(v)})",
                              doc="a point P on the coupler: u along A->B, v to its left; adds its path, "
                                  "velocity and acceleration (exact method)"),
         "title": Key("str", default="", doc="free text echoed in the output"),
+        **forces.KEYS,   # the force analysis (driver/fourbar/forces.py), run when 'mass' is given
     },
     check=_check,
 )
@@ -284,7 +312,7 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     [rad/s], ``start_deg``/``stop_deg`` [deg], ``branch`` 'open'/'crossed' or +1/-1.
     Returns the columns of the single-case summary (``summarise``) with identical values
     (missing figures as NaN): grashof_class, full_crank_rotation, assemblable, mu_min_deg,
-    mu_max_deg, meets_band_40_120, rocker_turns_fully, rocker_swing_deg, toggle_in_range,
+    mu_max_deg, meets_transmission_band (mu within the base deck's ``transmission_band_deg``), rocker_turns_fully, rocker_swing_deg, toggle_in_range,
     omega3_peak_rad_s, omega2_peak_rad_s, assembled_fraction, time_ratio (crank angle of the
     rocker's slower stroke over its quicker one, >= 1; missing unless the range holds a full
     turn, assembled throughout, without a toggle, with the rocker oscillating); with ``detail`` also the crank
@@ -297,16 +325,20 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     unknown = [k for k in columns if k not in BATCH_KEYS and k not in BATCH_IGNORED]
     if unknown:
         raise _bad(base, unknown[0], f"not a &fourbar key the summary depends on ({', '.join(BATCH_KEYS)})")
+    force_columns = {k: v for k, v in columns.items() if k in forces.BATCH_KEYS}
     columns = {k: v for k, v in columns.items() if k in BATCH_KEYS}
     sizes = {np.size(v) for v in columns.values() if np.ndim(v) > 0}
     if len(sizes) > 1:
         raise _bad(base, None, f"batch columns have different lengths {sorted(sizes)}")
     n = sizes.pop() if sizes else 1
     res = kernels.fourbar_summaries(_param_matrix(base, columns, n))
-    return _frame(res, detail)
+    frame = _frame(res, detail, band_of(base))
+    if forces.active(base):   # force columns (driver/fourbar/forces.py) when the deck gives masses
+        frame = pd.concat([frame, forces.summarise_force_batch(base, force_columns)], axis=1)
+    return frame
 
 
-def _frame(res: np.ndarray, detail: bool = False) -> pd.DataFrame:
+def _frame(res: np.ndarray, detail: bool = False, band: tuple[float, float] = BAND) -> pd.DataFrame:
     """Kernel rows -> the summary columns (vectorised; the one place both paths go through)."""
     c = dict(zip(kernels.FOURBAR_SUMMARY_COLUMNS, res.T))
     codes = c["grashof"].astype(int)
@@ -317,10 +349,10 @@ def _frame(res: np.ndarray, detail: bool = False) -> pd.DataFrame:
     turns = ok & (c["rocker_turns"] > 0)
     tog = ok & (c["toggles_in_range"] > 0)
     has = lambda v, m=ok: np.where(m, v, np.nan)
-    lo, hi = BAND
+    lo, hi = band
     out = {"grashof_class": names, "full_crank_rotation": full, "assemblable": ok,
            "mu_min_deg": has(c["mu_min_deg"]), "mu_max_deg": has(c["mu_max_deg"]),
-           "meets_band_40_120": ok & (c["mu_min_deg"] >= lo) & (c["mu_max_deg"] <= hi),
+           "meets_transmission_band": ok & (c["mu_min_deg"] >= lo) & (c["mu_max_deg"] <= hi),
            "rocker_turns_fully": turns, "rocker_swing_deg": has(c["rocker_swing_deg"]),
            "toggle_in_range": tog, "omega3_peak_rad_s": has(c["omega3_peak_rad_s"], ok & ~tog),
            "omega2_peak_rad_s": has(c["omega2_peak_rad_s"], ok & ~tog),
@@ -426,7 +458,7 @@ def summary_lines(p: Params, g: Grashof, ex: Extremes | None) -> list[str]:
     if ex is None:
         out.append("    the linkage cannot be assembled anywhere in the requested range")
         return out
-    lo, hi = BAND
+    lo, hi = band_of(p)
     meets = lo <= ex.mu_min and ex.mu_max <= hi
     out += [f"    transmission angle ... min {ex.mu_min:.2f} deg at theta = {ex.mu_min_at:.2f}, "
             f"max {ex.mu_max:.2f} deg at theta = {ex.mu_max_at:.2f}",
@@ -540,21 +572,37 @@ def _exact_columns(out: np.ndarray, status: np.ndarray, cp: np.ndarray | None = 
     return vals
 
 
+def output_name(p: Params) -> str:
+    """What the output link is called in figures: 'output crank' when it turns fully (a
+    double-crank, a drag link), 'rocker' otherwise."""
+    g = grashof(p.fixed_link, p.crank, p.coupler, p.rocker)
+    return "output crank" if g.name.startswith("double-crank") else "rocker"
+
+
 def _figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> list[Figure]:
     def curves():
         from driver import plotting   # matplotlib is the optional [plot] extra: import when drawing
         theta = np.linspace(p.start_deg, p.stop_deg, 721)
         out, st = exact_grid(p, theta)
         exact = tidy_frame("exact", theta, _exact_columns(out, st), st)
-        return plotting.fourbar_curves(exact, listing, stem_title)
+        return plotting.fourbar_curves(exact, listing, stem_title, band=band_of(p), output=output_name(p))
 
     def linkage():
         from driver import plotting
-        theta = np.linspace(0.0, 360.0, 721)
+        lo, hi = sorted((p.start_deg, p.stop_deg))
+        # the deck's crank range when it is less than a turn (a function generator's design range)
+        theta = np.linspace(lo, hi, 721) if hi - lo < 360.0 else np.linspace(0.0, 360.0, 721)
         out, st = exact_grid(p, theta)
         cp = coupler_point(p, theta, out, st)
+        limits = []
+        for a in limit_angles(p.fixed_link, p.crank, p.coupler, p.rocker):
+            if theta[0] - 1e-9 <= a <= theta[-1] + 1e-9 or hi - lo >= 360.0:
+                row, rst = exact_grid(p, np.array([a]))
+                if rst[0] != ST["no_assembly"] and np.all(np.isfinite(row[0, 3:7])):
+                    limits.append((a, row[0]))
         return plotting.fourbar_linkage(p.fixed_link, theta, out, st == ST["ok"], listing, stem_title,
-                                        point=None if cp is None else cp[:, :2])
+                                        point=None if cp is None else cp[:, :2], output=output_name(p),
+                                        limits=limits)
 
     return [Figure("curves", curves), Figure("linkage", linkage)]
 
@@ -571,7 +619,8 @@ def estimate(params: Params) -> Estimate:
     n = max(n, 1.0)
     span = min(abs(p.stop_deg - p.start_deg), 360.0) / 1.0 + 1.0
     range_key = "start_deg" if "start_deg" in p.given else ("stop_deg" if "stop_deg" in p.given else "step_deg")
-    rows = Estimate(2000.0 * n + 5e6, 5e-5 * n + 0.05, "step_deg", "step_deg", f"{n:.4g} crank angles")
+    k = 2.5 if forces.active(p) else 1.0   # the force table and columns: 13 more cells and 24 columns per row
+    rows = Estimate(k * 2000.0 * n + 5e6, k * 5e-5 * n + 0.05, "step_deg", "step_deg", f"{n:.4g} crank angles")
     grid = Estimate(500.0 * span, 1e-6 * span, range_key, range_key,
                     f"a {span:.4g}-point scan of one turn for the summary")
     return rows + grid
@@ -622,13 +671,29 @@ def run(params: Params, progress: bool = False) -> Result:
         if cp is not None:
             lines += [f"    coupler point P ...... u = {p.coupler_point[0]:g} along A->B, v = {p.coupler_point[1]:g} "
                       "to its left; xp, yp its position, vp its speed [length/s]"]
+        if forces.active(p):
+            lines += _force_section(p, theta, out, status, exact_frame)
         for k in np.flatnonzero(status == ST["no_assembly"])[:1]:
             warnings.append(f"the linkage cannot be assembled at {int((status == ST['no_assembly']).sum())} "
                             f"of {len(theta)} crank angles (first at {theta[k]:g} deg)")
         tidy = exact_frame
     summary = _summary(p)
-    return Result(text="\n".join(lines) + "\n", tidy=tidy, summary=summary, warnings=warnings,
-                  figures=_figures(p, title, listing_frame))
+    figs = _figures(p, title, listing_frame) + (forces.figures(p, title, exact_grid) if forces.active(p) else [])
+    return Result(text="\n".join(lines) + "\n", tidy=tidy, summary=summary, warnings=warnings, figures=figs)
+
+
+def _force_section(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarray,
+                   frame: pd.DataFrame) -> list[str]:
+    """The force analysis's lines of the .out; its columns are added to ``frame`` (in place)."""
+    fa = forces.analyse(p, out, status)
+    for name, values in forces.tidy_columns(fa).items():
+        frame[name] = values
+    with_units(frame, TIDY_UNITS)
+    words = ["toggle: forces unbounded" if s == ST["toggle"] else "not placed" for s in status]
+    title = ("Force analysis (Newton-Euler, closed form; " +
+             ("with the Berkof-Lowen counterweights" if fa.cw is not None else "links as given") + ")")
+    return (forces.echo_lines(p) + forces.table_lines(theta, fa.forces, fa.ok, words, title)
+            + forces.summary_lines(p, forces.summary(p), fa))
 
 
 def summarise(params: Params) -> dict:

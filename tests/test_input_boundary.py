@@ -1,0 +1,232 @@
+"""The input boundary, round two (issue 23): every reproducer of the campaign is a test.
+
+A number is what Fortran list-directed input means by one and nothing else; an expression
+is checked against the columns' kinds before any case runs; API values are checked by
+size before they are converted.  Each refusal is exit 2 (or a DeckError) naming the deck,
+the line and the key, and nothing is written.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import driver
+from driver.cli import main
+from driver.deck import DeckError, is_number, read_deck
+from driver.expr import ExprError, parse
+
+FOURBAR = """&fourbar
+  fixed_link = 12.0, crank = 2.0, coupler = 15.0, rocker = 9.0
+  omega = 5.0, step_deg = 60
+/
+"""
+BASE = dict(fixed_link=12.0, crank=5.0, coupler=15.0, rocker=9.0, omega=5.0, step_deg=20)
+
+
+def _refused(tmp_path, capsys, text: str, line: int, key: str, words: str = "", name: str = "d.dat") -> str:
+    deck = tmp_path / name
+    deck.write_text(text)
+    out = tmp_path / "out"
+    assert main([str(deck), "-o", str(out), "-q", "-j", "1", "--plot"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    assert err[0].startswith(f"error: {deck}:{line}: key '{key}': "), err[0]
+    assert words in err[0], err[0]
+    assert not out.exists() or not any(out.rglob("*"))
+    return err[0]
+
+
+# ----------------------------------------------------------------------------- 1. numbers
+
+@pytest.mark.parametrize("value,words", [
+    ("5.0_8", "kind suffix"),            # f90nml reads 5.08
+    ("1_5", "kind suffix"),              # 15
+    ("'5_0'", "not a number"),           # float('5_0') == 50
+    ("4+1", "arithmetic"),               # 4e+1
+    ("360-7", "arithmetic"),             # 3.6e-5
+    ("'\uff13\uff10'", "not a number"),  # fullwidth 30
+    ("'\u0663\u0660'", "not a number"),  # Arabic-Indic 30
+    ("0xfff", "not a number"),
+    ("1" * 400, "digits"),
+    ("1e", "exponent without digits"),
+    ("2.5e-", "exponent without digits"),
+    ("1d+", "exponent without digits"),
+    ("1.0q3", "not a number"),
+    ("(1, 2)", "complex"),
+    ("abc", "not a number"),
+    ("inf", "not a number"),
+    ("nan", "not a number"),
+])
+def test_misread_numbers_are_deck_errors(tmp_path, capsys, value, words):
+    text = FOURBAR.replace("crank = 2.0", f"crank = {value}")
+    _refused(tmp_path, capsys, text, 2, "crank", words)
+
+
+def test_no_namelist_debug_output_on_stdout(tmp_path, capsys):
+    for value in ("3e", "1d+", "2.5e-"):
+        deck = tmp_path / "d.dat"
+        deck.write_text(FOURBAR.replace("step_deg = 60", f"step_deg = {value}"))
+        assert main([str(deck), "-o", str(tmp_path / "o"), "-q"]) == 2
+        cap = capsys.readouterr()
+        assert cap.out == ""
+        assert f"{deck}:3: key 'step_deg'" in cap.err
+
+
+def test_repeat_count_of_a_repeat_count_is_refused(tmp_path, capsys):
+    text = FOURBAR + "&sweep\n  key1 = 'fourbar.crank', values1 = 2*1*4.0\n/\n"
+    _refused(tmp_path, capsys, text, 6, "values1", "repeat count applied to a repeat count")
+    text = FOURBAR + "&sweep\n  key1 = 'fourbar.crank', values1 = 0*4.0\n/\n"
+    _refused(tmp_path, capsys, text, 6, "values1", "repeat count 0")
+
+
+def test_fortran_spellings_still_read():
+    """What list-directed input does read: the same values as Fortran gives them."""
+    deck = read_deck("x.dat", text="&fourbar\n fixed_link = 12, crank = 5., coupler = 1.5d1, rocker = .9E+1\n"
+                                   " omega = +5.0e0, step_deg = 20 /\n&sweep key1 = 'fourbar.crank', "
+                                   "values1 = 2*3.0, 4 /\n")
+    g = deck.groups["fourbar"].values
+    assert (g["fixed_link"], g["crank"], g["coupler"], g["rocker"], g["omega"]) == (12, 5.0, 15.0, 9.0, 5.0)
+    assert deck.groups["sweep"].values["values1"] == [3.0, 3.0, 4]
+    for good in ("5", "-5.", ".5", "5.0e-3", "5d0", "+1E+2", " 7 "):
+        assert is_number(good), good
+    for bad in ("5_0", "5.0_8", "4+1", "0x10", "inf", "nan", "\uff15", "1e", "", ".", "e5", "1" * 41):
+        assert not is_number(bad), bad
+
+
+@pytest.mark.parametrize("value,words", [
+    ("5_0", "not a number"), ("\uff13\uff10", "not a number"), ("\u0663\u0660", "not a number"),
+    (10**400, "not a finite number"), (-(10**400), "not a finite number"), (float("inf"), "not a finite"),
+])
+def test_api_values_are_numbers_as_decks_are(value, words):
+    with pytest.raises(DeckError, match=words) as exc:
+        driver.run({"fourbar": {**BASE, "crank": value}})
+    assert exc.value.key == "crank"
+    assert len(str(exc.value)) < 400   # a 400-digit integer is not echoed
+
+
+def test_api_quoted_number_and_0d_array_read_as_the_number():
+    a = driver.run({"fourbar": {**BASE, "crank": "5.0"}})
+    b = driver.run({"fourbar": {**BASE, "crank": np.array(5.0)}})
+    c = driver.run({"fourbar": {**BASE, "crank": np.float32(5.0)}})
+    ref = driver.run({"fourbar": BASE})
+    assert a.summary == b.summary == c.summary == ref.summary
+
+
+def test_api_huge_and_nested_inputs_refused_by_size_first():
+    import tracemalloc
+    nested: list = [1.0]
+    for _ in range(500):
+        nested = [nested]
+    with pytest.raises(DeckError, match="list inside a list"):
+        driver.run({"fourbar": {**BASE, "crank": nested}})
+    tracemalloc.start()
+    try:
+        with pytest.raises(DeckError, match="values"):
+            driver.run({"fourbar": {**BASE, "coupler_point": range(10**9)}})
+        with pytest.raises(DeckError, match="shape"):
+            driver.run_sweep({"fourbar": BASE}, grid={"crank": np.broadcast_to(np.float64(1.0), (10**8,))})
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 50 * 2**20, peak   # the requests would need GBs if materialised
+
+
+def test_api_formats_checked_before_any_case_runs(tmp_path):
+    with pytest.raises(ValueError, match="unknown table format 'exe'"):
+        driver.run_sweep({"fourbar": BASE}, grid={"crank": [2, 3]}, formats=["exe"], outdir=tmp_path / "o")
+    assert not (tmp_path / "o").exists()
+
+
+def test_huge_integer_in_a_sweep_value_is_a_short_deck_error():
+    with pytest.raises(DeckError, match="not a finite number") as exc:
+        driver.run_sweep({"fourbar": BASE}, grid={"crank": [10**400, 3]}, jobs=1)
+    assert len(str(exc.value)) < 500
+
+
+# ----------------------------------------------------------------------------- 4. expressions
+
+SWEEP = FOURBAR + "&sweep\n  key1 = 'fourbar.crank', values1 = 2, 3\n  {line}\n/\n"
+
+
+@pytest.mark.parametrize("line,key,words", [
+    ("keep = 'min(mu_min_deg) > 1'", "keep", "two or more arguments"),
+    ("keep = 'grashof_class * 2 > 1'", "keep", "arithmetic on text"),
+    ("keep = \"'x'*1000000000 > 1\"", "keep", "arithmetic on text"),
+    ("keep = 'grashof_class > 1'", "keep", "is text"),
+    ("keep = 'mu_min_deg > 0 # and mu_min_deg < 0'", "keep", "'#'"),
+    ("keep = '\uff4du_min_deg > 1'", "keep", "U+FF4D"),
+    ("keep = 'mu_min_deg > 1_0'", "keep", "not a number"),
+    ("keep = 'mu_min_deg > 0x10'", "keep", "not a number"),
+    ("keep = 'mu_min_deg > " + "9" * 400 + "'", "keep", "digits"),
+    ("keep = 'mu_min_deg > 9**9**9**9'", "keep", "not a finite number"),
+    ("keep = 'grashof_class'", "keep", "gives text"),
+    ("plot_y = 'min(mu_min_deg)'", "plot_y", "two or more arguments"),
+    ("plot_y = 'grashof_class * 2'", "plot_y", "arithmetic on text"),
+    ("plot_y = '1e308'", "plot_y", "reads no column"),
+    ("plot_y = 'mu_min_deg + 1e400'", "plot_y", "not a finite"),
+])
+def test_sweep_expressions_type_checked_before_any_case(tmp_path, capsys, line, key, words):
+    _refused(tmp_path, capsys, SWEEP.format(line=line), 7, key, words)
+
+
+def test_good_expressions_still_run(tmp_path, capsys):
+    deck = tmp_path / "s.dat"
+    deck.write_text(SWEEP.format(line="keep = 'grashof_class == \"crank-rocker\" and mu_min_deg > 1'\n"
+                                      "  plot_y = 'mu_max_deg - mu_min_deg'"))
+    assert main([str(deck), "-o", str(tmp_path / "o"), "-q", "-j", "1"]) == 0
+
+
+OPT = """&fourbar
+  fixed_link = 10.0, crank = 3.0, coupler = 10.0, rocker = 8.0, omega = 5.0, step_deg = 10
+/
+&optimize
+  var1 = 'fourbar.crank', lower1 = 2.0, upper1 = 4.0
+  {line}
+  method = 'slsqp', starts = 1, seed = 1, maxiter = 3
+/
+"""
+
+
+@pytest.mark.parametrize("line,key,words", [
+    ("maximize = 'mu_min_deg # + 1000'", "maximize", "'#'"),
+    ("maximize = '9**9**9**9'", "maximize", "not a finite number"),
+    ("minimize = 'log(0.0)/mu_min_deg'", "minimize", "not a finite number"),
+    ("maximize = 'mu_min_deg'\n  constraint1 = 'grashof_class > 1'", "constraint1", "is text"),
+    ("maximize = 'grashof_class'", "maximize", "cannot be evaluated"),
+])
+def test_optimize_expressions_are_deck_errors(tmp_path, capsys, line, key, words):
+    text = OPT.format(line=line)
+    n = text.splitlines().index(next(l for l in text.splitlines() if l.strip().startswith(key))) + 1
+    _refused(tmp_path, capsys, text, n, key, words)
+
+
+def test_no_inf_in_optimisation_evaluations(tmp_path, capsys):
+    import pandas as pd
+    deck = tmp_path / "o.dat"   # log(0) on every design: each evaluation undefined, none inf in a table
+    deck.write_text(OPT.format(line="minimize = 'log(mu_min_deg - mu_min_deg)'"))
+    main([str(deck), "-o", str(tmp_path / "out"), "-q", "-j", "1"])
+    for f in (tmp_path / "out").glob("*_evals.*"):
+        frame = pd.read_parquet(f) if f.suffix == ".parquet" else pd.read_csv(f)
+        num = frame.select_dtypes("number").to_numpy(dtype=float)
+        assert not np.isinf(num).any(), f.name
+    for f in (tmp_path / "out").glob("*.csv"):
+        assert "inf" not in f.read_text().lower(), f.name
+
+
+def test_synthesis_function_comment_and_reduction_refused(tmp_path, capsys):
+    base = ("&synthesis\n  task = 'function', function = 'log10(x)', x_start = 1.0, x_stop = 2.0\n"
+            "  crank_start_deg = 45.0, crank_range_deg = 60.0\n  rocker_start_deg = 135.0, rocker_range_deg = 90.0\n"
+            "  points = 3, fixed_link = 1.0, step_deg = 5, branch = 'open'\n/\n")
+    _refused(tmp_path, capsys, base.replace("'log10(x)'", "'x # + 1'"), 2, "function", "'#'")
+    _refused(tmp_path, capsys, base.replace("'log10(x)'", "'min(x)'"), 2, "function", "two or more")
+
+
+def test_expression_kinds_unit():
+    e = parse("a > 1 and b == 'x'")
+    assert e.check_kinds({"a": "number", "b": "text"}) == "bool"
+    with pytest.raises(ExprError) as exc:
+        e.check_kinds({"a": "text", "b": "text"})
+    assert exc.value.token == "a"
+    assert parse("a * 2").check_kinds({"a": "bool"}) == "number"
+    with pytest.raises(ExprError, match="gives text"):
+        parse("b").check_kinds({"b": "text"})
