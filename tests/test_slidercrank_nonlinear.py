@@ -201,3 +201,26 @@ def test_growth_ratio_definition():
     assert growth_ratio(np.array([1.0] * 10 + [3.0, 1.0])) == 0.0        # one large revolution is no trend
     assert growth_ratio(1.1 ** np.arange(4)) == pytest.approx(0.1)       # the fewest revolutions allowed
     assert scatter(np.array([9.0] * 4 + [1.0, 2.0, 1.0, 1.5] * 2)) == pytest.approx(1.0)
+
+
+def test_nonlinear_figures_draw_the_given_curves_and_accept_axes():
+    pytest.importorskip("matplotlib")
+    from matplotlib.figure import Figure as MplFigure
+
+    from driver import plotting
+    x = np.linspace(0.0, 360.0, 7)
+    lin, nl = np.sin(np.radians(x)), 2 * np.sin(np.radians(x))
+    fig = plotting.slidercrank_nl_strain_figure([("10 rad/s", x, lin, nl)], "strain")
+    solid, dashed = fig.axes[0].lines[:2]
+    np.testing.assert_array_equal(solid.get_ydata(), nl)
+    np.testing.assert_array_equal(dashed.get_ydata(), lin)
+    assert dashed.get_linestyle() == "--"
+    own = MplFigure()
+    ax = own.subplots()
+    shapes = np.column_stack([np.linspace(0, 1e-3, 5), np.zeros(5)])
+    assert plotting.slidercrank_nl_shapes_figure([("a", (90.0, 180.0), shapes)], 0.5, "s", ax=ax) is own
+    np.testing.assert_allclose(ax.lines[0].get_ydata(), shapes[:, 0] * 1e3)   # drawn in mm
+    np.testing.assert_allclose(ax.lines[0].get_xdata(), np.linspace(0, 0.5, 5))
+    ax2 = MplFigure().subplots()
+    plotting.slidercrank_nl_revolutions_figure([("a", np.array([1.0, 2.0, 4.0]))], "r", ax=ax2)
+    np.testing.assert_array_equal(ax2.lines[0].get_xdata(), [1, 2, 3])
