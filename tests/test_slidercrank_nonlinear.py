@@ -184,7 +184,8 @@ def test_step_cuts_rescue_a_coarse_step(tmp_path):
 
 @pytest.mark.parametrize("line, key", [("element_counts = 2, 4", "element_counts"), ("end_time = 0.1", "end_time"),
                                        ("geometric_stiffness = .true.", "geometric_stiffness"),
-                                       ("revolutions = 3", "revolutions"), ("newton_tolerance = 0.5", "newton_tolerance")])
+                                       ("revolutions = 3", "revolutions"), ("newton_tolerance = 0.5", "newton_tolerance"),
+                                       ("onset_speeds = 0.5, 30", "onset_speeds"), ("hht_alpha = -0.5", "hht_alpha")])
 def test_linear_only_options_are_refused(tmp_path, line, key):
     deck = _deck(tmp_path, f"  speeds = 11.52\n  n_elements = 10\n  {line}\n")
     res = _run(deck, tmp_path / "out")

@@ -265,17 +265,18 @@ def _cross_check(params: Params) -> None:
                                            f"({model.length:g} m): the slider-crank cannot turn; "
                                            "crank_radius must be < rod_length")
     w_bend, _, _ = model.frequencies()
-    for omega in params.speeds:
+    grid = list(params.onset_speeds or []) if params.model == "nonlinear" else []
+    for key, omega in [("speeds", w) for w in params.speeds] + [("onset_speeds", w) for w in grid]:
         ratio = MIN_STEPS_PER_BENDING_PERIOD * w_bend / omega
         if not math.isfinite(ratio) or ratio > 1e9:   # e.g. speeds = 4.9e-324: refused before ceil() overflows
-            raise params.error("speeds", f"crank speed {omega:g} rad/s is too slow to integrate: one revolution "
+            raise params.error(key, f"crank speed {omega:g} rad/s is too slow to integrate: one revolution "
                                          f"would need more than 10^9 time steps ({MIN_STEPS_PER_BENDING_PERIOD} "
                                          f"per period of the first bending mode, {w_bend:.1f} rad/s)")
         need = min_steps_per_rev(omega, w_bend)
         if params.steps_per_rev < need:
             per = params.steps_per_rev * omega / w_bend
             raise params.error(
-                "steps_per_rev",
+                "steps_per_rev" if key == "speeds" else key,
                 f"time step too coarse: {params.steps_per_rev} steps per revolution at {omega:g} rad/s "
                 f"give {per:.1f} steps per period of the first bending mode ({w_bend:.1f} rad/s); "
                 f"the Newmark average-acceleration rule needs at least {MIN_STEPS_PER_BENDING_PERIOD} "
