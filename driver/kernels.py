@@ -33,7 +33,9 @@ __all__ = ["farray", "fourbar_listing", "fourbar_exact", "fourbar_coupler_point"
            "UJOINT_MODELS", "UJOINT_OBJECTIVES", "ujoint_speed", "ujoint_objective",
            "ujoint_equivalent", "ujoint_geometry", "ujoint_summaries", "UJOINT_SUMMARY_COLUMNS",
            "SLIDERCRANK_STATUS", "slidercrank_simulate", "slidercrank_matrices", "slidercrank_rigid",
-           "slidercrank_axial_force", "slidercrank_frequencies"]
+           "slidercrank_axial_force", "slidercrank_frequencies",
+           "SLIDERCRANK_NL_STATUS", "slidercrank_nl_simulate", "slidercrank_column_static",
+           "slidercrank_corot_element"]
 
 
 def farray(x, ndim: int | None = None) -> np.ndarray:
@@ -518,3 +520,70 @@ def slidercrank_frequencies(rho_a: float, ea: float, ei: float, rod_length: floa
     frequencies [rad/s], and the pinned-pinned Euler load pi^2 EI / L^2 [N]."""
     wb, wa, pe = _kernels.slidercrank.analytic_frequencies(rho_a, ea, ei, rod_length, slider_mass)
     return float(wb), float(wa), float(pe)
+
+
+# ----------------------------------------------------------------------------- slidercrank, nonlinear rod
+
+#: status codes of the nonlinear slider-crank kernel (fortran/slidercrank_nl.f90)
+SLIDERCRANK_NL_STATUS = {"ok": int(_kernels.slidercrank_nl.nl_ok), "limit": int(_kernels.slidercrank_nl.nl_limit),
+                         "not_spd": int(_kernels.slidercrank_nl.nl_not_spd),
+                         "bad_args": int(_kernels.slidercrank_nl.nl_bad_args),
+                         "no_convergence": int(_kernels.slidercrank_nl.nl_no_convergence)}
+
+
+def slidercrank_nl_simulate(n_elements: int, crank_radius: float, rod_length: float, rho_a: float,
+                            ea: float, ei: float, half_depth: float, slider_mass: float, omega: float,
+                            dt: float, n_steps: int, steps_per_rev: int, rec_start: int, n_rec: int,
+                            alpha: float = 0.0, beta: float = 0.0, hht: float = 0.0, start: str = "quasistatic",
+                            tol: float = 1e-8, max_iterations: int = 25, max_cuts: int = 6,
+                            energy: bool = False) -> dict:
+    """Geometrically nonlinear (co-rotational) connecting rod, whole time loop in Fortran.
+
+    Arguments as :func:`slidercrank_simulate` (SI units); steps_per_rev groups the steps into
+    revolutions for the per-revolution peaks; hht the HHT-alpha parameter in [-1/3, 0] (0: Newmark
+    average acceleration, no numerical damping); tol is the Newton tolerance on the relative
+    residual, max_iterations the Newton solves allowed per step, max_cuts the step halvings.
+
+    Returns a dict: eps_ax, eps_of (n_elements, n_rec) axial and outer-fibre strain [-];
+    lat_max largest |lateral deflection from the chord| [m], mid the midspan node's lateral
+    deflection [m], elong rod elongation [m], slider position [m], energy (4, n_rec):
+    kinetic, strain energy, work of the loads, damping dissipation since the start [J];
+    rev_lat, rev_eps peak |lateral deflection| [m] and |axial strain| per revolution;
+    shapes (n_elements + 1, 2) lateral deflection profiles [m] at the recorded steps
+    shape_step (largest deflection, largest crank-end compression); stats (Newton solves,
+    most solves in a step, step cuts, deepest cut level, steps completed); status (a
+    SLIDERCRANK_NL_STATUS value), fail_step, fail_iter.
+    """
+    n_rev = max(1, -(-int(n_steps) // int(steps_per_rev)))
+    out = _kernels.slidercrank_nl.simulate_nl(
+        int(n_elements), 3 * int(n_elements), int(n_rec), n_rev, crank_radius, rod_length, rho_a, ea, ei,
+        half_depth, slider_mass, omega, dt, int(n_steps), int(steps_per_rev), int(rec_start), alpha, beta, hht,
+        {"rest": 0, "quasistatic": 1}[start], tol, int(max_iterations), int(max_cuts), int(bool(energy)))
+    names = ("eps_ax", "eps_of", "lat_max", "mid", "elong", "slider", "energy", "rev_lat", "rev_eps", "shapes",
+             "shape_step", "stats", "status", "fail_step", "fail_iter")
+    res = dict(zip(names, out))
+    for key in ("status", "fail_step", "fail_iter"):
+        res[key] = int(res[key])
+    return res
+
+
+def slidercrank_column_static(n_elements: int, length: float, ea: float, ei: float, load: float,
+                              imperfection: float, tol: float = 1e-10,
+                              max_iterations: int = 500) -> tuple[float, float, int, int]:
+    """Static pinned-pinned column of co-rotational elements under an end load [N] (compression
+    positive), from a sine initial guess of amplitude ``imperfection`` [m].
+
+    Returns (midspan lateral deflection [m], end shortening [m], Newton solves, status).
+    """
+    n = int(n_elements)
+    _q, mid, short, iters, status = _kernels.slidercrank_nl.column_static(
+        n, 3 * n, length, ea, ei, load, imperfection, tol, int(max_iterations))
+    return float(mid), float(short), int(iters), int(status)
+
+
+def slidercrank_corot_element(le: float, ea: float, ei: float, p: np.ndarray,
+                              tangent: bool = True) -> tuple[np.ndarray, np.ndarray, float, float, float]:
+    """One co-rotational element: force (6,), tangent (6, 6) lower triangle [N, N/m], axial strain,
+    mean curvature [1/m] and strain energy [J] for displacements p = (u, v, th) of its two nodes."""
+    f, kt, eps, kap, en = _kernels.slidercrank_nl.element_corot(le, ea, ei, farray(p, 1), bool(tangent))
+    return f, kt, float(eps), float(kap), float(en)
