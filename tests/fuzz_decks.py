@@ -238,7 +238,8 @@ def grammar_deck(rng: random.Random) -> tuple[str, set[str], bool]:
         toks = [rng.choice(["2", "3", "4.5", "2*3.0"]) if rng.random() < 0.6 else number_token(rng)
                 for _ in range(rng.randrange(1, 4))]
         lines = ["  key1 = 'fourbar.crank'", f"  values1 = {', '.join(toks)}"]
-        if any(fortran_values(t) is None for t in toks):
+        # an empty token is Fortran's null value (a trailing separator, or ", ,"), not a bad number
+        if any(t.strip() and fortran_values(t) is None for t in toks):
             must.add("values1")
         if rng.random() < 0.6:
             lines.append(f"  keep = \"{expression(rng)}\"")
