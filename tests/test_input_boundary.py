@@ -409,3 +409,13 @@ def test_unknown_keys_refused_before_the_namelist_reader(monkeypatch):
     with pytest.raises(DeckError, match="more than 200 keys") as exc:
         read_deck("big.dat", text="&nosuchgroup\n" + keys + "/\n")
     assert exc.value.line == 202
+
+
+def test_a_text_column_may_still_be_plotted(tmp_path, capsys):
+    """The kind check refuses expressions that misuse text, not a plotted text column itself."""
+    deck = tmp_path / "sm.dat"
+    deck.write_text(FOURBAR + "&sweep\n  key1 = 'fourbar.method', values1 = 'listing', 'exact'\n"
+                              "  plot_x = 'fourbar.method', plot_y = 'mu_min_deg', 'grashof_class'\n/\n")
+    assert main([str(deck), "-o", str(tmp_path / "o"), "--plot", "-q", "-j", "1"]) in (0, 1)
+    assert (tmp_path / "o" / "sm_summary.png").is_file()
+    assert "error" not in capsys.readouterr().err

@@ -118,7 +118,8 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
         for key, text in named:
             try:
                 e = expr.parse(text, columns)
-                e.check_kinds(kinds)   # one number or logical per case, before any case runs
+                if key == "keep" or text.strip() not in columns:   # a plotted column may hold text
+                    e.check_kinds(kinds)   # one number or logical per case, before any case runs
                 if key != "keep" and not e.names:
                     raise expr.ExprError("reads no column: a plot shows a column or an expression of columns",
                                          text[:60])
