@@ -22,7 +22,8 @@ def _h(*arrays) -> str:
 
 
 def fingerprint() -> dict[str, str]:
-    """One hash per kernel family, inputs chosen to exercise every code path (vector loops included)."""
+    """One hash per kernel wrapper of driver.kernels (every one: test_packaging checks it), inputs chosen
+    to exercise every code path (vector loops included)."""
     rng = np.random.default_rng(20261125)
     theta = np.concatenate([np.linspace(0, 2 * np.pi, 2001), rng.uniform(-50, 50, 4003)])
     out = {}
@@ -53,6 +54,59 @@ def fingerprint() -> dict[str, str]:
     assert sc["status"] == k.SLIDERCRANK_STATUS["ok"], sc["status"]
     out["slidercrank_simulate"] = _h(*(sc[n] for n in ("eps_ax", "eps_of", "n_avg", "mid", "slider", "elong")),
                                      sc["status"])
+    out.update(_batch_and_auxiliary_kernels(rng, theta))
+    return out
+
+
+def _batch_and_auxiliary_kernels(rng: np.random.Generator, theta: np.ndarray) -> dict[str, str]:
+    """The batch-summary, force, geometry and closed-form kernels (every other wrapper of driver.kernels)."""
+    out = {}
+    nd = 2000
+    links = rng.uniform(2.0, 15.0, (nd, 4))
+    ends = np.column_stack([np.zeros(nd), np.where(rng.random(nd) < 0.5, 360.0, rng.uniform(30, 300, nd))])
+    params = np.column_stack([links, rng.uniform(1, 10, nd), ends, np.where(rng.random(nd) < 0.5, 1.0, -1.0)])
+    out["fourbar_summaries"] = _h(k.fourbar_summaries(params))
+    # forces in SI: the crank-5 linkage in metres, masses and inertias of steel bars, a load
+    p, q, r, s = 0.12, 0.05, 0.15, 0.09
+    props = np.array([0.4, 1.1, 0.7, 2e-4, 2.1e-3, 5e-4, 0.025, 0.075, 0.045, 0.0, 0.1, -0.05,
+                      9.81, 1.5, 3.0, -2.0, 0.07, 0.02])
+    states, st = k.fourbar_exact(theta, p, q, r, s, 5.0, 0.7, 1)
+    out["fourbar_joint_forces"] = _h(k.fourbar_joint_forces(states, st, p, q, r, s, 5.0, 0.7, props))
+    balanced, cw = k.fourbar_berkof_lowen(q, r, s, props, (0.03, 0.04))
+    out["fourbar_berkof_lowen"] = _h(balanced, cw)
+    nf = 200
+    scale = rng.uniform(0.8, 1.2, (nf, 4)) * np.array([p, q, r, s])
+    fparams = np.column_stack([scale, rng.uniform(2, 20, nf), rng.uniform(-1, 1, nf), np.zeros(nf),
+                               np.full(nf, 360.0), np.where(rng.random(nf) < 0.5, 1.0, -1.0),
+                               np.tile(props, (nf, 1)), np.full(nf, 0.05), (rng.random(nf) < 0.5) * 1.0,
+                               np.full((nf, 2), 0.03)])
+    out["fourbar_force_summaries"] = _h(k.fourbar_force_summaries(fparams))
+    wx, wy = rng.uniform(0.2, 0.5, 6), rng.uniform(0.2, 0.5, 6)
+    mparams = np.column_stack([rng.uniform(0.3, 0.8, (nd, 2)), rng.uniform(0.2, 0.6, (nd, 2)),
+                               np.full(nd, 3.0), np.full(nd, 9.81), np.full(nd, 1e-3)])
+    unit = rng.uniform(-1, 1, (500, 2))
+    out["manipulator_design_summaries"] = _h(
+        k.manipulator_design_summaries(wx, wy, mparams, 1, (1.0, 0.5, 0.2, 0.1), "global", unit),
+        k.manipulator_design_summaries(wx, wy, mparams, -1, (1.0, 0.5, 0.2, 0.1), "per_point", unit))
+    beta = rng.uniform(0.05, 0.5, (nd, 3))
+    phi, rho = rng.uniform(-np.pi, np.pi, (nd, 2)), rng.uniform(-np.pi, np.pi, (nd, 2))
+    kinds = k.UJOINT_OBJECTIVES
+    out["ujoint_summaries"] = _h(*(k.ujoint_summaries(code, kinds[obj], beta, phi, rho, 360)
+                                   for code in k.UJOINT_MODELS.values() for obj in kinds))
+    eq = [k.ujoint_equivalent(code, beta[i], phi[i], rho[i]) for code in k.UJOINT_MODELS.values() for i in range(50)]
+    eq += [k.ujoint_equivalent(k.UJOINT_MODELS["exact"], beta[0], [np.pi / 2, 0.0], [0.0, 0.0])]
+    out["ujoint_equivalent"] = _h([be for be, _ in eq], [np.nan if br is None else br for _, br in eq])
+    axes = rng.normal(0, 1, (5, 3)) * 0.2 + np.array([1.0, 0.0, 0.0])
+    g_beta, g_rho, g_status = k.ujoint_geometry(np.cumsum(axes, axis=0))
+    out["ujoint_geometry"] = _h(g_beta, g_rho, g_status)
+    sc = (0.15, 0.3, 7870 * 64e-6, 2e11 * 64e-6, 2e11 * 3.413333333e-10)
+    mb, kb = k.slidercrank_matrices(16, *sc, 0.075552, 1.3, 150.0, True)
+    out["slidercrank_matrices"] = _h(mb, kb)
+    out["slidercrank_rigid"] = _h(k.slidercrank_rigid(theta, 150.0, 0.15, 0.3))
+    out["slidercrank_axial_force"] = _h(k.slidercrank_axial_force(theta[:500], np.linspace(0, 0.3, 17), 150.0,
+                                                                  0.15, 0.3, 7870 * 64e-6, 0.075552))
+    out["slidercrank_frequencies"] = _h(k.slidercrank_frequencies(7870 * 64e-6, 2e11 * 64e-6,
+                                                                  2e11 * 3.413333333e-10, 0.3, 0.075552))
     return out
 
 

@@ -115,3 +115,14 @@ def test_build_backend_finds_meson_and_ninja_of_its_own_environment_without_acti
     assert meson_after == os.path.join(scripts, "meson") and ninja_after == os.path.join(scripts, "ninja")
     assert PYPROJECT["build-system"]["build-backend"] == "mesonpy_venv"
     assert PYPROJECT["build-system"]["backend-path"] == ["backend"]
+
+
+def test_kernel_fingerprint_covers_every_kernel_wrapper():
+    """tests/kernel_fingerprint.py (the native-vs-portable bit comparison of test_install) calls every
+    public wrapper of driver.kernels: a new kernel cannot escape the CPU-independence check."""
+    import inspect
+    from driver import kernels
+    wrappers = [n for n in kernels.__all__ if inspect.isfunction(getattr(kernels, n)) and n != "farray"]
+    source = (ROOT / "tests" / "kernel_fingerprint.py").read_text()
+    assert len(wrappers) >= 20
+    assert [n for n in wrappers if f"k.{n}(" not in source] == []
