@@ -489,3 +489,24 @@ def test_force_figures_draw_with_units_and_accept_ax():
     theta = np.linspace(0, 360, 37)
     fa = forces.ForceAnalysis(np.ones((37, 12)), np.ones(37, bool))
     assert forces.plot_torque(theta, fa, {}, ax=own) is own and len(own.get_lines()) >= 2
+
+
+def test_sweep_case_decks_of_a_force_deck_run_again(tmp_path):
+    """The case decks a sweep writes carry the force keys the base deck gave and no others
+    (a key defaulted to a value would be 'given' without mass in a deck that has none), and
+    each runs again to the same force summary."""
+    from driver.api import run_sweep
+    base = open(INPUTS / "fourbar_forces.dat").read()
+    res = run_sweep(base, grid={"coupler": [0.33, 0.37]}, case_outputs="all", outdir=tmp_path, jobs=1, name="fs")
+    cases = sorted(tmp_path.rglob("case_*.dat"))
+    assert len(cases) == 2
+    for i, case in enumerate(cases):
+        text = case.read_text()
+        assert "mass" in text and "speed_fluctuation" in text and "balance" not in text and "counterweight" not in text
+        again = run(text).summary
+        assert again["torque_peak_Nm"] == pytest.approx(res.summary["torque_peak_Nm"].iloc[i], rel=1e-12)
+    plain = run_sweep("&fourbar fixed_link = 12, crank = 5, coupler = 15, rocker = 9, step_deg = 30 /",
+                      grid={"crank": [4, 5]}, case_outputs="all", outdir=tmp_path / "plain", jobs=1, name="p")
+    for case in sorted((tmp_path / "plain").rglob("case_*.dat")):
+        assert not any(k in case.read_text() for k in ("gravity", "mass", "load_", "balance"))
+    assert "torque_peak_Nm" not in plain.summary.columns
