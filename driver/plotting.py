@@ -14,6 +14,7 @@ import contextlib
 import functools
 import math
 import textwrap
+import warnings
 from pathlib import Path
 from typing import Any, Callable, Iterator, Sequence, TypeVar
 
@@ -29,7 +30,7 @@ from matplotlib.figure import Figure
 from driver.atomic import atomic_open
 from driver.study import PLOT_FORMATS, plot_format
 
-__all__ = ["STYLE", "style", "styled", "new_figure", "save_figure", "line_panels"]
+__all__ = ["STYLE", "style", "styled", "new_figure", "save_figure", "line_panels", "plain_text"]
 
 #: the house style, applied only inside :func:`style` (never written to the global rcParams)
 STYLE: dict[str, Any] = {"figure.dpi": 150, "savefig.dpi": 150, "axes.grid": True, "grid.alpha": 0.3,
@@ -39,10 +40,23 @@ STYLE: dict[str, Any] = {"figure.dpi": 150, "savefig.dpi": 150, "axes.grid": Tru
 _F = TypeVar("_F", bound=Callable[..., Any])
 
 
+def plain_text(text: Any) -> str:
+    """Text from a deck (a title, a design name, the deck's file name, a value, an expression)
+    as matplotlib draws it literally: never mathtext (every ``$`` escaped, so ``'$\\frac$'`` or
+    nested braces cannot raise a parse error), control characters dropped.  Every figure
+    builder passes deck text through this one function."""
+    text = "".join(ch for ch in str(text) if ch.isprintable() or ch == "\n")
+    return text.replace("$", r"\$")
+
+
 @contextlib.contextmanager
 def style(**overrides: Any) -> Iterator[None]:
-    """Draw inside this context to get the house style; rcParams are restored on exit."""
-    with matplotlib.rc_context({**STYLE, **overrides}):
+    """Draw inside this context to get the house style; rcParams are restored on exit.
+
+    matplotlib's warnings (a glyph missing from the font, identical axis limits) are dropped
+    here: they name package paths and say nothing a user of the tool can act on."""
+    with matplotlib.rc_context({**STYLE, **overrides}), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
         yield
 
 
@@ -102,7 +116,7 @@ def line_panels(x: np.ndarray, panels: Sequence[tuple[str, dict[str, np.ndarray]
             ax.legend(loc="best")
     axes[-1].set_xlabel(xlabel)
     if title:
-        fig.suptitle(title)
+        fig.suptitle(plain_text(title))
     return fig
 
 
@@ -184,7 +198,7 @@ def fourbar_curves(exact, listing, title: str, band: Sequence[float] = (40.0, 12
         ax.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
     axes[-1].set_xlabel(r"crank angle $\theta_2$ [deg]")
     if title:
-        fig.suptitle(f"{title}: four-bar kinematics")
+        fig.suptitle(f"{plain_text(title)}: four-bar kinematics")
     return fig
 
 
@@ -257,7 +271,7 @@ def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.nd
     if len(runs) > 1:
         spans = ", ".join(f"{theta[r[0]]:.0f}-{theta[r[-1]]:.0f}°" for r in runs)
         what += f"\nassembles over {len(runs)} separate crank intervals ({spans}): separate motions"
-    ax.set_title(f"{title}: {what}" if title else what)
+    ax.set_title(f"{plain_text(title)}: {what}" if title else what)
     return fig
 
 
@@ -323,7 +337,7 @@ def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, 
             ax.plot(*optima[key], mk, ms=5, mfc="none")
         ax.plot(l1, l2, "r*", ms=9, label="chosen designs")
         for name, a, b in zip(names, l1, l2):
-            ax.annotate(name, (a, b), textcoords="offset points", xytext=(4, 4), fontsize=7)
+            ax.annotate(plain_text(name), (a, b), textcoords="offset points", xytext=(4, 4), fontsize=7)
         ax.set_xlim(0, top)
         ax.set_ylim(0, top)
         ax.set_aspect("equal")
@@ -333,7 +347,7 @@ def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, 
     axes[1].set_title("RI2 over the design plane")
     fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncol=4, frameon=False)
     if title:
-        fig.suptitle(title)
+        fig.suptitle(plain_text(title))
     return fig
 
 
@@ -357,7 +371,7 @@ def manipulator_torque_crob(l1: np.ndarray, tau1: np.ndarray, tau2: np.ndarray, 
     ax.set_ylabel("motor torque [N m]")
     ax.set_xlabel("l1 [m]  (l2 = sqrt(%g - l1^2) [m])" % c)
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
-    fig.suptitle(f"{title}: motor torques along C_rob" if title else "Motor torques along C_rob")
+    fig.suptitle(f"{plain_text(title)}: motor torques along C_rob" if title else "Motor torques along C_rob")
     return fig
 
 
@@ -395,7 +409,8 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
     import pandas as pd
     labels = labels or {}
     only_points = False
-    label = lambda c: textwrap.fill(labels.get(c, c), 28)  # noqa: E731  (two lines fit a panel)
+    # a label that is the column's own name may be deck text (an expression): drawn literally
+    label = lambda c: textwrap.fill(labels.get(c, c) if labels.get(c, c) != c else plain_text(c), 28)  # noqa: E731
     x = x or next((k for k in keys if pd.api.types.is_numeric_dtype(frame[k])), "case")
     if ys:
         ys = list(ys)
@@ -430,7 +445,7 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
             g = g.sort_values(x)
             style = "-" if len(frame) <= 2000 and not only_points else ""
             ax.plot(g[x], g[y], style, marker="o" if len(frame) <= 200 else ".", ms=3, lw=1,
-                    label=", ".join(f"{labels.get(k, k).split(' [')[0]} = {v}"
+                    label=", ".join(f"{labels.get(k, k).split(' [')[0]} = {plain_text(v)}"
                                     for k, v in zip(others, key if isinstance(key, tuple) else (key,))) or None)
         if not kept.all():
             ax.plot(frame.loc[kept, x], frame.loc[kept, y], "o", ms=4, mfc="none", color="k", label="kept")
@@ -439,7 +454,7 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
         axes[0].legend(ncol=min(3, max(1, len(frame.groupby(others)) if others else 1)),
                        loc="lower left", bbox_to_anchor=(0.0, 1.02), frameon=False)
     axes[-1].set_xlabel(label(x))
-    fig.suptitle(f"{title}: sweep summary" if title else "sweep summary")
+    fig.suptitle(f"{plain_text(title)}: sweep summary" if title else "sweep summary")
     return fig
 
 
@@ -501,7 +516,7 @@ def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.
         ax.set_xlim(0.0, 360.0)
         ax.set_xticks(np.arange(0, 361, 45))
         fig.legend(loc="outside lower center", ncol=2, frameon=False)
-    fig.suptitle(f"{title}: Hooke-joint chain, input and output shaft speed" if title
+    fig.suptitle(f"{plain_text(title)}: Hooke-joint chain, input and output shaft speed" if title
                  else "Hooke-joint chain: input and output shaft speed")
     return fig
 
@@ -537,7 +552,7 @@ def slidercrank_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray
     ax.set_ylabel(ylabel)
     fig.legend(loc="outside lower center", ncol=3 if len(series) + len(missing) > 4 else 2,
                frameon=False, title="crank speed")
-    ax.set_title(title)
+    ax.set_title(plain_text(title))
     return fig
 
 
@@ -555,7 +570,7 @@ def slidercrank_convergence_figure(series: dict[str, tuple[list[int], list[float
     axes[1].set_ylabel("change from previous count [%]")
     axes[1].set_xlabel("number of elements")
     axes[0].legend()
-    fig.suptitle(title)
+    fig.suptitle(plain_text(title))
     return fig
 
 
@@ -616,7 +631,7 @@ def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, 
     """
     import pandas as pd
     labels = labels or {}
-    lab = lambda c: labels.get(c, c)  # noqa: E731
+    lab = lambda c: labels.get(c, c) if labels.get(c, c) != c else plain_text(c)  # noqa: E731  (deck text: literal)
     keys = [k for k in keys if k in frame.columns][:3]
     kept = frame["kept"].astype(bool) if "kept" in frame else pd.Series(True, index=frame.index)
     z_all = pd.to_numeric(frame[metric], errors="coerce").to_numpy(dtype=float)
@@ -643,7 +658,7 @@ def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, 
         _plain_numbers(ax)
         ax.legend(loc="best")
         if title:
-            ax.set_title(title)
+            ax.set_title(plain_text(title))
         return fig
 
     kx, ky = keys[0], keys[1]
@@ -705,7 +720,7 @@ def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, 
     note = ("kept designs outlined in black" if not kept.all() else
             "only kept designs tabulated (blank: not kept)" if only_kept else "every design kept")
     if title:
-        fig.suptitle(f"{title}\n{note}" if (n > 1 or not kept.all() or only_kept) else title)
+        fig.suptitle(f"{plain_text(title)}\n{note}" if (n > 1 or not kept.all() or only_kept) else plain_text(title))
     elif not kept.all() or only_kept:
         axes[0].set_title(note, fontsize=8)
     return fig
@@ -785,7 +800,7 @@ def convergence_plot(history, evals, objective: str, sense: str = "minimize", ti
     _plain_numbers(a1)
     _plain_numbers(a3) if a3.get_yscale() == "linear" else None
     if title:
-        fig.suptitle(title)
+        fig.suptitle(plain_text(title))
     return fig
 
 

@@ -282,7 +282,7 @@ def expression_label(module: ModuleType | None, text: str) -> str:
             labels = getattr(module, "LABELS", {})
             if n in labels:
                 units.add(labels[n][1])
-    words = text.strip()
+    words = text.strip().replace("$", r"\$")   # the deck's text is never mathtext (driver.plotting.plain_text)
     for n in sorted(names, key=len, reverse=True):
         entry = getattr(module, "LABELS", {}).get(n)
         if entry:

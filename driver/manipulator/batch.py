@@ -26,7 +26,7 @@ import pandas as pd
 from driver import kernels
 from driver.deck import Params
 from driver.manipulator.analysis import STATUS, Conv, Workspace, _design_list, design_status, round_half_up
-from driver.manipulator.report import sweep_columns, workspace_columns
+from driver.manipulator.report import design_torque_columns, sweep_columns, workspace_columns
 from driver.manipulator.tables import _t48
 
 __all__ = ["BATCH_KEYS", "BATCH_IGNORED", "BATCH_INDEPENDENT", "summarise_batch", "summarise"]
@@ -193,14 +193,14 @@ def _arrays(base: Mapping[str, Any], columns: Mapping[str, Any] | None) -> dict[
     out.update({"design_l1_m": d1, "design_l2_m": d2, "design_ri1": nan(ri1, ri1 > 0), "design_ri2": ri2.copy(),
                 "design_ri3": r["ri3"][:, 0].copy(), "design_ri2_excess": ri2 - math.sqrt(ws.n),
                 "design_reaches_all": reach, "design_crob_residual_m2": d1 * d1 + d2 * d2 - ws.mean_d2,
-                "design_total_torque_Nm": nan(tau1[:, 0] + tau2[:, 0], ok[:, 0]),
+                **design_torque_columns(tau1[:, 0], tau2[:, 0], ok[:, 0]),
                 "design_status": _status(reach, ok[:, 0], ri1)})
     # the C_rob walk: once per distinct target, mass per length and g
     codes = [np.unique(v, return_inverse=True) for v in (tx, ty, mpl, g)]
     flat = np.ravel_multi_index([c[1].ravel() for c in codes], [len(c[0]) for c in codes])
     first, inv = np.unique(flat, return_index=True, return_inverse=True)[1:]
     walks = [_walk(p, conv, float(tx[i]), float(ty[i]), float(mpl[i]), float(g[i])) for i in first]
-    for c in ("sweep_min_total_torque_Nm", "sweep_min_l1_m", "sweep_min_l2_m", "sweep_min_row",
+    for c in ("sweep_min_tau_sum_signed_Nm", "sweep_min_l1_m", "sweep_min_l2_m", "sweep_min_row",
               "sweep_min_reaches_workspace"):
         vals = [w.get(c) for w in walks]
         if all(v is None for v in vals):
@@ -282,8 +282,17 @@ def summarise(params: Params) -> dict[str, Any]:
         elif isinstance(v, np.floating):
             v = float(v)
         out[key] = v
-    if out.get("sweep_min_total_torque_Nm") is None:   # as a run: no C_rob row reaches the target
-        for key in ("sweep_min_total_torque_Nm", "sweep_min_l1_m", "sweep_min_l2_m", "sweep_min_row",
+    if out.get("sweep_min_tau_sum_signed_Nm") is None:   # as a run: no C_rob row reaches the target
+        for key in ("sweep_min_tau_sum_signed_Nm", "sweep_min_l1_m", "sweep_min_l2_m", "sweep_min_row",
                     "sweep_min_reaches_workspace"):
             out.pop(key, None)
     return out
+
+
+def batch_refusal(row: Mapping[str, Any]) -> str | None:
+    """Why the study's own run refuses the design of a batch row, or None: an optimiser ranks such a
+    row as the case-by-case route does (the run refuses designs that violate the reach conditions)."""
+    if row.get("design_status") == "unreachable":
+        return ("designs_l1: design 1 violates the reach conditions |l1 - l2| <= r and l1 + l2 >= R: "
+                "it cannot reach every workspace point")
+    return None
