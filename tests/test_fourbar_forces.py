@@ -435,6 +435,12 @@ BAD = [
     (("inertia = 4e-4, 1.2e-2, 4.7e-3", "inertia = 4e2, 1.2e4, 4.7e3"), "inertia", "unit"),
     (("coupler_point = 0.175, 0.05      ! m: where the load force acts (u along A->B, v to its left)\n", ""),
      "load_force_x", "coupler_point"),
+    (("coupler_point = 0.175, 0.05", "coupler_point = 175, 50"), "coupler_point", "unit"),
+    (("speed_fluctuation = 0.02", "speed_fluctuation = 0.02\n  counterweight_radius = 0.1, 0.1"),
+     "counterweight_radius", "balance = 'force'"),
+    (("speed_fluctuation = 0.02", "speed_fluctuation = 0.02\n  balance = 'force'\n  counterweight_radius = 5, 0.1"),
+     "counterweight_radius", "unit mismatch"),
+    (("mass = 0.5, 1.2, 0.9", "mass = 0.5, nan, 0.9"), "mass", "not a number"),
     (("speed_fluctuation = 0.02", "speed_fluctuation = 0"), "speed_fluctuation", "positive"),
     (("speed_fluctuation = 0.02", "speed_fluctuation = 0.02\n  balance = 'moment'"), "balance", "not one of"),
     (("method = 'exact'", "method = 'listing'"), "mass", "method = 'exact'"),
@@ -492,3 +498,24 @@ def test_force_figures_draw_with_units_and_accept_ax():
     theta = np.linspace(0, 360, 37)
     fa = forces.ForceAnalysis(np.ones((37, 12)), np.ones(37, bool))
     assert forces.plot_torque(theta, fa, {}, ax=own) is own and len(own.get_lines()) >= 2
+
+
+def test_sweep_case_decks_of_a_force_deck_run_again(tmp_path):
+    """The case decks a sweep writes carry the force keys the base deck gave and no others
+    (a key defaulted to a value would be 'given' without mass in a deck that has none), and
+    each runs again to the same force summary."""
+    from driver.api import run_sweep
+    base = open(INPUTS / "fourbar_forces.dat").read()
+    res = run_sweep(base, grid={"coupler": [0.33, 0.37]}, case_outputs="all", outdir=tmp_path, jobs=1, name="fs")
+    cases = sorted(tmp_path.rglob("case_*.dat"))
+    assert len(cases) == 2
+    for i, case in enumerate(cases):
+        text = case.read_text()
+        assert "mass" in text and "speed_fluctuation" in text and "balance" not in text and "counterweight" not in text
+        again = run(text).summary
+        assert again["torque_peak_Nm"] == pytest.approx(res.summary["torque_peak_Nm"].iloc[i], rel=1e-12)
+    plain = run_sweep("&fourbar fixed_link = 12, crank = 5, coupler = 15, rocker = 9, step_deg = 30 /",
+                      grid={"crank": [4, 5]}, case_outputs="all", outdir=tmp_path / "plain", jobs=1, name="p")
+    for case in sorted((tmp_path / "plain").rglob("case_*.dat")):
+        assert not any(k in case.read_text() for k in ("gravity", "mass", "load_", "balance"))
+    assert "torque_peak_Nm" not in plain.summary.columns

@@ -131,6 +131,10 @@ def check(p: Params) -> None:
                 raise p.error("inertia", f"the {LINKS[i]}'s radius of gyration sqrt(I/m) = {math.sqrt(j / m):.3g} m "
                                          f"is over {MAX_GYRATION_RATIO:g} times its length {L:g} m: inertia and the "
                                          "lengths look like different units (kg m^2 and m expected)")
+    if p.coupler_point and max(abs(x) for x in p.coupler_point) > MAX_COM_RATIO * p.coupler:
+        raise p.error("coupler_point", f"{max(abs(x) for x in p.coupler_point):g} m is over {MAX_COM_RATIO:g} times "
+                                       f"the coupler length {p.coupler:g} m: coupler_point and the link lengths look "
+                                       "like different units (metres are expected when masses are given)")
     if p.counterweight_radius is not None:
         if value(p, "balance") != "force":
             raise p.error("counterweight_radius", "is used only with balance = 'force'")
