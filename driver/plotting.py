@@ -29,7 +29,7 @@ from matplotlib.figure import Figure
 from driver.atomic import atomic_open
 from driver.study import PLOT_FORMATS, plot_format
 
-__all__ = ["STYLE", "style", "styled", "new_figure", "save_figure", "line_panels"]
+__all__ = ["STYLE", "style", "styled", "new_figure", "save_figure", "line_panels", "deck_text"]
 
 #: the house style, applied only inside :func:`style` (never written to the global rcParams)
 STYLE: dict[str, Any] = {"figure.dpi": 150, "savefig.dpi": 150, "axes.grid": True, "grid.alpha": 0.3,
@@ -60,6 +60,13 @@ def new_figure(nrows: int = 1, ncols: int = 1, **kw) -> tuple[Figure, np.ndarray
     fig = Figure(figsize=kw.pop("figsize", (6.4 * ncols, 3.2 * nrows)), layout="constrained")
     axes = fig.subplots(nrows, ncols, squeeze=False, **kw)
     return fig, axes.ravel()
+
+
+def deck_text(text: str) -> str:
+    """Text from a deck or a file name as matplotlib draws it literally: every ``$`` escaped, so
+    a title such as ``cost in $ per part`` is never parsed as mathtext (figure labels written by
+    the tool itself use mathtext on purpose: omega_2 as $\\omega_2$)."""
+    return str(text).replace("\\$", "$").replace("$", "\\$")
 
 
 #: metadata written into every figure file: no dates, no software versions, so the same
@@ -93,6 +100,7 @@ def save_figure(fig: Figure, path: str | Path, fmt: bool | str | None = None) ->
 def line_panels(x: np.ndarray, panels: Sequence[tuple[str, dict[str, np.ndarray]]], xlabel: str,
                 title: str = "", styles: dict[str, dict] | None = None) -> Figure:
     """Stacked panels sharing x: each panel is (ylabel, {label: y}); NaN gaps break lines."""
+    title = deck_text(title)
     fig, axes = new_figure(len(panels), 1, sharex=True, figsize=(7.0, 2.2 * len(panels) + 0.6))
     for ax, (ylabel, series) in zip(axes, panels):
         for label, y in series.items():
@@ -152,6 +160,7 @@ def fourbar_curves(exact, listing, title: str, band: Sequence[float] = (40.0, 12
     [deg] is shaded.  ``output`` names the output link ('rocker', 'output crank').
     ``axes``: three axes to draw into.
     """
+    title = deck_text(title)
     names = _fourbar_names(output)
     panels = [("link angle [deg]", ["coupler_deg", "rocker_deg"]),
               ("transmission angle [deg]", ["transmission_deg"]),
@@ -212,6 +221,7 @@ def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.nd
     link.  Coordinates in the deck's length ``units``, crank pivot at the origin, ground along
     +x; the legend sits beside the drawing.
     """
+    title = deck_text(title)
     if ax is None:
         fig, (ax,) = new_figure(1, 1, figsize=(8.6, 5.2))
     else:
@@ -296,6 +306,7 @@ def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, 
     (eqs 4.14-4.17, c = sum d^2), dexterity line l2 = l1 sqrt(2)/2, manipulability line l1 = l2,
     optima and chosen designs.  Right: RI2 contours over the design plane with the same lines.
     """
+    title = deck_text(title)
     fig, axes = new_figure(1, 2, figsize=(11.0, 5.0))
     top = float(L1.max())
     g = np.linspace(0, top, 400)
@@ -345,6 +356,7 @@ def manipulator_torque_crob(l1: np.ndarray, tau1: np.ndarray, tau2: np.ndarray, 
     Rows where the target is out of reach are gaps; ``violates`` marks the rows (a boolean
     per row) whose design does not reach the whole workspace (the reach conditions
     |l1 - l2| <= r, l1 + l2 >= R fail): their points are crossed and named in the legend."""
+    title = deck_text(title)
     fig, (ax,) = new_figure(1, 1, figsize=(7.4, 3.8))
     total = tau1 + tau2
     for label, y in (("tau1", tau1), ("tau2", tau2), ("tau1 + tau2", total)):
@@ -392,6 +404,7 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
     the figures are drawn as lines over the cases, one line per value of the other keys;
     when some cases are not kept, kept cases are circled.
     """
+    title = deck_text(title)
     import pandas as pd
     labels = labels or {}
     only_points = False
@@ -461,6 +474,7 @@ def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.
     Cartesian or polar (angle = input angle, radius = speed); the polar radius starts near
     the slowest speed, not at 0, so a fluctuation of a fraction of an rpm stays visible (the
     empty centre says the radius does not start at 0)."""
+    title = deck_text(title)
     if polar:
         fig = Figure(figsize=(7.4, 5.2), layout="constrained")
         ax = fig.add_subplot(1, 1, 1, projection="polar")
@@ -520,6 +534,7 @@ def slidercrank_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray
     them although the rod would buckle).  ``missing`` are one-line texts of cases not drawn (e.g. a speed that
     buckled): they are listed in the legend, so no speed silently disappears.
     """
+    title = deck_text(title)
     from matplotlib.lines import Line2D
     above = above or {}
     fig, axes = new_figure(1, 1, figsize=(7.4, 4.4))
@@ -544,6 +559,7 @@ def slidercrank_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray
 @styled
 def slidercrank_convergence_figure(series: dict[str, tuple[list[int], list[float]]], title: str) -> Figure:
     """Peak strain against element count and its percentage change (the paper's Figures 8-9)."""
+    title = deck_text(title)
     fig, axes = new_figure(2, 1, sharex=True, figsize=(7.0, 5.0))
     for label, (n, peak) in series.items():
         n, peak = np.asarray(n, dtype=float), np.asarray(peak, dtype=float)
@@ -842,6 +858,53 @@ def sweep_maps(frame, keys: Sequence[str], ys: Sequence[str], labels: dict[str, 
                 f"{_words_value(labels.get(k, k), frame.loc[best, k])}" for k in keys) + \
                 f"; {labels.get(y, y).split(' [')[0]} {_words_value(labels.get(y, y), frame.loc[best, y], name=False)}"
         figs.append(design_space_map(frame, keys, y, labels, best=best, best_text=text,
-                                     title=f"{title}: {labels.get(y, y)}" if title else labels.get(y, y),
+                                     title=f"{deck_text(title)}: {labels.get(y, y)}" if title else labels.get(y, y),
                                      only_kept=only_kept))
     return figs
+
+
+# ----------------------------------------------------------------------------- robust design (Taylor)
+
+@styled
+def robust_design_figure(t: np.ndarray, means: dict[str, np.ndarray], spreads: dict[str, np.ndarray],
+                         points: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]],
+                         tmins: dict[str, float | None], sigma_x: float, title: str = "", axes=None) -> Figure:
+    """Taylor's robust-design example: the mean of Y (top) and its spread (bottom, log axis)
+    against the target t, every fitted curve beside the known relation's, the measured means
+    and standard deviations as markers, and the estimates of the target of least spread as
+    vertical lines.  ``means``/``spreads``: {label: values on ``t``}; ``points``: {label: (t,
+    mean, std)}; ``tmins``: {label: t_min or None}.  ``axes``: two axes to draw into."""
+    title = deck_text(title)
+    if axes is None:
+        fig, axes = new_figure(2, 1, sharex=True, figsize=(7.6, 6.4))
+    else:
+        fig = axes[0].figure
+    top, bot = axes
+    styles = ["-", "--", "-.", ":", (0, (5, 1, 1, 1))]
+    for k, (label, y) in enumerate(means.items()):
+        top.plot(t, y, ls=styles[k % len(styles)], color=f"C{k}", lw=1.5, label=label)
+    for k, (label, y) in enumerate(spreads.items()):
+        printed = "printed" in label
+        bot.plot(t, y, ls=":" if printed else styles[k % len(styles)], color="0.5" if printed else f"C{k}",
+                 lw=1.2 if printed else 1.6, label=label)
+    for k, (label, (pt, m, sd)) in enumerate(points.items()):
+        mk = "os"[k % 2]
+        top.plot(pt, m, mk, ms=6, mfc="white", mec="k", label=label)
+        bot.plot(pt, sd, mk, ms=6, mfc="white", mec="k", label=label)
+    for k, (label, tm) in enumerate(tmins.items()):
+        if tm is not None and np.isfinite(tm):
+            bot.axvline(tm, color=f"C{k}", lw=0.9, ls=(0, (2, 2)), alpha=0.9,
+                        label=rf"$t_{{min}}$ {label} = {tm:.3f}")
+    top.set_ylabel(r"mean of $Y$, $\mu_Y$")
+    bot.set_ylabel(r"spread of $Y$, $\sigma_Y$ (log)")
+    bot.set_yscale("log")
+    bot.set_xlabel(rf"target $t$ (X varies about $t$ with $\sigma_x$ = {sigma_x:g})")
+    finite = np.concatenate([y[np.isfinite(y) & (y > 0)] for label, y in spreads.items() if "printed" not in label]
+                            + [sd for _, _, sd in points.values()])
+    if finite.size:
+        bot.set_ylim(max(finite.min() * 0.5, 1e-6), finite.max() * 3.0)
+    top.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
+    bot.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
+    if title:
+        fig.suptitle(title)
+    return fig

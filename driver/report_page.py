@@ -557,7 +557,7 @@ def page_for_sweep(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> st
             figs = plotting.sweep_maps(ok, keys, wanted[:3], labels, senses, stem, sw.summary_rows == "kept")
         else:
             figs = [plotting.design_space_map(ok, numeric_keys[:1], y, labels, best=best, best_text=best_text,
-                                              title=f"{stem}: {labels[y]}") for y in wanted[:3]]
+                                              title=f"{plotting.deck_text(stem)}: {labels[y]}") for y in wanted[:3]]
         maps += [_figure_block(f, f"{labels[y]} over the swept keys") for f, y in zip(figs, wanted)]
     except Exception as exc:
         notes.append(f"the design-space maps could not be drawn: {exc.__class__.__name__}: {exc}")
@@ -625,7 +625,7 @@ def page_for_optimize(deck: "Deck", outdir: Path, stem: str, status: int = 0) ->
     notes: list[str] = []
     figs = []
     try:
-        fig = plotting.convergence_plot(history, evals, label, sense, title=f"{stem}: convergence")
+        fig = plotting.convergence_plot(history, evals, label, sense, title=plotting.deck_text(f"{stem}: convergence"))
         figs.append(_figure_block(fig, "best feasible objective, gap to the final best, constraint violation"))
     except Exception as exc:
         notes.append(f"the convergence plot could not be drawn: {exc.__class__.__name__}: {exc}")
@@ -635,7 +635,8 @@ def page_for_optimize(deck: "Deck", outdir: Path, stem: str, status: int = 0) ->
         opt = feas["objective"].idxmax() if sense == "maximize" else feas["objective"].idxmin()
         frame = evals.assign(kept=evals["feasible"].astype(bool))
         try:
-            fig = _evaluated_map(frame, design[:2], label, opt, _labels(module, design), f"{stem}: designs evaluated")
+            fig = _evaluated_map(frame, design[:2], label, opt, _labels(module, design),
+                                 plotting.deck_text(f"{stem}: designs evaluated"))
             figs.append(_figure_block(fig, "designs evaluated over the design variables"))
         except Exception as exc:
             notes.append(f"the map of designs could not be drawn: {exc.__class__.__name__}: {exc}")

@@ -238,7 +238,7 @@ def column_label(module: ModuleType | None, name: str) -> str:
     study ``module``: words and units from its ``LABELS``, else the key's ``SPEC`` units, else
     units read off the name's suffix (``_deg``, ``_rad_s``, ...).  E.g. ``'crank speed [rad/s]'``."""
     if not re.fullmatch(r"([a-z_][a-z0-9_]*\.)?[A-Za-z_][A-Za-z0-9_]*", name):
-        return name   # an expression of columns (driver.expr) is its own label
+        return name.replace("$", r"\$")   # an expression of columns (driver.expr) is its own label, drawn literally
     group, _, key = name.rpartition(".")
     if module is not None and group and group != getattr(module.SPEC, "name", group):
         module = None
@@ -282,7 +282,7 @@ def expression_label(module: ModuleType | None, text: str) -> str:
             labels = getattr(module, "LABELS", {})
             if n in labels:
                 units.add(labels[n][1])
-    words = text.strip()
+    words = text.strip().replace("$", r"\$")   # deck text: drawn literally, never as mathtext
     for n in sorted(names, key=len, reverse=True):
         entry = getattr(module, "LABELS", {}).get(n)
         if entry:

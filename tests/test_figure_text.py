@@ -1,0 +1,70 @@
+"""Figure text: deck text is drawn literally (never as mathtext), the tool's own labels use
+mathtext symbols, and the figures the issue found missing exist with the right content."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+pytest.importorskip("matplotlib")
+
+import driver  # noqa: E402
+from conftest import INPUTS  # noqa: E402
+
+
+def _is_math(text_artist) -> bool:
+    return bool(text_artist._preprocess_math(text_artist.get_text())[1])
+
+
+def test_deck_titles_are_never_mathtext(tmp_path):
+    """A title with dollar signs ('cost $x$ per $y$') is drawn as written: every figure renders,
+    and no title of a deck's text is parsed as mathtext."""
+    title = "cost $x$ per $y$ \\alpha"
+    r = driver.fourbar.run(fixed_link=12.0, crank=5.0, coupler=15.0, rocker=9.0, step_deg=20, title=title)
+    for name in r.figure_names:
+        fig = r.figure(name)
+        fig.canvas.draw()   # a mathtext parse error would raise here
+        titles = [t for t in ([fig._suptitle] if fig._suptitle else []) + [a.title for a in fig.axes]
+                  if "cost" in t.get_text()]
+        assert titles, name
+        for t in titles:
+            assert not _is_math(t)
+            assert t._preprocess_math(t.get_text())[0].startswith("cost $x$ per $y$")
+
+
+def test_tool_labels_use_mathtext_symbols():
+    r = driver.fourbar.run(fixed_link=12.0, crank=5.0, coupler=15.0, rocker=9.0, step_deg=20)
+    fig = r.figure("curves")
+    assert fig.axes[-1].get_xlabel() == r"crank angle $\theta_2$ [deg]"
+    legend = [t.get_text() for t in fig.axes[2].get_legend().get_texts()]
+    assert any(r"$\omega_4$" in t and t.startswith("rocker") for t in legend)
+    assert any(r"$\omega_3$" in t and t.startswith("coupler") for t in legend)
+
+
+def test_an_expression_label_is_drawn_literally():
+    from driver.study import column_label, expression_label
+    assert column_label(driver.fourbar, 'mu_min_deg + 0*("$" == "$")').count(r"\$") == 2
+    lab = expression_label(driver.fourbar, "min(mu_min_deg, 180 - mu_max_deg)")
+    assert lab == "min(minimum transmission angle, 180 - maximum transmission angle) [deg]"
+
+
+def test_robust_example_draws_its_fits():
+    """robust_example draws the mean and spread of Y against the target with the four t_min
+    estimates, at the values the .out reports (true t_min = -b1 / (2 b2) = 15 for (2.1))."""
+    r = driver.run(str(INPUTS / "robust_example.dat"))
+    assert r.figure_names == ["fits"]
+    fig = r.figure("fits")
+    top, bot = fig.axes[:2]
+    assert bot.get_yscale() == "log"
+    vlines = {ln.get_label(): ln.get_xdata()[0] for ln in bot.lines if ln.get_label().startswith("$t_{min}$")}
+    b = [-6.0, 1.2, -0.04]
+    assert vlines["$t_{min}$ true (2.2) = 15.000"] == pytest.approx(-b[1] / (2 * b[2]))
+    for key, label in (("tmin_dual_response", "dual response (2.9)"), ("tmin_taguchi", "Taguchi (2.13)"),
+                       ("tmin_tolerance_analysis", "tolerance analysis (2.15)")):
+        name = f"$t_{{min}}$ {label} = {r.summary[key]:.3f}"
+        assert vlines[name] == pytest.approx(r.summary[key])
+    # the known relation's spread (2.2) at t = 15 is sqrt(2 b2^2 sigma_x^4) = sqrt(2) |b2| sigma_x^2 (the slope term vanishes)
+    exact = [ln for ln in bot.lines if ln.get_label().startswith("tolerance analysis of (2.1)")][0]
+    t, s = exact.get_xdata(), exact.get_ydata()
+    assert np.interp(15.0, t, s) == pytest.approx(math.sqrt(2) * 0.04 * 0.5 ** 2, rel=1e-3)
