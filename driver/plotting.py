@@ -575,6 +575,33 @@ def slidercrank_convergence_figure(series: dict[str, tuple[list[int], list[float
     return fig
 
 
+@styled
+def slidercrank_history_figure(time: np.ndarray, series: dict[str, np.ndarray], labels: dict[str, str],
+                               reference: dict[str, tuple[float, float]], title: str, reference_label: str = "",
+                               axes=None) -> Figure:
+    """Quantities against time [s], one panel each (``series`` keyed like ``labels``, the axis
+    words with units), with a reference value (time, value) marked where given: a benchmark's
+    published end state beside the computed history."""
+    title = deck_text(title)
+    if axes is None:
+        fig, axes = new_figure(len(series), 1, sharex=True, figsize=(7.4, 2.4 * len(series) + 0.8))
+    else:
+        fig = axes[0].figure
+    for ax, (key, y) in zip(axes, series.items()):
+        ax.plot(time, y, color="C0", lw=1.2, label="this model (linear KED, Newmark)")
+        if key in reference:
+            t, v = reference[key]
+            ax.plot([t], [v], "D", ms=7, mfc="white", mec="C3", mew=1.5, label=reference_label or "reference")
+            ax.annotate(f"{v:.4g}", (t, v), xytext=(-6, 8), textcoords="offset points", ha="right", fontsize=8,
+                        color="C3")
+        ax.set_ylabel(labels.get(key, key))
+        ax.legend(loc="best")
+    axes[-1].set_xlabel("time $t$ [s]")
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
 # ----------------------------------------------------------------------------- design spaces and convergence
 
 def _numeric_axis(values) -> np.ndarray:
