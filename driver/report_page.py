@@ -63,6 +63,23 @@ def esc(text: Any) -> str:
     return html.escape(str(text), quote=True)
 
 
+_GREEK = {"alpha": "α", "beta": "β", "gamma": "γ", "delta": "δ", "theta": "θ", "mu": "μ", "rho": "ρ",
+          "sigma": "σ", "tau": "τ", "varphi": "φ", "phi": "φ", "omega": "ω", "psi": "ψ"}
+_SUB = str.maketrans("0123456789", "₀₁₂₃₄₅₆₇₈₉")
+
+
+def plain(label: str) -> str:
+    """A figure label as HTML text: its mathtext symbols as Unicode (``$\\omega_2$`` -> ω₂) and
+    an escaped ``\\$`` (deck text) as the dollar sign it stands for."""
+    def math(m: re.Match) -> str:
+        t = m.group(1)
+        t = re.sub(r"\\([A-Za-z]+)", lambda g: _GREEK.get(g.group(1), g.group(1)), t)
+        t = re.sub(r"_\{([0-9]+)\}|_([0-9])", lambda g: (g.group(1) or g.group(2)).translate(_SUB), t)
+        return t.replace("{", "").replace("}", "")
+    out = re.sub(r"(?<!\\)\$(.+?)(?<!\\)\$", math, label)
+    return out.replace("\\$", "$")
+
+
 # ----------------------------------------------------------------------------- metadata
 
 def run_metadata() -> dict[str, str]:
@@ -102,6 +119,7 @@ def figure_svg(fig: Any, label: str = "") -> str:
 
 
 def _figure_block(fig: Any, caption: str) -> str:
+    caption = plain(caption)
     return f'<figure class="plot">{figure_svg(fig, caption)}<figcaption>{esc(caption)}</figcaption></figure>'
 
 
@@ -570,7 +588,7 @@ def page_for_sweep(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> st
         try:
             result, params = _case_result(Path(f"{stem}_case{int(summary.loc[best, 'case'])}.dat"),
                                           _namelist(base_params.group, values))
-            body = (f'<p>Case {int(summary.loc[best, "case"])}, {esc(best_text)}: ' + ", ".join(
+            body = (f'<p>Case {int(summary.loc[best, "case"])}, {esc(plain(best_text))}: ' + ", ".join(
                 f"{esc(k)} = {summary.loc[best, k]:.6g}" for k in numeric_keys) + ".</p>")
             anim = mechanism_animation(params, "anim-best", "The marked design over one crank turn.")
             body += anim or ""

@@ -89,3 +89,12 @@ def test_simeon_benchmark_draws_its_history():
     assert elong_ax.lines[0].get_ydata()[-1] == pytest.approx(table["(q4)"] * 1e6, rel=1e-9)   # [um]
     assert ref.get_xdata()[0] == SIMEON1996["t"] and ref.get_ydata()[0] == pytest.approx(SIMEON1996["q1"] * 1e3)
     assert q1[-1] == pytest.approx(ref.get_ydata()[0], rel=5e-3)
+
+
+def test_report_page_text_of_a_label():
+    """The report page writes figure labels as text: mathtext symbols as Unicode, a deck's
+    escaped dollar as a dollar."""
+    from driver.report_page import plain
+    assert plain(r"phase angle $\varphi_{12}$ [deg]") == "phase angle φ₁₂ [deg]"
+    assert plain(r"crank angle $\theta_2$ [deg]") == "crank angle θ₂ [deg]"
+    assert plain(r"cost \$x\$ per part") == "cost $x$ per part"
