@@ -98,10 +98,14 @@ def save_figure(fig: Figure, path: str | Path, fmt: bool | str | None = None) ->
 
 @styled
 def line_panels(x: np.ndarray, panels: Sequence[tuple[str, dict[str, np.ndarray]]], xlabel: str,
-                title: str = "", styles: dict[str, dict] | None = None) -> Figure:
-    """Stacked panels sharing x: each panel is (ylabel, {label: y}); NaN gaps break lines."""
+                title: str = "", styles: dict[str, dict] | None = None, axes=None) -> Figure:
+    """Stacked panels sharing x: each panel is (ylabel, {label: y}); NaN gaps break lines.
+    ``axes``: one axes per panel to draw into (their figure is returned)."""
     title = deck_text(title)
-    fig, axes = new_figure(len(panels), 1, sharex=True, figsize=(7.0, 2.2 * len(panels) + 0.6))
+    if axes is None:
+        fig, axes = new_figure(len(panels), 1, sharex=True, figsize=(7.0, 2.2 * len(panels) + 0.6))
+    else:
+        fig = axes[0].figure
     for ax, (ylabel, series) in zip(axes, panels):
         for label, y in series.items():
             ax.plot(x, y, label=label, **(styles or {}).get(label, {}))
@@ -466,7 +470,8 @@ _UJOINT_STYLES = {"trial": dict(color="C1", lw=1.4), "design": dict(color="C1", 
 
 @styled
 def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.ndarray],
-                        polar: bool = False, band: Sequence[float] | None = None, title: str = "") -> Figure:
+                        polar: bool = False, band: Sequence[float] | None = None, title: str = "",
+                        ax=None) -> Figure:
     """Input and output shaft speed [rpm] against the input angle [deg], every design (trial,
     optimum, the paper's printed optimum) overlaid on one panel as in the paper's Figures 6-11,
     with the paper's trial band ``band`` = (min, max) [rpm] shaded when given.
@@ -475,7 +480,9 @@ def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.
     the slowest speed, not at 0, so a fluctuation of a fraction of an rpm stays visible (the
     empty centre says the radius does not start at 0)."""
     title = deck_text(title)
-    if polar:
+    if ax is not None:   # the caller's axes (a polar one for polar = True)
+        fig = ax.figure
+    elif polar:
         fig = Figure(figsize=(7.4, 5.2), layout="constrained")
         ax = fig.add_subplot(1, 1, 1, projection="polar")
     else:
@@ -507,14 +514,14 @@ def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.
             ax.text(np.radians(112.5), t, f"{t:g} rpm", fontsize=7.5, ha="center", va="center", zorder=6,
                     bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.85))
         ax.set_xlabel("input angle [deg]; radius: shaft speed [rpm], not starting at 0", fontsize=8)
-        fig.legend(loc="outside lower center", ncol=2, frameon=False)
+        fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncol=2, frameon=False)
     else:
         ax.set_ylim(low - pad, top + pad)
         ax.set_ylabel("shaft speed [rpm]")
         ax.set_xlabel("input angle [deg]")
         ax.set_xlim(0.0, 360.0)
         ax.set_xticks(np.arange(0, 361, 45))
-        fig.legend(loc="outside lower center", ncol=2, frameon=False)
+        fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncol=2, frameon=False)
     fig.suptitle(f"{title}: Hooke-joint chain, input and output shaft speed" if title
                  else "Hooke-joint chain: input and output shaft speed")
     return fig
@@ -526,32 +533,35 @@ def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.
 @styled
 def slidercrank_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray]], title: str,
                               ylabel: str = "axial strain [microstrain]", above: dict[str, float] | None = None,
-                              missing: Sequence[str] = ()) -> Figure:
+                              missing: Sequence[str] = (), ax=None) -> Figure:
     """A quantity against crank angle [deg], one line per case (label, angle, value): Figure 10.
 
     ``above`` maps the labels of cases whose rod compression exceeds the Euler load to that
     ratio N/P_E: their curves are dashed and flagged in the legend (a linear model draws
     them although the rod would buckle).  ``missing`` are one-line texts of cases not drawn (e.g. a speed that
-    buckled): they are listed in the legend, so no speed silently disappears.
+    buckled): they are listed in the legend, so no speed silently disappears.  ``ax``: an axes
+    to draw into (its figure is returned).
     """
     title = deck_text(title)
     from matplotlib.lines import Line2D
     above = above or {}
-    fig, axes = new_figure(1, 1, figsize=(7.4, 4.4))
-    ax = axes[0]
+    if ax is None:
+        fig, (ax,) = new_figure(1, 1, figsize=(7.4, 4.4))
+    else:
+        fig = ax.figure
     for label, x, y in series:
         flagged = label in above
-        ax.plot(x, y, label=f"{label}: N = {above[label]:.2f} P_E, above the Euler load" if flagged else label,
+        ax.plot(x, y, label=f"{label}: N = {above[label]:.2f} $P_E$, above the Euler load" if flagged else label,
                 lw=1.2, ls="--" if flagged else "-")
     for text in missing:
         ax.add_line(Line2D([], [], ls="none", marker="x", color="C3", label=text))
     ax.axhline(0.0, color="k", lw=0.6)
     ax.set_xlim(0, 360)
     ax.set_xticks(np.arange(0, 361, 45))
-    ax.set_xlabel("crank angle theta2 [deg]")
+    ax.set_xlabel(r"crank angle $\theta_2$ [deg]")
     ax.set_ylabel(ylabel)
-    fig.legend(loc="outside lower center", ncol=3 if len(series) + len(missing) > 4 else 2,
-               frameon=False, title="crank speed")
+    fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center",
+               ncol=3 if len(series) + len(missing) > 4 else 2, frameon=False, title="crank speed")
     ax.set_title(title)
     return fig
 

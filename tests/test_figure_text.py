@@ -98,3 +98,28 @@ def test_report_page_text_of_a_label():
     assert plain(r"phase angle $\varphi_{12}$ [deg]") == "phase angle φ₁₂ [deg]"
     assert plain(r"crank angle $\theta_2$ [deg]") == "crank angle θ₂ [deg]"
     assert plain(r"cost \$x\$ per part") == "cost $x$ per part"
+
+
+def test_figure_functions_draw_into_a_users_axes():
+    """The matplotlib convention: a figure function given ``ax=``/``axes=`` draws there and returns
+    that figure (a user's own layout, e.g. two studies side by side)."""
+    from matplotlib.figure import Figure
+
+    from driver import plotting
+    fig = Figure(layout="constrained")
+    a, b = fig.subplots(1, 2)
+    theta = np.linspace(0.0, 360.0, 73)
+    assert plotting.ujoint_speed_figure(theta, 25.0, {"optimum": 25 + np.sin(np.radians(2 * theta))}, ax=a) is fig
+    assert plotting.slidercrank_strain_figure([("10 rad/s", theta, np.cos(np.radians(theta)))], "t", ax=b) is fig
+    assert a.lines and b.lines
+    fig2 = Figure()
+    axes = fig2.subplots(2, 1)
+    assert plotting.line_panels(theta, [("y", {"a": theta}), ("z", {"b": -theta})], "x", axes=axes) is fig2
+    assert axes[0].lines and axes[1].lines
+    fig3 = Figure()
+    axes3 = fig3.subplots(3, 1)
+    r = driver.fourbar.run(fixed_link=12.0, crank=5.0, coupler=15.0, rocker=9.0, step_deg=20)
+    from driver.fourbar import exact_grid, tidy_frame, _exact_columns
+    out, st = exact_grid(r.params, theta)
+    assert plotting.fourbar_curves(tidy_frame("exact", theta, _exact_columns(out, st), st), None, "",
+                                   axes=axes3) is fig3
