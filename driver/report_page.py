@@ -573,10 +573,11 @@ def page_for_sweep(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> st
     try:
         if plotting.is_grid(ok, keys) and not sw.zip:
             figs = plotting.sweep_maps(ok, keys, wanted[:3], labels, senses, stem, sw.summary_rows == "kept")
-        else:
-            figs = [plotting.design_space_map(ok, numeric_keys[:1], y, labels, best=best, best_text=best_text,
-                                              title=f"{plotting.deck_text(stem)}: {labels[y]}") for y in wanted[:3]]
-        maps += [_figure_block(f, f"{labels[y]} over the swept keys") for f, y in zip(figs, wanted)]
+            maps += [_figure_block(f, f"{labels[y]} over the swept keys") for f, y in zip(figs, wanted)]
+        else:   # one key, zipped keys or a kept set that is no grid: the --plot summary (lines, strips)
+            fig = plotting.sweep_summary(ok, keys, sw.plot_x, sw.plot_y, stem, labels,
+                                         getattr(module, "SWEEP_PLOT", ()))
+            maps.append(_figure_block(fig, "the sweep's summary columns against the swept keys"))
     except Exception as exc:
         notes.append(f"the design-space maps could not be drawn: {exc.__class__.__name__}: {exc}")
     sections.append(Section("design-space", "design space", "\n".join(maps) or "<p>No numeric summary column to map.</p>"))
