@@ -11,7 +11,8 @@ defines
 
 and may define, for figures of sweeps over it,
 
-* ``LABELS``: ``{name: (words, units)}`` for summary columns and deck keys, the
+* ``LABELS``: ``{name: (words, units)}`` for summary columns and deck keys (words may set
+  symbols in mathtext, ``$\\omega_3$``), the
   axis labels a reader sees instead of identifiers (``{i}`` in a name stands for a
   case number, e.g. ``peak_tensile_{i}_deg``); deck keys default to their
   ``SPEC`` units, and
