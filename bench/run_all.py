@@ -29,6 +29,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import bench_fourbar  # noqa: E402
+import bench_fourbar_forces  # noqa: E402
 import bench_manipulator  # noqa: E402
 import bench_slidercrank  # noqa: E402
 import bench_ujoint  # noqa: E402
@@ -124,6 +125,20 @@ def fourbar(n: int, repeat: int) -> list[Row]:
     floor = write_floor(lambda: np.empty((n, 6), order="F").fill(0.0), repeat)
     rows.append(Row("four-bar coupler point", "ns/position", tk / n, tb / n, None, None,
                     "reads 44 B, writes 48 B/position (fresh array); 2 sincos", floor / n))
+    # issue 26: the force kernel against the kinematics kernel it follows (the 'baseline' here),
+    # both with fresh output arrays; target ratio 0.5 = forces cost at most 2x the kinematics
+    lk = (0.30, 0.10, 0.35, 0.25, 20.0, 3.0)
+    pr = bench_fourbar_forces.PROPS
+    st_out, st_sts = kernels.fourbar_exact(theta, *lk, 1)
+    f = kernels.fourbar_joint_forces(st_out, st_sts, *lk, pr)
+    ok = st_sts == 0
+    np.testing.assert_allclose(f[ok], bench_fourbar_forces.numpy_forces(st_out, *lk, pr)[ok], rtol=1e-9, atol=1e-9)
+    tk, tb = interleaved(lambda: kernels.fourbar_joint_forces(st_out, st_sts, *lk, pr),
+                         lambda: kernels.fourbar_exact(theta, *lk, 1), repeat)
+    floor = write_floor(lambda: np.empty((n, 12), order="F").fill(0.0), repeat)
+    rows.append(Row("four-bar joint forces (baseline: exact states)", "ns/position", tk / n, tb / n, None, 0.5,
+                    "reads 64 B, writes 96 B/position (fresh array); no transcendental function, 6 divisions",
+                    floor / n))
     return rows
 
 

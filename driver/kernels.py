@@ -25,6 +25,7 @@ except ImportError as _exc:
                       f"mechanism-driver (see docs/install.md)") from _exc
 
 __all__ = ["farray", "fourbar_listing", "fourbar_exact", "fourbar_coupler_point", "fourbar_summaries",
+           "fourbar_joint_forces", "fourbar_berkof_lowen", "fourbar_force_summaries", "FOURBAR_FORCE_SUMMARY_COLUMNS",
            "FOURBAR_SUMMARY_COLUMNS", "FOURBAR_GRASHOF", "FOURBAR_STATUS",
            "MANIPULATOR_STATUS", "manipulator_arm_states", "manipulator_torques", "manipulator_ik",
            "manipulator_design_indices", "manipulator_position_errors", "manipulator_design_summaries",
@@ -125,6 +126,52 @@ def fourbar_coupler_point(theta: np.ndarray, states: np.ndarray, status: np.ndar
     theta = farray(np.atleast_1d(theta), 1)
     return _kernels.fourbar.coupler_point(theta, q, omega, alpha, u, v, farray(states, 2),
                                           np.asarray(status, dtype=np.int32))
+
+
+def fourbar_joint_forces(states: np.ndarray, status: np.ndarray, p: float, q: float, r: float, s: float,
+                         omega: float, alpha: float, props: np.ndarray) -> np.ndarray:
+    """Joint forces from ``fourbar_exact`` results (same omega [rad/s], alpha [rad/s^2]): (n, 12).
+
+    ``props`` (18,): masses [kg], inertias about the centres of mass [kg m^2], com distances [m]
+    and angles [rad] of crank, coupler, rocker; gravity [m/s^2] (along -y); load torque on the
+    rocker [N m]; load force at the coupler point [N]; the point's u, v [m].  Columns: input
+    torque [N m]; F_O2, F_A, F_B, F_O4 (x, y) [N]; shaking force (x, y) [N]; shaking moment
+    about O2 [N m] (fortran/fourbar_forces.f90).  Zero where status is not ok.
+    """
+    props = np.ascontiguousarray(props, dtype=np.float64)
+    if props.shape != (18,):
+        raise ValueError(f"props must have 18 values, got shape {props.shape}")
+    return _kernels.fourbar_forces.joint_forces(farray(states, 2), np.asarray(status, dtype=np.int32),
+                                                p, q, r, s, omega, alpha, props)
+
+
+def fourbar_berkof_lowen(q: float, r: float, s: float, props: np.ndarray,
+                         radii: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
+    """Berkof-Lowen counterweights on crank and rocker at ``radii`` [m]: (props of the balanced
+    linkage (18,), cw (6,) = crank mass x radius [kg m] and angle [rad], rocker the same, the two
+    counterweight masses [kg])."""
+    return _kernels.fourbar_forces.berkof_lowen(q, r, s, np.asarray(props, dtype=np.float64),
+                                                np.asarray(radii, dtype=np.float64))
+
+
+#: columns of fourbar_force_summaries (fortran/fourbar_forces.f90 force_summaries)
+FOURBAR_FORCE_SUMMARY_COLUMNS = ("defined_fraction", "torque_peak_Nm", "torque_peak_at_deg", "torque_mean_Nm",
+                                 "torque_rms_Nm", "F_O2_peak_N", "F_A_peak_N", "F_B_peak_N", "F_O4_peak_N",
+                                 "shaking_force_peak_N", "shaking_moment_peak_Nm", "energy_fluctuation_J",
+                                 "flywheel_inertia_kgm2")
+
+
+def fourbar_force_summaries(params: np.ndarray) -> np.ndarray:
+    """Force summaries of many four-bars in one kernel call: (n, 13), FOURBAR_FORCE_SUMMARY_COLUMNS.
+
+    ``params`` (n, 31): p, q, r, s [m], omega [rad/s], alpha [rad/s^2], first and last crank
+    angle [deg], branch (+1/-1), the 18 props of ``fourbar_joint_forces``, speed fluctuation,
+    balance flag (1 = Berkof-Lowen counterweights first), counterweight radii [m].
+    """
+    params = farray(params, 2)
+    if params.shape[1] != 31:
+        raise ValueError(f"params must have 31 columns, got {params.shape[1]}")
+    return _kernels.fourbar_forces.force_summaries(params)
 
 
 # ----------------------------------------------------------------------------- manipulator

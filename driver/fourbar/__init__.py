@@ -17,6 +17,7 @@ from typing import Any, Mapping
 import numpy as np
 import pandas as pd
 
+from driver.fourbar import forces
 from driver import kernels
 from driver.limits import Estimate
 from driver.deck import GroupSpec, Key, Params, positive
@@ -76,6 +77,7 @@ def _check(p: Params) -> None:
                                    f"(got {p[key]:g}); use method='exact' for fractional angles")
         if "branch" in p.given and p.branch != "open":
             raise p.error("branch", "the listing computes one assembly only; branch applies to method='exact'")
+    forces.check(p)
 
 
 #: axis labels of summary columns and deck keys (driver.study.column_label): name -> (words, units)
@@ -86,7 +88,7 @@ LABELS = {"crank": ("crank length", "length units"), "coupler": ("coupler length
           "rocker_swing_deg": ("rocker swing", "deg"), "omega3_peak_rad_s": ("peak rocker speed", "rad/s"),
           "omega2_peak_rad_s": ("peak coupler speed", "rad/s"),
           "assembled_fraction": ("fraction of the turn assembled", "-"),
-          "time_ratio": ("time ratio (slow / quick stroke)", "-")}
+          "time_ratio": ("time ratio (slow / quick stroke)", "-"), **forces.LABELS}
 #: which way a summary column is better (the design-space maps star the best kept design)
 SWEEP_BEST = {"mu_min_deg": "max", "mu_max_deg": "min", "rocker_swing_deg": "max", "omega3_peak_rad_s": "min",
               "omega2_peak_rad_s": "min"}
@@ -123,6 +125,7 @@ SPEC = GroupSpec(
                              doc="a point P on the coupler: u along A->B, v to its left; adds its path, "
                                  "velocity and acceleration (exact method)"),
         "title": Key("str", default="", doc="free text echoed in the output"),
+        **forces.KEYS,   # the force analysis (driver/fourbar/forces.py), run when 'mass' is given
     },
     check=_check,
 )
@@ -322,13 +325,17 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     unknown = [k for k in columns if k not in BATCH_KEYS and k not in BATCH_IGNORED]
     if unknown:
         raise _bad(base, unknown[0], f"not a &fourbar key the summary depends on ({', '.join(BATCH_KEYS)})")
+    force_columns = {k: v for k, v in columns.items() if k in forces.BATCH_KEYS}
     columns = {k: v for k, v in columns.items() if k in BATCH_KEYS}
     sizes = {np.size(v) for v in columns.values() if np.ndim(v) > 0}
     if len(sizes) > 1:
         raise _bad(base, None, f"batch columns have different lengths {sorted(sizes)}")
     n = sizes.pop() if sizes else 1
     res = kernels.fourbar_summaries(_param_matrix(base, columns, n))
-    return _frame(res, detail, band_of(base))
+    frame = _frame(res, detail, band_of(base))
+    if forces.active(base):   # force columns (driver/fourbar/forces.py) when the deck gives masses
+        frame = pd.concat([frame, forces.summarise_force_batch(base, force_columns)], axis=1)
+    return frame
 
 
 def _frame(res: np.ndarray, detail: bool = False, band: tuple[float, float] = BAND) -> pd.DataFrame:
@@ -612,7 +619,8 @@ def estimate(params: Params) -> Estimate:
     n = max(n, 1.0)
     span = min(abs(p.stop_deg - p.start_deg), 360.0) / 1.0 + 1.0
     range_key = "start_deg" if "start_deg" in p.given else ("stop_deg" if "stop_deg" in p.given else "step_deg")
-    rows = Estimate(2000.0 * n + 5e6, 5e-5 * n + 0.05, "step_deg", "step_deg", f"{n:.4g} crank angles")
+    k = 2.5 if forces.active(p) else 1.0   # the force table and columns: 13 more cells and 24 columns per row
+    rows = Estimate(k * 2000.0 * n + 5e6, k * 5e-5 * n + 0.05, "step_deg", "step_deg", f"{n:.4g} crank angles")
     grid = Estimate(500.0 * span, 1e-6 * span, range_key, range_key,
                     f"a {span:.4g}-point scan of one turn for the summary")
     return rows + grid
@@ -663,13 +671,29 @@ def run(params: Params, progress: bool = False) -> Result:
         if cp is not None:
             lines += [f"    coupler point P ...... u = {p.coupler_point[0]:g} along A->B, v = {p.coupler_point[1]:g} "
                       "to its left; xp, yp its position, vp its speed [length/s]"]
+        if forces.active(p):
+            lines += _force_section(p, theta, out, status, exact_frame)
         for k in np.flatnonzero(status == ST["no_assembly"])[:1]:
             warnings.append(f"the linkage cannot be assembled at {int((status == ST['no_assembly']).sum())} "
                             f"of {len(theta)} crank angles (first at {theta[k]:g} deg)")
         tidy = exact_frame
     summary = _summary(p)
-    return Result(text="\n".join(lines) + "\n", tidy=tidy, summary=summary, warnings=warnings,
-                  figures=_figures(p, title, listing_frame))
+    figs = _figures(p, title, listing_frame) + (forces.figures(p, title, exact_grid) if forces.active(p) else [])
+    return Result(text="\n".join(lines) + "\n", tidy=tidy, summary=summary, warnings=warnings, figures=figs)
+
+
+def _force_section(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarray,
+                   frame: pd.DataFrame) -> list[str]:
+    """The force analysis's lines of the .out; its columns are added to ``frame`` (in place)."""
+    fa = forces.analyse(p, out, status)
+    for name, values in forces.tidy_columns(fa).items():
+        frame[name] = values
+    with_units(frame, TIDY_UNITS)
+    words = ["toggle: forces unbounded" if s == ST["toggle"] else "not placed" for s in status]
+    title = ("Force analysis (Newton-Euler, closed form; " +
+             ("with the Berkof-Lowen counterweights" if fa.cw is not None else "links as given") + ")")
+    return (forces.echo_lines(p) + forces.table_lines(theta, fa.forces, fa.ok, words, title)
+            + forces.summary_lines(p, forces.summary(p), fa))
 
 
 def summarise(params: Params) -> dict:
