@@ -809,8 +809,11 @@ def convergence_plot(history, evals, objective: str, sense: str = "minimize", ti
                    label="final best found")
         a2.legend(loc="upper right")
         lo, hi = np.nanmin(obj), np.nanmax(obj)
-        pad = 0.05 * (hi - lo) if hi > lo else max(1e-6, 0.05 * abs(hi))
-        a1.set_ylim(lo - pad, hi + pad)
+        # at least 1e-4 of the objective's size: a change in the 7th digit reads as converged here
+        # (a flat line), and the gap panel beside it shows how small it is
+        span = max(hi - lo, 1e-4 * max(abs(final), 1e-12))
+        mid = 0.5 * (lo + hi)
+        a1.set_ylim(mid - 0.55 * span, mid + 0.55 * span)
     else:
         a1.text(0.5, 0.5, "no feasible design", transform=a1.transAxes, ha="center", va="center")
     a1.set_ylabel(objective)
