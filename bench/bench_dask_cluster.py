@@ -2,7 +2,7 @@
 ``dask worker`` processes on loopback), the rate per worker, and what 10^9 linkages would need.
 
 Starts a scheduler and 1, then 2, single-threaded worker processes on 127.0.0.1 (the same
-commands the README shows), runs ``python -m driver DECK --scheduler tcp://127.0.0.1:PORT`` on
+commands docs/performance.md shows), runs ``python -m driver DECK --scheduler tcp://127.0.0.1:PORT`` on
 a copy of ``inputs/fourbar_design_search.dat`` enlarged to about N linkages (``--linkages``,
 default 10^7), and prints per run: wall time, linkages/s, linkages/s per worker, the driver's
 peak memory and the bytes per linkage of the resume record (``outputs/<stem>.sweep/``). From

@@ -435,7 +435,8 @@ def compare_decks(decks: list[Path], out=None) -> int:
     out = sys.stdout if out is None else out
     if not published.PUBLISHED_DIR.is_dir():
         print(f"error: the published tables are not installed ({published.PUBLISHED_DIR} is missing); "
-              "--compare needs the source tree (pip install -e .)", file=sys.stderr)
+              "the install is incomplete: reinstall it (pip install --force-reinstall PATH-TO-THE-SOURCE-OR-WHEEL; "
+              "in a clone: bash .ci/setup)", file=sys.stderr)
         return 1
     status, done = 0, []
     for deck in decks:

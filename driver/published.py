@@ -1,4 +1,5 @@
-"""Readers of the published record: the transcribed tables in the top-level ``published/`` folder.
+"""Readers of the published record: the transcribed tables in the top-level ``published/`` folder
+(installed inside the package as ``driver/published_record/``).
 
 Every file there holds printed values exactly as the papers print them (text, so the number of
 printed decimals is kept) and one ``match:`` line naming the study group and the deck values the
@@ -20,8 +21,17 @@ import pandas as pd
 __all__ = ["PUBLISHED_DIR", "Published", "PublishedError", "match_line", "records", "read_listing",
            "read_blocks", "matches", "listing_rows", "LISTING_COLUMNS"]
 
-#: the folder of published tables (next to ``outputs/`` in the source tree)
-PUBLISHED_DIR = Path(__file__).resolve().parents[1] / "published"
+def _published_dir() -> Path:
+    """The installed copy (``driver/published_record/``, a wheel or ``pip install .``) when there is
+    one, else the source checkout's ``published/`` (an editable install reads the checkout)."""
+    package = Path(__file__).resolve().parent
+    installed = package / "published_record"
+    return installed if installed.is_dir() else package.parent / "published"
+
+
+#: the folder of published tables: ``published/`` of the source tree, shipped inside the package
+#: as ``driver/published_record/``
+PUBLISHED_DIR = _published_dir()
 
 _MATCH = re.compile(r"^\W*match:\s*(\w+)((?:\s+\w+=\S+)*)\s*$")
 

@@ -1,5 +1,5 @@
 """A design search on a real Dask cluster (``dask scheduler`` + ``dask worker`` processes on
-loopback, started as the README says) writes the same summary tables as one in-process run.
+loopback, started as docs/performance.md says) writes the same summary tables as one in-process run.
 
 This is the path a user takes on a cluster: separate scheduler and worker processes talking
 TCP, the command line with ``--scheduler``; the LocalCluster tests in test_sweep_engine.py do

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import re
 import subprocess
+import tomllib
 import sys
 
 import pytest
@@ -93,3 +94,90 @@ def test_key_table_lists_units_and_defaults(group):
         assert "| `omega` | float | rad/s | `1.0` |" in table and "| `crank` | float | length | **required** |" in table
     else:
         assert "`key1`" in table
+
+
+def _slug(heading: str) -> str:
+    """GitHub's anchor for a heading: lower case, punctuation but '-' and '_' dropped, spaces to '-'."""
+    text = re.sub(r"[`*]", "", heading.strip().lower())
+    return re.sub(r"[^\w\- ]", "", text).replace(" ", "-")
+
+
+def _anchors(page) -> set[str]:
+    text = re.sub(r"^```.*?^```", "", page.read_text(), flags=re.M | re.S)   # no headings inside code
+    return {_slug(h) for h in re.findall(r"^#{1,6} (.+)$", text, flags=re.M)}
+
+
+def test_every_link_and_anchor_resolves():
+    """Links of README.md and docs/*.md reach an existing file and, with #anchor, a heading there."""
+    assert _slug("As a user: `pip install .`") == "as-a-user-pip-install-"
+    bad = []
+    for page in [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]:
+        for target in re.findall(r"\]\(([^)\s]+)\)", page.read_text()):
+            if re.match(r"\w+:", target):
+                continue   # an URL
+            path, _, anchor = target.partition("#")
+            dest = (page.parent / path) if path else page
+            if not dest.exists():
+                bad.append(f"{page.relative_to(ROOT)} -> {target}: no such file")
+            elif anchor and dest.suffix == ".md" and anchor not in _anchors(dest):
+                bad.append(f"{page.relative_to(ROOT)} -> {target}: no such heading")
+    assert not bad, "\n".join(bad)
+
+
+def test_readme_first_screen_is_for_a_newcomer():
+    """What it is, the two commands, install choices, one example, where the docs are -- first, and
+    the long reference material in docs/ (the README stays short)."""
+    lines = (ROOT / "README.md").read_text().splitlines()
+    first = "\n".join(lines[:45])
+    assert "bash .ci/setup && .venv/bin/python -m driver inputs/crank5.dat" in first
+    assert "bash .ci/setup && .venv/bin/python -m pytest -q" in first
+    assert "## Install" in first and "pip install ." in first and "docs/install.md" in first
+    heads = [n for n, line in enumerate(lines) if line.startswith("## ")]
+    names = [lines[n] for n in heads]
+    assert names[:3] == ["## Install", "## An example: run a deck, compare it with the paper", "## Documentation"]
+    assert heads[2] < 60, "the documentation index must start within the first screenful or two"
+    assert len(lines) <= 120, "reference material belongs in docs/, not the README"
+    # the CI line is exactly the README's test command
+    assert "bash .ci/setup && .venv/bin/python -m pytest -q" in (ROOT / ".ci" / "run").read_text()
+
+
+def _doc_blocks():
+    sys.path.insert(0, str(ROOT / ".ci"))
+    try:
+        import doc_blocks
+    finally:
+        sys.path.pop(0)
+    return doc_blocks.blocks()
+
+
+def test_every_documented_install_command_is_run_by_clean_clone():
+    """Every bash block of the docs that installs is marked for .ci/clean-clone (which runs it word
+    for word), clean-clone has checks for exactly the marked blocks, and the README's install
+    table names commands those blocks run."""
+    blocks = _doc_blocks()
+    installing = re.compile(r"pip (install|wheel)|\.ci/setup")
+    for page in [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]:
+        text = page.read_text()
+        for m in re.finditer(r"^```bash\n(.*?)^```", text, flags=re.M | re.S):
+            if installing.search(m.group(1)) and "pytest" not in m.group(1):
+                marked = text[:m.start()].rstrip().endswith("-->") and \
+                    text[:m.start()].rstrip().splitlines()[-1].startswith("<!-- clean-clone:")
+                assert marked or page.name == "README.md" and "bash .ci/setup && " in m.group(1), \
+                    f"{page.relative_to(ROOT)}: an install block not marked <!-- clean-clone: NAME -->"
+    script = (ROOT / ".ci" / "clean-clone").read_text()
+    expected = re.search(r'^EXPECTED="([^"]+)"', script, flags=re.M).group(1).split()
+    assert sorted(expected) == sorted(blocks)
+    assert all(f"run_block {name}" in script for name in blocks)
+    run_lines = [line.split("#")[0].strip() for _, text in blocks.values() for line in text.splitlines()]
+    readme = (ROOT / "README.md").read_text()
+    table = readme[readme.index("## Install"):readme.index("## An example")]
+    for code in re.findall(r"`([^`]*pip (?:install|wheel)[^`]*)`", table):
+        for command in code.split(" && "):
+            assert any(command.strip() in line for line in run_lines), f"README: {command!r} is run by no block"
+
+
+def test_documented_build_requirements_are_the_build_system_requirements():
+    requires = tomllib.loads((ROOT / "pyproject.toml").read_text())["build-system"]["requires"]
+    line = next(line for line in _doc_blocks()["editable"][1].splitlines() if "meson-python" in line)
+    assert re.findall(r'"([^"]+)"|\b(ninja)\b', line.split("#")[0]) and \
+        sorted(a or b for a, b in re.findall(r'"([^"]+)"|\b(ninja)\b', line.split("#")[0])) == sorted(requires)

@@ -93,3 +93,25 @@ def test_study_names_without_import_match_the_studies():
     from driver.runner import available_studies
     from driver.study import study_names
     assert study_names() == sorted(available_studies())
+
+
+def test_build_backend_finds_meson_and_ninja_of_its_own_environment_without_activation():
+    """venv/bin/pip install --no-build-isolation -e . from a shell where the venv is not activated:
+    the project's backend (backend/mesonpy_venv.py) must find this environment's meson and ninja,
+    which a bare meson-python looks up on PATH only.  (.ci/clean-clone runs the real install.)"""
+    import os
+    import sysconfig
+    scripts = sysconfig.get_path("scripts")
+    if not (os.path.exists(os.path.join(scripts, "meson")) and os.path.exists(os.path.join(scripts, "ninja"))):
+        pytest.skip("meson/ninja are not installed in this environment (bash .ci/setup installs them)")
+    probe = ("import shutil, sys; sys.path.insert(0, 'backend'); before = shutil.which('meson'); "
+             "import mesonpy_venv; print(before, shutil.which('meson'), shutil.which('ninja'))")
+    env = {k: v for k, v in os.environ.items() if k not in ("VIRTUAL_ENV",)}
+    env["PATH"] = "/usr/bin:/bin"
+    out = subprocess.run([sys.executable, "-c", probe], cwd=ROOT, env=env, capture_output=True, text=True,
+                         check=True).stdout.split()
+    meson_before, meson_after, ninja_after = out
+    assert meson_before == "None" or not meson_before.startswith(scripts)   # PATH alone would not find it
+    assert meson_after == os.path.join(scripts, "meson") and ninja_after == os.path.join(scripts, "ninja")
+    assert PYPROJECT["build-system"]["build-backend"] == "mesonpy_venv"
+    assert PYPROJECT["build-system"]["backend-path"] == ["backend"]
