@@ -23,7 +23,8 @@ import tempfile
 from pathlib import Path
 from typing import IO, Iterator
 
-__all__ = ["atomic_open", "write_text", "output_set", "OutputSet", "inside", "remove_stale_temporaries"]
+__all__ = ["atomic_open", "write_text", "output_set", "OutputSet", "inside", "remove_stale_temporaries",
+           "file_digest", "DIGEST_CHARS", "own_folder", "refuse_link", "LinkRefused"]
 
 
 class OutputSet:
@@ -63,8 +64,11 @@ def atomic_open(path: str | Path, mode: str = "w") -> Iterator[IO]:
     tmp = None
     try:   # mkstemp inside the try: an interrupt right after it still removes the file
         try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{os.getpid()}.", suffix=".tmp", dir=path.parent)
+            if current is not None:   # folders below the set's folder: made here, never a link
+                own_folder(path.parent, current.root)
+            else:
+                path.parent.mkdir(parents=True, exist_ok=True)
+            fd, tmp = tempfile.mkstemp(prefix=_temp_prefix(path), suffix=".tmp", dir=path.parent)
         except FileExistsError as exc:   # a file where a folder should be
             raise NotADirectoryError(exc.errno, "exists and is not a folder", exc.filename) from None
         except OSError as exc:
@@ -87,6 +91,16 @@ def atomic_open(path: str | Path, mode: str = "w") -> Iterator[IO]:
             with contextlib.suppress(FileNotFoundError):
                 os.unlink(tmp)
         raise
+
+
+#: characters of the final name kept in a temporary's name (a 255-byte deck name still fits)
+TEMP_NAME = 40
+
+
+def _temp_prefix(path: Path) -> str:
+    """``.<name>.<pid>.``, the name cut to :data:`TEMP_NAME` characters so that the temporary of
+    a file with a long name is no longer than the file system allows."""
+    return f".{path.name[:TEMP_NAME]}.{os.getpid()}."
 
 
 def write_text(path: str | Path, text: str) -> Path:
@@ -156,10 +170,81 @@ def remove_stale_temporaries(folder: str | Path, stem: str) -> list[Path]:
         return removed
     for e in entries:
         m = _TEMP.match(e.name)
-        if not m or not e.name.startswith(f".{stem}") or not e.is_file(follow_symlinks=False):
+        if not m or not e.name.startswith(f".{stem[:TEMP_NAME]}") or not e.is_file(follow_symlinks=False):
             continue
         if not _alive(int(m.group(1))):
             with contextlib.suppress(OSError):
                 os.unlink(e.path)
                 removed.append(Path(e.path))
     return removed
+
+
+#: hex characters of a content digest kept in names and records (sha256, 80 bits)
+DIGEST_CHARS = 20
+
+
+def file_digest(path: str | Path, follow: bool = False) -> str | None:
+    """sha256 of a file's bytes (first :data:`DIGEST_CHARS` hex characters), or None when it
+    cannot be read or is not a regular file (a symlink is not followed unless ``follow``)."""
+    import hashlib
+    flags = os.O_RDONLY | (0 if follow else getattr(os, "O_NOFOLLOW", 0))
+    try:
+        fd = os.open(path, flags)
+    except OSError:
+        return None
+    h = hashlib.sha256()
+    try:
+        import stat as _stat
+        if not _stat.S_ISREG(os.fstat(fd).st_mode):
+            return None
+        while True:
+            block = os.read(fd, 1 << 20)
+            if not block:
+                break
+            h.update(block)
+    except OSError:
+        return None
+    finally:
+        os.close(fd)
+    return h.hexdigest()[:DIGEST_CHARS]
+
+
+class LinkRefused(PermissionError):
+    """A symbolic link where the tool keeps a folder or file of its own (one line)."""
+
+    def __init__(self, path: str | Path):
+        super().__init__(1, "is a symbolic link where this tool keeps its own files; it creates and deletes "
+                            "files only in folders it made (remove the link, or give the real folder as -o OUTDIR)",
+                         str(path))
+
+
+def refuse_link(path: str | Path) -> None:
+    """Raise :class:`LinkRefused` when ``path`` is a symbolic link (a missing path is fine)."""
+    if os.path.islink(path):
+        raise LinkRefused(path)
+
+
+def own_folder(path: str | Path, base: str | Path) -> Path:
+    """Make folder ``path`` inside ``base`` (which the user gave: it may be a symbolic link), with
+    every folder between them made by this tool or already a real folder: a symbolic link
+    there is refused (:class:`LinkRefused`), never followed."""
+    path, base = Path(path), Path(base)
+    if not inside(base, path):
+        if os.path.abspath(path) == os.path.abspath(base):
+            base.mkdir(parents=True, exist_ok=True)
+            return path
+        raise PermissionError(1, f"refusing a folder outside the output folder {base}", str(path))
+    base.mkdir(parents=True, exist_ok=True)
+    current = base
+    for part in Path(os.path.relpath(os.path.abspath(path), os.path.abspath(base))).parts:
+        current = current / part
+        try:
+            os.mkdir(current)
+        except FileExistsError:
+            pass
+        except OSError as exc:
+            raise _fault(exc, current) from None
+        refuse_link(current)
+        if not current.is_dir():
+            raise NotADirectoryError(20, "exists and is not a folder", str(current))
+    return path

@@ -36,6 +36,11 @@ def _fs_error(exc: OSError) -> str:
                errno.EPERM: "not permitted", errno.ENOTDIR: "a part of the path is a file, not a folder",
                errno.EISDIR: "is a folder, not a file", errno.EDQUOT: "disk quota exceeded",
                errno.ENAMETOOLONG: "file name too long"}
+    from driver.atomic import LinkRefused
+    if isinstance(exc, LinkRefused):
+        return f"refusing {exc.filename}: {exc.strerror}"
+    if exc.errno == errno.EBUSY and exc.__class__.__name__ == "SweepBusy":
+        return f"{exc.strerror} ({exc.filename})"
     reason = reasons.get(exc.errno or 0, exc.strerror or str(exc))
     if exc.strerror and exc.errno not in reasons:
         reason = exc.strerror

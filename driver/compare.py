@@ -455,8 +455,11 @@ def compare_decks(decks: list[Path], out=None) -> int:
         if not c.ok:
             status = max(status, 1)
     if len(done) > 1:
+        totals = totals_text(done)
         print("Total", file=out)
-        print("\n".join(totals_text(done)), file=out)
+        print("\n".join(totals) if totals else
+              f"  no published cells among these {len(done)} decks (sweep, optimisation and synthesis decks "
+              "have none: compare the single-case decks a sweep writes instead)", file=out)
     return status
 
 

@@ -371,8 +371,16 @@ def _prescan(path: Path, text: str) -> tuple[list[tuple[str, int]], list[_Item]]
     group_line = 0
     seen: dict[str, dict[str, int]] = {}
     item: _Item | None = None
+    slash_key: str | None = None   # the key whose value a '/' cut (360/7)
     for n, raw_line in enumerate(text.split("\n"), start=1):
-        code, raw = _code_mask(path, n, raw_line)
+        try:
+            code, raw = _code_mask(path, n, raw_line)
+        except DeckError as exc:   # name the key whose value holds the character
+            prefix = raw_line[:int(re.match(r"column (\d+)", exc.message).group(1)) - 1] \
+                if exc.message.startswith("column ") else ""
+            here = list(_NAME_EQ.finditer(prefix))
+            key = here[-1].group(1).lower() if here else (item.key if item is not None and current else None)
+            raise DeckError(path, n, key, exc.message) from None
         pos, after_slash = 0, None
         while pos < len(code):
             if current is None:
@@ -390,7 +398,7 @@ def _prescan(path: Path, text: str) -> tuple[list[tuple[str, int]], list[_Item]]
                     continue
                 rest = raw[pos:].strip()
                 if after_slash is not None:
-                    raise DeckError(path, n, None, f"column {pos + 1}: text after the closing '/' of "
+                    raise DeckError(path, n, slash_key, f"column {pos + 1}: text after the closing '/' of "
                                     f"&{after_slash}: {rest!r} (a '/' ends the group, also inside a value "
                                     "such as 360/7: write the number itself)")
                 if code[pos] == "/" or (g and g.group(1).lower() == "end"):
@@ -445,6 +453,7 @@ def _prescan(path: Path, text: str) -> tuple[list[tuple[str, int]], list[_Item]]
                 nxt = re.compile(r"[&$]\s*(\w*)").match(code, stop)
                 raise DeckError(path, n, None, f"group &{current} (line {group_line}) is not closed with '/' "
                                 f"before '&{nxt.group(1) if nxt else ''}'")
+            slash_key = item.key if item is not None else None
             after_slash, current, item = current, None, None
             pos = end.end()
     if current is not None:
@@ -476,6 +485,12 @@ def _strip_comment(line: str) -> str:
         elif ch == "!":
             return line[:i]
     return line
+
+
+def _is_legacy_shape(text: str) -> bool:
+    """True when the text has no namelist group marker or assignment outside comments (so it can
+    only be a legacy deck, or no deck)."""
+    return not any(c in _strip_comment(l) for l in text.splitlines() for c in "&$=")
 
 
 def _is_legacy(text: str) -> bool:
@@ -553,8 +568,9 @@ def read_deck(path: str | Path, text: str | None = None) -> Deck:
     if text is None:
         text = _read_text(path)
     text = _normalise(text)
-    for n, line in enumerate(text.split("\n"), start=1):   # non-ASCII is an error in legacy decks too
-        _code_mask(path, n, line)
+    if _is_legacy_shape(text):   # non-ASCII is an error in legacy decks too (namelist decks: in the pre-scan)
+        for n, line in enumerate(text.split("\n"), start=1):
+            _code_mask(path, n, line)
     if _is_legacy(text):
         return _read_legacy(path, text)
     order, items = _prescan(path, text)
@@ -657,6 +673,10 @@ def _coerce(kind: str, v: Any) -> tuple[Any, str | None]:
         return None, f"not a logical (.true./.false.): {v!r}"
     if kind == "str":
         if isinstance(v, str):
+            bad = next((ch for ch in v if not ch.isprintable()), None)
+            if bad is not None:   # ESC, NUL, line breaks: text from a deck is printed in tables
+                return None, (f"text holds the control character U+{ord(bad):04X} "
+                              f"({unicodedata.name(bad, 'control')}); text is printable characters only")
             return v, None
         return None, f"not a quoted string: {v!r}"
     raise AssertionError(kind)

@@ -14,6 +14,7 @@ import contextlib
 import functools
 import math
 import textwrap
+import warnings
 from pathlib import Path
 from typing import Any, Callable, Iterator, Sequence, TypeVar
 
@@ -29,7 +30,7 @@ from matplotlib.figure import Figure
 from driver.atomic import atomic_open
 from driver.study import PLOT_FORMATS, plot_format
 
-__all__ = ["STYLE", "style", "styled", "new_figure", "save_figure", "line_panels", "deck_text"]
+__all__ = ["STYLE", "style", "styled", "new_figure", "save_figure", "line_panels", "plain_text"]
 
 #: the house style, applied only inside :func:`style` (never written to the global rcParams)
 STYLE: dict[str, Any] = {"figure.dpi": 150, "savefig.dpi": 150, "axes.grid": True, "grid.alpha": 0.3,
@@ -39,10 +40,23 @@ STYLE: dict[str, Any] = {"figure.dpi": 150, "savefig.dpi": 150, "axes.grid": Tru
 _F = TypeVar("_F", bound=Callable[..., Any])
 
 
+def plain_text(text: Any) -> str:
+    """Text from a deck (a title, a design name, the deck's file name, a value, an expression)
+    as matplotlib draws it literally: never mathtext (every ``$`` escaped, so ``'$\\frac$'`` or
+    nested braces cannot raise a parse error), control characters dropped.  Every figure
+    builder passes deck text through this one function."""
+    text = "".join(ch for ch in str(text) if ch.isprintable() or ch == "\n")
+    return text.replace("$", r"\$")
+
+
 @contextlib.contextmanager
 def style(**overrides: Any) -> Iterator[None]:
-    """Draw inside this context to get the house style; rcParams are restored on exit."""
-    with matplotlib.rc_context({**STYLE, **overrides}):
+    """Draw inside this context to get the house style; rcParams are restored on exit.
+
+    matplotlib's warnings (a glyph missing from the font, identical axis limits) are dropped
+    here: they name package paths and say nothing a user of the tool can act on."""
+    with matplotlib.rc_context({**STYLE, **overrides}), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
         yield
 
 
@@ -60,13 +74,6 @@ def new_figure(nrows: int = 1, ncols: int = 1, **kw) -> tuple[Figure, np.ndarray
     fig = Figure(figsize=kw.pop("figsize", (6.4 * ncols, 3.2 * nrows)), layout="constrained")
     axes = fig.subplots(nrows, ncols, squeeze=False, **kw)
     return fig, axes.ravel()
-
-
-def deck_text(text: str) -> str:
-    """Text from a deck or a file name as matplotlib draws it literally: every ``$`` escaped, so
-    a title such as ``cost in $ per part`` is never parsed as mathtext (figure labels written by
-    the tool itself use mathtext on purpose: omega_2 as $\\omega_2$)."""
-    return str(text).replace("\\$", "$").replace("$", "\\$")
 
 
 #: metadata written into every figure file: no dates, no software versions, so the same
@@ -101,7 +108,6 @@ def line_panels(x: np.ndarray, panels: Sequence[tuple[str, dict[str, np.ndarray]
                 title: str = "", styles: dict[str, dict] | None = None, axes=None) -> Figure:
     """Stacked panels sharing x: each panel is (ylabel, {label: y}); NaN gaps break lines.
     ``axes``: one axes per panel to draw into (their figure is returned)."""
-    title = deck_text(title)
     if axes is None:
         fig, axes = new_figure(len(panels), 1, sharex=True, figsize=(7.0, 2.2 * len(panels) + 0.6))
     else:
@@ -114,7 +120,7 @@ def line_panels(x: np.ndarray, panels: Sequence[tuple[str, dict[str, np.ndarray]
             ax.legend(loc="best")
     axes[-1].set_xlabel(xlabel)
     if title:
-        fig.suptitle(title)
+        fig.suptitle(plain_text(title))
     return fig
 
 
@@ -164,7 +170,6 @@ def fourbar_curves(exact, listing, title: str, band: Sequence[float] = (40.0, 12
     [deg] is shaded.  ``output`` names the output link ('rocker', 'output crank').
     ``axes``: three axes to draw into.
     """
-    title = deck_text(title)
     names = _fourbar_names(output)
     panels = [("link angle [deg]", ["coupler_deg", "rocker_deg"]),
               ("transmission angle [deg]", ["transmission_deg"]),
@@ -197,7 +202,7 @@ def fourbar_curves(exact, listing, title: str, band: Sequence[float] = (40.0, 12
         ax.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
     axes[-1].set_xlabel(r"crank angle $\theta_2$ [deg]")
     if title:
-        fig.suptitle(f"{title}: four-bar kinematics")
+        fig.suptitle(f"{plain_text(title)}: four-bar kinematics")
     return fig
 
 
@@ -225,7 +230,6 @@ def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.nd
     link.  Coordinates in the deck's length ``units``, crank pivot at the origin, ground along
     +x; the legend sits beside the drawing.
     """
-    title = deck_text(title)
     if ax is None:
         fig, (ax,) = new_figure(1, 1, figsize=(8.6, 5.2))
     else:
@@ -271,7 +275,7 @@ def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.nd
     if len(runs) > 1:
         spans = ", ".join(f"{theta[r[0]]:.0f}-{theta[r[-1]]:.0f}°" for r in runs)
         what += f"\nassembles over {len(runs)} separate crank intervals ({spans}): separate motions"
-    ax.set_title(f"{title}: {what}" if title else what)
+    ax.set_title(f"{plain_text(title)}: {what}" if title else what)
     return fig
 
 
@@ -310,7 +314,6 @@ def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, 
     (eqs 4.14-4.17, c = sum d^2), dexterity line l2 = l1 sqrt(2)/2, manipulability line l1 = l2,
     optima and chosen designs.  Right: RI2 contours over the design plane with the same lines.
     """
-    title = deck_text(title)
     fig, axes = new_figure(1, 2, figsize=(11.0, 5.0))
     top = float(L1.max())
     g = np.linspace(0, top, 400)
@@ -338,7 +341,7 @@ def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, 
             ax.plot(*optima[key], mk, ms=5, mfc="none")
         ax.plot(l1, l2, "r*", ms=9, label="chosen designs")
         for name, a, b in zip(names, l1, l2):
-            ax.annotate(name, (a, b), textcoords="offset points", xytext=(4, 4), fontsize=7)
+            ax.annotate(plain_text(name), (a, b), textcoords="offset points", xytext=(4, 4), fontsize=7)
         ax.set_xlim(0, top)
         ax.set_ylim(0, top)
         ax.set_aspect("equal")
@@ -348,7 +351,7 @@ def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, 
     axes[1].set_title("RI2 over the design plane")
     fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncol=4, frameon=False)
     if title:
-        fig.suptitle(title)
+        fig.suptitle(plain_text(title))
     return fig
 
 
@@ -360,7 +363,6 @@ def manipulator_torque_crob(l1: np.ndarray, tau1: np.ndarray, tau2: np.ndarray, 
     Rows where the target is out of reach are gaps; ``violates`` marks the rows (a boolean
     per row) whose design does not reach the whole workspace (the reach conditions
     |l1 - l2| <= r, l1 + l2 >= R fail): their points are crossed and named in the legend."""
-    title = deck_text(title)
     fig, (ax,) = new_figure(1, 1, figsize=(7.4, 3.8))
     total = tau1 + tau2
     for label, y in (("tau1", tau1), ("tau2", tau2), ("tau1 + tau2", total)):
@@ -373,7 +375,7 @@ def manipulator_torque_crob(l1: np.ndarray, tau1: np.ndarray, tau2: np.ndarray, 
     ax.set_ylabel("motor torque [N m]")
     ax.set_xlabel("l1 [m]  (l2 = sqrt(%g - l1^2) [m])" % c)
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
-    fig.suptitle(f"{title}: motor torques along C_rob" if title else "Motor torques along C_rob")
+    fig.suptitle(f"{plain_text(title)}: motor torques along C_rob" if title else "Motor torques along C_rob")
     return fig
 
 
@@ -408,11 +410,11 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
     the figures are drawn as lines over the cases, one line per value of the other keys;
     when some cases are not kept, kept cases are circled.
     """
-    title = deck_text(title)
     import pandas as pd
     labels = labels or {}
     only_points = False
-    label = lambda c: textwrap.fill(labels.get(c, c), 28)  # noqa: E731  (two lines fit a panel)
+    # a label that is the column's own name may be deck text (an expression): drawn literally
+    label = lambda c: textwrap.fill(labels.get(c, c) if labels.get(c, c) != c else plain_text(c), 28)  # noqa: E731
     x = x or next((k for k in keys if pd.api.types.is_numeric_dtype(frame[k])), "case")
     if ys:
         ys = list(ys)
@@ -447,7 +449,7 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
             g = g.sort_values(x)
             style = "-" if len(frame) <= 2000 and not only_points else ""
             ax.plot(g[x], g[y], style, marker="o" if len(frame) <= 200 else ".", ms=3, lw=1,
-                    label=", ".join(f"{labels.get(k, k).split(' [')[0]} = {v}"
+                    label=", ".join(f"{labels.get(k, k).split(' [')[0]} = {plain_text(v)}"
                                     for k, v in zip(others, key if isinstance(key, tuple) else (key,))) or None)
         if not kept.all():
             ax.plot(frame.loc[kept, x], frame.loc[kept, y], "o", ms=4, mfc="none", color="k", label="kept")
@@ -456,7 +458,7 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
         axes[0].legend(ncol=min(3, max(1, len(frame.groupby(others)) if others else 1)),
                        loc="lower left", bbox_to_anchor=(0.0, 1.02), frameon=False)
     axes[-1].set_xlabel(label(x))
-    fig.suptitle(f"{title}: sweep summary" if title else "sweep summary")
+    fig.suptitle(f"{plain_text(title)}: sweep summary" if title else "sweep summary")
     return fig
 
 
@@ -479,7 +481,6 @@ def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.
     Cartesian or polar (angle = input angle, radius = speed); the polar radius starts near
     the slowest speed, not at 0, so a fluctuation of a fraction of an rpm stays visible (the
     empty centre says the radius does not start at 0)."""
-    title = deck_text(title)
     if ax is not None:   # the caller's axes (a polar one for polar = True)
         fig = ax.figure
     elif polar:
@@ -522,7 +523,7 @@ def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.
         ax.set_xlim(0.0, 360.0)
         ax.set_xticks(np.arange(0, 361, 45))
         fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncol=2, frameon=False)
-    fig.suptitle(f"{title}: Hooke-joint chain, input and output shaft speed" if title
+    fig.suptitle(f"{plain_text(title)}: Hooke-joint chain, input and output shaft speed" if title
                  else "Hooke-joint chain: input and output shaft speed")
     return fig
 
@@ -542,7 +543,6 @@ def slidercrank_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray
     buckled): they are listed in the legend, so no speed silently disappears.  ``ax``: an axes
     to draw into (its figure is returned).
     """
-    title = deck_text(title)
     from matplotlib.lines import Line2D
     above = above or {}
     if ax is None:
@@ -562,14 +562,13 @@ def slidercrank_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray
     ax.set_ylabel(ylabel)
     fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center",
                ncol=3 if len(series) + len(missing) > 4 else 2, frameon=False, title="crank speed")
-    ax.set_title(title)
+    ax.set_title(plain_text(title))
     return fig
 
 
 @styled
 def slidercrank_convergence_figure(series: dict[str, tuple[list[int], list[float]]], title: str) -> Figure:
     """Peak strain against element count and its percentage change (the paper's Figures 8-9)."""
-    title = deck_text(title)
     fig, axes = new_figure(2, 1, sharex=True, figsize=(7.0, 5.0))
     for label, (n, peak) in series.items():
         n, peak = np.asarray(n, dtype=float), np.asarray(peak, dtype=float)
@@ -581,7 +580,7 @@ def slidercrank_convergence_figure(series: dict[str, tuple[list[int], list[float
     axes[1].set_ylabel("change from previous count [%]")
     axes[1].set_xlabel("number of elements")
     axes[0].legend()
-    fig.suptitle(title)
+    fig.suptitle(plain_text(title))
     return fig
 
 
@@ -592,7 +591,6 @@ def slidercrank_history_figure(time: np.ndarray, series: dict[str, np.ndarray], 
     """Quantities against time [s], one panel each (``series`` keyed like ``labels``, the axis
     words with units), with a reference value (time, value) marked where given: a benchmark's
     published end state beside the computed history."""
-    title = deck_text(title)
     if axes is None:
         fig, axes = new_figure(len(series), 1, sharex=True, figsize=(7.4, 2.4 * len(series) + 0.8))
     else:
@@ -608,7 +606,7 @@ def slidercrank_history_figure(time: np.ndarray, series: dict[str, np.ndarray], 
         ax.legend(loc="best")
     axes[-1].set_xlabel("time $t$ [s]")
     if title:
-        fig.suptitle(title)
+        fig.suptitle(plain_text(title))
     return fig
 
 
@@ -669,7 +667,7 @@ def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, 
     """
     import pandas as pd
     labels = labels or {}
-    lab = lambda c: labels.get(c, c)  # noqa: E731
+    lab = lambda c: labels.get(c, c) if labels.get(c, c) != c else plain_text(c)  # noqa: E731  (deck text: literal)
     keys = [k for k in keys if k in frame.columns][:3]
     kept = frame["kept"].astype(bool) if "kept" in frame else pd.Series(True, index=frame.index)
     z_all = pd.to_numeric(frame[metric], errors="coerce").to_numpy(dtype=float)
@@ -696,7 +694,7 @@ def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, 
         _plain_numbers(ax)
         ax.legend(loc="best")
         if title:
-            ax.set_title(title)
+            ax.set_title(title)   # composed by the caller: deck parts through plain_text
         return fig
 
     kx, ky = keys[0], keys[1]
@@ -841,7 +839,7 @@ def convergence_plot(history, evals, objective: str, sense: str = "minimize", ti
     _plain_numbers(a1)
     _plain_numbers(a3) if a3.get_yscale() == "linear" else None
     if title:
-        fig.suptitle(title)
+        fig.suptitle(title)   # composed by the caller: deck parts through plain_text
     return fig
 
 
@@ -898,7 +896,7 @@ def sweep_maps(frame, keys: Sequence[str], ys: Sequence[str], labels: dict[str, 
                 f"{_words_value(labels.get(k, k), frame.loc[best, k])}" for k in keys) + \
                 f"; {labels.get(y, y).split(' [')[0]} {_words_value(labels.get(y, y), frame.loc[best, y], name=False)}"
         figs.append(design_space_map(frame, keys, y, labels, best=best, best_text=text,
-                                     title=f"{deck_text(title)}: {labels.get(y, y)}" if title else labels.get(y, y),
+                                     title=f"{plain_text(title)}: {labels.get(y, y)}" if title else labels.get(y, y),
                                      only_kept=only_kept))
     return figs
 
@@ -914,7 +912,6 @@ def robust_design_figure(t: np.ndarray, means: dict[str, np.ndarray], spreads: d
     and standard deviations as markers, and the estimates of the target of least spread as
     vertical lines.  ``means``/``spreads``: {label: values on ``t``}; ``points``: {label: (t,
     mean, std)}; ``tmins``: {label: t_min or None}.  ``axes``: two axes to draw into."""
-    title = deck_text(title)
     if axes is None:
         fig, axes = new_figure(2, 1, sharex=True, figsize=(7.6, 6.4))
     else:
@@ -946,5 +943,5 @@ def robust_design_figure(t: np.ndarray, means: dict[str, np.ndarray], spreads: d
     top.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
     bot.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
     if title:
-        fig.suptitle(title)
+        fig.suptitle(plain_text(title))
     return fig

@@ -681,7 +681,7 @@ def page_for_optimize(deck: "Deck", outdir: Path, stem: str, status: int = 0) ->
     notes: list[str] = []
     figs = []
     try:
-        fig = plotting.convergence_plot(history, evals, label, sense, title=plotting.deck_text(f"{stem}: convergence"))
+        fig = plotting.convergence_plot(history, evals, label, sense, title=plotting.plain_text(f"{stem}: convergence"))
         figs.append(_figure_block(fig, "best feasible objective, gap to the final best, constraint violation"))
     except Exception as exc:
         notes.append(f"the convergence plot could not be drawn: {exc.__class__.__name__}: {exc}")
@@ -692,7 +692,7 @@ def page_for_optimize(deck: "Deck", outdir: Path, stem: str, status: int = 0) ->
         frame = evals.assign(kept=evals["feasible"].astype(bool))
         try:
             fig = _evaluated_map(frame, design[:2], label, opt, _labels(module, design),
-                                 plotting.deck_text(f"{stem}: designs evaluated"))
+                                 plotting.plain_text(f"{stem}: designs evaluated"))
             figs.append(_figure_block(fig, "designs evaluated over the design variables"))
         except Exception as exc:
             notes.append(f"the map of designs could not be drawn: {exc.__class__.__name__}: {exc}")

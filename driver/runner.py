@@ -73,7 +73,16 @@ def output_stem(outdir: str | Path, deck_path: str | Path) -> Path:
     if not stem or stem.strip(".") == "" or "/" in stem or "\\" in stem or not inside(outdir, candidate):
         raise DeckError(deck_path, None, None, f"outputs are named after the deck file, and {name!r} would name "
                         f"them outside the output folder {outdir}: rename the deck (e.g. case.dat)")
+    if len(stem.encode("utf-8", "surrogateescape")) + OUTPUT_SUFFIX_BYTES > NAME_MAX:
+        raise DeckError(deck_path, None, None, f"the deck's file name is {len(stem.encode('utf-8', 'surrogateescape'))} "
+                        f"bytes without its suffix; outputs are named after it with up to {OUTPUT_SUFFIX_BYTES} more "
+                        f"(e.g. <name>_summary.parquet) and a file name may have {NAME_MAX} bytes: rename the deck "
+                        f"(at most {NAME_MAX - OUTPUT_SUFFIX_BYTES} bytes before '.dat')")
     return candidate
+
+
+#: the longest file name a file system takes [bytes], and the most the tool appends to a deck's stem
+NAME_MAX, OUTPUT_SUFFIX_BYTES = 255, 24
 
 
 def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool | str,

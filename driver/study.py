@@ -11,8 +11,7 @@ defines
 
 and may define, for figures of sweeps over it,
 
-* ``LABELS``: ``{name: (words, units)}`` for summary columns and deck keys (words may set
-  symbols in mathtext, ``$\\omega_3$``), the
+* ``LABELS``: ``{name: (words, units)}`` for summary columns and deck keys, the
   axis labels a reader sees instead of identifiers (``{i}`` in a name stands for a
   case number, e.g. ``peak_tensile_{i}_deg``); deck keys default to their
   ``SPEC`` units, and
@@ -239,7 +238,7 @@ def column_label(module: ModuleType | None, name: str) -> str:
     study ``module``: words and units from its ``LABELS``, else the key's ``SPEC`` units, else
     units read off the name's suffix (``_deg``, ``_rad_s``, ...).  E.g. ``'crank speed [rad/s]'``."""
     if not re.fullmatch(r"([a-z_][a-z0-9_]*\.)?[A-Za-z_][A-Za-z0-9_]*", name):
-        return name.replace("$", r"\$")   # an expression of columns (driver.expr) is its own label, drawn literally
+        return name   # an expression of columns (driver.expr) is its own label
     group, _, key = name.rpartition(".")
     if module is not None and group and group != getattr(module.SPEC, "name", group):
         module = None
@@ -283,7 +282,7 @@ def expression_label(module: ModuleType | None, text: str) -> str:
             labels = getattr(module, "LABELS", {})
             if n in labels:
                 units.add(labels[n][1])
-    words = text.strip().replace("$", r"\$")   # deck text: drawn literally, never as mathtext
+    words = text.strip().replace("$", r"\$")   # the deck's text is never mathtext (driver.plotting.plain_text)
     for n in sorted(names, key=len, reverse=True):
         entry = getattr(module, "LABELS", {}).get(n)
         if entry:

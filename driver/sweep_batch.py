@@ -32,6 +32,7 @@ import hashlib
 import itertools
 import json
 import os
+import re
 import sys
 import threading
 import time
@@ -46,7 +47,7 @@ import pyarrow.parquet as pq
 
 import driver
 from driver import expr
-from driver.atomic import atomic_open
+from driver.atomic import DIGEST_CHARS, atomic_open, file_digest, own_folder, refuse_link
 from driver.deck import DeckError, RawGroup, validate
 from driver.study import code_digest, load_study
 
@@ -244,14 +245,21 @@ def worker_init() -> None:
 
 # ----------------------------------------------------------------------------- dataset (resume record)
 
-def _part_name(start: int) -> str:
-    return f"part-{start:012d}.parquet"
+_PART = re.compile(r"^part-(\d{12})-([0-9a-f]{%d})\.parquet$" % DIGEST_CHARS)
 
 
-def clean(folder: Path, signature: str, resume: bool) -> dict[int, dict]:
-    """Remove stray temporaries (and, without resume or on a signature change, old parts);
-    returns {start: metadata} of the complete chunks kept."""
+def _part_name(start: int, digest: str) -> str:
+    """A part's name: its first case and the checksum of its bytes (verified on resume)."""
+    return f"part-{start:012d}-{digest}.parquet"
+
+
+def clean(folder: Path, signature: str, resume: bool, damaged: list[int] | None = None) -> dict[int, dict]:
+    """Remove stray temporaries (and, without resume or on a signature change, old parts, and
+    parts whose bytes fail their checksum: their case counts are appended to ``damaged``);
+    returns {start: metadata (with its 'path')} of the complete chunks kept."""
     done: dict[int, dict] = {}
+    damaged = damaged if damaged is not None else []
+    refuse_link(folder)   # never list or delete where a link points
     if not folder.exists():
         return done
     for f in folder.iterdir():
@@ -261,29 +269,37 @@ def clean(folder: Path, signature: str, resume: bool) -> dict[int, dict]:
         if not f.name.startswith("part-"):
             continue
         meta = None
-        if resume:
+        m = _PART.match(f.name)
+        if resume and m:
             with contextlib.suppress(Exception):
                 raw = pq.read_schema(f).metadata or {}
                 meta = json.loads(raw.get(b"sweep", b"{}"))
-        if meta and meta.get("signature") == signature:
-            done[int(meta["start"])] = meta
-        else:
-            f.unlink(missing_ok=True)
+        if meta and meta.get("signature") == signature and int(meta["start"]) == int(m.group(1)):
+            if file_digest(f) == m.group(2):
+                done[int(meta["start"])] = {**meta, "path": str(f)}
+                continue
+            damaged.append(int(meta["stop"]) - int(meta["start"]))
+        f.unlink(missing_ok=True)
     return done
 
 
-def write_part(folder: Path, res: ChunkResult, signature: str) -> None:
+def write_part(folder: Path, res: ChunkResult, signature: str) -> Path:
     table = pa.Table.from_pandas(res.frame, preserve_index=False)
     meta = {"signature": signature, "start": res.start, "stop": res.stop, "n_ok": res.n_ok,
             "n_kept": res.n_kept, "n_failed": res.n_failed}
     table = table.replace_schema_metadata({**(table.schema.metadata or {}), b"sweep": json.dumps(meta).encode()})
-    folder.mkdir(parents=True, exist_ok=True)
-    with atomic_open(folder / _part_name(res.start), "wb") as fh:
-        pq.write_table(table, fh)
+    own_folder(folder, folder.parent)
+    buf = pa.BufferOutputStream()
+    pq.write_table(table, buf)
+    data = buf.getvalue().to_pybytes()
+    path = folder / _part_name(res.start, hashlib.sha256(data).hexdigest()[:DIGEST_CHARS])
+    with atomic_open(path, "wb") as fh:
+        fh.write(data)
+    return path
 
 
-def read_rows(folder: Path, starts: list[int]) -> pd.DataFrame:
-    frames = [pq.read_table(folder / _part_name(s)).to_pandas() for s in sorted(starts)]
+def read_rows(paths: list[Path]) -> pd.DataFrame:
+    frames = [pq.read_table(p).to_pandas() for p in paths]
     frames = [f for f in frames if len(f)]
     if not frames:
         return pd.DataFrame()
@@ -416,12 +432,17 @@ def run(p: BatchPlan, folder: Path, jobs: int, scheduler: Any, resume: bool, pro
     n = p.grid.n
     # the layout depends on the grid only (not on the workers), so --resume works with any -j
     size = chunk or min(CHUNK, max(64, -(-n // 16)))
-    done = clean(folder, p.signature, resume)
+    damaged: list[int] = []
+    done = clean(folder, p.signature, resume, damaged)
     # a resumed chunk counts only if it covers exactly one chunk of this run's layout
     ranges = [(s, min(s + size, n)) for s in range(0, n, size)]
     complete = {s for s, m in done.items() if (s, m["stop"]) in ranges}
     for s in set(done) - complete:
-        (folder / _part_name(s)).unlink(missing_ok=True)
+        Path(done[s]["path"]).unlink(missing_ok=True)
+    paths = {s: Path(done[s]["path"]) for s in complete}
+    if damaged:
+        print(f"warning: resume: {sum(damaged)} cases redone: {len(damaged)} record part(s) failed their "
+              "checksum (the record is verified, never believed)", file=sys.stderr)
     counts = {"ok": 0, "kept": 0, "failed": 0}
     for s in complete:
         for k in counts:
@@ -430,11 +451,11 @@ def run(p: BatchPlan, folder: Path, jobs: int, scheduler: Any, resume: bool, pro
     todo = [r for r in ranges if r[0] not in complete]
     if announce:
         announce(resumed)
-    folder.mkdir(parents=True, exist_ok=True)
+    own_folder(folder, folder.parent)
     bar = tqdm(total=n, initial=resumed, unit="case", disable=not progress, dynamic_ncols=True)
 
     def on_result(res: ChunkResult) -> None:
-        write_part(folder, res, p.signature)
+        paths[res.start] = write_part(folder, res, p.signature)
         counts["ok"] += res.n_ok
         counts["kept"] += res.n_kept
         counts["failed"] += res.n_failed
@@ -444,5 +465,5 @@ def run(p: BatchPlan, folder: Path, jobs: int, scheduler: Any, resume: bool, pro
         execute(p, todo, jobs, scheduler, on_result)
     finally:
         bar.close()
-    rows = read_rows(folder, [s for s, _ in ranges])
+    rows = read_rows([paths[s] for s, _ in ranges if s in paths])
     return rows, counts, size

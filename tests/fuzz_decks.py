@@ -5,7 +5,10 @@
 Decks are mutations of the shipped decks (every study group and sweeps; the optimisation and
 synthesis decks only through the reader) and generated ones: garbage and extreme values,
 wrong types and lengths, duplicated keys and groups, unicode, CRLF, BOM, binary junk, repeat
-counts, '/' and subscripts, truncation.  Every deck must end in exit 0, 1 or 2 with its
+counts, '/' and subscripts, truncation; and a share (GRAMMAR_SHARE) from a grammar-aware generator
+(:func:`grammar_deck`): number spellings near and off the Fortran syntax, repeat counts, keep and
+plot_y expressions over the typed summary columns, titles with '$', braces and control characters,
+where a number Fortran does not read must be refused naming its key (oracle :func:`fortran_values`).  Every deck must end in exit 0, 1 or 2 with its
 messages naming the deck, never a traceback or an unexpected exception ("run failed"), no
 NaN/inf/**** in a written table, and nothing written when the exit is 2 (the slowest deck is
 reported, not judged: no timing is a pass/fail rule).  Runs use a small work budget (``--max-work``) so that a mutated deck of a
@@ -30,6 +33,8 @@ from collections import Counter
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+#: share of the campaign's decks built by the grammar-aware generator (:func:`grammar_deck`)
+GRAMMAR_SHARE = float(os.environ.get("FUZZ_GRAMMAR_SHARE", "0.15"))
 INPUTS = ROOT / "inputs"
 #: decks whose runs are too long for a campaign even when valid (many cases / evaluations):
 #: mutations of these, and of every &optimize and &synthesis deck (their runs have no estimate
@@ -110,6 +115,139 @@ def _generated(rng: random.Random, specs: dict) -> str:
     return text
 
 
+def fortran_number(tok: str) -> float | None:
+    """Oracle: the value Fortran list-directed input reads from ``tok`` (no repeat count), or
+    None.  A hand scanner: [sign] digits [. digits] [(e|d) [sign] digits], ASCII digits, at least
+    one digit in the mantissa and in a given exponent, at most 40 digits."""
+    i, n = 0, len(tok)
+    if i < n and tok[i] in "+-":
+        i += 1
+    mant = 0
+    while i < n and tok[i] in "0123456789":
+        i, mant = i + 1, mant + 1
+    if i < n and tok[i] == ".":
+        i += 1
+        while i < n and tok[i] in "0123456789":
+            i, mant = i + 1, mant + 1
+    if mant == 0:
+        return None
+    exp = 0
+    if i < n and tok[i] in "eEdD":
+        i += 1
+        if i < n and tok[i] in "+-":
+            i += 1
+        while i < n and tok[i] in "0123456789":
+            i, exp = i + 1, exp + 1
+        if exp == 0:
+            return None
+    if i != n or mant + exp > 40:
+        return None
+    return float(tok.replace("d", "e").replace("D", "e"))
+
+
+def fortran_values(tok: str) -> list[float] | None:
+    """The values ``tok`` stands for: one number, or r copies after one repeat count r >= 1."""
+    head, star, rest = tok.partition("*")
+    if star:
+        if not head or any(c not in "0123456789" for c in head) or int(head) == 0 or "*" in rest:
+            return None
+        v = fortran_number(rest)
+        return None if v is None else [v] * int(head)
+    v = fortran_number(tok)
+    return None if v is None else [v]
+
+
+
+# ----------------------------------------------------------------------------- grammar-aware decks
+
+_ODD_DIGITS = ["\uff13", "\u0663", "\u00b2", "\u0967"]
+_TAILS = [""] * 8 + ["_8", "_", "+1", "-7", "*2", "x", "/7"]
+_SPECIAL = ["0xff", "inf", "nan", "1" * 45, "(1,2)", "1_000", "4+1", "360-7", "5.0_8", "2*1*4.0", "3e", "1d+"]
+
+
+def number_token(rng: random.Random) -> str:
+    """A token near the Fortran number syntax (the grammar of tests/test_grammar_fuzz.py)."""
+    if rng.random() < 0.06:
+        return rng.choice(_SPECIAL)
+    digits = lambda: "".join(rng.choice("0123456789") for _ in range(rng.randrange(0, 4)))  # noqa: E731
+    whole = digits() + (rng.choice(_ODD_DIGITS) if rng.random() < 0.05 else "")
+    dot = rng.choice(["", ".", "."])
+    body = rng.choice(["", "", "+", "-"]) + whole + dot + (digits() if dot else "")
+    if rng.random() < 0.4:
+        body += rng.choice("eEdDq") + rng.choice(["", "+", "-"]) + digits()
+    body += rng.choice(_TAILS)
+    return rng.choice(["", "", "", "2*", "3*", "0*", "2*2*"]) + body
+
+
+#: summary columns of &fourbar by kind, for expressions (the typed columns of a sweep's keep)
+_COLUMNS = {"number": ["mu_min_deg", "mu_max_deg", "rocker_swing_deg", "fourbar.crank", "case"],
+            "bool": ["meets_band_40_120", "assemblable"], "text": ["grashof_class"]}
+
+
+def expression(rng: random.Random, depth: int = 0) -> str:
+    """An expression over the typed columns: often well typed, often not (text arithmetic, min of
+    one column, '#', fullwidth letters, non-finite constants, bad number spellings)."""
+    if depth >= 3 or rng.random() < 0.3:
+        kind = rng.choice(["number", "number", "bool", "text", "const"])
+        if kind == "const":
+            return rng.choice(["2", "0.5", "1e3", "'crank-rocker'", "True", "1_0", "0x1f", "1e400", "9**9**9",
+                               "log(0.0)", "'x'*1000000000", "\uff4du_min_deg", "mu_min_deg # + 1"])
+        return rng.choice(_COLUMNS[kind])
+    form = rng.choice(["arith", "compare", "bool", "not", "call", "minmax"])
+    x = expression(rng, depth + 1)
+    if form == "not":
+        return f"not ({x})"
+    if form == "call":
+        return f"{rng.choice(['abs', 'sqrt', 'floor', 'cos', 'exp'])}({x})"
+    y = expression(rng, depth + 1)
+    if form == "minmax":
+        return f"{rng.choice(['min', 'max'])}({x}" + (f", {y})" if rng.random() < 0.8 else ")")
+    op = {"arith": ["+", "-", "*", "/", "**"], "compare": ["<", ">=", "==", "!="], "bool": ["and", "or"]}[form]
+    return f"({x}) {rng.choice(op)} ({y})"
+
+
+_TITLE = list("ab $\\{}^_%#&") + ["\x1b", "\x00", "\x07", "\t", "\u00e9", "\U0001F600", "\\frac", "$$", "{" * 20]
+
+
+def title(rng: random.Random) -> str:
+    return "".join(rng.choice(_TITLE) for _ in range(rng.randrange(1, 10))).replace("'", "")
+
+
+def grammar_deck(rng: random.Random) -> tuple[str, set[str], bool]:
+    """(deck text, the keys one of which a refusal must name (empty: no refusal is required),
+    whether to draw figures).
+
+    A four-bar deck whose number values, sweep values (repeat counts), keep/plot_y expressions
+    and title come from the grammars above; when a number token is not one Fortran reads, the
+    deck must be refused naming that key (the oracle :func:`fortran_values`)."""
+    keys = {"fixed_link": "12.0", "crank": "2.0", "coupler": "15.0", "rocker": "9.0", "omega": "5.0",
+            "step_deg": "60"}
+    must: set[str] = set()
+    k = rng.choice(list(keys))
+    if rng.random() < 0.5:
+        tok = number_token(rng)
+        keys[k] = tok
+        vals = fortran_values(tok)
+        if tok.strip() and (vals is None or len(vals) != 1):   # an empty value is Fortran's null
+            must.add(k)
+    text = "&fourbar\n" + "\n".join(f"  {key} = {v}" for key, v in keys.items())
+    if rng.random() < 0.3:
+        text += f"\n  title = '{title(rng)}'"
+    text += "\n/\n"
+    if rng.random() < 0.7:
+        toks = [rng.choice(["2", "3", "4.5", "2*3.0"]) if rng.random() < 0.6 else number_token(rng)
+                for _ in range(rng.randrange(1, 4))]
+        lines = ["  key1 = 'fourbar.crank'", f"  values1 = {', '.join(toks)}"]
+        if any(fortran_values(t) is None for t in toks):
+            must.add("values1")
+        if rng.random() < 0.6:
+            lines.append(f"  keep = \"{expression(rng)}\"")
+        if rng.random() < 0.3:
+            lines.append(f"  plot_y = \"{expression(rng)}\"")
+        text += "&sweep\n" + "\n".join(lines) + "\n/\n"
+    return text, must, rng.random() < 0.05
+
+
 _BAD = re.compile(r"(?<![A-Za-z_])(nan|[+-]?inf)(?![A-Za-z_])|\*\*\*\*", re.IGNORECASE)
 
 
@@ -129,7 +267,12 @@ def campaign(count: int, seed: int, max_work: str, workdir: Path) -> dict:
     slowest = (0.0, "")
     t_start = time.perf_counter()
     for n in range(count):
-        if rng.random() < 0.15:
+        must, plot = set(), False
+        if rng.random() < GRAMMAR_SHARE:
+            name = f"grammar{n}.dat"
+            text, must, plot = grammar_deck(rng)
+            original = text
+        elif rng.random() < 0.15:
             name, text = f"gen{n}.dat", _generated(rng, specs)
             original = text
         else:
@@ -146,7 +289,7 @@ def campaign(count: int, seed: int, max_work: str, workdir: Path) -> dict:
         shutil.rmtree(out, ignore_errors=True)
         err = io.StringIO()
         t0 = time.perf_counter()
-        args = [str(deck), "-o", str(out), "-q", "-j", "1", "--max-work", max_work]
+        args = [str(deck), "-o", str(out), "-q", "-j", "1", "--max-work", max_work] + (["--plot"] if plot else [])
         try:
             with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
                 if name.startswith("read_only_"):
@@ -172,6 +315,10 @@ def campaign(count: int, seed: int, max_work: str, workdir: Path) -> dict:
             why.append("traceback or unexpected exception")
         if rc in (1, 2) and str(deck) not in msg:
             why.append("message does not name the deck")
+        if must and not (rc == 2 and any(f"key '{k}'" in msg for k in must)):
+            why.append(f"a number Fortran does not read was not refused naming one of {sorted(must)}")
+        if re.search(r"\w*Warning: |site-packages", msg):
+            why.append("a library warning reached stderr")
         if rc == 2 and out.exists() and any(out.rglob("*")):
             why.append("files written for bad input")
         if out.exists():

@@ -230,3 +230,182 @@ def test_expression_kinds_unit():
     assert parse("a * 2").check_kinds({"a": "bool"}) == "number"
     with pytest.raises(ExprError, match="gives text"):
         parse("b").check_kinds({"b": "text"})
+
+
+# ----------------------------------------------------------------------------- 3. symbolic links
+
+SWEEP_DECK = FOURBAR + "&sweep\n  key1 = 'fourbar.crank', values1 = 2, 3\n/\n"
+
+
+@pytest.mark.parametrize("link", ["sw.sweep", "sw", "sw.sweep/cases"])
+def test_a_link_in_place_of_a_sweep_folder_is_refused(tmp_path, capsys, link):
+    victim = tmp_path / "victim"
+    victim.mkdir()
+    (victim / "part-r1-000001.parquet").write_text("not the tool's")
+    (victim / "case_0001.out").write_text("not the tool's")
+    before = sorted(p.name for p in victim.iterdir())
+    deck = tmp_path / "sw.dat"
+    deck.write_text(SWEEP_DECK)
+    out = tmp_path / "out"
+    (out / link).parent.mkdir(parents=True, exist_ok=True)
+    (out / link).symlink_to(victim, target_is_directory=True)
+    rc = main([str(deck), "-o", str(out), "-q", "-j", "1"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 1 and len(err) == 1 and "symbolic link" in err[0] and link in err[0], err
+    assert sorted(p.name for p in victim.iterdir()) == before
+    assert (victim / "case_0001.out").read_text() == "not the tool's"
+
+
+def test_a_link_in_place_of_an_output_file_is_replaced_not_followed(tmp_path, capsys):
+    target = tmp_path / "target.txt"
+    target.write_text("keep me")
+    deck = tmp_path / "sw.dat"
+    deck.write_text(SWEEP_DECK)
+    out = tmp_path / "out"
+    (out / "sw").mkdir(parents=True)
+    (out / "sw.out").symlink_to(target)
+    (out / "sw" / "case_0001.out").symlink_to(target)
+    assert main([str(deck), "-o", str(out), "-q", "-j", "1"]) == 0
+    assert target.read_text() == "keep me"
+    assert not (out / "sw.out").is_symlink() and not (out / "sw" / "case_0001.out").is_symlink()
+    # a resume reads no file through a link: the case is redone
+    (out / "sw" / "case_0002.json").unlink()
+    (out / "sw" / "case_0002.json").symlink_to(target)
+    capsys.readouterr()
+    assert main([str(deck), "-o", str(out), "-j", "1", "--resume"]) == 0
+    assert "1 cases redone" in capsys.readouterr().err
+    assert target.read_text() == "keep me" and not (out / "sw" / "case_0002.json").is_symlink()
+
+
+def test_a_symlinked_outdir_given_by_the_user_works(tmp_path, capsys):
+    real = tmp_path / "real"
+    real.mkdir()
+    (tmp_path / "link").symlink_to(real, target_is_directory=True)
+    deck = tmp_path / "sw.dat"
+    deck.write_text(SWEEP_DECK)
+    assert main([str(deck), "-o", str(tmp_path / "link"), "-q", "-j", "1"]) == 0
+    assert (real / "sw.out").is_file() and (real / "sw" / "case_0001.out").is_file()
+
+
+# ----------------------------------------------------------------------------- 5. the rest
+
+def test_concurrent_run_of_one_sweep_is_refused_with_one_line(tmp_path, capsys):
+    from driver.sweep import store
+    deck = tmp_path / "sw.dat"
+    deck.write_text(SWEEP_DECK)
+    out = tmp_path / "out"
+    with store.sweep_lock(out, "sw"):   # another run holds the sweep
+        assert main([str(deck), "-o", str(out), "-q", "-j", "1"]) == 1
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and "another run is writing this sweep" in err[0]
+    assert main([str(deck), "-o", str(out), "-q", "-j", "1"]) == 0
+
+
+def test_concurrent_processes_one_waits_out(tmp_path):
+    import subprocess
+    import sys
+    deck = tmp_path / "sw.dat"
+    deck.write_text(SWEEP_DECK.replace("values1 = 2, 3", "start1 = 2, stop1 = 5, count1 = 24")
+                    .replace("step_deg = 60", "step_deg = 1"))
+    cmd = [sys.executable, "-m", "driver", str(deck), "-o", str(tmp_path / "out"), "-q", "-j", "1"]
+    procs = [subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True) for _ in range(2)]
+    results = [(p.wait(timeout=600), p.stderr.read()) for p in procs]
+    for rc, err in results:
+        assert rc == 0 or (rc == 1 and "another run is writing this sweep" in err and "cannot write" not in err), err
+    assert any(rc == 0 for rc, _ in results)
+
+
+def test_long_deck_names(tmp_path, capsys):
+    name = "a" * 231 + ".dat"   # the longest stem whose every output name fits; the temporaries must too
+    deck = tmp_path / name
+    deck.write_text(FOURBAR + "&sweep key1 = 'fourbar.crank', values1 = 2, 3 /\n")
+    assert main([str(deck), "-o", str(tmp_path / "o"), "-q", "-j", "1", "--plot"]) == 0
+    assert (tmp_path / "o" / ("a" * 231 + "_summary.parquet")).is_file()
+    sweep = tmp_path / ("b" * 245 + ".dat")   # its <name>_summary.parquet cannot exist: said before running
+    sweep.write_text(SWEEP_DECK)
+    capsys.readouterr()
+    assert main([str(sweep), "-o", str(tmp_path / "o2"), "-q", "-j", "1"]) == 2
+    err = capsys.readouterr().err
+    assert "255 bytes" in err and ".tmp" not in err
+    assert not (tmp_path / "o2").exists() or not any((tmp_path / "o2").rglob("*"))
+
+
+@pytest.mark.parametrize("char", ["\x1b", "\x00", "\x07", "\u2028"])
+def test_control_characters_in_titles_are_refused(tmp_path, capsys, char):
+    text = FOURBAR.replace("step_deg = 60", f"step_deg = 60, title = 'a{char}[31mb'")
+    deck = tmp_path / "d.dat"
+    deck.write_bytes(text.encode())
+    out = tmp_path / "out"
+    assert main([str(deck), "-o", str(out), "-q"]) == 2
+    err = capsys.readouterr().err
+    assert f"{deck}:3: key 'title'" in err and "control character" in err
+    with pytest.raises(DeckError, match="control character"):
+        driver.run({"fourbar": {**BASE, "title": f"x{char}y"}})
+
+
+@pytest.mark.parametrize("title", ["$\\frac$", "$" + "{" * 300 + "x" + "}" * 300 + "$", "a$b$c", "$x^{$"])
+def test_dollar_text_is_never_mathtext(tmp_path, capsys, title):
+    deck = tmp_path / "t.dat"
+    deck.write_text(FOURBAR.replace("step_deg = 60", f"step_deg = 60, title = '{title}'"))
+    assert main([str(deck), "-o", str(tmp_path / "o"), "--plot", "-q"]) == 0
+    assert "Traceback" not in capsys.readouterr().err
+    from driver.plotting import plain_text
+    assert plain_text(title).count("\\$") == title.count("$")
+
+
+def test_dollar_in_a_sweep_file_name_and_design_names(tmp_path, capsys):
+    from conftest import INPUTS
+    deck = tmp_path / "s$x^{$.dat"
+    deck.write_text(SWEEP_DECK)
+    assert main([str(deck), "-o", str(tmp_path / "o"), "--plot", "-q", "-j", "1"]) == 0
+    assert (tmp_path / "o" / "s$x^{$_summary.png").is_file()
+    m = (INPUTS / "manipulator_case1_report.dat").read_text().replace("'Dexterity'", "'$\\frac{$'")
+    (tmp_path / "m.dat").write_text(m)
+    assert main([str(tmp_path / "m.dat"), "-o", str(tmp_path / "o"), "--plot", "-q"]) == 0
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and "Warning" not in err
+
+
+def test_no_matplotlib_warnings_reach_stderr(tmp_path, capfd):
+    deck = tmp_path / "t.dat"   # glyphs missing from the font: matplotlib warns while drawing
+    deck.write_text(FOURBAR.replace("step_deg = 60", "step_deg = 60, title = '\U0001F600 \u4e2d\u6587 \u0dc1'"))
+    assert main([str(deck), "-o", str(tmp_path / "o"), "--plot", "-q"]) == 0
+    err = capfd.readouterr().err
+    assert "Warning" not in err and "site-packages" not in err, err
+
+
+def test_compare_with_only_control_decks_says_so(capsys):
+    from conftest import INPUTS
+    assert main(["--compare", str(INPUTS / "fourbar_paper_sweep.dat"), str(INPUTS / "synthesis_path.dat")]) == 0
+    out = capsys.readouterr().out
+    total = out.split("Total", 1)[1]
+    assert "no published cells" in total
+
+
+@pytest.mark.parametrize("change,key", [
+    (("crank_range_deg = 60.0", "crank_range_deg = 1e-300"), "crank_range_deg"),
+    (("'log10(x)'", "'ceil(x)'"), "function"),
+    (("rocker_range_deg = 90.0", "rocker_range_deg = 1e-300"), "rocker_range_deg"),
+])
+def test_degenerate_syntheses_are_deck_errors(tmp_path, capsys, change, key):
+    from conftest import INPUTS
+    text = (INPUTS / "synthesis_function_log.dat").read_text().replace(*change)
+    line = next(i for i, l in enumerate(text.splitlines(), 1) if change[1] in l)
+    _refused(tmp_path, capsys, text, line, key)
+
+
+def test_unknown_keys_refused_before_the_namelist_reader(monkeypatch):
+    """A group of 12 000 unknown keys: refused in the pre-scan, linear in the deck's size (the
+    namelist library's work grows with the square of a group's keys: it is never reached)."""
+    import driver.deck as deck_module
+
+    def never(text):
+        raise AssertionError("f90nml reached")
+    monkeypatch.setattr(deck_module, "_f90nml_reads", never)
+    keys = "".join(f"  k{i} = 1\n" for i in range(12_000))
+    with pytest.raises(DeckError, match="unknown key in &fourbar") as exc:
+        read_deck("big.dat", text="&fourbar\n  fixed_link = 12, crank = 5, coupler = 15, rocker = 9\n" + keys + "/\n")
+    assert (exc.value.line, exc.value.key) == (3, "k0")
+    with pytest.raises(DeckError, match="more than 200 keys") as exc:
+        read_deck("big.dat", text="&nosuchgroup\n" + keys + "/\n")
+    assert exc.value.line == 202

@@ -48,7 +48,7 @@ import numpy as np
 import pandas as pd
 
 from driver import expr, sweep_batch
-from driver.atomic import remove_stale_temporaries
+from driver.atomic import refuse_link, remove_stale_temporaries
 from driver.deck import Deck, Params, RawGroup, validate
 from driver.extras import require
 from driver.runner import compute, output_stem, study_of
@@ -139,9 +139,12 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
     sig = store.signature(raw, names, str(deck.path), sw.keep, sw.case_outputs, formats, case_plot, module)
     if batchable:
         bplan = sweep_batch.plan(module, raw, str(deck.path), grid, sw.keep, sw.summary_rows)
+    else:
+        bplan = None
+    with store.sweep_lock(outdir, stem_path.name):   # one run at a time writes a sweep's files
         if bplan is not None:
             return run.batch(bplan, sig)
-    return run.cases(sig, estimates)
+        return run.cases(sig, estimates)
 
 
 class _CasesTable:
@@ -218,9 +221,17 @@ class _Run:
                 client.close()
 
     # ------------------------------------------------------------------ per case
+    def _refuse_links(self) -> None:
+        """The sweep's own folders (record, cases) are never symbolic links: refused before any
+        file is listed, written or removed there (OUTDIR itself may be one)."""
+        for p in (self.outdir / f"{self.stem}.sweep", self.outdir / f"{self.stem}.sweep" / "cases",
+                  Path(self.layout.root)):
+            refuse_link(p)
+
     def cases(self, signature: str, estimates: dict[int, float]) -> int:
         sw, grid, layout, n = self.sw, self.grid, self.layout, self.grid.n
         names = grid.names
+        self._refuse_links()
         store.clean_temporaries(layout)   # left by a killed earlier run of this deck
         remove_stale_temporaries(self.outdir, self.stem)
         record = store.Record(self.outdir / f"{self.stem}.sweep", signature, n)
@@ -229,6 +240,8 @@ class _Run:
         n_done = int(done[1:].sum())
         if self.resume and not self.quiet:
             print(f"resume: {n_done} of {n} cases complete, {n - n_done} to run")
+        if self.resume:
+            self._say_redone(record)
         self._check_workers_see(sw.case_outputs != "none" and n_done < n)
         if estimates and len(set(estimates.values())) > 1:   # longest first: the last case to start is short
             order: Any = [i for i in sorted(estimates, key=lambda i: -estimates[i]) if not done[i]]
@@ -294,6 +307,19 @@ class _Run:
             print(f"wrote {self.outdir / (self.stem + '.out')} and {self.outdir / self.stem}_summary.{{csv,parquet}}")
         return max([EXIT_OK] + [r.status for r in failed])
 
+    def _say_redone(self, record: store.Record, what: str = "cases") -> None:
+        """One warning line when a resume found record parts or case files that failed their
+        checksum: how many cases run again, and why."""
+        redone = record.redone()
+        if not redone and not record.damaged_parts:
+            return
+        k = sum(redone.values())
+        why = "; ".join(f"{c} because {w}" for w, c in redone.items())
+        parts = (f"{record.damaged_parts} damaged record part(s) dropped" + ("; " if why else "")
+                 if record.damaged_parts else "")
+        print(f"warning: {self.deck.path}: resume: {k} {what} redone ({parts}{why}): the record is verified, "
+              "never believed", file=sys.stderr)
+
     def _print_failed(self, failed: list[tuple[int, dict, str]], most: int = 20) -> None:
         for index, values, error in failed[:most]:
             vals = ", ".join(f"{k} = {v!r}" for k, v in values.items())
@@ -308,6 +334,7 @@ class _Run:
         With case_outputs = 'kept' the kept cases then run case by case for their files, with
         their own resume record ``<stem>.sweep/cases/`` (:mod:`driver.sweep.store`)."""
         sw, names, n = self.sw, self.grid.names, bplan.grid.n
+        self._refuse_links()
         t_start = time.perf_counter()
 
         def announce(resumed: int) -> None:
@@ -323,11 +350,12 @@ class _Run:
         has_files = np.zeros(n + 1, dtype=bool) if n <= 10 * store.SHARD * store.SHARD else None
         if sw.case_outputs == "kept" and counts["kept"]:   # the kept cases' own files, case by case
             kept = [int(c) for c in rows.loc[rows["kept"], "case"]]
-            record = store.Record(self.outdir / f"{self.stem}.sweep" / "cases", signature, n)
+            record = store.Record(self.outdir / f"{self.stem}.sweep" / "cases", signature, n, base=self.outdir)
             store.clean_temporaries(self.layout)
             record.start(self.resume)
             if self.resume:
                 record.scan(self.grid, self.layout)
+                self._say_redone(record, "kept cases' files")
             todo = [k for k in kept if not record.complete(k)]
             if self.resume and not self.quiet:
                 print(f"resume: {len(kept) - len(todo)} of {len(kept)} kept cases' files complete, {len(todo)} to write")

@@ -36,7 +36,7 @@ import numpy as np
 import pandas as pd
 
 from driver import expr
-from driver.atomic import output_set, write_text
+from driver.atomic import output_set, own_folder, write_text
 from driver.deck import DeckError, Params, RawGroup, validate
 from driver.export import write_tidy
 from driver.runner import compute, write_outputs
@@ -137,6 +137,7 @@ def _write_case(task: Task, case: Case, res: CaseResult, result, params: Params,
         record = {"index": case.index, "values": case.values, "base": task.base_hash,
                   "status": res.status, "error": res.error, "summary": res.summary,
                   "kept": res.kept, "warnings": res.warnings}
+        own_folder(stem.parent, Path(task.layout.root).parent)   # the case folders: made here, never links
         with output_set(stem.parent):   # the case's files together, or none
             written = [write_text(stem.with_suffix(".dat"),
                                   _case_deck_text(task.raw.name, params, case, Path(task.deck_path)))]

@@ -14,6 +14,13 @@ ok, holds the values the grid now gives that number, and every file it wrote is 
 in this sweep's layout; every other case runs again.  So a changed base deck or tool build
 re-runs every case, a changed grid re-runs the cases whose values changed, and a deleted
 ``.out`` re-runs its case.
+
+The record is verified, never believed: a part's name ends with the sha256 of its bytes
+(``part-r<run>-<seq>-<digest>.parquet``), checked before it is read, and each row holds the
+digest of every file its case wrote (``digests``), checked against the file (opened without
+following a link) before the case counts as complete.  What fails is redone and counted by
+reason (:meth:`Record.redone`).  The record's folders are never symbolic links
+(:func:`driver.atomic.own_folder`), and :func:`sweep_lock` lets one run at a time write them.
 """
 from __future__ import annotations
 
@@ -30,7 +37,7 @@ from typing import Any, Iterator
 import numpy as np
 
 import driver
-from driver.atomic import atomic_open, remove_stale_temporaries
+from driver.atomic import DIGEST_CHARS, atomic_open, file_digest, own_folder, refuse_link, remove_stale_temporaries
 from driver.deck import RawGroup
 from driver.sweep.spec import CaseResult, case_at
 from driver.sweep_batch import Grid
@@ -45,7 +52,7 @@ SHARD = 1000
 
 _CASE_FILE = re.compile(r"^case_(\d+)[._]")
 _SHARD_DIR = re.compile(r"^(\d+)-(\d+)$")
-_PART = re.compile(r"^part-r(\d+)-(\d+)\.parquet$")
+_PART = re.compile(r"^part-r(\d+)-(\d+)-([0-9a-f]{%d})\.parquet$" % DIGEST_CHARS)
 
 
 def json_default(o: Any) -> Any:
@@ -99,9 +106,38 @@ def signature(raw: RawGroup, swept: list[str], deck_path: str, keep: str, case_o
     return h.hexdigest()[:20]
 
 
+class SweepBusy(OSError):
+    """Another run holds the lock of this sweep's record (one line)."""
+
+    def __init__(self, folder: Path):
+        super().__init__(16, "another run is writing this sweep; wait for it to finish (or give another -o OUTDIR)",
+                         str(folder))
+
+
+@contextlib.contextmanager
+def sweep_lock(outdir: Path, stem: str) -> Iterator[None]:
+    """Hold an exclusive lock on ``<outdir>/<stem>.sweep/.lock`` while a run writes the sweep's
+    record, cases and tables; :class:`SweepBusy` at once when another run holds it.  The lock
+    is the kernel's (flock): it goes with the process, so a killed run leaves none behind."""
+    import fcntl
+    folder = Path(outdir) / f"{stem}.sweep"
+    refuse_link(folder)
+    own_folder(folder, outdir)
+    fd = os.open(folder / ".lock", os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0), 0o644)
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise SweepBusy(folder) from None
+        yield
+    finally:
+        os.close(fd)
+
+
 def clean_temporaries(layout: Layout) -> None:
     """Remove the temporaries of case files whose writer died (SIGKILL), in every case folder."""
     root = Path(layout.root)
+    refuse_link(root)
     remove_stale_temporaries(root, "case_")
     with contextlib.suppress(OSError):
         for e in os.scandir(root):
@@ -139,19 +175,26 @@ DENSE_MAX = 10_000_000
 class Record:
     """The resume record ``<folder>`` of one sweep run (module docstring)."""
 
-    def __init__(self, folder: Path, signature: str, n_cases: int):
+    def __init__(self, folder: Path, signature: str, n_cases: int, base: Path | None = None):
         self.folder = Path(folder)
+        #: the output folder the record lives in (the user's: it may be a link; the record's
+        #: own folders below it never are)
+        self.base = Path(base) if base is not None else self.folder.parent
         self.signature = signature
         self.parts: list[Path] = []
         #: per case number, the index in ``parts`` of its newest row (-1: none)
         self.winner = _Winners(n_cases)
         self.run = time.time_ns()
         self.seq = 0
+        #: cases whose record or files failed verification on resume: case -> why (see :meth:`redone`)
+        self.suspect: dict[int, str] = {}
+        self.damaged_parts = 0
 
     # -- start: clean and find what is complete
     def start(self, resume: bool) -> None:
         """Remove stray temporaries, and parts of another signature (all parts without ``resume``)."""
         kept = []
+        refuse_link(self.folder)   # never list or delete where a link points
         if self.folder.exists():
             remove_stale_temporaries(self.folder, "part-")   # of a driver killed while writing a part
             for f in self.folder.iterdir():
@@ -160,10 +203,23 @@ class Record:
                 m = _PART.match(f.name)
                 meta = self._meta(f) if (resume and m) else None
                 if meta and meta.get("signature") == self.signature:
-                    kept.append(((int(m.group(1)), int(m.group(2))), f))
-                else:
-                    f.unlink(missing_ok=True)
+                    if file_digest(f) == m.group(3):
+                        kept.append(((int(m.group(1)), int(m.group(2))), f))
+                        continue
+                    for case in self._cases_of(f):   # its cases run again, and the tool says why
+                        self.suspect[case] = "a resume record part failed its checksum"
+                    self.damaged_parts += 1
+                f.unlink(missing_ok=True)
         self.parts = [f for _, f in sorted(kept)]
+
+    @staticmethod
+    def _cases_of(path: Path) -> list[int]:
+        """The case numbers a (damaged) part lists, as far as it can still be read."""
+        import pyarrow.parquet as pq
+        try:
+            return [int(c) for c in pq.read_table(path, columns=["case"]).column("case").to_pylist()]
+        except Exception:   # noqa: BLE001 - unreadable: its cases are found missing instead
+            return []
 
     @staticmethod
     def _meta(path: Path) -> dict | None:
@@ -179,26 +235,18 @@ class Record:
         above DENSE_MAX cases: ask :meth:`complete`)."""
         import pyarrow.parquet as pq
         n = grid.n
-        listing: dict[str, set[str]] = {}
-
-        def present(rel: str) -> bool:
-            parent, _, name = rel.rpartition("/")
-            if parent not in listing:
-                try:
-                    listing[parent] = {e.name for e in os.scandir(Path(layout.root) / parent)}
-                except OSError:
-                    listing[parent] = set()
-            return name in listing[parent]
-
+        root = Path(layout.root)
         good: list[Path] = []
         for part in self.parts:
             try:
-                t = pq.read_table(part, columns=["case", "status", "values", "files"]).to_pydict()
-            except Exception:   # an unreadable part: its cases run again
+                t = pq.read_table(part, columns=["case", "status", "values", "files", "digests"]).to_pydict()
+            except Exception:   # an unreadable part (its checksum held, yet): its cases run again
+                self.damaged_parts += 1
                 continue
             k = len(good)
             good.append(part)
-            for case, status, values, files in zip(t["case"], t["status"], t["values"], t["files"]):
+            for case, status, values, files, digests in zip(t["case"], t["status"], t["values"], t["files"],
+                                                            t["digests"]):
                 if not 1 <= case <= n:
                     continue
                 ok = status == "ok"
@@ -206,11 +254,28 @@ class Record:
                     ok = values == json.dumps(case_at(grid, case).values, default=json_default)
                 if ok:
                     stem = self._rel(layout, case)
-                    names = json.loads(files)
-                    ok = all(f.startswith(stem) and f[len(stem):len(stem) + 1] in (".", "_") and present(f) for f in names)
+                    names, sums = json.loads(files), json.loads(digests)
+                    ok = len(names) == len(sums) and all(
+                        f.startswith(stem) and f[len(stem):len(stem) + 1] in (".", "_") for f in names)
+                    if ok:   # every file the case wrote is still there, byte for byte
+                        bad = [f for f, d in zip(names, sums) if d is None or file_digest(root / f) != d]
+                        if bad:
+                            ok = False
+                            missing = not (root / bad[0]).exists()
+                            self.suspect[case] = (f"its file {Path(bad[0]).name} is missing" if missing else
+                                                  f"its file {Path(bad[0]).name} failed its checksum")
                 self.winner.set(case, k if ok else -1)
         self.parts = good
         return self.winner.a >= 0 if self.winner.a is not None else np.zeros(0, dtype=bool)
+
+    def redone(self) -> dict[str, int]:
+        """After :meth:`scan`: the cases found in the record that failed verification and run
+        again, counted by reason."""
+        out: dict[str, int] = {}
+        for case, why in self.suspect.items():
+            if not self.complete(case):
+                out[why] = out.get(why, 0) + 1
+        return dict(sorted(out.items(), key=lambda kv: (-kv[1], kv[0])))
 
     def complete(self, case: int) -> bool:
         """Whether case ``case`` has a valid row (after :meth:`scan` and :meth:`append`)."""
@@ -235,6 +300,8 @@ class Record:
             "kept": pa.array([bool(r.kept and r.status == 0) for r in results], pa.bool_()),
             "values": [json.dumps(r.values, default=json_default) for r in results],
             "files": [json.dumps(r.files) for r in results],
+            # the content of each file as written, checked on resume (file_digest)
+            "digests": [json.dumps([file_digest(Path(layout.root) / f) for f in r.files]) for r in results],
             "seconds": pa.array([float(r.seconds) for r in results], pa.float64()),
             "cpu": pa.array([float(r.cpu) for r in results], pa.float64()),
             "record": [json.dumps({"status": r.status, "error": r.error, "summary": r.summary,
@@ -243,10 +310,14 @@ class Record:
         self.seq += 1
         meta = {"signature": self.signature, "run": self.run, "seq": self.seq}
         table = table.replace_schema_metadata({b"sweep": json.dumps(meta).encode()})
-        self.folder.mkdir(parents=True, exist_ok=True)
-        path = self.folder / f"part-r{self.run}-{self.seq:06d}.parquet"
+        own_folder(self.folder, self.base)
+        buf = pa.BufferOutputStream()
+        pq.write_table(table, buf)
+        data = buf.getvalue().to_pybytes()
+        digest = hashlib.sha256(data).hexdigest()[:DIGEST_CHARS]   # the part's name carries its checksum
+        path = self.folder / f"part-r{self.run}-{self.seq:06d}-{digest}.parquet"
         with atomic_open(path, "wb") as fh:
-            pq.write_table(table, fh)
+            fh.write(data)
         self.parts.append(path)
         k = len(self.parts) - 1
         for r in results:
@@ -304,6 +375,7 @@ def remove_stale_case_files(layout: Layout, has_files: np.ndarray) -> int:
                         os.unlink(e.path)
                         removed += 1
 
+    refuse_link(root)
     if not root.is_dir():
         return 0
     sweep_folder(root, "")

@@ -170,6 +170,23 @@ def _y_of(p: Params, x: np.ndarray) -> np.ndarray:
     return y
 
 
+def _distinct_angles(p: Params, th2: np.ndarray, th4: np.ndarray) -> None:
+    """Deck error when two precision points share a crank angle or a rocker angle (their
+    Freudenstein equations coincide: no unique linkage), naming the key that makes them so."""
+    def gap(a: np.ndarray) -> float:
+        a = np.sort(np.asarray(a, dtype=float))
+        return float(np.min(np.diff(a))) if a.size > 1 else math.inf
+    if not gap(th2) > 1e-9:
+        raise p.error("crank_range_deg", f"the precision points' crank angles coincide (range "
+                      f"{p.crank_range_deg:g} deg): no unique linkage; give a crank range of a few degrees at least")
+    if not gap(th4) > 1e-9:
+        key = "function" if p.function else ("y_values" if p.x_values is not None else "rocker_range_deg")
+        if not abs(p.rocker_range_deg) > 1e-9:
+            key = "rocker_range_deg"
+        raise p.error(key, "two precision points have the same rocker angle (y(x) is flat between them, or the "
+                      "rocker range is nil): no unique linkage through them")
+
+
 def _function(p: Params) -> Synthesis:
     d = p.fixed_link
     if p.x_values is not None:
@@ -195,7 +212,14 @@ def _function(p: Params) -> Synthesis:
     phi = lambda x: p.crank_start_deg + (np.asarray(x) - x0) / (xf - x0) * p.crank_range_deg
     psi = lambda y: p.rocker_start_deg + (np.asarray(y) - y0) / (yf - y0) * p.rocker_range_deg
     th2, th4 = np.radians(phi(xs)), np.radians(psi(ys))
-    k, cond = freudenstein(th2, th4)
+    _distinct_angles(p, th2, th4)
+    try:
+        k, cond = freudenstein(th2, th4)
+    except np.linalg.LinAlgError:
+        cond = math.inf
+    if not (math.isfinite(cond) and cond < 1e12):   # a degenerate set of precision points: bad input
+        raise p.error("crank_range_deg", f"the precision points give a singular Freudenstein system (condition "
+                      f"number {cond:.3g}); spread the crank and rocker angles apart")
     a, b, c, reason = links_from_k(k, d)
     fd = FunctionDesign(xs, ys, phi(xs), psi(ys), k, cond, abs(a), b, abs(c),
                         p.crank_start_deg + (180.0 if a < 0 else 0.0), p.rocker_start_deg + (180.0 if c < 0 else 0.0),
