@@ -73,7 +73,7 @@ def design_batch(n: int, n_case: int, repeat: int) -> tuple[float, float]:
     frame = manipulator.summarise_batch(base, cols)
     for i in range(min(n_case, 5)):
         s = manipulator.run(deck(i)).summary
-        assert s["design_total_torque_Nm"] == frame["design_total_torque_Nm"].iloc[i]
+        assert s["design_tau_sum_signed_Nm"] == frame["design_tau_sum_signed_Nm"].iloc[i]
 
     def per_case():
         for i in range(n_case):

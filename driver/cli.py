@@ -67,16 +67,23 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool | str, pro
                  if (sweep_options or {}).get(key) and not ({"sweep", "optimize"} & set(deck.groups))]
         if "synthesis" in deck.groups:
             from driver import synthesis
-            status = synthesis.run_synthesis_deck(deck, outdir, formats, plot, progress, quiet)
+            status = synthesis.run_synthesis_deck(deck, outdir, formats, plot, progress, quiet,
+                                                  summary_json=summary_json)
             return _report(deck, outdir, "synthesis", status, quiet) if report else status
         if "optimize" in deck.groups:
             from driver import optimize
-            status = optimize.run_optimize_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))
+            status = optimize.run_optimize_deck(deck, outdir, formats, plot, progress, quiet,
+                                                summary_json=summary_json, **(sweep_options or {}))
             return _report(deck, outdir, "optimize", status, quiet) if report else status
         if "sweep" in deck.groups:
             require("parquet")   # sweeps keep their cases in Parquet: say so before importing them
             from driver import sweep
             status = sweep.run_sweep_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))
+            if summary_json:
+                from driver.sweep.record import write_sweep_json
+                path_ = write_sweep_json(deck, outdir, status)
+                if not quiet:
+                    print(f"wrote {path_}")
             return _report(deck, outdir, "sweep", status, quiet) if report else status
         outcome = run_study(deck, outdir, formats, plot, progress, summary_json=summary_json)
         if report:
@@ -237,7 +244,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--format", dest="formats", action="append", choices=FORMATS, default=[],
                         help="also write the tidy table in this format (repeatable)")
     parser.add_argument("--json", action="store_true",
-                        help="also write the run's summary (headline figures, warnings) as <stem>.json")
+                        help="also write the run's summary (headline figures, warnings) as <stem>.json; for an "
+                             "optimisation its result (x, fun, success, status, message, nit, nfev, constraints), "
+                             "for a synthesis its linkage and checks, for a sweep its cases and summary table")
     parser.add_argument("--plot", action="store_true", help="write figures <stem>_<name>.png (see --plot-format)")
     parser.add_argument("--plot-format", choices=PLOT_FORMATS, default=None,
                         help="figure file format (implies --plot; default png); the same inputs give "

@@ -155,7 +155,7 @@ def _manipulator(params: Params, result: Result) -> list[dict]:
                "dexterity_l1": s["dexterity_l1_m"], "dexterity_l2": s["dexterity_l2_m"],
                "manipulability_l1": s["manipulability_l1_m"], "manipulability_l2": s["manipulability_l2_m"],
                "manipulability_l1_t44": None,
-               "min_total_torque": s.get("sweep_min_total_torque_Nm"), "min_total_l1": s.get("sweep_min_l1_m"),
+               "min_total_torque": s.get("sweep_min_tau_sum_signed_Nm"), "min_total_l1": s.get("sweep_min_l1_m"),
                "min_total_l2": s.get("sweep_min_l2_m")}
         t44 = m.table_frame(result.tidy, "4.4")
         if len(t44) > 1:

@@ -33,7 +33,9 @@ __all__ = ["farray", "fourbar_listing", "fourbar_exact", "fourbar_coupler_point"
            "UJOINT_MODELS", "UJOINT_OBJECTIVES", "ujoint_speed", "ujoint_objective",
            "ujoint_equivalent", "ujoint_geometry", "ujoint_summaries", "UJOINT_SUMMARY_COLUMNS",
            "SLIDERCRANK_STATUS", "slidercrank_simulate", "slidercrank_matrices", "slidercrank_rigid",
-           "slidercrank_axial_force", "slidercrank_frequencies"]
+           "slidercrank_axial_force", "slidercrank_frequencies",
+           "SLIDERCRANK_NL_STATUS", "slidercrank_nl_simulate", "slidercrank_column_static",
+           "slidercrank_corot_element"]
 
 
 def farray(x, ndim: int | None = None) -> np.ndarray:
@@ -104,18 +106,26 @@ FOURBAR_GRASHOF = {int(getattr(_kernels.fourbar_summary, f"gr_{k}")): k for k in
                     "triple_rocker")}
 
 
-def fourbar_summaries(params: np.ndarray) -> np.ndarray:
+#: pass bits of fourbar_summaries (fortran/fourbar_summary.f90 pass_*); 'dense_scan' with
+#: 'peaks' is the previous peak search (every 1 deg grid point), the baseline of bench and tests
+FOURBAR_PASSES = {k: int(getattr(_kernels.fourbar_summary, f"pass_{k}")) for k in
+                  ("transmission", "rocker", "peaks", "dense_scan")}
+
+
+def fourbar_summaries(params: np.ndarray, passes: int = 7) -> np.ndarray:
     """Headline figures of many four-bars in one kernel call: (n, 19) array.
 
     ``params`` (n, 8): fixed link p, crank q, coupler r, rocker s [length], crank speed
     [rad/s], first and last crank angle of the range [deg], branch (+1 open, -1 crossed).
     Columns: FOURBAR_SUMMARY_COLUMNS (angles in degrees, speeds in rad/s; flags 0/1;
     figures that do not exist are 0 -- mask them with 'assemblable' and 'toggles_in_range').
+    ``passes``: sum of FOURBAR_PASSES bits; the columns of a pass not asked for are 0 (not
+    computed), the others have the same bits whichever passes run (default: all three).
     """
     params = farray(params, 2)
     if params.shape[1] != 8:
         raise ValueError(f"params must have 8 columns, got {params.shape[1]}")
-    return _kernels.fourbar_summary.summaries(params)
+    return _kernels.fourbar_summary.summaries(params, int(passes))
 
 
 def fourbar_coupler_point(theta: np.ndarray, states: np.ndarray, status: np.ndarray, q: float,
@@ -279,8 +289,13 @@ MANIPULATOR_SUMMARY_COLUMNS = ("ri1", "ri2", "ri3", "sum_c2", "reach", "target_s
                                "tau1", "tau2", "reaches_points", "dl1", "dl2", "mc_max")
 
 
+#: pass bits of manipulator_design_summaries (fortran/manipulator_summary.f90 ds_*)
+MANIPULATOR_PASSES = {k: int(getattr(_kernels.manipulator_summary, f"ds_{k}")) for k in
+                      ("indices", "target", "tolerance")}
+
+
 def manipulator_design_summaries(x, y, params, branch: int = 1, rates=(1.0, 1.0, 1.0, 1.0),
-                                 measure: str = "global", unit=None) -> np.ndarray:
+                                 measure: str = "global", unit=None, passes: int = 7) -> np.ndarray:
     """Design summaries of nd 2R arms for workspace points (x, y) [m] in one call: (nd, 14).
 
     ``params`` (nd, 7): columns MANIPULATOR_SUMMARY_PARAMS -- l1, l2 [m] (positive), the
@@ -292,7 +307,9 @@ def manipulator_design_summaries(x, y, params, branch: int = 1, rates=(1.0, 1.0,
     reach (1/0, conditions 4.4), IK status at the target (MANIPULATOR_STATUS), theta1, theta2
     there [deg], tau1, tau2 [N m] (0 unless the status is ok), reaches_points (1 when the IK
     reaches every workspace point), tolerance half-widths dl1, dl2 [m] and the Monte Carlo
-    maximum error [m] (the last three 0 unless reaches_points).
+    maximum error [m] (the last three 0 unless reaches_points).  ``passes``: sum of
+    MANIPULATOR_PASSES bits (indices: columns 0-4, target: 5-9, tolerance: 10-13); the
+    columns of a pass not asked for are 0 (not computed).
     """
     x, y = farray(np.atleast_1d(x), 1), farray(np.atleast_1d(y), 1)
     params = farray(params, 2)
@@ -303,7 +320,7 @@ def manipulator_design_summaries(x, y, params, branch: int = 1, rates=(1.0, 1.0,
         raise ValueError(f"unit must have shape (ns >= 1, 2), got {unit.shape}")
     return _kernels.manipulator_summary.design_summaries(
         x, y, params, int(branch), farray(np.asarray(rates, dtype=np.float64).ravel(), 1),
-        {"global": 0, "per_point": 1}[measure], unit)
+        {"global": 0, "per_point": 1}[measure], unit, int(passes))
 
 
 
@@ -379,7 +396,11 @@ UJOINT_SUMMARY_COLUMNS = ("objective", "ratio_min", "ratio_max", "dratio_abs_max
                           "beta_res_status")
 
 
-def ujoint_summaries(model: int, kind: int, beta, phi, rho, m: int, tol: float = 1e-7) -> np.ndarray:
+#: pass bits of ujoint_summaries (fortran/ujoint.f90 sum_*)
+UJOINT_PASSES = {k: int(getattr(_kernels.ujoint, f"sum_{k}")) for k in ("objective", "speed", "equivalent")}
+
+
+def ujoint_summaries(model: int, kind: int, beta, phi, rho, m: int, tol: float = 1e-7, passes: int = 7) -> np.ndarray:
     """Headline figures of many designs of one chain layout in one kernel call: (nd, 7) array.
 
     beta (nd, n) joint angles [rad]; phi (nd, n-1) the paper's phases [rad]; rho (nd, n-1)
@@ -389,7 +410,9 @@ def ujoint_summaries(model: int, kind: int, beta, phi, rho, m: int, tol: float =
     min and max of R = omega_out/omega_in and max |dR/dtheta| [1/rad] on the grid
     theta_j = 2 pi j/m (as :func:`ujoint_speed` there), beta_e and beta_res [rad] and the
     status of beta_res (0: defined; as :func:`ujoint_equivalent` with ``tol`` [rad]).
-    Each row has the same bits as those single-design calls.
+    Each row has the same bits as those single-design calls.  ``passes``: sum of
+    UJOINT_PASSES bits (objective: column 0, speed: 1-3, equivalent: 4-6); the columns of a
+    pass not asked for are 0 (not computed).
     """
     beta = np.asarray(beta, dtype=np.float64)
     if beta.ndim != 2 or beta.shape[1] < 1:
@@ -402,7 +425,7 @@ def ujoint_summaries(model: int, kind: int, beta, phi, rho, m: int, tol: float =
     x[:, n:2 * n - 1] = phi
     x[:, 2 * n - 1:] = 0.0 if rho is None else rho
     return _kernels.ujoint.chain_summaries(model=int(model), kind=int(kind), n=n, nd=nd, x=x, m=int(m),
-                                           tol=float(tol))
+                                           tol=float(tol), passes=int(passes))
 
 
 def ujoint_geometry(axes) -> tuple[np.ndarray, np.ndarray, int]:
@@ -497,3 +520,70 @@ def slidercrank_frequencies(rho_a: float, ea: float, ei: float, rod_length: floa
     frequencies [rad/s], and the pinned-pinned Euler load pi^2 EI / L^2 [N]."""
     wb, wa, pe = _kernels.slidercrank.analytic_frequencies(rho_a, ea, ei, rod_length, slider_mass)
     return float(wb), float(wa), float(pe)
+
+
+# ----------------------------------------------------------------------------- slidercrank, nonlinear rod
+
+#: status codes of the nonlinear slider-crank kernel (fortran/slidercrank_nl.f90)
+SLIDERCRANK_NL_STATUS = {"ok": int(_kernels.slidercrank_nl.nl_ok), "limit": int(_kernels.slidercrank_nl.nl_limit),
+                         "not_spd": int(_kernels.slidercrank_nl.nl_not_spd),
+                         "bad_args": int(_kernels.slidercrank_nl.nl_bad_args),
+                         "no_convergence": int(_kernels.slidercrank_nl.nl_no_convergence)}
+
+
+def slidercrank_nl_simulate(n_elements: int, crank_radius: float, rod_length: float, rho_a: float,
+                            ea: float, ei: float, half_depth: float, slider_mass: float, omega: float,
+                            dt: float, n_steps: int, steps_per_rev: int, rec_start: int, n_rec: int,
+                            alpha: float = 0.0, beta: float = 0.0, hht: float = 0.0, start: str = "quasistatic",
+                            tol: float = 1e-8, max_iterations: int = 25, max_cuts: int = 6,
+                            energy: bool = False) -> dict:
+    """Geometrically nonlinear (co-rotational) connecting rod, whole time loop in Fortran.
+
+    Arguments as :func:`slidercrank_simulate` (SI units); steps_per_rev groups the steps into
+    revolutions for the per-revolution peaks; hht the HHT-alpha parameter in [-1/3, 0] (0: Newmark
+    average acceleration, no numerical damping); tol is the Newton tolerance on the relative
+    residual, max_iterations the Newton solves allowed per step, max_cuts the step halvings.
+
+    Returns a dict: eps_ax, eps_of (n_elements, n_rec) axial and outer-fibre strain [-];
+    lat_max largest |lateral deflection from the chord| [m], mid the midspan node's lateral
+    deflection [m], elong rod elongation [m], slider position [m], energy (4, n_rec):
+    kinetic, strain energy, work of the loads, damping dissipation since the start [J];
+    rev_lat, rev_eps peak |lateral deflection| [m] and |axial strain| per revolution;
+    shapes (n_elements + 1, 2) lateral deflection profiles [m] at the recorded steps
+    shape_step (largest deflection, largest crank-end compression); stats (Newton solves,
+    most solves in a step, step cuts, deepest cut level, steps completed); status (a
+    SLIDERCRANK_NL_STATUS value), fail_step, fail_iter.
+    """
+    n_rev = max(1, -(-int(n_steps) // int(steps_per_rev)))
+    out = _kernels.slidercrank_nl.simulate_nl(
+        int(n_elements), 3 * int(n_elements), int(n_rec), n_rev, crank_radius, rod_length, rho_a, ea, ei,
+        half_depth, slider_mass, omega, dt, int(n_steps), int(steps_per_rev), int(rec_start), alpha, beta, hht,
+        {"rest": 0, "quasistatic": 1}[start], tol, int(max_iterations), int(max_cuts), int(bool(energy)))
+    names = ("eps_ax", "eps_of", "lat_max", "mid", "elong", "slider", "energy", "rev_lat", "rev_eps", "shapes",
+             "shape_step", "stats", "status", "fail_step", "fail_iter")
+    res = dict(zip(names, out))
+    for key in ("status", "fail_step", "fail_iter"):
+        res[key] = int(res[key])
+    return res
+
+
+def slidercrank_column_static(n_elements: int, length: float, ea: float, ei: float, load: float,
+                              imperfection: float, tol: float = 1e-10,
+                              max_iterations: int = 500) -> tuple[float, float, int, int]:
+    """Static pinned-pinned column of co-rotational elements under an end load [N] (compression
+    positive), from a sine initial guess of amplitude ``imperfection`` [m].
+
+    Returns (midspan lateral deflection [m], end shortening [m], Newton solves, status).
+    """
+    n = int(n_elements)
+    _q, mid, short, iters, status = _kernels.slidercrank_nl.column_static(
+        n, 3 * n, length, ea, ei, load, imperfection, tol, int(max_iterations))
+    return float(mid), float(short), int(iters), int(status)
+
+
+def slidercrank_corot_element(le: float, ea: float, ei: float, p: np.ndarray,
+                              tangent: bool = True) -> tuple[np.ndarray, np.ndarray, float, float, float]:
+    """One co-rotational element: force (6,), tangent (6, 6) lower triangle [N, N/m], axial strain,
+    mean curvature [1/m] and strain energy [J] for displacements p = (u, v, th) of its two nodes."""
+    f, kt, eps, kap, en = _kernels.slidercrank_nl.element_corot(le, ea, ei, farray(p, 1), bool(tangent))
+    return f, kt, float(eps), float(kap), float(en)

@@ -945,3 +945,65 @@ def robust_design_figure(t: np.ndarray, means: dict[str, np.ndarray], spreads: d
     if title:
         fig.suptitle(plain_text(title))
     return fig
+
+
+# ----------------------------------------------------------------------------- slidercrank, nonlinear rod
+
+def _own_axes(ax, figsize: tuple[float, float]):
+    """(figure, axes): the given axes and its figure, or a new house-style figure."""
+    if ax is not None:
+        return ax.figure, ax
+    fig, axes = new_figure(1, 1, figsize=figsize)
+    return fig, axes[0]
+
+
+@styled
+def slidercrank_nl_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray, np.ndarray]], title: str,
+                                 ax=None) -> Figure:
+    """Crank-end axial strain [microstrain] against crank angle [deg]: per speed (label, angle,
+    linear, nonlinear), the linear model dashed and the nonlinear rod solid in one colour."""
+    fig, ax = _own_axes(ax, (7.4, 4.4))
+    for k, (label, x, lin, nl) in enumerate(series):
+        ax.plot(x, nl, color=f"C{k % 10}", lw=1.2, label=label)
+        ax.plot(x, lin, color=f"C{k % 10}", lw=0.9, ls="--")
+    ax.axhline(0.0, color="k", lw=0.6)
+    ax.set_xlim(0, 360)
+    ax.set_xticks(np.arange(0, 361, 45))
+    ax.set_xlabel("crank angle theta2 [deg]")
+    ax.set_ylabel("axial strain [microstrain]")
+    ax.legend(fontsize=7, title="crank speed", title_fontsize=7)
+    ax.set_title(title)
+    return fig
+
+
+@styled
+def slidercrank_nl_shapes_figure(series: Sequence[tuple[str, tuple[float, float], np.ndarray]], length: float,
+                                 title: str, ax=None) -> Figure:
+    """Lateral deflection [mm] along the rod [m] at the step of largest deflection (solid) and of
+    largest crank-end compression (dotted), one colour per speed; true scale in mm (the axis
+    is stretched, not the shape)."""
+    fig, ax = _own_axes(ax, (7.4, 4.4))
+    for k, (label, (a1, a2), shapes) in enumerate(series):
+        s = np.linspace(0.0, length, shapes.shape[0])
+        ax.plot(s, shapes[:, 0] * 1e3, color=f"C{k % 10}", lw=1.2, label=f"{label}, theta2 = {a1:.0f} deg")
+        ax.plot(s, shapes[:, 1] * 1e3, color=f"C{k % 10}", lw=0.8, ls=":")
+    ax.axhline(0.0, color="k", lw=0.6)
+    ax.set_xlabel("position along the rod from the crank pin [m]")
+    ax.set_ylabel("lateral deflection from the chord [mm]")
+    ax.legend(fontsize=7)
+    ax.set_title(title)
+    return fig
+
+
+@styled
+def slidercrank_nl_revolutions_figure(series: Sequence[tuple[str, np.ndarray]], title: str, ax=None) -> Figure:
+    """Peak lateral deflection [mm] in each revolution, one line per speed (log scale)."""
+    fig, ax = _own_axes(ax, (7.0, 4.0))
+    for label, d in series:
+        ax.plot(np.arange(1, len(d) + 1), d, "o-", ms=3, label=label)
+    ax.set_yscale("log")
+    ax.set_xlabel("revolution")
+    ax.set_ylabel("peak lateral deflection [mm]")
+    ax.legend(fontsize=7)
+    ax.set_title(title)
+    return fig

@@ -55,6 +55,9 @@ __all__ = ["Grid", "BatchPlan", "batchable", "plan", "run", "worker_init", "chun
 
 #: cases per task: ~0.3-0.6 s of kernel time on one core for the four-bar
 CHUNK = 16384
+#: above CHUNK * MAX_CHUNKS cases the chunks grow instead of multiplying: the driver's work (a
+#: result to merge, a part in the record) is per chunk, so 10^9 cases are 4096 chunks, not 61 035
+MAX_CHUNKS = 4096
 #: largest batch sweep (no case is listed, so only the grid's size is limited)
 MAX_CASES = 10**10
 #: largest number of combinations of coupled swept keys validated one by one
@@ -103,12 +106,24 @@ class BatchPlan:
     coupled: list[int]                          # axes validated together
     coupled_errors: dict[tuple, str]            # value-index tuple of the coupled axes -> error
     signature: str = ""
+    #: summary columns computed for every case (those the filter reads); None: all
+    filter_columns: list[str] | None = None
+    #: summary columns of the rows the tables show (kept rows with rows = 'kept'); None: all
+    shown_columns: list[str] | None = None
 
 
-def _signature(raw: RawGroup, grid: Grid, keep: str, rows: str, module) -> str:
+def chunk_size(n: int) -> int:
+    """Cases per chunk of a batch sweep of ``n`` cases: a function of ``n`` only (not of the
+    workers), so ``--resume`` works with any ``-j``; at most :data:`MAX_CHUNKS` chunks."""
+    if n > CHUNK * MAX_CHUNKS:
+        return -(-n // MAX_CHUNKS)
+    return min(CHUNK, max(64, -(-n // 16)))
+
+
+def _signature(raw: RawGroup, grid: Grid, keep: str, rows: str, module, shown: list[str] | None = None) -> str:
     h = hashlib.sha256()
-    h.update(json.dumps([raw.name, raw.values, grid.names, grid.values, grid.zipped, keep, rows, driver.__version__],
-                        sort_keys=True, default=str).encode())
+    h.update(json.dumps([raw.name, raw.values, grid.names, grid.values, grid.zipped, keep, rows, driver.__version__]
+                        + ([shown] if shown is not None else []), sort_keys=True, default=str).encode())
     h.update(code_digest(module))
     return h.hexdigest()[:20]
 
@@ -128,8 +143,29 @@ def batchable(module, names: list[str], keep: str, case_outputs: str) -> bool:
     return all(n.partition(".")[2] in batch_keys for n in names)
 
 
-def plan(module, raw: RawGroup, deck_path: str, grid: Grid, keep: str, rows: str) -> BatchPlan | None:
-    """A batch plan for this sweep (see :func:`batchable`), or None when it must run case by case."""
+def wanted_columns(module, keep: str, plotted: list[str], shown: list[str] | None
+                   ) -> tuple[list[str] | None, list[str] | None]:
+    """(columns every case needs, columns the shown rows need) of the study's batch summary,
+    from its column -> pass table ``BATCH_PASSES``: the filter's columns for every case; the
+    shown rows also the plotted ones and ``shown`` (summary_columns; None: every column).
+    (None, None) when the study declares no table (everything is computed)."""
+    table = getattr(module, "BATCH_PASSES", None)
+    if table is None:
+        return None, None
+    def names(text: str) -> set[str]:   # summary columns an expression reads (not swept keys, not 'case')
+        return {n for n in expr.parse(text).names if "." not in n and n != "case"} if text else set()
+
+    order = lambda cols: [c for c in table if c in cols] + sorted(c for c in cols if c not in table)
+    filt = order(names(keep))
+    if shown is None:
+        return filt, None
+    return filt, order(set(filt).union(*(names(t) for t in plotted)) | set(shown))
+
+
+def plan(module, raw: RawGroup, deck_path: str, grid: Grid, keep: str, rows: str,
+         plotted: list[str] | None = None, shown: list[str] | None = None) -> BatchPlan | None:
+    """A batch plan for this sweep (see :func:`batchable`), or None when it must run case by case.
+    ``plotted``: the plot_x/plot_y expressions; ``shown``: summary_columns (None: all)."""
     applies = getattr(module, "batch_applies", None)   # e.g. not for a base deck that optimises per case
     if applies is not None and not applies(validate(raw, module.SPEC, deck_path)):
         return None
@@ -162,7 +198,8 @@ def plan(module, raw: RawGroup, deck_path: str, grid: Grid, keep: str, rows: str
             except DeckError as exc:
                 coupled_errors[combo] = str(exc)
     p = BatchPlan(deck_path, raw, grid, keep, rows, single, coupled, coupled_errors)
-    p.signature = _signature(raw, grid, keep, rows, module)
+    p.filter_columns, p.shown_columns = wanted_columns(module, keep, plotted or [], shown)
+    p.signature = _signature(raw, grid, keep, rows, module, p.shown_columns)
     return p
 
 
@@ -180,41 +217,80 @@ class ChunkResult:
     n_failed: int = 0
     seconds: float = 0.0
     errors: list[str] = field(default_factory=list)
+    written: bool = False       # its part is in the record already (the worker wrote it)
 
 
-def chunk_rows(p: BatchPlan, start: int, stop: int) -> ChunkResult:
-    """Summaries of cases start+1..stop (the unit of work of a worker)."""
+def _summaries(module, base, cols: dict[str, np.ndarray], rows: np.ndarray, wanted: list[str] | None,
+               bad: np.ndarray | None) -> pd.DataFrame:
+    """The study's batch summary of cases ``rows`` (indices into ``cols``; ``bad[rows]`` True
+    where the case is bad input: a row of None), columns ``wanted`` (None: all)."""
+    good = rows if bad is None else rows[~bad[rows]]
+    sub = {k.partition(".")[2]: v[good] for k, v in cols.items()}
+    summ = module.summarise_batch(base, sub) if wanted is None else module.summarise_batch(base, sub, wanted=wanted)
+    if bad is not None and bad[rows].any():
+        summ = summ.astype(object)
+        full = pd.DataFrame(None, index=range(len(rows)), columns=summ.columns, dtype=object)
+        full.iloc[np.flatnonzero(~bad[rows])] = summ.to_numpy()
+        summ = full
+    return summ
+
+
+def chunk_rows(p: BatchPlan, start: int, stop: int, folder: str = "") -> ChunkResult:
+    """Summaries of cases start+1..stop (the unit of work of a worker); with ``folder`` the
+    worker also writes the chunk's part of the resume record there (the driver then only merges
+    the rows it returns: the kept and failed ones with ``rows = 'kept'``).
+
+    With a filter and ``rows = 'kept'`` in two steps: the columns the filter reads for every
+    case (``p.filter_columns``), then the columns the tables show (``p.shown_columns``) for the
+    kept cases only; so a column nobody asks for is never computed, and the kept rows hold
+    the same values as a single summary of every column would give."""
     t0 = time.perf_counter()
     module = load_study(p.raw.name)
     n = stop - start
     cols = p.grid.columns(start, stop)
     idx = p.grid.indices(start, stop)
-    err = np.full(n, "", dtype=object)
+    bad = np.zeros(n, dtype=bool)
+    err = None
     for i, name in enumerate(p.grid.names):
         for j, msg in p.single_errors.get(name, {}).items():
-            err[(idx[i] == j) & (err == "")] = msg
+            hit = idx[i] == j
+            if hit.any():
+                err = np.full(n, "", dtype=object) if err is None else err
+                err[hit & ~bad] = msg
+                bad |= hit
     if p.coupled_errors:
         keys = list(zip(*(idx[i] for i in p.coupled)))
         for k, key in enumerate(keys):
             msg = p.coupled_errors.get(tuple(int(x) for x in key))
-            if msg and not err[k]:
+            if msg and not bad[k]:
+                err = np.full(n, "", dtype=object) if err is None else err
                 err[k] = msg
-    bad = err != ""
+                bad[k] = True
+    if err is None:
+        err = np.full(n, "", dtype=object)
     base = validate(p.raw, module.SPEC, p.deck_path)
-    frame = pd.DataFrame({"case": np.arange(start + 1, stop + 1, dtype=np.int64), **cols})
-    good = np.flatnonzero(~bad)
-    summ = module.summarise_batch(base, {k.partition(".")[2]: v[good] for k, v in cols.items()})
-    if bad.any():
-        summ = summ.astype(object)
-        full = pd.DataFrame(None, index=range(n), columns=summ.columns, dtype=object)
-        full.iloc[good] = summ.to_numpy()
-        summ = full
-    summ.index = frame.index
-    status = np.where(bad, "bad input", "ok").astype(object)
-    frame["status"] = status
-    frame["kept"] = False
-    frame = pd.concat([frame, summ], axis=1)
-    frame["error"] = err
+    every = np.arange(n)
+    two_step = bool(p.keep) and p.rows == "kept" and p.filter_columns is not None
+    if two_step and not bad.any():   # the common case: the filter on plain arrays, no full frame
+        first = _summaries(module, base, cols, every, p.filter_columns, None)
+        data = {"case": np.arange(start + 1, stop + 1, dtype=np.int64), **cols,
+                **{c: first[c].to_numpy() for c in first.columns}}
+        try:
+            mask = np.asarray(expr.parse(p.keep).mask(data), dtype=bool)
+        except expr.ExprError:
+            mask = np.zeros(n, dtype=bool)
+        shown = np.flatnonzero(mask)
+        out = _frame(start, stop, cols, bad, err, _summaries(module, base, cols, shown, p.shown_columns, None), shown)
+        out["kept"] = True
+        res = ChunkResult(start, stop, out, n, len(shown), 0)
+        return _finish(res, p, folder, t0)
+    if two_step:
+        first = _summaries(module, base, cols, every, p.filter_columns, bad)
+    else:
+        wanted = None if p.shown_columns is None else list(dict.fromkeys([*(p.filter_columns or []),
+                                                                          *p.shown_columns]))
+        first = _summaries(module, base, cols, every, wanted, bad)
+    frame = _frame(start, stop, cols, bad, err, first)
     mask = ~bad
     if p.keep:
         try:
@@ -224,9 +300,40 @@ def chunk_rows(p: BatchPlan, start: int, stop: int) -> ChunkResult:
     frame["kept"] = mask
     res = ChunkResult(start, stop, frame, int((~bad).sum()), int(mask.sum()), int(bad.sum()))
     if p.rows == "kept":
-        res.frame = frame[mask | bad].reset_index(drop=True)
+        shown = np.flatnonzero(mask | bad)
+        if two_step:   # the shown rows' columns, for those rows only
+            summ = _summaries(module, base, cols, shown, p.shown_columns, bad)
+            out = _frame(start, stop, cols, bad, err, summ, shown)
+            out["kept"] = mask[shown]
+            res.frame = out
+        else:
+            res.frame = frame.iloc[shown].reset_index(drop=True)
+    elif p.shown_columns is not None:   # the filter's columns that are not shown go
+        res.frame = frame[[c for c in frame.columns if c not in set(p.filter_columns or ()) - set(p.shown_columns)]]
+    return _finish(res, p, folder, t0)
+
+
+def _finish(res: ChunkResult, p: BatchPlan, folder: str, t0: float) -> ChunkResult:
+    """Write the chunk's part when the worker owns the record's folder; time the chunk."""
+    if folder:
+        write_part(Path(folder), res, p.signature)
+        res.written = True
     res.seconds = time.perf_counter() - t0
     return res
+
+
+def _frame(start: int, stop: int, cols: dict[str, np.ndarray], bad: np.ndarray, err: np.ndarray,
+           summ: pd.DataFrame, rows: np.ndarray | None = None) -> pd.DataFrame:
+    """The rows of a chunk (all, or ``rows``): case, swept values, status, kept, summary, error."""
+    case = np.arange(start + 1, stop + 1, dtype=np.int64)
+    pick = (lambda a: a) if rows is None else (lambda a: a[rows])
+    frame = pd.DataFrame({"case": pick(case), **{k: pick(v) for k, v in cols.items()}})
+    frame["status"] = np.where(pick(bad), "bad input", "ok").astype(object)
+    frame["kept"] = False
+    summ.index = frame.index
+    frame = pd.concat([frame, summ], axis=1)
+    frame["error"] = pick(err)
+    return frame
 
 
 def _watch_parent(ppid: int) -> None:
@@ -316,31 +423,33 @@ def _died(p: BatchPlan, start: int, stop: int) -> ChunkResult:
     return ChunkResult(start, stop, frame, 0, 0, stop - start)
 
 
-def _alone(p: BatchPlan, start: int, stop: int) -> ChunkResult:
+def _alone(p: BatchPlan, start: int, stop: int, folder: str = "") -> ChunkResult:
     """Retry of a chunk whose worker died: alone in a fresh process."""
     with cf.ProcessPoolExecutor(max_workers=1, initializer=worker_init) as pool:
         try:
-            return pool.submit(chunk_rows, p, start, stop).result()
+            return pool.submit(chunk_rows, p, start, stop, folder).result()
         except cf.process.BrokenProcessPool:
             return _died(p, start, stop)
 
 
 def execute(p: BatchPlan, todo: list[tuple[int, int]], jobs: int, scheduler: Any,
-            on_result, in_flight: int = 0) -> None:
-    """Run chunks ``todo`` [(start, stop)]; ``on_result(ChunkResult)`` as each completes."""
+            on_result, in_flight: int = 0, folder: str = "") -> None:
+    """Run chunks ``todo`` [(start, stop)]; ``on_result(ChunkResult)`` as each completes.
+    ``folder``: the record's folder, where the workers write their chunks' parts (on Dask only
+    when every worker sees it; otherwise the result comes back unwritten)."""
     if not todo:
         return
     if scheduler:
-        _execute_dask(p, todo, scheduler, on_result, in_flight)
+        _execute_dask(p, todo, scheduler, on_result, in_flight, folder)
         return
     if jobs <= 1:
         for s, e in todo:
-            on_result(chunk_rows(p, s, e))
+            on_result(chunk_rows(p, s, e, folder))
         return
     queue: Iterator[tuple[int, int]] = iter(todo)
-    run_pool(lambda: next(queue, None), lambda pool, rng: pool.submit(chunk_rows, p, *rng),
-             lambda rng: _alone(p, *rng), lambda rng, res, pending: on_result(res), jobs, in_flight or 2 * jobs,
-             "chunks")
+    run_pool(lambda: next(queue, None), lambda pool, rng: pool.submit(chunk_rows, p, *rng, folder),
+             lambda rng: _alone(p, *rng, folder), lambda rng, res, pending: on_result(res), jobs,
+             in_flight or 2 * jobs, "chunks")
 
 
 def run_pool(source: Callable[[], Any], submit: Callable[[cf.ProcessPoolExecutor, Any], cf.Future],
@@ -393,11 +502,18 @@ def run_pool(source: Callable[[], Any], submit: Callable[[cf.ProcessPoolExecutor
         pool.shutdown(wait=True)
 
 
-def _execute_dask(p: BatchPlan, todo: list[tuple[int, int]], scheduler: Any, on_result, in_flight: int) -> None:
+def _execute_dask(p: BatchPlan, todo: list[tuple[int, int]], scheduler: Any, on_result, in_flight: int,
+                  folder: str = "") -> None:
     from dask.distributed import Client, as_completed
     from distributed.scheduler import KilledWorker
     client = scheduler if not isinstance(scheduler, str) else Client(scheduler)
     try:
+        if folder:   # workers write their parts only where this machine reads them back
+            from driver.sweep.engine import check_shared_folder
+            try:
+                check_shared_folder(client, Path(folder))
+            except OSError:
+                folder = ""
         workers = max(1, len(client.scheduler_info().get("workers", {})))
         limit = in_flight or 2 * workers
         queue = iter(todo)
@@ -405,7 +521,7 @@ def _execute_dask(p: BatchPlan, todo: list[tuple[int, int]], scheduler: Any, on_
         pdata = client.scatter(p, broadcast=True)
 
         def submit(rng):
-            fut = client.submit(chunk_rows, pdata, *rng, pure=False, retries=1)
+            fut = client.submit(chunk_rows, pdata, *rng, folder, pure=False, retries=1)
             ranges[fut] = rng
             return fut
 
@@ -431,12 +547,12 @@ def run(p: BatchPlan, folder: Path, jobs: int, scheduler: Any, resume: bool, pro
     from tqdm import tqdm
     n = p.grid.n
     # the layout depends on the grid only (not on the workers), so --resume works with any -j
-    size = chunk or min(CHUNK, max(64, -(-n // 16)))
+    size = chunk or chunk_size(n)
     damaged: list[int] = []
     done = clean(folder, p.signature, resume, damaged)
     # a resumed chunk counts only if it covers exactly one chunk of this run's layout
     ranges = [(s, min(s + size, n)) for s in range(0, n, size)]
-    complete = {s for s, m in done.items() if (s, m["stop"]) in ranges}
+    complete = {s for s, m in done.items() if s % size == 0 and m["stop"] == min(s + size, n)}
     for s in set(done) - complete:
         Path(done[s]["path"]).unlink(missing_ok=True)
     paths = {s: Path(done[s]["path"]) for s in complete}
@@ -454,16 +570,24 @@ def run(p: BatchPlan, folder: Path, jobs: int, scheduler: Any, resume: bool, pro
     own_folder(folder, folder.parent)
     bar = tqdm(total=n, initial=resumed, unit="case", disable=not progress, dynamic_ncols=True)
 
+    merged: dict[int, pd.DataFrame] = {}   # the rows each chunk returned (kept and failed with rows = 'kept')
+
     def on_result(res: ChunkResult) -> None:
-        paths[res.start] = write_part(folder, res, p.signature)
+        if not res.written:   # a chunk whose worker died, or Dask workers that do not see the folder
+            write_part(folder, res, p.signature)
+        merged[res.start] = res.frame
         counts["ok"] += res.n_ok
         counts["kept"] += res.n_kept
         counts["failed"] += res.n_failed
         bar.update(res.stop - res.start)
 
     try:
-        execute(p, todo, jobs, scheduler, on_result)
+        execute(p, todo, jobs, scheduler, on_result, folder=str(folder))
     finally:
         bar.close()
-    rows = read_rows([paths[s] for s, _ in ranges if s in paths])
+    # the rows: those of the resumed chunks from the record, the others as the workers returned them
+    frames = {s: pq.read_table(paths[s]).to_pandas() for s in sorted(paths)}
+    frames.update(merged)
+    parts = [frames[s] for s in sorted(frames) if len(frames[s])]
+    rows = pd.DataFrame() if not parts else parts[0] if len(parts) == 1 else pd.concat(parts, ignore_index=True)
     return rows, counts, size

@@ -27,7 +27,16 @@ class TableValueError(ValueError):
 
 
 def _round_half_up(value: float, decimals: int) -> str:
-    """Decimal text of ``value`` rounded half away from zero (Fortran's RN-compatible)."""
+    """Decimal text of ``value`` rounded half away from zero (Fortran's RN-compatible).
+
+    Python's ``f`` format rounds the exact binary value correctly, half to even; the two
+    differ only when that exact value lies exactly halfway between two ``decimals``-digit
+    numbers, which the integer ratio of the double tells exactly -- then Decimal rounds."""
+    if 0 <= decimals <= 300 and math.isfinite(value):
+        num, den = value.as_integer_ratio()
+        twice = 2 * num * 10 ** decimals
+        if twice % den or not (twice // den) % 2:   # not a tie: the fast text is the answer
+            return f"{value:.{decimals}f}"
     q = Decimal(1).scaleb(-decimals)
     with localcontext(Context(prec=330 + decimals)):   # room for every finite double (<= 1.8e308)
         return format(Decimal(value).quantize(q, rounding=ROUND_HALF_UP), "f")

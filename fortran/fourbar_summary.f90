@@ -16,15 +16,30 @@
 !>   circle |O_A B| = q + r or |q - r| and on the circle |O_B B| = s (closed form); between
 !>   consecutive candidates the rocker angle is monotonic, so it is unwrapped exactly with
 !>   the sign of omega3 at the midpoint;
-!> * peak speeds (no toggle in the range): a 1 deg scan of the whole range in one vectorised
-!>   kernel call, then each sign change of the angular acceleration (crank speed constant,
-!>   so alpha = d omega / dt vanishes at a speed extremum) refined by Illinois regula falsi
-!>   to 1e-12 rad, all brackets of a linkage in one kernel call per iteration;
+!> * peak speeds (no toggle in the range): the extremes of omega sit where the angular
+!>   acceleration alpha = d omega / dt vanishes (crank speed constant).  The range is cut into
+!>   a grid of at most 1 deg (as before); a coarse scan evaluates every coarse_every-th grid
+!>   point in one vectorised kernel call, and a coarse interval is refined to the 1 deg grid
+!>   unless, for both speeds, alpha keeps one strict sign at its ends AND the cubic Hermite
+!>   model of omega over it (end values and end slopes alpha) has a slope that stays above
+!>   half the smaller end slope (smooth).  A refined 1 deg interval whose ends agree in sign
+!>   but fail the same test is bisected (to 1/1024 deg) looking for a hidden pair of roots.
+!>   Each sign change of alpha is refined by Illinois regula falsi to 1e-12 rad, all brackets
+!>   of a linkage in one kernel call per iteration.  The coarse test is checked against a
+!>   dense brute-force oracle (tests/test_fourbar_peaks.py); wherever it refines, the
+!>   brackets are those of a plain 1 deg scan, so the figures are bit-identical to it;
 !> * time ratio (a full turn, assembled throughout, no toggle, rocker oscillating): the crank
 !>   turns a = (crank angle of the upper rocker extreme - that of the lower) mod 360 on one
 !>   stroke and 360 - a on the other; the ratio is the slower over the quicker, >= 1.
 !>
 !> Velocities are evaluated for a unit crank speed and scaled by omega (they are linear in it).
+!>
+!> Passes: the caller names the figures it needs (a bit mask, pass_*); the Grashof class, the
+!> toggle count and the assembled fraction (closed form) are always computed, the transmission
+!> angle (pass_transmission, closed form), the rocker extremes, swing and time ratio
+!> (pass_rocker, kernel states at the candidates) and the peak speeds (pass_peaks, the scan
+!> above) only when asked; the columns of a pass not run are 0.  A figure does not depend on
+!> which other passes ran.
 module fourbar_summary
   use kinds, only: dp
   use fourbar, only: exact_states, st_ok, st_no_assembly, st_toggle, st_indeterminate
@@ -39,13 +54,20 @@ module fourbar_summary
   !> Grashof class codes shared with driver/fourbar.py
   integer, parameter, public :: gr_double_crank = 0, gr_crank_rocker = 1, gr_rocker_crank = 2, &
                                 gr_double_rocker = 3, gr_change_point = 4, gr_triple_rocker = 5
+  !> passes (bits of summaries' passes argument)
+  integer, parameter, public :: pass_transmission = 1, pass_rocker = 2, pass_peaks = 4, pass_all = 7
+  !> with pass_peaks: the previous peak search (every 1 deg grid point, no bisection below 1 deg),
+  !> kept as the baseline of bench/bench_sweep.py and of the tests
+  integer, parameter, public :: pass_dense_scan = 8
 
   real(dp), parameter :: pi = 3.14159265358979323846_dp, twopi = 2*pi
   real(dp), parameter :: rad = pi/180.0_dp
   integer, parameter :: maxc = 64          ! candidates per linkage (at most ~20 are used)
   integer, parameter :: maxscan = 364      ! 1 deg scan of one turn (+ ends)
   integer, parameter :: maxbr = 64         ! speed brackets per linkage
-  real(dp), parameter :: scan_step = 1.0_dp   ! [deg]
+  real(dp), parameter :: scan_step = 1.0_dp   ! [deg] the fine grid
+  integer, parameter :: coarse_every = 6      ! coarse scan: every 6th fine point (6 deg)
+  integer, parameter :: max_depth = 10        ! bisections of a suspicious 1 deg interval
 
 contains
 
@@ -67,16 +89,19 @@ contains
   !>            0 unless the range holds a full turn, assembled throughout, without a toggle, and
   !>            the rocker oscillates
   !> Figures that do not exist (not assemblable) are 0; the caller masks them with res(:, 2) / res(:, 14).
-  subroutine summaries(n, params, res)
+  !> passes: sum of pass_* bits: 4:7 (pass_transmission), 8:13 and 19 (pass_rocker), 15:18
+  !> (pass_peaks) are computed only when their bit is set (else 0); 1:3 and 14 always.
+  subroutine summaries(n, params, passes, res)
     !f2py threadsafe
     integer, intent(in) :: n
     real(dp), intent(in) :: params(n, 8)      ! npar columns (literal for f2py)
+    integer, intent(in) :: passes
     real(dp), intent(out) :: res(n, 19)        ! ncol columns
     real(dp) :: row(ncol)
     integer :: i
     do i = 1, n
       call one_linkage(params(i, 1), params(i, 2), params(i, 3), params(i, 4), params(i, 5), &
-                       params(i, 6), params(i, 7), params(i, 8), row)
+                       params(i, 6), params(i, 7), params(i, 8), passes, row)
       res(i, :) = row
     end do
   end subroutine summaries
@@ -190,16 +215,19 @@ contains
   end function mu_of
 
   !> All figures of one linkage (see summaries for the columns).
-  subroutine one_linkage(p, q, r, s, omega, t0, t1, branch_r, row)
+  subroutine one_linkage(p, q, r, s, omega, t0, t1, branch_r, passes, row)
     real(dp), intent(in) :: p, q, r, s, omega, t0, t1, branch_r
+    integer, intent(in) :: passes
     real(dp), intent(out) :: row(ncol)
     real(dp) :: lo, hi, hie, lim(4), bp(maxc), ia(maxc), ib(maxc), zer(4), cand(maxc), tt(2*maxc)
     real(dp) :: st(2*maxc, 11), u(maxc), dd(2), x, y2, phi, t, mid, total, d, dmin, dmax
     real(dp) :: umin, umax, tumin, tumax, ushift, c1, delta, sg, tc, dtol
     integer :: stat(2*maxc), nlim, nbp, niv, nz, nc, i, j, k, branch, ntog, nt, kmin, kmax
-    logical :: okm, first
+    logical :: okm, first, want_mu, want_rocker
 
     row = 0.0_dp
+    want_mu = iand(passes, pass_transmission) /= 0
+    want_rocker = iand(passes, pass_rocker) /= 0
     branch = merge(1, -1, branch_r >= 0.0_dp)
     lo = min(t0, t1)
     hi = max(t0, t1)
@@ -215,7 +243,7 @@ contains
     row(14) = real(ntog, dp)
 
     if (hie <= lo) then                 ! a single crank angle
-      call single_angle(p, q, r, s, omega, lo, branch, row)
+      call single_angle(p, q, r, s, omega, lo, branch, passes, row)
       return
     end if
 
@@ -258,123 +286,145 @@ contains
       niv = niv - 1
     end if
 
-    ! ---- crank angles where omega3 = 0 (crank and coupler collinear), any branch
-    nz = 0
-    dd = [q + r, abs(q - r)]
-    do k = 1, 2
-      if (dd(k) <= 0.0_dp) cycle
-      x = (dd(k)*dd(k) + p*p - s*s)/(2*p)
-      y2 = dd(k)*dd(k) - x*x
-      if (y2 < 0.0_dp) cycle
-      do j = -1, 1, 2
-        phi = atan2(j*sqrt(y2), x)/rad
-        if (k == 2 .and. r > q) phi = phi + 180.0_dp   ! folded with the coupler longer: B opposite A
-        nz = nz + 1
-        zer(nz) = modulo(phi, 360.0_dp)
-      end do
-    end do
-
-    ! ---- per interval: candidates (ends, 0/180 deg, omega3 zeros, inner breakpoints) and midpoints
-    first = .true.
-    umin = 0; umax = 0; tumin = 0; tumax = 0
-    dmin = huge(1.0_dp); dmax = -1.0_dp
-    dtol = 1.0e-12_dp*(p + q)
-    do i = 1, niv
-      nc = 1
-      cand(1) = ia(i)
-      call add_periodic(0.0_dp, ia(i), ib(i), cand, nc)
-      call add_periodic(180.0_dp, ia(i), ib(i), cand, nc)
-      do k = 1, nz
-        call add_periodic(zer(k), ia(i), ib(i), cand, nc)
-      end do
-      do k = 1, nlim
-        call add_periodic(lim(k), ia(i), ib(i), cand, nc)
-      end do
-      nc = nc + 1
-      cand(nc) = ib(i)
-      call sort(cand, nc)
-      ! transmission angle: extremes of d among the candidates (ascending, first wins ties)
-      do j = 1, nc
-        d = dist(p, q, cand(j))
-        tc = cand(j)
-        if (tc < lo) tc = tc + 360.0_dp
-        ! ties within rounding (e.g. the two crank angles of one limit) go to the smaller angle
-        if (d < dmin - dtol .or. (abs(d - dmin) <= dtol .and. tc < row(5))) then
-          dmin = min(d, dmin)
-          row(5) = tc
-        end if
-        if (d > dmax + dtol .or. (abs(d - dmax) <= dtol .and. tc < row(7))) then
-          dmax = max(d, dmax)
-          row(7) = tc
-        end if
-      end do
-      ! states at candidates and midpoints in one kernel call (unit crank speed)
-      nt = 0
-      do j = 1, nc
-        nt = nt + 1
-        tt(nt) = cand(j)
-        if (j < nc) then
-          nt = nt + 1
-          tt(nt) = 0.5_dp*(cand(j) + cand(j + 1))
-        end if
-      end do
-      call states_at(nt, tt, p, q, r, s, branch, ia(i), ib(i), st, stat)
-      ! unwrap the rocker angle along the interval: monotonic between candidates
-      u(1) = st(1, 2)
-      do j = 1, nc - 1
-        sg = st(2*j, 9)                 ! omega3 at the midpoint
-        delta = st(2*j + 1, 2) - st(2*j - 1, 2)
-        delta = delta - twopi*anint(delta/twopi)          ! in [-pi, pi]
-        if (sg > 0.0_dp .and. delta < -1.0e-9_dp) delta = delta + twopi
-        if (sg < 0.0_dp .and. delta > 1.0e-9_dp) delta = delta - twopi
-        u(j + 1) = u(j) + delta
-      end do
-      ! a later interval is placed on the turn nearest to the first one's centre
-      if (first) then
-        ushift = 0.0_dp
+    if (want_mu .or. want_rocker) then
+      call motion()
+      if (want_mu) then
+        row(4) = mu_of(r, s, dmin)
+        row(6) = mu_of(r, s, dmax)
       else
-        c1 = 0.5_dp*(umin + umax)
-        ushift = twopi*anint((c1 - u(1))/twopi)
+        row(5) = 0.0_dp
+        row(7) = 0.0_dp
       end if
-      do j = 1, nc
-        t = u(j) + ushift
-        tc = cand(j)
-        if (tc < lo) tc = tc + 360.0_dp
-        if (first .and. j == 1) then
-          umin = t; umax = t; tumin = tc; tumax = tc
-        else
-          if (t < umin .or. (t == umin .and. tc < tumin)) then
-            umin = t; tumin = tc
-          end if
-          if (t > umax .or. (t == umax .and. tc < tumax)) then
-            umax = t; tumax = tc
-          end if
-        end if
-      end do
-      first = .false.
-    end do
-    row(4) = mu_of(r, s, dmin)
-    row(6) = mu_of(r, s, dmax)
-    row(8) = fold360(umin/rad)
-    row(9) = tumin
-    row(10) = fold360(umax/rad)
-    row(11) = tumax
-    if (row(3) >= 1.0_dp .and. niv == 1 .and. (umax - umin) >= twopi - 1.0e-6_dp) then
-      row(13) = 1.0_dp
-      row(12) = 360.0_dp
-    else
-      row(12) = (umax - umin)/rad
-    end if
-
-    ! ---- time ratio: a full turn without toggles, the rocker oscillating
-    if (hie - lo >= 360.0_dp .and. row(3) >= 1.0_dp .and. niv == 1 .and. ntog == 0 .and. &
-        row(13) == 0.0_dp) then
-      t = modulo(tumax - tumin, 360.0_dp)
-      if (t > 0.0_dp .and. t < 360.0_dp) row(19) = max(t, 360.0_dp - t)/min(t, 360.0_dp - t)
+      if (want_rocker) call rocker_figures()
     end if
 
     ! ---- peak speeds: only without a toggle in the range (then the range is one interval)
-    if (ntog == 0 .and. niv == 1) call peaks(p, q, r, s, omega, lo, hie, branch, row)
+    if (iand(passes, pass_peaks) /= 0 .and. ntog == 0 .and. niv == 1) &
+      call peaks(p, q, r, s, omega, lo, hie, branch, iand(passes, pass_dense_scan) /= 0, row)
+
+  contains
+
+    !> Transmission-angle and rocker extremes over the assembled intervals (candidates in
+    !> closed form, states at the candidates only for the rocker).
+    subroutine motion()
+      ! ---- crank angles where omega3 = 0 (crank and coupler collinear), any branch
+      nz = 0
+      dd = [q + r, abs(q - r)]
+      do k = 1, 2
+        if (dd(k) <= 0.0_dp) cycle
+        x = (dd(k)*dd(k) + p*p - s*s)/(2*p)
+        y2 = dd(k)*dd(k) - x*x
+        if (y2 < 0.0_dp) cycle
+        do j = -1, 1, 2
+          phi = atan2(j*sqrt(y2), x)/rad
+          if (k == 2 .and. r > q) phi = phi + 180.0_dp   ! folded with the coupler longer: B opposite A
+          nz = nz + 1
+          zer(nz) = modulo(phi, 360.0_dp)
+        end do
+      end do
+
+      ! ---- per interval: candidates (ends, 0/180 deg, omega3 zeros, inner breakpoints) and midpoints
+      first = .true.
+      umin = 0; umax = 0; tumin = 0; tumax = 0
+      dmin = huge(1.0_dp); dmax = -1.0_dp
+      dtol = 1.0e-12_dp*(p + q)
+      do i = 1, niv
+        nc = 1
+        cand(1) = ia(i)
+        call add_periodic(0.0_dp, ia(i), ib(i), cand, nc)
+        call add_periodic(180.0_dp, ia(i), ib(i), cand, nc)
+        do k = 1, nz
+          call add_periodic(zer(k), ia(i), ib(i), cand, nc)
+        end do
+        do k = 1, nlim
+          call add_periodic(lim(k), ia(i), ib(i), cand, nc)
+        end do
+        nc = nc + 1
+        cand(nc) = ib(i)
+        call sort(cand, nc)
+        ! transmission angle: extremes of d among the candidates (ascending, first wins ties)
+        do j = 1, nc
+          d = dist(p, q, cand(j))
+          tc = cand(j)
+          if (tc < lo) tc = tc + 360.0_dp
+          ! ties within rounding (e.g. the two crank angles of one limit) go to the smaller angle
+          if (d < dmin - dtol .or. (abs(d - dmin) <= dtol .and. tc < row(5))) then
+            dmin = min(d, dmin)
+            row(5) = tc
+          end if
+          if (d > dmax + dtol .or. (abs(d - dmax) <= dtol .and. tc < row(7))) then
+            dmax = max(d, dmax)
+            row(7) = tc
+          end if
+        end do
+        if (.not. want_rocker) cycle
+        ! states at candidates and midpoints in one kernel call (unit crank speed)
+        nt = 0
+        do j = 1, nc
+          nt = nt + 1
+          tt(nt) = cand(j)
+          if (j < nc) then
+            nt = nt + 1
+            tt(nt) = 0.5_dp*(cand(j) + cand(j + 1))
+          end if
+        end do
+        call states_at(nt, tt, p, q, r, s, branch, ia(i), ib(i), st, stat)
+        ! unwrap the rocker angle along the interval: monotonic between candidates
+        u(1) = st(1, 2)
+        do j = 1, nc - 1
+          sg = st(2*j, 9)                 ! omega3 at the midpoint
+          delta = st(2*j + 1, 2) - st(2*j - 1, 2)
+          delta = delta - twopi*anint(delta/twopi)          ! in [-pi, pi]
+          if (sg > 0.0_dp .and. delta < -1.0e-9_dp) delta = delta + twopi
+          if (sg < 0.0_dp .and. delta > 1.0e-9_dp) delta = delta - twopi
+          u(j + 1) = u(j) + delta
+        end do
+        ! a later interval is placed on the turn nearest to the first one's centre
+        if (first) then
+          ushift = 0.0_dp
+        else
+          c1 = 0.5_dp*(umin + umax)
+          ushift = twopi*anint((c1 - u(1))/twopi)
+        end if
+        do j = 1, nc
+          t = u(j) + ushift
+          tc = cand(j)
+          if (tc < lo) tc = tc + 360.0_dp
+          if (first .and. j == 1) then
+            umin = t; umax = t; tumin = tc; tumax = tc
+          else
+            if (t < umin .or. (t == umin .and. tc < tumin)) then
+              umin = t; tumin = tc
+            end if
+            if (t > umax .or. (t == umax .and. tc < tumax)) then
+              umax = t; tumax = tc
+            end if
+          end if
+        end do
+        first = .false.
+      end do
+    end subroutine motion
+
+    !> Rocker extremes, swing, full turn and time ratio from the unwrapped extremes.
+    subroutine rocker_figures()
+      row(8) = fold360(umin/rad)
+      row(9) = tumin
+      row(10) = fold360(umax/rad)
+      row(11) = tumax
+      if (row(3) >= 1.0_dp .and. niv == 1 .and. (umax - umin) >= twopi - 1.0e-6_dp) then
+        row(13) = 1.0_dp
+        row(12) = 360.0_dp
+      else
+        row(12) = (umax - umin)/rad
+      end if
+
+      ! ---- time ratio: a full turn without toggles, the rocker oscillating
+      if (hie - lo >= 360.0_dp .and. row(3) >= 1.0_dp .and. niv == 1 .and. ntog == 0 .and. &
+          row(13) == 0.0_dp) then
+        t = modulo(tumax - tumin, 360.0_dp)
+        if (t > 0.0_dp .and. t < 360.0_dp) row(19) = max(t, 360.0_dp - t)/min(t, 360.0_dp - t)
+      end if
+    end subroutine rocker_figures
   end subroutine one_linkage
 
   !> Rocker angle folded into [0, 360) [deg].
@@ -408,10 +458,10 @@ contains
     stat(1:m) = ist
   end subroutine states_at
 
-  !> The whole summary at one crank angle (a range of zero length).
-  subroutine single_angle(p, q, r, s, omega, t, branch, row)
+  !> The whole summary at one crank angle (a range of zero length): the passes asked for.
+  subroutine single_angle(p, q, r, s, omega, t, branch, passes, row)
     real(dp), intent(in) :: p, q, r, s, omega, t
-    integer, intent(in) :: branch
+    integer, intent(in) :: branch, passes
     real(dp), intent(inout) :: row(ncol)
     real(dp) :: th(1), out(1, 11)
     integer :: ist(1)
@@ -419,13 +469,17 @@ contains
     call exact_states(1, th, p, q, r, s, 1.0_dp, 0.0_dp, branch, out, ist)
     if (ist(1) /= st_ok .and. ist(1) /= st_toggle) return
     row(2:3) = 1.0_dp
-    row(4) = mu_of(r, s, dist(p, q, t))
-    row(5) = t
-    row(6:7) = row(4:5)
-    row(8) = fold360(out(1, 2)/rad)
-    row(9) = t
-    row(10:11) = row(8:9)
-    if (nint(row(14)) == 0 .and. ist(1) == st_ok) then
+    if (iand(passes, pass_transmission) /= 0) then
+      row(4) = mu_of(r, s, dist(p, q, t))
+      row(5) = t
+      row(6:7) = row(4:5)
+    end if
+    if (iand(passes, pass_rocker) /= 0) then
+      row(8) = fold360(out(1, 2)/rad)
+      row(9) = t
+      row(10:11) = row(8:9)
+    end if
+    if (iand(passes, pass_peaks) /= 0 .and. nint(row(14)) == 0 .and. ist(1) == st_ok) then
       row(15) = omega*out(1, 9)
       row(16) = t
       row(17) = omega*out(1, 8)
@@ -433,38 +487,138 @@ contains
     end if
   end subroutine single_angle
 
-  !> Peak |omega3| and |omega2| over [lo, hie] (assembled throughout, no toggle): 1 deg scan,
-  !> then every sign change of the matching angular acceleration refined to 1e-12 rad.
-  subroutine peaks(p, q, r, s, omega, lo, hie, branch, row)
+  !> omega3, alpha3, omega2, alpha2 (unit crank speed) and status at crank angles t(1:np) [rad].
+  !> work: the caller's buffer of at least 11 np values (viewed here as exact_states' (np, 11)
+  !> output, so neither a copy-in/out temporary nor a heap-allocated automatic array is made).
+  subroutine speeds_at(np, t, p, q, r, s, branch, work, w3, a3, w2, a2, ist)
+    integer, intent(in) :: np, branch
+    real(dp), intent(in) :: t(np), p, q, r, s
+    real(dp), intent(inout) :: work(np, 11)
+    real(dp), intent(inout) :: w3(np), a3(np), w2(np), a2(np)
+    integer, intent(inout) :: ist(np)
+    call exact_states(np, t, p, q, r, s, 1.0_dp, 0.0_dp, branch, work, ist)
+    w3 = work(:, 9)
+    a3 = work(:, 11)
+    w2 = work(:, 8)
+    a2 = work(:, 10)
+  end subroutine speeds_at
+
+  !> Whether omega has no extremum in an interval of length h [rad] with end values fa, fb and
+  !> end slopes da, db (alpha at unit crank speed = d omega / d theta): the ends' slopes share a
+  !> strict sign and the slope of the cubic Hermite model of omega, a quadratic
+  !> A (1 - x) + B x + c x (1 - x) with the interval's mean slope, stays above half the smaller
+  !> end slope.  False sends the interval to a finer scan.
+  pure logical function smooth(fa, fb, da, db, h)
+    real(dp), intent(in) :: fa, fb, da, db, h
+    real(dp) :: sg, a, b, c, xs, qmin
+    smooth = .false.
+    if (.not. (da*db > 0.0_dp)) return
+    sg = sign(1.0_dp, da)
+    a = sg*da
+    b = sg*db
+    c = 6.0_dp*(sg*(fb - fa)/h - 0.5_dp*(a + b))
+    qmin = min(a, b)
+    if (c < 0.0_dp) then
+      xs = 0.5_dp + (b - a)/(2.0_dp*c)
+      if (xs > 0.0_dp .and. xs < 1.0_dp) qmin = min(qmin, a*(1.0_dp - xs) + b*xs + c*xs*(1.0_dp - xs))
+    end if
+    smooth = qmin >= 0.5_dp*min(a, b)
+  end function smooth
+
+  !> Peak |omega3| and |omega2| over [lo, hie] (assembled throughout, no toggle): the grid of
+  !> at most 1 deg, scanned coarsely and refined where needed (module header), then every
+  !> sign change of the matching angular acceleration refined to 1e-12 rad.
+  subroutine peaks(p, q, r, s, omega, lo, hie, branch, dense, row)
     real(dp), intent(in) :: p, q, r, s, omega, lo, hie
     integer, intent(in) :: branch
+    logical, intent(in) :: dense
     real(dp), intent(inout) :: row(ncol)
-    real(dp) :: th(maxscan), out(maxscan, 11), h
-    real(dp) :: ba(maxbr), bb(maxbr), fa(maxbr), fb(maxbr), tx(maxbr), ox(maxbr, 11)
+    real(dp) :: th(maxscan), w(maxscan, 4), tg(maxscan), g(maxscan, 4), wk(11*maxscan), h
+    real(dp) :: ba(maxbr), bb(maxbr), fa(maxbr), fb(maxbr), tx(maxbr), ox(maxbr, 4)
     real(dp) :: best(2), bestat(2), v
-    integer :: ist(maxscan), isx(maxbr), bcol(maxbr), side(maxbr), m, k, nb, it, j, c, live
-    integer, parameter :: wcol(2) = [9, 8], acol(2) = [11, 10]   ! omega3 / alpha3, omega2 / alpha2
+    integer :: ci(maxscan), gi(maxscan), ist(maxscan), isx(maxbr), bcol(maxbr), side(maxbr)
+    real(dp) :: okc(maxscan), hc, da, db, sg, av, bv, cv, qv, xs, qm
+    integer :: rj(maxscan), m, nco, ng, nref, k, ka, kb, nb, it, j, jr, c, live
 
     m = min(maxscan, max(2, ceiling((hie - lo)/scan_step) + 1))
     h = (hie - lo)/(m - 1)
-    ! the whole scan in one (vectorised) kernel call
     ! hot-loop: fourbar_summary scan angles
     do k = 1, m
       th(k) = (lo + (k - 1)*h)*rad
     end do
     th(m) = hie*rad
-    call exact_states(m, th(1:m), p, q, r, s, 1.0_dp, 0.0_dp, branch, out(1:m, :), ist(1:m))
-    ! brackets of alpha sign changes, both columns
+    ! the coarse scan (first and last grid points included) in one kernel call
+    nco = 0
+    k = 1
+    do
+      nco = nco + 1
+      ci(nco) = k
+      if (k == m) exit
+      k = min(k + coarse_every, m)
+    end do
+    do j = 1, nco
+      tg(j) = th(ci(j))
+    end do
+    call speeds_at(nco, tg(1:nco), p, q, r, s, branch, wk, g(1:nco, 1), g(1:nco, 2), g(1:nco, 3), &
+                   g(1:nco, 4), ist(1:nco))
+    do j = 1, nco
+      w(ci(j), :) = g(j, :)
+    end do
+    ! the smooth test (see smooth) of every coarse interval, both speeds, in one loop
+    ! hot-loop: fourbar_summary coarse test
+    do j = 1, nco - 1
+      hc = tg(j + 1) - tg(j)
+      okc(j) = 1.0_dp
+      do c = 1, 2
+        da = g(j, 2*c)
+        db = g(j + 1, 2*c)
+        sg = sign(1.0_dp, da)
+        av = sg*da
+        bv = sg*db
+        cv = 6.0_dp*(sg*(g(j + 1, 2*c - 1) - g(j, 2*c - 1))/hc - 0.5_dp*(av + bv))
+        qv = min(av, bv)
+        xs = 0.5_dp + (bv - av)/(2.0_dp*min(cv, -tiny(1.0_dp)))
+        qm = merge(min(qv, av*(1.0_dp - xs) + bv*xs + cv*xs*(1.0_dp - xs)), qv, &
+                   cv < 0.0_dp .and. xs > 0.0_dp .and. xs < 1.0_dp)
+        okc(j) = okc(j)*merge(1.0_dp, 0.0_dp, da*db > 0.0_dp .and. qm >= 0.5_dp*qv)
+      end do
+    end do
+    ! the grid points inside every coarse interval that is not smooth for both speeds
+    ng = 0
+    nref = 0
+    do j = 1, nco - 1
+      ka = ci(j)
+      kb = ci(j + 1)
+      if (okc(j) > 0.0_dp .and. kb - ka >= 2 .and. .not. dense) cycle
+      nref = nref + 1
+      rj(nref) = j
+      do k = ka + 1, kb - 1
+        ng = ng + 1
+        gi(ng) = k
+        tg(ng) = th(k)
+      end do
+    end do
+    if (ng > 0) then
+      call speeds_at(ng, tg(1:ng), p, q, r, s, branch, wk, g(1:ng, 1), g(1:ng, 2), g(1:ng, 3), &
+                     g(1:ng, 4), ist(1:ng))
+      do j = 1, ng
+        w(gi(j), :) = g(j, :)
+      end do
+    end if
+    ! brackets of alpha sign changes on the grid of the refined intervals, both speeds (grid
+    ! order, as a full scan)
     nb = 0
     do c = 1, 2
-      do k = 1, m - 1
-        if (out(k, acol(c))*out(k + 1, acol(c)) < 0.0_dp .and. nb < maxbr) then
-          nb = nb + 1
-          ba(nb) = th(k); bb(nb) = th(k + 1)
-          fa(nb) = out(k, acol(c)); fb(nb) = out(k + 1, acol(c))
-          bcol(nb) = c
-          side(nb) = 0
-        end if
+      do jr = 1, nref
+        do k = ci(rj(jr)), ci(rj(jr) + 1) - 1
+          if (w(k, 2*c)*w(k + 1, 2*c) < 0.0_dp) then
+            call add_bracket(th(k), th(k + 1), w(k, 2*c), w(k + 1, 2*c), c)
+          else if (dense) then
+            cycle
+          else if (.not. smooth(w(k, 2*c - 1), w(k + 1, 2*c - 1), w(k, 2*c), w(k + 1, 2*c), th(k + 1) - th(k))) then
+            call hidden(th(k), th(k + 1), w(k, 2*c - 1), w(k + 1, 2*c - 1), w(k, 2*c), w(k + 1, 2*c), c, 1)
+          end if
+        end do
       end do
     end do
     ! Illinois regula falsi, every bracket advanced in one kernel call per iteration
@@ -478,10 +632,11 @@ contains
         tx(j) = min(max(tx(j), ba(j)), bb(j))
       end do
       if (live == 0) exit
-      call exact_states(nb, tx(1:nb), p, q, r, s, 1.0_dp, 0.0_dp, branch, ox(1:nb, :), isx(1:nb))
+      call speeds_at(nb, tx(1:nb), p, q, r, s, branch, wk, ox(1:nb, 1), ox(1:nb, 2), ox(1:nb, 3), &
+                     ox(1:nb, 4), isx(1:nb))
       do j = 1, nb
         if (bb(j) - ba(j) <= 1.0e-12_dp) cycle
-        v = ox(j, acol(bcol(j)))
+        v = ox(j, 2*bcol(j))
         if (v == 0.0_dp) then
           ba(j) = tx(j); bb(j) = tx(j); fa(j) = 0; fb(j) = 0
           cycle
@@ -501,18 +656,19 @@ contains
     do j = 1, nb
       tx(j) = 0.5_dp*(ba(j) + bb(j))
     end do
-    if (nb > 0) call exact_states(nb, tx(1:nb), p, q, r, s, 1.0_dp, 0.0_dp, branch, ox(1:nb, :), isx(1:nb))
+    if (nb > 0) call speeds_at(nb, tx(1:nb), p, q, r, s, branch, wk, ox(1:nb, 1), ox(1:nb, 2), ox(1:nb, 3), &
+                               ox(1:nb, 4), isx(1:nb))
     ! pick the largest |omega| among the range ends and the refined roots (earliest on ties)
     do c = 1, 2
-      best(c) = out(1, wcol(c))
+      best(c) = w(1, 2*c - 1)
       bestat(c) = th(1)
-      if (abs(out(m, wcol(c))) > abs(best(c))) then
-        best(c) = out(m, wcol(c)); bestat(c) = th(m)
+      if (abs(w(m, 2*c - 1)) > abs(best(c))) then
+        best(c) = w(m, 2*c - 1); bestat(c) = th(m)
       end if
     end do
     do j = 1, nb
       c = bcol(j)
-      v = ox(j, wcol(c))
+      v = ox(j, 2*c - 1)
       if (isx(j) /= st_ok) cycle
       if (abs(v) > abs(best(c)) .or. (abs(v) == abs(best(c)) .and. tx(j) < bestat(c))) then
         best(c) = v
@@ -523,6 +679,45 @@ contains
     row(16) = bestat(1)/rad
     row(17) = omega*best(2)
     row(18) = bestat(2)/rad
+
+  contains
+
+    subroutine add_bracket(a, b, da, db, col)
+      real(dp), intent(in) :: a, b, da, db
+      integer, intent(in) :: col
+      if (nb >= maxbr) return
+      nb = nb + 1
+      ba(nb) = a; bb(nb) = b
+      fa(nb) = da; fb(nb) = db
+      bcol(nb) = col
+      side(nb) = 0
+    end subroutine add_bracket
+
+    !> A grid interval whose ends agree in the sign of alpha but which is not smooth: bisected
+    !> (max_depth levels) looking for a hidden pair of sign changes, each one a bracket.
+    recursive subroutine hidden(a, b, ya, yb, da, db, col, depth)
+      real(dp), intent(in) :: a, b, ya, yb, da, db
+      integer, intent(in) :: col, depth
+      real(dp) :: tm(1), o(1, 4), o1(11), ym, dm
+      integer :: sm(1)
+      if (depth > max_depth) return
+      tm(1) = 0.5_dp*(a + b)
+      call speeds_at(1, tm, p, q, r, s, branch, o1, o(:, 1), o(:, 2), o(:, 3), o(:, 4), sm)
+      if (sm(1) /= st_ok) return
+      ym = o(1, 2*col - 1)
+      dm = o(1, 2*col)
+      if (da*dm < 0.0_dp) then
+        call add_bracket(a, tm(1), da, dm, col)
+      else if (.not. smooth(ya, ym, da, dm, tm(1) - a)) then
+        call hidden(a, tm(1), ya, ym, da, dm, col, depth + 1)
+      end if
+      if (dm*db < 0.0_dp) then
+        call add_bracket(tm(1), b, dm, db, col)
+      else if (.not. smooth(ym, yb, dm, db, b - tm(1))) then
+        call hidden(tm(1), b, ym, yb, dm, db, col, depth + 1)
+      end if
+    end subroutine hidden
+
   end subroutine peaks
 
 end module fourbar_summary

@@ -23,6 +23,9 @@ module manipulator_summary
   implicit none
   private
   public :: design_summaries
+  !> passes of design_summaries (bits): indices res(:, 1:5), target res(:, 6:10),
+  !> tolerance box res(:, 11:14)
+  integer, parameter, public :: ds_indices = 1, ds_target = 2, ds_tolerance = 4
 
   !> numpy's rad2deg / deg2rad constants (x * (180/pi), x * (pi/180)): the single run
   !> converts the IK angles to degrees and back before the torques
@@ -48,9 +51,10 @@ contains
   !> res(:, 11)  1 if the IK reaches every workspace point (the tolerance box exists)
   !> res(:, 12:13) tolerance half-widths dl1, dl2 [m]      res(:, 14) Monte Carlo max error [m]
   !> (res(:, 12:14) are 0 where res(:, 11) = 0)
-  subroutine design_summaries(npt, x, y, nd, params, branch, rates, measure, ns, unit, res)
+  !> passes: sum of ds_* bits; the columns of a pass not asked for are 0 (not computed).
+  subroutine design_summaries(npt, x, y, nd, params, branch, rates, measure, ns, unit, passes, res)
     !f2py threadsafe
-    integer, intent(in) :: npt, nd, branch, measure, ns
+    integer, intent(in) :: npt, nd, branch, measure, ns, passes
     real(dp), intent(in) :: x(npt), y(npt), params(nd, 7), rates(4), unit(ns, 2)
     real(dp), intent(out) :: res(nd, 14)
     integer, allocatable :: reach(:), status(:)
@@ -61,76 +65,83 @@ contains
     allocate(reach(nd), status(nd), csum(nd), cmax(nd), cmin(nd), bad(nd))
     res = 0.0_dp
     ! robustness indices and the reach conditions (4.4)
-    call design_indices(npt, x, y, nd, params(:, 1), params(:, 2), res(:, 1:3), res(:, 4), reach)
-    res(:, 5) = real(reach, dp)
+    if (iand(passes, ds_indices) /= 0) then
+      call design_indices(npt, x, y, nd, params(:, 1), params(:, 2), res(:, 1:3), res(:, 4), reach)
+      res(:, 5) = real(reach, dp)
+    end if
     ! joint angles at the target, then the torques block by block
-    call inverse_kin(nd, params(:, 1), params(:, 2), params(:, 3), params(:, 4), branch, &
-                     res(:, 7), res(:, 8), status)
-    res(:, 6) = real(status, dp)
-    qd1 = rates(1); qd2 = rates(2); qdd1 = rates(3); qdd2 = rates(4)
-    do k0 = 1, nd, nb
-      m = min(nb, nd - k0 + 1)
-      ! hot-loop: manipulator_summary angles and masses
-      do i = 1, m
-        k = k0 + i - 1
-        res(k, 7) = res(k, 7)*r2d
-        res(k, 8) = res(k, 8)*r2d
-        a1(i) = res(k, 7)*d2r
-        a2(i) = res(k, 8)*d2r
-        m1(i) = params(k, 5)*params(k, 1)
-        m2(i) = params(k, 5)*params(k, 2)
-        gb(i) = params(k, 6)
+    if (iand(passes, ds_target) /= 0) then
+      call inverse_kin(nd, params(:, 1), params(:, 2), params(:, 3), params(:, 4), branch, &
+                       res(:, 7), res(:, 8), status)
+      res(:, 6) = real(status, dp)
+      qd1 = rates(1); qd2 = rates(2); qdd1 = rates(3); qdd2 = rates(4)
+      do k0 = 1, nd, nb
+        m = min(nb, nd - k0 + 1)
+        ! hot-loop: manipulator_summary angles and masses
+        do i = 1, m
+          k = k0 + i - 1
+          res(k, 7) = res(k, 7)*r2d
+          res(k, 8) = res(k, 8)*r2d
+          a1(i) = res(k, 7)*d2r
+          a2(i) = res(k, 8)*d2r
+          m1(i) = params(k, 5)*params(k, 1)
+          m2(i) = params(k, 5)*params(k, 2)
+          gb(i) = params(k, 6)
+        end do
+        call block_trig(m, a1(1:m), a2(1:m), sc)
+        call torque_block(m, params(k0:k0 + m - 1, 1), params(k0:k0 + m - 1, 2), m1(1:m), m2(1:m), gb(1:m), sc, &
+                          qd1(1:m), qd2(1:m), qdd1(1:m), qdd2(1:m), res(k0:k0 + m - 1, 9), res(k0:k0 + m - 1, 10))
       end do
-      call block_trig(m, a1(1:m), a2(1:m), sc)
-      call torque_block(m, params(k0:k0 + m - 1, 1), params(k0:k0 + m - 1, 2), m1(1:m), m2(1:m), gb(1:m), sc, &
-                        qd1(1:m), qd2(1:m), qdd1(1:m), qdd2(1:m), res(k0:k0 + m - 1, 9), res(k0:k0 + m - 1, 10))
-    end do
-    where (status /= st_ok)
-      res(:, 9) = 0.0_dp
-      res(:, 10) = 0.0_dp
-    end where
-    ! the IK at every workspace point: reached or not, and c2_i = cos(th2_i) (clipped as inverse_kin)
-    csum = 0.0_dp
-    cmax = -1.0_dp
-    cmin = 1.0_dp
-    bad = 0.0_dp
-    do i = 1, npt
-      d2 = x(i)**2 + y(i)**2
-      ! hot-loop: manipulator_summary workspace ik
+      where (status /= st_ok)
+        res(:, 9) = 0.0_dp
+        res(:, 10) = 0.0_dp
+      end where
+    end if
+    ! the tolerance box where the design reaches every workspace point, and its Monte Carlo check
+    if (iand(passes, ds_tolerance) /= 0) then
+      ! the IK at every workspace point: reached or not, and c2_i = cos(th2_i) (clipped as inverse_kin)
+      csum = 0.0_dp
+      cmax = -1.0_dp
+      cmin = 1.0_dp
+      bad = 0.0_dp
+      do i = 1, npt
+        d2 = x(i)**2 + y(i)**2
+        ! hot-loop: manipulator_summary workspace ik
+        do k = 1, nd
+          c2 = (d2 - params(k, 1)**2 - params(k, 2)**2)/(2.0_dp*params(k, 1)*params(k, 2))
+          bad(k) = max(bad(k), merge(1.0_dp, 0.0_dp, abs(c2) > 1.0_dp + reach_tol))
+          cc = max(-1.0_dp, min(1.0_dp, c2))
+          csum(k) = csum(k) + cc
+          cmax(k) = max(cmax(k), cc)
+          cmin(k) = min(cmin(k), cc)
+        end do
+      end do
+      ! the largest tolerance box (closed form) where the design reaches every point
+      fn = real(npt, dp)
+      ! hot-loop: manipulator_summary tolerance box
       do k = 1, nd
-        c2 = (d2 - params(k, 1)**2 - params(k, 2)**2)/(2.0_dp*params(k, 1)*params(k, 2))
-        bad(k) = max(bad(k), merge(1.0_dp, 0.0_dp, abs(c2) > 1.0_dp + reach_tol))
-        cc = max(-1.0_dp, min(1.0_dp, c2))
-        csum(k) = csum(k) + cc
-        cmax(k) = max(cmax(k), cc)
-        cmin(k) = min(cmin(k), cc)
+        res(k, 11) = 1.0_dp - bad(k)
+        if (measure == 0) then
+          tol1 = params(k, 7)/sqrt(2.0_dp*(fn + abs(csum(k))))
+        else
+          tol1 = params(k, 7)/sqrt(2.0_dp*(1.0_dp + max(abs(cmax(k)), abs(cmin(k)))))
+        end if
+        res(k, 12) = merge(tol1, 0.0_dp, bad(k) == 0.0_dp)
+        res(k, 13) = res(k, 12)
       end do
-    end do
-    ! the largest tolerance box (closed form) where the design reaches every point
-    fn = real(npt, dp)
-    ! hot-loop: manipulator_summary tolerance box
-    do k = 1, nd
-      res(k, 11) = 1.0_dp - bad(k)
-      if (measure == 0) then
-        tol1 = params(k, 7)/sqrt(2.0_dp*(fn + abs(csum(k))))
-      else
-        tol1 = params(k, 7)/sqrt(2.0_dp*(1.0_dp + max(abs(cmax(k)), abs(cmin(k)))))
-      end if
-      res(k, 12) = merge(tol1, 0.0_dp, bad(k) == 0.0_dp)
-      res(k, 13) = res(k, 12)
-    end do
-    ! Monte Carlo: largest error over the samples, designs in blocks (the block's data stays
-    ! in cache while the samples stream past; the inner loop runs across designs)
-    do k0 = 1, nd, nb
-      m = min(nb, nd - k0 + 1)
-      if (measure == 0) then
-        call mc_global(m, ns, unit, fn, res(k0:k0 + m - 1, 12), res(k0:k0 + m - 1, 13), csum(k0:k0 + m - 1), &
-                       res(k0:k0 + m - 1, 14))
-      else
-        call mc_point(m, ns, unit, res(k0:k0 + m - 1, 12), res(k0:k0 + m - 1, 13), cmax(k0:k0 + m - 1), &
-                      cmin(k0:k0 + m - 1), res(k0:k0 + m - 1, 14))
-      end if
-    end do
+      ! Monte Carlo: largest error over the samples, designs in blocks (the block's data stays
+      ! in cache while the samples stream past; the inner loop runs across designs)
+      do k0 = 1, nd, nb
+        m = min(nb, nd - k0 + 1)
+        if (measure == 0) then
+          call mc_global(m, ns, unit, fn, res(k0:k0 + m - 1, 12), res(k0:k0 + m - 1, 13), csum(k0:k0 + m - 1), &
+                         res(k0:k0 + m - 1, 14))
+        else
+          call mc_point(m, ns, unit, res(k0:k0 + m - 1, 12), res(k0:k0 + m - 1, 13), cmax(k0:k0 + m - 1), &
+                        cmin(k0:k0 + m - 1), res(k0:k0 + m - 1, 14))
+        end if
+      end do
+    end if
     deallocate(reach, status, csum, cmax, cmin, bad)
   end subroutine design_summaries
 

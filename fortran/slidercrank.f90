@@ -39,6 +39,9 @@ module slidercrank
   implicit none
   private
   public :: simulate, assemble_matrices, rigid_states, axial_force_at, analytic_frequencies
+  !> building blocks shared with the geometrically nonlinear rod (fortran/slidercrank_nl.f90)
+  !> (not wrapped for Python: fortran/meson.build lists them after f2py's skip:)
+  public :: rigid_kin, element_matrices, apply_ops, band_cholesky, band_solve
 
   !> half bandwidth of the banded matrices in q ordering
   integer, parameter, public :: kd = 5

@@ -43,6 +43,8 @@ module ujoint
   integer, parameter, public :: st_ok = 0, st_res_undefined = 1, st_zero_axis = 2, st_right_angle = 3
   !> result columns of chain_summaries
   integer, parameter, public :: nsum = 7
+  !> passes of chain_summaries (bits)
+  integer, parameter, public :: sum_objective = 1, sum_speed = 2, sum_equivalent = 4
 
   real(dp), parameter :: pi = 3.14159265358979323846264338327950288_dp
 
@@ -280,8 +282,10 @@ contains
   !>   res(i, 5)  beta_e [rad]; res(i, 6) beta_res [rad], 0 unless res(i, 7) = st_ok
   !>   res(i, 7)  status of beta_res (chain_equivalent with tolerance tol [rad])
   !> The sines and cosines of the grid are taken once for all designs.
-  subroutine chain_summaries(model, kind, n, nd, x, m, tol, res)
-    integer, intent(in) :: model, kind, n, nd, m
+  !> passes: sum of sum_* bits -- sum_objective (res(:, 1)), sum_speed (res(:, 2:4)),
+  !> sum_equivalent (res(:, 5:7)); the columns of a pass not asked for are 0 (not computed).
+  subroutine chain_summaries(model, kind, n, nd, x, m, tol, passes, res)
+    integer, intent(in) :: model, kind, n, nd, m, passes
     real(dp), intent(in) :: x(nd, 3*n - 2), tol
     real(dp), intent(out) :: res(nd, 7)                ! nsum columns (literal for f2py)
     real(dp), allocatable :: th(:), c(:), s(:), rat(:), ratf(:), dlth(:), dlp(:, :), thout(:), acc(:)
@@ -301,20 +305,27 @@ contains
       beta = x(i, 1:n)
       phi = x(i, n + 1:2*n - 1)
       rho = x(i, 2*n:3*n - 2)
-      call propagate_nograd(model, n, beta, phi, rho, mh, c(1:mh), s(1:mh), rat)
-      res(i, 1) = objective_value(kind, mh, rat)
-      call propagate(model, n, beta, phi, rho, m, c, s, 0, 0, ratf, dlth, dlp, thout)
-      ! hot-loop: ujoint summaries acceleration
-      do j = 1, m
-        acc(j) = abs(ratf(j)*dlth(j))
-      end do
-      res(i, 2) = minval(ratf)
-      res(i, 3) = maxval(ratf)
-      res(i, 4) = maxval(acc)
-      call chain_equivalent(model, n, beta, phi, rho, tol, be, br, st)
-      res(i, 5) = be
-      res(i, 6) = br
-      res(i, 7) = real(st, dp)
+      res(i, :) = 0.0_dp
+      if (iand(passes, sum_objective) /= 0) then
+        call propagate_nograd(model, n, beta, phi, rho, mh, c(1:mh), s(1:mh), rat)
+        res(i, 1) = objective_value(kind, mh, rat)
+      end if
+      if (iand(passes, sum_speed) /= 0) then
+        call propagate(model, n, beta, phi, rho, m, c, s, 0, 0, ratf, dlth, dlp, thout)
+        ! hot-loop: ujoint summaries acceleration
+        do j = 1, m
+          acc(j) = abs(ratf(j)*dlth(j))
+        end do
+        res(i, 2) = minval(ratf)
+        res(i, 3) = maxval(ratf)
+        res(i, 4) = maxval(acc)
+      end if
+      if (iand(passes, sum_equivalent) /= 0) then
+        call chain_equivalent(model, n, beta, phi, rho, tol, be, br, st)
+        res(i, 5) = be
+        res(i, 6) = br
+        res(i, 7) = real(st, dp)
+      end if
     end do
   end subroutine chain_summaries
 

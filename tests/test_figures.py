@@ -70,7 +70,7 @@ def test_column_labels_have_words_and_units():
     sc, fb = load_study("slidercrank"), load_study("fourbar")
     assert column_label(sc, "slidercrank.speeds") == "crank speed [rad/s]"
     assert column_label(sc, "peak_tensile_2_deg") == "crank angle of peak tension, speed 2 [deg]"
-    assert column_label(sc, "peak_compressive_microstrain") == "peak compressive strain [microstrain]"
+    assert column_label(sc, "peak_compressive_microstrain") == "peak compressive strain (negative) [microstrain]"
     assert column_label(sc, "rod_mass_kg") == "rod mass [kg]"          # an optimisation objective
     assert column_label(fb, "fourbar.omega") == "crank speed [rad/s]"          # units from the key's SPEC
     assert column_label(fb, "mu_min_deg") == "minimum transmission angle [deg]"

@@ -29,7 +29,7 @@ from driver.manipulator import BATCH_KEYS, SPEC, summarise, summarise_batch
 ROOT = Path(__file__).resolve().parents[1]
 #: what the bit-exact comparison covers (an optimiser's finite differences see these)
 BITWISE = ("design_l1_m", "design_l2_m", "design_ri1", "design_ri2", "design_ri3", "design_ri2_excess",
-           "design_crob_residual_m2", "design_total_torque_Nm")
+           "design_crob_residual_m2", "design_tau_sum_signed_Nm")
 
 
 def params(**kw) -> Params:
@@ -134,7 +134,7 @@ def test_swept_target_masses_gravity_and_bound():
                                      **{k: v[i] for k, v in cols.items()}))
         assert_row_equals_run(batch.iloc[i], one.summary)
     # the C_rob walk depends on the target, masses and g: rows 1 and 4 share the target only
-    assert batch["sweep_min_total_torque_Nm"].nunique() == 4
+    assert batch["sweep_min_tau_sum_signed_Nm"].nunique() == 4
 
 
 def test_target_out_of_reach_and_singular_designs():
@@ -143,7 +143,7 @@ def test_target_out_of_reach_and_singular_designs():
     base = params(designs_l1=[5.61], designs_l2=[3.97])
     row = summarise_batch(base, {"target_x": [0.5], "target_y": [0.5]}).iloc[0]
     assert row["design_status"] == "target_unreachable" and bool(row["design_reaches_all"])
-    assert pd.isna(row["design_total_torque_Nm"]) and pd.isna(row["design_1_tau1_Nm"])
+    assert pd.isna(row["design_tau_sum_signed_Nm"]) and pd.isna(row["design_1_tau1_Nm"])
     assert row["design_1_dl_m"] > 0                      # the tolerance box does not need the target
     with pytest.raises(DeckError, match="out of reach of every design"):
         manipulator.run(params(designs_l1=[5.61], designs_l2=[3.97], target_x=0.5, target_y=0.5))
@@ -202,7 +202,7 @@ SWEEP = """&manipulator
 &sweep key1 = 'manipulator.designs_l1', start1 = {lo1}, stop1 = 6.5, count1 = 7
        key2 = 'manipulator.designs_l2', start2 = {lo2}, stop2 = 5.0, count2 = 6
        key3 = 'manipulator.gravity', values3 = 9.8, 3.71
-       keep = 'design_status == "ok" and design_total_torque_Nm < 4200'
+       keep = 'design_status == "ok" and design_tau_sum_signed_Nm < 4200'
        case_outputs = '{outputs}' /
 """
 
@@ -238,7 +238,7 @@ def test_sweep_with_unreachable_designs(tmp_path):
     # torques exist where the target (1, 5) is reached, whether or not the whole workspace is
     at_target = np.array([reaches(a, b, [1], [5]) for a, b in
                           zip(batch["manipulator.designs_l1"], batch["manipulator.designs_l2"])])
-    assert (batch["design_total_torque_Nm"].notna().to_numpy() == at_target).all()
+    assert (batch["design_tau_sum_signed_Nm"].notna().to_numpy() == at_target).all()
     assert (batch["design_1_dl_m"].isna() == un).all()
     assert "nan" not in text.lower()
     rc, single, _ = sweep_rows(tmp_path, "all", lo1=1.0, lo2=1.0)
@@ -265,12 +265,18 @@ def test_optimiser_evaluates_populations_in_one_call(tmp_path, monkeypatch):
     monkeypatch.setattr(kernels, "manipulator_design_summaries", counted)
     monkeypatch.setattr(evaluate, "evaluate_cases", never)
     out = tmp_path / "o"
-    assert main([str(ROOT / "inputs" / "optimize_manipulator_torque.dat"), "-o", str(out), "-q"]) == 0
+    monkeypatch.chdir(ROOT)     # the deck named as the committed run named it (the .out quotes it)
+    assert main(["inputs/optimize_manipulator_torque.dat", "-o", str(out), "-q"]) == 0
     evals = pd.read_parquet(out / "optimize_manipulator_torque_evals.parquet")
     assert sum(calls) >= len(evals) and max(calls) > 1
     assert len(calls) < len(evals)            # populations, not designs, per call
+    # the run equals the committed one: the .out and the optimum's deck byte for byte; the evaluations
+    # (the SLSQP path, which follows the BLAS kernel) by the outputs test's rule for path records
+    from test_outputs_fresh import same_path_record
+    for name in ("optimize_manipulator_torque.out", "optimize_manipulator_torque.optimum.dat"):
+        assert (out / name).read_bytes() == (ROOT / "outputs" / name).read_bytes(), name
     committed = pd.read_parquet(ROOT / "outputs" / "optimize_manipulator_torque_evals.parquet")
-    pd.testing.assert_frame_equal(evals, committed)
+    assert same_path_record(evals, committed, sense=1)
 
 
 def test_per_case_summaries_equal_runs(tmp_path, capsys):
@@ -287,4 +293,4 @@ def test_per_case_summaries_equal_runs(tmp_path, capsys):
         assert "batch path" not in capsys.readouterr().out
         frames.append(pd.read_parquet(tmp_path / o / f"{o}_summary.parquet"))
     pd.testing.assert_frame_equal(frames[0], frames[1], check_dtype=False, rtol=1e-12)
-    assert frames[0]["design_total_torque_Nm"].nunique() == 6     # both elbows differ
+    assert frames[0]["design_tau_sum_signed_Nm"].nunique() == 6     # both elbows differ

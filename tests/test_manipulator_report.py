@@ -175,7 +175,7 @@ def test_chapter5_claims():
     ref = {r["quantity"]: r["printed"] for _, r in csv("chapter5.csv").iterrows()}
     assert set(ref) == {"min_total_torque", "min_total_l1", "min_total_l2"}
     s = res.summary
-    assert_printed(s["sweep_min_total_torque_Nm"], ref["min_total_torque"], "min total torque")
+    assert_printed(s["sweep_min_tau_sum_signed_Nm"], ref["min_total_torque"], "min total torque")
     assert_printed(s["sweep_min_l1_m"], ref["min_total_l1"], "l1 at the minimum")
     assert_printed(s["sweep_min_l2_m"], ref["min_total_l2"], "l2 at the minimum")
     assert s["sweep_min_reaches_workspace"] is False   # row 28 violates |l1 - l2| <= sqrt(17)

@@ -151,7 +151,7 @@ def test_resume_skips_complete_chunks(tmp_path, capsys):
     assert not list((out / "sw.sweep").glob("*.tmp"))
 
 
-def _dies(p, start, stop, _real=sweep_batch.chunk_rows):
+def _dies(p, start, stop, folder="", _real=sweep_batch.chunk_rows):
     """A chunk function whose worker is SIGKILLed on the chunk starting at case 30 (always, or
     once when DIE_ONCE names a marker file)."""
     marker = os.environ.get("DIE_ONCE")
@@ -159,7 +159,7 @@ def _dies(p, start, stop, _real=sweep_batch.chunk_rows):
         if marker:
             Path(marker).write_text("died")
         os.kill(os.getpid(), signal.SIGKILL)
-    return _real(p, start, stop)
+    return _real(p, start, stop, folder)
 
 
 @pytest.mark.parametrize("once", [True, False])

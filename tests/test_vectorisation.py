@@ -239,3 +239,27 @@ def test_native_and_portable_builds_give_identical_bits(flags, tmp_path):
         blobs.append((work / "bits.bin").read_bytes())
     assert len(blobs[0]) > 100_000
     assert blobs[0] == blobs[1]
+
+
+TEMPORARY = re.compile(r"^(?P<file>[^:\s]+\.f90):(?P<line>\d+):\d+:\s*\n(?:.*\n){0,3}?Warning: Creating array temporary",
+                       re.MULTILINE)
+
+
+def test_no_array_temporaries_at_the_summary_kernel_calls(flags, tmp_path):
+    """fourbar_summary.f90 hands exact_states (and its speeds_at wrapper) arrays it can use in
+    place: no copy-in/out temporary at any call (gfortran -Warray-temporaries; the peak search's
+    three exact_states calls made one per call, 11 % of the kernel's time)."""
+    work = tmp_path
+    calls: dict[int, str] = {}
+    for src in kernel_sources():
+        res = subprocess.run(["gfortran", *flags, "-Warray-temporaries", "-c", str(src), "-J", str(work), "-I",
+                              str(work), "-o", str(work / (src.stem + ".o"))], capture_output=True, text=True, cwd=work)
+        assert res.returncode == 0, f"gfortran failed on {src.name}:\n{res.stderr[-3000:]}"
+        if src.name != "fourbar_summary.f90":
+            continue
+        lines = src.read_text().splitlines()
+        found = {int(m.group("line")) for m in TEMPORARY.finditer(res.stderr) if Path(m.group("file")).name == src.name}
+        calls = {n: lines[n - 1].strip() for n in sorted(found) if re.search(r"\bcall\b", lines[n - 1])}
+        assert "Creating array temporary" in res.stderr   # the check sees gfortran's warnings at all
+    assert not calls, "array temporaries at calls in fourbar_summary.f90:\n  " + "\n  ".join(
+        f"{n}: {t}" for n, t in calls.items())

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Mapping
+from typing import Any, Callable, Collection, Mapping
 
 import numpy as np
 import pandas as pd
@@ -85,8 +85,8 @@ LABELS = {"crank": ("crank length", "length units"), "coupler": ("coupler length
           "rocker": ("rocker length", "length units"),
           "fixed_link": ("ground link length", "length units"), "omega": ("crank speed", ""),
           "mu_min_deg": ("minimum transmission angle", "deg"), "mu_max_deg": ("maximum transmission angle", "deg"),
-          "rocker_swing_deg": ("rocker swing", "deg"), "omega3_peak_rad_s": ("peak rocker speed", "rad/s"),
-          "omega2_peak_rad_s": ("peak coupler speed", "rad/s"),
+          "rocker_swing_deg": ("rocker swing", "deg"), "omega3_peak_rad_s": ("peak rocker speed (signed: the largest in size)", "rad/s"),
+          "omega2_peak_rad_s": ("peak coupler speed (signed: the largest in size)", "rad/s"),
           "assembled_fraction": ("fraction of the turn assembled", "-"),
           "time_ratio": ("time ratio (slow / quick stroke)", "-"), **forces.LABELS}
 #: which way a summary column is better (the design-space maps star the best kept design)
@@ -262,6 +262,36 @@ BATCH_IGNORED = ("alpha", "step_deg", "method", "title", "coupler_point")
 #: keys whose deck checks do not involve other keys (a sweep validates each of their values once)
 BATCH_INDEPENDENT = ("fixed_link", "crank", "coupler", "rocker", "omega", "alpha", "title", "coupler_point")
 
+#: The column -> pass dependency table of the batch summary (the study's part of "compute only
+#: what the deck asks for"): for each column of :func:`summarise_batch` (``detail`` columns
+#: included), the kernel passes of fortran/fourbar_summary.f90 it needs.  Columns with no pass
+#: are closed form and always computed (Grashof class, assembly, toggles); 'transmission' is
+#: closed form too, 'rocker' evaluates the states at the rocker's candidate extremes, 'peaks'
+#: scans the range for the speed extremes (about 80 % of the kernel time when asked).
+BATCH_PASSES: dict[str, tuple[str, ...]] = {
+    "grashof_class": (), "full_crank_rotation": (), "assemblable": (),
+    "mu_min_deg": ("transmission",), "mu_max_deg": ("transmission",), "meets_transmission_band": ("transmission",),
+    "rocker_turns_fully": ("rocker",), "rocker_swing_deg": ("rocker",), "toggle_in_range": (),
+    "omega3_peak_rad_s": ("peaks",), "omega2_peak_rad_s": ("peaks",), "assembled_fraction": (),
+    "time_ratio": ("rocker",),
+    "mu_min_at_deg": ("transmission",), "mu_max_at_deg": ("transmission",), "rocker_min_deg": ("rocker",),
+    "rocker_min_at_deg": ("rocker",), "rocker_max_deg": ("rocker",), "rocker_max_at_deg": ("rocker",),
+    "omega3_peak_at_deg": ("peaks",), "omega2_peak_at_deg": ("peaks",), "toggles_in_range": (),
+    # decks that give masses: the force summary (driver/fourbar/forces.py), a pass of its own
+    **{f"{pre}{c}": ("forces",) for pre in ("", "unbalanced_") for c in forces.SUMMARY_DOC},
+}
+#: the kernel's pass bits (fortran/fourbar_summary.f90 pass_*)
+PASS_BITS = {"transmission": kernels.FOURBAR_PASSES["transmission"], "rocker": kernels.FOURBAR_PASSES["rocker"],
+             "peaks": kernels.FOURBAR_PASSES["peaks"]}
+
+
+def _pass_mask(wanted: Collection[str] | None) -> int:
+    """The kernel's pass bits for summary columns ``wanted`` (None: every pass)."""
+    if wanted is None:
+        return sum(PASS_BITS.values())
+    return sum({PASS_BITS[p] for c in wanted for p in BATCH_PASSES.get(c, ()) if p in PASS_BITS})
+
+
 #: kernel Grashof codes -> (class name as grashof() prints it, full crank rotation)
 GRASHOF_NAMES = {"double_crank": ("double-crank (drag link)", True), "crank_rocker": ("crank-rocker", True),
                  "rocker_crank": ("rocker-crank", False), "double_rocker": ("Grashof double-rocker", False),
@@ -303,7 +333,7 @@ def _param_matrix(base: Mapping[str, Any], columns: Mapping[str, Any], n: int) -
 
 
 def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None = None,
-                    detail: bool = False) -> pd.DataFrame:
+                    detail: bool = False, wanted: Collection[str] | None = None) -> pd.DataFrame:
     """Summaries of many four-bar designs in one Fortran call: one row per design.
 
     ``base``: a validated ``&fourbar`` Params (or any mapping with the BATCH_KEYS).
@@ -317,9 +347,12 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     rocker's slower stroke over its quicker one, >= 1; missing unless the range holds a full
     turn, assembled throughout, without a toggle, with the rocker oscillating); with ``detail`` also the crank
     angles [deg] of those extremes, the rocker extreme positions [deg] and the number of
-    toggle positions in the range.  A bad value raises DeckError (``base`` a deck's Params:
-    deck, line and key of the base deck, the design's index in the message) or ValueError.
-    About 20 microseconds per design on one core (bench/bench_sweep.py).
+    toggle positions in the range.  ``wanted``: only these columns (names of the columns
+    above; others are ignored), computed by only the kernel passes they need
+    (:data:`BATCH_PASSES`) -- each with the same bits as in a full summary; None: all.
+    A bad value raises DeckError (``base`` a deck's Params: deck, line and key of the base
+    deck, the design's index in the message) or ValueError.  About 3 microseconds per design
+    on one core with every column, 0.7 without the peak speeds (bench/bench_sweep.py).
     """
     columns = {k.partition(".")[2] if k.startswith("fourbar.") else k: v for k, v in (columns or {}).items()}
     unknown = [k for k in columns if k not in BATCH_KEYS and k not in BATCH_IGNORED]
@@ -331,41 +364,56 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     if len(sizes) > 1:
         raise _bad(base, None, f"batch columns have different lengths {sorted(sizes)}")
     n = sizes.pop() if sizes else 1
-    res = kernels.fourbar_summaries(_param_matrix(base, columns, n))
-    frame = _frame(res, detail, band_of(base))
-    if forces.active(base):   # force columns (driver/fourbar/forces.py) when the deck gives masses
-        frame = pd.concat([frame, forces.summarise_force_batch(base, force_columns)], axis=1)
+    res = kernels.fourbar_summaries(_param_matrix(base, columns, n), _pass_mask(wanted))
+    frame = _frame(res, detail or (wanted is not None and any(c in _DETAIL for c in wanted)), band_of(base), wanted)
+    if forces.active(base) and (wanted is None or any(BATCH_PASSES.get(c) == ("forces",) for c in wanted)):
+        # force columns (driver/fourbar/forces.py) when the deck gives masses, and someone reads one
+        more = forces.summarise_force_batch(base, force_columns)
+        if wanted is not None:
+            more = more[[c for c in more.columns if c in set(wanted)]]
+        frame = pd.concat([frame, more], axis=1)
     return frame
 
 
-def _frame(res: np.ndarray, detail: bool = False, band: tuple[float, float] = BAND) -> pd.DataFrame:
-    """Kernel rows -> the summary columns (vectorised; the one place both paths go through)."""
+#: the columns of summarise_batch(detail=True) only
+_DETAIL = ("mu_min_at_deg", "mu_max_at_deg", "rocker_min_deg", "rocker_min_at_deg", "rocker_max_deg",
+           "rocker_max_at_deg", "omega3_peak_at_deg", "omega2_peak_at_deg", "toggles_in_range")
+
+
+def _frame(res: np.ndarray, detail: bool = False, band: tuple[float, float] = BAND,
+           wanted: Collection[str] | None = None) -> pd.DataFrame:
+    """Kernel rows -> the summary columns (vectorised; the one place both paths go through);
+    with ``wanted``, only those columns are built."""
     c = dict(zip(kernels.FOURBAR_SUMMARY_COLUMNS, res.T))
-    codes = c["grashof"].astype(int)
-    lut = [GRASHOF_NAMES[kernels.FOURBAR_GRASHOF[k]] for k in range(len(GRASHOF_NAMES))]
-    names = np.array([n for n, _ in lut], dtype=object)[codes]
-    full = np.array([f for _, f in lut])[codes]
     ok = c["assemblable"] > 0
-    turns = ok & (c["rocker_turns"] > 0)
-    tog = ok & (c["toggles_in_range"] > 0)
-    has = lambda v, m=ok: np.where(m, v, np.nan)
+    lut = [GRASHOF_NAMES[kernels.FOURBAR_GRASHOF[k]] for k in range(len(GRASHOF_NAMES))]
+    tog = lambda: ok & (c["toggles_in_range"] > 0)
+    has = lambda v, m=None: np.where(ok if m is None else m, v, np.nan)
     lo, hi = band
-    out = {"grashof_class": names, "full_crank_rotation": full, "assemblable": ok,
-           "mu_min_deg": has(c["mu_min_deg"]), "mu_max_deg": has(c["mu_max_deg"]),
-           "meets_transmission_band": ok & (c["mu_min_deg"] >= lo) & (c["mu_max_deg"] <= hi),
-           "rocker_turns_fully": turns, "rocker_swing_deg": has(c["rocker_swing_deg"]),
-           "toggle_in_range": tog, "omega3_peak_rad_s": has(c["omega3_peak_rad_s"], ok & ~tog),
-           "omega2_peak_rad_s": has(c["omega2_peak_rad_s"], ok & ~tog),
-           "assembled_fraction": np.where(ok, c["assembled_fraction"], 0.0),
-           "time_ratio": np.where(ok & (c["time_ratio"] > 0), c["time_ratio"], np.nan)}
+    build: dict[str, Callable[[], Any]] = {
+        "grashof_class": lambda: np.array([n for n, _ in lut], dtype=object)[c["grashof"].astype(int)],
+        "full_crank_rotation": lambda: np.array([f for _, f in lut])[c["grashof"].astype(int)],
+        "assemblable": lambda: ok,
+        "mu_min_deg": lambda: has(c["mu_min_deg"]), "mu_max_deg": lambda: has(c["mu_max_deg"]),
+        "meets_transmission_band": lambda: ok & (c["mu_min_deg"] >= lo) & (c["mu_max_deg"] <= hi),
+        "rocker_turns_fully": lambda: ok & (c["rocker_turns"] > 0),
+        "rocker_swing_deg": lambda: has(c["rocker_swing_deg"]),
+        "toggle_in_range": tog,
+        "omega3_peak_rad_s": lambda: has(c["omega3_peak_rad_s"], ok & ~tog()),
+        "omega2_peak_rad_s": lambda: has(c["omega2_peak_rad_s"], ok & ~tog()),
+        "assembled_fraction": lambda: np.where(ok, c["assembled_fraction"], 0.0),
+        "time_ratio": lambda: np.where(ok & (c["time_ratio"] > 0), c["time_ratio"], np.nan)}
     if detail:
-        out |= {"mu_min_at_deg": has(c["mu_min_at_deg"]), "mu_max_at_deg": has(c["mu_max_at_deg"]),
-                "rocker_min_deg": has(c["rocker_min_deg"]), "rocker_min_at_deg": has(c["rocker_min_at_deg"]),
-                "rocker_max_deg": has(c["rocker_max_deg"]), "rocker_max_at_deg": has(c["rocker_max_at_deg"]),
-                "omega3_peak_at_deg": has(c["omega3_peak_at_deg"], ok & ~tog),
-                "omega2_peak_at_deg": has(c["omega2_peak_at_deg"], ok & ~tog),
-                "toggles_in_range": c["toggles_in_range"].astype(int)}
-    return pd.DataFrame(out)
+        build |= {"mu_min_at_deg": lambda: has(c["mu_min_at_deg"]), "mu_max_at_deg": lambda: has(c["mu_max_at_deg"]),
+                  "rocker_min_deg": lambda: has(c["rocker_min_deg"]),
+                  "rocker_min_at_deg": lambda: has(c["rocker_min_at_deg"]),
+                  "rocker_max_deg": lambda: has(c["rocker_max_deg"]),
+                  "rocker_max_at_deg": lambda: has(c["rocker_max_at_deg"]),
+                  "omega3_peak_at_deg": lambda: has(c["omega3_peak_at_deg"], ok & ~tog()),
+                  "omega2_peak_at_deg": lambda: has(c["omega2_peak_at_deg"], ok & ~tog()),
+                  "toggles_in_range": lambda: c["toggles_in_range"].astype(int)}
+    keys = build if wanted is None else [k for k in build if k in set(wanted)]
+    return pd.DataFrame({k: build[k]() for k in keys}, index=pd.RangeIndex(len(res)))
 
 
 # ----------------------------------------------------------------------------- tables

@@ -32,16 +32,18 @@ from __future__ import annotations
 from driver.deck import Params
 from driver.manipulator.analysis import (DESIGN_STATUS, SIGNIFICANT, STATUS, Conv, Workspace, _sensitivity_blocks,
                                          optima, round_half_up, tolerance_box)
-from driver.manipulator.batch import BATCH_IGNORED, BATCH_INDEPENDENT, BATCH_KEYS, summarise, summarise_batch
+from driver.manipulator.batch import (BATCH_IGNORED, BATCH_INDEPENDENT, BATCH_KEYS, BATCH_PASS_SUFFIXES, BATCH_PASSES,
+                                      batch_refusal, summarise, summarise_batch)
 from driver.manipulator import report as _report
 from driver.manipulator.report import TIDY_UNITS, table_frame
-from driver.manipulator.spec import LABELS, SPEC, SWEEP_BEST, SWEEP_PLOT, estimate
+from driver.manipulator.spec import LABELS, RENAMED, SPEC, SWEEP_BEST, SWEEP_PLOT, estimate
 from driver.manipulator.tables import NOT_REPRODUCIBLE, REASONS, TEXT_REASONS, TIDY_NAMES, Table
 from driver.study import Result, keyword_run
 
 __all__ = ["SPEC", "run", "Workspace", "tolerance_box", "round_half_up", "REASONS", "NOT_REPRODUCIBLE", "TEXT_REASONS",
            "TIDY_NAMES", "TIDY_UNITS", "table_frame", "LABELS", "SWEEP_PLOT", "SWEEP_BEST", "estimate", "optima",
-           "summarise", "summarise_batch", "BATCH_KEYS", "BATCH_IGNORED", "BATCH_INDEPENDENT", "DESIGN_STATUS"]
+           "summarise", "summarise_batch", "BATCH_KEYS", "BATCH_PASSES", "BATCH_PASS_SUFFIXES", "BATCH_IGNORED",
+           "BATCH_INDEPENDENT", "DESIGN_STATUS"]
 
 
 @keyword_run

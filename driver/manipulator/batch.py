@@ -18,7 +18,7 @@ deck design: its tables need a design that reaches.)
 from __future__ import annotations
 
 import math
-from typing import Any, Mapping
+from typing import Any, Collection, Mapping
 
 import numpy as np
 import pandas as pd
@@ -26,10 +26,11 @@ import pandas as pd
 from driver import kernels
 from driver.deck import Params
 from driver.manipulator.analysis import STATUS, Conv, Workspace, _design_list, design_status, round_half_up
-from driver.manipulator.report import sweep_columns, workspace_columns
+from driver.manipulator.report import design_torque_columns, sweep_columns, workspace_columns
 from driver.manipulator.tables import _t48
 
-__all__ = ["BATCH_KEYS", "BATCH_IGNORED", "BATCH_INDEPENDENT", "summarise_batch", "summarise"]
+__all__ = ["BATCH_KEYS", "BATCH_IGNORED", "BATCH_INDEPENDENT", "BATCH_PASSES", "BATCH_PASS_SUFFIXES", "summarise_batch",
+           "summarise"]
 
 #: deck keys a batch may vary (one value per design deck; designs_l1/designs_l2 one length, or
 #: an (n, k) array for k designs per deck); every other key is the base deck's
@@ -38,6 +39,41 @@ BATCH_KEYS = ("designs_l1", "designs_l2", "mass_per_length", "gravity", "target_
 BATCH_IGNORED = ("title", "ri2_levels", "crob_l1", "text_optimum_decimals")
 #: keys whose deck checks do not involve other keys (a sweep validates each of their values once)
 BATCH_INDEPENDENT = ("mass_per_length", "gravity", "tolerance_bound", "title", "crob_l1")
+
+#: The column -> pass dependency table of the batch summary: the passes each column of
+#: :func:`summarise_batch` needs -- the kernel's (fortran/manipulator_summary.f90 ds_*):
+#: 'indices' (RI1-RI3, reach conditions), 'target' (IK and torques at the target),
+#: 'tolerance' (the tolerance box and its Monte Carlo check), and 'walk' (the C_rob walk of
+#: Table 4.8, in Python).  The workspace figures and the design's own lengths need none.
+#: Per-design columns ``<design>_<suffix>`` are in :data:`BATCH_PASS_SUFFIXES`.
+BATCH_PASSES: dict[str, tuple[str, ...]] = {
+    "design_l1_m": (), "design_l2_m": (), "design_ri1": ("indices",), "design_ri2": ("indices",),
+    "design_ri3": ("indices",), "design_ri2_excess": ("indices",), "design_reaches_all": ("indices",),
+    "design_crob_residual_m2": (), "design_total_torque_Nm": ("target",), "design_tau_sum_signed_Nm": ("target",),
+    "design_torque_demand_Nm": ("target",), "design_peak_torque_Nm": ("target",),
+    "design_status": ("indices", "target"), "sweep_min_total_torque_Nm": ("walk",), "sweep_min_l1_m": ("walk",),
+    "sweep_min_l2_m": ("walk",), "sweep_min_row": ("walk",), "sweep_min_reaches_workspace": ("walk",),
+}
+BATCH_PASS_SUFFIXES: dict[str, tuple[str, ...]] = {
+    "_tau1_Nm": ("target",), "_tau2_Nm": ("target",), "_dl_m": ("tolerance",), "_mc_max_m": ("tolerance",),
+    "_reaches_workspace": ("tolerance",),
+}
+
+
+def _passes(wanted: Collection[str] | None) -> set[str]:
+    """The passes columns ``wanted`` need (None: all)."""
+    if wanted is None:
+        return {"indices", "target", "tolerance", "walk"}
+    out: set[str] = set()
+    for c in wanted:
+        if c in BATCH_PASSES:
+            out.update(BATCH_PASSES[c])
+        elif c.startswith("sweep_min_"):   # every column of the C_rob walk
+            out.add("walk")
+        else:
+            out.update(*(p for sfx, p in BATCH_PASS_SUFFIXES.items() if c.endswith(sfx)))
+    return out
+
 
 #: C_rob walks cached per distinct (target, mass per length, g) and base deck: an optimiser
 #: asks for the same one at every population
@@ -111,7 +147,8 @@ def _walk(p: Params, conv: Conv, tx: float, ty: float, mpl: float, g: float) -> 
     return _WALKS[key]
 
 
-def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None = None) -> pd.DataFrame:
+def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None = None,
+                    wanted: Collection[str] | None = None) -> pd.DataFrame:
     """Summaries of many &manipulator design decks in one Fortran call: one row per deck.
 
     ``base``: a validated ``&manipulator`` Params.  ``columns``: {key: n values} for keys in
@@ -123,13 +160,22 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     and ``design_status`` (analysis.DESIGN_STATUS) saying why a figure is missing.
     A bad value raises DeckError (deck, line and key of the base deck; the design's index in the
     message) or ValueError for a plain mapping.  About 0.5 us per design on one core
-    (bench/bench_manipulator.py), a tenth of it in the kernel.
+    (bench/bench_manipulator.py), a tenth of it in the kernel.  ``wanted``: only these
+    columns, computed by only the passes they need (:data:`BATCH_PASSES`; the same values as
+    in a full summary); None: all.
     """
-    return pd.DataFrame(_arrays(base, columns))
+    out = _arrays(base, columns, wanted)
+    if wanted is not None:
+        names = set(wanted)
+        out = {k: v for k, v in out.items() if k in names}
+    return pd.DataFrame(out)
 
 
-def _arrays(base: Mapping[str, Any], columns: Mapping[str, Any] | None) -> dict[str, np.ndarray]:
-    """The columns of :func:`summarise_batch` as numpy arrays (what :func:`summarise` reads)."""
+def _arrays(base: Mapping[str, Any], columns: Mapping[str, Any] | None,
+            wanted: Collection[str] | None = None) -> dict[str, np.ndarray]:
+    """The columns of :func:`summarise_batch` as numpy arrays (what :func:`summarise` reads);
+    the passes ``wanted`` needs only (None: all)."""
+    passes = _passes(wanted)
     p = _as_params(base)
     columns = {k.partition(".")[2] if k.startswith("manipulator.") else k: v for k, v in (columns or {}).items()}
     unknown = [k for k in columns if k not in BATCH_KEYS and k not in BATCH_IGNORED]
@@ -168,11 +214,12 @@ def _arrays(base: Mapping[str, Any], columns: Mapping[str, Any] | None) -> dict[
         prm[:, j] = np.repeat(v, k)
     rates = [*p.joint_rates, *p.joint_accels]
     unit = _mc_samples(p.mc_seed, p.mc_samples)
-    res = kernels.manipulator_design_summaries(ws.x, ws.y, prm, p.elbow, rates, p.error_measure, unit)
+    bits = sum(b for k, b in kernels.MANIPULATOR_PASSES.items() if k in passes)
+    res = kernels.manipulator_design_summaries(ws.x, ws.y, prm, p.elbow, rates, p.error_measure, unit, passes=bits)
     r = {c: res[:, i].reshape(n, k) for i, c in enumerate(kernels.MANIPULATOR_SUMMARY_COLUMNS)}
     ok = r["target_status"] == STATUS["ok"]
     tau1, tau2 = r["tau1"], r["tau2"]
-    if conv.report:
+    if conv.report and "target" in passes:
         tau1, tau2 = _report_torques(p, prm, r, n, k)
 
     out: dict[str, Any] = {c: np.full(n, v, dtype=object if isinstance(v, str) else None)
@@ -193,14 +240,16 @@ def _arrays(base: Mapping[str, Any], columns: Mapping[str, Any] | None) -> dict[
     out.update({"design_l1_m": d1, "design_l2_m": d2, "design_ri1": nan(ri1, ri1 > 0), "design_ri2": ri2.copy(),
                 "design_ri3": r["ri3"][:, 0].copy(), "design_ri2_excess": ri2 - math.sqrt(ws.n),
                 "design_reaches_all": reach, "design_crob_residual_m2": d1 * d1 + d2 * d2 - ws.mean_d2,
-                "design_total_torque_Nm": nan(tau1[:, 0] + tau2[:, 0], ok[:, 0]),
+                **design_torque_columns(tau1[:, 0], tau2[:, 0], ok[:, 0]),
                 "design_status": _status(reach, ok[:, 0], ri1)})
+    if "walk" not in passes:
+        return out
     # the C_rob walk: once per distinct target, mass per length and g
     codes = [np.unique(v, return_inverse=True) for v in (tx, ty, mpl, g)]
     flat = np.ravel_multi_index([c[1].ravel() for c in codes], [len(c[0]) for c in codes])
     first, inv = np.unique(flat, return_index=True, return_inverse=True)[1:]
     walks = [_walk(p, conv, float(tx[i]), float(ty[i]), float(mpl[i]), float(g[i])) for i in first]
-    for c in ("sweep_min_total_torque_Nm", "sweep_min_l1_m", "sweep_min_l2_m", "sweep_min_row",
+    for c in ("sweep_min_tau_sum_signed_Nm", "sweep_min_l1_m", "sweep_min_l2_m", "sweep_min_row",
               "sweep_min_reaches_workspace"):
         vals = [w.get(c) for w in walks]
         if all(v is None for v in vals):
@@ -282,8 +331,17 @@ def summarise(params: Params) -> dict[str, Any]:
         elif isinstance(v, np.floating):
             v = float(v)
         out[key] = v
-    if out.get("sweep_min_total_torque_Nm") is None:   # as a run: no C_rob row reaches the target
-        for key in ("sweep_min_total_torque_Nm", "sweep_min_l1_m", "sweep_min_l2_m", "sweep_min_row",
+    if out.get("sweep_min_tau_sum_signed_Nm") is None:   # as a run: no C_rob row reaches the target
+        for key in ("sweep_min_tau_sum_signed_Nm", "sweep_min_l1_m", "sweep_min_l2_m", "sweep_min_row",
                     "sweep_min_reaches_workspace"):
             out.pop(key, None)
     return out
+
+
+def batch_refusal(row: Mapping[str, Any]) -> str | None:
+    """Why the study's own run refuses the design of a batch row, or None: an optimiser ranks such a
+    row as the case-by-case route does (the run refuses designs that violate the reach conditions)."""
+    if row.get("design_status") == "unreachable":
+        return ("designs_l1: design 1 violates the reach conditions |l1 - l2| <= r and l1 + l2 >= R: "
+                "it cannot reach every workspace point")
+    return None

@@ -116,15 +116,28 @@ def workspace_columns(p: Params, ws: Workspace, conv: Conv) -> dict[str, Any]:
 
 
 def sweep_columns(sweep: dict) -> dict[str, Any]:
-    """Summary columns of the least total torque along C_rob (Table 4.8); none when no row
-    reaches the target."""
+    """Summary columns of the least signed sum tau1 + tau2 along C_rob (Table 4.8's 'total
+    torque', as the report ranks it); none when no row reaches the target."""
     tot = np.where(sweep["ok"], sweep["tau"].sum(1), np.inf)
     if not np.isfinite(tot).any():
         return {}
     k = int(np.argmin(tot))
-    return {"sweep_min_total_torque_Nm": float(tot[k]), "sweep_min_l1_m": float(sweep["l1"][k]),
+    return {"sweep_min_tau_sum_signed_Nm": float(tot[k]), "sweep_min_l1_m": float(sweep["l1"][k]),
             "sweep_min_l2_m": float(sweep["l2"][k]), "sweep_min_row": k + 1,
             "sweep_min_reaches_workspace": bool(sweep["reach_all"][k])}
+
+
+def design_torque_columns(tau1: Any, tau2: Any, ok: Any) -> dict[str, Any]:
+    """The design's torques at the target [N m]: the signed sum tau1 + tau2 (the report's 'total
+    torque': a negative torque lowers it, so it is no measure of effort), the demand |tau1| + |tau2|
+    and the peak max(|tau1|, |tau2|) (the arm holds one pose: no trajectory, so no peak over time).
+    Scalars or arrays (the batch path); missing (None / NaN) where ``ok`` is false."""
+    t1, t2 = np.asarray(tau1, dtype=float), np.asarray(tau2, dtype=float)
+    cols = {"design_tau_sum_signed_Nm": t1 + t2, "design_torque_demand_Nm": np.abs(t1) + np.abs(t2),
+            "design_peak_torque_Nm": np.fmax(np.abs(t1), np.abs(t2))}
+    if np.ndim(t1) == 0:
+        return {k: (float(v) if ok else None) for k, v in cols.items()}
+    return {k: np.where(ok, v, np.nan) for k, v in cols.items()}
 
 
 def _summary(p: Params, ws: Workspace, conv: Conv, used: dict, sweep: dict, tol: list[dict]) -> dict[str, Any]:
@@ -145,7 +158,7 @@ def _summary(p: Params, ws: Workspace, conv: Conv, used: dict, sweep: dict, tol:
               "design_ri2": float(ri[0, 1]), "design_ri3": float(ri[0, 2]),
               "design_ri2_excess": float(ri[0, 1]) - math.sqrt(ws.n),
               "design_reaches_all": bool(reach[0]), "design_crob_residual_m2": l1 * l1 + l2 * l2 - ws.mean_d2,
-              "design_total_torque_Nm": float(used["tau"][0].sum()) if used["ok"][0] else None,
+              **design_torque_columns(used["tau"][0, 0], used["tau"][0, 1], bool(used["ok"][0])),
               "design_status": design_status(bool(reach[0]), bool(used["ok"][0]), float(ri[0, 0]))})
     s.update(sweep_columns(sweep))
     return s

@@ -46,17 +46,40 @@ from driver.runner import compute, output_stem, write_outputs
 __all__ = ["SPEC", "OptimizeOutcome", "optimize", "run_optimize_deck", "problem_of"]
 
 EXIT_OK, EXIT_FAILED = 0, 1
+#: methods whose every step is free of BLAS (their evaluations are the deterministic kernel's): the
+#: best design they evaluated is the same on every machine
+DETERMINISTIC = ("differential_evolution", "grid")
+
+
+def o_method(problem: Problem) -> str:
+    return problem.opts.method
+
+
+class DesignVector(dict):
+    """A design: {'group.key': value} in the order of the variables, and an array
+    (``np.asarray(x)``) with its ``names``."""
+
+    @property
+    def names(self) -> list[str]:
+        return list(self.keys())
+
+    def __array__(self, dtype: Any = None, copy: Any = None) -> np.ndarray:
+        return np.array(list(self.values()), dtype=dtype or np.float64)
 
 
 @dataclass
 class OptimizeOutcome:
-    """Result of an optimisation (scipy.optimize.OptimizeResult-like).
+    """Result of an optimisation, shaped like ``scipy.optimize.OptimizeResult``.
 
-    x         best feasible design {'group.key': value} (None when none is feasible)
-    fun       its objective value (the expression's value, not sign-flipped)
-    success   the method converged and x is feasible: x is an optimum
-    message   the method's words
-    nfev      designs evaluated (each distinct design once)
+    x            best feasible design: a :class:`DesignVector` ({'group.key': value}, and an
+                 array by ``np.asarray(x)`` with ``x.names``); None when none is feasible
+    fun          its objective value (the expression's value, not sign-flipped)
+    success      the method converged and x is feasible: x is an optimum
+    status       0 optimum, 1 not converged (x is the best feasible design found), 2 no feasible design
+    message      the method's words
+    nit          iterations (generations for differential evolution; all starts' for local methods)
+    nfev         designs evaluated (each distinct design once)
+    constraints  per constraint at x: text, kind, value, margin, tolerance, met (see :meth:`to_dict`)
     """
 
     problem: Problem
@@ -72,6 +95,58 @@ class OptimizeOutcome:
     evaluator: Evaluator
     written: list[Path] = field(default_factory=list)
     study_result: Any = None
+
+    @property
+    def status(self) -> int:
+        return 0 if self.success else (2 if self.x is None else 1)
+
+    @property
+    def nit(self) -> int:
+        return int(self.method.iterations)
+
+    @property
+    def constraints(self) -> list[dict]:
+        """Constraint values and margins at x (empty without a feasible design)."""
+        if self.best is None:
+            return []
+        r, out = self.best, []
+        for k, c in enumerate(self.problem.constraints):
+            kind = "equality" if c.equality else ("inequality" if c.sense else "condition")
+            num = lambda v: (float(v) if v is not None and math.isfinite(v) else None)
+            out.append({"constraint": c.text, "kind": kind,
+                        "value": num(r.values[k]) if (c.numeric and r.values) else None,
+                        "margin": num(r.margins[k]) if r.margins else None,
+                        "tolerance": num(r.tols[k]) if (c.numeric and r.tols) else None,
+                        "met": bool(r.met[k]) if r.met else False})
+        return out
+
+    def to_dict(self) -> dict:
+        """The result as plain data (the ``--json`` record): scipy's fields, the constraints at x,
+        the starts of a local method and the polish of differential evolution."""
+        p = self.problem
+        rec = {"study": p.study.SPEC.name, "deck": str(p.deck.path), "objective": p.objective_text,
+               "x": None if self.x is None else [float(v) for v in self.x.values()], "x_names": p.names,
+               "fun": self.fun, "success": self.success, "status": self.status, "message": self.message,
+               "nit": self.nit, "nfev": self.nfev, "constraint_tol": p.opts.constraint_tol,
+               "constraints": self.constraints,
+               "warnings": list(self.study_result.warnings) if self.study_result is not None else []}
+        if self.method.starts:
+            rec["starts"] = [{"start": r["start"], "x0": [float(v) for v in r["x0"]],
+                              "end": [float(v) for v in r["x"]], "objective": _num(r["objective"]),
+                              "feasible": bool(r["feasible"]), "settled": bool(r["settled"]),
+                              "reached": bool(r.get("reached", False)), "method_success": bool(r["success"]),
+                              "method_message": r["message"], "iterations": r["iterations"]} for r in self.method.starts]
+        if self.method.polish is not None:
+            rec["polish"] = self.method.polish["text"]
+        return rec
+
+
+def _num(v: Any) -> float | None:
+    try:
+        v = float(v)
+    except (TypeError, ValueError):
+        return None
+    return v if math.isfinite(v) else None
 
 
 def _probe(problem: Problem) -> None:
@@ -98,8 +173,16 @@ def _probe(problem: Problem) -> None:
     exprs = [("minimize" if problem.sense > 0 else "maximize", problem.objective)]
     nums = [n for n in range(1, 10) if o[f"constraint{n}"] is not None]
     exprs += [(f"constraint{n}", c.whole) for n, c in zip(nums, problem.constraints)]
+    unknown = [c for c in o.summary_columns if c not in frame]
+    if unknown and clean:
+        raise o.error("summary_columns", f"unknown summary column '{unknown[0]}' of &{problem.raw.name} "
+                                         f"(columns: {', '.join(frame.columns)})")
     for key, e in exprs:
         missing = [name for name in sorted(e.names) if name not in frame]
+        renamed = getattr(problem.study, "RENAMED", {})
+        if missing and missing[0] in renamed:
+            raise o.error(key, f"summary column '{missing[0]}' of &{problem.raw.name} is now "
+                               f"{renamed[missing[0]]}")
         if missing and clean:   # a clean run of the deck's design has every column its study writes
             raise o.error(key, f"unknown summary column '{missing[0]}' of &{problem.raw.name} "
                                f"(columns: {', '.join(frame.columns)})")
@@ -179,7 +262,12 @@ def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[
         scheduler = _configured_scheduler() or None
     with Evaluator(problem, njobs, journal, resumed, scheduler) as ev:
         mres = run_method(ev, history)
-    best = ev.best()
+    best = mres.best if mres.best is not None else (ev.best() if o_method(problem) in DETERMINISTIC else None)
+    if best is None and o_method(problem) not in DETERMINISTIC and mres.starts:
+        # no start settled on a feasible design: the best feasible design evaluated, on the lattice
+        cand = ev.best()
+        best = None if cand is None else ev.evaluate(problem.snap(cand.x)[None, :])[0]
+        best = best if best is not None and best.feasible else None
     check, result, params = None, None, None
     if best is not None:
         params = design_params(problem, np.array(best.x))
@@ -188,7 +276,7 @@ def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[
         rec = Record(0, best.x, "failed" if result.failure else "ok", result.failure or "", dict(result.summary))
         probe._score([rec])
         check = rec
-    outcome = OptimizeOutcome(problem, None if best is None else dict(zip(problem.names, best.x)),
+    outcome = OptimizeOutcome(problem, None if best is None else DesignVector(zip(problem.names, best.x)),
                               None if best is None else best.objective, bool(mres.converged and best is not None),
                               mres.message, len(ev.records), best, check, mres, history, ev, study_result=result)
     if stem is not None:
@@ -213,7 +301,7 @@ def _write(oc: OptimizeOutcome, stem: Path, params, formats: list[str], plot: bo
     evals.insert(1, "base", p.fingerprint())
     hist = report.history_frame(p, oc.history)
     text = report.report_text(p, ev, oc.method, oc.history, oc.best, oc.check, files,
-                              ev.jobs)
+                              ev.jobs, list(oc.study_result.warnings) if oc.study_result is not None else [])
     written.append(write_text(stem.with_name(stem.name + ".out"), text))
     written.append(write_tidy(hist, stem.with_name(stem.name + "_history"), "csv"))
     for fmt in dict.fromkeys(["parquet"] + formats):
@@ -229,7 +317,7 @@ def _write(oc: OptimizeOutcome, stem: Path, params, formats: list[str], plot: bo
 
 def run_optimize_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool = False,
                       quiet: bool = False, jobs: int | None = None, resume: bool = False,
-                      scheduler: Any = None, **_: Any) -> int:
+                      scheduler: Any = None, summary_json: bool = False, **_: Any) -> int:
     """Command-line entry: run, report written files, return the exit status (DeckError propagates).
 
     Raises :class:`~driver.extras.MissingExtra` before running when pyarrow is missing (the
@@ -239,6 +327,10 @@ def run_optimize_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, 
     if scheduler:
         require("dask")
     oc = optimize(deck, outdir, formats, plot, jobs, resume, scheduler or None)
+    if summary_json:
+        stem = output_stem(outdir, deck.path)
+        oc.written.append(write_text(stem.with_name(stem.name + ".json"),
+                                     json.dumps(oc.to_dict(), indent=1, allow_nan=False) + "\n"))
     if oc.study_result is not None:
         for w in oc.study_result.warnings:
             print(f"warning: {deck.path}: optimum: {w}", file=sys.stderr)

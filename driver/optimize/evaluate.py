@@ -37,6 +37,9 @@ __all__ = ["Evaluator", "evaluate_cases", "FAILED_VIOLATION"]
 
 #: constraint violation given to a design whose case failed (ranks below every evaluated design)
 FAILED_VIOLATION = 1e6
+#: violation of a design whose constraints are met but the study's own run refuses (ranks it just
+#: below the feasible designs, so the polish steps back to one the study accepts)
+REFUSED_VIOLATION = 1e-300
 #: objective given to failed designs in the local methods (which need a finite number)
 FAILED_OBJECTIVE = 1e12
 #: a batch of designs goes to worker processes (-j) when it is estimated to take longer than
@@ -151,6 +154,10 @@ class Record:
     margins: tuple[float, ...] = ()
     met: tuple[bool, ...] = ()
     why: str = ""                   # infeasibility reason (counted in the report)
+    tols: tuple[float, ...] = ()    # feasibility tolerance of each constraint (its units; 0: a condition)
+    values: tuple[float, ...] = ()  # left side of each numeric constraint (NaN for a condition)
+    signed: tuple[float, ...] = ()  # a - b of each numeric constraint (NaN for a condition)
+    terms: tuple[float, ...] = ()   # epigraph terms of the objective (Problem.terms), if any
 
 
 class Evaluator:
@@ -311,20 +318,42 @@ class Evaluator:
             if name not in frame:
                 frame[name] = np.nan
         f = _values(p.objective, frame)
-        margins, met = [], []
+        terms = [_values(t, frame) for t in p.terms]
+        ctol = p.opts.constraint_tol
+        margins, met, tols, lefts, diffs = [], [], [], [], []
+        nan = np.full(len(frame), math.nan)
         for c in p.constraints:
-            truth = c.whole.mask(frame)
-            if c.sense:
-                m = c.sense * (_values(c.left, frame) - _values(c.right, frame))
+            numeric = c.numeric
+            if numeric:
+                try:
+                    a, b = _values(c.left, frame), _values(c.right, frame)
+                except expr.ExprError:      # 'a == b' over text columns: a condition after all
+                    numeric = False
+            if numeric:
+                # met within constraint_tol x max(1, |a|, |b|): the scale of the constraint's own numbers
+                tol = ctol * np.fmax(1.0, np.fmax(np.abs(a), np.abs(b)))
+                m = -np.abs(a - b) if c.equality else c.sense * (a - b)
                 m = np.where(np.isnan(m), -math.inf, m)
+                truth = m >= -tol
+                tol = np.where(np.isfinite(tol), tol, 0.0)
+                left, diff = a, a - b
             else:
+                truth = c.whole.mask(frame)
                 m = np.where(truth, 0.0, -1.0)
+                tol, left, diff = np.zeros(len(frame)), nan, nan
             margins.append(m)
             met.append(truth)
+            tols.append(tol)
+            lefts.append(left)
+            diffs.append(diff)
         for i, r in enumerate(ok):
             r.objective = float(f[i])
+            r.terms = tuple(float(t[i]) for t in terms)
             r.margins = tuple(float(m[i]) for m in margins)
             r.met = tuple(bool(t[i]) for t in met)
+            r.tols = tuple(float(t[i]) for t in tols)
+            r.values = tuple(float(v[i]) for v in lefts)
+            r.signed = tuple(float(v[i]) for v in diffs)
             viol = [0.0 if t else (min(-m, FAILED_VIOLATION) if math.isfinite(m) and m < 0 else
                                    (1.0 if math.isfinite(m) else FAILED_VIOLATION))
                     for m, t in zip(r.margins, r.met)]
@@ -335,6 +364,9 @@ class Evaluator:
             elif not all(r.met):
                 k = r.met.index(False)
                 r.why = f"violates constraint{_constraint_number(p, k)}"
+            elif r.reason:      # the study's own run refuses it (a batch row's verdict)
+                r.why = f"not a valid design: {_short(r.reason)}"
+                r.violation = max(r.violation, REFUSED_VIOLATION)
             r.feasible = not r.why
 
     # ------------------------------------------------------------------ views for the methods
@@ -391,16 +423,26 @@ def _batch_summaries(problem: Problem, xs: list[tuple[float, ...]]) -> list[tupl
     if applies is not None and not applies(problem.base):
         return None
     columns = {slot: np.array([x[i] for x in xs]) for i, slot in enumerate(_slots(problem))}
+    wanted = None
+    if problem.opts.summary_columns and hasattr(problem.study, "BATCH_PASSES"):
+        # only what the objective, the constraints and summary_columns read: only their passes run
+        wanted = sorted(_names(problem) | set(problem.opts.summary_columns))
     try:
-        frame = fn(problem.base, columns)
+        frame = fn(problem.base, columns) if wanted is None else fn(problem.base, columns, wanted=wanted)
     except DeckError:
         return None                     # some design is not a valid deck: case by case says which
     rows = frame.to_dict("records") if hasattr(frame, "to_dict") else list(frame)
+    # a design the study's own run refuses (DeckError case by case, e.g. an arm that cannot reach) is
+    # a batch row with a status: infeasible here too, so the optimum is a design the study accepts
+    refusal = getattr(problem.study, "batch_refusal", None)
     out = []
     for row in rows:
         row = {k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in row.items()}
         err = row.pop("error", None) or row.pop("case_error", None)
-        out.append(("failed", str(err), row) if err else ("ok", "", row))
+        why = refusal(row) if (refusal is not None and not err) else None
+        # the row keeps its summary (its margins stay smooth for a gradient method) and its reason:
+        # _score makes it infeasible
+        out.append(("failed", str(err), row) if err else ("ok", why or "", row))
     return out
 
 

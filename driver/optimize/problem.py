@@ -80,8 +80,19 @@ def _spec() -> GroupSpec:
                           doc="points per variable of the grid (method = 'grid' or start = 'grid')"),
         "max_evals": Key("int", default=200_000, check=_at_least(1),
                          doc="refuse a run that could need more design evaluations than this"),
+        "constraint_tol": Key("float", default=1e-7, check=lambda v: None if 0 <= v < 1 else "must be in [0, 1)",
+                              doc="feasibility tolerance, relative: a constraint a >= b (<=, ==) is met when "
+                                  "it is violated by at most constraint_tol x max(1, |a|, |b|) (in its units)"),
+        "resolution": Key("float", default=1e-7, check=lambda v: None if 0 < v < 1 else "must be in (0, 1)",
+                          doc="local methods and polish: the reported design is a point of the lattice of step "
+                              "10^floor(log10(resolution x (upper - lower))) per variable, polished there by a "
+                              "deterministic pattern search (the same design on every machine)"),
         "jobs": Key("int", default=0, check=lambda v: None if v >= 0 else "must not be negative",
                     doc="worker processes for studies without a batch path (0: all cores, 1: serial)"),
+        "summary_columns": Key("strs", default=[],
+                               doc="the summary columns the evaluations table records besides those the objective "
+                                   "and constraints read (default: all); on a study's batch path only the kernel "
+                                   "passes these columns need run"),
     })
     return GroupSpec("optimize", keys, doc="optimise a study's design over bounded deck keys")
 
@@ -102,9 +113,11 @@ class Variable:
 
 @dataclass(frozen=True)
 class Constraint:
-    """A constraint expression; ``left``/``right`` set when it is a numeric inequality.
+    """A constraint expression; ``left``/``right`` set when it is a numeric inequality or equality.
 
-    ``sense`` is +1 for ``left >= right`` (margin left - right) and -1 for ``left <= right``.
+    ``sense`` is +1 for ``left >= right`` (margin left - right), -1 for ``left <= right``
+    (margin right - left); ``equality`` for ``left == right`` (margin -|left - right|).  Met
+    within the problem's tolerance ``constraint_tol x max(1, |left|, |right|)``.
     """
 
     text: str
@@ -112,6 +125,11 @@ class Constraint:
     left: expr.Expr | None = None
     right: expr.Expr | None = None
     sense: int = 0
+    equality: bool = False
+
+    @property
+    def numeric(self) -> bool:
+        return bool(self.sense or self.equality)
 
 
 @dataclass
@@ -127,6 +145,9 @@ class Problem:
     objective: expr.Expr
     sense: int                 # +1 minimise, -1 maximise
     constraints: list[Constraint] = field(default_factory=list)
+    #: epigraph terms: 'maximize = min(a, b, ...)' / 'minimize = max(a, b, ...)' -> [a, b, ...]
+    #: (gradient methods then solve min s subject to s >= sense x term, smooth at the optimum)
+    terms: list[expr.Expr] = field(default_factory=list)
 
     @property
     def names(self) -> list[str]:
@@ -141,6 +162,33 @@ class Problem:
         return np.array([v.upper for v in self.variables])
 
     @property
+    def steps(self) -> np.ndarray:
+        """Lattice step of each variable (deck units): 10^floor(log10(resolution x span))."""
+        return np.array([10.0 ** self.exponents[i] for i in range(len(self.variables))])
+
+    @property
+    def exponents(self) -> list[int]:
+        r = self.opts.resolution
+        return [math.floor(math.log10(r * (v.upper - v.lower))) for v in self.variables]
+
+    def snap(self, x: Any) -> np.ndarray:
+        """The lattice point nearest ``x`` inside the bounds, each value the double nearest its
+        decimal text (so the design and the deck written from it read the same)."""
+        out = []
+        for v, e, xi in zip(self.variables, self.exponents, np.asarray(x, dtype=np.float64)):
+            k = round(float(xi) / 10.0 ** e)
+            val = float(f"{k * 10.0 ** e:.{max(0, -e)}f}") if e < 0 else float(k * 10 ** e)
+            if val < v.lower or val > v.upper:
+                val = min(max(val, v.lower), v.upper)
+            out.append(val)
+        return np.array(out)
+
+    def x_text(self, i: int, value: float) -> str:
+        """Variable i's value with the lattice's decimals."""
+        e = self.exponents[i]
+        return f"{value:.{max(0, -e)}f}"
+
+    @property
     def objective_text(self) -> str:
         return f"{'minimize' if self.sense > 0 else 'maximize'} {self.objective.text}"
 
@@ -148,21 +196,46 @@ class Problem:
         """Hash of everything that changes an evaluation's result (study group minus the variables)."""
         whole = {v.key for v in self.variables if v.index is None}
         fixed = {k: v for k, v in self.raw.values.items() if k not in whole}
-        blob = json.dumps([self.raw.name, sorted(fixed.items(), key=lambda kv: kv[0])], default=str)
+        parts: list[Any] = [self.raw.name, sorted(fixed.items(), key=lambda kv: kv[0])]
+        if self.opts.summary_columns:   # fewer columns recorded: another set of evaluations
+            parts.append(sorted(self.opts.summary_columns))
+        blob = json.dumps(parts, default=str)
         return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 
-def _split(e: expr.Expr) -> tuple[expr.Expr | None, expr.Expr | None, int]:
-    """A single numeric inequality ``a OP b`` -> (a, b, sense), else (None, None, 0)."""
+def _sub(e: expr.Expr, node: ast.AST) -> expr.Expr:
+    """The sub-expression ``node`` of ``e`` (reads a subset of e's columns)."""
+    return expr.Expr(e.text, e.names, ast.Expression(body=node), e._source, e._aliases)
+
+
+def _split(e: expr.Expr) -> tuple[expr.Expr | None, expr.Expr | None, int, bool]:
+    """A single numeric comparison ``a OP b`` -> (a, b, sense, equality), else (None, None, 0, False).
+
+    ``a == b`` is an equality unless a side is a text or logical constant (``grashof_class ==
+    "crank-rocker"`` is a condition, met or not)."""
     body = e._tree.body
     if not (isinstance(body, ast.Compare) and len(body.ops) == 1):
-        return None, None, 0
+        return None, None, 0, False
     op = body.ops[0]
+    if isinstance(op, ast.Eq):
+        sides = (body.left, body.comparators[0])
+        if any(isinstance(n, ast.Constant) and not isinstance(n.value, (int, float)) or
+               isinstance(n, ast.Constant) and isinstance(n.value, bool) for n in sides):
+            return None, None, 0, False
+        return _sub(e, body.left), _sub(e, body.comparators[0]), 0, True
     sense = 1 if isinstance(op, (ast.Gt, ast.GtE)) else (-1 if isinstance(op, (ast.Lt, ast.LtE)) else 0)
     if not sense:
-        return None, None, 0
-    side = lambda node: expr.Expr(e.text, e.names, ast.Expression(body=node), e._source, e._aliases)
-    return side(body.left), side(body.comparators[0]), sense
+        return None, None, 0, False
+    return _sub(e, body.left), _sub(e, body.comparators[0]), sense, False
+
+
+def _terms(e: expr.Expr, sense: int) -> list[expr.Expr]:
+    """Arguments of a top-level min(...) maximised or max(...) minimised (an epigraph form)."""
+    body = e._tree.body
+    if (isinstance(body, ast.Call) and isinstance(body.func, ast.Name) and not body.keywords
+            and body.func.id == ("min" if sense < 0 else "max") and len(body.args) >= 2):
+        return [_sub(e, a) for a in body.args]
+    return []
 
 
 def _parse_expr(opts: Params, key: str) -> expr.Expr:
@@ -237,8 +310,8 @@ def problem_of(deck: Deck) -> Problem:
         if opts[f"constraint{k}"] is None:
             continue
         whole = _parse_expr(opts, f"constraint{k}")
-        left, right, sense = _split(whole)
-        constraints.append(Constraint(whole.text, whole, left, right, sense))
+        left, right, sense, eq = _split(whole)
+        constraints.append(Constraint(whole.text, whole, left, right, sense, eq))
     n = len(variables)
     worst = _worst_evals(opts, n)
     if worst > opts.max_evals or worst > MAX_EVALS:
@@ -246,7 +319,8 @@ def problem_of(deck: Deck) -> Problem:
                                                        and opts.start == "grid") else "maxiter"
         raise opts.error(key, f"this run may need {worst:.3g} design evaluations, more than max_evals = "
                               f"{min(opts.max_evals, MAX_EVALS)}; reduce it or raise max_evals (at most {MAX_EVALS})")
-    return Problem(deck, study, raw, base, opts, variables, objective, 1 if okey == "minimize" else -1, constraints)
+    sense = 1 if okey == "minimize" else -1
+    return Problem(deck, study, raw, base, opts, variables, objective, sense, constraints, _terms(objective, sense))
 
 
 def _worst_evals(opts: Params, n: int) -> float:

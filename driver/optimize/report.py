@@ -50,63 +50,110 @@ def optimum_deck(p: Problem, params: Params, rec: Record, converged: bool) -> st
 def _constraint_rows(p: Problem, rec: Record) -> list[list]:
     rows = []
     for k, c in enumerate(p.constraints):
-        value = "-"
-        if c.sense and rec.summary:
-            frame = pd.DataFrame([rec.summary])
-            for name in c.whole.names:
-                if name not in frame:
-                    frame[name] = np.nan
-            try:
-                value = _g(float(np.asarray(c.left.evaluate(frame), dtype=float)[0]))
-            except (TypeError, ValueError):
-                value = "-"
+        value = _g(rec.values[k]) if c.numeric and rec.values and math.isfinite(rec.values[k]) else "-"
         m = rec.margins[k] if rec.margins else -math.inf
-        rows.append([f"{k + 1}", c.text, value, _g(m) if math.isfinite(m) else "-", "yes" if rec.met and rec.met[k] else "NO"])
+        tol = _g(rec.tols[k]) if c.numeric and rec.tols else "-"
+        met = "NO" if not (rec.met and rec.met[k]) else ("yes" if m >= 0 or not c.numeric else "yes, within tol")
+        rows.append([f"{k + 1}", c.text, value, _g(m) if math.isfinite(m) else "-", tol, met])
     return rows
 
 
+def deterministic(p: Problem) -> bool:
+    """The method has no BLAS-dependent step (differential evolution without polish, grid):
+    its counts and history are the same on every machine and may be printed."""
+    return p.opts.method == "grid" or (p.opts.method == "differential_evolution" and not p.opts.polish)
+
+
+def lattice(p: Problem) -> bool:
+    """The reported design is a lattice point (local methods, or the evolution's polish when it won)."""
+    return not deterministic(p)
+
+
+def x_text(p: Problem, i: int, v: float, on_lattice: bool) -> str:
+    return p.x_text(i, v) if on_lattice else _g(v)
+
+
 def report_text(p: Problem, ev: Evaluator, mres: MethodResult, history: list[HistoryRow],
-                best: Record | None, check: Record | None, files: list[str], jobs: int) -> str:
-    """The optimisation's .out file."""
+                best: Record | None, check: Record | None, files: list[str], jobs: int,
+                warnings: list[str] | None = None) -> str:
+    """The optimisation's .out file.
+
+    Everything printed is the same on every machine (BLAS kernel, thread count, CPU): designs
+    from a BLAS-dependent method (SLSQP, trust-constr) are lattice points polished by a
+    deterministic pattern search, every value is the study's (deterministic) kernel at the
+    printed design, and counts of iterations and evaluations -- which follow the floating-point
+    path -- are printed only for methods without such a step (the tables keep them).
+    """
     o = p.opts
+    det = deterministic(p)
+    on_lat = best is not None and not (o.method == "differential_evolution" and
+                                       (mres.polish is None or mres.polish.get("record") is None))
+    on_lat = on_lat and o.method != "grid"
     L = [f"  optimisation of &{p.study.SPEC.name} from deck {p.deck.path}", ""]
+    epi = "   (max-min form: solved as its epigraph by the gradient method)" if p.terms and o.method in (
+        "slsqp", "trust-constr") or (p.terms and o.polish) else ""
     L += [f"    method ............... {method_line(p)}",
-          f"    objective ............ {p.objective_text}"]
+          f"    objective ............ {p.objective_text}{epi}"]
     for k, c in enumerate(p.constraints):
-        kind = "inequality, margin in its units" if c.sense else "condition, met or not"
+        kind = ("equality, met within its tolerance" if c.equality else
+                "inequality, margin in its units" if c.sense else "condition, met or not")
         L.append(f"    constraint ........... {c.text}   ({kind})")
+    if any(c.numeric for c in p.constraints):
+        L.append(f"    feasibility .......... a constraint a >= b, a <= b or a == b is met when violated by at most "
+                 f"constraint_tol x max(1, |a|, |b|), constraint_tol = {o.constraint_tol:g}")
+    if det:
+        L.append("    precision ............ every step of the method is free of BLAS: the design is the best one it "
+                 "evaluated (the optimum to the method's tol/atol), its values the study's at that design")
+    else:
+        L.append(f"    precision ............ the design is a point of the lattice of the 'step' column (resolution "
+                 f"{o.resolution:g} of each range), polished there by a deterministic pattern search; its values are "
+                 "the study's at that design.  The path of the gradient method (iterations, evaluations, the ends "
+                 "before the polish) follows the floating-point path and is in the _history and _evals tables only")
     L.append("")
     cols = [Column("variable", "s", 24, 0, 4), Column("lower", "s", 14, 0, 2), Column("upper", "s", 14, 0, 2),
-            Column("deck value", "s", 14, 0, 2), Column("optimum" if mres.converged else "best found", "s", 18, 0, 2)]
+            Column("deck value", "s", 14, 0, 2)]
+    if not det:
+        cols.append(Column("step", "s", 8, 0, 2))
+    cols.append(Column("optimum" if mres.converged else "best found", "s", 18, 0, 2))
     rows = []
     for i, v in enumerate(p.variables):
         base = p.base[v.key]
         base = base[(v.index or 1) - 1] if isinstance(base, list) else base
-        rows.append([v.name, _g(v.lower), _g(v.upper), _g(base), _g(best.x[i]) if best else "-"])
+        row = [v.name, _g(v.lower), _g(v.upper), _g(base)]
+        if not det:
+            row.append(f"{p.steps[i]:.0e}")
+        rows.append(row + [x_text(p, i, best.x[i], on_lat) if best else "-"])
     L += render_table(cols, rows) + [""]
     status = "CONVERGED" if mres.converged else "NOT CONVERGED"
     L += [f"  Result: {status} -- {mres.message}"]
+    unsettled = [w for w in (warnings or []) if "not settled" in w.lower()]
+    if best is not None and unsettled:
+        L += ["    BUT NOT SETTLED: the optimum's full run has not settled (its values are those of a run "
+              "that needs more revolutions; see the warnings below)"]
     if best is None:
         least = ev.least_infeasible()
-        L += ["    no feasible design was evaluated; nothing is reported as an optimum."]
-        if least is not None:
+        L += ["    no feasible design was found; nothing is reported as an optimum."]
+        if least is not None and det:
             L += ["    least infeasible design: " + ", ".join(f"{n} = {_g(x)}" for n, x in zip(p.names, least.x))
                   + f" ({least.why})"]
     else:
-        what = "optimum" if mres.converged else "best feasible design evaluated (not an optimum: the method did not converge)"
+        what = "optimum" if mres.converged else "best feasible design (not an optimum: the method did not converge)"
         L += [f"    {what}",
-              f"    objective ............ {p.objective.text} = {_g(best.objective)}  (evaluation {best.index + 1})"]
-    n_bad = sum(1 for r in ev.records if not r.feasible)
-    L += [f"    evaluations .......... {len(ev.records)} designs; {mres.iterations} "
-          f"{'generations' if o.method == 'differential_evolution' else 'iterations'}",
-          f"    infeasible designs ... {n_bad}"]
-    for why, count in ev.reasons().items():
-        L.append(f"      {count:>8}  {why}")
+              f"    objective ............ {p.objective.text} = {_g(best.objective)}"]
+    if mres.polish is not None:
+        L += [f"    polish ............... {mres.polish['text']}"]
+    if det:
+        n_bad = sum(1 for r in ev.records if not r.feasible)
+        L += [f"    evaluations .......... {len(ev.records)} designs; {mres.iterations} "
+              f"{'generations' if o.method == 'differential_evolution' else 'iterations'}",
+              f"    infeasible designs ... {n_bad}"]
+        for why, count in ev.reasons().items():
+            L.append(f"      {count:>8}  {why}")
     L.append("")
     if best is not None and p.constraints:
         L += ["  Constraints at the " + ("optimum" if mres.converged else "best design")]
         cols = [Column("#", "s", 3, 0, 4), Column("constraint", "s", 40, 0, 2), Column("value", "s", 16, 0, 2),
-                Column("margin", "s", 16, 0, 2), Column("met", "s", 4, 0, 2)]
+                Column("margin", "s", 16, 0, 2), Column("tolerance", "s", 10, 0, 2), Column("met", "s", 15, 0, 2)]
         L += render_table(cols, _constraint_rows(p, best)) + [""]
     if best is not None and check is not None:
         same = (check.feasible == best.feasible and
@@ -116,25 +163,38 @@ def report_text(p: Problem, ev: Evaluator, mres: MethodResult, history: list[His
               f"    {files[0] if files else ''}",
               f"    objective {_g(check.objective)}, feasible {_g(check.feasible)}, margins "
               + (", ".join(_g(m) for m in check.margins) or "-")
-              + ("  -- agrees with the evaluation" if same else "  -- DIFFERS from the evaluation"), ""]
+              + ("  -- agrees with the evaluation" if same else "  -- DIFFERS from the evaluation")]
+        L += [f"    warning: {w}" for w in (warnings or [])] + [""]
     if mres.starts:
-        L += ["  Local starts"]
-        cols = [Column("start", "s", 5, 0, 4)] + [Column(n, "s", 16, 0, 2) for n in p.names] + [
-            Column("objective", "s", 16, 0, 2), Column("feasible", "s", 8, 0, 2), Column("converged", "s", 9, 0, 2),
-            Column("iter", "s", 5, 0, 2)]
-        rows = [[str(r["start"])] + [_g(x) for x in r["x"]] + [_g(r["objective"]), _g(r["feasible"]),
-                                                                _g(r["success"]), str(r["iterations"])]
-                for r in mres.starts]
+        top = mres.best.objective if mres.best is not None else None
+        L += ["  Local starts (where each ended follows the method's floating-point path: the _history table has it)",
+              f"    reached = its end, polished on the lattice, is feasible and within tol x max(1, |f|) of the best"]
+        cols = [Column("start", "s", 5, 0, 4)] + [Column(f"{n} (start)", "s", 16, 0, 2) for n in p.names] + [
+            Column("outcome", "s", 40, 0, 2)]
+        rows = []
+        for r in mres.starts:
+            if r.get("reached"):
+                word = "reached the optimum"
+            elif r["settled"] and r["feasible"]:
+                word = f"another local optimum, f = {r['objective']:.6g}"
+            elif r["feasible"]:
+                word = "feasible, did not settle"
+            else:
+                word = "ended infeasible"
+            rows.append([str(r["start"])] + [_g(x) for x in r["x0"]] + [word])
         L += render_table(cols, rows) + [""]
-    L += ["  History: best feasible design after each " +
-          {"differential_evolution": "generation", "grid": "grid batch"}.get(o.method, "iteration")]
-    cols = [Column("step", "s", 24, 0, 4), Column("evals", "s", 8, 0, 2), Column("objective", "s", 16, 0, 2)] + [
-        Column(n, "s", 16, 0, 2) for n in p.names]
-    rows = [[h.step, str(h.evals), _g(h.objective) if h.feasible else "none feasible"] + [_g(x) for x in h.x]
-            for h in _thin(history)]
-    L += render_table(cols, rows)
-    if len(history) > len(_thin(history)):
-        L.append(f"    ({len(history)} rows in all; the _history table has every one)")
+    if det:
+        L += ["  History: best feasible design after each " +
+              {"differential_evolution": "generation", "grid": "grid batch"}.get(o.method, "iteration")]
+        cols = [Column("step", "s", 24, 0, 4), Column("evals", "s", 8, 0, 2), Column("objective", "s", 16, 0, 2)] + [
+            Column(n, "s", 16, 0, 2) for n in p.names]
+        rows = [[h.step, str(h.evals), _g(h.objective) if h.feasible else "none feasible"] + [_g(x) for x in h.x]
+                for h in _thin(history)]
+        L += render_table(cols, rows)
+        if len(history) > len(_thin(history)):
+            L.append(f"    ({len(history)} rows in all; the _history table has every one)")
+    else:
+        L.append("  History: in the _history table (its rows follow the method's floating-point path)")
     return "\n".join(L).rstrip() + "\n"
 
 

@@ -55,6 +55,10 @@ def estimate(params: Params) -> Estimate:
             dof = 3.0 * (n + 1)
             work += 2e-7 * dof * steps
             mem = max(mem, dof * 8.0 * 40 + rec * (dof * 8.0 * 3 + 400.0))
+    if p.model == "nonlinear":   # Newton, 1-2 solves of the assembled tangent a step: about 3.5e-7 s per
+        work *= 3.0              # dof and step (the linear rate above is a generous bound), plus the linear
+        grid = len(p.onset_speeds or ())    # run beside it; the onset search runs onset_elements, ~14 bisections
+        work += (grid + 14 if grid else 0) * 6e-7 * 3.0 * (p.onset_elements + 1) * p.revolutions * p.steps_per_rev
     work += 3e-4 * 3.0 * (counts[-1] + 1)      # static_onset on the reported mesh
     key = "end_time" if p.end_time > 0 else ("steps_per_rev" if p.steps_per_rev > 100_000 else
                                              ("element_counts" if p.element_counts else "n_elements"))
@@ -66,6 +70,9 @@ def estimate(params: Params) -> Estimate:
 @keyword_run
 def run(params: Params, progress: bool = False) -> Result:
     """Run every crank speed (and element count) of the deck; see the module docstring."""
+    if params.model == "nonlinear":
+        from driver.slidercrank.report_nl import run_nonlinear
+        return run_nonlinear(params, progress)
     model = _model(params)
     w_bend, w_axial, p_euler = model.frequencies()
     alpha, beta = rayleigh(params.damping_ratio, w_bend, w_axial)

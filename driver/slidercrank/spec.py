@@ -68,6 +68,22 @@ def _revs(v: int) -> str | None:
     return None if 1 <= v <= 1000 else f"must be between 1 and 1000 (got {v})"
 
 
+def _fraction_tol(v: float) -> str | None:
+    return None if 1e-14 <= v <= 1e-2 else f"must be between 1e-14 and 1e-2 (got {v})"
+
+
+def _hht(v: float) -> str | None:
+    return None if -1 / 3 <= v <= 0 else f"must be between -1/3 and 0 (got {v})"
+
+
+def _iterations(v: int) -> str | None:
+    return None if 1 <= v <= 200 else f"must be between 1 and 200 (got {v})"
+
+
+def _cuts(v: int) -> str | None:
+    return None if 0 <= v <= 20 else f"must be between 0 and 20 (got {v})"
+
+
 _SECTION_DOC = "(default: from the named material's Table 1a column)"
 
 _KEYS: dict[str, Key] = {
@@ -119,6 +135,33 @@ _KEYS: dict[str, Key] = {
                         "(benchmark mode, one speed) instead of the last revolution"),
     "benchmark": Key("str", default="none", choices=("none", "simeon1996"),
                      doc="compare the end state with a published reference solution"),
+    "model": Key("str", default="linear", choices=("linear", "nonlinear"),
+                 doc="rod model: the paper's linear KED frame elements, or geometrically nonlinear "
+                     "co-rotational elements (large deflections; reported beside the linear model)"),
+    "newton_tolerance": Key("float", default=1e-8, check=_fraction_tol, units="-",
+                            doc="nonlinear model: Newton converged when the residual is below this "
+                                "fraction of the load and internal-force norms"),
+    "hht_alpha": Key("float", default=-0.05, check=_hht, units="-",
+                     doc="nonlinear model: HHT-alpha parameter in [-1/3, 0]; 0 is Newmark average "
+                         "acceleration (no numerical damping), < 0 damps the unresolved high frequencies"),
+    "newton_max_iterations": Key("int", default=25, check=_iterations,
+                                 doc="nonlinear model: Newton solves allowed per time step before the "
+                                     "step is halved"),
+    "max_step_cuts": Key("int", default=6, check=_cuts,
+                         doc="nonlinear model: halvings of a time step allowed (0: none) before the run "
+                             "stops with NO CONVERGENCE"),
+    "growth_tolerance": Key("float", default=0.01, check=positive, units="-",
+                            doc="nonlinear model: the response grows when the median per-revolution peak "
+                                "lateral deflection of the last revolutions exceeds that of those before by more "
+                                "than this fraction per revolution (docs/slidercrank.md)"),
+    "large_deflection": Key("float", default=0.02, check=positive, units="-",
+                            doc="nonlinear model: peak lateral deflection, as a fraction of the rod "
+                                "length, counted as a buckled (large-deflection) rod"),
+    "onset_speeds": Key("floats", default=None, check=positive, units="rad/s",
+                        doc="nonlinear model: speed grid of the dynamic-buckling onset search (bisected "
+                            "to 0.05 rad/s where the verdict changes); none: no search"),
+    "onset_elements": Key("int", default=40, check=_valid_count,
+                          doc="nonlinear model: rod elements of the onset search"),
 }
 
 
@@ -222,17 +265,18 @@ def _cross_check(params: Params) -> None:
                                            f"({model.length:g} m): the slider-crank cannot turn; "
                                            "crank_radius must be < rod_length")
     w_bend, _, _ = model.frequencies()
-    for omega in params.speeds:
+    grid = list(params.onset_speeds or []) if params.model == "nonlinear" else []
+    for key, omega in [("speeds", w) for w in params.speeds] + [("onset_speeds", w) for w in grid]:
         ratio = MIN_STEPS_PER_BENDING_PERIOD * w_bend / omega
         if not math.isfinite(ratio) or ratio > 1e9:   # e.g. speeds = 4.9e-324: refused before ceil() overflows
-            raise params.error("speeds", f"crank speed {omega:g} rad/s is too slow to integrate: one revolution "
+            raise params.error(key, f"crank speed {omega:g} rad/s is too slow to integrate: one revolution "
                                          f"would need more than 10^9 time steps ({MIN_STEPS_PER_BENDING_PERIOD} "
                                          f"per period of the first bending mode, {w_bend:.1f} rad/s)")
         need = min_steps_per_rev(omega, w_bend)
         if params.steps_per_rev < need:
             per = params.steps_per_rev * omega / w_bend
             raise params.error(
-                "steps_per_rev",
+                "steps_per_rev" if key == "speeds" else key,
                 f"time step too coarse: {params.steps_per_rev} steps per revolution at {omega:g} rad/s "
                 f"give {per:.1f} steps per period of the first bending mode ({w_bend:.1f} rad/s); "
                 f"the Newmark average-acceleration rule needs at least {MIN_STEPS_PER_BENDING_PERIOD} "
@@ -244,6 +288,23 @@ def _cross_check(params: Params) -> None:
     if params.end_time > 0 and params.element_counts:
         raise params.error("element_counts", "a convergence study reports last revolutions; "
                                              "remove element_counts or end_time")
+    if params.model == "nonlinear":
+        for key, bad, why in (("element_counts", bool(params.element_counts), "a convergence study"),
+                              ("end_time", params.end_time > 0, "benchmark mode"),
+                              ("analysis", params.analysis != "dynamic", "a quasi-static analysis"),
+                              ("geometric_stiffness", params.geometric_stiffness,
+                               "K_G (the nonlinear rod has its own geometric stiffness)"),
+                              ("start", params.start == "simeon1996", "the Simeon start")):
+            if bad:
+                raise params.error(key, f"model = 'nonlinear' runs the last revolutions of each speed; "
+                                        f"{why} is a linear-model option: remove {key}")
+        if params.revolutions < 4:
+            raise params.error("revolutions", "model = 'nonlinear' judges growth over the last four "
+                                              f"revolutions: revolutions must be >= 4 (got {params.revolutions})")
+        if params.n_elements < 2:
+            raise params.error("n_elements", "model = 'nonlinear' needs at least 2 elements")
+    elif params.onset_speeds:
+        raise params.error("onset_speeds", "the dynamic-buckling onset search needs model = 'nonlinear'")
     if params.start == "simeon1996" or params.benchmark == "simeon1996":
         key = "start" if params.start == "simeon1996" else "benchmark"
         ref = SIMEON1996
@@ -262,11 +323,11 @@ LABELS = {"speeds": ("crank speed", "rad/s"), "n_elements": ("rod elements", "-"
           "omega_{i}_rad_s": ("crank speed {i}", "rad/s"), "euler_ratio_{i}": ("peak compression / Euler load, speed {i}", "-"),
           "peak_tensile_{i}_microstrain": ("peak tensile strain, speed {i}", "microstrain"),
           "peak_tensile_{i}_deg": ("crank angle of peak tension, speed {i}", "deg"),
-          "peak_compressive_{i}_microstrain": ("peak compressive strain, speed {i}", "microstrain"),
+          "peak_compressive_{i}_microstrain": ("peak compressive strain (negative), speed {i}", "microstrain"),
           "peak_compressive_{i}_deg": ("crank angle of peak compression, speed {i}", "deg"),
           "peak_tensile_microstrain": ("peak tensile strain", "microstrain"),
           "peak_tensile_deg": ("crank angle of peak tension", "deg"),
-          "peak_compressive_microstrain": ("peak compressive strain", "microstrain"),
+          "peak_compressive_microstrain": ("peak compressive strain (negative)", "microstrain"),
           "peak_compressive_deg": ("crank angle of peak compression", "deg"),
           "euler_ratio_max": ("peak compression / Euler load", "-"), "n_buckled": ("speeds buckled", "-"),
           "rod_mass_kg": ("rod mass", "kg"), "section_area_m2": ("rod section area", "m^2"),

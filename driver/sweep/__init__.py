@@ -109,7 +109,8 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
                        "may have; split the sweep into several decks or coarsen the grid")
     estimates = validate_sweep(sw, raw, module, grid)
     named = [(k, v) for k, v in [("keep", sw.keep), ("plot_x", sw.plot_x)] + [("plot_y", y) for y in sw.plot_y] if v]
-    if named:   # check the filter and plotted columns on the base deck's summary before running anything
+    shown_columns: list[str] | None = None
+    if named or sw.summary_columns:   # check the filter and plotted columns on the base deck's summary first
         probe = (module.summarise(base_params) if hasattr(module, "summarise")
                  else compute(module, base_params).summary)
         columns = [*names, *probe, "case"]
@@ -124,6 +125,14 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
             except expr.ExprError as exc:
                 raise sw.error(key, f"{exc.message}" + (f" (at '{exc.token}')" if exc.token else "")
                                + ("" if key == "keep" else f"; summary columns: {', '.join(columns)}")) from None
+        if sw.summary_columns:
+            unknown = [c for c in sw.summary_columns if c not in probe]
+            if unknown:
+                raise sw.error("summary_columns", f"'{unknown[0]}' is not a summary column of &{base_params.group} "
+                               f"(summary columns: {', '.join(probe)})")
+            # what the tables show: the columns asked for, and those the filter and the plot read
+            read = {n for _, text in named for n in expr.parse(text, columns).names}
+            shown_columns = [c for c in probe if c in set(sw.summary_columns) | read]
     stem_path = output_stem(outdir, deck.path)
     scheduler = scheduler or _configured_scheduler()
     jobs = jobs or os.cpu_count() or 1
@@ -136,9 +145,11 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
 
     run = _Run(deck, sw, base_params, module, grid, outdir, stem_path.name, layout, task_of, plot, progress, quiet,
                jobs, scheduler, resume)
+    run.shown_columns = shown_columns
     sig = store.signature(raw, names, str(deck.path), sw.keep, sw.case_outputs, formats, case_plot, module)
     if batchable:
-        bplan = sweep_batch.plan(module, raw, str(deck.path), grid, sw.keep, sw.summary_rows)
+        bplan = sweep_batch.plan(module, raw, str(deck.path), grid, sw.keep, sw.summary_rows,
+                                 plotted=[v for k, v in named if k != "keep"], shown=shown_columns)
     else:
         bplan = None
     with store.sweep_lock(outdir, stem_path.name):   # one run at a time writes a sweep's files
@@ -204,6 +215,7 @@ class _Run:
         self.plot, self.progress, self.quiet, self.jobs, self.scheduler, self.resume = (
             plot, progress, quiet, jobs, scheduler, resume)
         self.axes = list(zip(grid.names, grid.values))
+        self.shown_columns: list[str] | None = None   # summary_columns given: the columns the tables show
 
     def _where(self) -> str:
         return f"dask {self.scheduler}" if self.scheduler else f"{self.jobs} worker(s)"
@@ -285,6 +297,9 @@ class _Run:
         shown.sort(key=lambda r: r.index)
         written.sort()
         frame = summary_frame(shown, names)
+        if self.shown_columns is not None:   # summary_columns: the tables show only those (and keep's, plot's)
+            fixed = {"case", "status", "kept", "error", *names}
+            frame = frame[[c for c in frame.columns if c in fixed or c in set(self.shown_columns)]]
         table = frame if sw.summary_rows == "all" else frame[frame["kept"] | (frame["status"] != "ok")]
         failed = [r for r in shown if r.status != EXIT_OK]
         text = sweep_text(self.deck, sw, self.base, self.axes, n, frame, n_kept,
@@ -335,7 +350,8 @@ class _Run:
         their own resume record ``<stem>.sweep/cases/`` (:mod:`driver.sweep.store`)."""
         sw, names, n = self.sw, self.grid.names, bplan.grid.n
         self._refuse_links()
-        t_start = time.perf_counter()
+        t_start, c_start = time.perf_counter(), time.process_time()
+        LAST_RUN["prepare_cpu"] = c_start - LAST_RUN.get("start_cpu", c_start)
 
         def announce(resumed: int) -> None:
             if self.resume and not self.quiet:
@@ -343,6 +359,9 @@ class _Run:
 
         rows, counts, chunk = sweep_batch.run(bplan, self.outdir / f"{self.stem}.sweep", self.jobs, self.scheduler,
                                               self.resume, self.progress, sw.chunk, announce)
+        c_run = time.process_time()
+        # the driver's CPU per phase (bench/bench_search.py): merging the chunks, then the tables
+        LAST_RUN.update(run_cpu=c_run - c_start, chunk=chunk, chunks=-(-n // chunk), rows=len(rows))
         elapsed = time.perf_counter() - t_start
         if rows.empty:
             rows = pd.DataFrame(columns=["case", *names, "status", "kept", "error"])
@@ -379,6 +398,7 @@ class _Run:
         write_sweep_files(self.outdir, self.stem, rows, cases, text, self.plot, sw, names, self.module, rows)
         if has_files is not None:
             store.remove_stale_case_files(self.layout, has_files)
+        LAST_RUN["finish_cpu"] = time.process_time() - c_run
         self._print_failed(failed)
         if not self.quiet:
             print(f"sweep {self.deck.path}: {n - len(failed)} of {n} cases ok, {int(rows['kept'].sum())} kept, "

@@ -44,7 +44,8 @@ def _summary_table(frame: pd.DataFrame, limit: int = 2000, n_cases: int | None =
         if name in ("error",):
             continue
         s = frame[name]
-        if pd.api.types.is_bool_dtype(s) or s.map(lambda v: isinstance(v, (bool, np.bool_))).all():
+        if pd.api.types.is_bool_dtype(s) or len(s) == 0 or (
+                s.dtype == object and s.map(lambda v: isinstance(v, (bool, np.bool_))).all()):
             cols.append(Column(name, "s", max(4, len(name)), 0))
         elif pd.api.types.is_integer_dtype(s):
             cols.append(Column(name, "i", max(5, len(name)), 0))
@@ -54,10 +55,9 @@ def _summary_table(frame: pd.DataFrame, limit: int = 2000, n_cases: int | None =
             cols.append(Column(name, "s", max(6, len(name)), 0))
         keys.append(name)
     rows = []
-    for _, r in show.iterrows():
+    for values in zip(*(show[k].tolist() for k in keys)):   # column-wise: no Series per row
         row = []
-        for c, k in zip(cols, keys):
-            v = r[k]
+        for c, v in zip(cols, values):
             if v is None or (isinstance(v, float) and not math.isfinite(v)):
                 row.append("-")
             elif isinstance(v, (bool, np.bool_)):

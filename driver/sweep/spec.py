@@ -91,6 +91,10 @@ def _spec() -> GroupSpec:
                               "draws the sweep's summary only: per-case figures cost more than the sweep)"),
         "plot_x": Key("str", default="", doc="summary column (or expression, driver.expr) on the x axis of the summary plot"),
         "plot_y": Key("strs", default=[], doc="summary columns (or expressions) plotted against plot_x"),
+        "summary_columns": Key("strs", default=[],
+                               doc="the summary columns the tables show (default: all); with keep and the "
+                                   "plot_* columns they decide what a batch sweep computes (a column nobody "
+                                   "asks for is not computed)"),
     })
     return GroupSpec("sweep", keys, doc="run a study over a grid or list of deck values")
 

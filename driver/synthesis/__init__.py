@@ -138,6 +138,12 @@ SPEC = GroupSpec(
         "popsize": Key("int", default=15, check=_between(2, 1000), doc="path: population per variable"),
         "tolerance": Key("float", default=1e-3, check=positive, units="length",
                          doc="path: largest target error accepted as 'through the points'"),
+        "min_link_fraction": Key("float", default=0.05, check=_between(0.0, 1.0),
+                                 doc="a link shorter than this fraction of the ground is named a poor design "
+                                     "(crank-rocker: the member returned has every link at least this long)"),
+        "poor_transmission_deg": Key("float", default=30.0, check=_between(0.0, 90.0), units="deg",
+                                     doc="a design whose worse transmission angle, min(mu_min, 180 - mu_max), "
+                                         "is below this is named a poor design"),
     },
     check=_check,
 )
@@ -156,6 +162,26 @@ class Synthesis:
     study_result: Any = None
     design: Any = None
     checks: dict[str, float] = field(default_factory=dict)
+    #: degenerate or poor design, in words (also in the .out and the --json record)
+    warnings: list[str] = field(default_factory=list)
+
+
+def _quality_warnings(p: Params, ground: float, links: dict[str, float], mu_min: float | None,
+                      mu_max: float | None) -> list[str]:
+    """A link shorter than min_link_fraction of the ground; a transmission angle poorer than
+    poor_transmission_deg (min(mu_min, 180 - mu_max))."""
+    out = []
+    short = [f"{k} {v:.6g}" for k, v in links.items() if v < p.min_link_fraction * ground]
+    if short:
+        out.append(f"poor design: {', '.join(short)} shorter than {p.min_link_fraction:g} x the ground "
+                   f"({ground:.6g}) (min_link_fraction)")
+    if mu_min is not None and mu_max is not None and math.isfinite(mu_min) and math.isfinite(mu_max):
+        q = min(mu_min, 180.0 - mu_max)
+        if q < p.poor_transmission_deg:
+            out.append(f"poor design: transmission angle {mu_min:.4f} .. {mu_max:.4f} deg, "
+                       f"min(mu_min, 180 - mu_max) = {q:.4f} deg < {p.poor_transmission_deg:g} deg "
+                       "(poor_transmission_deg): the coupler pushes the rocker nearly along it")
+    return out
 
 
 # ----------------------------------------------------------------------------- function generation
@@ -239,6 +265,7 @@ def _function(p: Params) -> Synthesis:
     linkage = None
     failure = None
     table = pd.DataFrame()
+    warnings: list[str] = []
     if reason:
         failure = f"no four-bar satisfies these precision points: {reason}"
         lines += [f"  {failure}"]
@@ -292,15 +319,40 @@ def _function(p: Params) -> Synthesis:
         table = pd.DataFrame({"x": x, "crank_deg": crank_deg, "y_desired": fd.y_desired, "y_generated": y_gen,
                               "structural_error": y_gen - fd.y_desired, "rocker_error_deg": err,
                               "status": np.array(["ok", "cannot_assemble", "toggle", "indeterminate"])[st]})
+        good = st == ST["ok"]
+        mu = np.degrees(out[good, 2]) if good.any() else np.array([])
+        warnings = _quality_warnings(p, d, {"crank": fd.crank, "coupler": fd.coupler, "rocker": fd.rocker},
+                                     float(mu.min()) if mu.size else None, float(mu.max()) if mu.size else None)
+        lines += [f"  WARNING: {w} (over the x range)" if "transmission" in w else f"  WARNING: {w}" for w in warnings]
     return Synthesis(p, linkage, "\n".join(lines), failure, table, "_error", design=fd,
-                     checks={"max_error_y": fd.max_error_y})
+                     checks={"max_error_y": fd.max_error_y}, warnings=warnings)
 
 
 # ----------------------------------------------------------------------------- crank-rocker
 
 def _crank_rocker(p: Params) -> Synthesis:
     members = cr.family(p.swing_deg, p.time_ratio, p.family_points)
-    best = cr.best_member(p.swing_deg, p.time_ratio, members)
+    frac = p.min_link_fraction
+    usable = lambda m: min(m.crank, m.coupler, m.rocker) >= frac * m.ground
+    free = cr.best_member(p.swing_deg, p.time_ratio, members)
+    best = cr.best_member(p.swing_deg, p.time_ratio, [m for m in members if usable(m)])
+    if best is not None and not usable(best):     # the refinement stepped below the fraction
+        best = max((m for m in members if usable(m) and m.crank_rocker and math.isfinite(m.quality_deg)),
+                   key=lambda m: (m.quality_deg, -m.arc, -m.t))
+    warnings: list[str] = []
+    edge = free is not None and _at_family_end(members, free)
+    if free is not None and edge:
+        limit = 90.0 - p.swing_deg / 2 if cr.alpha_deg(p.time_ratio) <= 1e-12 else free.quality_deg
+        how = ("the closed form for time ratio 1: 90 - swing/2" if cr.alpha_deg(p.time_ratio) <= 1e-12
+               else "approached at the family's end")
+        warnings.append(f"no interior optimum: the transmission quality rises towards the end of the family, "
+                        f"where the shortest link ({min(free.crank, free.coupler, free.rocker) / free.ground:.3g} "
+                        f"of the ground at the last member scanned) shrinks to nothing; its limit is {limit:.6f} deg "
+                        f"({how}).  Returned: the best member whose links are all at least "
+                        f"min_link_fraction = {frac:g} of the ground")
+    elif free is not None and best is not None and free is not best and not usable(free):
+        warnings.append(f"the best member has a link shorter than min_link_fraction = {frac:g} of the ground "
+                        f"(quality {free.quality_deg:.6f} deg); returned: the best member whose links reach it")
     al = cr.alpha_deg(p.time_ratio)
     lines = ["  four-bar synthesis: crank-rocker for a rocker swing and a time ratio",
              f"  deck: {p.path}" + (f" -- {p.title}" if p.title else ""), "",
@@ -314,8 +366,9 @@ def _crank_rocker(p: Params) -> Synthesis:
                            "fixed_link": p.fixed_link, "crank_rocker": m.crank_rocker, "mu_min_deg": m.mu_min_deg,
                            "mu_max_deg": m.mu_max_deg, "quality_deg": m.quality_deg} for m in members])
     if best is None:
-        failure = "no member of the family is a crank-rocker"
-        return Synthesis(p, None, "\n".join(lines + [f"  {failure}"]), failure, table, "_family")
+        failure = ("no member of the family is a crank-rocker" if free is None else
+                   f"no crank-rocker member has every link at least min_link_fraction = {frac:g} of the ground")
+        return Synthesis(p, None, "\n".join(lines + [f"  {failure}"]), failure, table, "_family", warnings=warnings)
     a, b, c = best.scaled(p.fixed_link)
     lines += ["  Family (every tenth member of each arc; the _family table has all)",
               "     arc        t       crank     coupler      rocker   crank-rocker   mu_min   mu_max   quality"]
@@ -350,7 +403,18 @@ def _crank_rocker(p: Params) -> Synthesis:
         if abs(swing - p.swing_deg) > 1e-6 or abs(q - p.time_ratio) > 1e-6 * p.time_ratio:
             failure = "the exact kernel does not confirm the swing and time ratio"
             lines += [f"    FAILED: {failure}"]
-    return Synthesis(p, linkage, "\n".join(lines), failure, table, "_family", design=best, checks=checks)
+    warnings += _quality_warnings(p, p.fixed_link, {"crank": a, "coupler": b, "rocker": c},
+                                  best.mu_min_deg, best.mu_max_deg)
+    lines += [f"  WARNING: {w}" for w in warnings]
+    return Synthesis(p, linkage, "\n".join(lines), failure, table, "_family", design=best, checks=checks,
+                     warnings=warnings)
+
+
+def _at_family_end(members: list, m) -> bool:
+    """The member lies in the first or last scan interval of its arc (the quality's best is at an end)."""
+    same = sorted(x.t for x in members if x.arc == m.arc)
+    return bool(same) and (m.t <= same[0] or m.t >= same[-1] or
+                           (len(same) > 1 and (m.t < same[1] or m.t > same[-2])))
 
 
 # ----------------------------------------------------------------------------- path generation
@@ -411,10 +475,13 @@ def _path(p: Params) -> Synthesis:
             failure = failure or "the exact kernel cannot turn the crank fully"
     if failure:
         lines += [f"    FAILED: {failure}"]
+    warnings = _quality_warnings(p, q["ground"], {"crank": q["crank"], "coupler": q["coupler"], "rocker": q["rocker"]},
+                                 None if ex is None else ex.mu_min, None if ex is None else ex.mu_max)
+    lines += [f"  WARNING: {w}" for w in warnings]
     table = pd.DataFrame({"target_x": targets[:, 0], "target_y": targets[:, 1], "error": design.errors,
                           "crank_deg": design.theta_at_targets_deg})
     return Synthesis(p, linkage, "\n".join(lines), failure, table, "_targets", design=design,
-                     checks={"rms": design.rms, "max_error": float(design.errors.max())})
+                     checks={"rms": design.rms, "max_error": float(design.errors.max())}, warnings=warnings)
 
 
 # ----------------------------------------------------------------------------- run
@@ -458,8 +525,16 @@ def _path_figure(syn: Synthesis, path: Path, title: str, fmt: bool | str = True)
     return plotting.save_figure(fig, path, fmt)
 
 
+def synthesis_record(syn: Synthesis) -> dict[str, Any]:
+    """The ``--json`` record of a synthesis: task, linkage, checks, failure and warnings."""
+    from driver.export import json_safe
+    return json_safe({"kind": "synthesis", "task": syn.params.task, "deck": str(syn.params.path),
+                      "ok": syn.failure is None, "failure": syn.failure, "warnings": list(syn.warnings),
+                      "linkage": syn.linkage, "checks": syn.checks})
+
+
 def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool = False,
-                       quiet: bool = False, **_: Any) -> int:
+                       quiet: bool = False, summary_json: bool = False, **_: Any) -> int:
     """Command-line entry: synthesise, write, return the exit status (DeckError propagates)."""
     syn = synthesise(deck)
     stem = output_stem(outdir, deck.path)
@@ -475,6 +550,10 @@ def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool,
         if syn.linkage is not None:
             text += f"\n  linkage deck {stem.name}.linkage.dat; its exact analysis in {stem.name}.linkage.out\n"
         written.append(write_text(stem.with_name(stem.name + ".out"), text))
+        if summary_json:
+            import json
+            written.append(write_text(stem.with_name(stem.name + ".json"),
+                                      json.dumps(synthesis_record(syn), indent=1, allow_nan=False) + "\n"))
         if len(syn.table):
             written.append(write_tidy(syn.table, stem.with_name(stem.name + syn.table_name), "csv"))
         if plot and syn.params.task == "function" and syn.design is not None and len(syn.design.x):
@@ -497,6 +576,8 @@ def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool,
     if not quiet:
         for w in written:
             print(f"wrote {w}")
+    for w in syn.warnings:
+        print(f"warning: {deck.path}: {w}", file=sys.stderr)
     if syn.failure:
         print(f"error: {deck.path}: {syn.failure}", file=sys.stderr)
         return 1

@@ -89,9 +89,12 @@ def member(swing_deg: float, q: float, arc: int, t: float) -> Member | None:
     side = lambda pt: oa[0] * pt[1] - oa[1] * pt[0]
     if side(b1) * side(b2) <= 0:
         return None
-    l1, l2 = float(np.linalg.norm(oa - b1)), float(np.linalg.norm(oa - b2))
+    # math.hypot, not np.linalg.norm: the norm goes through BLAS, whose kernel (OPENBLAS_CORETYPE)
+    # changes its last bits -- and the refined member with them
+    l1 = math.hypot(float(oa[0] - b1[0]), float(oa[1] - b1[1]))
+    l2 = math.hypot(float(oa[0] - b2[0]), float(oa[1] - b2[1]))
     fold, ext = min(l1, l2), max(l1, l2)
-    a, b, c, d = 0.5 * (ext - fold), 0.5 * (ext + fold), 1.0, float(np.linalg.norm(oa))
+    a, b, c, d = 0.5 * (ext - fold), 0.5 * (ext + fold), 1.0, math.hypot(float(oa[0]), float(oa[1]))
     if a <= 1e-9 or d <= 1e-9 or not math.isfinite(d):
         return None
     links = sorted([a, b, c, d])

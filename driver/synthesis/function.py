@@ -39,9 +39,34 @@ def freudenstein(theta2: np.ndarray, theta4: np.ndarray) -> tuple[np.ndarray, fl
     A = np.column_stack([np.cos(theta4), -np.cos(theta2), np.ones_like(theta2)])
     rhs = np.cos(theta2 - theta4)
     if len(theta2) == 3:
-        return np.linalg.solve(A, rhs), float(np.linalg.cond(A))
-    k, *_ = np.linalg.lstsq(A, rhs, rcond=None)
-    return k, float(np.linalg.cond(A))
+        return _cramer(A.tolist(), rhs.tolist()), float(np.linalg.cond(A))
+    # normal equations summed exactly (math.fsum): the same bits whatever BLAS kernel is loaded
+    cols = A.T.tolist()
+    N = [[math.fsum(p * q for p, q in zip(ci, cj)) for cj in cols] for ci in cols]
+    r = [math.fsum(p * q for p, q in zip(ci, rhs.tolist())) for ci in cols]
+    return _cramer(N, r), float(np.linalg.cond(A))
+
+
+def _cramer(A: list[list[float]], b: list[float]) -> np.ndarray:
+    """The 3x3 solve by Cramer's rule in plain floats.
+
+    Not np.linalg.solve: LAPACK's result changes in its last bits with the BLAS kernel
+    (OPENBLAS_CORETYPE), and the linkage written to the .linkage.dat would with it.
+    """
+    def det(m: list[list[float]]) -> float:
+        return (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+                - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+                + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]))
+    D = det(A)
+    if D == 0.0:
+        return np.array([math.nan, math.nan, math.nan])
+    out = []
+    for j in range(3):
+        m = [row[:] for row in A]
+        for i in range(3):
+            m[i][j] = b[i]
+        out.append(det(m) / D)
+    return np.array(out)
 
 
 def links_from_k(k: np.ndarray, d: float) -> tuple[float, float, float, str]:

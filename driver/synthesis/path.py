@@ -27,6 +27,8 @@ __all__ = ["PathProblem", "PathDesign", "solve", "evaluate"]
 
 ST_OK = kernels.FOURBAR_STATUS["ok"]
 PENALTY = 1e3
+#: weight of the pull towards the start in the least-squares stage (see polish)
+REG = 1e-6
 
 
 @dataclass
@@ -187,8 +189,15 @@ def polish(pp: PathProblem, design: PathDesign) -> PathDesign:
         r[st != ST_OK] = 10 * pp.length_max
         return r.ravel()
 
-    try:   # trust-region least squares, unbounded (more unknowns than residuals; bounds checked after)
-        res = least_squares(residuals, z0, method="trf", xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=3000)
+    # Levenberg-Marquardt (MINPACK: its own QR, no BLAS/LAPACK call, so the same bits whatever BLAS
+    # kernel is loaded), unbounded; bounds checked after.  More unknowns than residuals: MINPACK needs
+    # at least as many residuals, so a tiny pull towards the start (REG x (z - z0)) picks the solution
+    # nearest the start from the family of exact ones, and changes an exact fit by ~REG^2 only.
+    def padded(z: np.ndarray) -> np.ndarray:
+        return np.concatenate([residuals(z), REG * (z - z0)])
+
+    try:
+        res = least_squares(padded, z0, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=3000)
     except ValueError:
         return design
     if not (np.all(res.x[:n9] >= lo) and np.all(res.x[:n9] <= hi)):

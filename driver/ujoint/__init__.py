@@ -35,15 +35,15 @@ from driver.study import Figure, Result, keyword_run
 from driver.ujoint.analysis import (BOUND_TOL, CLUSTER_TOL, PHASE_PERIOD, SADDLE_NUDGE, SYM_TOL, TIE_RTOL, Chain,
                                     Design, StartRun, _chain, _free_index, _starts, evaluate, objective_scale,
                                     optimise, phases_for, pick_best, yoke_shifts)
-from driver.ujoint.batch import (BATCH_ELEMENTS, BATCH_IGNORED, BATCH_INDEPENDENT, BATCH_KEYS, batch_applies,
-                                 summarise_batch)
+from driver.ujoint.batch import (BATCH_ELEMENTS, BATCH_IGNORED, BATCH_INDEPENDENT, BATCH_KEYS, BATCH_PASSES,
+                                 batch_applies, summarise_batch)
 from driver.ujoint.report import _figure, _render, _result_dat, _summary, _tidy
 from driver.ujoint.spec import (BAND_TOL, CONVENTIONS, DEG, LABELS, NOT_REPRODUCIBLE, OPTIONS, SPEC, SWEEP_PLOT,
                                 _geometry, _per, _phases, cross_check)
 
 __all__ = ["SPEC", "run", "estimate", "Chain", "Design", "StartRun", "evaluate", "optimise", "objective_scale",
            "pick_best", "yoke_shifts", "phases_for", "cross_check", "summarise_batch", "batch_applies", "BATCH_KEYS",
-           "BATCH_IGNORED", "BATCH_INDEPENDENT", "BATCH_ELEMENTS", "LABELS", "SWEEP_PLOT", "BAND_TOL",
+           "BATCH_PASSES", "BATCH_IGNORED", "BATCH_INDEPENDENT", "BATCH_ELEMENTS", "LABELS", "SWEEP_PLOT", "BAND_TOL",
            "NOT_REPRODUCIBLE", "CONVENTIONS", "OPTIONS", "DEG", "SYM_TOL", "SADDLE_NUDGE", "PHASE_PERIOD", "TIE_RTOL",
            "CLUSTER_TOL", "BOUND_TOL"]
 

@@ -6,13 +6,14 @@ from __future__ import annotations
 
 import math
 import re
-from typing import Any, Mapping
+from typing import Any, Collection, Mapping
 
 import numpy as np
 import pandas as pd
 
 from driver.deck import Params
-from driver.kernels import UJOINT_MODELS, UJOINT_OBJECTIVES, UJOINT_SUMMARY_COLUMNS, ujoint_geometry, ujoint_summaries
+from driver.kernels import (UJOINT_MODELS, UJOINT_OBJECTIVES, UJOINT_PASSES, UJOINT_SUMMARY_COLUMNS, ujoint_geometry,
+                            ujoint_summaries)
 from driver.ujoint.spec import _KEYS, DEG
 
 
@@ -26,6 +27,17 @@ BATCH_IGNORED = ("table_step", "n_starts", "seed", "maxiter", "ftol", "beta_lowe
 #: keys whose deck checks do not involve other keys (a sweep validates each of their values once)
 BATCH_INDEPENDENT = ("rpm", "objective", "n_grid", "table_step", "n_starts", "seed", "maxiter", "ftol",
                      "paper_u", "paper_nit", "paper_nfev")
+#: The column -> pass dependency table of the batch summary: the kernel passes of
+#: chain_summaries (fortran/ujoint.f90) each column of :func:`summarise_batch` needs; columns
+#: with none are the design's own values.  ``beta_<k>_deg``/``phi_<k>_deg`` (one per joint and
+#: shaft) need none either.
+BATCH_PASSES: dict[str, tuple[str, ...]] = {
+    "objective": ("objective",), "objective_trial": ("objective",), "pp_ratio": ("speed",),
+    "omega_out_min_rpm": ("speed",), "omega_out_max_rpm": ("speed",), "beta_e_deg": ("equivalent",),
+    "beta_res_deg": ("equivalent",), "peak_accel_rad_s2": ("speed",), "converged": (), "iterations": (),
+    "evaluations": (),
+}
+
 #: list keys a batch column may set one element of, as 'phi(2)' (1-based; the optimiser's variables)
 BATCH_ELEMENTS = ("beta", "phi", "delta", "rho")
 _ELEMENT = re.compile(r"([a-z_]+)\((\d+)\)")
@@ -112,7 +124,8 @@ def _number_column(base: Mapping[str, Any], key: str, columns: dict[str, Any], n
     return v
 
 
-def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None = None) -> pd.DataFrame:
+def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None = None,
+                    wanted: Collection[str] | None = None) -> pd.DataFrame:
     """Summaries of many Hooke-joint designs, one Fortran call per chain layout: one row per design.
 
     What it computes: for each design the figures of an option-0 run (``run(...).summary``:
@@ -136,7 +149,9 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     given by ``axes`` in the base deck keeps its geometry (beta and rho cannot vary then).
     A bad value raises DeckError (``base`` a deck's Params: deck, line and key of the base
     deck, the design's index in the message) or ValueError.  About 4 microseconds per
-    3-joint design at 360 angles on one core (bench/bench_ujoint.py).
+    3-joint design at 360 angles on one core (bench/bench_ujoint.py).  ``wanted``: only these
+    columns, computed by only the kernel passes they need (:data:`BATCH_PASSES`; the same bits
+    as in a full summary); None: all.
     """
     if not batch_applies(base):
         raise _bad(base, "option", f"option {base['option']} optimises inside each case; the batch path "
@@ -212,9 +227,12 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     else:
         keys, inverse = np.unique(layout, axis=1, return_inverse=True)
         groups = [(keys[:, g], np.flatnonzero(inverse.ravel() == g)) for g in range(keys.shape[1])]
+    names = None if wanted is None else set(wanted)
+    passes = (sum(UJOINT_PASSES.values()) if names is None else
+              sum({UJOINT_PASSES[p] for c in names for p in BATCH_PASSES.get(c, ())}))
     for (c, k, m), rows in groups:
         res[rows] = ujoint_summaries(int(c), int(k), beta[rows] * DEG, phi[rows] * DEG,
-                                     None if rho_rad is None else rho_rad[rows], int(m))
+                                     None if rho_rad is None else rho_rad[rows], int(m), passes=passes)
     r = dict(zip(UJOINT_SUMMARY_COLUMNS, res.T))
     omega = rpm * 2.0 * math.pi / 60.0      # the association of Chain.omega (same bits)
     defined = r["beta_res_status"] == 0
@@ -228,4 +246,6 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
            "evaluations": np.zeros(nd, np.int64)}
     out.update({f"beta_{k + 1}_deg": beta[:, k] for k in range(n)})
     out.update({f"phi_{k + 1}_deg": phi[:, k] for k in range(n - 1)})
-    return pd.DataFrame(out)
+    if names is not None:
+        out = {k: v for k, v in out.items() if k in names}
+    return pd.DataFrame(out, index=pd.RangeIndex(nd))

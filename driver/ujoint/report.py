@@ -312,7 +312,10 @@ def _result_dat(params: Params, chain: Chain, designs: list[Design], best: Desig
              f"% deck {params.path}; model {_model_text(params)}; objective {params.objective}",
              f"option     = {params.option}",
              "x          = " + " ".join(fortran_f(v, None, 6) for v in np.concatenate([best.beta, best.phi])),
-             f"fval       = {best.objective:.10e}",
+             # below the optimiser's resolution the digits are the stopping point's noise (and change
+             # with the BLAS kernel): the bound is written, as in the .out
+             "fval       = " + (f"<{res:.1E}" if (res := best.extra.get("resolution")) is not None
+                                and best.objective < res else f"{best.objective:.10e}"),
              f"exitflag   = {1 if fixed or pick.success else 0}",
              f"iterations = {0 if fixed else pick.nit}",
              f"funccount  = {1 if fixed else pick.nfev}",

@@ -1,0 +1,32 @@
+"""The ``--json`` record of a sweep deck: what ran and where its summary is (``<stem>.json``)."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from driver.atomic import write_text
+from driver.deck import Deck
+from driver.export import json_safe
+from driver.runner import output_stem
+
+__all__ = ["write_sweep_json"]
+
+
+def write_sweep_json(deck: Deck, outdir: Path, exit_status: int) -> Path:
+    """Write ``<stem>.json``: the deck, exit status, cases summarised (by status, and kept by the
+    filter), the swept keys and the summary table's columns and file; returns its path."""
+    stem = output_stem(outdir, deck.path)
+    table = stem.with_name(stem.name + "_summary.parquet")
+    rec: dict = {"kind": "sweep", "deck": str(deck.path), "ok": exit_status == 0, "exit_status": exit_status,
+                 "summary_table": table.name if table.exists() else None}
+    if table.exists():
+        import pandas as pd
+        frame = pd.read_parquet(table)
+        rec["rows"] = int(len(frame))
+        if "status" in frame:
+            rec["status_counts"] = {str(k): int(v) for k, v in frame["status"].value_counts().sort_index().items()}
+        if "kept" in frame:
+            rec["kept"] = int(frame["kept"].astype(bool).sum())
+        rec["swept_keys"] = [c for c in frame.columns if "." in c]
+        rec["columns"] = [str(c) for c in frame.columns]
+    return write_text(stem.with_name(stem.name + ".json"), json.dumps(json_safe(rec), indent=1, allow_nan=False) + "\n")
