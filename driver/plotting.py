@@ -105,9 +105,13 @@ def save_figure(fig: Figure, path: str | Path, fmt: bool | str | None = None) ->
 
 @styled
 def line_panels(x: np.ndarray, panels: Sequence[tuple[str, dict[str, np.ndarray]]], xlabel: str,
-                title: str = "", styles: dict[str, dict] | None = None) -> Figure:
-    """Stacked panels sharing x: each panel is (ylabel, {label: y}); NaN gaps break lines."""
-    fig, axes = new_figure(len(panels), 1, sharex=True, figsize=(7.0, 2.2 * len(panels) + 0.6))
+                title: str = "", styles: dict[str, dict] | None = None, axes=None) -> Figure:
+    """Stacked panels sharing x: each panel is (ylabel, {label: y}); NaN gaps break lines.
+    ``axes``: one axes per panel to draw into (their figure is returned)."""
+    if axes is None:
+        fig, axes = new_figure(len(panels), 1, sharex=True, figsize=(7.0, 2.2 * len(panels) + 0.6))
+    else:
+        fig = axes[0].figure
     for ax, (ylabel, series) in zip(axes, panels):
         for label, y in series.items():
             ax.plot(x, y, label=label, **(styles or {}).get(label, {}))
@@ -468,7 +472,8 @@ _UJOINT_STYLES = {"trial": dict(color="C1", lw=1.4), "design": dict(color="C1", 
 
 @styled
 def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.ndarray],
-                        polar: bool = False, band: Sequence[float] | None = None, title: str = "") -> Figure:
+                        polar: bool = False, band: Sequence[float] | None = None, title: str = "",
+                        ax=None) -> Figure:
     """Input and output shaft speed [rpm] against the input angle [deg], every design (trial,
     optimum, the paper's printed optimum) overlaid on one panel as in the paper's Figures 6-11,
     with the paper's trial band ``band`` = (min, max) [rpm] shaded when given.
@@ -476,7 +481,9 @@ def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.
     Cartesian or polar (angle = input angle, radius = speed); the polar radius starts near
     the slowest speed, not at 0, so a fluctuation of a fraction of an rpm stays visible (the
     empty centre says the radius does not start at 0)."""
-    if polar:
+    if ax is not None:   # the caller's axes (a polar one for polar = True)
+        fig = ax.figure
+    elif polar:
         fig = Figure(figsize=(7.4, 5.2), layout="constrained")
         ax = fig.add_subplot(1, 1, 1, projection="polar")
     else:
@@ -508,14 +515,14 @@ def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.
             ax.text(np.radians(112.5), t, f"{t:g} rpm", fontsize=7.5, ha="center", va="center", zorder=6,
                     bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.85))
         ax.set_xlabel("input angle [deg]; radius: shaft speed [rpm], not starting at 0", fontsize=8)
-        fig.legend(loc="outside lower center", ncol=2, frameon=False)
+        fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncol=2, frameon=False)
     else:
         ax.set_ylim(low - pad, top + pad)
         ax.set_ylabel("shaft speed [rpm]")
         ax.set_xlabel("input angle [deg]")
         ax.set_xlim(0.0, 360.0)
         ax.set_xticks(np.arange(0, 361, 45))
-        fig.legend(loc="outside lower center", ncol=2, frameon=False)
+        fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncol=2, frameon=False)
     fig.suptitle(f"{plain_text(title)}: Hooke-joint chain, input and output shaft speed" if title
                  else "Hooke-joint chain: input and output shaft speed")
     return fig
@@ -527,31 +534,34 @@ def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.
 @styled
 def slidercrank_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray]], title: str,
                               ylabel: str = "axial strain [microstrain]", above: dict[str, float] | None = None,
-                              missing: Sequence[str] = ()) -> Figure:
+                              missing: Sequence[str] = (), ax=None) -> Figure:
     """A quantity against crank angle [deg], one line per case (label, angle, value): Figure 10.
 
     ``above`` maps the labels of cases whose rod compression exceeds the Euler load to that
     ratio N/P_E: their curves are dashed and flagged in the legend (a linear model draws
     them although the rod would buckle).  ``missing`` are one-line texts of cases not drawn (e.g. a speed that
-    buckled): they are listed in the legend, so no speed silently disappears.
+    buckled): they are listed in the legend, so no speed silently disappears.  ``ax``: an axes
+    to draw into (its figure is returned).
     """
     from matplotlib.lines import Line2D
     above = above or {}
-    fig, axes = new_figure(1, 1, figsize=(7.4, 4.4))
-    ax = axes[0]
+    if ax is None:
+        fig, (ax,) = new_figure(1, 1, figsize=(7.4, 4.4))
+    else:
+        fig = ax.figure
     for label, x, y in series:
         flagged = label in above
-        ax.plot(x, y, label=f"{label}: N = {above[label]:.2f} P_E, above the Euler load" if flagged else label,
+        ax.plot(x, y, label=f"{label}: N = {above[label]:.2f} $P_E$, above the Euler load" if flagged else label,
                 lw=1.2, ls="--" if flagged else "-")
     for text in missing:
         ax.add_line(Line2D([], [], ls="none", marker="x", color="C3", label=text))
     ax.axhline(0.0, color="k", lw=0.6)
     ax.set_xlim(0, 360)
     ax.set_xticks(np.arange(0, 361, 45))
-    ax.set_xlabel("crank angle theta2 [deg]")
+    ax.set_xlabel(r"crank angle $\theta_2$ [deg]")
     ax.set_ylabel(ylabel)
-    fig.legend(loc="outside lower center", ncol=3 if len(series) + len(missing) > 4 else 2,
-               frameon=False, title="crank speed")
+    fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center",
+               ncol=3 if len(series) + len(missing) > 4 else 2, frameon=False, title="crank speed")
     ax.set_title(plain_text(title))
     return fig
 
@@ -571,6 +581,32 @@ def slidercrank_convergence_figure(series: dict[str, tuple[list[int], list[float
     axes[1].set_xlabel("number of elements")
     axes[0].legend()
     fig.suptitle(plain_text(title))
+    return fig
+
+
+@styled
+def slidercrank_history_figure(time: np.ndarray, series: dict[str, np.ndarray], labels: dict[str, str],
+                               reference: dict[str, tuple[float, float]], title: str, reference_label: str = "",
+                               axes=None) -> Figure:
+    """Quantities against time [s], one panel each (``series`` keyed like ``labels``, the axis
+    words with units), with a reference value (time, value) marked where given: a benchmark's
+    published end state beside the computed history."""
+    if axes is None:
+        fig, axes = new_figure(len(series), 1, sharex=True, figsize=(7.4, 2.4 * len(series) + 0.8))
+    else:
+        fig = axes[0].figure
+    for ax, (key, y) in zip(axes, series.items()):
+        ax.plot(time, y, color="C0", lw=1.2, label="this model (linear KED, Newmark)")
+        if key in reference:
+            t, v = reference[key]
+            ax.plot([t], [v], "D", ms=7, mfc="white", mec="C3", mew=1.5, label=reference_label or "reference")
+            ax.annotate(f"{v:.4g}", (t, v), xytext=(-6, 8), textcoords="offset points", ha="right", fontsize=8,
+                        color="C3")
+        ax.set_ylabel(labels.get(key, key))
+        ax.legend(loc="best")
+    axes[-1].set_xlabel("time $t$ [s]")
+    if title:
+        fig.suptitle(plain_text(title))
     return fig
 
 
@@ -658,7 +694,7 @@ def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, 
         _plain_numbers(ax)
         ax.legend(loc="best")
         if title:
-            ax.set_title(plain_text(title))
+            ax.set_title(title)   # composed by the caller: deck parts through plain_text
         return fig
 
     kx, ky = keys[0], keys[1]
@@ -720,7 +756,7 @@ def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, 
     note = ("kept designs outlined in black" if not kept.all() else
             "only kept designs tabulated (blank: not kept)" if only_kept else "every design kept")
     if title:
-        fig.suptitle(f"{plain_text(title)}\n{note}" if (n > 1 or not kept.all() or only_kept) else plain_text(title))
+        fig.suptitle(f"{title}\n{note}" if (n > 1 or not kept.all() or only_kept) else title)
     elif not kept.all() or only_kept:
         axes[0].set_title(note, fontsize=8)
     return fig
@@ -771,8 +807,11 @@ def convergence_plot(history, evals, objective: str, sense: str = "minimize", ti
                    label="final best found")
         a2.legend(loc="upper right")
         lo, hi = np.nanmin(obj), np.nanmax(obj)
-        pad = 0.05 * (hi - lo) if hi > lo else max(1e-6, 0.05 * abs(hi))
-        a1.set_ylim(lo - pad, hi + pad)
+        # at least 1e-4 of the objective's size: a change in the 7th digit reads as converged here
+        # (a flat line), and the gap panel beside it shows how small it is
+        span = max(hi - lo, 1e-4 * max(abs(final), 1e-12))
+        mid = 0.5 * (lo + hi)
+        a1.set_ylim(mid - 0.55 * span, mid + 0.55 * span)
     else:
         a1.text(0.5, 0.5, "no feasible design", transform=a1.transAxes, ha="center", va="center")
     a1.set_ylabel(objective)
@@ -800,7 +839,7 @@ def convergence_plot(history, evals, objective: str, sense: str = "minimize", ti
     _plain_numbers(a1)
     _plain_numbers(a3) if a3.get_yscale() == "linear" else None
     if title:
-        fig.suptitle(plain_text(title))
+        fig.suptitle(title)   # composed by the caller: deck parts through plain_text
     return fig
 
 
@@ -857,9 +896,55 @@ def sweep_maps(frame, keys: Sequence[str], ys: Sequence[str], labels: dict[str, 
                 f"{_words_value(labels.get(k, k), frame.loc[best, k])}" for k in keys) + \
                 f"; {labels.get(y, y).split(' [')[0]} {_words_value(labels.get(y, y), frame.loc[best, y], name=False)}"
         figs.append(design_space_map(frame, keys, y, labels, best=best, best_text=text,
-                                     title=f"{title}: {labels.get(y, y)}" if title else labels.get(y, y),
+                                     title=f"{plain_text(title)}: {labels.get(y, y)}" if title else labels.get(y, y),
                                      only_kept=only_kept))
     return figs
+
+
+# ----------------------------------------------------------------------------- robust design (Taylor)
+
+@styled
+def robust_design_figure(t: np.ndarray, means: dict[str, np.ndarray], spreads: dict[str, np.ndarray],
+                         points: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]],
+                         tmins: dict[str, float | None], sigma_x: float, title: str = "", axes=None) -> Figure:
+    """Taylor's robust-design example: the mean of Y (top) and its spread (bottom, log axis)
+    against the target t, every fitted curve beside the known relation's, the measured means
+    and standard deviations as markers, and the estimates of the target of least spread as
+    vertical lines.  ``means``/``spreads``: {label: values on ``t``}; ``points``: {label: (t,
+    mean, std)}; ``tmins``: {label: t_min or None}.  ``axes``: two axes to draw into."""
+    if axes is None:
+        fig, axes = new_figure(2, 1, sharex=True, figsize=(7.6, 6.4))
+    else:
+        fig = axes[0].figure
+    top, bot = axes
+    styles = ["-", "--", "-.", ":", (0, (5, 1, 1, 1))]
+    for k, (label, y) in enumerate(means.items()):
+        top.plot(t, y, ls=styles[k % len(styles)], color=f"C{k}", lw=1.5, label=label)
+    for k, (label, y) in enumerate(spreads.items()):
+        printed = "printed" in label
+        bot.plot(t, y, ls=":" if printed else styles[k % len(styles)], color="0.5" if printed else f"C{k}",
+                 lw=1.2 if printed else 1.6, label=label)
+    for k, (label, (pt, m, sd)) in enumerate(points.items()):
+        mk = "os"[k % 2]
+        top.plot(pt, m, mk, ms=6, mfc="white", mec="k", label=label)
+        bot.plot(pt, sd, mk, ms=6, mfc="white", mec="k", label=label)
+    for k, (label, tm) in enumerate(tmins.items()):
+        if tm is not None and np.isfinite(tm):
+            bot.axvline(tm, color=f"C{k}", lw=0.9, ls=(0, (2, 2)), alpha=0.9,
+                        label=rf"$t_{{min}}$ {label} = {tm:.3f}")
+    top.set_ylabel(r"mean of $Y$, $\mu_Y$")
+    bot.set_ylabel(r"spread of $Y$, $\sigma_Y$ (log)")
+    bot.set_yscale("log")
+    bot.set_xlabel(rf"target $t$ (X varies about $t$ with $\sigma_x$ = {sigma_x:g})")
+    finite = np.concatenate([y[np.isfinite(y) & (y > 0)] for label, y in spreads.items() if "printed" not in label]
+                            + [sd for _, _, sd in points.values()])
+    if finite.size:
+        bot.set_ylim(max(finite.min() * 0.5, 1e-6), finite.max() * 3.0)
+    top.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
+    bot.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
+    if title:
+        fig.suptitle(plain_text(title))
+    return fig
 
 
 # ----------------------------------------------------------------------------- slidercrank, nonlinear rod

@@ -63,6 +63,23 @@ def esc(text: Any) -> str:
     return html.escape(str(text), quote=True)
 
 
+_GREEK = {"alpha": "α", "beta": "β", "gamma": "γ", "delta": "δ", "theta": "θ", "mu": "μ", "rho": "ρ",
+          "sigma": "σ", "tau": "τ", "varphi": "φ", "phi": "φ", "omega": "ω", "psi": "ψ"}
+_SUB = str.maketrans("0123456789", "₀₁₂₃₄₅₆₇₈₉")
+
+
+def plain(label: str) -> str:
+    """A figure label as HTML text: its mathtext symbols as Unicode (``$\\omega_2$`` -> ω₂) and
+    an escaped ``\\$`` (deck text) as the dollar sign it stands for."""
+    def math(m: re.Match) -> str:
+        t = m.group(1)
+        t = re.sub(r"\\([A-Za-z]+)", lambda g: _GREEK.get(g.group(1), g.group(1)), t)
+        t = re.sub(r"_\{([0-9]+)\}|_([0-9])", lambda g: (g.group(1) or g.group(2)).translate(_SUB), t)
+        return t.replace("{", "").replace("}", "")
+    out = re.sub(r"(?<!\\)\$(.+?)(?<!\\)\$", math, label)
+    return out.replace("\\$", "$")
+
+
 # ----------------------------------------------------------------------------- metadata
 
 def run_metadata() -> dict[str, str]:
@@ -102,6 +119,7 @@ def figure_svg(fig: Any, label: str = "") -> str:
 
 
 def _figure_block(fig: Any, caption: str) -> str:
+    caption = plain(caption)
     return f'<figure class="plot">{figure_svg(fig, caption)}<figcaption>{esc(caption)}</figcaption></figure>'
 
 
@@ -141,7 +159,7 @@ def _fourbar_frames(params: "Params") -> dict[str, Any] | None:
     return frames
 
 
-def _slidercrank_frames(params: "Params") -> dict[str, Any] | None:
+def _slidercrank_frames(params: "Params", result: "Result | None" = None) -> dict[str, Any] | None:
     from driver import kernels
     from driver.slidercrank.spec import _model
     model = _model(params)
@@ -154,7 +172,30 @@ def _slidercrank_frames(params: "Params") -> dict[str, Any] | None:
               "B": np.round(b, 6).tolist(), "P": None, "ground": [[0.0, 0.0], [float(b[:, 0].max()), 0.0]],
               "kind": "slidercrank", "names": {"crank": "crank", "out": "slider"}}
     frames["box"] = _box(np.vstack([a, b, [[0.0, 0.0]]]), pad_y=0.25 * r)
+    frames["bow"], frames["bow_note"] = _rod_bow(result, theta, length)
     return frames
+
+
+def _rod_bow(result: "Result | None", theta: np.ndarray, length: float) -> tuple[list[float] | None, str]:
+    """The elastic rod's midpoint deflection [m] at the animation's crank angles, magnified so
+    its largest is 6 % of the rod (from the run's tidy table: the fastest crank speed that ran),
+    and the words saying so; (None, '') without one."""
+    tidy = getattr(result, "tidy", None)
+    if tidy is None or "midpoint_deflection_mm" not in tidy or not len(tidy):
+        return None, ""
+    w = float(tidy["omega_rad_s"].max())
+    rows = tidy[tidy["omega_rad_s"] == w]
+    ang = np.mod(rows["crank_angle_deg"].to_numpy(dtype=float), 360.0)
+    mid = rows["midpoint_deflection_mm"].to_numpy(dtype=float) * 1e-3
+    order = np.argsort(ang)
+    ang, mid = ang[order], mid[order]
+    peak = float(np.max(np.abs(mid)))
+    if not np.isfinite(peak) or peak <= 0:
+        return None, ""
+    scale = 0.06 * length / peak
+    bow = np.interp(theta, ang, mid, period=360.0) * scale
+    return np.round(bow, 7).tolist(), (f"rod deflection magnified {scale:.3g} times "
+                                       f"(midpoint deflection at {w:g} rad/s, largest {peak * 1e3:.3g} mm)")
 
 
 def _box(pts: np.ndarray, pad_y: float = 0.0) -> list[float]:
@@ -184,7 +225,11 @@ _ANIM_JS = r"""
     [coupler, out, pb, pp, block].forEach(function(e){ if (e) e.style.visibility = ok ? "visible" : "hidden"; });
     note.style.visibility = ok ? "hidden" : "visible";
     if (!ok) return;
-    if (F.P) coupler.setAttribute("points", [A, B, F.P[k]].map(function(p){ return p.join(","); }).join(" "));
+    if (F.kind === "slidercrank") {
+      var dx = B[0] - A[0], dy = B[1] - A[1], L = Math.sqrt(dx * dx + dy * dy), b = F.bow ? 2 * F.bow[k] : 0;
+      var C = [(A[0] + B[0]) / 2 - b * dy / L, (A[1] + B[1]) / 2 + b * dx / L];
+      coupler.setAttribute("d", "M" + A.join(",") + " Q" + C.join(",") + " " + B.join(","));
+    } else if (F.P) coupler.setAttribute("points", [A, B, F.P[k]].map(function(p){ return p.join(","); }).join(" "));
     else coupler.setAttribute("points", [A, B].map(function(p){ return p.join(","); }).join(" "));
     dot(pb, B);
     if (F.P) dot(pp, F.P[k]);
@@ -203,13 +248,15 @@ _ANIM_JS = r"""
 """
 
 
-def mechanism_animation(params: "Params", anim_id: str = "anim", caption: str = "") -> str | None:
+def mechanism_animation(params: "Params", anim_id: str = "anim", caption: str = "",
+                        result: "Result | None" = None) -> str | None:
     """The animation of a four-bar or slider-crank deck over one crank turn (inline SVG, JSON
-    positions from the kernel and a few lines of JavaScript), or None for another study."""
+    positions from the kernel and a few lines of JavaScript), or None for another study.  A
+    slider-crank ``result`` adds its elastic rod's midpoint deflection, magnified."""
     if params.group == "fourbar":
         F = _fourbar_frames(params)
     elif params.group == "slidercrank":
-        F = _slidercrank_frames(params)
+        F = _slidercrank_frames(params, result)
     else:
         return None
     if F is None:
@@ -256,6 +303,14 @@ def mechanism_animation(params: "Params", anim_id: str = "anim", caption: str = 
         out = ""
         block = (f'<rect data-part="block" width="{6 * rad:.5g}" height="{3 * rad:.5g}" fill="#e67e22" '
                  f'fill-opacity="0.85" stroke="#333" stroke-width="{lw / 4:.4g}"/>')
+    if F["kind"] == "slidercrank":   # the rod: a curve A-B (bowed by the elastic deflection when known)
+        coupler = (f'<path data-part="coupler" fill="none" stroke="#2980b9" stroke-width="{lw:.4g}" '
+                   'stroke-linecap="round"/>')
+    else:
+        coupler = (f'<polygon data-part="coupler" fill="#3498db" fill-opacity="0.25" stroke="#2980b9" '
+                   f'stroke-width="{lw:.4g}" stroke-linejoin="round"/>')
+    if F.get("bow_note"):
+        caption = (caption + " " if caption else "") + F["bow_note"][0].upper() + F["bow_note"][1:] + "."
     n = len(F["theta"])
     data = json.dumps(F, separators=(",", ":"))
     body = f"""
@@ -266,7 +321,7 @@ def mechanism_animation(params: "Params", anim_id: str = "anim", caption: str = 
   {a_path}
   {''.join(paths)}
   <line data-part="crank" stroke="#2c3e50" stroke-width="{lw:.4g}" stroke-linecap="round"/>
-  <polygon data-part="coupler" fill="#3498db" fill-opacity="0.25" stroke="#2980b9" stroke-width="{lw:.4g}" stroke-linejoin="round"/>
+  {coupler}
   {out}{block}{pivots}
   <circle data-part="A" r="{rad:.4g}" fill="#fff" stroke="#000" stroke-width="{lw / 4:.4g}"/>
   <circle data-part="B" r="{rad:.4g}" fill="#fff" stroke="#000" stroke-width="{lw / 4:.4g}"/>
@@ -432,7 +487,7 @@ def _result_sections(result: "Result", params: "Params | None", comparison: "pd.
     if params is not None:
         anim = mechanism_animation(params, f"anim-{re.sub(r'[^A-Za-z0-9]', '', result.name) or 'x'}",
                                    anim_caption or "The mechanism over one crank turn (positions from the kernel); "
-                                   "drag the slider or press play.")
+                                   "drag the slider or press play.", result=result)
         if anim:
             sections.append(Section("animation", "animation over the crank cycle", anim))
     figs, failed = _figures_html(result)
@@ -555,10 +610,11 @@ def page_for_sweep(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> st
     try:
         if plotting.is_grid(ok, keys) and not sw.zip:
             figs = plotting.sweep_maps(ok, keys, wanted[:3], labels, senses, stem, sw.summary_rows == "kept")
-        else:
-            figs = [plotting.design_space_map(ok, numeric_keys[:1], y, labels, best=best, best_text=best_text,
-                                              title=f"{stem}: {labels[y]}") for y in wanted[:3]]
-        maps += [_figure_block(f, f"{labels[y]} over the swept keys") for f, y in zip(figs, wanted)]
+            maps += [_figure_block(f, f"{labels[y]} over the swept keys") for f, y in zip(figs, wanted)]
+        else:   # one key, zipped keys or a kept set that is no grid: the --plot summary (lines, strips)
+            fig = plotting.sweep_summary(ok, keys, sw.plot_x, sw.plot_y, stem, labels,
+                                         getattr(module, "SWEEP_PLOT", ()))
+            maps.append(_figure_block(fig, "the sweep's summary columns against the swept keys"))
     except Exception as exc:
         notes.append(f"the design-space maps could not be drawn: {exc.__class__.__name__}: {exc}")
     sections.append(Section("design-space", "design space", "\n".join(maps) or "<p>No numeric summary column to map.</p>"))
@@ -570,7 +626,7 @@ def page_for_sweep(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> st
         try:
             result, params = _case_result(Path(f"{stem}_case{int(summary.loc[best, 'case'])}.dat"),
                                           _namelist(base_params.group, values))
-            body = (f'<p>Case {int(summary.loc[best, "case"])}, {esc(best_text)}: ' + ", ".join(
+            body = (f'<p>Case {int(summary.loc[best, "case"])}, {esc(plain(best_text))}: ' + ", ".join(
                 f"{esc(k)} = {summary.loc[best, k]:.6g}" for k in numeric_keys) + ".</p>")
             anim = mechanism_animation(params, "anim-best", "The marked design over one crank turn.")
             body += anim or ""
@@ -625,7 +681,7 @@ def page_for_optimize(deck: "Deck", outdir: Path, stem: str, status: int = 0) ->
     notes: list[str] = []
     figs = []
     try:
-        fig = plotting.convergence_plot(history, evals, label, sense, title=f"{stem}: convergence")
+        fig = plotting.convergence_plot(history, evals, label, sense, title=plotting.plain_text(f"{stem}: convergence"))
         figs.append(_figure_block(fig, "best feasible objective, gap to the final best, constraint violation"))
     except Exception as exc:
         notes.append(f"the convergence plot could not be drawn: {exc.__class__.__name__}: {exc}")
@@ -635,7 +691,8 @@ def page_for_optimize(deck: "Deck", outdir: Path, stem: str, status: int = 0) ->
         opt = feas["objective"].idxmax() if sense == "maximize" else feas["objective"].idxmin()
         frame = evals.assign(kept=evals["feasible"].astype(bool))
         try:
-            fig = _evaluated_map(frame, design[:2], label, opt, _labels(module, design), f"{stem}: designs evaluated")
+            fig = _evaluated_map(frame, design[:2], label, opt, _labels(module, design),
+                                 plotting.plain_text(f"{stem}: designs evaluated"))
             figs.append(_figure_block(fig, "designs evaluated over the design variables"))
         except Exception as exc:
             notes.append(f"the map of designs could not be drawn: {exc.__class__.__name__}: {exc}")

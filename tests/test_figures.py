@@ -272,8 +272,8 @@ def test_slidercrank_buckled_speed_is_named_not_missing(write_deck):
 def test_slidercrank_linear_model_flags_cases_above_the_euler_load(write_deck):
     fig = _slider_figures(write_deck, False)["strain"]
     lines = {ln.get_label(): ln for ln in fig.axes[0].get_lines() if len(ln.get_xdata()) > 2}
-    assert set(lines) == {"11.52 rad/s", "29.32 rad/s: N = 1.43 P_E, above the Euler load"}
-    assert lines["29.32 rad/s: N = 1.43 P_E, above the Euler load"].get_linestyle() == "--"
+    assert set(lines) == {"11.52 rad/s", "29.32 rad/s: N = 1.43 $P_E$, above the Euler load"}
+    assert lines["29.32 rad/s: N = 1.43 $P_E$, above the Euler load"].get_linestyle() == "--"
     assert lines["11.52 rad/s"].get_linestyle() == "-"
     assert "linear model" in fig.axes[0].get_title()
 

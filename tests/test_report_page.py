@@ -132,7 +132,7 @@ def _parts(browser) -> dict:
         return {theta: r.querySelector('output').textContent,
                 crank: [num(c,'x1'), num(c,'y1'), num(c,'x2'), num(c,'y2')],
                 A: [num(A,'cx'), num(A,'cy')], B: [num(B,'cx'), num(B,'cy')],
-                coupler: k.getAttribute('points'), visible: k.style.visibility,
+                coupler: k.getAttribute('points'), rod: k.getAttribute('d'), visible: k.style.visibility,
                 out: o ? [num(o,'x1'), num(o,'y1'), num(o,'x2'), num(o,'y2')] : null,
                 block: blk ? [num(blk,'x') + num(blk,'width') / 2, num(blk,'y') + num(blk,'height') / 2] : null,
                 note: r.querySelector("[data-part='note']").style.visibility}; })()""")
@@ -149,6 +149,14 @@ def _move(browser, k: int) -> None:
     ("slidercrank_small", dict(crank=0.125, rod=0.505)),
 ])
 def test_animation_follows_the_slider(pages, browser, stem, lengths):
+    if stem == "slidercrank_small":   # the run's midpoint deflection at its fastest speed, in metres
+        import driver
+        tidy = driver.run(SLIDERCRANK, name="slidercrank_small").tidy
+        fast = tidy[tidy["omega_rad_s"] == tidy["omega_rad_s"].max()]
+        ang = np.mod(fast["crank_angle_deg"].to_numpy(), 360.0)
+        mid = fast["midpoint_deflection_mm"].to_numpy() * 1e-3
+        order = np.argsort(ang)
+        lengths = dict(lengths, mid=(ang[order], mid[order]), scale=0.06 * 0.505 / np.abs(mid).max())
     browser.events.clear()
     browser.open(pages / f"{stem}.html")
     n = int(browser.eval("document.querySelector('.anim input[type=range]').max")) + 1
@@ -175,6 +183,16 @@ def test_animation_follows_the_slider(pages, browser, stem, lengths):
         else:                     # the slider on its guide, the rod at its length
             assert abs(b[1]) < 1e-9 and math.isclose(np.hypot(*(b - a)), lengths["rod"], rel_tol=1e-4)
             assert np.allclose(p["block"], b, atol=1e-6)
+            # the rod drawn from A to B, bowed by its midpoint deflection (magnified as the caption says)
+            nums = [float(v) for v in re.findall(r"-?[0-9.]+(?:e-?[0-9]+)?", p["rod"])]
+            start, ctrl, end = np.array(nums[:2]), np.array(nums[2:4]), np.array(nums[4:6])
+            assert np.allclose(start, a) and np.allclose(end, b)
+            mid_drawn = 0.25 * start + 0.5 * ctrl + 0.25 * end   # the quadratic Bezier at t = 1/2
+            chord = (b - a) / np.hypot(*(b - a))
+            off = mid_drawn - 0.5 * (a + b)
+            bow = float(chord[0] * off[1] - chord[1] * off[0])   # signed distance to the left of A->B
+            assert bow == pytest.approx(lengths["scale"] * np.interp(theta, *lengths["mid"], period=360.0),
+                                        abs=1e-6 * lengths["rod"])
     # the drawing changes with the slider
     assert len({tuple(p["A"]) for p in seen}) == len(seen)
     assert browser.errors() == []

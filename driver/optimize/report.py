@@ -229,4 +229,4 @@ def convergence_figure(p: Problem, history: pd.DataFrame, evals: pd.DataFrame, t
     from driver.study import expression_label
     return plotting.convergence_plot(history, evals, expression_label(p.study, p.objective.text),
                                      "minimize" if p.sense > 0 else "maximize",
-                                     title=f"{title}: {p.objective_text}")
+                                     title=plotting.plain_text(f"{title}: {p.objective_text}"))

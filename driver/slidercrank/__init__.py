@@ -23,7 +23,7 @@ from tqdm import tqdm
 
 from driver.deck import Params
 from driver.limits import Estimate
-from driver.slidercrank.analysis import Case, _run_case, simeon_initial_state, static_onset
+from driver.slidercrank.analysis import Case, _run_case, history, simeon_initial_state, static_onset
 from driver.slidercrank.report import (_benchmark_lines, _convergence_table, _crank_end_table, _header, _peak_notes,
                                        _peak_table, _plotting, _status_text, _summary, _tidy, _unsettled)
 from driver.slidercrank.spec import (EULER_WARN, LABELS, MATERIALS, MIN_STEPS_PER_BENDING_PERIOD, MIN_STEPS_PER_REV,
@@ -166,6 +166,10 @@ def run(params: Params, progress: bool = False) -> Result:
             [(f"{c.omega:g} rad/s", c.angle_deg, c.mid * 1e3) for c in good],
             f"{params.material}: midpoint deflection ({stiffness})", ylabel="midpoint deflection [mm]",
             above=above, missing=missing)))
+    if params.end_time > 0 and cases[0].ok:   # a benchmark run: its time history against the reference
+        c0 = cases[0]
+        ref = SIMEON1996 if params.benchmark == "simeon1996" else None
+        figures.append(Figure("history", lambda: _history_figure(model, params, c0, alpha, beta, ref)))
     if conv:
         series = {f"{w:g} rad/s": ([c.n_elements for c in cs if c.ok], [c.peak(+1)[0] * 1e6 for c in cs if c.ok])
                   for w, cs in conv.items()}
@@ -173,3 +177,19 @@ def run(params: Params, progress: bool = False) -> Result:
             series, f"{params.material}: element convergence")))
     return Result(text="\n".join(text) + "\n", tidy=_tidy(params.material, list(done.values())),
                   summary=_summary(cases, model if _shape(params)[1] else None), warnings=warnings, failure=failure, figures=figures)
+
+
+def _history_figure(model: Model, params: Params, case: Case, alpha: float, beta: float, ref: dict | None):
+    """Midpoint deflection and rod elongation against time of a benchmark run, with the
+    reference end state (Simeon 1996) marked."""
+    h = history(model, params, case.omega, case.n_elements, alpha, beta)
+    refs = {}
+    if ref is not None:
+        refs = {"mid": (ref["t"], ref["q1"]), "elong": (ref["t"], ref["q4"])}
+    return _plotting().slidercrank_history_figure(
+        h["time"], {"mid": h["mid"] * 1e3, "elong": h["elong"] * 1e6},
+        {"mid": "midpoint deflection $q_1$ [mm]", "elong": "rod elongation $q_4$ [$\\mu$m]"},
+        {k: (t, v * (1e3 if k == "mid" else 1e6)) for k, (t, v) in refs.items()},
+        f"{'Simeon (1996) crank benchmark' if ref is not None else params.material}: {case.n_elements} elements "
+        f"at {case.omega:g} rad/s, t = 0 to {params.end_time:g} s",
+        "Simeon (1996), MEBDFI tol 1e-14")

@@ -186,3 +186,27 @@ def _settle(res: dict, spr: int) -> dict:
     out["settle_strain"] = change(res["eps_ax"][:, :spr + 1], out["eps_ax"])
     out["settle_mid"] = change(res["mid"][:spr + 1], out["mid"])
     return out
+
+
+def history(model: Model, params: Params, omega: float, n_el: int, alpha: float,
+            beta: float) -> dict[str, np.ndarray]:
+    """The whole time history of a benchmark run (``end_time`` > 0), for its figure: the same
+    kernel call as :func:`_run_case` recording every step instead of the end state only.
+    Returns time [s], midpoint deflection from the chord [m], rod elongation [m], slider
+    position [m]; empty arrays when the run stops early."""
+    dt = 2 * math.pi / (omega * params.steps_per_rev)
+    n_steps = max(1, round(params.end_time / dt))
+    dt = params.end_time / n_steps
+    q0 = qd0 = None
+    start = params.start
+    if start == "simeon1996":
+        q0, qd0 = simeon_initial_state(n_el, model.length)
+        start = "given"
+    res = kernels.slidercrank_simulate(
+        n_el, model.r2, model.length, model.rho_a, model.ea, model.ei, model.depth / 2, model.m_s, omega,
+        dt, n_steps, 0, n_steps + 1, alpha, beta, start=start, dynamic=params.analysis == "dynamic",
+        geometric_stiffness=params.geometric_stiffness, q_init=q0, qd_init=qd0)
+    if res["status"] != kernels.SLIDERCRANK_STATUS["ok"]:
+        return {k: np.empty(0) for k in ("time", "mid", "elong", "slider")}
+    return {"time": dt * np.arange(n_steps + 1), "mid": np.asarray(res["mid"]), "elong": np.asarray(res["elong"]),
+            "slider": np.asarray(res["slider"])}

@@ -1,0 +1,135 @@
+"""Figure text: deck text is drawn literally (never as mathtext), the tool's own labels use
+mathtext symbols, and the figures the issue found missing exist with the right content."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+pytest.importorskip("matplotlib")
+
+import driver  # noqa: E402
+from conftest import INPUTS  # noqa: E402
+
+
+def _is_math(text_artist) -> bool:
+    return bool(text_artist._preprocess_math(text_artist.get_text())[1])
+
+
+def test_deck_titles_are_never_mathtext(tmp_path):
+    """A title with dollar signs ('cost $x$ per $y$') is drawn as written: every figure renders,
+    and no title of a deck's text is parsed as mathtext."""
+    title = "cost $x$ per $y$ \\alpha"
+    r = driver.fourbar.run(fixed_link=12.0, crank=5.0, coupler=15.0, rocker=9.0, step_deg=20, title=title)
+    for name in r.figure_names:
+        fig = r.figure(name)
+        fig.canvas.draw()   # a mathtext parse error would raise here
+        titles = [t for t in ([fig._suptitle] if fig._suptitle else []) + [a.title for a in fig.axes]
+                  if "cost" in t.get_text()]
+        assert titles, name
+        for t in titles:
+            assert not _is_math(t)
+            assert t._preprocess_math(t.get_text())[0].startswith("cost $x$ per $y$")
+
+
+def test_tool_labels_use_mathtext_symbols():
+    r = driver.fourbar.run(fixed_link=12.0, crank=5.0, coupler=15.0, rocker=9.0, step_deg=20)
+    fig = r.figure("curves")
+    assert fig.axes[-1].get_xlabel() == r"crank angle $\theta_2$ [deg]"
+    legend = [t.get_text() for t in fig.axes[2].get_legend().get_texts()]
+    assert any(r"$\omega_4$" in t and t.startswith("rocker") for t in legend)
+    assert any(r"$\omega_3$" in t and t.startswith("coupler") for t in legend)
+
+
+def test_an_expression_label_is_drawn_literally():
+    import pandas as pd
+
+    from driver import plotting
+    from driver.study import column_label, expression_label
+    expr = 'mu_min_deg + 0*("$" == "$")'
+    frame = pd.DataFrame({"case": [1, 2, 3], "fourbar.crank": [2.0, 3.0, 4.0], "kept": [True] * 3,
+                          expr: [40.0, 33.0, 26.0]})
+    fig = plotting.sweep_summary(frame, ["fourbar.crank"], ys=[expr],
+                                 labels={c: column_label(driver.fourbar, c) for c in frame.columns})
+    fig.canvas.draw() if fig.canvas is not None else None
+    ylabel = fig.axes[0].yaxis.label
+    assert not _is_math(ylabel) and "$" in ylabel._preprocess_math(ylabel.get_text())[0]
+    lab = expression_label(driver.fourbar, "min(mu_min_deg, 180 - mu_max_deg)")
+    assert lab == "min(minimum transmission angle, 180 - maximum transmission angle) [deg]"
+
+
+def test_robust_example_draws_its_fits():
+    """robust_example draws the mean and spread of Y against the target with the four t_min
+    estimates, at the values the .out reports (true t_min = -b1 / (2 b2) = 15 for (2.1))."""
+    r = driver.run(str(INPUTS / "robust_example.dat"))
+    assert r.figure_names == ["fits"]
+    fig = r.figure("fits")
+    top, bot = fig.axes[:2]
+    assert bot.get_yscale() == "log"
+    vlines = {ln.get_label(): ln.get_xdata()[0] for ln in bot.lines if ln.get_label().startswith("$t_{min}$")}
+    b = [-6.0, 1.2, -0.04]
+    assert vlines["$t_{min}$ true (2.2) = 15.000"] == pytest.approx(-b[1] / (2 * b[2]))
+    for key, label in (("tmin_dual_response", "dual response (2.9)"), ("tmin_taguchi", "Taguchi (2.13)"),
+                       ("tmin_tolerance_analysis", "tolerance analysis (2.15)")):
+        name = f"$t_{{min}}$ {label} = {r.summary[key]:.3f}"
+        assert vlines[name] == pytest.approx(r.summary[key])
+    # the known relation's spread (2.2) at t = 15 is sqrt(2 b2^2 sigma_x^4) = sqrt(2) |b2| sigma_x^2 (the slope term vanishes)
+    exact = [ln for ln in bot.lines if ln.get_label().startswith("tolerance analysis of (2.1)")][0]
+    t, s = exact.get_xdata(), exact.get_ydata()
+    assert np.interp(15.0, t, s) == pytest.approx(math.sqrt(2) * 0.04 * 0.5 ** 2, rel=1e-3)
+
+
+def test_simeon_benchmark_draws_its_history():
+    """The Simeon (1996) benchmark deck draws q1 and q4 against time; the drawn history ends at
+    the end state the .out tabulates, the reference marker sits at Simeon's published values,
+    and the two agree within the .out's 0.2 % (a linear KED model against the full model)."""
+    from driver.slidercrank import SIMEON1996
+    r = driver.run(str(INPUTS / "slidercrank_simeon1996.dat"))
+    assert "history" in r.figure_names
+    fig = r.figure("history")
+    mid_ax, elong_ax = fig.axes[:2]
+    model = mid_ax.lines[0]
+    ref = [ln for ln in mid_ax.lines if ln.get_label().startswith("Simeon")][0]
+    t, q1 = model.get_xdata(), model.get_ydata()
+    assert t[0] == 0.0 and t[-1] == pytest.approx(0.1)
+    table = {line.split()[-5]: float(line.split()[-3]) for line in r.text.splitlines()
+             if "(q1)" in line or "(q4)" in line}   # quantity ... (q1)  m  this-model  Simeon  diff%
+    assert q1[-1] == pytest.approx(table["(q1)"] * 1e3, rel=1e-9)   # [mm]
+    assert elong_ax.lines[0].get_ydata()[-1] == pytest.approx(table["(q4)"] * 1e6, rel=1e-9)   # [um]
+    assert ref.get_xdata()[0] == SIMEON1996["t"] and ref.get_ydata()[0] == pytest.approx(SIMEON1996["q1"] * 1e3)
+    assert q1[-1] == pytest.approx(ref.get_ydata()[0], rel=5e-3)
+
+
+def test_report_page_text_of_a_label():
+    """The report page writes figure labels as text: mathtext symbols as Unicode, a deck's
+    escaped dollar as a dollar."""
+    from driver.report_page import plain
+    assert plain(r"phase angle $\varphi_{12}$ [deg]") == "phase angle φ₁₂ [deg]"
+    assert plain(r"crank angle $\theta_2$ [deg]") == "crank angle θ₂ [deg]"
+    assert plain(r"cost \$x\$ per part") == "cost $x$ per part"
+
+
+def test_figure_functions_draw_into_a_users_axes():
+    """The matplotlib convention: a figure function given ``ax=``/``axes=`` draws there and returns
+    that figure (a user's own layout, e.g. two studies side by side)."""
+    from matplotlib.figure import Figure
+
+    from driver import plotting
+    fig = Figure(layout="constrained")
+    a, b = fig.subplots(1, 2)
+    theta = np.linspace(0.0, 360.0, 73)
+    assert plotting.ujoint_speed_figure(theta, 25.0, {"optimum": 25 + np.sin(np.radians(2 * theta))}, ax=a) is fig
+    assert plotting.slidercrank_strain_figure([("10 rad/s", theta, np.cos(np.radians(theta)))], "t", ax=b) is fig
+    assert a.lines and b.lines
+    fig2 = Figure()
+    axes = fig2.subplots(2, 1)
+    assert plotting.line_panels(theta, [("y", {"a": theta}), ("z", {"b": -theta})], "x", axes=axes) is fig2
+    assert axes[0].lines and axes[1].lines
+    fig3 = Figure()
+    axes3 = fig3.subplots(3, 1)
+    r = driver.fourbar.run(fixed_link=12.0, crank=5.0, coupler=15.0, rocker=9.0, step_deg=20)
+    from driver.fourbar import exact_grid, tidy_frame, _exact_columns
+    out, st = exact_grid(r.params, theta)
+    assert plotting.fourbar_curves(tidy_frame("exact", theta, _exact_columns(out, st), st), None, "",
+                                   axes=axes3) is fig3
