@@ -107,6 +107,16 @@ def _batch_and_auxiliary_kernels(rng: np.random.Generator, theta: np.ndarray) ->
                                                                   0.15, 0.3, 7870 * 64e-6, 0.075552))
     out["slidercrank_frequencies"] = _h(k.slidercrank_frequencies(7870 * 64e-6, 2e11 * 64e-6,
                                                                   2e11 * 3.413333333e-10, 0.3, 0.075552))
+    nl = k.slidercrank_nl_simulate(6, 0.15, 0.3, 7870 * 64e-6, 2e11 * 64e-6, 2e11 * 3.413333333e-10, 0.004, 1.3,
+                                   150.0, 2 * np.pi / 150.0 / 360, 400, 360, 0, 400, 0.0, 1e-4, -0.05)
+    out["slidercrank_nl_simulate"] = _h(*(nl[key] for key in ("eps_ax", "eps_of", "lat_max", "mid", "elong",
+                                                               "slider", "rev_lat", "rev_eps", "stats")),
+                                        [nl["status"]])
+    out["slidercrank_column_static"] = _h(k.slidercrank_column_static(8, 1.0, 2e11 * 64e-6, 2e11 * 3.413333333e-10,
+                                                                      1.06 * np.pi ** 2 * 2e11 * 3.413333333e-10,
+                                                                      1e-3))
+    pe = rng.normal(0, 1e-3, 6)
+    out["slidercrank_corot_element"] = _h(*k.slidercrank_corot_element(0.05, 2e11 * 64e-6, 2e11 * 3.413333333e-10, pe))
     return out
 
 
