@@ -136,11 +136,7 @@ def _run_case(model: Model, params: Params, omega: float, n_el: int, alpha: floa
         n_steps = params.revolutions * spr
         two = params.revolutions >= 2     # record the last two revolutions to judge settling
         rec_start, n_rec = (params.revolutions - (2 if two else 1)) * spr, (2 if two else 1) * spr + 1
-    q0 = qd0 = None
-    start = params.start
-    if start == "simeon1996":
-        q0, qd0 = simeon_initial_state(n_el, model.length)
-        start = "given"
+    start, q0, qd0 = _start_state(params.start, n_el, model.length)
     res = kernels.slidercrank_simulate(
         n_el, model.r2, model.length, model.rho_a, model.ea, model.ei, model.depth / 2, model.m_s, omega,
         dt, n_steps, rec_start, n_rec, alpha, beta, start=start, dynamic=params.analysis == "dynamic",
@@ -197,11 +193,7 @@ def history(model: Model, params: Params, omega: float, n_el: int, alpha: float,
     dt = 2 * math.pi / (omega * params.steps_per_rev)
     n_steps = max(1, round(params.end_time / dt))
     dt = params.end_time / n_steps
-    q0 = qd0 = None
-    start = params.start
-    if start == "simeon1996":
-        q0, qd0 = simeon_initial_state(n_el, model.length)
-        start = "given"
+    start, q0, qd0 = _start_state(params.start, n_el, model.length)
     res = kernels.slidercrank_simulate(
         n_el, model.r2, model.length, model.rho_a, model.ea, model.ei, model.depth / 2, model.m_s, omega,
         dt, n_steps, 0, n_steps + 1, alpha, beta, start=start, dynamic=params.analysis == "dynamic",
@@ -210,3 +202,12 @@ def history(model: Model, params: Params, omega: float, n_el: int, alpha: float,
         return {k: np.empty(0) for k in ("time", "mid", "elong", "slider")}
     return {"time": dt * np.arange(n_steps + 1), "mid": np.asarray(res["mid"]), "elong": np.asarray(res["elong"]),
             "slider": np.asarray(res["slider"])}
+
+
+def _start_state(start: str, n_el: int, length: float) -> tuple[str, np.ndarray | None, np.ndarray | None]:
+    """(kernel start mode, q0, qd0) for the deck's ``start``: Simeon's benchmark gives its own
+    initial state to the kernel as 'given'; every other mode starts from the kernel's own state."""
+    if start == "simeon1996":
+        q0, qd0 = simeon_initial_state(n_el, length)
+        return "given", q0, qd0
+    return start, None, None
