@@ -115,10 +115,11 @@ def output_set(root: str | Path) -> Iterator[OutputSet]:
     """Write a set of files inside folder ``root`` all or nothing (see the module docstring)."""
     s = OutputSet(Path(root))
     token = _CURRENT.set(s)
+    current = True   # this set is the current one until reset
     try:
         yield s
         _CURRENT.reset(token)
-        token = None
+        current = False
         done = 0
         try:
             for tmp, path in s.pending:
@@ -137,7 +138,7 @@ def output_set(root: str | Path) -> Iterator[OutputSet]:
                 os.unlink(tmp)
         raise
     finally:
-        if token is not None:
+        if current:
             _CURRENT.reset(token)
 
 
@@ -163,7 +164,7 @@ def _alive(pid: int) -> bool:
 def remove_stale_temporaries(folder: str | Path, stem: str) -> list[Path]:
     """Remove this tool's temporaries for outputs ``<stem>*`` in ``folder`` whose writer is dead."""
     folder = Path(folder)
-    removed = []
+    removed: list[Path] = []
     try:
         entries = list(os.scandir(folder))
     except OSError:

@@ -13,6 +13,7 @@ Nothing here computes anything; :mod:`driver.compare` puts these cells beside a 
 from __future__ import annotations
 
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -93,7 +94,8 @@ def matches(match: dict[str, str], values: dict[str, object], rel: float = 1e-12
         if key not in values:
             return False
         want = text.split(",")
-        got = values[key] if isinstance(values[key], (list, tuple)) else [values[key]]
+        value = values[key]
+        got: Sequence[object] = value if isinstance(value, (list, tuple)) else [value]
         if len(want) != len(got):
             return False
         for t, v in zip(want, got):

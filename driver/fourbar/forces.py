@@ -324,7 +324,7 @@ def summary(p: Params) -> dict[str, Any]:
     """Force summary of one deck (one row of the batch kernel, of the balanced linkage with
     ``balance = 'force'``; then also the figures of the linkage as given, prefixed ``unbalanced_``)."""
     d = summarise_force_batch(p).iloc[0].to_dict()
-    return {k: (None if isinstance(v, float) and math.isnan(v) else float(v)) for k, v in d.items()}
+    return {str(k): (None if isinstance(v, float) and math.isnan(v) else float(v)) for k, v in d.items()}
 
 
 def summarise_force_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None = None) -> pd.DataFrame:

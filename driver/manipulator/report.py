@@ -256,7 +256,9 @@ def _design_notes(p: Params, conv: Conv, used: dict) -> list[str]:
         pa = np.array(p.printed_angles_deg, float).reshape(-1, 2)
         for i, name in enumerate(used["names"]):
             for j, key in ((0, "shown1"), (1, "shown2")):
-                half = 0.5 * 10.0 ** Decimal(repr(float(pa[i, j]))).as_tuple().exponent  # half a printed unit
+                exponent = Decimal(repr(float(pa[i, j]))).as_tuple().exponent
+                assert isinstance(exponent, int)   # a finite number's ('n'/'N'/'F' are NaN and inf)
+                half = 0.5 * 10.0 ** exponent   # half a printed unit
                 if used["ok"][i] and abs(pa[i, j] - used[key][i]) > half + 1e-9:
                     lines.append(f"  design {name}: printed theta{j + 1} = {pa[i, j]:g} deg but the report's IK gives "
                                  f"{used[key][i]:.2f} deg (not reproducible; used as printed for Table 4.7)")

@@ -82,6 +82,7 @@ def _t42(p: Params, conv: Conv) -> Table:
             trailers.append(f"l1 >= C_rob radius {radius:.3f}: no l2 on C_rob")
             continue
         l2 = math.sqrt(c - v * v)
+        assert ri is not None   # v is valid, so there are valid designs
         ok = bool(ri[2][j])
         rows.append([f"{i + 1}.", float(ri[0][j, 1]), v, l2, "yes" if ok else "no"])
         trailers.append("" if ok else "violates the reach conditions (4.4)")

@@ -228,7 +228,7 @@ def _resumed(problem: Problem, stem: Path) -> list[dict]:
             for rec in frame[frame["base"] == fp].to_dict("records"):
                 summary = {c[len("summary."):]: (None if isinstance(rec[c], float) and math.isnan(rec[c]) else rec[c])
                            for c in summ}
-                summary = {k: (v.item() if hasattr(v, "item") else v) for k, v in summary.items()}
+                summary = {k: (v.item() if v is not None and hasattr(v, "item") else v) for k, v in summary.items()}
                 rows.append({"x": [rec[n] for n in problem.names], "status": rec["status"],
                              "reason": rec["case_error"] or "", "summary": summary})
     return rows
@@ -337,7 +337,7 @@ def run_optimize_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, 
     if not quiet:
         for path in oc.written:
             print(f"wrote {path}")
-        if oc.best is not None:
+        if oc.best is not None and oc.x is not None:   # x is the best design's
             word = "optimum" if oc.success else "best design (not converged)"
             print(f"{deck.path}: {word} {p_obj(oc)} after {oc.nfev} designs: "
                   + ", ".join(f"{k} = {v:.6g}" for k, v in oc.x.items()))

@@ -24,10 +24,10 @@ from tqdm import tqdm
 from driver.deck import Params
 from driver.limits import Estimate
 from driver.slidercrank.analysis import Case, _run_case, history, simeon_initial_state, static_onset
-from driver.slidercrank.report import (_benchmark_lines, _convergence_table, _crank_end_table, _header, _peak_notes,
+from driver.slidercrank.report import (Derived, _benchmark_lines, _convergence_table, _crank_end_table, _header, _peak_notes,
                                        _peak_table, _plotting, _status_text, _summary, _tidy, _unsettled)
 from driver.slidercrank.spec import (EULER_WARN, LABELS, MATERIALS, MIN_STEPS_PER_BENDING_PERIOD, MIN_STEPS_PER_REV,
-                                     PAPER_SPEEDS, SIMEON1996, SPEC, STATUS_TEXT, SWEEP_PLOT, Model, _model, _shape,
+                                     PAPER_SPEEDS, SIMEON1996, SPEC, STATUS_TEXT, SWEEP_PLOT, Model, Simeon1996, _model, _shape,
                                      min_steps_per_rev, rayleigh)
 from driver.study import Figure, Result, keyword_run
 
@@ -77,7 +77,7 @@ def run(params: Params, progress: bool = False) -> Result:
     w_bend, w_axial, p_euler = model.frequencies()
     alpha, beta = rayleigh(params.damping_ratio, w_bend, w_axial)
     counts = list(params.element_counts) if params.element_counts else [params.n_elements]
-    derived = dict(w_bend=w_bend, w_axial=w_axial, p_euler=p_euler, alpha=alpha, beta=beta,
+    derived = Derived(w_bend=w_bend, w_axial=w_axial, p_euler=p_euler, alpha=alpha, beta=beta,
                    onset=static_onset(model, counts[-1]))
     jobs = [(w, n) for w in params.speeds for n in counts]
     done: dict[tuple[float, int], Case] = {}
@@ -104,7 +104,7 @@ def run(params: Params, progress: bool = False) -> Result:
                 msg += "; the linear model cannot show buckling: rerun with geometric_stiffness = .true."
             warnings.append(msg)
     for c in cases:
-        if c.ok and _unsettled(c, params.settle_tolerance):
+        if c.ok and _unsettled(c, params.settle_tolerance) and c.settle_strain is not None and c.settle_mid is not None:
             warnings.append(f"crank speed {c.omega:g} rad/s: the reported revolution has not settled: strain "
                             f"changes {100 * c.settle_strain:.3f} % and midpoint deflection "
                             f"{100 * c.settle_mid:.3f} % of their peaks between the last two revolutions "
@@ -179,7 +179,7 @@ def run(params: Params, progress: bool = False) -> Result:
                   summary=_summary(cases, model if _shape(params)[1] else None), warnings=warnings, failure=failure, figures=figures)
 
 
-def _history_figure(model: Model, params: Params, case: Case, alpha: float, beta: float, ref: dict | None):
+def _history_figure(model: Model, params: Params, case: Case, alpha: float, beta: float, ref: Simeon1996 | None):
     """Midpoint deflection and rod elongation against time of a benchmark run, with the
     reference end state (Simeon 1996) marked."""
     h = history(model, params, case.omega, case.n_elements, alpha, beta)

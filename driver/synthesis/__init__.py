@@ -154,7 +154,7 @@ class Synthesis:
     """A synthesis result: the linkage deck, the study run of it, and the report."""
 
     params: Params
-    linkage: dict[str, Any]
+    linkage: dict[str, Any] | None   # the linkage deck's values; None when no linkage was found
     text: str
     failure: str | None
     table: pd.DataFrame
@@ -365,6 +365,7 @@ def _crank_rocker(p: Params) -> Synthesis:
                            "coupler": m.coupler * p.fixed_link / m.ground, "rocker": m.rocker * p.fixed_link / m.ground,
                            "fixed_link": p.fixed_link, "crank_rocker": m.crank_rocker, "mu_min_deg": m.mu_min_deg,
                            "mu_max_deg": m.mu_max_deg, "quality_deg": m.quality_deg} for m in members])
+    failure: str | None
     if best is None:
         failure = ("no member of the family is a crank-rocker" if free is None else
                    f"no crank-rocker member has every link at least min_link_fraction = {frac:g} of the ground")
@@ -576,8 +577,8 @@ def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool,
     if not quiet:
         for w in written:
             print(f"wrote {w}")
-    for w in syn.warnings:
-        print(f"warning: {deck.path}: {w}", file=sys.stderr)
+    for msg in syn.warnings:
+        print(f"warning: {deck.path}: {msg}", file=sys.stderr)
     if syn.failure:
         print(f"error: {deck.path}: {syn.failure}", file=sys.stderr)
         return 1

@@ -224,7 +224,9 @@ def solve(pp: PathProblem, seed: int, maxiter: int, popsize: int,
             seen.append((val, tuple(x)))
         return val
 
-    res = differential_evolution(fun, bounds(pp), rng=seed, maxiter=maxiter, popsize=popsize, tol=1e-10,
+    # scipy-stubs types 'bounds' as one (lower, upper) pair; scipy takes (min, max) per variable, as here
+    res = differential_evolution(fun, bounds(pp),  # type: ignore[arg-type]
+                                 rng=seed, maxiter=maxiter, popsize=popsize, tol=1e-10,
                                  atol=1e-12, polish=False, init="sobol", mutation=(0.5, 1.0), recombination=0.9,
                                  strategy="best1bin")
     starts, keys = [], set()
@@ -236,8 +238,8 @@ def solve(pp: PathProblem, seed: int, maxiter: int, popsize: int,
         if len(starts) >= polish_starts:
             break
     best = refine(pp, evaluate(pp, res.x))
-    for x in starts:
-        cand = polish(pp, refine(pp, evaluate(pp, x)))
+    for x0 in starts:
+        cand = polish(pp, refine(pp, evaluate(pp, x0)))
         if cand.violation <= best.violation and cand.rms < best.rms:
             best = cand
     return best, bool(res.success), str(res.message), int(res.nfev)
