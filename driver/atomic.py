@@ -20,8 +20,9 @@ import contextvars
 import os
 import re
 import tempfile
+from collections.abc import Iterator
 from pathlib import Path
-from typing import IO, Iterator
+from typing import IO
 
 __all__ = ["atomic_open", "write_text", "output_set", "OutputSet", "inside", "remove_stale_temporaries",
            "file_digest", "DIGEST_CHARS", "own_folder", "refuse_link", "LinkRefused"]

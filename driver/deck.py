@@ -23,10 +23,10 @@ import re
 import stat
 import unicodedata
 import warnings
-from collections.abc import Mapping
-from dataclasses import dataclass, field
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Iterator
+from typing import Any
 
 import f90nml
 
@@ -87,7 +87,7 @@ class GroupSpec:
     name: str
     keys: dict[str, Key]
     doc: str = ""
-    check: Callable[["Params"], None] | None = None
+    check: Callable[[Params], None] | None = None
 
 
 @dataclass
@@ -276,7 +276,7 @@ def _value_tokens(text: str) -> Iterator[str]:
         i = j
 
 
-def _check_values(path: Path, it: "_Item") -> None:
+def _check_values(path: Path, it: _Item) -> None:
     """Every value of ``it`` is a number, a logical or a quoted string as Fortran list-directed
     input reads them, with at most one repeat count; anything else is a DeckError naming the
     token (f90nml would read ``5.0_8`` as 5.08, ``4+1`` as 40 and ``2*1*4.0`` as 1, 1, 4)."""

@@ -27,9 +27,9 @@ import ast
 import math
 import re
 import unicodedata
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
@@ -395,7 +395,7 @@ class _Kinds:
             return "number"
         if isinstance(node, ast.Compare):
             left = node.left
-            for op, right in zip(node.ops, node.comparators):
+            for right in node.comparators:
                 a, b = self.of(left), self.of(right)
                 if "any" not in (a, b) and (a == "text") != (b == "text"):
                     txt, num = (left, right) if a == "text" else (right, left)

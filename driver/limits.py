@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from driver.deck import DeckError, Params
+from driver.deck import Params
 
 __all__ = ["Estimate", "Budget", "budget", "configure", "restore", "check", "parse_size", "parse_seconds",
            "DEFAULT_WORK", "ENV_MEMORY", "ENV_WORK"]
@@ -43,7 +43,7 @@ class Estimate:
     work_key: str | None = None
     detail: str = ""
 
-    def __add__(self, other: "Estimate") -> "Estimate":
+    def __add__(self, other: Estimate) -> Estimate:
         big_m = self if self.bytes >= other.bytes else other
         big_w = self if self.seconds >= other.seconds else other
         return Estimate(self.bytes + other.bytes, self.seconds + other.seconds, big_m.memory_key,

@@ -12,8 +12,7 @@ import pandas as pd
 from driver import kernels
 from driver.deck import Params
 from driver.export import with_units
-from driver.manipulator.analysis import (SIGNIFICANT, Conv, Workspace, _design_list, _target, design_status, optima,
-                                         round_half_up)
+from driver.manipulator.analysis import SIGNIFICANT, Conv, Workspace, _design_list, _target, design_status, optima, round_half_up
 from driver.manipulator.tables import TIDY_NAMES, Table, _differences, _tables, _tolerance
 from driver.study import Figure, Result
 from driver.table import fortran_f

@@ -29,9 +29,9 @@ import pandas as pd
 
 from driver import blas, expr, limits
 from driver.deck import DeckError, Params, RawGroup, validate
-from driver.study import load_study
 from driver.optimize.problem import Problem
 from driver.runner import NUMERICAL, CaseFailure, compute, numerical_error
+from driver.study import load_study
 
 if TYPE_CHECKING:   # pragma: no cover - dask is an optional dependency
     from dask.distributed import Client
@@ -204,7 +204,7 @@ class Evaluator:
             self._journal_fh.close()
             self._journal_fh = None
 
-    def __enter__(self) -> "Evaluator":
+    def __enter__(self) -> Evaluator:
         return self
 
     def __exit__(self, *exc: Any) -> None:

@@ -385,9 +385,9 @@ def _local_runs(ev: Evaluator, starts: np.ndarray, history: list[HistoryRow], me
             z0 = np.concatenate([z0, [s0]])
             lb, ub = np.concatenate([lb, [-np.inf]]), np.concatenate([ub, [np.inf]])
 
-        def callback(*args, **kw) -> None:
-            it[0] += 1
-            _snapshot(ev, f"{label} {s} iteration {it[0]}", history)
+        def callback(*args, **kw) -> None:   # called only by this start's minimize below
+            it[0] += 1  # noqa: B023
+            _snapshot(ev, f"{label} {s} iteration {it[0]}", history)  # noqa: B023
 
         kw = {}
         cons: list[dict[str, object] | NonlinearConstraint] = []

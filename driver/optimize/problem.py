@@ -21,9 +21,9 @@ from __future__ import annotations
 
 import ast
 import hashlib
-import re
 import json
 import math
+import re
 from dataclasses import dataclass, field
 from typing import Any
 

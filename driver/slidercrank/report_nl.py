@@ -74,7 +74,8 @@ def _side_by_side(pairs: list[tuple[Case, NLCase]], tol: float, limit: float) ->
             "         load; growth% = mean growth per revolution of the per-revolution peak lateral deflection",
             f"         (Table 6; medians of the last revolutions against those before; GROWS above {100 * tol:g} %);",
             "         spread% = max/min - 1 of those peaks (irregular above "
-            f"{100 * IRREGULAR:g} %); BUCKLED = lateral deflection above {1e3 * limit:.1f} mm", ""] + render_table(cols, rows, trailers)
+            f"{100 * IRREGULAR:g} %); BUCKLED = lateral deflection above {1e3 * limit:.1f} mm", ""] \
+        + render_table(cols, rows, trailers)
 
 
 def _per_revolution(cases: list[NLCase]) -> list[str]:
@@ -100,7 +101,7 @@ def _newton_table(cases: list[NLCase], params: Params) -> list[str]:
                      c.deepest_cut])
         trailers.append("" if c.ok else nl_status_text(c))
     return ["Table 7  Newton iterations and step control of the nonlinear runs",
-            f"         solves = Newton solves in all; max = most in one step; cuts = time steps halved",
+            "         solves = Newton solves in all; max = most in one step; cuts = time steps halved",
             f"         (deepest = most halvings of one step, of {params.max_step_cuts} allowed); tolerance "
             f"{params.newton_tolerance:g} (relative residual)", ""] + render_table(cols, rows, trailers)
 

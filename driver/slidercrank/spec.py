@@ -12,7 +12,6 @@ from typing import Any, TypedDict
 from driver import kernels
 from driver.deck import GroupSpec, Key, Params, non_negative, positive
 
-
 #: Table 1a of the paper (columns re-ordered, docs/slidercrank.md); the depth is the
 #: in-plane section depth used for the outer-fibre strain (weak axis in plane).
 MATERIALS: dict[str, dict[str, Any]] = {

@@ -141,7 +141,7 @@ def refine(pp: PathProblem, design: PathDesign) -> PathDesign:
     step = 360.0 / pp.samples
     errs, ats = [], []
     for (tx, ty), t0, e0 in zip(tk, design.theta_at_targets_deg, design.errors):
-        def dist(t: float) -> float:
+        def dist(t: float, tx: float = tx, ty: float = ty) -> float:
             th = np.radians([t])
             out, st = kernels.fourbar_exact(th, d, a, b, c, 1.0, 0.0, pp.branch)
             if st[0] != ST_OK:
@@ -230,7 +230,7 @@ def solve(pp: PathProblem, seed: int, maxiter: int, popsize: int,
                                  atol=1e-12, polish=False, init="sobol", mutation=(0.5, 1.0), recombination=0.9,
                                  strategy="best1bin")
     starts, keys = [], set()
-    for val, x in sorted(seen, key=lambda s: s[0]):
+    for _val, x in sorted(seen, key=lambda s: s[0]):
         key = tuple(np.round(np.asarray(x[3:9]) / pp.length_max, 2))
         if key not in keys:
             keys.add(key)

@@ -12,7 +12,6 @@ import numpy as np
 from driver.deck import GroupSpec, Key, Params, non_empty, positive
 from driver.kernels import ujoint_geometry
 
-
 DEG = math.pi / 180.0
 OPTIONS = {0: "analyse only", 1: "phases free, joint angles fixed",
            2: "joint angles free, phases fixed", 3: "joint angles and phases free"}
