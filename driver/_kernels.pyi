@@ -4,7 +4,6 @@ signatures: do not edit; regenerate after a kernel interface changes."""
 import numpy as np
 from numpy.typing import NDArray
 
-
 class _fourbar:
     """Fortran module ``fourbar`` (fortran/*.f90)."""
     @staticmethod

@@ -27,9 +27,11 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from driver import _keywords
 from driver.deck import GroupSpec, Key, Params, non_empty, positive
 from driver.export import with_units
 from driver.limits import Estimate
+from driver.signatures import keyword_signature
 from driver.study import Figure, Result, keyword_run
 from driver.table import Column, render_table
 
@@ -272,6 +274,7 @@ def estimate(params: Params) -> Estimate:
 TIDY_UNITS = {"index": "1", "value": "unit of item"}
 
 
+@keyword_signature(_keywords.robust_example, SPEC)
 @keyword_run
 def run(params: Params, progress: bool = False) -> Result:
     """Run one &robust_example deck."""

@@ -29,6 +29,7 @@ report/exact differences), :mod:`.report` (the run: text, tidy table, summary, f
 """
 from __future__ import annotations
 
+from driver import _keywords
 from driver.deck import Params
 from driver.manipulator import report as _report
 from driver.manipulator.analysis import (
@@ -55,6 +56,7 @@ from driver.manipulator.batch import (
 from driver.manipulator.report import TIDY_UNITS, table_frame
 from driver.manipulator.spec import LABELS, RENAMED, SPEC, SWEEP_BEST, SWEEP_PLOT, estimate
 from driver.manipulator.tables import NOT_REPRODUCIBLE, REASONS, TEXT_REASONS, TIDY_NAMES, Table
+from driver.signatures import keyword_signature
 from driver.study import Result, keyword_run
 
 __all__ = ["SPEC", "run", "Workspace", "tolerance_box", "round_half_up", "REASONS", "NOT_REPRODUCIBLE", "TEXT_REASONS",
@@ -63,6 +65,7 @@ __all__ = ["SPEC", "run", "Workspace", "tolerance_box", "round_half_up", "REASON
            "BATCH_INDEPENDENT", "DESIGN_STATUS"]
 
 
+@keyword_signature(_keywords.manipulator, SPEC)
 @keyword_run
 def run(params: Params, progress: bool = False) -> Result:
     """Run one &manipulator deck (see the package docstring): validated Params, or the deck's

@@ -21,8 +21,10 @@ import math
 
 from tqdm import tqdm
 
+from driver import _keywords
 from driver.deck import Params
 from driver.limits import Estimate
+from driver.signatures import keyword_signature
 from driver.slidercrank.analysis import Case, _run_case, history, simeon_initial_state, static_onset
 from driver.slidercrank.report import (
     Derived,
@@ -94,6 +96,7 @@ def estimate(params: Params) -> Estimate:
                     f"{len(p.speeds)} speed(s) x {len(counts)} element count(s), up to {steps_max:.4g} time steps")
 
 
+@keyword_signature(_keywords.slidercrank, SPEC)
 @keyword_run
 def run(params: Params, progress: bool = False) -> Result:
     """Run every crank speed (and element count) of the deck; see the module docstring."""

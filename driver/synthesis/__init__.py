@@ -359,7 +359,8 @@ def _crank_rocker(p: Params) -> Synthesis:
              f"    rocker swing ......... {p.swing_deg:g} deg",
              f"    time ratio ........... {p.time_ratio:g}  (crank turns 180 + {al:.6g} and 180 - {al:.6g} deg)",
              "    family ............... O_A on the "
-             + ("line through the rocker extremes" if al <= 1e-12 else "circle through the rocker extremes seeing them under alpha")
+             + ("line through the rocker extremes" if al <= 1e-12 else
+                "circle through the rocker extremes seeing them under alpha")
              + "; "
              f"{len(members)} members scanned ({p.family_points} per arc)",
              f"    crank-rockers ........ {sum(m.crank_rocker for m in members)} of them", ""]

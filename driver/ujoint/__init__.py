@@ -29,8 +29,10 @@ import math
 
 import numpy as np
 
+from driver import _keywords
 from driver.deck import Params
 from driver.limits import Estimate
+from driver.signatures import keyword_signature
 from driver.study import Figure, Result, keyword_run
 from driver.ujoint.analysis import (
     BOUND_TOL,
@@ -107,6 +109,7 @@ def estimate(params: Params) -> Estimate:
     return mem + table
 
 
+@keyword_signature(_keywords.ujoint, SPEC)
 @keyword_run
 def run(params: Params, progress: bool = False) -> Result:
     """Analyse (option 0) or optimise (options 1-3) the chain of the deck."""

@@ -1,0 +1,32 @@
+"""Write ``driver/_keywords.py``, the static keyword signatures of every study's ``run``.
+
+The signatures are generated from each study's SPEC (the deck keys, their kinds, defaults
+and allowed values) by :func:`driver.signatures.render_module`; a type checker then refuses a
+misspelt or mistyped key in ``driver.<study>.run(...)``.  Run after adding a study or changing
+a SPEC (tests/test_keyword_signatures.py fails while the committed file is stale)::
+
+    .venv/bin/python tools/gen_keyword_signatures.py
+"""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+TARGET = Path(__file__).resolve().parents[1] / "driver" / "_keywords.py"
+
+
+def specs() -> list:
+    """The SPEC of every study the runner knows, in name order."""
+    from driver.runner import available_studies
+    return [module.SPEC for _, module in sorted(available_studies().items())]
+
+
+def main() -> int:
+    from driver.signatures import render_module
+    TARGET.write_text(render_module(specs()))
+    print(f"wrote {TARGET}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
