@@ -1,5 +1,5 @@
 """Static signatures of the studies' ``run`` (type checkers and IDEs).  GENERATED from each
-study's SPEC by tools/gen_keyword_signatures.py (driver.signatures.render_module): do not
+study's SPEC by tools/gen_keyword_signatures.py (driver._signatures.render_module): do not
 edit; tests/test_keyword_signatures.py fails while it is stale."""
 from __future__ import annotations
 

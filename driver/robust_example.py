@@ -28,10 +28,10 @@ import numpy as np
 import pandas as pd
 
 from driver import _keywords
+from driver._signatures import keyword_signature
 from driver.deck import GroupSpec, Key, Params, non_empty, positive
 from driver.export import with_units
 from driver.limits import Estimate
-from driver.signatures import keyword_signature
 from driver.study import Figure, Result, keyword_run
 from driver.table import Column, render_table
 

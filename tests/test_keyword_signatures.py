@@ -1,4 +1,4 @@
-"""The studies' ``run`` show their deck keys to help(), IDEs and type checkers (driver.signatures).
+"""The studies' ``run`` show their deck keys to help(), IDEs and type checkers (driver._signatures).
 
 Truth is each study's SPEC (the keys the deck reader validates against): the runtime
 signature and docstring must name every key with its default (or say it is required), its
@@ -17,9 +17,9 @@ from pathlib import Path
 
 import pytest
 
+from driver._signatures import NOT_GIVEN
 from driver.deck import DeckError
 from driver.runner import available_studies
-from driver.signatures import NOT_GIVEN
 
 ROOT = Path(__file__).resolve().parents[1]
 STUDIES = sorted(available_studies())
@@ -35,7 +35,7 @@ def _tool():
 
 
 def test_committed_static_signatures_are_fresh():
-    from driver.signatures import render_module
+    from driver._signatures import render_module
     committed = (ROOT / "driver" / "_keywords.py").read_text()
     assert committed == render_module(_tool().specs()), \
         "driver/_keywords.py is stale: run .venv/bin/python tools/gen_keyword_signatures.py"

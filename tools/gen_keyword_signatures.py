@@ -1,7 +1,7 @@
 """Write ``driver/_keywords.py``, the static keyword signatures of every study's ``run``.
 
 The signatures are generated from each study's SPEC (the deck keys, their kinds, defaults
-and allowed values) by :func:`driver.signatures.render_module`; a type checker then refuses a
+and allowed values) by :func:`driver._signatures.render_module`; a type checker then refuses a
 misspelt or mistyped key in ``driver.<study>.run(...)``.  Run after adding a study or changing
 a SPEC (tests/test_keyword_signatures.py fails while the committed file is stale)::
 
@@ -22,7 +22,7 @@ def specs() -> list:
 
 
 def main() -> int:
-    from driver.signatures import render_module
+    from driver._signatures import render_module
     TARGET.write_text(render_module(specs()))
     print(f"wrote {TARGET}")
     return 0

@@ -22,42 +22,16 @@ import math
 from tqdm import tqdm
 
 from driver import _keywords
+from driver._signatures import keyword_signature
 from driver.deck import Params
 from driver.limits import Estimate
-from driver.signatures import keyword_signature
 from driver.slidercrank.analysis import Case, _run_case, history, simeon_initial_state, static_onset
-from driver.slidercrank.report import (
-    Derived,
-    _benchmark_lines,
-    _convergence_table,
-    _crank_end_table,
-    _header,
-    _peak_notes,
-    _peak_table,
-    _plotting,
-    _status_text,
-    _summary,
-    _tidy,
-    _unsettled,
-)
-from driver.slidercrank.spec import (
-    EULER_WARN,
-    LABELS,
-    MATERIALS,
-    MIN_STEPS_PER_BENDING_PERIOD,
-    MIN_STEPS_PER_REV,
-    PAPER_SPEEDS,
-    SIMEON1996,
-    SPEC,
-    STATUS_TEXT,
-    SWEEP_PLOT,
-    Model,
-    Simeon1996,
-    _model,
-    _shape,
-    min_steps_per_rev,
-    rayleigh,
-)
+from driver.slidercrank.report import (Derived, _benchmark_lines, _convergence_table, _crank_end_table, _header, _peak_notes,
+                                       _peak_table, _plotting, _status_text, _summary, _tidy, _unsettled)
+from driver.slidercrank.spec import (EULER_WARN, LABELS, MATERIALS, MIN_STEPS_PER_BENDING_PERIOD, MIN_STEPS_PER_REV,
+                                     PAPER_SPEEDS, SIMEON1996, SPEC, STATUS_TEXT, SWEEP_PLOT, Model, Simeon1996, _model,
+                                     _shape,
+                                     min_steps_per_rev, rayleigh)
 from driver.study import Figure, Result, keyword_run
 
 __all__ = ["SPEC", "run", "estimate", "MATERIALS", "PAPER_SPEEDS", "SIMEON1996", "simeon_initial_state",

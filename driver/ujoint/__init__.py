@@ -30,54 +30,18 @@ import math
 import numpy as np
 
 from driver import _keywords
+from driver._signatures import keyword_signature
 from driver.deck import Params
 from driver.limits import Estimate
-from driver.signatures import keyword_signature
 from driver.study import Figure, Result, keyword_run
-from driver.ujoint.analysis import (
-    BOUND_TOL,
-    CLUSTER_TOL,
-    PHASE_PERIOD,
-    SADDLE_NUDGE,
-    SYM_TOL,
-    TIE_RTOL,
-    Chain,
-    Design,
-    StartRun,
-    _chain,
-    _free_index,
-    _starts,
-    evaluate,
-    objective_scale,
-    optimise,
-    phases_for,
-    pick_best,
-    yoke_shifts,
-)
-from driver.ujoint.batch import (
-    BATCH_ELEMENTS,
-    BATCH_IGNORED,
-    BATCH_INDEPENDENT,
-    BATCH_KEYS,
-    BATCH_PASSES,
-    batch_applies,
-    summarise_batch,
-)
+from driver.ujoint.analysis import (BOUND_TOL, CLUSTER_TOL, PHASE_PERIOD, SADDLE_NUDGE, SYM_TOL, TIE_RTOL, Chain,
+                                    Design, StartRun, _chain, _free_index, _starts, evaluate, objective_scale,
+                                    optimise, phases_for, pick_best, yoke_shifts)
+from driver.ujoint.batch import (BATCH_ELEMENTS, BATCH_IGNORED, BATCH_INDEPENDENT, BATCH_KEYS, BATCH_PASSES,
+                                 batch_applies, summarise_batch)
 from driver.ujoint.report import _figure, _render, _result_dat, _summary, _tidy
-from driver.ujoint.spec import (
-    BAND_TOL,
-    CONVENTIONS,
-    DEG,
-    LABELS,
-    NOT_REPRODUCIBLE,
-    OPTIONS,
-    SPEC,
-    SWEEP_PLOT,
-    _geometry,
-    _per,
-    _phases,
-    cross_check,
-)
+from driver.ujoint.spec import (BAND_TOL, CONVENTIONS, DEG, LABELS, NOT_REPRODUCIBLE, OPTIONS, SPEC, SWEEP_PLOT,
+                                _geometry, _per, _phases, cross_check)
 
 __all__ = ["SPEC", "run", "estimate", "Chain", "Design", "StartRun", "evaluate", "optimise", "objective_scale",
            "pick_best", "yoke_shifts", "phases_for", "cross_check", "summarise_batch", "batch_applies", "BATCH_KEYS",

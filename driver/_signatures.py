@@ -152,7 +152,7 @@ def render_module(specs: Sequence[GroupSpec]) -> str:
     """Text of ``driver/_keywords.py``: per study, an overloaded ``run`` signature (validated
     Params, or the keys as keyword-only arguments with their types and defaults)."""
     out = ['"""Static signatures of the studies\' ``run`` (type checkers and IDEs).  GENERATED from each',
-           "study's SPEC by tools/gen_keyword_signatures.py (driver.signatures.render_module): do not",
+           "study's SPEC by tools/gen_keyword_signatures.py (driver._signatures.render_module): do not",
            'edit; tests/test_keyword_signatures.py fails while it is stale."""',
            "from __future__ import annotations",
            "",
