@@ -53,10 +53,18 @@ from driver.study import code_digest, load_study
 
 __all__ = ["Grid", "BatchPlan", "batchable", "plan", "run", "worker_init", "chunk_rows", "MAX_CASES", "StreamedRows"]
 
-#: cases per task: ~0.3-0.6 s of kernel time on one core for the four-bar
-CHUNK = 16384
+#: largest number of cases per task below MAX_CHUNKS chunks: 0.05 s of four-bar kernel time on one
+#: core for the filter's passes, 0.2 s with the peak speeds; smaller sweeps have 8 chunks
+CHUNK = 65536
+#: chunks of a sweep below CHUNK * 8 cases (at least 64 cases each)
+MIN_CHUNKS = 8
+#: a sweep of at most this many cases may run in the driver's process when it is cheap
+#: (:func:`execute`): a crash in a kernel then ends the driver, so only small ones
+SMALL_SWEEP = 1 << 18
+#: below this much CPU time [s] for the chunks after the first, the worker pool is not started
+POOL_MIN_SECONDS = 0.25
 #: above CHUNK * MAX_CHUNKS cases the chunks grow instead of multiplying: the driver's work (a
-#: result to merge, a part in the record) is per chunk, so 10^9 cases are 4096 chunks, not 61 035
+#: result to merge, a part in the record) is per chunk, so 10^9 cases are 4096 chunks, not 15 259
 MAX_CHUNKS = 4096
 #: largest batch sweep (no case is listed, so only the grid's size is limited)
 MAX_CASES = 10**10
@@ -117,7 +125,7 @@ def chunk_size(n: int) -> int:
     workers), so ``--resume`` works with any ``-j``; at most :data:`MAX_CHUNKS` chunks."""
     if n > CHUNK * MAX_CHUNKS:
         return -(-n // MAX_CHUNKS)
-    return min(CHUNK, max(64, -(-n // 16)))
+    return min(CHUNK, max(64, -(-n // MIN_CHUNKS)))
 
 
 def _signature(raw: RawGroup, grid: Grid, keep: str, rows: str, module, shown: list[str] | None = None) -> str:
@@ -434,10 +442,13 @@ def _alone(p: BatchPlan, start: int, stop: int, folder: str = "") -> ChunkResult
 
 
 def execute(p: BatchPlan, todo: list[tuple[int, int]], jobs: int, scheduler: Any,
-            on_result, in_flight: int = 0, folder: str = "") -> None:
+            on_result, in_flight: int = 0, folder: str = "", adaptive: bool = False) -> None:
     """Run chunks ``todo`` [(start, stop)]; ``on_result(ChunkResult)`` as each completes.
     ``folder``: the record's folder, where the workers write their chunks' parts (on Dask only
-    when every worker sees it; otherwise the result comes back unwritten)."""
+    when every worker sees it; otherwise the result comes back unwritten).  ``adaptive`` (the
+    deck sets no chunk size): a sweep of at most :data:`SMALL_SWEEP` cases runs its first chunk
+    in this process and the rest too when, at that chunk's CPU time, they would take less than
+    :data:`POOL_MIN_SECONDS` (the worker pool is started only when it pays)."""
     if not todo:
         return
     if scheduler:
@@ -447,6 +458,16 @@ def execute(p: BatchPlan, todo: list[tuple[int, int]], jobs: int, scheduler: Any
         for s, e in todo:
             on_result(chunk_rows(p, s, e, folder))
         return
+    if adaptive and p.grid.n <= SMALL_SWEEP and POOL_MIN_SECONDS > 0:
+        # a small sweep: the first chunk here, timed; the rest here too when the pool would not pay
+        # for starting its workers (forking them costs tens of ms of CPU each)
+        c0 = time.process_time()
+        on_result(chunk_rows(p, *todo[0], folder))
+        todo = todo[1:]
+        if (time.process_time() - c0) * len(todo) < POOL_MIN_SECONDS:
+            for s, e in todo:
+                on_result(chunk_rows(p, s, e, folder))
+            return
     queue: Iterator[tuple[int, int]] = iter(todo)
     run_pool(lambda: next(queue, None), lambda pool, rng: pool.submit(chunk_rows, p, *rng, folder),
              lambda rng: _alone(p, *rng, folder), lambda rng, res, pending: on_result(res), jobs,
@@ -609,7 +630,7 @@ def run(p: BatchPlan, folder: Path, jobs: int, scheduler: Any, resume: bool, pro
             bar.update(res.stop - res.start)
 
     try:
-        execute(p, todo, jobs, scheduler, on_result, folder=str(folder))
+        execute(p, todo, jobs, scheduler, on_result, folder=str(folder), adaptive=not chunk)
     finally:
         if bar is not None:
             bar.close()
