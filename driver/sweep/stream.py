@@ -36,7 +36,7 @@ from driver.table import Column
 __all__ = ["STREAM_ROWS", "write_streamed", "Streamed"]
 
 #: above this many rows (kept and failed cases) a batch sweep's tables are written part by part
-STREAM_ROWS = 50_000
+STREAM_ROWS = 20_000
 #: the .out lists every case up to this many cases (as :data:`driver.sweep.TABLE_ALL_MAX`)
 TABLE_ALL_MAX = 2000
 
