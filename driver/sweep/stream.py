@@ -8,7 +8,8 @@ parts of its resume record, one Parquet file per chunk, in case order.  Above
 memory does not grow with the rows.  The files are those the in-memory path writes: the same
 ``.out`` and CSV bytes, the same Parquet table (in one row group per part); the
 ``.out`` table's column widths, which the widest cell decides, are taken in a first pass that
-writes the body to a scratch file and only redone when a cell did not fit the default width.
+writes the body to a scratch file (the case column at the width of the last case number) and
+only redone when a cell did not fit.
 
 Parts whose columns differ in type (bad-input rows turn a chunk's summary columns into
 objects) cannot be streamed this way; :func:`write_streamed` then returns None and the caller
@@ -116,6 +117,10 @@ def write_streamed(outdir: Path, stem: str, paths: list[Path], deck: Deck, sw: P
                     if k == 0:
                         cols, keys = table_columns(frame)
                         widths = [max(c.width, len(c.header)) for c in cols]
+                        if "case" in keys:   # case numbers grow row by row: the last part's last one is widest
+                            last = pq.read_table(paths[-1], columns=["case"]).column("case")
+                            j = keys.index("case")
+                            widths[j] = max(widths[j], len(str(int(last[len(last) - 1].as_py()))))
                         need = list(widths)
                     bad = frame["status"] != "ok"
                     result.n_kept += int(frame["kept"].sum())
