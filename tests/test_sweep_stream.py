@@ -36,8 +36,9 @@ def _run(tmp_path: Path, name: str, text: str, stream_rows: int, monkeypatch, jo
 def _same(a: Path, b: Path, stem: str) -> None:
     assert (a / f"{stem}.out").read_bytes() == (b / f"{stem}.out").read_bytes()
     assert (a / f"{stem}_summary.csv").read_bytes() == (b / f"{stem}_summary.csv").read_bytes()
-    pd.testing.assert_frame_equal(pd.read_parquet(a / f"{stem}_summary.parquet"),
-                                  pd.read_parquet(b / f"{stem}_summary.parquet"))
+    fa, fb = pd.read_parquet(a / f"{stem}_summary.parquet"), pd.read_parquet(b / f"{stem}_summary.parquet")
+    pd.testing.assert_frame_equal(fa, fb)
+    assert fa.attrs == fb.attrs and fa.attrs["summary_settings"]["transmission_band_deg"] == [40.0, 120.0]
 
 
 def test_streamed_tables_equal_the_in_memory_ones(tmp_path, monkeypatch):

@@ -86,16 +86,21 @@ def _frame(table: pa.Table, origins: dict[str, str]) -> pd.DataFrame:
 
 def write_streamed(outdir: Path, stem: str, paths: list[Path], deck: Deck, sw: Params, base: Params,
                    axes: list[tuple[str, list]], names: list[str], n_cases: int, plot: bool | str = False,
-                   module: Any = None) -> Streamed | None:
+                   module: Any = None, settings: dict[str, Any] | None = None) -> Streamed | None:
     """Write ``<stem>.out`` and ``<stem>_summary.{csv,parquet}`` from the record parts ``paths``
     (case order; each with rows), one part at a time, and with ``plot`` the summary figure (its
-    rows are read back for it), all renamed into place together.  Returns None, writing
-    nothing, when the parts' columns differ in type (see the module)."""
+    rows are read back for it), all renamed into place together.  ``settings``
+    (:func:`driver.sweep.report.summary_settings`) go into the Parquet metadata as pandas
+    writes a frame's attrs.  Returns None, writing nothing, when the parts' columns differ in
+    type (see the module)."""
     from driver.export import _write_csv_arrow
     schema = _uniform(paths)
     if schema is None:
         return None
     origins = _origins(schema)
+    if settings:   # as DataFrame.to_parquet records attrs (driver.sweep.report.with_settings)
+        schema = schema.with_metadata({**(schema.metadata or {}),
+                                       b"PANDAS_ATTRS": json.dumps({"summary_settings": dict(settings)}).encode()})
     limit_rows = n_cases > TABLE_ALL_MAX   # above: the .out lists the kept and failed cases only
     result = Streamed()
     cols: list[Column] = []
