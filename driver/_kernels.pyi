@@ -272,6 +272,16 @@ class _slidercrank:
         """``out = axial_force_at(theta2,s,omega,r2,rl,rhoa,msl,[n,ns])``; shapes out(ns,n)"""
         ...
     kd: NDArray[np.int32]
+    n_prof: NDArray[np.int32]
+    prof_eps_1: NDArray[np.int32]
+    prof_eps_2: NDArray[np.int32]
+    prof_eps_max: NDArray[np.int32]
+    prof_eps_max_el: NDArray[np.int32]
+    prof_eps_min: NDArray[np.int32]
+    prof_eps_min_el: NDArray[np.int32]
+    prof_lag_change: NDArray[np.int32]
+    prof_n_avg_1: NDArray[np.int32]
+    prof_outer_max: NDArray[np.int32]
     @staticmethod
     def rigid_states(
         theta2: NDArray[np.float64],
@@ -286,6 +296,7 @@ class _slidercrank:
     def simulate(
         nel: int,
         nrec: int,
+        nrf: int,
         r2: float,
         rl: float,
         rhoa: float,
@@ -303,11 +314,12 @@ class _slidercrank:
         dynamic: int,
         geom: int,
         fast: int,
+        lag: int,
         q_init: NDArray[np.float64],
         qd_init: NDArray[np.float64],
         nq: int = ...,
-    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], int, int]:
-        """``eps_ax,eps_of,n_avg,mid,slider,elong,q_end,qd_end,status,fail_step = simulate(nel,nrec,r2,rl,rhoa,ea,ei,half_depth,msl,omega,dt,nsteps,rec_start,alpha,beta,start_mode,dynamic,geom,fast,q_init,qd_init,[nq])``; shapes eps_ax(nel,nrec), eps_of(nel,nrec), n_avg(nel,nrec), mid(nrec), slider(nrec), elong(nrec), q_end(nq), qd_end(nq)"""
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], int, int]:
+        """``eps_ax,eps_of,n_avg,mid,slider,elong,prof,q_end,qd_end,status,fail_step = simulate(nel,nrec,nrf,r2,rl,rhoa,ea,ei,half_depth,msl,omega,dt,nsteps,rec_start,alpha,beta,start_mode,dynamic,geom,fast,lag,q_init,qd_init,[nq])``; shapes eps_ax(nel,nrf), eps_of(nel,nrf), n_avg(nel,nrf), mid(nrec), slider(nrec), elong(nrec), prof(9,nrec), q_end(nq), qd_end(nq)"""
         ...
     st_bad_args: NDArray[np.int32]
     st_buckled: NDArray[np.int32]
