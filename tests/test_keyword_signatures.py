@@ -18,13 +18,20 @@ from pathlib import Path
 import pytest
 
 from driver._signatures import NOT_GIVEN
-from driver.deck import DeckError
+from driver.deck import DeckError, GroupSpec
 from driver.runner import available_studies
 
 ROOT = Path(__file__).resolve().parents[1]
 STUDIES = sorted(available_studies())
 #: studies whose run carries the generated signature (all of them once fourbar's module settles)
 TYPED = [g for g in STUDIES if hasattr(available_studies()[g].run, "__signature__")]
+
+
+def _spec(group: str):
+    """The deck keys of study ``group`` (its module's SPEC, or its study contract's spec)."""
+    study = available_studies()[group]
+    spec = getattr(study, "spec", None)   # a study package's 'spec' may be its spec module
+    return spec if isinstance(spec, GroupSpec) else study.SPEC
 
 
 def _tool():
@@ -48,11 +55,10 @@ def test_every_study_has_a_static_signature():
 
 @pytest.mark.parametrize("group", TYPED)
 def test_signature_names_every_key_with_its_default(group):
-    module = available_studies()[group]
-    params = inspect.signature(module.run).parameters
+    params = inspect.signature(available_studies()[group].run).parameters
     assert list(params)[:2] == ["params", "progress"]
-    assert list(params)[2:] == list(module.SPEC.keys)
-    for name, key in module.SPEC.keys.items():
+    assert list(params)[2:] == list(_spec(group).keys)
+    for name, key in _spec(group).keys.items():
         p = params[name]
         assert p.kind is inspect.Parameter.KEYWORD_ONLY
         if key.required:
@@ -80,10 +86,9 @@ def _entries(doc: str) -> dict[str, tuple[str, str]]:
 
 @pytest.mark.parametrize("group", TYPED)
 def test_help_lists_keys_units_defaults_and_choices(group):
-    module = available_studies()[group]
-    entries = _entries(pydoc.render_doc(module.run, renderer=pydoc.plaintext))
-    assert list(entries) == ["params", "progress", *module.SPEC.keys]
-    for name, key in module.SPEC.keys.items():
+    entries = _entries(pydoc.render_doc(available_studies()[group].run, renderer=pydoc.plaintext))
+    assert list(entries) == ["params", "progress", *_spec(group).keys]
+    for name, key in _spec(group).keys.items():
         head, desc = entries[name]
         if key.required:
             assert desc.endswith("Required."), name
