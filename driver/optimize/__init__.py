@@ -223,7 +223,7 @@ def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[
     problem = problem_of(deck)
     _probe(problem)
     formats = list(formats or [])
-    stem = None if outdir is None else output_stem(outdir, deck.path)
+    stem = None if outdir is None else output_stem(outdir, deck.path, _suffixes(formats, plot))
     journal = None if stem is None else journal_file.journal_path(stem)
     found = journal_file.read(problem.fingerprint(), problem.names, stem) if (resume and stem is not None) \
         else journal_file.Resumed()
@@ -260,6 +260,13 @@ def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[
         if journal is not None and journal.exists():
             journal.unlink()
     return outcome
+
+
+def _suffixes(formats: list[str], plot: bool) -> tuple[str, ...]:
+    """What a run appends to the deck's stem, known before it runs (the optimum's figures are not)."""
+    return (".out", ".optimum.dat", ".optimum.out", "_history.csv", "_evals.parquet", journal_file.SUFFIX,
+            *(s for fmt in formats for s in (f"_evals.{fmt}", f"_history.{fmt}", f".optimum.{fmt}")),
+            *(("_convergence.png",) if plot else ()))
 
 
 def _write(oc: OptimizeOutcome, stem: Path, params, formats: list[str], plot: bool, jobs: int) -> list[Path]:
@@ -304,7 +311,7 @@ def run_optimize_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, 
         require("dask")
     oc = optimize(deck, outdir, formats, plot, jobs, resume, scheduler or None)
     if summary_json:
-        stem = output_stem(outdir, deck.path)
+        stem = output_stem(outdir, deck.path, (".json",))
         oc.written.append(write_text(stem.with_name(stem.name + ".json"),
                                      json.dumps(oc.to_dict(), indent=1, allow_nan=False) + "\n"))
     if oc.evaluator.resume_note:
