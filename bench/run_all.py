@@ -6,7 +6,8 @@ measured in the same run, and the target.
 
 Kernel and baseline calls are interleaved (kernel, baseline, kernel, ...), timed by the
 process's CPU time, and the median of each is taken, so a machine whose load changes
-during the run slows both alike and the ratio stays meaningful.  Each baseline is checked against its kernel before timing.  The
+during the run slows both alike and the ratio stays meaningful.  Each baseline is checked against its kernel before timing
+(except the nonlinear rod's, whose baseline is the other model: tests/test_slidercrank_nonlinear.py compares them).  The
 detailed per-study benchmarks (bench_<study>.py) remain for the wider measurements
 (fresh vs reused buffers, searches, sweeps).  Exit status 0 whether or not targets are met:
 this reports, the test suite guards (tests/test_vectorisation.py).
@@ -32,6 +33,7 @@ import bench_fourbar  # noqa: E402
 import bench_fourbar_forces  # noqa: E402
 import bench_manipulator  # noqa: E402
 import bench_slidercrank  # noqa: E402
+import bench_slidercrank_nl  # noqa: E402
 import bench_ujoint  # noqa: E402
 from driver import kernels  # noqa: E402
 from driver import ujoint as ujoint_study  # noqa: E402
@@ -255,6 +257,22 @@ def slidercrank(n_el: int, spr: int, base_steps: int, repeat: int) -> list[Row]:
     return rows
 
 
+def slidercrank_nl(n_el: int, revs: int, repeat: int) -> list[Row]:
+    """The nonlinear (co-rotational) rod against the linear KED kernel on the same case (issue 29:
+    at most 25x the linear model's time); the 'baseline' here is the linear kernel."""
+    linear, nonlinear = bench_slidercrank_nl.case(n_el, revs)
+    res = nonlinear()
+    assert res["status"] == 0, res["status"]
+    tk, tb = interleaved(nonlinear, linear, repeat)
+    solves = res["stats"][0] / (revs * bench_slidercrank_nl.SPR)
+    return [Row("slider-crank nonlinear rod (baseline: linear)", "ms/revolution", tk / revs, tb / revs, None,
+                1 / bench_slidercrank_nl.TARGET_RATIO,
+                f"{n_el} elements at {bench_slidercrank_nl.OMEGA} rad/s, {revs} revolution(s): nonlinear/linear time "
+                f"{tk / tb:.1f}x (target <= {bench_slidercrank_nl.TARGET_RATIO:g}x); {solves:.2f} Newton solves per "
+                "step, each residual the element forces (a sqrt and an atan2 each), each solve the tangent and a "
+                "band LU (a latency chain like the linear model's solves)")]
+
+
 SCALE = {"ns/position": 1e9, "ns/sample": 1e9, "us/config": 1e6, "us/objective": 1e6, "us/design": 1e6,
          "ms/revolution": 1e3}
 
@@ -283,16 +301,16 @@ def main(argv: list[str] | None = None) -> list[Row]:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smaller sizes, fewer repeats")
     ap.add_argument("--smoke", action="store_true", help="tiny sizes (the test suite's check that this runs)")
-    ap.add_argument("--only", choices=["fourbar", "manipulator", "ujoint", "slidercrank"], action="append",
-                    help="run only these studies (repeatable)")
+    ap.add_argument("--only", choices=["fourbar", "manipulator", "ujoint", "slidercrank", "slidercrank_nl"],
+                    action="append", help="run only these studies (repeatable)")
     args = ap.parse_args(argv)
-    only = set(args.only or ["fourbar", "manipulator", "ujoint", "slidercrank"])
+    only = set(args.only or ["fourbar", "manipulator", "ujoint", "slidercrank", "slidercrank_nl"])
     if args.smoke:
-        sizes = dict(n=2048, samples=4096, n_el=20, spr=72, base_steps=4, repeat=2)
+        sizes = dict(n=2048, samples=4096, n_el=20, spr=72, base_steps=4, repeat=2, nl_el=20, nl_revs=1)
     elif args.quick:
-        sizes = dict(n=200_000, samples=200_000, n_el=700, spr=1440, base_steps=20, repeat=5)
+        sizes = dict(n=200_000, samples=200_000, n_el=700, spr=1440, base_steps=20, repeat=5, nl_el=700, nl_revs=2)
     else:
-        sizes = dict(n=1_000_000, samples=1_000_000, n_el=700, spr=1440, base_steps=60, repeat=9)
+        sizes = dict(n=1_000_000, samples=1_000_000, n_el=700, spr=1440, base_steps=60, repeat=9, nl_el=700, nl_revs=4)
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     print(f"bench/run_all.py: cpu count {os.cpu_count()}, load average {load:.2f} at start, one thread, CPU time, "
           f"medians of {sizes['repeat']} interleaved rounds\n")
@@ -305,6 +323,8 @@ def main(argv: list[str] | None = None) -> list[Row]:
         rows += ujoint(sizes["repeat"])
     if "slidercrank" in only:
         rows += slidercrank(sizes["n_el"], sizes["spr"], sizes["base_steps"], max(3, sizes["repeat"] // 3))
+    if "slidercrank_nl" in only:
+        rows += slidercrank_nl(sizes["nl_el"], sizes["nl_revs"], max(3, sizes["repeat"] // 3))
     print_table(rows)
     return rows
 

@@ -643,8 +643,18 @@ def slidercrank_column_static(n_elements: int, length: float, ea: float, ei: flo
 
 
 def slidercrank_corot_element(le: float, ea: float, ei: float, p: np.ndarray,
-                              tangent: bool = True) -> tuple[np.ndarray, np.ndarray, float, float, float]:
-    """One co-rotational element: force (6,), tangent (6, 6) lower triangle [N, N/m], axial strain,
-    mean curvature [1/m] and strain energy [J] for displacements p = (u, v, th) of its two nodes."""
-    f, kt, eps, kap, en = _kernels.slidercrank_nl.element_corot(le, ea, ei, farray(p, 1), bool(tangent))
+                              tangent: bool = True, rates: np.ndarray | None = None, damping: float = 0.0,
+                              rate_weight: float = 0.0) -> tuple[np.ndarray, np.ndarray, float, float, float]:
+    """One co-rotational element: force (6,), tangent (6, 6) [N, N/m], axial strain, mean curvature
+    [1/m] and strain energy [J] for displacements p = (u, v, th) of its two nodes [m, rad].
+
+    With ``damping`` bd [s] the force includes the damping of the deformation rates for the nodal
+    velocities ``rates`` [m/s, rad/s] and the tangent its derivative at fixed rates (not
+    symmetric) plus ``rate_weight`` cd times the rate derivative bd B^T K_l B / bd."""
+    if damping == 0.0 and rate_weight == 0.0:
+        f, kt, eps, kap, en = _kernels.slidercrank_nl.element_corot(le, ea, ei, farray(p, 1), bool(tangent))
+    else:
+        pd = np.zeros(6) if rates is None else rates
+        f, kt, eps, kap, en = _kernels.slidercrank_nl.element_corot_d(le, ea, ei, farray(p, 1), farray(pd, 1),
+                                                                      damping, rate_weight, bool(tangent))
     return f, kt, float(eps), float(kap), float(en)

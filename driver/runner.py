@@ -6,8 +6,10 @@ exits; it raises :class:`~driver.deck.DeckError` for bad input and returns what 
 """
 from __future__ import annotations
 
+import os
 import pkgutil
 import re
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
@@ -16,7 +18,7 @@ import numpy as np
 
 import driver
 from driver import blas, limits
-from driver.atomic import inside, output_set, remove_stale_temporaries, write_text
+from driver.atomic import NAME_MAX, inside, output_set, remove_stale_temporaries, write_text
 from driver.deck import Deck, DeckError, Params
 from driver.deck import validate
 from driver.export import FORMATS, summary_json_text, write_tidy
@@ -61,8 +63,11 @@ def study_of(deck: Deck) -> tuple[ModuleType, Params]:
     return module, validate(raw, module.SPEC, deck.path)
 
 
-def output_stem(outdir: str | Path, deck_path: str | Path) -> Path:
-    """``OUTDIR/<deck stem>``, refused (DeckError) unless every output named after it stays in OUTDIR.
+def output_stem(outdir: str | Path, deck_path: str | Path, suffixes: Iterable[str] = (".out",)) -> Path:
+    """``OUTDIR/<deck stem>``, refused (DeckError) unless every output named after it stays in OUTDIR
+    and fits a file name: ``suffixes`` are what the run appends to the stem that it knows before
+    running (the longest counts); a name known only later (a figure's) is checked when its file
+    is opened (:class:`driver.atomic.NameTooLong`, before anything is renamed into place).
 
     A deck named ``..dat`` has the stem ``.``, ``...dat`` the stem ``..``: their outputs would
     land beside or above OUTDIR.
@@ -73,16 +78,24 @@ def output_stem(outdir: str | Path, deck_path: str | Path) -> Path:
     if not stem or stem.strip(".") == "" or "/" in stem or "\\" in stem or not inside(outdir, candidate):
         raise DeckError(deck_path, None, None, f"outputs are named after the deck file, and {name!r} would name "
                         f"them outside the output folder {outdir}: rename the deck (e.g. case.dat)")
-    if len(stem.encode("utf-8", "surrogateescape")) + OUTPUT_SUFFIX_BYTES > NAME_MAX:
-        raise DeckError(deck_path, None, None, f"the deck's file name is {len(stem.encode('utf-8', 'surrogateescape'))} "
-                        f"bytes without its suffix; outputs are named after it with up to {OUTPUT_SUFFIX_BYTES} more "
-                        f"(e.g. <name>_summary.parquet) and a file name may have {NAME_MAX} bytes: rename the deck "
-                        f"(at most {NAME_MAX - OUTPUT_SUFFIX_BYTES} bytes before '.dat')")
+    longest = max(suffixes, key=lambda s: len(os.fsencode(s)))
+    n, extra = len(os.fsencode(stem)), len(os.fsencode(longest))
+    if n + extra > NAME_MAX:
+        raise DeckError(deck_path, None, None, name_too_long(n, longest))
     return candidate
 
 
-#: the longest file name a file system takes [bytes], and the most the tool appends to a deck's stem
-NAME_MAX, OUTPUT_SUFFIX_BYTES = 255, 24
+def name_too_long(stem_bytes: int, suffix: str) -> str:
+    """The words of the refusal of an output name: the stem's length, the suffix, the limit."""
+    extra = len(os.fsencode(suffix))
+    return (f"the deck's file name is {stem_bytes} bytes without '.dat'; its output <name>{suffix} would have "
+            f"{stem_bytes + extra} and a file name may have {NAME_MAX} bytes: rename the deck (at most "
+            f"{NAME_MAX - extra} bytes before '.dat' for this run)")
+
+
+def study_suffixes(formats: list[str], summary_json: bool) -> tuple[str, ...]:
+    """What a single-case run appends to the stem, known before it runs (figures' names are not)."""
+    return (".out", *(f".{fmt}" for fmt in formats), *((".json",) if summary_json else ()))
 
 
 def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool | str,
@@ -114,7 +127,7 @@ def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool | s
     # the set replaces an earlier run's: its tidy tables in formats not written now go
     for fmt in FORMATS:
         old = stem.with_name(f"{stem.name}.{fmt}")
-        if fmt not in formats and old.is_file():
+        if fmt not in formats and len(os.fsencode(old.name)) <= NAME_MAX and old.is_file():   # else it cannot exist
             old.unlink()
     return written
 
@@ -211,5 +224,6 @@ def run_study(deck: Deck, outdir: Path | None, formats: list[str], plot: bool,
     result = compute(module, params, progress=progress)
     result.name, result.study = name or Path(deck.path).stem, params.group
     written = [] if outdir is None else write_outputs(
-        result, output_stem(outdir, deck.path if name is None else f"{name}.dat"), formats, plot, summary_json)
+        result, output_stem(outdir, deck.path if name is None else f"{name}.dat", study_suffixes(formats, summary_json)),
+        formats, plot, summary_json)
     return Outcome(result, written)

@@ -259,15 +259,15 @@ def test_grid_started_local_search_and_partial_journal_resume(tmp_path):
     evals = pd.read_parquet(out / "opt_evals.parquet")
     assert list(evals["fourbar.coupler"].iloc[:6]) == pytest.approx(list(np.linspace(10, 20, 6)))
     # an interrupted run: a journal holding the first half of the evaluations (as the run appends them)
-    import json
+    from driver.optimize import journal
     half = evals.iloc[: len(evals) // 2]
-    lines = [json.dumps({"base": oc.problem.fingerprint(), "x": [float(v)], "status": "ok", "reason": "",
-                         "summary": {k[len("summary."):]: (None if isinstance(row[k], float) and math.isnan(row[k])
-                                                           else (row[k].item() if hasattr(row[k], "item") else row[k]))
-                                     for k in evals.columns if k.startswith("summary.")}})
+    lines = [journal.line(journal.record(oc.problem.fingerprint(), [float(v)], "ok", "",
+                          {k[len("summary."):]: (None if isinstance(row[k], float) and math.isnan(row[k])
+                                                 else (row[k].item() if hasattr(row[k], "item") else row[k]))
+                           for k in evals.columns if k.startswith("summary.")}))
              for v, (_, row) in zip(half["fourbar.coupler"], half.iterrows())]
     (out / "opt_evals.parquet").unlink()
-    (out / "opt.journal.jsonl").write_text("\n".join(lines) + "\n{\"cut by an interrupt")
+    (out / "opt.journal.jsonl").write_text("".join(lines) + "{\"cut by an interrupt")
     again = optimize(path, out, jobs=1, resume=True)
     assert again.evaluator.computed == len(evals) - len(half)
     assert again.x == oc.x and again.nfev == oc.nfev

@@ -67,6 +67,52 @@ def test_element_force_and_tangent_are_derivatives():
         np.testing.assert_allclose((fp - fm) / (2 * h), kt[:, j], rtol=1e-5, atol=1e-6 * np.abs(kt).max())
 
 
+def test_damped_element_tangent_is_the_derivative_of_the_damped_force():
+    """With stiffness-proportional damping of the deformation rates, f = f_el(p) + bd B(p)^T K_l B(p) pd:
+    the tangent at rate_weight 0 is df/dp at fixed rates (central differences; not symmetric: the
+    variation of B in the deformation rates), and the rate_weight part is (1/bd) df/dpd."""
+    le, ea, ei, bd = 0.02, 1e6, 2.0, 3e-3
+    p = np.array([1e-4, 2e-3, 0.3, -2e-4, 5e-3, -0.1])
+    pd = np.array([0.3, -1.2, 40.0, -0.5, 2.0, -25.0])      # fast turns: the buckled rod's rates
+    f, kt, _, _, _ = kernels.slidercrank_corot_element(le, ea, ei, p, True, pd, bd)
+    f_el, _, _, _, _ = kernels.slidercrank_corot_element(le, ea, ei, p, False)
+    assert np.abs(f - f_el).max() > 1e-3 * np.abs(f_el).max()            # the damping force counts here
+    h = 1e-7
+    fd_p, fd_pd = np.zeros((6, 6)), np.zeros((6, 6))
+    for j in range(6):
+        dp = np.zeros(6)
+        dp[j] = h
+        fd_p[:, j] = (kernels.slidercrank_corot_element(le, ea, ei, p + dp, False, pd, bd)[0]
+                      - kernels.slidercrank_corot_element(le, ea, ei, p - dp, False, pd, bd)[0]) / (2 * h)
+        fd_pd[:, j] = (kernels.slidercrank_corot_element(le, ea, ei, p, False, pd + dp, bd)[0]
+                       - kernels.slidercrank_corot_element(le, ea, ei, p, False, pd - dp, bd)[0]) / (2 * h)
+    np.testing.assert_allclose(kt, fd_p, rtol=1e-5, atol=1e-6 * np.abs(kt).max())
+    assert np.abs(kt - kt.T).max() > 1e-4 * np.abs(kt).max()              # not symmetric
+    kt1 = kernels.slidercrank_corot_element(le, ea, ei, p, True, pd, bd, rate_weight=1.0)[1]
+    np.testing.assert_allclose(bd * (kt1 - kt), fd_pd, rtol=1e-5, atol=1e-6 * np.abs(fd_pd).max())
+
+
+def test_newton_converges_quadratically_on_the_buckled_rod():
+    """With the consistent tangent (damping included) a step converges in one Newton solve whenever
+    the predictor is close.  40 elements, 3 revolutions: below the onset every step takes one
+    solve; on the buckled rods, whose elements turn fast, well under two (a tangent without the
+    damping's geometric variation converges only linearly there: 1.04, 2.07 and 1.82 solves a step
+    in these three cases)."""
+    out = {}
+    for mat, omega in (("aluminium", 21.99), ("aluminium", 25.13), ("medium_carbon_steel", 29.32)):
+        m = MATERIALS[mat]
+        ea, ei, rhoa = m["youngs_modulus"] * m["area"], m["youngs_modulus"] * m["second_moment"], m["density"] * m["area"]
+        al, be = rayleigh(0.02, *kernels.slidercrank_frequencies(rhoa, ea, ei, L, MS)[:2])
+        spr, revs = 1440, 3
+        dt = 2 * math.pi / (omega * spr)
+        r = kernels.slidercrank_nl_simulate(40, R2, L, rhoa, ea, ei, m["section_depth"] / 2, MS, omega, dt, revs * spr,
+                                            spr, (revs - 1) * spr, spr + 1, al, be, hht=-0.05)
+        assert r["status"] == 0
+        out[mat, omega] = r["stats"][0] / (revs * spr)
+    assert out["aluminium", 21.99] < 1.001, out
+    assert out["aluminium", 25.13] < 1.7 and out["medium_carbon_steel", 29.32] < 1.4, out
+
+
 def test_small_displacements_reproduce_the_linear_frame_element():
     le, ea, ei = 0.02, 1e6, 2.0
     _, kt, _, _, _ = kernels.slidercrank_corot_element(le, ea, ei, np.zeros(6))

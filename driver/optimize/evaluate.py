@@ -15,7 +15,6 @@ Every design the optimiser asks for goes through :class:`Evaluator`, which
 from __future__ import annotations
 
 import concurrent.futures as cf
-import json
 import math
 import os
 import re
@@ -30,6 +29,7 @@ import pandas as pd
 from driver import blas, expr, limits
 from driver.deck import DeckError, Params, RawGroup, validate
 from driver.study import load_study
+from driver.optimize import journal as journal_file
 from driver.optimize.problem import Problem
 from driver.runner import NUMERICAL, CaseFailure, compute, numerical_error
 
@@ -176,6 +176,8 @@ class Evaluator:
         self.kinds = [problem.study.SPEC.keys[v.key].kind for v in problem.variables]
         self.journal = journal
         self._journal_fh = None
+        #: what a resume found wrong with the records it was given (driver.optimize.journal), or ''
+        self.resume_note = ""
         self._pool: cf.ProcessPoolExecutor | None = None
         self.seconds_per_case: float | None = None
         self.compute_seconds = 0.0
@@ -282,11 +284,11 @@ class Evaluator:
             if self._journal_fh is None:
                 self.journal.parent.mkdir(parents=True, exist_ok=True)
                 self._journal_fh = open(self.journal, "a")
+            fp = self.problem.fingerprint()
             for r, j in zip(recs, journal):
-                if j:
-                    self._journal_fh.write(json.dumps({"base": self.problem.fingerprint(), "x": list(r.x),
-                                                       "status": r.status, "reason": r.reason,
-                                                       "summary": r.summary}, default=_plain) + "\n")
+                if j:   # one checksummed line per computed design (driver.optimize.journal)
+                    self._journal_fh.write(journal_file.line(journal_file.record(fp, r.x, r.status, r.reason,
+                                                                                 r.summary)))
             self._journal_fh.flush()
 
     def _score(self, recs: list[Record]) -> None:
@@ -478,11 +480,3 @@ def _short(text: str, n: int = 90) -> str:
     """A reason to count: one line, numbers replaced by '#' (so the same failure counts once)."""
     text = _NUMBER.sub("#", " ".join(str(text).split()))
     return text if len(text) <= n else text[: n - 3] + "..."
-
-
-def _plain(o: Any) -> Any:
-    if isinstance(o, (np.floating, np.integer)):
-        return o.item()
-    if isinstance(o, np.bool_):
-        return bool(o)
-    return str(o)

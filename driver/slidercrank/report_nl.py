@@ -205,7 +205,8 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
     text = _header(params, model, derived)
     text += ["  nonlinear rod: co-rotational Euler-Bernoulli frame elements (same mesh, masses, damping and",
              "  inertia loading); Newmark average acceleration with Newton iterations on the consistent",
-             "  tangent, a step halved when Newton fails; banded Cholesky solves (fortran/slidercrank_nl.f90)",
+             "  tangent (the damping's included), a step halved when Newton fails; banded LU solves",
+             "  (fortran/slidercrank_nl.f90)",
              f"  time integration: HHT-alpha, alpha = {params.hht_alpha:g}"
              + (" (Newmark average acceleration)" if params.hht_alpha == 0 else
                 " (damps the unresolved high frequencies; 0 = Newmark average acceleration)"),

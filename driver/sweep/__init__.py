@@ -134,7 +134,9 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
             # what the tables show: the columns asked for, and those the filter and the plot read
             read = {n for _, text in named for n in expr.parse(text, columns).names}
             shown_columns = [c for c in probe if c in set(sw.summary_columns) | read]
-    stem_path = output_stem(outdir, deck.path)
+    # every name the sweep gives its files and folders, known before it runs (the longest counts)
+    stem_path = output_stem(outdir, deck.path, (".out", ".sweep", "_summary.csv", "_summary.parquet", "_cases.csv",
+                                                "_cases.parquet", *(("_summary.png",) if plot else ())))
     scheduler = scheduler or _configured_scheduler()
     jobs = jobs or os.cpu_count() or 1
     layout = store.layout_for(stem_path, grid.n)

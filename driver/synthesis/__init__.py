@@ -537,7 +537,10 @@ def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool,
                        quiet: bool = False, summary_json: bool = False, **_: Any) -> int:
     """Command-line entry: synthesise, write, return the exit status (DeckError propagates)."""
     syn = synthesise(deck)
-    stem = output_stem(outdir, deck.path)
+    stem = output_stem(outdir, deck.path, (".out", ".linkage.dat", ".linkage.out", f"{syn.table_name}.csv",
+                                           *(f".linkage.{fmt}" for fmt in formats),
+                                           *((".json",) if summary_json else ()),
+                                           *(("_error.png", "_path.png") if plot else ())))
     written = []
     with output_set(stem.parent):   # the deck's files all together, or none
         if syn.linkage is not None:
