@@ -358,7 +358,7 @@ def run_comparison(deck: str | Path) -> Comparison:
                               note=f"a &{control} deck runs the study over many cases or designs; the published tables "
                                    "belong to single-case decks (compare a case deck it writes instead)")
     module, params = study_of(d)
-    group = module.SPEC.name
+    group = module.name
     comparer = _COMPARERS.get(group)
     rows: list[dict] = []
     if comparer is not None:

@@ -30,6 +30,7 @@ import pandas as pd
 from driver.deck import GroupSpec, Key, Params, non_empty, positive
 from driver.export import with_units
 from driver.limits import Estimate
+from driver._study import Study
 from driver.study import Figure, Result, keyword_run
 from driver.table import Column, render_table
 
@@ -384,3 +385,6 @@ def _fits_figure(p: Params, r: dict[str, Any]):
              "tolerance analysis (2.15)": r["eq215"]}
     return plotting.robust_design_figure(t, means, spreads, points, tmins, sx,
                                          title=p.title or "Taylor's robust-design example")
+
+
+STUDY = Study(name="robust_example", package=__name__, spec=SPEC, run=run, estimate=estimate)

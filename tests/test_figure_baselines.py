@@ -52,7 +52,7 @@ def _design_map(keys: int):
                          grid=grid, keep="meets_transmission_band", case_outputs="none", jobs=1)
     frame = s.summary
     names = [f"fourbar.{k}" for k in grid]
-    labels = {c: column_label(driver.fourbar, c) for c in frame.columns}
+    labels = {c: column_label(driver.fourbar.STUDY, c) for c in frame.columns}
     if keys == 1:
         best = plotting.best_index(frame, "mu_min_deg", "max")
         return plotting.design_space_map(frame, names, "mu_min_deg", labels, best=best, best_text="best",

@@ -51,11 +51,11 @@ def test_an_expression_label_is_drawn_literally():
     frame = pd.DataFrame({"case": [1, 2, 3], "fourbar.crank": [2.0, 3.0, 4.0], "kept": [True] * 3,
                           expr: [40.0, 33.0, 26.0]})
     fig = plotting.sweep_summary(frame, ["fourbar.crank"], ys=[expr],
-                                 labels={c: column_label(driver.fourbar, c) for c in frame.columns})
+                                 labels={c: column_label(driver.fourbar.STUDY, c) for c in frame.columns})
     fig.canvas.draw() if fig.canvas is not None else None
     ylabel = fig.axes[0].yaxis.label
     assert not _is_math(ylabel) and "$" in ylabel._preprocess_math(ylabel.get_text())[0]
-    lab = expression_label(driver.fourbar, "min(mu_min_deg, 180 - mu_max_deg)")
+    lab = expression_label(driver.fourbar.STUDY, "min(mu_min_deg, 180 - mu_max_deg)")
     assert lab == "min(minimum transmission angle, 180 - maximum transmission angle) [deg]"
 
 

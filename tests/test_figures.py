@@ -22,7 +22,8 @@ from conftest import INPUTS
 from driver import plotting
 from driver.deck import read_deck
 from driver.runner import compute, study_of
-from driver.study import column_label, load_study, plot_format
+from driver._study import load_study
+from driver.study import column_label, plot_format
 
 
 @lru_cache(maxsize=None)
@@ -95,7 +96,7 @@ def test_sweep_summary_labels_and_no_trivial_panels():
     module = load_study("slidercrank")
     labels = {c: column_label(module, c) for c in frame.columns}
     fig = plotting.sweep_summary(frame, ["slidercrank.material", "slidercrank.speeds"], title="t", labels=labels,
-                                 preferred=module.SWEEP_PLOT)
+                                 preferred=module.sweep_plot)
     ylabels = [ax.get_ylabel().replace("\n", " ") for ax in fig.axes]
     # omega_1 repeats x, the angles and n_buckled are constants, the _1 columns repeat the totals
     assert ylabels == ["peak tensile strain [microstrain]", "peak compression / Euler load [-]"]

@@ -91,7 +91,7 @@ def test_example_command_line(tmp_path):
 
 def test_study_names_without_import_match_the_studies():
     from driver.runner import available_studies
-    from driver.study import study_names
+    from driver._study import study_names
     assert study_names() == sorted(available_studies())
 
 

@@ -22,6 +22,7 @@ from driver import kernels
 from driver.limits import Estimate
 from driver.deck import GroupSpec, Key, Params, positive
 from driver.export import with_units
+from driver._study import BatchSummary, Study
 from driver.study import Figure, Result, keyword_run
 from driver.table import Column, fortran_f, render_table
 
@@ -755,3 +756,11 @@ def _summary(p: Params) -> dict:
     return {k: (None if isinstance(v, float) and math.isnan(v) else
                 bool(v) if isinstance(v, (bool, np.bool_)) else
                 float(v) if isinstance(v, np.floating) else v) for k, v in row.items()}
+
+
+STUDY = Study(name="fourbar", package=__name__, spec=SPEC, run=run, estimate=estimate, summarise=summarise,
+              batch=BatchSummary(summarise_batch, keys=BATCH_KEYS, ignored=BATCH_IGNORED,
+                                 independent=BATCH_INDEPENDENT, passes=BATCH_PASSES,
+                                 pass_names=(*PASS_BITS, "forces")),
+              labels=LABELS, sweep_plot=SWEEP_PLOT, sweep_best=SWEEP_BEST, summary_settings=SUMMARY_SETTINGS,
+              blame=blame)

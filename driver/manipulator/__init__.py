@@ -38,6 +38,7 @@ from driver.manipulator import report as _report
 from driver.manipulator.report import TIDY_UNITS, table_frame
 from driver.manipulator.spec import LABELS, RENAMED, SPEC, SWEEP_BEST, SWEEP_PLOT, estimate
 from driver.manipulator.tables import NOT_REPRODUCIBLE, REASONS, TEXT_REASONS, TIDY_NAMES, Table
+from driver._study import BatchSummary, Study
 from driver.study import Result, keyword_run
 
 __all__ = ["SPEC", "run", "Workspace", "tolerance_box", "round_half_up", "REASONS", "NOT_REPRODUCIBLE", "TEXT_REASONS",
@@ -51,3 +52,10 @@ def run(params: Params, progress: bool = False) -> Result:
     """Run one &manipulator deck (see the package docstring): validated Params, or the deck's
     keys as keyword arguments (``driver.manipulator.run(points_x=[...], points_y=[...])``)."""
     return _report.run(params, progress=progress)
+
+
+STUDY = Study(name="manipulator", package=__name__, spec=SPEC, run=run, estimate=estimate, summarise=summarise,
+              batch=BatchSummary(summarise_batch, keys=BATCH_KEYS, ignored=BATCH_IGNORED,
+                                 independent=BATCH_INDEPENDENT, passes=BATCH_PASSES,
+                                 pass_names=("indices", "target", "tolerance", "walk"), refusal=batch_refusal),
+              labels=LABELS, sweep_plot=SWEEP_PLOT, sweep_best=SWEEP_BEST, renamed=RENAMED)

@@ -49,9 +49,9 @@ BATCH_INDEPENDENT = ("mass_per_length", "gravity", "tolerance_bound", "title", "
 BATCH_PASSES: dict[str, tuple[str, ...]] = {
     "design_l1_m": (), "design_l2_m": (), "design_ri1": ("indices",), "design_ri2": ("indices",),
     "design_ri3": ("indices",), "design_ri2_excess": ("indices",), "design_reaches_all": ("indices",),
-    "design_crob_residual_m2": (), "design_total_torque_Nm": ("target",), "design_tau_sum_signed_Nm": ("target",),
+    "design_crob_residual_m2": (), "design_tau_sum_signed_Nm": ("target",),
     "design_torque_demand_Nm": ("target",), "design_peak_torque_Nm": ("target",),
-    "design_status": ("indices", "target"), "sweep_min_total_torque_Nm": ("walk",), "sweep_min_l1_m": ("walk",),
+    "design_status": ("indices", "target"), "sweep_min_l1_m": ("walk",),
     "sweep_min_l2_m": ("walk",), "sweep_min_row": ("walk",), "sweep_min_reaches_workspace": ("walk",),
 }
 BATCH_PASS_SUFFIXES: dict[str, tuple[str, ...]] = {

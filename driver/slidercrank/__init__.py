@@ -29,6 +29,7 @@ from driver.slidercrank.report import (_benchmark_lines, _convergence_table, _cr
 from driver.slidercrank.spec import (EULER_WARN, LABELS, MATERIALS, MIN_STEPS_PER_BENDING_PERIOD, MIN_STEPS_PER_REV,
                                      PAPER_SPEEDS, SIMEON1996, SPEC, STATUS_TEXT, SWEEP_PLOT, Model, _model, _shape,
                                      min_steps_per_rev, rayleigh)
+from driver._study import Study
 from driver.study import Figure, Result, keyword_run
 
 __all__ = ["SPEC", "run", "estimate", "MATERIALS", "PAPER_SPEEDS", "SIMEON1996", "simeon_initial_state",
@@ -193,3 +194,7 @@ def _history_figure(model: Model, params: Params, case: Case, alpha: float, beta
         f"{'Simeon (1996) crank benchmark' if ref is not None else params.material}: {case.n_elements} elements "
         f"at {case.omega:g} rad/s, t = 0 to {params.end_time:g} s",
         "Simeon (1996), MEBDFI tol 1e-14")
+
+
+STUDY = Study(name="slidercrank", package=__name__, spec=SPEC, run=run, estimate=estimate, labels=LABELS,
+              sweep_plot=SWEEP_PLOT)

@@ -124,14 +124,14 @@ def write_sweep_files(outdir: Path, stem: str, table: pd.DataFrame, cases: Any, 
             labels = {c: column_label(module, c) for c in shown.columns}
             from driver.plotting import is_grid, sweep_maps
             if is_grid(shown, names) and not sw.zip:   # a design space: maps over the keys, not strips
-                ys = [y for y in sw.plot_y if y in shown] or [c for c in getattr(module, "SWEEP_PLOT", ())
+                ys = [y for y in sw.plot_y if y in shown] or [c for c in module.sweep_plot
                                                              if c in shown][:1]
-                for k, fig in enumerate(sweep_maps(shown, names, ys[:3], labels, getattr(module, "SWEEP_BEST", {}),
+                for k, fig in enumerate(sweep_maps(shown, names, ys[:3], labels, module.sweep_best,
                                                    stem, sw.summary_rows == "kept")):
                     save_figure(fig, outdir / f"{stem}_summary{'' if k == 0 else f'_{k + 1}'}.png", plot)
             else:
                 save_figure(sweep_summary(shown, names, sw.plot_x, sw.plot_y, stem, labels,
-                                          getattr(module, "SWEEP_PLOT", ())), outdir / f"{stem}_summary.png", plot)
+                                          module.sweep_plot), outdir / f"{stem}_summary.png", plot)
 
 
 def sweep_text(deck: Deck, sw: Params, base: Params, axes: list[tuple[str, list]], n_cases: int,
@@ -145,9 +145,10 @@ def sweep_text(deck: Deck, sw: Params, base: Params, axes: list[tuple[str, list]
         shown = (", ".join(map(fmt, vals[:8])) if len(vals) <= 8 else
                  f"{fmt(vals[0])}, {fmt(vals[1])}, ..., {fmt(vals[-1])} ({len(vals)} values)")
         lines.append(f"    {name:<28} {shown}")
-    from driver.study import load_study   # settings of the base deck the summary columns depend on
+    from driver._study import load_study   # settings of the base deck the summary columns depend on
     swept = {name.partition(".")[2] for name, _ in axes}
-    for key in getattr(load_study(base.group), "SUMMARY_SETTINGS", ()):
+    study = load_study(base.group)
+    for key in study.summary_settings if study is not None else ():
         if key in base and key not in swept:
             v = base[key]
             lines.append(f"    {key:<28} " + (", ".join(f"{x:g}" for x in v) if isinstance(v, (list, tuple)) else f"{v}")

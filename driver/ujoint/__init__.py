@@ -31,6 +31,7 @@ import numpy as np
 
 from driver.deck import Params
 from driver.limits import Estimate
+from driver._study import BatchSummary, Study
 from driver.study import Figure, Result, keyword_run
 from driver.ujoint.analysis import (BOUND_TOL, CLUSTER_TOL, PHASE_PERIOD, SADDLE_NUDGE, SYM_TOL, TIE_RTOL, Chain,
                                     Design, StartRun, _chain, _free_index, _starts, evaluate, objective_scale,
@@ -135,3 +136,11 @@ def run(params: Params, progress: bool = False) -> Result:
                Figure("polar", lambda: _figure(chain, designs, True, params.paper_band, title))]
     return Result(text=text, tidy=tidy, summary=summary, warnings=warnings, failure=failure,
                   figures=figures, extra=extra)
+
+
+STUDY = Study(name="ujoint", package=__name__, spec=SPEC, run=run, estimate=estimate,
+              batch=BatchSummary(summarise_batch, keys=BATCH_KEYS, ignored=BATCH_IGNORED,
+                                 independent=BATCH_INDEPENDENT, passes=BATCH_PASSES,
+                                 pass_names=("objective", "speed", "equivalent"), applies=batch_applies,
+                                 elements=BATCH_ELEMENTS),
+              labels=LABELS, sweep_plot=SWEEP_PLOT)
