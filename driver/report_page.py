@@ -160,12 +160,12 @@ def _fourbar_frames(params: "Params") -> dict[str, Any] | None:
 
 
 def _slidercrank_frames(params: "Params", result: "Result | None" = None) -> dict[str, Any] | None:
-    from driver import kernels
+    from driver.slidercrank import kernel as slidercrank_kernel
     from driver.slidercrank.spec import _model
     model = _model(params)
     r, length = float(model.r2), float(model.length)
     theta = np.linspace(0.0, 360.0, ANIMATION_FRAMES, endpoint=False)
-    states = kernels.slidercrank_rigid(np.radians(theta), 1.0, r, length)
+    states = slidercrank_kernel.slidercrank_rigid(np.radians(theta), 1.0, r, length)
     a = np.column_stack([r * np.cos(np.radians(theta)), r * np.sin(np.radians(theta))])
     b = np.column_stack([states[:, 3], np.zeros_like(theta)])
     frames = {"theta": theta.tolist(), "ok": [1] * len(theta), "A": np.round(a, 6).tolist(),

@@ -18,11 +18,11 @@ import pandas as pd
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from driver import kernels
+from driver.fourbar import kernel as fourbar_kernel
 from driver.deck import DeckError, Params
 from driver.fourbar import SPEC, grashof, limit_angles, summarise, summarise_batch
 
-OK, TOG = kernels.FOURBAR_STATUS["ok"], kernels.FOURBAR_STATUS["toggle"]
+OK, TOG = fourbar_kernel.FOURBAR_STATUS["ok"], fourbar_kernel.FOURBAR_STATUS["toggle"]
 
 
 def params(**kw) -> Params:
@@ -36,7 +36,7 @@ def oracle(p, q, r, s, lo=0.0, hi=360.0, branch=1, omega=1.0, step=0.01):
     """Brute-force summary on a fine grid (test oracle only)."""
     lims = [a + 360.0 * k for a in limit_angles(p, q, r, s) for k in range(-2, 3)]
     grid = np.unique(np.concatenate([np.arange(lo, hi, step), [hi], [t for t in lims if lo <= t <= hi]]))
-    out, stt = kernels.fourbar_exact(np.radians(grid), p, q, r, s, omega, 0.0, branch)
+    out, stt = fourbar_kernel.fourbar_exact(np.radians(grid), p, q, r, s, omega, 0.0, branch)
     placed = (stt == OK) | (stt == TOG)
     d = np.hypot(p - q * np.cos(np.radians(grid)), q * np.sin(np.radians(grid)))
     eps = 1e-9 * (p + q + r + s)   # the limit angles themselves are assemblable (rounded in limit_angles)
@@ -142,7 +142,7 @@ def test_partial_ranges_and_long_ranges():
         o = oracle(12.0, 5.0, 15.0, 9.0, lo, hi, omega=5.0) if hi > lo else None
         row = f.iloc[i]
         if o is None:   # one crank angle: every extreme at it
-            one, _ = kernels.fourbar_exact(np.radians([lo]), 12.0, 5.0, 15.0, 9.0, 5.0)
+            one, _ = fourbar_kernel.fourbar_exact(np.radians([lo]), 12.0, 5.0, 15.0, 9.0, 5.0)
             assert row["omega3_peak_rad_s"] == pytest.approx(one[0, 8], rel=1e-12)
             assert row["rocker_swing_deg"] == 0.0 and row["omega3_peak_at_deg"] == lo
             continue

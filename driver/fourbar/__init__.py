@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from driver.fourbar import forces
-from driver import kernels
+from driver.fourbar import kernel
 from driver.limits import Estimate
 from driver.deck import GroupSpec, Key, Params, positive
 from driver.export import with_units
@@ -29,7 +29,7 @@ from driver.table import Column, fortran_f, render_table
 __all__ = ["SPEC", "run", "summarise", "summarise_batch", "BATCH_KEYS", "grashof", "limit_angles", "exact_grid",
            "listing_grid", "exact_as_listed"]
 
-ST = kernels.FOURBAR_STATUS
+ST = kernel.FOURBAR_STATUS
 MAX_ANGLE = 1.0e6   # |crank angle| [deg] a deck may give (ulp of 1e6 is 1.2e-10 deg)
 BAND = (40.0, 120.0)  # transmission-angle band recommended by the paper [deg]: transmission_band_deg's default
 
@@ -180,8 +180,8 @@ def crank_angles(p: Params) -> np.ndarray:
 
 
 def exact_grid(p: Params, theta_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Closed-loop states at ``theta_deg`` (kernel columns, see kernels.fourbar_exact)."""
-    return kernels.fourbar_exact(np.radians(theta_deg), p.fixed_link, p.crank, p.coupler, p.rocker,
+    """Closed-loop states at ``theta_deg`` (kernel columns, see kernel.fourbar_exact)."""
+    return kernel.fourbar_exact(np.radians(theta_deg), p.fixed_link, p.crank, p.coupler, p.rocker,
                                  p.omega, p.alpha, 1 if p.branch == "open" else -1)
 
 
@@ -190,14 +190,14 @@ def coupler_point(p: Params, theta_deg: np.ndarray, out: np.ndarray, status: np.
     if not p.coupler_point:
         return None
     u, v = p.coupler_point
-    return kernels.fourbar_coupler_point(np.radians(theta_deg), out, status, p.crank, p.omega, p.alpha, u, v)
+    return kernel.fourbar_coupler_point(np.radians(theta_deg), out, status, p.crank, p.omega, p.alpha, u, v)
 
 
 def listing_grid(p: Params) -> tuple[np.ndarray, np.ndarray]:
     """The published program's rows for the deck's crank angles."""
     start, step = int(p.start_deg), int(p.step_deg)
     n = len(crank_angles(p))
-    return kernels.fourbar_listing(p.fixed_link, p.crank, p.coupler, p.rocker, p.omega, start, step, n)
+    return kernel.fourbar_listing(p.fixed_link, p.crank, p.coupler, p.rocker, p.omega, start, step, n)
 
 
 def _deg360(rad: np.ndarray) -> np.ndarray:
@@ -246,7 +246,7 @@ def extremes(p: Params) -> Extremes | None:
     None when the linkage cannot be assembled anywhere in the range.
     """
     lo, hi = sorted((p.start_deg, p.stop_deg))
-    row = kernels.fourbar_summaries(_param_matrix(p, {}, 1))[0]
+    row = kernel.fourbar_summaries(_param_matrix(p, {}, 1))[0]
     if not row[1]:
         return None
     toggles = toggles_in_range(p.fixed_link, p.crank, p.coupler, p.rocker, lo, hi)
@@ -282,8 +282,8 @@ BATCH_PASSES: dict[str, tuple[str, ...]] = {
     **{f"{pre}{c}": ("forces",) for pre in ("", "unbalanced_") for c in forces.SUMMARY_DOC},
 }
 #: the kernel's pass bits (fortran/fourbar_summary.f90 pass_*)
-PASS_BITS = {"transmission": kernels.FOURBAR_PASSES["transmission"], "rocker": kernels.FOURBAR_PASSES["rocker"],
-             "peaks": kernels.FOURBAR_PASSES["peaks"]}
+PASS_BITS = {"transmission": kernel.FOURBAR_PASSES["transmission"], "rocker": kernel.FOURBAR_PASSES["rocker"],
+             "peaks": kernel.FOURBAR_PASSES["peaks"]}
 
 
 def _pass_mask(wanted: Collection[str] | None) -> int:
@@ -365,7 +365,7 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     if len(sizes) > 1:
         raise _bad(base, None, f"batch columns have different lengths {sorted(sizes)}")
     n = sizes.pop() if sizes else 1
-    res = kernels.fourbar_summaries(_param_matrix(base, columns, n), _pass_mask(wanted))
+    res = kernel.fourbar_summaries(_param_matrix(base, columns, n), _pass_mask(wanted))
     frame = _frame(res, detail or (wanted is not None and any(c in _DETAIL for c in wanted)), band_of(base), wanted)
     if forces.active(base) and (wanted is None or any(BATCH_PASSES.get(c) == ("forces",) for c in wanted)):
         # force columns (driver/fourbar/forces.py) when the deck gives masses, and someone reads one
@@ -385,9 +385,9 @@ def _frame(res: np.ndarray, detail: bool = False, band: tuple[float, float] = BA
            wanted: Collection[str] | None = None) -> pd.DataFrame:
     """Kernel rows -> the summary columns (vectorised; the one place both paths go through);
     with ``wanted``, only those columns are built."""
-    c = dict(zip(kernels.FOURBAR_SUMMARY_COLUMNS, res.T))
+    c = dict(zip(kernel.FOURBAR_SUMMARY_COLUMNS, res.T))
     ok = c["assemblable"] > 0
-    lut = [GRASHOF_NAMES[kernels.FOURBAR_GRASHOF[k]] for k in range(len(GRASHOF_NAMES))]
+    lut = [GRASHOF_NAMES[kernel.FOURBAR_GRASHOF[k]] for k in range(len(GRASHOF_NAMES))]
     tog = lambda: ok & (c["toggles_in_range"] > 0)
     has = lambda v, m=None: np.where(ok if m is None else m, v, np.nan)
     lo, hi = band
@@ -458,7 +458,7 @@ def exact_table(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarra
                 cp: np.ndarray | None = None) -> list[str]:
     """Fixed-format exact table: the listing's ten columns (angles rounded) plus accelerations,
     and the coupler point's position and speed when the deck defines one (``cp`` from
-    kernels.fourbar_coupler_point)."""
+    kernel.fourbar_coupler_point)."""
     whole = np.all(np.isclose(theta, np.round(theta)))
     tcol = Column("theta", "i", 5, 0, 2) if whole else Column("theta", "f", 8, 3, 2)
     cols = [tcol, Column("coupler", "f", 7, 1), Column("rocker", "f", 7, 1), Column("transm", "f", 7, 1)]
@@ -763,4 +763,4 @@ STUDY = Study(name="fourbar", package=__name__, spec=SPEC, run=run, estimate=est
                                  independent=BATCH_INDEPENDENT, passes=BATCH_PASSES,
                                  pass_names=(*PASS_BITS, "forces")),
               labels=LABELS, sweep_plot=SWEEP_PLOT, sweep_best=SWEEP_BEST, summary_settings=SUMMARY_SETTINGS,
-              blame=blame)
+              blame=blame, kernel=kernel)

@@ -38,6 +38,7 @@ from driver.manipulator import report as _report
 from driver.manipulator.report import TIDY_UNITS, table_frame
 from driver.manipulator.spec import LABELS, RENAMED, SPEC, SWEEP_BEST, SWEEP_PLOT, estimate
 from driver.manipulator.tables import NOT_REPRODUCIBLE, REASONS, TEXT_REASONS, TIDY_NAMES, Table
+from driver.manipulator import kernel
 from driver._study import BatchSummary, Study
 from driver.study import Result, keyword_run
 
@@ -58,4 +59,4 @@ STUDY = Study(name="manipulator", package=__name__, spec=SPEC, run=run, estimate
               batch=BatchSummary(summarise_batch, keys=BATCH_KEYS, ignored=BATCH_IGNORED,
                                  independent=BATCH_INDEPENDENT, passes=BATCH_PASSES,
                                  pass_names=("indices", "target", "tolerance", "walk"), refusal=batch_refusal),
-              labels=LABELS, sweep_plot=SWEEP_PLOT, sweep_best=SWEEP_BEST, renamed=RENAMED)
+              labels=LABELS, sweep_plot=SWEEP_PLOT, sweep_best=SWEEP_BEST, renamed=RENAMED, kernel=kernel)

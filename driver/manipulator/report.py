@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from driver import kernels
+from driver.manipulator import kernel
 from driver.deck import Params
 from driver.export import with_units
 from driver.manipulator.analysis import (SIGNIFICANT, Conv, Workspace, _design_list, _target, design_status, optima,
@@ -153,7 +153,7 @@ def _summary(p: Params, ws: Workspace, conv: Conv, used: dict, sweep: dict, tol:
         s[f"{key}_reaches_workspace"] = not rec["reason"]
     # design measures of the first design (what an &optimize deck varies: designs_l1, designs_l2)
     l1, l2 = float(used["l1"][0]), float(used["l2"][0])
-    ri, _, reach = kernels.manipulator_design_indices(ws.x, ws.y, [l1], [l2])
+    ri, _, reach = kernel.manipulator_design_indices(ws.x, ws.y, [l1], [l2])
     s.update({"design_l1_m": l1, "design_l2_m": l2, "design_ri1": float(ri[0, 0]) if ri[0, 0] > 0 else None,
               "design_ri2": float(ri[0, 1]), "design_ri3": float(ri[0, 2]),
               "design_ri2_excess": float(ri[0, 1]) - math.sqrt(ws.n),
@@ -210,7 +210,7 @@ def _check_designs(p: Params, ws: Workspace, conv: Conv) -> None:
     if p.designs_l1 is None:
         return
     _, l1, l2 = _design_list(p, conv)
-    ri = kernels.manipulator_design_indices(ws.x, ws.y, l1, l2)
+    ri = kernel.manipulator_design_indices(ws.x, ws.y, l1, l2)
     for i in np.flatnonzero(ri[2] == 0):
         raise p.error("designs_l1", f"design {i + 1} (l1 = {l1[i]:g}, l2 = {l2[i]:g}) violates the reach "
                                     f"conditions |l1 - l2| <= r = {ws.r:.4f} and l1 + l2 >= R = {ws.R:.4f}: "
@@ -271,7 +271,7 @@ def _fig_design(p: Params, ws: Workspace, conv: Conv, used: dict):
     from driver.plotting import manipulator_design_space
     field_l = np.linspace(0.05, ws.R + 1.0, 161)
     L1, L2 = np.meshgrid(field_l, field_l)
-    ri = kernels.manipulator_design_indices(ws.x, ws.y, L1.ravel(), L2.ravel())[0][:, 1].reshape(L1.shape)
+    ri = kernel.manipulator_design_indices(ws.x, ws.y, L1.ravel(), L2.ravel())[0][:, 1].reshape(L1.shape)
     levels = p.ri2_levels or [math.sqrt(ws.n)]
     return manipulator_design_space(ws.r, ws.R, math.sqrt(conv.c_pairs), L1, L2, ri, float(ws.d2.sum()), ws.n,
                                     levels, optima(conv.c_pairs), used["names"], used["l1"], used["l2"],

@@ -29,6 +29,7 @@ from driver.slidercrank.report import (_benchmark_lines, _convergence_table, _cr
 from driver.slidercrank.spec import (EULER_WARN, LABELS, MATERIALS, MIN_STEPS_PER_BENDING_PERIOD, MIN_STEPS_PER_REV,
                                      PAPER_SPEEDS, SIMEON1996, SPEC, STATUS_TEXT, SWEEP_PLOT, Model, _model, _shape,
                                      min_steps_per_rev, rayleigh)
+from driver.slidercrank import kernel
 from driver._study import Study
 from driver.study import Figure, Result, keyword_run
 
@@ -197,4 +198,4 @@ def _history_figure(model: Model, params: Params, case: Case, alpha: float, beta
 
 
 STUDY = Study(name="slidercrank", package=__name__, spec=SPEC, run=run, estimate=estimate, labels=LABELS,
-              sweep_plot=SWEEP_PLOT)
+              sweep_plot=SWEEP_PLOT, kernel=kernel)

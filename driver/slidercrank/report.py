@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from driver import kernels
+from driver.slidercrank import kernel
 from driver.deck import Params
 from driver.export import with_units
 from driver.slidercrank.analysis import Case
@@ -236,7 +236,7 @@ def _benchmark_lines(params: Params, case: Case) -> list[str]:
     lines = ["Table 4  End state at t = " + f"{params.end_time:g} s", ""]
     if not case.ok:
         return lines + [f"  {_status_text(case)}"]
-    kin = kernels.slidercrank_rigid(np.array([case.omega * case.time[-1]]), case.omega,
+    kin = kernel.slidercrank_rigid(np.array([case.omega * case.time[-1]]), case.omega,
                                     params.crank_radius, params.rod_length)[0]
     vals = [("midpoint deflection from the chord (q1)", "m", float(case.mid[-1]), "q1"),
             ("rod elongation (q4)", "m", float(case.elong[-1]), "q4"),

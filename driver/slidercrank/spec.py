@@ -9,7 +9,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
-from driver import kernels
+from driver.slidercrank import kernel
 from driver.deck import GroupSpec, Key, Params, non_negative, positive
 
 
@@ -200,7 +200,7 @@ class Model:
 
     def frequencies(self) -> tuple[float, float, float]:
         """First bending, first axial frequency [rad/s] and Euler load [N] (closed forms, kernel)."""
-        return kernels.slidercrank_frequencies(self.rho_a, self.ea, self.ei, self.length, self.m_s)
+        return kernel.slidercrank_frequencies(self.rho_a, self.ea, self.ei, self.length, self.m_s)
 
 
 def _shape(params: Params) -> tuple[dict[str, float], str]:

@@ -31,6 +31,7 @@ import numpy as np
 
 from driver.deck import Params
 from driver.limits import Estimate
+from driver.ujoint import kernel
 from driver._study import BatchSummary, Study
 from driver.study import Figure, Result, keyword_run
 from driver.ujoint.analysis import (BOUND_TOL, CLUSTER_TOL, PHASE_PERIOD, SADDLE_NUDGE, SYM_TOL, TIE_RTOL, Chain,
@@ -143,4 +144,4 @@ STUDY = Study(name="ujoint", package=__name__, spec=SPEC, run=run, estimate=esti
                                  independent=BATCH_INDEPENDENT, passes=BATCH_PASSES,
                                  pass_names=("objective", "speed", "equivalent"), applies=batch_applies,
                                  elements=BATCH_ELEMENTS),
-              labels=LABELS, sweep_plot=SWEEP_PLOT)
+              labels=LABELS, sweep_plot=SWEEP_PLOT, kernel=kernel)

@@ -13,7 +13,7 @@ from scipy.optimize import minimize
 from tqdm import tqdm
 
 from driver.deck import Params
-from driver.kernels import UJOINT_MODELS, UJOINT_OBJECTIVES, ujoint_equivalent, ujoint_objective, ujoint_speed
+from driver.ujoint.kernel import UJOINT_MODELS, UJOINT_OBJECTIVES, ujoint_equivalent, ujoint_objective, ujoint_speed
 from driver.ujoint.spec import DEG
 
 

@@ -12,7 +12,7 @@ import pandas as pd
 
 from driver.deck import Params
 from driver.export import with_units
-from driver.kernels import UJOINT_MODELS, ujoint_speed
+from driver.ujoint.kernel import UJOINT_MODELS, ujoint_speed
 from driver.table import Column, fortran_f, render_table
 from driver.ujoint.analysis import TIE_RTOL, Chain, Design, StartRun, _free_index, evaluate, phases_for, yoke_shifts
 from driver.ujoint.spec import BAND_TOL, CONVENTIONS, DEG, OPTIONS, _per

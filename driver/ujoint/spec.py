@@ -10,7 +10,7 @@ import math
 import numpy as np
 
 from driver.deck import GroupSpec, Key, Params, non_empty, positive
-from driver.kernels import ujoint_geometry
+from driver.ujoint.kernel import ujoint_geometry
 
 
 DEG = math.pi / 180.0
