@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 try:
-    from driver import _kernels
+    from driver import _kernels  # noqa: F401 - the studies' kernel modules take it from here
 except ImportError as _exc:
     _root = Path(__file__).resolve().parents[1]
     if (_root / "meson.build").is_file() and (_root / "fortran").is_dir():
@@ -27,17 +27,6 @@ except ImportError as _exc:
                       f"mechanism-driver (see docs/install.md)") from _exc
 
 __all__ = ["farray"]
-
-
-def farray(x, ndim: int | None = None) -> np.ndarray:
-    """``x`` as a Fortran-contiguous float64 array (no copy when it already is one)."""
-    if type(x) is np.ndarray and x.dtype == np.float64 and x.flags.f_contiguous \
-            and (ndim is None or x.ndim == ndim):
-        return x          # fast path: the optimisers call kernels with such arrays (~1 us saved)
-    a = np.asfortranarray(x, dtype=np.float64)
-    if ndim is not None and a.ndim != ndim:
-        raise ValueError(f"expected a {ndim}-D array, got shape {a.shape}")
-    return a
 
 
 def farray(x, ndim: int | None = None) -> np.ndarray:

@@ -129,7 +129,7 @@ def test_figure_functions_draw_into_a_users_axes():
     fig3 = Figure()
     axes3 = fig3.subplots(3, 1)
     r = driver.fourbar.run(fixed_link=12.0, crank=5.0, coupler=15.0, rocker=9.0, step_deg=20)
-    from driver.fourbar import exact_grid, tidy_frame, _exact_columns
+    from driver.fourbar.analysis import exact_columns, exact_grid, tidy_frame
     out, st = exact_grid(r.params, theta)
-    assert plotting.fourbar_curves(tidy_frame("exact", theta, _exact_columns(out, st), st), None, "",
+    assert plotting.fourbar_curves(tidy_frame("exact", theta, exact_columns(out, st), st), None, "",
                                    axes=axes3) is fig3

@@ -12,7 +12,8 @@ from hypothesis import given, settings, strategies as st
 from driver.manipulator import kernel as manipulator_kernel
 from driver.runner import study_of
 from driver.deck import read_deck
-from driver.manipulator import _sensitivity_blocks, table_frame, tolerance_box
+from driver.manipulator import table_frame, tolerance_box
+from driver.manipulator.analysis import _sensitivity_blocks
 
 ROOT = Path(__file__).resolve().parents[1]
 

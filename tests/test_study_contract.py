@@ -12,7 +12,6 @@ summary has); and for the example pendulum an independent integration of its equ
 from __future__ import annotations
 
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -130,9 +129,9 @@ def test_batch_pass_table_agrees_with_the_summary_columns(name):
 def _optional(s: Study, column: str) -> bool:
     """Columns of a pass table a deck may not produce: the four-bar's detail columns and its
     force columns (decks that give masses); the manipulator's C_rob walk minimum."""
-    fb = sys.modules.get("driver.fourbar")
-    if s.name == "fourbar" and fb is not None:
-        return column in fb._DETAIL or s.batch.passes[column] == ("forces",)
+    if s.name == "fourbar":
+        from driver.fourbar.batch import DETAIL
+        return column in DETAIL or s.batch.passes[column] == ("forces",)
     return False
 
 

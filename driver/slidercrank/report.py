@@ -1,4 +1,5 @@
-"""Slider-crank study: the fixed-format .out sections, the tidy table, the summary and the plotting hook.
+"""Slider-crank study: a deck run (every crank speed and element count), the fixed-format .out
+sections, the tidy table, the summary and the plotting hook.
 
 Strains are printed in microstrain, angles in degrees, forces in N.
 """
@@ -8,12 +9,16 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+from tqdm import tqdm
 
-from driver.slidercrank import kernel
 from driver.deck import Params
 from driver.export import with_units
-from driver.slidercrank.analysis import Case
-from driver.slidercrank.spec import EULER_WARN, SIMEON1996, STATUS_TEXT, Model
+from driver.slidercrank import kernel
+from driver.slidercrank.analysis import Case, _run_case, static_onset
+from driver.slidercrank.figures import history_figure
+from driver.slidercrank.spec import (EULER_WARN, MIN_STEPS_PER_BENDING_PERIOD, MIN_STEPS_PER_REV, SIMEON1996, STATUS_TEXT,
+                                     Model, _model, _shape, rayleigh)
+from driver.study import Figure, Result, keyword_run
 from driver.table import Column, render_table
 
 
@@ -263,3 +268,115 @@ def _plotting():
     """driver.plotting, imported only when a figure is drawn (matplotlib is optional)."""
     from driver import plotting
     return plotting
+
+
+@keyword_run
+def run(params: Params, progress: bool = False) -> Result:
+    """Run every crank speed (and element count) of the deck; see the module docstring."""
+    if params.model == "nonlinear":
+        from driver.slidercrank.report_nl import run_nonlinear
+        return run_nonlinear(params, progress)
+    model = _model(params)
+    w_bend, w_axial, p_euler = model.frequencies()
+    alpha, beta = rayleigh(params.damping_ratio, w_bend, w_axial)
+    counts = list(params.element_counts) if params.element_counts else [params.n_elements]
+    derived = dict(w_bend=w_bend, w_axial=w_axial, p_euler=p_euler, alpha=alpha, beta=beta,
+                   onset=static_onset(model, counts[-1]))
+    jobs = [(w, n) for w in params.speeds for n in counts]
+    done: dict[tuple[float, int], Case] = {}
+    for w, n in tqdm(jobs, desc="slidercrank", unit="case", disable=not progress):
+        done[(w, n)] = _run_case(model, params, w, n, alpha, beta, p_euler)
+    main_n = counts[-1] if params.element_counts else params.n_elements
+    cases = [done[(w, main_n)] for w in params.speeds]
+
+    text = _header(params, model, derived) + [""]
+    warnings: list[str] = []
+    failure = None
+    if params.end_time > 0:
+        text += _benchmark_lines(params, cases[0]) + [""]
+    else:
+        text += _peak_table(cases, params.settle_tolerance) + [""] + _crank_end_table(cases) + [""]
+    conv = {w: [done[(w, n)] for n in counts] for w in params.speeds} if params.element_counts else {}
+    if conv:
+        text += _convergence_table(conv, model.length) + [""]
+    for c in cases:
+        if c.euler_ratio > EULER_WARN:
+            msg = (f"crank speed {c.omega:g} rad/s: peak rod compression {c.peak_compression:.1f} N is "
+                   f"{c.euler_ratio:.2f} of the Euler load {p_euler:.1f} N (> {EULER_WARN})")
+            if not params.geometric_stiffness:
+                msg += "; the linear model cannot show buckling: rerun with geometric_stiffness = .true."
+            warnings.append(msg)
+    for c in cases:
+        if c.ok and _unsettled(c, params.settle_tolerance):
+            warnings.append(f"crank speed {c.omega:g} rad/s: the reported revolution has not settled: strain "
+                            f"changes {100 * c.settle_strain:.3f} % and midpoint deflection "
+                            f"{100 * c.settle_mid:.3f} % of their peaks between the last two revolutions "
+                            f"(> {100 * params.settle_tolerance:g} %); run more revolutions")
+    onset = derived["onset"]
+    for c in done.values():
+        if not c.ok:
+            if params.geometric_stiffness and c.status in ("buckled", "diverged"):
+                warnings.append(f"crank speed {c.omega:g} rad/s, {c.n_elements} elements: "
+                                f"{_status_text(c)}")
+            else:
+                failure = f"crank speed {c.omega:g} rad/s, {c.n_elements} elements: {_status_text(c)}"
+                warnings.append(failure)
+    le = model.length / max(counts)
+    notes = ["Notes"]
+    if params.end_time <= 0:
+        notes += ["  * Strains: element axial strain (u_e - u_e-1)/le (the paper's 'regangan aksial'); tension",
+                  "    positive."] + _peak_notes(cases) + [
+                  "  * The paper publishes figures only; validation is against closed forms (quasi-static",
+                  "    limit N(s)/EA, natural frequencies) and the Simeon (1996) benchmark (see tests).",
+                  "  * Damping is not given in the paper: Rayleigh damping at the first bending and axial modes."]
+    else:
+        notes += [f"  * Benchmark mode: integrated from t = 0 to end_time with the time step {cases[0].dt:.6g} s.",
+                  "  * Midpoint deflection is measured from the chord A-C; elongation is the axial elastic",
+                  "    displacement of the slider end of the rod."]
+    notes.append(f"  * Time-step criterion: >= {MIN_STEPS_PER_BENDING_PERIOD} steps per period of the first "
+                 f"bending mode and >= {MIN_STEPS_PER_REV} per revolution.")
+    if le < model.depth:
+        notes.append(f"  * Elements ({le * 1e3:.3f} mm) are shorter than the section depth "
+                     f"({model.depth * 1e3:g} mm), as in the paper's")
+        notes.append("    700-element mesh; Euler-Bernoulli elements are used regardless (shear neglected).")
+    notes.append("  * A case stops, and its numbers are not reported, on one of two named triggers: STATIC")
+    notes.append("    INSTABILITY when the tangent stiffness K + K_G of the rigid-body axial force loses")
+    notes.append("    definiteness (geometric stiffness on only), LIMIT L/20 when the elastic deflection exceeds")
+    notes.append("    L/20 (or a rotation 0.25 rad), where the small-motion model is no longer valid.")
+    if onset is not None:
+        notes.append(f"  * Static buckling onset {onset[0]:.2f} rad/s (Model above): the lowest constant crank speed at")
+        notes.append("    which K + K_G loses definiteness at some crank angle; it is a property of the rod, not of")
+        notes.append("    the small-motion guard, which can trip earlier through dynamic amplification.")
+    if params.geometric_stiffness:
+        notes.append("  * Geometric stiffness on: K_G of the rigid-body axial force is part of the model.")
+    else:
+        notes.append("  * Geometric stiffness off (the paper's linear model, which cannot buckle); N/P_E is reported")
+        notes.append("    for every case.")
+    text += notes
+    if warnings:
+        text += ["", "Warnings"] + [f"  * {w}" for w in warnings]
+    figures = []
+    good = [c for c in cases if c.ok]
+    plotting = _plotting   # imported when a figure is drawn (matplotlib is the optional [plot] extra)
+    if good and params.end_time <= 0:
+        above = {f"{c.omega:g} rad/s": c.euler_ratio for c in good if c.euler_ratio > 1.0}
+        missing = [f"{c.omega:g} rad/s: {_status_text(c).split(' (')[0].lower()}, not drawn" for c in cases if not c.ok]
+        stiffness = "K + K_G" if params.geometric_stiffness else "linear model"
+        figures.append(Figure("strain", lambda: _plotting().slidercrank_strain_figure(
+            [(f"{c.omega:g} rad/s", c.angle_deg, c.eps_ax[0] * 1e6) for c in good],
+            f"{params.material}: crank-end element axial strain ({stiffness})", above=above, missing=missing)))
+        figures.append(Figure("deflection", lambda: _plotting().slidercrank_strain_figure(
+            [(f"{c.omega:g} rad/s", c.angle_deg, c.mid * 1e3) for c in good],
+            f"{params.material}: midpoint deflection ({stiffness})", ylabel="midpoint deflection [mm]",
+            above=above, missing=missing)))
+    if params.end_time > 0 and cases[0].ok:   # a benchmark run: its time history against the reference
+        c0 = cases[0]
+        ref = SIMEON1996 if params.benchmark == "simeon1996" else None
+        figures.append(Figure("history", lambda: history_figure(model, params, c0, alpha, beta, ref)))
+    if conv:
+        series = {f"{w:g} rad/s": ([c.n_elements for c in cs if c.ok], [c.peak(+1)[0] * 1e6 for c in cs if c.ok])
+                  for w, cs in conv.items()}
+        figures.append(Figure("convergence", lambda: plotting().slidercrank_convergence_figure(
+            series, f"{params.material}: element convergence")))
+    return Result(text="\n".join(text) + "\n", tidy=_tidy(params.material, list(done.values())),
+                  summary=_summary(cases, model if _shape(params)[1] else None), warnings=warnings, failure=failure, figures=figures)
