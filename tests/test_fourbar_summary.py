@@ -207,3 +207,18 @@ def test_batch_input_errors():
         summarise_batch(dict(base), {"branch": ["open", "sideways"]})
     f = summarise_batch(base, {"crank": np.linspace(1, 5, 5), "step_deg": 7.0, "branch": ["open"] * 5})
     assert len(f) == 5 and f["assemblable"].all()
+
+
+def test_a_run_calls_the_summary_kernel_once_and_reports_its_row(monkeypatch):
+    """The .out's headline figures (transmission, rocker, peaks) and the summary come from one call
+    of the summary kernel: the same row, so they cannot disagree, and it is not computed twice."""
+    import driver.fourbar
+    calls = []
+    real = fourbar_kernel.fourbar_summaries
+    monkeypatch.setattr(fourbar_kernel, "fourbar_summaries", lambda *a, **k: (calls.append(1), real(*a, **k))[1])
+    res = driver.fourbar.run(fixed_link=12.0, crank=5.0, coupler=15.0, rocker=9.0, omega=5.0, step_deg=20)
+    assert len(calls) == 1
+    s = res.summary
+    assert f"min {s['mu_min_deg']:.2f} deg" in res.text and f"max {s['mu_max_deg']:.2f} deg" in res.text
+    assert f"swing {s['rocker_swing_deg']:.3f} deg" in res.text
+    assert f"peak rocker speed .... {s['omega3_peak_rad_s']:.4f} rad/s" in res.text
