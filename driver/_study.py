@@ -158,7 +158,13 @@ class Study:
                  is due to
     published    ``published(params, result) -> list[dict]``: the run compared cell by cell
                  with the published tables (:mod:`driver.compare`), or None
-    figures      the study's figure module (figures drawn in the house style), or None
+    animation    ``animation(params, result, n) -> dict | None``: the mechanism's positions at ``n``
+                 crank angles over one turn for the report page's animation (crank pin ``A``,
+                 driven pin ``B``, coupler point ``P``, ``ground``, ``kind`` 'rocker' or 'slider',
+                 ``box_points``; :func:`driver.report_page.mechanism_animation`), or None
+    figures      the dotted name of the study's figure module (drawn in the house style of
+                 :mod:`driver.plotting`; imported only when a figure is drawn, matplotlib being
+                 the optional [plot] extra), or None
     kernel       the study's kernel wrappers (module over ``driver._kernels``), or None
     """
 
@@ -176,7 +182,8 @@ class Study:
     renamed: Mapping[str, str] = field(default_factory=dict)
     blame: Callable[[Params, BaseException], tuple[str, str] | None] | None = None
     published: Callable[[Params, Result], list[dict]] | None = None
-    figures: ModuleType | None = None
+    animation: Callable[[Params, Result | None, int], dict | None] | None = None
+    figures: str | None = None
     kernel: ModuleType | None = None
 
     def __post_init__(self) -> None:
@@ -189,14 +196,15 @@ class Study:
         for attr in ("run", "estimate"):
             if not callable(getattr(self, attr)):
                 raise TypeError(f"{self.name}: Study.{attr} is required and must be callable")
-        for attr in ("summarise", "blame", "published"):
+        for attr in ("summarise", "blame", "published", "animation"):
             v = getattr(self, attr)
             if v is not None and not callable(v):
                 raise TypeError(f"{self.name}: Study.{attr} must be callable or None")
-        for attr in ("figures", "kernel"):
-            v = getattr(self, attr)
-            if v is not None and not isinstance(v, ModuleType):
-                raise TypeError(f"{self.name}: Study.{attr} must be a module or None")
+        if self.kernel is not None and not isinstance(self.kernel, ModuleType):
+            raise TypeError(f"{self.name}: Study.kernel must be a module or None")
+        if self.figures is not None and not (isinstance(self.figures, str)
+                                             and self.figures.startswith(self.package + ".")):
+            raise TypeError(f"{self.name}: Study.figures must name a module of the study's package")
         if self.batch is not None:
             if not isinstance(self.batch, BatchSummary):
                 raise TypeError(f"{self.name}: Study.batch must be a BatchSummary or None")
@@ -226,7 +234,7 @@ class Study:
         return importlib.import_module(self.package)
 
     def __repr__(self) -> str:
-        offers = [n for n in ("summarise", "batch", "blame", "published", "figures", "kernel")
+        offers = [n for n in ("summarise", "batch", "blame", "published", "animation", "figures", "kernel")
                   if getattr(self, n) is not None]
         return f"<Study &{self.name} ({self.package}): {len(self.spec.keys)} keys; {', '.join(offers) or 'run only'}>"
 

@@ -140,64 +140,6 @@ def _figures_html(result: "Result", skip: Iterable[str] = ()) -> tuple[str, list
 
 # ----------------------------------------------------------------------------- animation
 
-def _fourbar_frames(params: "Params") -> dict[str, Any] | None:
-    from driver import fourbar
-    theta = np.linspace(0.0, 360.0, ANIMATION_FRAMES, endpoint=False)
-    out, status = fourbar.exact_grid(params, theta)
-    ok = (status != fourbar.ST["no_assembly"]) & (status != fourbar.ST["indeterminate"])
-    cp = fourbar.coupler_point(params, theta, out, status)
-    g = params.fixed_link
-    frames = {"theta": theta.tolist(), "ok": ok.astype(int).tolist(),
-              "A": np.round(out[:, 3:5], 5).tolist(), "B": np.round(np.where(ok[:, None], out[:, 5:7], 0.0), 5).tolist(),
-              "P": None if cp is None else np.round(np.where(ok[:, None], cp[:, :2], 0.0), 5).tolist(),
-              "ground": [[0.0, 0.0], [g, 0.0]], "kind": "fourbar",
-              "names": {"crank": "crank", "out": "rocker"}}
-    pts = [out[:, 3:5], out[ok][:, 5:7], np.array([[0.0, 0.0], [g, 0.0]])]
-    if cp is not None:
-        pts.append(cp[ok][:, :2])
-    frames["box"] = _box(np.vstack(pts))
-    return frames
-
-
-def _slidercrank_frames(params: "Params", result: "Result | None" = None) -> dict[str, Any] | None:
-    from driver.slidercrank import kernel as slidercrank_kernel
-    from driver.slidercrank.spec import _model
-    model = _model(params)
-    r, length = float(model.r2), float(model.length)
-    theta = np.linspace(0.0, 360.0, ANIMATION_FRAMES, endpoint=False)
-    states = slidercrank_kernel.slidercrank_rigid(np.radians(theta), 1.0, r, length)
-    a = np.column_stack([r * np.cos(np.radians(theta)), r * np.sin(np.radians(theta))])
-    b = np.column_stack([states[:, 3], np.zeros_like(theta)])
-    frames = {"theta": theta.tolist(), "ok": [1] * len(theta), "A": np.round(a, 6).tolist(),
-              "B": np.round(b, 6).tolist(), "P": None, "ground": [[0.0, 0.0], [float(b[:, 0].max()), 0.0]],
-              "kind": "slidercrank", "names": {"crank": "crank", "out": "slider"}}
-    frames["box"] = _box(np.vstack([a, b, [[0.0, 0.0]]]), pad_y=0.25 * r)
-    frames["bow"], frames["bow_note"] = _rod_bow(result, theta, length)
-    return frames
-
-
-def _rod_bow(result: "Result | None", theta: np.ndarray, length: float) -> tuple[list[float] | None, str]:
-    """The elastic rod's midpoint deflection [m] at the animation's crank angles, magnified so
-    its largest is 6 % of the rod (from the run's tidy table: the fastest crank speed that ran),
-    and the words saying so; (None, '') without one."""
-    tidy = getattr(result, "tidy", None)
-    if tidy is None or "midpoint_deflection_mm" not in tidy or not len(tidy):
-        return None, ""
-    w = float(tidy["omega_rad_s"].max())
-    rows = tidy[tidy["omega_rad_s"] == w]
-    ang = np.mod(rows["crank_angle_deg"].to_numpy(dtype=float), 360.0)
-    mid = rows["midpoint_deflection_mm"].to_numpy(dtype=float) * 1e-3
-    order = np.argsort(ang)
-    ang, mid = ang[order], mid[order]
-    peak = float(np.max(np.abs(mid)))
-    if not np.isfinite(peak) or peak <= 0:
-        return None, ""
-    scale = 0.06 * length / peak
-    bow = np.interp(theta, ang, mid, period=360.0) * scale
-    return np.round(bow, 7).tolist(), (f"rod deflection magnified {scale:.3g} times "
-                                       f"(midpoint deflection at {w:g} rad/s, largest {peak * 1e3:.3g} mm)")
-
-
 def _box(pts: np.ndarray, pad_y: float = 0.0) -> list[float]:
     pts = pts[np.all(np.isfinite(pts), axis=1)]
     lo, hi = pts.min(axis=0), pts.max(axis=0)
@@ -225,7 +167,7 @@ _ANIM_JS = r"""
     [coupler, out, pb, pp, block].forEach(function(e){ if (e) e.style.visibility = ok ? "visible" : "hidden"; });
     note.style.visibility = ok ? "hidden" : "visible";
     if (!ok) return;
-    if (F.kind === "slidercrank") {
+    if (F.kind === "slider") {
       var dx = B[0] - A[0], dy = B[1] - A[1], L = Math.sqrt(dx * dx + dy * dy), b = F.bow ? 2 * F.bow[k] : 0;
       var C = [(A[0] + B[0]) / 2 - b * dy / L, (A[1] + B[1]) / 2 + b * dx / L];
       coupler.setAttribute("d", "M" + A.join(",") + " Q" + C.join(",") + " " + B.join(","));
@@ -233,7 +175,7 @@ _ANIM_JS = r"""
     else coupler.setAttribute("points", [A, B].map(function(p){ return p.join(","); }).join(" "));
     dot(pb, B);
     if (F.P) dot(pp, F.P[k]);
-    if (F.kind === "fourbar") line(out, G[1], B);
+    if (F.kind === "rocker") line(out, G[1], B);
     else { var w = parseFloat(block.getAttribute("width")), h = parseFloat(block.getAttribute("height"));
            block.setAttribute("x", B[0] - w / 2); block.setAttribute("y", B[1] - h / 2); }
   }
@@ -250,17 +192,17 @@ _ANIM_JS = r"""
 
 def mechanism_animation(params: "Params", anim_id: str = "anim", caption: str = "",
                         result: "Result | None" = None) -> str | None:
-    """The animation of a four-bar or slider-crank deck over one crank turn (inline SVG, JSON
-    positions from the kernel and a few lines of JavaScript), or None for another study.  A
-    slider-crank ``result`` adds its elastic rod's midpoint deflection, magnified."""
-    if params.group == "fourbar":
-        F = _fourbar_frames(params)
-    elif params.group == "slidercrank":
-        F = _slidercrank_frames(params, result)
-    else:
-        return None
+    """The animation of a deck's mechanism over one crank turn (inline SVG, JSON positions from the
+    study's ``Study.animation``, and a few lines of JavaScript), or None for a study without one.
+    The positions' ``kind`` says what the crank drives: a coupler and a ``'rocker'`` (four-bar) or a
+    rod and a ``'slider'`` (a slider-crank ``result`` adds its elastic rod's midpoint deflection,
+    magnified, as ``bow``)."""
+    from driver._study import load_study
+    study = load_study(params.group)
+    F = study.animation(params, result, ANIMATION_FRAMES) if study is not None and study.animation else None
     if F is None:
         return None
+    F["box"] = _box(np.asarray(F.pop("box_points"), float), F.pop("pad_y", 0.0))
     x0, y0, w, h = F["box"]
     s = max(w, h)
     lw, rad = 0.012 * s, 0.014 * s
@@ -269,7 +211,7 @@ def mechanism_animation(params: "Params", anim_id: str = "anim", caption: str = 
     paths = []
     if ok.any():
         for name, key, colour in (("path of B", "B", "#c0392b"), ("path of P", "P", "#8e44ad")):
-            if F[key] is None or (F["kind"] == "slidercrank"):
+            if F[key] is None or (F["kind"] == "slider"):
                 continue
             pts = np.array(F[key])
             runs = np.split(np.arange(len(ok)), np.flatnonzero(np.diff(ok.astype(int))) + 1)
@@ -281,7 +223,7 @@ def mechanism_animation(params: "Params", anim_id: str = "anim", caption: str = 
                     paths.append(f'<{tag} points="{d}" fill="none" stroke="{colour}" stroke-width="{lw / 3:.4g}" '
                                  f'stroke-dasharray="{lw:.4g},{lw / 2:.4g}"><title>{name}</title></{tag}>')
     a_pts = np.array(F["A"])
-    if ok.all() or F["kind"] == "slidercrank":
+    if ok.all() or F["kind"] == "slider":
         a_path = ('<polygon points="' + " ".join(f"{p[0]:.5g},{p[1]:.5g}" for p in a_pts) + f'" fill="none" '
                   f'stroke="#999" stroke-width="{lw / 4:.4g}"><title>path of A</title></polygon>')
     else:   # a crank that cannot turn: its pin's path only where the linkage assembles
@@ -291,8 +233,8 @@ def mechanism_animation(params: "Params", anim_id: str = "anim", caption: str = 
                          for run in runs if ok[run[0]] and len(run) > 1)
     g0, g1 = F["ground"]
     pivots = "".join(f'<path d="M{p[0] - 2 * rad:.5g},{p[1] - 2.2 * rad:.5g} L{p[0] + 2 * rad:.5g},{p[1] - 2.2 * rad:.5g} '
-                     f'L{p[0]:.5g},{p[1]:.5g} Z" fill="#555"/>' for p in ([g0, g1] if F["kind"] == "fourbar" else [g0]))
-    if F["kind"] == "fourbar":
+                     f'L{p[0]:.5g},{p[1]:.5g} Z" fill="#555"/>' for p in ([g0, g1] if F["kind"] == "rocker" else [g0]))
+    if F["kind"] == "rocker":
         guide = f'<line x1="{g0[0]}" y1="{g0[1]}" x2="{g1[0]}" y2="{g1[1]}" stroke="#555" stroke-width="{lw / 2:.4g}"/>'
         out = f'<line data-part="out" stroke="#e67e22" stroke-width="{lw:.4g}" stroke-linecap="round"/>'
         block = ""
@@ -303,7 +245,7 @@ def mechanism_animation(params: "Params", anim_id: str = "anim", caption: str = 
         out = ""
         block = (f'<rect data-part="block" width="{6 * rad:.5g}" height="{3 * rad:.5g}" fill="#e67e22" '
                  f'fill-opacity="0.85" stroke="#333" stroke-width="{lw / 4:.4g}"/>')
-    if F["kind"] == "slidercrank":   # the rod: a curve A-B (bowed by the elastic deflection when known)
+    if F["kind"] == "slider":   # the rod: a curve A-B (bowed by the elastic deflection when known)
         coupler = (f'<path data-part="coupler" fill="none" stroke="#2980b9" stroke-width="{lw:.4g}" '
                    'stroke-linecap="round"/>')
     else:

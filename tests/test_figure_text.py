@@ -116,11 +116,14 @@ def test_figure_functions_draw_into_a_users_axes():
     from matplotlib.figure import Figure
 
     from driver import plotting
+    from driver.fourbar import figures as fourbar_figures
+    from driver.slidercrank import figures as slidercrank_figures
+    from driver.ujoint import figures as ujoint_figures
     fig = Figure(layout="constrained")
     a, b = fig.subplots(1, 2)
     theta = np.linspace(0.0, 360.0, 73)
-    assert plotting.ujoint_speed_figure(theta, 25.0, {"optimum": 25 + np.sin(np.radians(2 * theta))}, ax=a) is fig
-    assert plotting.slidercrank_strain_figure([("10 rad/s", theta, np.cos(np.radians(theta)))], "t", ax=b) is fig
+    assert ujoint_figures.ujoint_speed_figure(theta, 25.0, {"optimum": 25 + np.sin(np.radians(2 * theta))}, ax=a) is fig
+    assert slidercrank_figures.slidercrank_strain_figure([("10 rad/s", theta, np.cos(np.radians(theta)))], "t", ax=b) is fig
     assert a.lines and b.lines
     fig2 = Figure()
     axes = fig2.subplots(2, 1)
@@ -131,5 +134,5 @@ def test_figure_functions_draw_into_a_users_axes():
     r = driver.fourbar.run(fixed_link=12.0, crank=5.0, coupler=15.0, rocker=9.0, step_deg=20)
     from driver.fourbar.analysis import exact_columns, exact_grid, tidy_frame
     out, st = exact_grid(r.params, theta)
-    assert plotting.fourbar_curves(tidy_frame("exact", theta, exact_columns(out, st), st), None, "",
+    assert fourbar_figures.fourbar_curves(tidy_frame("exact", theta, exact_columns(out, st), st), None, "",
                                    axes=axes3) is fig3

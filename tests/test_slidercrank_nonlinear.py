@@ -208,10 +208,10 @@ def test_nonlinear_figures_draw_the_given_curves_and_accept_axes():
     pytest.importorskip("matplotlib")
     from matplotlib.figure import Figure as MplFigure
 
-    from driver import plotting
+    from driver.slidercrank import figures as slidercrank_figures
     x = np.linspace(0.0, 360.0, 7)
     lin, nl = np.sin(np.radians(x)), 2 * np.sin(np.radians(x))
-    fig = plotting.slidercrank_nl_strain_figure([("10 rad/s", x, lin, nl)], "strain")
+    fig = slidercrank_figures.slidercrank_nl_strain_figure([("10 rad/s", x, lin, nl)], "strain")
     solid, dashed = fig.axes[0].lines[:2]
     np.testing.assert_array_equal(solid.get_ydata(), nl)
     np.testing.assert_array_equal(dashed.get_ydata(), lin)
@@ -219,9 +219,9 @@ def test_nonlinear_figures_draw_the_given_curves_and_accept_axes():
     own = MplFigure()
     ax = own.subplots()
     shapes = np.column_stack([np.linspace(0, 1e-3, 5), np.zeros(5)])
-    assert plotting.slidercrank_nl_shapes_figure([("a", (90.0, 180.0), shapes)], 0.5, "s", ax=ax) is own
+    assert slidercrank_figures.slidercrank_nl_shapes_figure([("a", (90.0, 180.0), shapes)], 0.5, "s", ax=ax) is own
     np.testing.assert_allclose(ax.lines[0].get_ydata(), shapes[:, 0] * 1e3)   # drawn in mm
     np.testing.assert_allclose(ax.lines[0].get_xdata(), np.linspace(0, 0.5, 5))
     ax2 = MplFigure().subplots()
-    plotting.slidercrank_nl_revolutions_figure([("a", np.array([1.0, 2.0, 4.0]))], "r", ax=ax2)
+    slidercrank_figures.slidercrank_nl_revolutions_figure([("a", np.array([1.0, 2.0, 4.0]))], "r", ax=ax2)
     np.testing.assert_array_equal(ax2.lines[0].get_xdata(), [1, 2, 3])

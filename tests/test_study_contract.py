@@ -11,7 +11,10 @@ summary has); and for the example pendulum an independent integration of its equ
 """
 from __future__ import annotations
 
+import ast
+import importlib
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -92,6 +95,39 @@ def test_estimate_gives_sane_numbers_for_every_shipped_deck_of_the_study(name):
         assert est.memory_key is None or est.memory_key in s.spec.keys, (path, est.memory_key)
         assert est.work_key is None or est.work_key in s.spec.keys, (path, est.work_key)
         assert limits.check(s, params) == est
+
+
+#: the files every study package has (plus kernel.py with a kernel, batch.py with a batch path)
+LAYOUT = {"__init__.py", "spec.py", "analysis.py", "report.py", "figures.py", "published.py"}
+
+
+@pytest.mark.parametrize("name", STUDIES)
+def test_every_study_has_the_one_layout(name):
+    s = load_study(name)
+    folder = Path(s.module.__file__).parent
+    files = {p.name for p in folder.glob("*.py")}
+    need = LAYOUT | ({"kernel.py"} if s.kernel is not None else set()) | ({"batch.py"} if s.batch is not None else set())
+    assert need <= files, sorted(need - files)
+    assert s.figures == f"{s.package}.figures" and importlib.import_module(s.figures).__file__
+    assert s.published is not None and s.published.__module__ == f"{s.package}.published"
+    assert s.kernel is None or s.kernel.__name__ == f"{s.package}.kernel"
+    assert s.run.__module__ == f"{s.package}.report" and s.estimate.__module__ == f"{s.package}.spec"
+    assert len((folder / "__init__.py").read_text().splitlines()) <= 60   # public names and STUDY
+
+
+def test_shared_modules_hold_no_per_study_code():
+    """plotting keeps the house style and the shared figures, compare the comparison machinery,
+    kernels the loader: no study group is named in their code (docstrings aside)."""
+    for module in ("plotting", "compare", "kernels", "published", "runner", "limits", "report_page"):
+        tree = ast.parse((ROOT / "driver" / f"{module}.py").read_text())
+        for node in ast.walk(tree):
+            body = getattr(node, "body", None)
+            if isinstance(body, list) and body and isinstance(body[0], ast.Expr) \
+                    and isinstance(body[0].value, ast.Constant) and isinstance(body[0].value.value, str):
+                body[0].value.value = ""   # the docstring
+        code = ast.unparse(tree)
+        for name in STUDIES:
+            assert not re.search(rf"\b{name}\b", code), (module, name)
 
 
 def _same(a: pd.Series, b: pd.Series) -> bool:

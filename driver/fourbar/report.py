@@ -3,6 +3,8 @@ the closed loop, or the closed-loop table with accelerations, coupler point and 
 (``method = 'exact'``); the summary lines, tidy table, summary and figures."""
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pandas as pd
 
@@ -13,12 +15,11 @@ from driver.fourbar.analysis import (ST, TIDY_UNITS, Extremes, Grashof, coupler_
                                      exact_columns, exact_grid, extremes, grashof, limit_angles, listing_grid,
                                      tidy_frame)
 from driver.fourbar.batch import summary_of, summary_rows
-from driver.fourbar.figures import deck_figures
 from driver.fourbar.spec import band_of
-from driver.study import Result, keyword_run
+from driver.study import Figure, Result, keyword_run
 from driver.table import Column, fortran_f, render_table
 
-__all__ = ['run', 'listing_text', 'exact_table', 'summary_lines', 'audit']
+__all__ = ["run", "listing_text", "exact_table", "summary_lines", "audit", "deck_figures", "output_name", "animation_frames"]
 
 
 def _echo(p: Params) -> list[str]:
@@ -216,3 +217,59 @@ def _force_section(p: Params, theta: np.ndarray, out: np.ndarray, status: np.nda
              ("with the Berkof-Lowen counterweights" if fa.cw is not None else "links as given") + ")")
     return (forces.echo_lines(p) + forces.table_lines(theta, fa.forces, fa.ok, words, title)
             + forces.summary_lines(p, forces.summary(p), fa))
+
+
+def output_name(p: Params) -> str:
+    """What the output link is called in figures: 'output crank' when it turns fully (a
+    double-crank, a drag link), 'rocker' otherwise."""
+    g = grashof(p.fixed_link, p.crank, p.coupler, p.rocker)
+    return "output crank" if g.name.startswith("double-crank") else "rocker"
+
+
+def deck_figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> list[Figure]:
+    """The figures of a run (drawn on demand): the curves and the linkage at its limit positions."""
+    def curves():
+        from driver.fourbar import figures   # matplotlib is the optional [plot] extra: imported when drawn
+        theta = np.linspace(p.start_deg, p.stop_deg, 721)
+        out, st = exact_grid(p, theta)
+        exact = tidy_frame("exact", theta, exact_columns(out, st), st)
+        return figures.fourbar_curves(exact, listing, stem_title, band=band_of(p), output=output_name(p))
+
+    def linkage():
+        from driver.fourbar import figures
+        lo, hi = sorted((p.start_deg, p.stop_deg))
+        # the deck's crank range when it is less than a turn (a function generator's design range)
+        theta = np.linspace(lo, hi, 721) if hi - lo < 360.0 else np.linspace(0.0, 360.0, 721)
+        out, st = exact_grid(p, theta)
+        cp = coupler_point(p, theta, out, st)
+        limits = []
+        for a in limit_angles(p.fixed_link, p.crank, p.coupler, p.rocker):
+            if theta[0] - 1e-9 <= a <= theta[-1] + 1e-9 or hi - lo >= 360.0:
+                row, rst = exact_grid(p, np.array([a]))
+                if rst[0] != ST["no_assembly"] and np.all(np.isfinite(row[0, 3:7])):
+                    limits.append((a, row[0]))
+        return figures.fourbar_linkage(p.fixed_link, theta, out, st == ST["ok"], listing, stem_title,
+                                       point=None if cp is None else cp[:, :2], output=output_name(p),
+                                       limits=limits)
+
+    return [Figure("curves", curves), Figure("linkage", linkage)]
+
+
+def animation_frames(params: Params, result: Result | None = None, n: int = 180) -> dict[str, Any] | None:
+    """The linkage's positions at ``n`` crank angles over one turn, for the report page's animation
+    (:func:`driver.report_page.mechanism_animation`): crank pin A, coupler pin B, coupler point P."""
+    theta = np.linspace(0.0, 360.0, n, endpoint=False)
+    out, status = exact_grid(params, theta)
+    ok = (status != ST["no_assembly"]) & (status != ST["indeterminate"])
+    cp = coupler_point(params, theta, out, status)
+    g = params.fixed_link
+    frames = {"theta": theta.tolist(), "ok": ok.astype(int).tolist(),
+              "A": np.round(out[:, 3:5], 5).tolist(), "B": np.round(np.where(ok[:, None], out[:, 5:7], 0.0), 5).tolist(),
+              "P": None if cp is None else np.round(np.where(ok[:, None], cp[:, :2], 0.0), 5).tolist(),
+              "ground": [[0.0, 0.0], [g, 0.0]], "kind": "rocker",
+              "names": {"crank": "crank", "out": "rocker"}}
+    pts = [out[:, 3:5], out[ok][:, 5:7], np.array([[0.0, 0.0], [g, 0.0]])]
+    if cp is not None:
+        pts.append(cp[ok][:, :2])
+    frames["box_points"] = np.vstack(pts)
+    return frames

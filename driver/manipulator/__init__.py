@@ -31,7 +31,7 @@ report/exact differences), :mod:`.report` (the run: text, tidy table, summary) a
 from __future__ import annotations
 
 from driver._study import BatchSummary, Study
-from driver.manipulator import figures, kernel, published
+from driver.manipulator import kernel, published
 from driver.manipulator.analysis import DESIGN_STATUS, Workspace, optima, round_half_up, tolerance_box
 from driver.manipulator.batch import (BATCH_IGNORED, BATCH_INDEPENDENT, BATCH_KEYS, BATCH_PASS_SUFFIXES, BATCH_PASSES,
                                       batch_refusal, summarise, summarise_batch)
@@ -49,4 +49,4 @@ STUDY = Study(name="manipulator", package=__name__, spec=SPEC, run=run, estimate
                                  independent=BATCH_INDEPENDENT, passes=BATCH_PASSES,
                                  pass_names=("indices", "target", "tolerance", "walk"), refusal=batch_refusal),
               labels=LABELS, sweep_plot=SWEEP_PLOT, sweep_best=SWEEP_BEST, renamed=RENAMED,
-              published=published.compare, figures=figures, kernel=kernel)
+              published=published.compare, figures=f"{__name__}.figures", kernel=kernel)

@@ -15,7 +15,6 @@ from driver.export import with_units
 from driver.manipulator.analysis import (SIGNIFICANT, Conv, Workspace, _design_list, _target, design_status, optima,
                                          round_half_up)
 from driver.manipulator.tables import TIDY_NAMES, Table, _differences, _tables, _tolerance
-from driver.manipulator.figures import design_space_figure, torque_figure
 from driver.study import Figure, Result, keyword_run
 from driver.table import fortran_f
 
@@ -201,8 +200,8 @@ def run(params: Params, progress: bool = False) -> Result:
     if warnings:
         lines += ["Warnings", "--------"] + [f"  {w}" for w in warnings] + [""]
     tidy = _tidy(tables, tol, sweep, used)
-    figures = [Figure("design_space", lambda: design_space_figure(p, ws, conv, used)),
-               Figure("torque_crob", lambda: torque_figure(sweep, conv, p.title or p.path.stem))]
+    figures = [Figure("design_space", lambda: _figures().design_space_figure(p, ws, conv, used)),
+               Figure("torque_crob", lambda: _figures().torque_figure(sweep, conv, p.title or p.path.stem))]
     return Result(text="\n".join(lines).rstrip() + "\n", tidy=tidy, summary=_summary(p, ws, conv, used, sweep, tol),
                   warnings=warnings, figures=figures)
 
@@ -265,3 +264,9 @@ def _design_notes(p: Params, conv: Conv, used: dict) -> list[str]:
     if lines:
         lines = ["Printed inputs that the report's own formulas do not give", "-" * 58] + lines + [""]
     return lines
+
+
+def _figures():
+    """The study's figure module, imported when a figure is drawn (matplotlib is the optional [plot] extra)."""
+    from driver.manipulator import figures
+    return figures

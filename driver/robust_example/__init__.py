@@ -25,7 +25,7 @@ The package, by job: ``spec`` (deck keys, the cross-check, the budget estimate),
 from __future__ import annotations
 
 from driver._study import Study
-from driver.robust_example import figures, published
+from driver.robust_example import published
 from driver.robust_example.analysis import analyse, quadratic_fit
 from driver.robust_example.published import MODE_REASONS, NOT_REPRODUCIBLE
 from driver.robust_example.report import run
@@ -34,4 +34,4 @@ from driver.robust_example.spec import SPEC, estimate
 __all__ = ["SPEC", "STUDY", "run", "estimate", "quadratic_fit", "analyse", "MODE_REASONS", "NOT_REPRODUCIBLE"]
 
 STUDY = Study(name="robust_example", package=__name__, spec=SPEC, run=run, estimate=estimate,
-              published=published.compare, figures=figures)
+              published=published.compare, figures=f"{__name__}.figures")

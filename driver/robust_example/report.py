@@ -11,7 +11,6 @@ import pandas as pd
 from driver.deck import Params
 from driver.export import with_units
 from driver.robust_example.analysis import analyse, tmin
-from driver.robust_example.figures import fits_figure
 from driver.robust_example.published import MODE_REASONS
 from driver.study import Figure, Result, keyword_run
 from driver.table import Column, render_table
@@ -149,10 +148,16 @@ def run(params: Params, progress: bool = False) -> Result:
     for i, row in enumerate(r["t24"]):
         for j, v in enumerate(row):
             recs.append({"item": "t24", "index": i * len(row) + j, "value": float(v)})
-    figures = [Figure("fits", lambda: fits_figure(p, r))]
+    figures = [Figure("fits", lambda: _figures().fits_figure(p, r))]
     summary = {"mode": p.mode, "tmin_true": r["eq22_tmin"], "tmin_dual_response": r["eq29"],
                "tmin_taguchi": r["eq213"], "tmin_tolerance_analysis": r["eq215"], "flagged": len(flags)}
     return Result(text="\n".join(L).rstrip() + "\n", tidy=with_units(pd.DataFrame.from_records(recs), TIDY_UNITS),
                   summary=summary, figures=figures,
                   warnings=[f"printed value differs in its last digit: {f}" if "the last digit only" in f
                             else f"printed value does not reproduce: {f}" for f in flags])
+
+
+def _figures():
+    """The study's figure module, imported when a figure is drawn (matplotlib is the optional [plot] extra)."""
+    from driver.robust_example import figures
+    return figures

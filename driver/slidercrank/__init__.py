@@ -20,9 +20,9 @@ batch path: a sweep runs them one per task.
 from __future__ import annotations
 
 from driver._study import Study
-from driver.slidercrank import figures, kernel, published
+from driver.slidercrank import kernel, published
 from driver.slidercrank.analysis import Case, simeon_initial_state, static_onset
-from driver.slidercrank.report import run
+from driver.slidercrank.report import animation_frames, run
 from driver.slidercrank.spec import (LABELS, MATERIALS, PAPER_SPEEDS, SIMEON1996, SPEC, STATUS_TEXT, SWEEP_PLOT, Model,
                                      estimate, min_steps_per_rev, rayleigh)
 
@@ -31,4 +31,4 @@ __all__ = ["SPEC", "STUDY", "run", "estimate", "MATERIALS", "PAPER_SPEEDS", "SIM
            "kernel"]
 
 STUDY = Study(name="slidercrank", package=__name__, spec=SPEC, run=run, estimate=estimate, labels=LABELS,
-              sweep_plot=SWEEP_PLOT, published=published.compare, figures=figures, kernel=kernel)
+              sweep_plot=SWEEP_PLOT, published=published.compare, animation=animation_frames, figures=f"{__name__}.figures", kernel=kernel)

@@ -15,7 +15,6 @@ from driver.deck import Params
 from driver.export import with_units
 from driver.slidercrank import kernel
 from driver.slidercrank.analysis import Case, _run_case, static_onset
-from driver.slidercrank.figures import history_figure
 from driver.slidercrank.spec import (EULER_WARN, MIN_STEPS_PER_BENDING_PERIOD, MIN_STEPS_PER_REV, SIMEON1996, STATUS_TEXT,
                                      Model, _model, _shape, rayleigh)
 from driver.study import Figure, Result, keyword_run
@@ -264,10 +263,10 @@ def _benchmark_lines(params: Params, case: Case) -> list[str]:
     return lines
 
 
-def _plotting():
-    """driver.plotting, imported only when a figure is drawn (matplotlib is optional)."""
-    from driver import plotting
-    return plotting
+def _figures():
+    """The study's figure module, imported when a figure is drawn (matplotlib is the optional [plot] extra)."""
+    from driver.slidercrank import figures
+    return figures
 
 
 @keyword_run
@@ -357,26 +356,65 @@ def run(params: Params, progress: bool = False) -> Result:
         text += ["", "Warnings"] + [f"  * {w}" for w in warnings]
     figures = []
     good = [c for c in cases if c.ok]
-    plotting = _plotting   # imported when a figure is drawn (matplotlib is the optional [plot] extra)
     if good and params.end_time <= 0:
         above = {f"{c.omega:g} rad/s": c.euler_ratio for c in good if c.euler_ratio > 1.0}
         missing = [f"{c.omega:g} rad/s: {_status_text(c).split(' (')[0].lower()}, not drawn" for c in cases if not c.ok]
         stiffness = "K + K_G" if params.geometric_stiffness else "linear model"
-        figures.append(Figure("strain", lambda: _plotting().slidercrank_strain_figure(
+        figures.append(Figure("strain", lambda: _figures().slidercrank_strain_figure(
             [(f"{c.omega:g} rad/s", c.angle_deg, c.eps_ax[0] * 1e6) for c in good],
             f"{params.material}: crank-end element axial strain ({stiffness})", above=above, missing=missing)))
-        figures.append(Figure("deflection", lambda: _plotting().slidercrank_strain_figure(
+        figures.append(Figure("deflection", lambda: _figures().slidercrank_strain_figure(
             [(f"{c.omega:g} rad/s", c.angle_deg, c.mid * 1e3) for c in good],
             f"{params.material}: midpoint deflection ({stiffness})", ylabel="midpoint deflection [mm]",
             above=above, missing=missing)))
     if params.end_time > 0 and cases[0].ok:   # a benchmark run: its time history against the reference
         c0 = cases[0]
         ref = SIMEON1996 if params.benchmark == "simeon1996" else None
-        figures.append(Figure("history", lambda: history_figure(model, params, c0, alpha, beta, ref)))
+        figures.append(Figure("history", lambda: _figures().history_figure(model, params, c0, alpha, beta, ref)))
     if conv:
         series = {f"{w:g} rad/s": ([c.n_elements for c in cs if c.ok], [c.peak(+1)[0] * 1e6 for c in cs if c.ok])
                   for w, cs in conv.items()}
-        figures.append(Figure("convergence", lambda: plotting().slidercrank_convergence_figure(
+        figures.append(Figure("convergence", lambda: _figures().slidercrank_convergence_figure(
             series, f"{params.material}: element convergence")))
     return Result(text="\n".join(text) + "\n", tidy=_tidy(params.material, list(done.values())),
                   summary=_summary(cases, model if _shape(params)[1] else None), warnings=warnings, failure=failure, figures=figures)
+
+
+def animation_frames(params: Params, result: Result | None = None, n: int = 180) -> dict[str, Any] | None:
+    """The mechanism's positions at ``n`` crank angles over one turn, for the report page's animation
+    (:func:`driver.report_page.mechanism_animation`): crank pin A, slider B, and with ``result`` the
+    elastic rod's midpoint deflection, magnified."""
+    model = _model(params)
+    r, length = float(model.r2), float(model.length)
+    theta = np.linspace(0.0, 360.0, n, endpoint=False)
+    states = kernel.slidercrank_rigid(np.radians(theta), 1.0, r, length)
+    a = np.column_stack([r * np.cos(np.radians(theta)), r * np.sin(np.radians(theta))])
+    b = np.column_stack([states[:, 3], np.zeros_like(theta)])
+    frames = {"theta": theta.tolist(), "ok": [1] * len(theta), "A": np.round(a, 6).tolist(),
+              "B": np.round(b, 6).tolist(), "P": None, "ground": [[0.0, 0.0], [float(b[:, 0].max()), 0.0]],
+              "kind": "slider", "names": {"crank": "crank", "out": "slider"}}
+    frames["box_points"], frames["pad_y"] = np.vstack([a, b, [[0.0, 0.0]]]), 0.25 * r
+    frames["bow"], frames["bow_note"] = _rod_bow(result, theta, length)
+    return frames
+
+
+def _rod_bow(result: Result | None, theta: np.ndarray, length: float) -> tuple[list[float] | None, str]:
+    """The elastic rod's midpoint deflection [m] at the animation's crank angles, magnified so
+    its largest is 6 % of the rod (from the run's tidy table: the fastest crank speed that ran),
+    and the words saying so; (None, '') without one."""
+    tidy = getattr(result, "tidy", None)
+    if tidy is None or "midpoint_deflection_mm" not in tidy or not len(tidy):
+        return None, ""
+    w = float(tidy["omega_rad_s"].max())
+    rows = tidy[tidy["omega_rad_s"] == w]
+    ang = np.mod(rows["crank_angle_deg"].to_numpy(dtype=float), 360.0)
+    mid = rows["midpoint_deflection_mm"].to_numpy(dtype=float) * 1e-3
+    order = np.argsort(ang)
+    ang, mid = ang[order], mid[order]
+    peak = float(np.max(np.abs(mid)))
+    if not np.isfinite(peak) or peak <= 0:
+        return None, ""
+    scale = 0.06 * length / peak
+    bow = np.interp(theta, ang, mid, period=360.0) * scale
+    return np.round(bow, 7).tolist(), (f"rod deflection magnified {scale:.3g} times "
+                                       f"(midpoint deflection at {w:g} rad/s, largest {peak * 1e3:.3g} mm)")

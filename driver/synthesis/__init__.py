@@ -510,13 +510,14 @@ def synthesise(deck: Deck | str | Path) -> Synthesis:
 def _path_figure(syn: Synthesis, path: Path, title: str, fmt: bool | str = True) -> Path:
     """The linkage, its coupler curve and the target points, in the linkage deck's frame."""
     from driver import plotting
+    from driver.fourbar import figures as fourbar_figures
     from driver.synthesis import path as pg
     q = syn.design.parts
     theta = np.linspace(0.0, 360.0, 721)
     out, st = fourbar_kernel.fourbar_exact(np.radians(theta), q["ground"], q["crank"], q["coupler"], q["rocker"], 1.0, 0.0,
                                     1 if syn.params.branch == "open" else -1)
     cp = fourbar_kernel.fourbar_coupler_point(np.radians(theta), out, st, q["crank"], 1.0, 0.0, q["u"], q["v"])
-    fig = plotting.fourbar_linkage(q["ground"], theta, out, st == ST["ok"], None, title, point=cp[:, :2])
+    fig = fourbar_figures.fourbar_linkage(q["ground"], theta, out, st == ST["ok"], None, title, point=cp[:, :2])
     targets = np.column_stack([syn.params.target_x, syn.params.target_y]).astype(float)
     pp = pg.PathProblem(targets, None, 1, False, (0.0, 180.0), 1.0, 1.0)
     tk = pg._to_kernel(pp, syn.design.x)

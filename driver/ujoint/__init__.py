@@ -27,7 +27,7 @@ wrappers).
 from __future__ import annotations
 
 from driver._study import BatchSummary, Study
-from driver.ujoint import figures, kernel, published
+from driver.ujoint import kernel, published
 from driver.ujoint.analysis import (BOUND_TOL, CLUSTER_TOL, PHASE_PERIOD, SADDLE_NUDGE, SYM_TOL, TIE_RTOL, Chain,
                                     Design, StartRun, evaluate, objective_scale, optimise, phases_for, pick_best,
                                     yoke_shifts)
@@ -48,4 +48,4 @@ STUDY = Study(name="ujoint", package=__name__, spec=SPEC, run=run, estimate=esti
                                  independent=BATCH_INDEPENDENT, passes=BATCH_PASSES,
                                  pass_names=("objective", "speed", "equivalent"), applies=batch_applies,
                                  elements=BATCH_ELEMENTS),
-              labels=LABELS, sweep_plot=SWEEP_PLOT, published=published.compare, figures=figures, kernel=kernel)
+              labels=LABELS, sweep_plot=SWEEP_PLOT, published=published.compare, figures=f"{__name__}.figures", kernel=kernel)

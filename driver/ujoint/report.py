@@ -18,7 +18,6 @@ from driver.ujoint.kernel import UJOINT_MODELS
 from driver.table import Column, fortran_f, render_table
 from driver.ujoint.analysis import (TIE_RTOL, Chain, Design, StartRun, _chain, _free_index, _starts, evaluate,
                                     objective_scale, optimise, output_speed, phases_for, pick_best, yoke_shifts)
-from driver.ujoint.figures import speed_figure
 from driver.ujoint.spec import BAND_TOL, CONVENTIONS, DEG, OPTIONS, _geometry, _per, _phases
 
 
@@ -388,7 +387,13 @@ def run(params: Params, progress: bool = False) -> Result:
     summary = _summary(trial, best, runs, failure)
     extra = {".result.dat": _result_dat(params, chain, designs, best, runs)} if best is not None else {}
     title = params.path.stem if getattr(params, "path", None) else ""
-    figures = [Figure("speed", lambda: speed_figure(chain, designs, False, params.paper_band, title)),
-               Figure("polar", lambda: speed_figure(chain, designs, True, params.paper_band, title))]
+    figures = [Figure("speed", lambda: _figures().speed_figure(chain, designs, False, params.paper_band, title)),
+               Figure("polar", lambda: _figures().speed_figure(chain, designs, True, params.paper_band, title))]
     return Result(text=text, tidy=tidy, summary=summary, warnings=warnings, failure=failure,
                   figures=figures, extra=extra)
+
+
+def _figures():
+    """The study's figure module, imported when a figure is drawn (matplotlib is the optional [plot] extra)."""
+    from driver.ujoint import figures
+    return figures

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from driver._study import BatchSummary, Study
 
-from . import figures, kernel
+from . import kernel
 from .analysis import run, summarise
 from .batch import BATCH_KEYS, BATCH_PASSES, summarise_batch
 from .spec import LABELS, SPEC, estimate
@@ -25,4 +25,4 @@ STUDY = Study(name="pendulum", package=__name__, spec=SPEC, run=run, estimate=es
                                  independent=("length", "gravity", "amplitude_deg", "title", "points"),
                                  passes=BATCH_PASSES, pass_names=("elliptic",)),
               labels=LABELS, sweep_plot=("period_s", "period_ratio"), sweep_best={"period_ratio": "min"},
-              figures=figures, kernel=kernel)
+              figures=f"{__name__}.figures", kernel=kernel)

@@ -9,7 +9,7 @@ from driver.export import with_units
 from driver.study import Figure, Result, keyword_run
 from driver.table import Column, render_table
 
-from . import figures, kernel
+from . import kernel
 from .batch import summarise_batch
 
 
@@ -32,4 +32,10 @@ def run(params: Params, progress: bool = False) -> Result:
     lines += render_table([Column("t [s]", "f", 10, 5), Column("theta [deg]", "f", 12, 4)], zip(t, theta))
     tidy = with_units(pd.DataFrame({"time_s": t, "theta_deg": theta}))
     return Result(text="\n".join(lines) + "\n", tidy=tidy, summary=s,
-                  figures=[Figure("swing", lambda: figures.swing_figure(t, theta, p.title or "rigid pendulum"))])
+                  figures=[Figure("swing", lambda: _figures().swing_figure(t, theta, p.title or "rigid pendulum"))])
+
+
+def _figures():
+    """The figure module, imported when a figure is drawn (matplotlib is the optional [plot] extra)."""
+    from . import figures
+    return figures
