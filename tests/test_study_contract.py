@@ -259,7 +259,7 @@ def _ode_period_and_swing(length: float, g: float, theta0: float, t: np.ndarray)
 def test_adding_a_study_is_one_folder_and_one_registry_line(pendulum):
     """The example lives in one folder of the house layout; no file of driver/ names it."""
     files = sorted(p.name for p in EXAMPLE.glob("*.py"))
-    assert files == ["__init__.py", "analysis.py", "batch.py", "figures.py", "kernel.py", "spec.py"]
+    assert files == ["__init__.py", "batch.py", "figures.py", "kernel.py", "report.py", "spec.py"]
     for src in (ROOT / "driver").rglob("*.py"):
         assert "pendulum" not in src.read_text(), src
     assert isinstance(pendulum, Study) and pendulum.name in study_names()

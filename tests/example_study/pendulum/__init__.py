@@ -14,7 +14,7 @@ from __future__ import annotations
 from driver._study import BatchSummary, Study
 
 from . import kernel
-from .analysis import run, summarise
+from .report import run, summarise
 from .batch import BATCH_KEYS, BATCH_PASSES, summarise_batch
 from .spec import LABELS, SPEC, estimate
 

@@ -1,4 +1,4 @@
-"""One &pendulum deck: the period, the half swing tabulated, the summary."""
+"""One &pendulum deck run: the period, the half swing tabulated, the summary."""
 from __future__ import annotations
 
 import numpy as np
