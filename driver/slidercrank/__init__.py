@@ -10,19 +10,20 @@ Euler-load ratio of every case and, with geometric stiffness, buckling.
 
 Units in decks: SI (m, kg, Pa, rad/s, s).  Strains are reported in microstrain.
 
-The package, by job: ``spec`` (deck keys, materials, the model a deck describes, checks, the
-budget estimate), ``analysis`` (one case through the kernel, settling, static buckling onset),
-``report`` (the run: .out sections, tidy table, summary), ``figures``, ``published`` (Table 1
-and the Simeon 1996 reference), ``kernel`` (the Fortran wrappers), and the nonlinear rod
-(``nonlinear``, ``report_nl``).  Cases are heavy (a time integration each), so the study has no
-batch path: a sweep runs them one per task.
+The package, by job: ``spec`` (deck keys, materials, the model a deck describes, checks, the budget
+estimate), ``analysis`` (one case through the kernel, settling, static buckling onset), ``report``
+(the linear run: .out sections, tidy table, summary), ``figures``, ``published`` (Table 1 and the
+Simeon 1996 reference), ``kernel`` (the Fortran wrappers), and the nonlinear rod (``nonlinear``,
+``report_nl``: the run of a deck, either model). Cases are heavy (a time integration each), so the
+study has no batch path: a sweep runs them one per task.
 """
 from __future__ import annotations
 
 from driver._study import Study
 from driver.slidercrank import kernel, published
 from driver.slidercrank.analysis import Case, simeon_initial_state, static_onset
-from driver.slidercrank.report import animation_frames, run
+from driver.slidercrank.report import animation_frames
+from driver.slidercrank.report_nl import run
 from driver.slidercrank.spec import (LABELS, MATERIALS, PAPER_SPEEDS, SIMEON1996, SPEC, STATUS_TEXT, SWEEP_PLOT, Model,
                                      estimate, min_steps_per_rev, rayleigh)
 

@@ -17,7 +17,7 @@ from driver.slidercrank import kernel
 from driver.slidercrank.analysis import Case, _run_case, static_onset
 from driver.slidercrank.spec import (EULER_WARN, MIN_STEPS_PER_BENDING_PERIOD, MIN_STEPS_PER_REV, SIMEON1996, STATUS_TEXT,
                                      Model, _model, _shape, rayleigh)
-from driver.study import Figure, Result, keyword_run
+from driver.study import Figure, Result
 from driver.table import Column, render_table
 
 
@@ -269,12 +269,9 @@ def _figures():
     return figures
 
 
-@keyword_run
-def run(params: Params, progress: bool = False) -> Result:
-    """Run every crank speed (and element count) of the deck; see the module docstring."""
-    if params.model == "nonlinear":
-        from driver.slidercrank.report_nl import run_nonlinear
-        return run_nonlinear(params, progress)
+def run_linear(params: Params, progress: bool = False) -> Result:
+    """Run every crank speed (and element count) of a linear-model deck (``model = 'linear'``):
+    the paper's KED model; see the package docstring."""
     model = _model(params)
     w_bend, w_axial, p_euler = model.frequencies()
     alpha, beta = rayleigh(params.damping_ratio, w_bend, w_axial)

@@ -1,4 +1,5 @@
-"""Slider-crank, ``model = 'nonlinear'``: runs every speed in both models and writes the .out
+"""Slider-crank: a deck's run (:func:`run`: the linear model, or with ``model = 'nonlinear'`` both).
+The nonlinear run takes every speed in both models and writes the .out
 sections (linear and nonlinear side by side, per-revolution deflection, Newton statistics,
 onset search), the tidy table, the summary and the figures.
 
@@ -16,9 +17,9 @@ from driver.deck import Params
 from driver.export import with_units
 from driver.slidercrank.analysis import Case, _run_case, static_onset
 from driver.slidercrank.nonlinear import IRREGULAR, NLCase, onset_search, run_nl_case
-from driver.slidercrank.report import _figures, _header, _status_text
+from driver.slidercrank.report import _figures, _header, _status_text, run_linear
 from driver.slidercrank.spec import _model, rayleigh
-from driver.study import Figure, Result
+from driver.study import Figure, Result, keyword_run
 from driver.table import Column, render_table
 
 NL_STATUS_TEXT = {
@@ -259,3 +260,12 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
          for c in nls if c.steps_done], f"{params.material}: peak lateral deflection per revolution")))
     return Result(text="\n".join(text) + "\n", tidy=_tidy(params.material, pairs),
                   summary=_summary(pairs, tol, limit, onset), warnings=warnings, failure=failure, figures=figures)
+
+
+@keyword_run
+def run(params: Params, progress: bool = False) -> Result:
+    """Run one &slidercrank deck: the paper's linear KED model (:func:`run_linear`), or with
+    ``model = 'nonlinear'`` the co-rotational rod beside it (:func:`run_nonlinear`)."""
+    if params.model == "nonlinear":
+        return run_nonlinear(params, progress)
+    return run_linear(params, progress)
