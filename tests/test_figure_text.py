@@ -147,7 +147,7 @@ def test_manipulator_labels_set_their_symbols_in_mathtext():
     from conftest import ROOT
     from driver import plotting
     from driver.study import column_label
-    m = driver.manipulator
+    m = driver.manipulator.STUDY
     want = {"design_tau_sum_signed_Nm": r"$\tau_1 + \tau_2$", "design_torque_demand_Nm": r"$|\tau_1| + |\tau_2|$",
             "design_peak_torque_Nm": r"$\max(|\tau_1|, |\tau_2|)$", "sweep_min_tau_sum_signed_Nm": r"$\tau_1 + \tau_2$",
             "design_l1_m": "$l_1$", "design_l2_m": "$l_2$", "design_ri2": "$RI_2$", "crob_radius_m": "$C_{rob}$",
@@ -178,7 +178,7 @@ def test_manipulator_labels_set_their_symbols_in_mathtext():
 def test_report_page_writes_manipulator_symbols_as_unicode():
     from driver.report_page import plain
     from driver.study import column_label
-    m = driver.manipulator
+    m = driver.manipulator.STUDY
     assert plain(column_label(m, "design_torque_demand_Nm")) == \
         "design torque demand |\u03c4\u2081| + |\u03c4\u2082| at the target [N m]"
     assert plain(column_label(m, "design_ri2_excess")) == "design RI\u2082 - \u221an [-]"
@@ -190,7 +190,7 @@ def test_a_wrapped_label_keeps_each_mathtext_span_on_one_line():
     """Long labels are wrapped onto lines; each line is parsed on its own, so a span
     ($|\\tau_1| + |\\tau_2|$) cut in two would be drawn as raw source."""
     from driver import plotting
-    label = driver.study.column_label(driver.manipulator, "design_torque_demand_Nm")
+    label = driver.study.column_label(driver.manipulator.STUDY, "design_torque_demand_Nm")
     for width in (10, 20, 30, 40):
         lines = plotting.wrap(label, width).split("\n")
         assert len(lines) > 1

@@ -264,7 +264,7 @@ def test_optimiser_evaluates_populations_in_one_call(tmp_path, monkeypatch):
     def never(*a, **kw):
         raise AssertionError("a design evaluated case by case")
 
-    monkeypatch.setattr(kernel, "manipulator_design_summaries", counted)
+    monkeypatch.setattr(manipulator_kernel, "manipulator_design_summaries", counted)
     monkeypatch.setattr(evaluate, "evaluate_cases", never)
     out = tmp_path / "o"
     monkeypatch.chdir(ROOT)     # the deck named as the committed run named it (the .out quotes it)

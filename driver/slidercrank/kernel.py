@@ -12,7 +12,7 @@ import numpy as np
 
 from driver.kernels import _kernels, farray
 
-__all__ = ['SLIDERCRANK_STATUS', 'slidercrank_simulate', 'slidercrank_matrices', 'slidercrank_rigid', 'slidercrank_axial_force', 'slidercrank_frequencies', 'SLIDERCRANK_NL_STATUS', 'slidercrank_nl_simulate', 'slidercrank_column_static', 'slidercrank_corot_element']
+__all__ = ['SLIDERCRANK_STATUS', 'SLIDERCRANK_PROFILE', 'slidercrank_simulate', 'slidercrank_matrices', 'slidercrank_rigid', 'slidercrank_axial_force', 'slidercrank_frequencies', 'SLIDERCRANK_NL_STATUS', 'slidercrank_nl_simulate', 'slidercrank_column_static', 'slidercrank_corot_element']
 
 
 #: status codes of the slider-crank kernel (fortran/slidercrank.f90)
@@ -23,12 +23,18 @@ SLIDERCRANK_STATUS = {"ok": int(_kernels.slidercrank.st_ok), "buckled": int(_ker
 _SC_START = {"rest": 0, "quasistatic": 1, "given": 2}
 
 
+#: rows of slidercrank_simulate's per-step profile (fortran/slidercrank.f90 prof_*)
+SLIDERCRANK_PROFILE = ("eps_1", "eps_2", "eps_max", "eps_max_el", "eps_min", "eps_min_el", "outer_max",
+                       "n_avg_1", "lag_change")
+
+
 def slidercrank_simulate(n_elements: int, crank_radius: float, rod_length: float, rho_a: float,
                          ea: float, ei: float, half_depth: float, slider_mass: float, omega: float,
                          dt: float, n_steps: int, rec_start: int, n_rec: int, alpha: float = 0.0,
                          beta: float = 0.0, start: str = "quasistatic", dynamic: bool = True,
                          geometric_stiffness: bool = False, fast: bool = True,
-                         q_init: np.ndarray | None = None, qd_init: np.ndarray | None = None) -> dict:
+                         q_init: np.ndarray | None = None, qd_init: np.ndarray | None = None,
+                         fields: bool = True, lag: int = 0) -> dict:
     """Elastic connecting rod of a slider-crank, whole time loop in Fortran.
 
     SI units: lengths [m], rho_a mass per length [kg/m], ea [N], ei [N m^2], masses [kg],
@@ -38,20 +44,36 @@ def slidercrank_simulate(n_elements: int, crank_radius: float, rod_length: float
     Records steps rec_start .. rec_start + n_rec - 1 (step 0 is the start).
 
     Returns a dict: eps_ax, eps_of (n_elements, n_rec) axial and outer-fibre strain [-];
-    n_avg (n_elements, n_rec) element-averaged rigid-body axial force [N]; mid midpoint
-    deflection from the chord [m]; slider position [m]; elong rod elongation [m];
+    n_avg (n_elements, n_rec) element-averaged rigid-body axial force [N] -- these three only
+    with ``fields`` (else None: a study that prints the profile below need not record 3 x 8
+    bytes per element and step); mid midpoint deflection from the chord [m]; slider position
+    [m]; elong rod elongation [m]; the per-step profile of the fields, always: eps_1, eps_2
+    axial strain of elements 1 and 2, eps_max / eps_min the largest / smallest axial strain
+    with eps_max_el / eps_min_el the (first, 0-based) element holding it, outer_max the
+    largest outer-fibre strain, n_avg_1 element 1's rigid-body force [N], and with ``lag`` > 0
+    lag_change: max over elements of |eps_ax[:, j] - eps_ax[:, j - lag]| (0 for j < lag);
     q_end, qd_end final state; status (a SLIDERCRANK_STATUS value) and fail_step.
     """
     nq = 3 * int(n_elements)
     q0 = farray(np.zeros(nq) if q_init is None else q_init, 1)
     qd0 = farray(np.zeros(nq) if qd_init is None else qd_init, 1)
     out = _kernels.slidercrank.simulate(
-        int(n_elements), int(n_rec), crank_radius, rod_length, rho_a, ea, ei, half_depth, slider_mass,
-        omega, dt, int(n_steps), int(rec_start), alpha, beta, _SC_START[start], int(bool(dynamic)),
-        int(bool(geometric_stiffness)), int(bool(fast)), q0, qd0)
-    names = ("eps_ax", "eps_of", "n_avg", "mid", "slider", "elong", "q_end", "qd_end", "status", "fail_step")
+        int(n_elements), int(n_rec), int(n_rec) if fields else 0, crank_radius, rod_length, rho_a, ea, ei,
+        half_depth, slider_mass, omega, dt, int(n_steps), int(rec_start), alpha, beta, _SC_START[start],
+        int(bool(dynamic)), int(bool(geometric_stiffness)), int(bool(fast)), int(lag), q0, qd0)
+    names = ("eps_ax", "eps_of", "n_avg", "mid", "slider", "elong", "prof", "q_end", "qd_end", "status",
+             "fail_step")
     res = dict(zip(names, out))
     res["status"], res["fail_step"] = int(res["status"]), int(res["fail_step"])
+    prof = res.pop("prof")
+    for k, name in enumerate(SLIDERCRANK_PROFILE):
+        res[name] = prof[k]
+    res["eps_max_el"] = res["eps_max_el"].astype(np.int64) - 1
+    res["eps_min_el"] = res["eps_min_el"].astype(np.int64) - 1
+    if not lag:
+        del res["lag_change"]
+    if not fields:
+        res["eps_ax"] = res["eps_of"] = res["n_avg"] = None
     return res
 
 

@@ -53,7 +53,7 @@ from driver.deck import Deck, Params, RawGroup, validate
 from driver.extras import require
 from driver.runner import compute, output_stem, study_of
 from driver._study import load_study
-from driver.sweep import engine, store
+from driver.sweep import engine, store, stream
 from driver.sweep.engine import Task, auto_chunk, run_task
 from driver.sweep.report import Warnings, summary_frame, summary_settings, sweep_text, write_sweep_files
 from driver.sweep.spec import (EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, FULL_VALIDATION, MAX_CASES, MAX_KEYS, SPEC, Case,
@@ -324,6 +324,26 @@ class _Run:
             print(f"wrote {self.outdir / (self.stem + '.out')} and {self.outdir / self.stem}_summary.{{csv,parquet}}")
         return max([EXIT_OK] + [r.status for r in failed])
 
+    def _batch_streamed(self, rows: sweep_batch.StreamedRows, n: int, elapsed: float, chunk: int) -> int | None:
+        """The tables of a batch sweep written part by part from the record (:mod:`driver.sweep.stream`);
+        None when the parts cannot be streamed (nothing written then)."""
+        sw, names = self.sw, self.grid.names
+        remove_stale_temporaries(self.outdir, self.stem)
+        res = stream.write_streamed(self.outdir, self.stem, rows.paths, self.deck, sw, self.base, self.axes, names, n,
+                                    self.plot, self.module, self._settings())
+        if res is None:
+            return None
+        if n <= 10 * store.SHARD * store.SHARD:
+            store.remove_stale_case_files(self.layout, np.zeros(n + 1, dtype=bool))
+        self._print_failed(res.failed, n_failed=res.n_failed)
+        if not self.quiet:
+            print(f"sweep {self.deck.path}: {n - res.n_failed} of {n} cases ok, {res.n_kept} kept, "
+                  f"{elapsed:.2f} s, {n / max(elapsed, 1e-9):.0f} cases/s ({self._where()}, batch path, chunk {chunk})")
+            print(f"wrote {self.outdir / (self.stem + '.out')} and {self.outdir / self.stem}_summary.{{csv,parquet}}")
+        if res.n_failed:
+            return EXIT_BAD_INPUT if res.bad_input else EXIT_FAILED
+        return EXIT_OK
+
     def _settings(self) -> dict:
         """The base deck's settings the summary columns depend on (recorded with the table)."""
         return summary_settings(self.module, self.base, {name.partition(".")[2] for name, _ in self.axes})
@@ -341,12 +361,13 @@ class _Run:
         print(f"warning: {self.deck.path}: resume: {k} {what} redone ({parts}{why}): the record is verified, "
               "never believed", file=sys.stderr)
 
-    def _print_failed(self, failed: list[tuple[int, dict, str]], most: int = 20) -> None:
+    def _print_failed(self, failed: list[tuple[int, dict, str]], most: int = 20, n_failed: int | None = None) -> None:
+        n_failed = len(failed) if n_failed is None else n_failed
         for index, values, error in failed[:most]:
             vals = ", ".join(f"{k} = {v!r}" for k, v in values.items())
             print(f"error: {self.deck.path}: case {index} ({vals}): {error}", file=sys.stderr)
-        if len(failed) > most:
-            print(f"error: {self.deck.path}: ... and {len(failed) - most} more failed cases (see {self.stem}.out)",
+        if n_failed > most:
+            print(f"error: {self.deck.path}: ... and {n_failed - most} more failed cases (see {self.stem}.out)",
                   file=sys.stderr)
 
     # ------------------------------------------------------------------ batch path
@@ -363,12 +384,21 @@ class _Run:
             if self.resume and not self.quiet:
                 print(f"resume: {resumed} of {n} cases complete, {n - resumed} to run")
 
+        # rows beyond STREAM_ROWS stay in the record's parts (driver memory flat); not with
+        # case_outputs = 'kept', whose kept cases' failures rewrite their rows
         rows, counts, chunk = sweep_batch.run(bplan, self.outdir / f"{self.stem}.sweep", self.jobs, self.scheduler,
-                                              self.resume, self.progress, sw.chunk, announce)
+                                              self.resume, self.progress, sw.chunk, announce,
+                                              stream_rows=stream.STREAM_ROWS if sw.case_outputs == "none" else 0)
         c_run = time.process_time()
         # the driver's CPU per phase (bench/bench_search.py): merging the chunks, then the tables
         LAST_RUN.update(run_cpu=c_run - c_start, chunk=chunk, chunks=-(-n // chunk), rows=len(rows))
         elapsed = time.perf_counter() - t_start
+        if isinstance(rows, sweep_batch.StreamedRows):
+            status = self._batch_streamed(rows, n, elapsed, chunk)
+            if status is not None:
+                LAST_RUN["finish_cpu"] = time.process_time() - c_run
+                return status
+            rows = stream.read_columns(rows.paths)   # parts of differing column types: in memory after all
         if rows.empty:
             rows = pd.DataFrame(columns=["case", *names, "status", "kept", "error"])
         cases = None

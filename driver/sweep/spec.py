@@ -85,7 +85,9 @@ def _spec() -> GroupSpec:
         "scheduler": Key("str", check=_no_scheduler_in_deck,
                          doc="refused: the scheduler comes from --scheduler or Dask's configuration"),
         "chunk": Key("int", default=0, check=lambda v: "must not be negative" if v < 0 else None,
-                     doc="cases per task; 0 = chosen from the time of a warm case (not a worker's first)"),
+                     doc="cases per task; 0 = chosen by the tool (case by case: from the time of a warm case, "
+                         "not a worker's first; batch path: from the case count, and a small sweep runs in "
+                         "the driver when workers would not pay)"),
         "case_plots": Key("bool", default=False,
                           doc="with --plot, also draw every written case's own figures (by default --plot "
                               "draws the sweep's summary only: per-case figures cost more than the sweep)"),
