@@ -160,7 +160,7 @@ def test_manipulator_labels_set_their_symbols_in_mathtext():
         assert _is_math(t)
     fig.canvas.draw()   # every label parses as mathtext
     import re
-    for name, (words, units) in m.LABELS.items():   # no ASCII symbol left outside the mathtext
+    for name, (words, units) in m.labels.items():   # no ASCII symbol left outside the mathtext
         outside = re.sub(r"\$[^$]*\$", "", f"{words} [{units}]")
         for ascii_ in ("tau", " l1", " l2", "RI", "C_rob", "sqrt", "^"):
             assert ascii_ not in outside, (name, words, units)
@@ -168,7 +168,7 @@ def test_manipulator_labels_set_their_symbols_in_mathtext():
     frame = pd.read_parquet(ROOT / "outputs" / "manipulator_design_search_summary.parquet")
     keys = ["manipulator.designs_l1", "manipulator.designs_l2"]
     labels = {c: column_label(m, c) for c in frame.columns}
-    fig = plotting.sweep_maps(frame, keys, ["design_torque_demand_Nm"], labels, m.SWEEP_BEST, "search", True)[0]
+    fig = plotting.sweep_maps(frame, keys, ["design_torque_demand_Nm"], labels, m.sweep_best, "search", True)[0]
     fig.canvas.draw()
     texts = [a.get_xlabel() for a in fig.axes] + [a.get_ylabel() for a in fig.axes]
     assert "design link length $l_1$ [m]" in texts and "design link length $l_2$ [m]" in texts
