@@ -152,8 +152,8 @@ class Study:
                  (``{i}`` in a name stands for a case number)
     sweep_plot   summary columns a sweep plots when the deck names none
     sweep_best   ``{column: 'max' | 'min'}``: which end of a column is the better design
-    summary_settings  ``{deck key: (summary columns that depend on it, ...)}``: a sweep's and an
-                 optimisation's .out state their base values, their tables record them
+    summary_settings  deck keys the summary columns depend on: a sweep's and an optimisation's .out
+                 state their base values, their tables record them
     renamed      ``{old column: new name}`` of summary columns that were renamed
     blame        ``blame(params, exc) -> (key, message) | None``: the key a numerical failure
                  is due to
@@ -179,7 +179,7 @@ class Study:
     labels: Mapping[str, tuple[str, str]] = field(default_factory=dict)
     sweep_plot: tuple[str, ...] = ()
     sweep_best: Mapping[str, str] = field(default_factory=dict)
-    summary_settings: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
+    summary_settings: tuple[str, ...] = ()
     renamed: Mapping[str, str] = field(default_factory=dict)
     blame: Callable[[Params, BaseException], tuple[str, str] | None] | None = None
     published: Callable[[Params, Result], list[dict]] | None = None
@@ -217,9 +217,8 @@ class Study:
             labels[k] = v
         object.__setattr__(self, "labels", MappingProxyType(labels))
         object.__setattr__(self, "sweep_plot", _names(f"{self.name}: Study.sweep_plot", self.sweep_plot))
-        _names(f"{self.name}: Study.summary_settings", self.summary_settings, self.spec.keys)
-        object.__setattr__(self, "summary_settings", MappingProxyType(
-            {k: _names(f"{self.name}: Study.summary_settings[{k!r}]", v) for k, v in dict(self.summary_settings).items()}))
+        object.__setattr__(self, "summary_settings", _names(f"{self.name}: Study.summary_settings",
+                                                            self.summary_settings, self.spec.keys))
         bad = {k: v for k, v in dict(self.sweep_best).items() if v not in _SENSES}
         if bad:
             raise ValueError(f"{self.name}: Study.sweep_best[{next(iter(bad))!r}] must be 'max' or 'min'")

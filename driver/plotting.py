@@ -438,7 +438,8 @@ def convergence_plot(history, evals, objective: str, sense: str = "minimize", ti
     a1.set_ylabel(objective)
     a1.set_title(f"best feasible ({'largest' if sign < 0 else 'smallest'})")
     a1.legend(loc="best")
-    a2.set_ylabel("|best so far - final best|")
+    unit = re.search(r"\[([^\[\]]+)\]\s*$", objective)   # the objective's unit, when its label has one
+    a2.set_ylabel("|best so far - final best|" + (f" [{unit.group(1)}]" if unit else ""))
     a2.set_title("gap to the final best")
     viol = pd.to_numeric(ev["violation"], errors="coerce").to_numpy(dtype=float) if "violation" in ev else np.array([])
     if viol.size and np.nanmax(viol) > 0:

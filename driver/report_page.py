@@ -165,7 +165,7 @@ _ANIM_JS = r"""
   function show(k){
     var A = F.A[k], B = F.B[k], ok = F.ok[k] === 1, G = F.ground;
     line(crank, G[0], A); dot(pa, A);
-    label.textContent = F.theta[k].toFixed(0) + "\u00b0";
+    label.textContent = F.theta[k].toFixed(0) + "\u00b0" + (F.phase ? " " + F.phase[k] : "");
     [coupler, out, pb, pp, block].forEach(function(e){ if (e) e.style.visibility = ok ? "visible" : "hidden"; });
     note.style.visibility = ok ? "hidden" : "visible";
     if (!ok) return;
@@ -211,7 +211,22 @@ def mechanism_animation(params: "Params", anim_id: str = "anim", caption: str = 
     flip = f"translate(0,{2 * y0 + h:.6g}) scale(1,-1)"   # y up, as the figures draw it
     ok = np.array(F["ok"], bool)
     paths = []
-    if ok.any():
+    if F.get("segments"):   # a rocking crank: per motion B's (and P's) loop, A's arc, the limits dashed
+        for a, b in F["segments"]:
+            for name, key, colour in (("path of B", "B", "#c0392b"), ("path of P", "P", "#8e44ad")):
+                if F[key] is None:
+                    continue
+                d = " ".join(f"{p[0]:.5g},{p[1]:.5g}" for p in np.array(F[key])[a:b])
+                paths.append(f'<polyline points="{d}" fill="none" stroke="{colour}" stroke-width="{lw / 3:.4g}" '
+                             f'stroke-dasharray="{lw:.4g},{lw / 2:.4g}"><title>{name}</title></polyline>')
+        g1 = F["ground"][1]
+        for (lo, hi), rows in zip(F["limit_angles"], F["limits"]):
+            for ang, r in zip((lo, hi), rows):
+                d = f"0,0 {r[0]:.5g},{r[1]:.5g} {r[2]:.5g},{r[3]:.5g} {g1[0]:.5g},{g1[1]:.5g}"
+                paths.append(f'<polyline data-part="limit" points="{d}" fill="none" stroke="#000" '
+                             f'stroke-width="{lw / 4:.4g}" stroke-dasharray="{lw / 2:.4g},{lw / 2:.4g}">'
+                             f'<title>limit position: crank angle {ang:.1f}\u00b0 (the crank reverses)</title></polyline>')
+    elif ok.any():
         for name, key, colour in (("path of B", "B", "#c0392b"), ("path of P", "P", "#8e44ad")):
             if F[key] is None or (F["kind"] == "slider"):
                 continue
@@ -225,7 +240,11 @@ def mechanism_animation(params: "Params", anim_id: str = "anim", caption: str = 
                     paths.append(f'<{tag} points="{d}" fill="none" stroke="{colour}" stroke-width="{lw / 3:.4g}" '
                                  f'stroke-dasharray="{lw:.4g},{lw / 2:.4g}"><title>{name}</title></{tag}>')
     a_pts = np.array(F["A"])
-    if ok.all() or F["kind"] == "slider":
+    if F.get("segments"):   # the crank pin's arc, once per motion (the forward stroke covers it)
+        a_path = "".join('<polyline points="' + " ".join(f"{p[0]:.5g},{p[1]:.5g}" for p in a_pts[a:(a + b) // 2]) +
+                         f'" fill="none" stroke="#999" stroke-width="{lw / 4:.4g}"><title>path of A</title></polyline>'
+                         for a, b in F["segments"])
+    elif ok.all() or F["kind"] == "slider":
         a_path = ('<polygon points="' + " ".join(f"{p[0]:.5g},{p[1]:.5g}" for p in a_pts) + f'" fill="none" '
                   f'stroke="#999" stroke-width="{lw / 4:.4g}"><title>path of A</title></polygon>')
     else:   # a crank that cannot turn: its pin's path only where the linkage assembles
@@ -474,9 +493,9 @@ def page_for_result(result: "Result", deck: "Deck | None" = None, params: "Param
 
 
 def _subtitle(study: str, params: "Params | None") -> str:
-    from driver._study import load_study
+    from driver.study import load_study
     module = load_study(study) if study else None
-    doc = module.spec.doc if module is not None else ""
+    doc = getattr(getattr(module, "SPEC", None), "doc", "") if module is not None else ""
     t = getattr(params, "get", lambda k, d=None: d)("title", "") if params is not None else ""
     return " — ".join(x for x in (doc, t) if x)
 
@@ -516,7 +535,7 @@ def _namelist(group: str, values: dict[str, Any]) -> str:
 def page_for_sweep(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> str:
     """The page of a sweep deck, from the files the sweep wrote: the design-space maps of the
     plotted summary columns (kept designs outlined; the best kept design by the first plotted
-    column marked where the study says which way is better, its ``sweep_best``, else the first
+    column marked where the study says which way is better, its ``SWEEP_BEST``, else the first
     kept design), that design's drawing and animation, the summary .out, the deck."""
     import pandas as pd
 
@@ -535,11 +554,11 @@ def page_for_sweep(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> st
     numeric = [c for c in summary.columns if c not in keys and c not in ("case", "kept") and
                pd.api.types.is_numeric_dtype(summary[c]) and not pd.api.types.is_bool_dtype(summary[c])]
     wanted = [y for y in (sw.plot_y or []) if y in numeric] or \
-        [c for c in module.sweep_plot if c in numeric][:2] or numeric[:1]
+        [c for c in getattr(module, "SWEEP_PLOT", ()) if c in numeric][:2] or numeric[:1]
     labels = _labels(module, list(summary.columns))
     ok = summary[summary["status"] == "ok"] if "status" in summary else summary
     kept = ok[ok["kept"].astype(bool)] if "kept" in ok else ok
-    senses = module.sweep_best
+    senses = getattr(module, "SWEEP_BEST", {})
     sections: list[Section] = []
     notes: list[str] = []
     numeric_keys = [k for k in keys if pd.api.types.is_numeric_dtype(summary[k])]
@@ -557,7 +576,7 @@ def page_for_sweep(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> st
             maps += [_figure_block(f, f"{labels[y]} over the swept keys") for f, y in zip(figs, wanted)]
         else:   # one key, zipped keys or a kept set that is no grid: the --plot summary (lines, strips)
             fig = plotting.sweep_summary(ok, keys, sw.plot_x, sw.plot_y, stem, labels,
-                                         module.sweep_plot)
+                                         getattr(module, "SWEEP_PLOT", ()))
             maps.append(_figure_block(fig, "the sweep's summary columns against the swept keys"))
     except Exception as exc:
         notes.append(f"the design-space maps could not be drawn: {exc.__class__.__name__}: {exc}")

@@ -222,7 +222,7 @@ def test_misspelt_names_raise_when_the_study_is_declared():
     with pytest.raises(ValueError, match="'max' or 'min'"):
         Study(name="toy", package=__name__, spec=_spec(), run=_run, estimate=_est, sweep_best={"x": "best"})
     with pytest.raises(ValueError, match="not a key"):
-        Study(name="toy", package=__name__, spec=_spec(), run=_run, estimate=_est, summary_settings={"band": ("x",)})
+        Study(name="toy", package=__name__, spec=_spec(), run=_run, estimate=_est, summary_settings=("band",))
     with pytest.raises(TypeError, match=r"labels\['x'\]"):
         Study(name="toy", package=__name__, spec=_spec(), run=_run, estimate=_est, labels={"x": "words"})
     s = Study(name="toy", package=__name__, spec=_spec(), run=_run, estimate=_est, labels={"a": ("aa", "m")})

@@ -6,6 +6,7 @@ Drawn in the house style (:mod:`driver.plotting`); this module imports matplotli
 """
 from __future__ import annotations
 
+import math
 from typing import Sequence
 
 import matplotlib
@@ -108,7 +109,8 @@ def _runs(ok: np.ndarray) -> list[np.ndarray]:
 def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.ndarray,
                     listing, title: str, n_poses: int = 6, point: np.ndarray | None = None,
                     units: str = "length units", output: str = "rocker",
-                    limits: Sequence[tuple[float, np.ndarray]] = (), ax=None) -> Figure:
+                    limits: Sequence[tuple[float, np.ndarray]] = (), ax=None,
+                    motions: Sequence[dict] | None = None) -> Figure:
     """The linkage drawn at a few crank angles with the paths of A and B (exact), and the
     path of a coupler point (``point``: (n, 2) positions) when the deck defines one, the
     coupler then drawn as the plate A-B-P in every pose.
@@ -117,14 +119,21 @@ def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.nd
     turn); the crank pin's path is drawn only where the linkage assembles, so a crank that
     cannot turn shows the arc it swings through, not a circle.  Separate assembly intervals
     are drawn and named as separate motions.  ``limits``: (crank angle [deg], kernel row)
-    of the limit (toggle) positions, drawn dashed and labelled.  ``output`` names the output
-    link.  Coordinates in the deck's length ``units``, crank pivot at the origin, ground along
+    of the limit (toggle) positions, drawn dashed and labelled.  ``motions``: for a crank that
+    cannot turn (driver.fourbar.rocking_motions), per motion a dict of ``lo``, ``hi`` [deg],
+    ``theta``, ``out`` (kernel rows), ``stroke`` (0 forward, 1 back), ``branch`` (+1 open, -1
+    crossed) and ``point`` (coupler point positions or None): then the linkage is drawn rocking
+    between its limit positions, out on one assembly branch and back on the other, each
+    motion (a separate assembly interval) on its own.  ``output`` names the output link.  Coordinates in the deck's length ``units``, crank pivot at the origin, ground along
     +x; the legend sits beside the drawing.
     """
     if ax is None:
         fig, (ax,) = new_figure(1, 1, figsize=(8.6, 5.2))
     else:
         fig = ax.figure
+    if motions:
+        _rocking_drawing(ax, ground, motions, title, units, output)
+        return fig
     runs = _runs(ok)
     full = bool(ok.all()) and np.ptp(theta) >= 359.0
     for j, r in enumerate(runs if not full else [np.arange(len(ok))]):
@@ -153,8 +162,7 @@ def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.nd
         xs = [0.0, row[3], row[5], ground]
         ys = [0.0, row[4], row[6], 0.0]
         ax.plot(xs, ys, "--", color="k", lw=1.1, label="limit (toggle) positions" if j == 0 else None)
-        ax.annotate(rf"$\theta_2$ = {angle:.1f}°", (row[3], row[4]), xytext=(4, -10), textcoords="offset points",
-                    fontsize=8)
+        _limit_label(ax, row, rf"$\theta_2$ = {angle:.1f}°")
     ax.plot([0.0, ground], [0.0, 0.0], color="k", lw=2.5)
     ax.plot([0.0, ground], [0.0, 0.0], "^", color="k", ms=9, label="ground pivots $O_2$, $O_4$")
     ax.set_aspect("equal")
@@ -168,6 +176,90 @@ def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.nd
         what += f"\nassembles over {len(runs)} separate crank intervals ({spans}): separate motions"
     ax.set_title(f"{plain_text(title)}: {what}" if title else what)
     return fig
+
+
+def _deg(value: float, digits: int = 1) -> str:
+    """An angle [deg] as printed in a figure: ``digits`` decimals, no '-0'."""
+    text = f"{value:.{digits}f}"
+    return text[1:] if text.lstrip("-").strip("0.") == "" and text.startswith("-") else text
+
+
+def _limit_label(ax, row: np.ndarray, text: str) -> None:
+    """A limit position's label beside its crank pin A, pushed outward (away from the crank
+    pivot) on a white ground so it does not sit on the pose lines."""
+    x, y = float(row[3]), float(row[4])
+    r = math.hypot(x, y) or 1.0
+    ux, uy = x / r, y / r
+    ax.annotate(text, (x, y), xytext=(14 * ux, 14 * uy), textcoords="offset points", fontsize=8,
+                ha="left" if ux > 0.3 else "right" if ux < -0.3 else "center",
+                va="bottom" if uy > 0.3 else "top" if uy < -0.3 else "center",
+                bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.85), zorder=6)
+
+
+def _rocking_drawing(ax, ground: float, motions: Sequence[dict], title: str, units: str, output: str) -> None:
+    """The linkage of a crank that cannot turn, rocking between its limit positions (see
+    :func:`fourbar_linkage`): per motion the crank pin's arc, B's path out (solid, the first
+    branch) and back (dashed, the other branch), the coupler point's likewise, a few poses of
+    each stroke and the two limit positions dashed black and labelled."""
+    cmap = matplotlib.colormaps["viridis"]
+    word = {1: "open", -1: "crossed"}
+    n_m = len(motions)
+    for i, m in enumerate(motions):
+        out, stroke, theta = np.asarray(m["out"]), np.asarray(m["stroke"]), np.asarray(m["theta"])
+        first = int(np.asarray(m["branch"])[0])
+        tag = "" if n_m == 1 else f" (motion {i + 1})"
+        fwd, back = np.flatnonzero(stroke == 0), np.flatnonzero(stroke == 1)
+        ax.plot(out[fwd, 3], out[fwd, 4], color="0.55", lw=0.9, label="path of A (crank pin): an arc" if i == 0 else None)
+        ax.plot(out[fwd, 5], out[fwd, 6], color="C3", lw=1.3,
+                label=f"path of B, out on the {word[first]} assembly" if i == 0 else None)
+        ax.plot(out[back, 5], out[back, 6], color="C3", lw=1.3, ls="--",
+                label=f"path of B, back on the {word[-first]} assembly" if i == 0 else None)
+        pt = m.get("point")
+        if pt is not None:
+            pt = np.asarray(pt)
+            ax.plot(pt[fwd, 0], pt[fwd, 1], color="C4", lw=1.2, label="path of coupler point P" if i == 0 else None)
+            ax.plot(pt[back, 0], pt[back, 1], color="C4", lw=1.2, ls="--")
+        # poses: three inside each stroke (the limits are drawn on their own)
+        at = [1 / 3, 2 / 3] if n_m > 1 else [0.2, 0.5, 0.8]   # fractions of a stroke's samples
+        picks = [fwd[int(f * (len(fwd) - 1))] for f in at] + [back[int(f * (len(back) - 1))] for f in at]
+        for j, k in enumerate(picks):
+            c = cmap((j + 0.5) / len(picks))
+            back_pose = stroke[k] == 1
+            xs = [0.0, out[k, 3], out[k, 5], ground]
+            ys = [0.0, out[k, 4], out[k, 6], 0.0]
+            arrow = "\u2192" if not back_pose else "\u2190"
+            ax.plot(xs, ys, "-o", color=c, ms=3, lw=1.4, ls=":" if back_pose else "-", alpha=0.95,
+                    label=(rf"$\theta_2$ = {_deg(theta[k], 0)}° {arrow} {word[int(np.asarray(m['branch'])[k])]}"
+                           + tag))
+            if pt is not None:
+                tri = np.array([[out[k, 3], out[k, 4]], [out[k, 5], out[k, 6]], pt[k], [out[k, 3], out[k, 4]]])
+                ax.fill(tri[:, 0], tri[:, 1], color=c, alpha=0.12, lw=0)
+                ax.plot(tri[:, 0], tri[:, 1], color=c, lw=0.9, ls=":" if back_pose else "-")
+        for end, angle in ((fwd[0], m["lo"]), (fwd[-1], m["hi"])):
+            row = out[end]
+            ax.plot([0.0, row[3], row[5], ground], [0.0, row[4], row[6], 0.0], "--", color="k", lw=1.1,
+                    label="limit positions (the crank reverses)" if i == 0 and end == fwd[0] else None)
+            ax.plot([row[3]], [row[4]], "o", color="k", ms=4)
+            _limit_label(ax, row, rf"limit $\theta_2$ = {_deg(angle)}°")
+    ax.plot([0.0, ground], [0.0, 0.0], color="k", lw=2.5)
+    ax.plot([0.0, ground], [0.0, 0.0], "^", color="k", ms=9, label="ground pivots $O_2$, $O_4$")
+    ax.set_aspect("equal")
+    ax.margins(0.1)   # room for the limit labels
+    ax.set_xlabel(f"x [{units}]")
+    ax.set_ylabel(f"y [{units}]")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
+    first = word[int(np.asarray(motions[0]["branch"])[0])]
+    other = word[-int(np.asarray(motions[0]["branch"])[0])]
+    what = "the crank rocks between its limit positions"
+    if n_m == 1:
+        m = motions[0]
+        what += (f"\n$\\theta_2$ = {_deg(m['lo'])}° to {_deg(m['hi'])}°: out on the {first} assembly, "
+                 f"back on the {other}")
+    else:
+        spans = " and ".join(f"{_deg(m['lo'])}-{_deg(m['hi'])}°" for m in motions)
+        what += (f"\n{n_m} separate motions (mirror assemblies, $\\theta_2$ = {spans}),"
+                 f"\neach out on the {first} assembly, back on the {other}")
+    ax.set_title(f"{plain_text(title)}: {what}" if title else what)
 
 
 # ----------------------------------------------------------------------------- figures of a run

@@ -12,8 +12,8 @@ from driver.deck import Params
 from driver.export import with_units
 from driver.fourbar import forces
 from driver.fourbar.analysis import (ST, TIDY_UNITS, Extremes, Grashof, coupler_point, crank_angles, deg360,
-                                     exact_columns, exact_grid, extremes, grashof, limit_angles, listing_grid,
-                                     tidy_frame)
+                                     assembly_intervals, exact_columns, exact_grid, extremes, grashof, limit_angles,
+                                     listing_grid, rocking_motions, tidy_frame)
 from driver.fourbar.batch import summary_of, summary_rows
 from driver.fourbar.spec import band_of
 from driver.study import Figure, Result, keyword_run
@@ -242,6 +242,15 @@ def deck_figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> li
         theta = np.linspace(lo, hi, 721) if hi - lo < 360.0 else np.linspace(0.0, 360.0, 721)
         out, st = exact_grid(p, theta)
         cp = coupler_point(p, theta, out, st)
+        motions = rocking_motions(p) if hi - lo >= 360.0 else None
+        if motions:   # a crank that cannot turn: it rocks between its limit positions
+            drawn = []
+            for m in motions:
+                mp = coupler_point(p, m.theta, m.out, m.status)
+                drawn.append({"lo": m.lo, "hi": m.hi, "theta": m.theta, "out": m.out, "stroke": m.stroke,
+                              "branch": m.branch, "point": None if mp is None else mp[:, :2]})
+            return figures.fourbar_linkage(p.fixed_link, theta, out, st == ST["ok"], None, stem_title,
+                                           output=output_name(p), motions=drawn)
         limits = []
         for a in limit_angles(p.fixed_link, p.crank, p.coupler, p.rocker):
             if theta[0] - 1e-9 <= a <= theta[-1] + 1e-9 or hi - lo >= 360.0:
@@ -257,9 +266,29 @@ def deck_figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> li
 
 def animation_frames(params: Params, result: Result | None = None, n: int = 180) -> dict[str, Any] | None:
     """The linkage's positions at ``n`` crank angles over one turn, for the report page's animation
-    (:func:`driver.report_page.mechanism_animation`): crank pin A, coupler pin B, coupler point P."""
-    theta = np.linspace(0.0, 360.0, n, endpoint=False)
-    out, status = exact_grid(params, theta)
+    (:func:`driver.report_page.mechanism_animation`): crank pin A, coupler pin B, coupler point P;
+    for a crank that cannot turn, its rocking motions (out on one assembly branch, back on the
+    other) with their phases, segments and limit positions."""
+    motions = rocking_motions(params, max(8, n // 2 // max(
+        1, len(assembly_intervals(params.fixed_link, params.crank, params.coupler, params.rocker) or [1]))))
+    extra: dict[str, Any] = {}
+    if motions:   # a crank that cannot turn: it rocks between its limit positions, out on one
+        # assembly branch and back on the other; each assembly interval a motion of its own
+        theta = np.concatenate([m.theta for m in motions])
+        out = np.vstack([m.out for m in motions])
+        status = np.concatenate([m.status for m in motions])
+        word = {1: "open", -1: "crossed"}
+        tag = (lambda i: "") if len(motions) == 1 else (lambda i: f", motion {i + 1} of {len(motions)}")
+        arrow = {0: "\u2192", 1: "\u2190"}   # forward stroke, return stroke
+        extra["phase"] = [f"{arrow[int(st)]} {word[int(b)]} assembly{tag(i)}"
+                          for i, m in enumerate(motions) for st, b in zip(m.stroke, m.branch)]
+        starts = np.cumsum([0] + [len(m.theta) for m in motions])
+        extra["segments"] = [[int(a), int(b)] for a, b in zip(starts[:-1], starts[1:])]
+        extra["limits"] = [[np.round(m.out[k, 3:7], 5).tolist() for k in (0, len(m.theta) // 2 - 1)] for m in motions]
+        extra["limit_angles"] = [[m.lo, m.hi] for m in motions]
+    else:
+        theta = np.linspace(0.0, 360.0, n, endpoint=False)
+        out, status = exact_grid(params, theta)
     ok = (status != ST["no_assembly"]) & (status != ST["indeterminate"])
     cp = coupler_point(params, theta, out, status)
     g = params.fixed_link
@@ -267,7 +296,8 @@ def animation_frames(params: Params, result: Result | None = None, n: int = 180)
               "A": np.round(out[:, 3:5], 5).tolist(), "B": np.round(np.where(ok[:, None], out[:, 5:7], 0.0), 5).tolist(),
               "P": None if cp is None else np.round(np.where(ok[:, None], cp[:, :2], 0.0), 5).tolist(),
               "ground": [[0.0, 0.0], [g, 0.0]], "kind": "rocker",
-              "names": {"crank": "crank", "out": "rocker"}}
+              "names": {"crank": "crank", "out": "rocker"}, **extra}
+    frames["theta"] = np.round(theta, 6).tolist()
     pts = [out[:, 3:5], out[ok][:, 5:7], np.array([[0.0, 0.0], [g, 0.0]])]
     if cp is not None:
         pts.append(cp[ok][:, :2])

@@ -77,9 +77,9 @@ SWEEP_BEST = {"mu_min_deg": "max", "mu_max_deg": "min", "rocker_swing_deg": "max
               "omega2_peak_rad_s": "min"}
 
 
-#: keys of the base deck the summary columns depend on -> those columns: a sweep's .out and an
-#: optimisation's .out state them, and the summary/evals Parquet tables record them in their metadata
-SUMMARY_SETTINGS = {"transmission_band_deg": ("meets_transmission_band",)}
+#: keys of the base deck the summary columns depend on (transmission_band_deg: meets_transmission_band):
+#: a sweep's and an optimisation's .out state them, their summary/evals Parquet tables record them
+SUMMARY_SETTINGS = ("transmission_band_deg",)
 
 
 #: what a sweep summary plots when its deck names no plot_y

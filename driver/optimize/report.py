@@ -40,7 +40,7 @@ def method_line(p: Problem) -> str:
 def optimum_deck(p: Problem, params: Params, rec: Record, converged: bool) -> str:
     """A complete deck of the optimum: the validated study group with the variables set."""
     values = {k: v for k, v in params.items() if v is not None and v != [] and v != ""}
-    nml = f90nml.Namelist({p.study.spec.name: values})
+    nml = f90nml.Namelist({p.study.SPEC.name: values})
     word = "optimum" if converged else "best design found (NOT converged)"
     head = [f"! {word} of optimisation deck {p.deck.path}",
             f"! {p.objective_text} = {_g(rec.objective)}; " + ", ".join(f"{n} = {_g(x)}" for n, x in zip(p.names, rec.x))]
@@ -75,8 +75,8 @@ def x_text(p: Problem, i: int, v: float, on_lattice: bool) -> str:
 
 def settings_of(p: Problem) -> dict[str, Any]:
     """The base deck's settings the study's summary columns depend on (the four-bar's
-    ``transmission_band_deg``) that are not design variables: the .out states those the
-    problem's objective or constraints use; the _evals table records them all in its metadata."""
+    ``transmission_band_deg``) that are not design variables: the .out states them and the
+    _evals table records them in its metadata."""
     from driver.sweep.report import summary_settings
     return summary_settings(p.study, p.base, {v.key for v in p.variables})
 
@@ -97,7 +97,7 @@ def report_text(p: Problem, ev: Evaluator, mres: MethodResult, history: list[His
     on_lat = best is not None and not (o.method == "differential_evolution" and
                                        (mres.polish is None or mres.polish.get("record") is None))
     on_lat = on_lat and o.method != "grid"
-    L = [f"  optimisation of &{p.study.spec.name} from deck {p.deck.path}", ""]
+    L = [f"  optimisation of &{p.study.SPEC.name} from deck {p.deck.path}", ""]
     epi = "   (max-min form: solved as its epigraph by the gradient method)" if p.terms and o.method in (
         "slsqp", "trust-constr") or (p.terms and o.polish) else ""
     L += [f"    method ............... {method_line(p)}",
@@ -106,12 +106,9 @@ def report_text(p: Problem, ev: Evaluator, mres: MethodResult, history: list[His
         kind = ("equality, met within its tolerance" if c.equality else
                 "inequality, margin in its units" if c.sense else "condition, met or not")
         L.append(f"    constraint ........... {c.text}   ({kind})")
-    texts = " ".join([p.objective_text, *(c.text for c in p.constraints)])
-    for key, v in settings_of(p).items():   # a setting of the deck behind a column the problem uses
-        if any(col in texts for col in p.study.summary_settings[key]):
-            shown = ", ".join(f"{x:g}" for x in v) if isinstance(v, (list, tuple)) else f"{v}"
-            L.append(f"    setting .............. {key} = {shown}   (base deck; used by "
-                     f"{', '.join(p.study.summary_settings[key])})")
+    for key, v in settings_of(p).items():   # a setting of the deck the summary columns depend on
+        shown = ", ".join(f"{x:g}" for x in v) if isinstance(v, (list, tuple)) else f"{v}"
+        L.append(f"    setting .............. {key} = {shown}   (base deck; used by the summary columns)")
     if any(c.numeric for c in p.constraints):
         L.append(f"    feasibility .......... a constraint a >= b, a <= b or a == b is met when violated by at most "
                  f"constraint_tol x max(1, |a|, |b|), constraint_tol = {o.constraint_tol:g}")

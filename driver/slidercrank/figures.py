@@ -7,7 +7,7 @@ Drawn in the house style (:mod:`driver.plotting`); this module imports matplotli
 """
 from __future__ import annotations
 
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -54,20 +54,82 @@ def slidercrank_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray
 
 
 @styled
-def slidercrank_convergence_figure(series: dict[str, tuple[list[int], list[float]]], title: str) -> Figure:
-    """Peak strain against element count and its percentage change (the paper's Figures 8-9)."""
-    fig, axes = new_figure(2, 1, sharex=True, figsize=(7.0, 5.0))
-    for label, (n, peak) in series.items():
-        n, peak = np.asarray(n, dtype=float), np.asarray(peak, dtype=float)
-        axes[0].plot(n, peak, "o-", ms=3, label=label)
-        if n.size > 1:
-            axes[1].plot(n[1:], 100 * np.diff(peak) / peak[:-1], "o-", ms=3, label=label)
-    axes[0].set_xscale("log")
-    axes[0].set_ylabel("peak tensile strain [microstrain]")
-    axes[1].set_ylabel("change from previous count [%]")
-    axes[1].set_xlabel("number of elements")
-    axes[0].legend()
-    fig.suptitle(plain_text(title))
+def slidercrank_convergence_figure(series: dict[str, Any], title: str, axes=None) -> Figure:
+    """An element-convergence study as an engineer reads it (the paper's Figures 8-9 redrawn).
+
+    ``series``: per crank speed (its label) either ``(n, element)`` or ``(n, element, pin)``:
+    the element counts and the peak tensile strain [microstrain] of the crank-end element (the
+    paper's quantity, an element average) and, optionally, at the crank pin recovered from the
+    first two elements.  Left: the strain against the number of elements (log axis), the
+    finest mesh's value dotted.  Right: the size of the difference from the finest mesh [%] on
+    log-log axes, with a slope -1 guide (an element average converges as 1/N) and the 0.1 %
+    line.  ``axes``: two axes of the caller's figure to draw into."""
+    if axes is None:
+        fig, axes = new_figure(1, 2, figsize=(10.0, 4.8))
+    else:
+        fig = axes[0].figure
+    ax_q, ax_e = axes[0], axes[1]
+    one = len(series) == 1
+    n_all: list[float] = []
+    for k, (label, data) in enumerate(series.items()):
+        n = np.asarray(data[0], dtype=float)
+        kinds = [("crank-end element (the paper's quantity)", np.asarray(data[1], dtype=float), "-", "o")]
+        if len(data) > 2 and data[2] is not None:
+            kinds.append(("at the crank pin (recovered from two elements)", np.asarray(data[2], dtype=float), "--", "s"))
+        colour = f"C{k % 10}"
+        for j, (what, v, ls, mk) in enumerate(kinds):
+            name = what if one else f"{label}: {what}"
+            if n.size > 1:   # where it settles: every finer mesh within 0.1 % of the finest
+                err_ = 100 * np.abs(v - v[np.argmax(n)]) / abs(v[np.argmax(n)])
+                order = np.argsort(n)
+                bad = np.nonzero(err_[order] > 0.1)[0]
+                n_ok = n[order][bad[-1] + 1] if bad.size else n[order][0]
+                name += f", within 0.1 % from N = {n_ok:g}" if n_ok < n.max() else ""
+            ax_q.plot(n, v, ls=ls, marker=mk, ms=4, color=colour if one is False else f"C{j}", label=name,
+                      mfc="white" if j else None)
+            if n.size > 1:
+                finest = v[np.argmax(n)]
+                err = 100 * np.abs(v - finest) / abs(finest)
+                use = (n < n.max()) & (err > 0)
+                ax_e.plot(n[use], err[use], ls=ls, marker=mk, ms=4, color=colour if one is False else f"C{j}",
+                          mfc="white" if j else None, label=name)
+                if j == 0:
+                    ax_q.axhline(finest, color="0.45", lw=0.8, ls=":", zorder=0,
+                                 label=f"{'' if one else label + ': '}finest mesh, N = {n.max():g}: "
+                                       f"{finest:.4g} microstrain")
+        n_all += list(n)
+    from matplotlib.ticker import FuncFormatter
+    for ax in (ax_q, ax_e):
+        ax.set_xscale("log")
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.set_xlabel("number of rod elements $N$")
+    ax_q.set_ylabel("peak tensile strain [microstrain]")
+    ax_q.set_title("peak strain against mesh size")
+    ax_e.set_yscale("log")
+    ax_e.set_ylabel("|difference from the finest mesh| [%]")
+    ax_e.set_title("difference from the finest mesh")
+    lines = [ln for ln in ax_e.lines if len(ln.get_xdata())]
+    if lines:
+        x0 = min(float(np.min(ln.get_xdata())) for ln in lines)
+        y0 = max(float(ln.get_ydata()[0]) for ln in lines)
+        xs = np.array([x0, max(n_all) / 2])
+        ax_e.plot(xs, y0 * x0 / xs, color="0.5", lw=0.9, ls="-.", label="slope $-1$ (error $\\propto 1/N$)")
+        pins = [ln for ln in lines if ln.get_linestyle() == "--" and len(ln.get_xdata()) > 1]
+        if pins:   # the recovered pin strain is second order: a slope -2 guide through its second point
+            x1, y1 = float(pins[0].get_xdata()[1]), float(pins[0].get_ydata()[1])
+            xs2 = np.array([x1, max(n_all) / 2])
+            ax_e.plot(xs2, 0.6 * y1 * (x1 / xs2) ** 2, color="0.5", lw=0.9, ls=(0, (1, 1.5)),
+                      label="slope $-2$ (error $\\propto 1/N^2$)")
+        ax_e.axhline(0.1, color="0.6", lw=0.8, ls=":")
+        ax_e.annotate("0.1 %", (0.0, 0.1), xycoords=("axes fraction", "data"), xytext=(4, 3),
+                      textcoords="offset points", fontsize=8, color="0.35")
+    handles, names = ax_q.get_legend_handles_labels()
+    more = [(h, t) for h, t in zip(*ax_e.get_legend_handles_labels()) if t.startswith("slope")]
+    handles, names = handles + [h for h, _ in more], names + [t for _, t in more]
+    fig.legend(handles, names, loc="outside lower center", ncol=1 if max(map(len, names)) > 60 else 2,
+               frameon=False)
+    if title:
+        fig.suptitle(plain_text(title))
     return fig
 
 
@@ -82,16 +144,27 @@ def slidercrank_history_figure(time: np.ndarray, series: dict[str, np.ndarray], 
         fig, axes = new_figure(len(series), 1, sharex=True, figsize=(7.4, 2.4 * len(series) + 0.8))
     else:
         fig = axes[0].figure
+    import re as _re
+    model_label = "this model (linear KED, Newmark)"
     for ax, (key, y) in zip(axes, series.items()):
-        ax.plot(time, y, color="C0", lw=1.2, label="this model (linear KED, Newmark)")
+        ax.plot(time, y, color="C0", lw=1.2, label=model_label)
         if key in reference:
             t, v = reference[key]
             ax.plot([t], [v], "D", ms=7, mfc="white", mec="C3", mew=1.5, label=reference_label or "reference")
-            ax.annotate(f"{v:.4g}", (t, v), xytext=(-6, 8), textcoords="offset points", ha="right", fontsize=8,
-                        color="C3")
+            m = _re.search(r"\[([^\]]+)\]\s*$", labels.get(key, ""))
+            unit = f" {m.group(1)}" if m else ""
+            mine = float(np.interp(t, time, y))
+            # the two end values side by side, in the figure's own font, on a white ground beside the marker
+            span = float(np.nanmax(time) - np.nanmin(time)) or 1.0
+            ax.set_xlim(right=max(float(np.nanmax(time)), t) + 0.24 * span)   # room right of the curves
+            ax.annotate(f"reference {v:.4g}{unit}\nthis model {mine:.4g}{unit}", (t, v), xytext=(12, 0),
+                        textcoords="offset points", ha="left", va="center", fontsize=8.5, color="0.15",
+                        bbox=dict(boxstyle="round,pad=0.3", fc="white", ec="C3", lw=0.8, alpha=0.9),
+                        arrowprops=dict(arrowstyle="-", color="C3", lw=0.8), zorder=6)
         ax.set_ylabel(labels.get(key, key))
-        ax.legend(loc="best")
     axes[-1].set_xlabel("time $t$ [s]")
+    handles, names = axes[0].get_legend_handles_labels()
+    fig.legend(handles, names, loc="outside lower center", ncol=2, frameon=False)
     if title:
         fig.suptitle(plain_text(title))
     return fig
