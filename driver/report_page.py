@@ -493,9 +493,9 @@ def page_for_result(result: "Result", deck: "Deck | None" = None, params: "Param
 
 
 def _subtitle(study: str, params: "Params | None") -> str:
-    from driver.study import load_study
+    from driver._study import load_study
     module = load_study(study) if study else None
-    doc = getattr(getattr(module, "SPEC", None), "doc", "") if module is not None else ""
+    doc = module.spec.doc if module is not None else ""
     t = getattr(params, "get", lambda k, d=None: d)("title", "") if params is not None else ""
     return " — ".join(x for x in (doc, t) if x)
 
@@ -535,7 +535,7 @@ def _namelist(group: str, values: dict[str, Any]) -> str:
 def page_for_sweep(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> str:
     """The page of a sweep deck, from the files the sweep wrote: the design-space maps of the
     plotted summary columns (kept designs outlined; the best kept design by the first plotted
-    column marked where the study says which way is better, its ``SWEEP_BEST``, else the first
+    column marked where the study says which way is better, its ``sweep_best``, else the first
     kept design), that design's drawing and animation, the summary .out, the deck."""
     import pandas as pd
 
@@ -554,11 +554,11 @@ def page_for_sweep(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> st
     numeric = [c for c in summary.columns if c not in keys and c not in ("case", "kept") and
                pd.api.types.is_numeric_dtype(summary[c]) and not pd.api.types.is_bool_dtype(summary[c])]
     wanted = [y for y in (sw.plot_y or []) if y in numeric] or \
-        [c for c in getattr(module, "SWEEP_PLOT", ()) if c in numeric][:2] or numeric[:1]
+        [c for c in module.sweep_plot if c in numeric][:2] or numeric[:1]
     labels = _labels(module, list(summary.columns))
     ok = summary[summary["status"] == "ok"] if "status" in summary else summary
     kept = ok[ok["kept"].astype(bool)] if "kept" in ok else ok
-    senses = getattr(module, "SWEEP_BEST", {})
+    senses = module.sweep_best
     sections: list[Section] = []
     notes: list[str] = []
     numeric_keys = [k for k in keys if pd.api.types.is_numeric_dtype(summary[k])]
@@ -576,7 +576,7 @@ def page_for_sweep(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> st
             maps += [_figure_block(f, f"{labels[y]} over the swept keys") for f, y in zip(figs, wanted)]
         else:   # one key, zipped keys or a kept set that is no grid: the --plot summary (lines, strips)
             fig = plotting.sweep_summary(ok, keys, sw.plot_x, sw.plot_y, stem, labels,
-                                         getattr(module, "SWEEP_PLOT", ()))
+                                         module.sweep_plot)
             maps.append(_figure_block(fig, "the sweep's summary columns against the swept keys"))
     except Exception as exc:
         notes.append(f"the design-space maps could not be drawn: {exc.__class__.__name__}: {exc}")
