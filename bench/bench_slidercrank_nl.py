@@ -24,7 +24,7 @@ from typing import Callable
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from driver import kernels  # noqa: E402
+from driver.slidercrank import kernel as slidercrank_kernel  # noqa: E402
 from driver.slidercrank import MATERIALS, rayleigh  # noqa: E402
 
 R2, LEN, M_S, OMEGA = 0.125, 0.505, 0.95, 29.32
@@ -37,17 +37,17 @@ def case(n_el: int, revs: int, omega: float = OMEGA, spr: int = SPR) -> tuple[Ca
     mat = MATERIALS["aluminium"]
     rho_a, ea = mat["density"] * mat["area"], mat["youngs_modulus"] * mat["area"]
     ei, half = mat["youngs_modulus"] * mat["second_moment"], mat["section_depth"] / 2
-    wb, wa, _ = kernels.slidercrank_frequencies(rho_a, ea, ei, LEN, M_S)
+    wb, wa, _ = slidercrank_kernel.slidercrank_frequencies(rho_a, ea, ei, LEN, M_S)
     alpha, beta = rayleigh(0.02, wb, wa)
     dt = 2 * math.pi / (omega * spr)
     steps, rec = revs * spr, (revs - 1) * spr
 
     def linear() -> dict:
-        return kernels.slidercrank_simulate(n_el, R2, LEN, rho_a, ea, ei, half, M_S, omega, dt, steps, rec, spr + 1,
+        return slidercrank_kernel.slidercrank_simulate(n_el, R2, LEN, rho_a, ea, ei, half, M_S, omega, dt, steps, rec, spr + 1,
                                             alpha, beta)
 
     def nonlinear() -> dict:
-        return kernels.slidercrank_nl_simulate(n_el, R2, LEN, rho_a, ea, ei, half, M_S, omega, dt, steps, spr, rec,
+        return slidercrank_kernel.slidercrank_nl_simulate(n_el, R2, LEN, rho_a, ea, ei, half, M_S, omega, dt, steps, spr, rec,
                                                spr + 1, alpha, beta, hht=-0.05)
 
     return linear, nonlinear

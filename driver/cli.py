@@ -22,7 +22,8 @@ from pathlib import Path
 from driver import __version__, limits
 from driver.export import FORMATS
 from driver.extras import MissingExtra, require
-from driver.study import PLOT_FORMATS, study_names
+from driver._study import study_names
+from driver.study import PLOT_FORMATS
 
 __all__ = ["main", "run_deck", "EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT"]
 
@@ -181,11 +182,11 @@ def keys_help(group: str) -> str | None:
         import importlib
         spec = importlib.import_module(f"driver.{group}").SPEC
     else:
-        from driver.study import load_study
-        module = load_study(group)
-        if module is None:
+        from driver._study import load_study
+        study = load_study(group)
+        if study is None:
             return None
-        spec = module.SPEC
+        spec = study.spec
     lines = [f"&{spec.name}: {spec.doc}".rstrip(": "), ""]
     for name, key in spec.keys.items():
         req = "required" if key.required else f"default {key.default!r}"

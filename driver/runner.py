@@ -7,22 +7,20 @@ exits; it raises :class:`~driver.deck.DeckError` for bad input and returns what 
 from __future__ import annotations
 
 import os
-import pkgutil
 import re
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
-from types import ModuleType
 
 import numpy as np
 
-import driver
 from driver import blas, limits
+from driver._study import Study, load_study, registered, study_names
 from driver.atomic import NAME_MAX, inside, output_set, remove_stale_temporaries, write_text
 from driver.deck import Deck, DeckError, Params
 from driver.deck import validate
 from driver.export import FORMATS, summary_json_text, write_tidy
-from driver.study import Result, load_study
+from driver.study import Result
 from driver.table import TableValueError
 
 __all__ = ["CONTROL_GROUPS", "CaseFailure", "Outcome", "available_studies", "study_of", "run_study", "write_outputs",
@@ -32,35 +30,30 @@ __all__ = ["CONTROL_GROUPS", "CaseFailure", "Outcome", "available_studies", "stu
 CONTROL_GROUPS = ("sweep", "optimize", "synthesis")
 
 
-def available_studies() -> dict[str, ModuleType]:
-    """Every study module in the package, by group name."""
-    found = {}
-    for info in pkgutil.iter_modules(driver.__path__):
-        module = load_study(info.name)
-        if module is not None:
-            found[info.name] = module
-    return found
+def available_studies() -> dict[str, Study]:
+    """Every registered study (:data:`driver._study.REGISTRY`), by group name."""
+    return registered()
 
 
-def study_of(deck: Deck) -> tuple[ModuleType, Params]:
+def study_of(deck: Deck) -> tuple[Study, Params]:
     """The single study group of a deck, validated; DeckError otherwise."""
     studies = []
     for name, raw in deck.groups.items():
         if name in CONTROL_GROUPS:
             continue
-        module = load_study(name)
-        if module is None:
-            known = ", ".join(f"&{g}" for g in sorted(available_studies()) + list(CONTROL_GROUPS))
+        study = load_study(name)
+        if study is None:
+            known = ", ".join(f"&{g}" for g in study_names() + list(CONTROL_GROUPS))
             raise DeckError(deck.path, raw.line, None, f"unknown group &{name} (known groups: {known})")
-        studies.append((module, raw))
+        studies.append((study, raw))
     if not studies:
         raise DeckError(deck.path, None, None, "deck has no study group")
     if len(studies) > 1:
         names = ", ".join(f"&{raw.name} (line {raw.line})" for _, raw in studies)
         raise DeckError(deck.path, studies[1][1].line, None,
                         f"a deck describes one study; found {names}")
-    module, raw = studies[0]
-    return module, validate(raw, module.SPEC, deck.path)
+    study, raw = studies[0]
+    return study, validate(raw, study.spec, deck.path)
 
 
 def output_stem(outdir: str | Path, deck_path: str | Path, suffixes: Iterable[str] = (".out",)) -> Path:
@@ -156,11 +149,11 @@ class CaseFailure(DeckError):
 def numerical_error(params: Params, exc: BaseException) -> CaseFailure:
     """The deck error for a numerical failure reached from ``params``.
 
-    A study may define ``blame(params, exc) -> (key, message) | None`` to name the key; otherwise
+    A study may declare ``blame(params, exc) -> (key, message) | None`` to name the key; otherwise
     the error is placed at the group and lists the keys the deck gave.
     """
-    module = load_study(params.group)
-    blamed = module.blame(params, exc) if module is not None and hasattr(module, "blame") else None
+    study = load_study(params.group)
+    blamed = study.blame(params, exc) if study is not None and study.blame is not None else None
     if blamed:
         e = params.error(*blamed)
     else:
@@ -188,15 +181,15 @@ def check_finite(result: Result, params: Params) -> Result:
     return result
 
 
-def compute(module: ModuleType, params: Params, progress: bool = False,
+def compute(study: Study, params: Params, progress: bool = False,
             budget: limits.Budget | None = None) -> Result:
-    """``module.run(params)`` within the budget (:mod:`driver.limits`; ``budget`` default this
+    """``study.run(params)`` within the budget (:mod:`driver.limits`; ``budget`` default this
     process's), with numerical failures turned into deck errors and the result checked for
     non-finite numbers (no NaN, inf or '****' ever reaches a table)."""
-    limits.check(module, params, lim=budget)   # absurd requests are refused before anything is allocated
+    limits.check(study, params, lim=budget)   # absurd requests are refused before anything is allocated
     try:
         with np.errstate(all="ignore"), blas.one_thread():   # one BLAS thread: the same digits on any machine
-            result = module.run(params, progress=progress)
+            result = study.run(params, progress=progress)
     except DeckError:
         raise
     except NUMERICAL as exc:
@@ -220,8 +213,8 @@ def run_study(deck: Deck, outdir: Path | None, formats: list[str], plot: bool,
 
     Raises DeckError for bad input (nothing is written then); other exceptions are run failures.
     """
-    module, params = study_of(deck)
-    result = compute(module, params, progress=progress)
+    study, params = study_of(deck)
+    result = compute(study, params, progress=progress)
     result.name, result.study = name or Path(deck.path).stem, params.group
     written = [] if outdir is None else write_outputs(
         result, output_stem(outdir, deck.path if name is None else f"{name}.dat", study_suffixes(formats, summary_json)),

@@ -369,8 +369,7 @@ def test_over_budget_and_non_finite_designs_are_infeasible_with_reasons(tmp_path
     def run_nan(params, progress=False):   # a slow design writes a NaN into its table
         result = run(params, progress)
         return dataclasses.replace(result, text=result.text + "   nan\n") if params.speeds[0] < 12 else result
-    monkeypatch.setattr(slidercrank, "estimate", estimate)
-    monkeypatch.setattr(slidercrank, "run", run_nan)
+    monkeypatch.setattr(slidercrank, "STUDY", dataclasses.replace(slidercrank.STUDY, estimate=estimate, run=run_nan))
     oc = optimize(path, tmp_path / "out", jobs=1)
     nan = [r for r in oc.evaluator.records if r.x[2] < 12 and r.status != "bad_input"]
     assert nan and all(r.status == "failed" and "not a finite number" in r.reason for r in nan)

@@ -127,7 +127,7 @@ class OptimizeOutcome:
         """The result as plain data (the ``--json`` record): scipy's fields, the constraints at x,
         the starts of a local method and the polish of differential evolution."""
         p = self.problem
-        rec = {"study": p.study.SPEC.name, "deck": str(p.deck.path), "objective": p.objective_text,
+        rec = {"study": p.study.spec.name, "deck": str(p.deck.path), "objective": p.objective_text,
                "x": None if self.x is None else [float(v) for v in self.x.values()], "x_names": p.names,
                "fun": self.fun, "success": self.success, "status": self.status, "message": self.message,
                "nit": self.nit, "nfev": self.nfev, "constraint_tol": p.opts.constraint_tol,
@@ -161,7 +161,7 @@ def _probe(problem: Problem) -> None:
     x = [base_value(problem, v) for v in problem.variables]
     try:
         params = design_params(problem, np.array(x))
-        if hasattr(problem.study, "summarise"):
+        if problem.study.summarise is not None:
             summary, clean = dict(problem.study.summarise(params)), True
         else:       # through the runner: the budget and the finite-number checks apply here too
             result = compute(problem.study, params)
@@ -182,7 +182,7 @@ def _probe(problem: Problem) -> None:
                                          f"(columns: {', '.join(frame.columns)})")
     for key, e in exprs:
         missing = [name for name in sorted(e.names) if name not in frame]
-        renamed = getattr(problem.study, "RENAMED", {})
+        renamed = problem.study.renamed
         if missing and missing[0] in renamed:
             raise o.error(key, f"summary column '{missing[0]}' of &{problem.raw.name} is now "
                                f"{renamed[missing[0]]}")

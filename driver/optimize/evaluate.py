@@ -28,7 +28,7 @@ import pandas as pd
 
 from driver import blas, expr, limits
 from driver.deck import DeckError, Params, RawGroup, validate
-from driver.study import load_study
+from driver._study import load_study
 from driver.optimize import journal as journal_file
 from driver.optimize.problem import Problem
 from driver.runner import NUMERICAL, CaseFailure, compute, numerical_error
@@ -63,9 +63,9 @@ def _design_raw(raw: RawGroup, keys: list[str], kinds: list[str], x: np.ndarray)
 
 def design_params(problem: Problem, x: np.ndarray) -> Params:
     """The validated study group of design ``x`` (DeckError if the design is not a valid deck)."""
-    kinds = [problem.study.SPEC.keys[v.key].kind for v in problem.variables]
+    kinds = [problem.study.spec.keys[v.key].kind for v in problem.variables]
     raw = _design_raw(problem.raw, _slots(problem), kinds, x)
-    return validate(raw, problem.study.SPEC, problem.deck.path)
+    return validate(raw, problem.study.spec, problem.deck.path)
 
 
 @blas.one_thread()
@@ -83,7 +83,7 @@ def evaluate_cases(group: str, deck_path: str, raw: RawGroup, keys: list[str], k
     out: list[tuple[str, str, dict]] = []
     for x in xs:
         try:
-            params = validate(_design_raw(raw, keys, kinds, np.asarray(x)), module.SPEC, deck_path)
+            params = validate(_design_raw(raw, keys, kinds, np.asarray(x)), module.spec, deck_path)
         except DeckError as exc:
             out.append(("bad_input", _deck_reason(exc), {}))
             continue
@@ -93,7 +93,7 @@ def evaluate_cases(group: str, deck_path: str, raw: RawGroup, keys: list[str], k
             out.append(("refused", _deck_reason(exc), {}))
             continue
         try:
-            if hasattr(module, "summarise"):
+            if module.summarise is not None:
                 try:
                     with np.errstate(all="ignore"):
                         summary = dict(module.summarise(params))
@@ -173,7 +173,7 @@ class Evaluator:
         self.cache: dict[tuple[float, ...], int] = {}
         self.replayed: dict[tuple[float, ...], dict] = {}
         self.keys = _slots(problem)
-        self.kinds = [problem.study.SPEC.keys[v.key].kind for v in problem.variables]
+        self.kinds = [problem.study.spec.keys[v.key].kind for v in problem.variables]
         self.journal = journal
         self._journal_fh = None
         #: what a resume found wrong with the records it was given (driver.optimize.journal), or ''
@@ -416,17 +416,16 @@ def _slots(problem: Problem) -> list[str]:
 
 
 def _batch_summaries(problem: Problem, xs: list[tuple[float, ...]]) -> list[tuple[str, str, dict]] | None:
-    """The study's batch path (``summarise_batch``), when it has one; None otherwise."""
-    fn = getattr(problem.study, "summarise_batch", None)
-    elements = getattr(problem.study, "BATCH_ELEMENTS", ())   # list keys whose elements a batch may set
-    if fn is None or not xs or any(v.index is not None and v.key not in elements for v in problem.variables):
+    """The study's batch path (``Study.batch``), when it has one; None otherwise."""
+    batch = problem.study.batch
+    if batch is None or not xs or any(v.index is not None and v.key not in batch.elements for v in problem.variables):
         return None
-    applies = getattr(problem.study, "batch_applies", None)
+    fn, applies = batch.fn, batch.applies
     if applies is not None and not applies(problem.base):
         return None
     columns = {slot: np.array([x[i] for x in xs]) for i, slot in enumerate(_slots(problem))}
     wanted = None
-    if problem.opts.summary_columns and hasattr(problem.study, "BATCH_PASSES"):
+    if problem.opts.summary_columns and batch.passes is not None:
         # only what the objective, the constraints and summary_columns read: only their passes run
         wanted = sorted(_names(problem) | set(problem.opts.summary_columns))
     try:
@@ -436,7 +435,7 @@ def _batch_summaries(problem: Problem, xs: list[tuple[float, ...]]) -> list[tupl
     rows = frame.to_dict("records") if hasattr(frame, "to_dict") else list(frame)
     # a design the study's own run refuses (DeckError case by case, e.g. an arm that cannot reach) is
     # a batch row with a status: infeasible here too, so the optimum is a design the study accepts
-    refusal = getattr(problem.study, "batch_refusal", None)
+    refusal = batch.refusal
     out = []
     for row in rows:
         row = {k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in row.items()}
