@@ -22,7 +22,8 @@ from pathlib import Path
 from driver import __version__, limits
 from driver.export import FORMATS
 from driver.extras import MissingExtra, require
-from driver.study import PLOT_FORMATS, study_names
+from driver._study import study_names
+from driver.study import PLOT_FORMATS
 
 __all__ = ["main", "run_deck", "EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT"]
 
@@ -59,10 +60,13 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool | str, pro
     ``<stem>.json``.  ``report`` also writes the deck's report page ``<stem>.html``
     (:mod:`driver.report_page`) once its run has written its outputs.
     """
+    from driver.atomic import NameTooLong
     from driver.deck import DeckError, read_deck
-    from driver.runner import run_study
+    from driver.runner import name_too_long, output_stem, run_study
     try:
         deck = read_deck(path)
+        if report:   # the page's name is known now: refused before the run, not after it
+            output_stem(outdir, deck.path, (".html",))
         given = [opt for opt, key in (("-j/--jobs", "jobs"), ("--scheduler", "scheduler"), ("--resume", "resume"))
                  if (sweep_options or {}).get(key) and not ({"sweep", "optimize"} & set(deck.groups))]
         if "synthesis" in deck.groups:
@@ -90,6 +94,12 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool | str, pro
             outcome.written.append(_report_page(deck, outdir, outcome.result))
     except DeckError as exc:
         print(f"error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except NameTooLong as exc:   # an output name known only once computed (a figure's): nothing was written
+        stem, name = Path(path).stem, Path(exc.filename).name
+        what = (name_too_long(len(os.fsencode(stem)), name[len(stem):]) if name.startswith(stem)
+                else f"cannot write {exc.filename}: {exc.strerror}")
+        print(f"error: {path}: {what}; nothing written", file=sys.stderr)
         return EXIT_BAD_INPUT
     except MissingExtra as exc:
         print(f"error: {path}: {exc}", file=sys.stderr)
@@ -128,7 +138,7 @@ def _report_page(deck, outdir: Path, result) -> Path:
     from driver import report_page
     from driver.runner import output_stem, study_of
     _, params = study_of(deck)
-    stem = output_stem(outdir, deck.path)
+    stem = output_stem(outdir, deck.path, (".html",))
     page = report_page.page_for_result(result, deck, params)
     return report_page.write_report(stem.with_name(stem.name + ".html"), page)
 
@@ -141,7 +151,7 @@ def _report(deck, outdir: Path, kind: str, status: int, quiet: bool) -> int:
         return status
     from driver import report_page
     from driver.runner import output_stem
-    stem = output_stem(outdir, deck.path)
+    stem = output_stem(outdir, deck.path, (".html",))
     build = {"sweep": report_page.page_for_sweep, "optimize": report_page.page_for_optimize,
              "synthesis": report_page.page_for_synthesis}[kind]
     try:
@@ -172,11 +182,11 @@ def keys_help(group: str) -> str | None:
         import importlib
         spec = importlib.import_module(f"driver.{group}").SPEC
     else:
-        from driver.study import load_study
-        module = load_study(group)
-        if module is None:
+        from driver._study import load_study
+        study = load_study(group)
+        if study is None:
             return None
-        spec = module.SPEC
+        spec = study.spec
     lines = [f"&{spec.name}: {spec.doc}".rstrip(": "), ""]
     for name, key in spec.keys.items():
         req = "required" if key.required else f"default {key.default!r}"

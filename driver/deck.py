@@ -347,11 +347,11 @@ def _known_keys(group: str) -> frozenset[str] | None:
         module: ModuleType | None
         try:
             if group in ("sweep", "optimize", "synthesis"):
-                module = importlib.import_module(f"driver.{group}")
+                spec = importlib.import_module(f"driver.{group}").SPEC
             else:
-                from driver.study import load_study
-                module = load_study(group)
-            spec = getattr(module, "SPEC", None)
+                from driver._study import load_study
+                study = load_study(group)
+                spec = study.spec if study is not None else None
             keys = frozenset(spec.keys) if isinstance(spec, GroupSpec) else None
         except Exception:   # noqa: BLE001 - a module that fails to import declares no keys here
             keys = None

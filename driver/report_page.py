@@ -24,10 +24,10 @@ import json
 import math
 import platform
 import re
-from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+import sys
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Iterable, Sequence
 
 import numpy as np
 
@@ -96,7 +96,7 @@ def run_metadata() -> dict[str, str]:
         meta["kernels"] = "not found"
     meta["build"] = (f"Python {platform.python_version()}, numpy {np.__version__}, "
                      f"{platform.system()} {platform.machine()}")
-    meta["date"] = _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M:%S UTC")
+    meta["date"] = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC")
     return meta
 
 
@@ -125,7 +125,7 @@ def _figure_block(fig: Any, caption: str) -> str:
     return f'<figure class="plot">{figure_svg(fig, caption)}<figcaption>{esc(caption)}</figcaption></figure>'
 
 
-def _figures_html(result: Result, skip: Iterable[str] = ()) -> tuple[str, list[str]]:
+def _figures_html(result: "Result", skip: Iterable[str] = ()) -> tuple[str, list[str]]:
     """Every figure of ``result`` drawn as inline SVG; and the figures that could not be drawn."""
     blocks, failed = [], []
     for f in result.figures:
@@ -141,83 +141,6 @@ def _figures_html(result: Result, skip: Iterable[str] = ()) -> tuple[str, list[s
 
 
 # ----------------------------------------------------------------------------- animation
-
-def _fourbar_frames(params: Params) -> dict[str, Any] | None:
-    from driver import fourbar
-    motions = fourbar.rocking_motions(params, max(8, ANIMATION_FRAMES // 2 // max(
-        1, len(fourbar.assembly_intervals(params.fixed_link, params.crank, params.coupler, params.rocker) or [1]))))
-    extra: dict[str, Any] = {}
-    if motions:   # a crank that cannot turn: it rocks between its limit positions, out on one
-        # assembly branch and back on the other; each assembly interval a motion of its own
-        theta = np.concatenate([m.theta for m in motions])
-        out = np.vstack([m.out for m in motions])
-        status = np.concatenate([m.status for m in motions])
-        word = {1: "open", -1: "crossed"}
-        tag = (lambda i: "") if len(motions) == 1 else (lambda i: f", motion {i + 1} of {len(motions)}")
-        arrow = {0: "\u2192", 1: "\u2190"}   # forward stroke, return stroke
-        extra["phase"] = [f"{arrow[int(st)]} {word[int(b)]} assembly{tag(i)}"
-                          for i, m in enumerate(motions) for st, b in zip(m.stroke, m.branch)]
-        starts = np.cumsum([0] + [len(m.theta) for m in motions])
-        extra["segments"] = [[int(a), int(b)] for a, b in zip(starts[:-1], starts[1:])]
-        extra["limits"] = [[np.round(m.out[k, 3:7], 5).tolist() for k in (0, len(m.theta) // 2 - 1)] for m in motions]
-        extra["limit_angles"] = [[m.lo, m.hi] for m in motions]
-    else:
-        theta = np.linspace(0.0, 360.0, ANIMATION_FRAMES, endpoint=False)
-        out, status = fourbar.exact_grid(params, theta)
-    ok = (status != fourbar.ST["no_assembly"]) & (status != fourbar.ST["indeterminate"])
-    cp = fourbar.coupler_point(params, theta, out, status)
-    g = params.fixed_link
-    frames = {"theta": theta.tolist(), "ok": ok.astype(int).tolist(),
-              "A": np.round(out[:, 3:5], 5).tolist(), "B": np.round(np.where(ok[:, None], out[:, 5:7], 0.0), 5).tolist(),
-              "P": None if cp is None else np.round(np.where(ok[:, None], cp[:, :2], 0.0), 5).tolist(),
-              "ground": [[0.0, 0.0], [g, 0.0]], "kind": "fourbar",
-              "names": {"crank": "crank", "out": "rocker"}, **extra}
-    frames["theta"] = np.round(theta, 6).tolist()
-    pts = [out[:, 3:5], out[ok][:, 5:7], np.array([[0.0, 0.0], [g, 0.0]])]
-    if cp is not None:
-        pts.append(cp[ok][:, :2])
-    frames["box"] = _box(np.vstack(pts))
-    return frames
-
-
-def _slidercrank_frames(params: Params, result: Result | None = None) -> dict[str, Any] | None:
-    from driver import kernels
-    from driver.slidercrank.spec import _model
-    model = _model(params)
-    r, length = float(model.r2), float(model.length)
-    theta = np.linspace(0.0, 360.0, ANIMATION_FRAMES, endpoint=False)
-    states = kernels.slidercrank_rigid(np.radians(theta), 1.0, r, length)
-    a = np.column_stack([r * np.cos(np.radians(theta)), r * np.sin(np.radians(theta))])
-    b = np.column_stack([states[:, 3], np.zeros_like(theta)])
-    frames = {"theta": theta.tolist(), "ok": [1] * len(theta), "A": np.round(a, 6).tolist(),
-              "B": np.round(b, 6).tolist(), "P": None, "ground": [[0.0, 0.0], [float(b[:, 0].max()), 0.0]],
-              "kind": "slidercrank", "names": {"crank": "crank", "out": "slider"}}
-    frames["box"] = _box(np.vstack([a, b, [[0.0, 0.0]]]), pad_y=0.25 * r)
-    frames["bow"], frames["bow_note"] = _rod_bow(result, theta, length)
-    return frames
-
-
-def _rod_bow(result: Result | None, theta: np.ndarray, length: float) -> tuple[list[float] | None, str]:
-    """The elastic rod's midpoint deflection [m] at the animation's crank angles, magnified so
-    its largest is 6 % of the rod (from the run's tidy table: the fastest crank speed that ran),
-    and the words saying so; (None, '') without one."""
-    tidy = getattr(result, "tidy", None)
-    if tidy is None or "midpoint_deflection_mm" not in tidy or not len(tidy):
-        return None, ""
-    w = float(tidy["omega_rad_s"].max())
-    rows = tidy[tidy["omega_rad_s"] == w]
-    ang = np.mod(rows["crank_angle_deg"].to_numpy(dtype=float), 360.0)
-    mid = rows["midpoint_deflection_mm"].to_numpy(dtype=float) * 1e-3
-    order = np.argsort(ang)
-    ang, mid = ang[order], mid[order]
-    peak = float(np.max(np.abs(mid)))
-    if not np.isfinite(peak) or peak <= 0:
-        return None, ""
-    scale = 0.06 * length / peak
-    bow = np.interp(theta, ang, mid, period=360.0) * scale
-    return np.round(bow, 7).tolist(), (f"rod deflection magnified {scale:.3g} times "
-                                       f"(midpoint deflection at {w:g} rad/s, largest {peak * 1e3:.3g} mm)")
-
 
 def _box(pts: np.ndarray, pad_y: float = 0.0) -> list[float]:
     pts = pts[np.all(np.isfinite(pts), axis=1)]
@@ -246,7 +169,7 @@ _ANIM_JS = r"""
     [coupler, out, pb, pp, block].forEach(function(e){ if (e) e.style.visibility = ok ? "visible" : "hidden"; });
     note.style.visibility = ok ? "hidden" : "visible";
     if (!ok) return;
-    if (F.kind === "slidercrank") {
+    if (F.kind === "slider") {
       var dx = B[0] - A[0], dy = B[1] - A[1], L = Math.sqrt(dx * dx + dy * dy), b = F.bow ? 2 * F.bow[k] : 0;
       var C = [(A[0] + B[0]) / 2 - b * dy / L, (A[1] + B[1]) / 2 + b * dx / L];
       coupler.setAttribute("d", "M" + A.join(",") + " Q" + C.join(",") + " " + B.join(","));
@@ -254,7 +177,7 @@ _ANIM_JS = r"""
     else coupler.setAttribute("points", [A, B].map(function(p){ return p.join(","); }).join(" "));
     dot(pb, B);
     if (F.P) dot(pp, F.P[k]);
-    if (F.kind === "fourbar") line(out, G[1], B);
+    if (F.kind === "rocker") line(out, G[1], B);
     else { var w = parseFloat(block.getAttribute("width")), h = parseFloat(block.getAttribute("height"));
            block.setAttribute("x", B[0] - w / 2); block.setAttribute("y", B[1] - h / 2); }
   }
@@ -266,22 +189,22 @@ _ANIM_JS = r"""
   });
   show(parseInt(slider.value, 10));
 })();
-"""  # noqa: E501 - the page's script, written as it is served
+"""
 
 
-def mechanism_animation(params: Params, anim_id: str = "anim", caption: str = "",
-                        result: Result | None = None) -> str | None:
-    """The animation of a four-bar or slider-crank deck over one crank turn (inline SVG, JSON
-    positions from the kernel and a few lines of JavaScript), or None for another study.  A
-    slider-crank ``result`` adds its elastic rod's midpoint deflection, magnified."""
-    if params.group == "fourbar":
-        F = _fourbar_frames(params)
-    elif params.group == "slidercrank":
-        F = _slidercrank_frames(params, result)
-    else:
-        return None
+def mechanism_animation(params: "Params", anim_id: str = "anim", caption: str = "",
+                        result: "Result | None" = None) -> str | None:
+    """The animation of a deck's mechanism over one crank turn (inline SVG, JSON positions from the
+    study's ``Study.animation``, and a few lines of JavaScript), or None for a study without one.
+    The positions' ``kind`` says what the crank drives: a coupler and a ``'rocker'`` (four-bar) or a
+    rod and a ``'slider'`` (a slider-crank ``result`` adds its elastic rod's midpoint deflection,
+    magnified, as ``bow``)."""
+    from driver._study import load_study
+    study = load_study(params.group)
+    F = study.animation(params, result, ANIMATION_FRAMES) if study is not None and study.animation else None
     if F is None:
         return None
+    F["box"] = _box(np.asarray(F.pop("box_points"), float), F.pop("pad_y", 0.0))
     x0, y0, w, h = F["box"]
     s = max(w, h)
     lw, rad = 0.012 * s, 0.014 * s
@@ -305,7 +228,7 @@ def mechanism_animation(params: Params, anim_id: str = "anim", caption: str = ""
                              f'<title>limit position: crank angle {ang:.1f}\u00b0 (the crank reverses)</title></polyline>')
     elif ok.any():
         for name, key, colour in (("path of B", "B", "#c0392b"), ("path of P", "P", "#8e44ad")):
-            if F[key] is None or (F["kind"] == "slidercrank"):
+            if F[key] is None or (F["kind"] == "slider"):
                 continue
             pts = np.array(F[key])
             runs = np.split(np.arange(len(ok)), np.flatnonzero(np.diff(ok.astype(int))) + 1)
@@ -321,7 +244,7 @@ def mechanism_animation(params: Params, anim_id: str = "anim", caption: str = ""
         a_path = "".join('<polyline points="' + " ".join(f"{p[0]:.5g},{p[1]:.5g}" for p in a_pts[a:(a + b) // 2]) +
                          f'" fill="none" stroke="#999" stroke-width="{lw / 4:.4g}"><title>path of A</title></polyline>'
                          for a, b in F["segments"])
-    elif ok.all() or F["kind"] == "slidercrank":
+    elif ok.all() or F["kind"] == "slider":
         a_path = ('<polygon points="' + " ".join(f"{p[0]:.5g},{p[1]:.5g}" for p in a_pts) + f'" fill="none" '
                   f'stroke="#999" stroke-width="{lw / 4:.4g}"><title>path of A</title></polygon>')
     else:   # a crank that cannot turn: its pin's path only where the linkage assembles
@@ -331,8 +254,8 @@ def mechanism_animation(params: Params, anim_id: str = "anim", caption: str = ""
                          for run in runs if ok[run[0]] and len(run) > 1)
     g0, g1 = F["ground"]
     pivots = "".join(f'<path d="M{p[0] - 2 * rad:.5g},{p[1] - 2.2 * rad:.5g} L{p[0] + 2 * rad:.5g},{p[1] - 2.2 * rad:.5g} '
-                     f'L{p[0]:.5g},{p[1]:.5g} Z" fill="#555"/>' for p in ([g0, g1] if F["kind"] == "fourbar" else [g0]))
-    if F["kind"] == "fourbar":
+                     f'L{p[0]:.5g},{p[1]:.5g} Z" fill="#555"/>' for p in ([g0, g1] if F["kind"] == "rocker" else [g0]))
+    if F["kind"] == "rocker":
         guide = f'<line x1="{g0[0]}" y1="{g0[1]}" x2="{g1[0]}" y2="{g1[1]}" stroke="#555" stroke-width="{lw / 2:.4g}"/>'
         out = f'<line data-part="out" stroke="#e67e22" stroke-width="{lw:.4g}" stroke-linecap="round"/>'
         block = ""
@@ -343,7 +266,7 @@ def mechanism_animation(params: Params, anim_id: str = "anim", caption: str = ""
         out = ""
         block = (f'<rect data-part="block" width="{6 * rad:.5g}" height="{3 * rad:.5g}" fill="#e67e22" '
                  f'fill-opacity="0.85" stroke="#333" stroke-width="{lw / 4:.4g}"/>')
-    if F["kind"] == "slidercrank":   # the rod: a curve A-B (bowed by the elastic deflection when known)
+    if F["kind"] == "slider":   # the rod: a curve A-B (bowed by the elastic deflection when known)
         coupler = (f'<path data-part="coupler" fill="none" stroke="#2980b9" stroke-width="{lw:.4g}" '
                    'stroke-linecap="round"/>')
     else:
@@ -365,7 +288,7 @@ def mechanism_animation(params: Params, anim_id: str = "anim", caption: str = ""
   {out}{block}{pivots}
   <circle data-part="A" r="{rad:.4g}" fill="#fff" stroke="#000" stroke-width="{lw / 4:.4g}"/>
   <circle data-part="B" r="{rad:.4g}" fill="#fff" stroke="#000" stroke-width="{lw / 4:.4g}"/>
-  {f'<circle data-part="P" r="{rad:.4g}" fill="#8e44ad"/>' if F["P"] is not None else ''}
+  {'<circle data-part="P" r="%.4g" fill="#8e44ad"/>' % rad if F["P"] is not None else ''}
  </g>
  <text data-part="note" x="{x0 + 0.02 * w:.5g}" y="{y0 + 0.06 * h:.5g}" font-size="{0.04 * s:.4g}" fill="#c0392b"
   style="visibility:hidden">the linkage cannot be assembled at this crank angle</text>
@@ -399,7 +322,7 @@ def _fmt(v: Any) -> str:
     return str(v)
 
 
-def _frame_table(frame: pd.DataFrame, limit: int = MAX_TIDY_ROWS, cls: str = "data") -> str:
+def _frame_table(frame: "pd.DataFrame", limit: int = MAX_TIDY_ROWS, cls: str = "data") -> str:
     shown = frame.head(limit)
     head = "".join(f"<th>{esc(c)}</th>" for c in shown.columns)
     rows = "".join("<tr>" + "".join(f"<td>{esc(_fmt(v))}</td>" for v in r) + "</tr>"
@@ -415,7 +338,7 @@ def _warnings_html(warnings: Sequence[str]) -> str:
     return '<ul class="warn">' + "".join(f"<li>{esc(w)}</li>" for w in warnings) + "</ul>"
 
 
-def _comparison_html(frame: pd.DataFrame | None, note: str = "") -> str:
+def _comparison_html(frame: "pd.DataFrame | None", note: str = "") -> str:
     if frame is None or not len(frame):
         return f'<p class="note">{esc(note or "No published table belongs to this deck.")}</p>'
     counts = frame.groupby(["table", "status"]).size().unstack(fill_value=0)
@@ -500,7 +423,7 @@ def build_page(title: str, subtitle: str, sections: Sequence[Section], meta: dic
 """
 
 
-def _deck_text(deck: Deck | None, params: Params | None = None) -> str:
+def _deck_text(deck: "Deck | None", params: "Params | None" = None) -> str:
     """The deck as its file says it (or, for a deck given in Python, its groups as namelists)."""
     if deck is not None:
         path = Path(deck.path)
@@ -520,7 +443,7 @@ def _deck_text(deck: Deck | None, params: Params | None = None) -> str:
     return ""
 
 
-def _result_sections(result: Result, params: Params | None, comparison: pd.DataFrame | None,
+def _result_sections(result: "Result", params: "Params | None", comparison: "pd.DataFrame | None",
                      comparison_note: str = "", anim_caption: str = "") -> tuple[list[Section], list[str]]:
     sections = []
     notes: list[str] = []
@@ -547,7 +470,7 @@ def _result_sections(result: Result, params: Params | None, comparison: pd.DataF
     return sections, notes
 
 
-def page_for_result(result: Result, deck: Deck | None = None, params: Params | None = None,
+def page_for_result(result: "Result", deck: "Deck | None" = None, params: "Params | None" = None,
                     compare: bool = True) -> str:
     """The page of one single-case run: ``result`` as the runner returned it, the ``deck`` it
     ran (for the echo) and its validated ``params`` (for the animation and the comparison)."""
@@ -569,10 +492,10 @@ def page_for_result(result: Result, deck: Deck | None = None, params: Params | N
     return build_page(title, sub, sections, run_metadata())
 
 
-def _subtitle(study: str, params: Params | None) -> str:
-    from driver.study import load_study
+def _subtitle(study: str, params: "Params | None") -> str:
+    from driver._study import load_study
     module = load_study(study) if study else None
-    doc = getattr(getattr(module, "SPEC", None), "doc", "") if module is not None else ""
+    doc = module.spec.doc if module is not None else ""
     t = getattr(params, "get", lambda k, d=None: d)("title", "") if params is not None else ""
     return " — ".join(x for x in (doc, t) if x)
 
@@ -584,7 +507,7 @@ def _labels(module: Any, names: Iterable[str]) -> dict[str, str]:
     return {n: column_label(module, n) for n in names}
 
 
-def _case_result(deck_path: Path, text: str) -> tuple[Result, Params]:
+def _case_result(deck_path: Path, text: str) -> tuple["Result", "Params"]:
     """Run a deck text in memory (an optimum, a best case): its Result and Params."""
     from driver.deck import read_deck
     from driver.runner import compute, study_of
@@ -609,10 +532,10 @@ def _namelist(group: str, values: dict[str, Any]) -> str:
     return f"&{group}\n" + "".join(f"  {k} = {lit(v)}\n" for k, v in values.items() if v is not None) + "/\n"
 
 
-def page_for_sweep(deck: Deck, outdir: Path, stem: str, status: int = 0) -> str:
+def page_for_sweep(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> str:
     """The page of a sweep deck, from the files the sweep wrote: the design-space maps of the
     plotted summary columns (kept designs outlined; the best kept design by the first plotted
-    column marked where the study says which way is better, its ``SWEEP_BEST``, else the first
+    column marked where the study says which way is better, its ``sweep_best``, else the first
     kept design), that design's drawing and animation, the summary .out, the deck."""
     import pandas as pd
 
@@ -631,11 +554,11 @@ def page_for_sweep(deck: Deck, outdir: Path, stem: str, status: int = 0) -> str:
     numeric = [c for c in summary.columns if c not in keys and c not in ("case", "kept") and
                pd.api.types.is_numeric_dtype(summary[c]) and not pd.api.types.is_bool_dtype(summary[c])]
     wanted = [y for y in (sw.plot_y or []) if y in numeric] or \
-        [c for c in getattr(module, "SWEEP_PLOT", ()) if c in numeric][:2] or numeric[:1]
+        [c for c in module.sweep_plot if c in numeric][:2] or numeric[:1]
     labels = _labels(module, list(summary.columns))
     ok = summary[summary["status"] == "ok"] if "status" in summary else summary
     kept = ok[ok["kept"].astype(bool)] if "kept" in ok else ok
-    senses = getattr(module, "SWEEP_BEST", {})
+    senses = module.sweep_best
     sections: list[Section] = []
     notes: list[str] = []
     numeric_keys = [k for k in keys if pd.api.types.is_numeric_dtype(summary[k])]
@@ -653,7 +576,7 @@ def page_for_sweep(deck: Deck, outdir: Path, stem: str, status: int = 0) -> str:
             maps += [_figure_block(f, f"{labels[y]} over the swept keys") for f, y in zip(figs, wanted)]
         else:   # one key, zipped keys or a kept set that is no grid: the --plot summary (lines, strips)
             fig = plotting.sweep_summary(ok, keys, sw.plot_x, sw.plot_y, stem, labels,
-                                         getattr(module, "SWEEP_PLOT", ()))
+                                         module.sweep_plot)
             maps.append(_figure_block(fig, "the sweep's summary columns against the swept keys"))
     except Exception as exc:
         notes.append(f"the design-space maps could not be drawn: {exc.__class__.__name__}: {exc}")
@@ -670,9 +593,9 @@ def page_for_sweep(deck: Deck, outdir: Path, stem: str, status: int = 0) -> str:
                 f"{esc(k)} = {summary.loc[best, k]:.6g}" for k in numeric_keys) + ".</p>")
             anim = mechanism_animation(params, "anim-best", "The marked design over one crank turn.")
             body += anim or ""
-            figs_html, failed = _figures_html(result)
+            figs, failed = _figures_html(result)
             notes += failed
-            body += figs_html + _kv_table(result.summary)
+            body += figs + _kv_table(result.summary)
             sections.append(Section("best", "the marked design", body))
         except Exception as exc:
             notes.append(f"the marked design could not be run again: {exc.__class__.__name__}: {exc}")
@@ -690,7 +613,7 @@ def page_for_sweep(deck: Deck, outdir: Path, stem: str, status: int = 0) -> str:
     return build_page(f"{stem}: sweep", sub, sections, run_metadata())
 
 
-def _objective(deck: Deck) -> tuple[str, str]:
+def _objective(deck: "Deck") -> tuple[str, str]:
     """The optimisation's objective text and sense from the deck's &optimize group."""
     values = deck.groups["optimize"].values
     for sense in ("minimize", "maximize", "minimise", "maximise"):
@@ -699,7 +622,7 @@ def _objective(deck: Deck) -> tuple[str, str]:
     return "objective", "minimize"
 
 
-def page_for_optimize(deck: Deck, outdir: Path, stem: str, status: int = 0) -> str:
+def page_for_optimize(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> str:
     """The page of an optimisation deck, from the files it wrote: the convergence plot, the map
     of the designs evaluated over the first two design variables (coloured by the objective,
     infeasible designs grey, the optimum marked), the optimum's drawing and animation, the
@@ -761,7 +684,7 @@ def page_for_optimize(deck: Deck, outdir: Path, stem: str, status: int = 0) -> s
     return build_page(f"{stem}: optimisation", sub, sections, run_metadata())
 
 
-def _evaluated_map(frame: pd.DataFrame, design: Sequence[str], objective: str, opt: Any,
+def _evaluated_map(frame: "pd.DataFrame", design: Sequence[str], objective: str, opt: Any,
                    labels: dict[str, str], title: str) -> Any:
     """The designs an optimiser evaluated: feasible ones coloured by the objective, infeasible
     grey, the optimum starred (a scatter: an optimiser's designs are not on a grid)."""
@@ -787,7 +710,7 @@ def _evaluated_map(frame: pd.DataFrame, design: Sequence[str], objective: str, o
     return fig
 
 
-def page_for_synthesis(deck: Deck, outdir: Path, stem: str, status: int = 0) -> str:
+def page_for_synthesis(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> str:
     """The page of a synthesis deck, from the files it wrote: the synthesised linkage's
     animation and figures (run again from ``<stem>.linkage.dat``), the report and the deck."""
     outdir = Path(outdir)

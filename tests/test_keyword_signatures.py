@@ -23,7 +23,7 @@ from driver.runner import available_studies
 
 ROOT = Path(__file__).resolve().parents[1]
 STUDIES = sorted(available_studies())
-#: studies whose run carries the generated signature (all of them once fourbar's module settles)
+#: studies whose run carries the generated signature: every one
 TYPED = [g for g in STUDIES if hasattr(available_studies()[g].run, "__signature__")]
 
 
@@ -120,11 +120,19 @@ def test_mypy_refuses_a_misspelt_key_and_a_value_outside_the_choices(tmp_path):
         "driver.ujoint.run(beta=[10.0, 20.0], rmp=30.0)\n"                              # 4: misspelt
         "driver.ujoint.run(beta=[10.0, 20.0], model='exakt')\n"                         # 5: not a choice
         "driver.slidercrank.run(speeds=[100.0], n_elements=4.5)\n"                      # 6: an int key
-        "driver.slidercrank.run(speeds=[100.0, 150.0], n_elements=4)\n")                # 7: fine
+        "driver.slidercrank.run(speeds=[100.0, 150.0], n_elements=4)\n"                # 7: fine
+        "import driver.fourbar\n"
+        "driver.fourbar.run(fixed_link=12, crank=5, coupler=15, rocker=9, step_deg=20)\n"  # 9: fine
+        "driver.fourbar.run(fixed_lnik=12, crank=5, coupler=15, rocker=9, step_deg=20)\n")  # 10: misspelt
     proc = subprocess.run([sys.executable, "-m", "mypy", "--follow-imports=silent", "--no-error-summary",
                            "--cache-dir", str(tmp_path / "cache"), str(snippet)],
                           cwd=ROOT, capture_output=True, text=True, timeout=600)
     errors = [line for line in proc.stdout.splitlines() if ": error:" in line]
     lines = sorted({int(line.split(":")[1]) for line in errors})
-    assert lines == [4, 5, 6], proc.stdout
+    assert lines == [4, 5, 6, 10], proc.stdout
     assert any('Unexpected keyword argument "rmp"' in line for line in errors), proc.stdout
+    assert any('Unexpected keyword argument "fixed_lnik"' in line for line in errors), proc.stdout
+
+
+def test_every_study_run_carries_its_signature():
+    assert TYPED == STUDIES

@@ -1,4 +1,5 @@
-"""Slider-crank, ``model = 'nonlinear'``: runs every speed in both models and writes the .out
+"""Slider-crank: a deck's run (:func:`run`: the linear model, or with ``model = 'nonlinear'`` both).
+The nonlinear run takes every speed in both models and writes the .out
 sections (linear and nonlinear side by side, per-revolution deflection, Newton statistics,
 onset search), the tidy table, the summary and the figures.
 
@@ -12,14 +13,17 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
+from driver import _keywords
+from driver._signatures import keyword_signature
 from driver.deck import Params
 from driver.export import with_units
 from driver.slidercrank.analysis import Case, _run_case, static_onset
 from driver.slidercrank.nonlinear import IRREGULAR, NLCase, onset_search, run_nl_case
-from driver.slidercrank.report import Derived, _header, _plotting, _status_text
+from driver.slidercrank.report import _figures, _header, _status_text, run_linear
 from driver.slidercrank.spec import _model, rayleigh
-from driver.study import Figure, Result
-from driver.table import Cell, Column, render_table
+from driver.study import Figure, Result, keyword_run
+from driver.slidercrank.spec import SPEC
+from driver.table import Column, render_table
 
 NL_STATUS_TEXT = {
     "limit": ("COLLAPSE", "the lateral deflection passed L/2: the rod has folded up"),
@@ -54,8 +58,7 @@ def _side_by_side(pairs: list[tuple[Case, NLCase]], tol: float, limit: float) ->
             Column("lin comp", "f", 9, 2), Column("nl comp", "f", 9, 2), Column("lin outer", "f", 9, 1),
             Column("nl outer", "f", 9, 1), Column("lin lat", "f", 8, 3), Column("nl lat", "f", 8, 3),
             Column("N/P_E", "f", 6, 3), Column("growth%", "f", 8, 2), Column("spread%", "f", 8, 1)]
-    rows: list[list[Cell]] = []
-    trailers: list[str] = []
+    rows, trailers = [], []
     for lin, nl in pairs:
         row: list[Any] = [nl.omega]
         lin_vals = ([lin.peak(+1)[0] * 1e6, lin.peak(-1)[0] * 1e6, lin.outer_peak() * 1e6,
@@ -74,15 +77,13 @@ def _side_by_side(pairs: list[tuple[Case, NLCase]], tol: float, limit: float) ->
             "         load; growth% = mean growth per revolution of the per-revolution peak lateral deflection",
             f"         (Table 6; medians of the last revolutions against those before; GROWS above {100 * tol:g} %);",
             "         spread% = max/min - 1 of those peaks (irregular above "
-            f"{100 * IRREGULAR:g} %); BUCKLED = lateral deflection above {1e3 * limit:.1f} mm", ""] \
-        + render_table(cols, rows, trailers)
+            f"{100 * IRREGULAR:g} %); BUCKLED = lateral deflection above {1e3 * limit:.1f} mm", ""] + render_table(cols, rows, trailers)
 
 
 def _per_revolution(cases: list[NLCase]) -> list[str]:
     nrev = max(len(c.rev_lat) for c in cases)
     cols = [Column("omega", "f", 7, 2)] + [Column(f"rev {k + 1}", "f", 8, 3) for k in range(nrev)]
-    rows: list[list[Cell]] = []
-    trailers: list[str] = []
+    rows, trailers = [], []
     for c in cases:
         done = min(nrev, max(c.steps_done - 1, 0) // c.steps_per_rev + 1) if c.steps_done else 0
         rows.append([c.omega] + [float(c.rev_lat[k]) * 1e3 if k < done else "-" for k in range(nrev)])
@@ -94,14 +95,13 @@ def _per_revolution(cases: list[NLCase]) -> list[str]:
 def _newton_table(cases: list[NLCase], params: Params) -> list[str]:
     cols = [Column("omega", "f", 7, 2), Column("steps", "i", 7), Column("solves", "i", 8),
             Column("per step", "f", 8, 3), Column("max", "i", 4), Column("cuts", "i", 5), Column("deepest", "i", 7)]
-    rows: list[list[Cell]] = []
-    trailers: list[str] = []
+    rows, trailers = [], []
     for c in cases:
         rows.append([c.omega, c.steps_done, c.solves, c.solves / max(c.steps_done, 1), c.max_solves, c.cuts,
                      c.deepest_cut])
         trailers.append("" if c.ok else nl_status_text(c))
     return ["Table 7  Newton iterations and step control of the nonlinear runs",
-            "         solves = Newton solves in all; max = most in one step; cuts = time steps halved",
+            f"         solves = Newton solves in all; max = most in one step; cuts = time steps halved",
             f"         (deepest = most halvings of one step, of {params.max_step_cuts} allowed); tolerance "
             f"{params.newton_tolerance:g} (relative residual)", ""] + render_table(cols, rows, trailers)
 
@@ -197,7 +197,7 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
     alpha, beta = rayleigh(params.damping_ratio, w_bend, w_axial)
     n = params.n_elements
     static = static_onset(model, n)
-    derived = Derived(w_bend=w_bend, w_axial=w_axial, p_euler=p_euler, alpha=alpha, beta=beta, onset=static)
+    derived = dict(w_bend=w_bend, w_axial=w_axial, p_euler=p_euler, alpha=alpha, beta=beta, onset=static)
     tol, limit = params.growth_tolerance, params.large_deflection * model.length
     pairs: list[tuple[Case, NLCase]] = []
     for w in tqdm(params.speeds, desc="slidercrank nonlinear", unit="speed", disable=not progress):
@@ -209,7 +209,8 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
     text = _header(params, model, derived)
     text += ["  nonlinear rod: co-rotational Euler-Bernoulli frame elements (same mesh, masses, damping and",
              "  inertia loading); Newmark average acceleration with Newton iterations on the consistent",
-             "  tangent, a step halved when Newton fails; banded Cholesky solves (fortran/slidercrank_nl.f90)",
+             "  tangent (the damping's included), a step halved when Newton fails; banded LU solves",
+             "  (fortran/slidercrank_nl.f90)",
              f"  time integration: HHT-alpha, alpha = {params.hht_alpha:g}"
              + (" (Newmark average acceleration)" if params.hht_alpha == 0 else
                 " (damps the unresolved high frequencies; 0 = Newmark average acceleration)"),
@@ -250,16 +251,26 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
     figures = []
     good = [(lin, nl) for lin, nl in pairs if nl.ok and lin.ok]
     if good:
-        figures.append(Figure("strain_linear_nonlinear", lambda: _plotting().slidercrank_nl_strain_figure(
+        figures.append(Figure("strain_linear_nonlinear", lambda: _figures().slidercrank_nl_strain_figure(
             [(f"{nl.omega:g} rad/s", lin.angle_deg, lin.eps_1 * 1e6, nl.eps_ax[0] * 1e6) for lin, nl in good],
             f"{params.material}: crank-end axial strain, linear (dashed) and nonlinear (solid)")))
     okn = [nl for nl in nls if nl.ok]
     if okn:
-        figures.append(Figure("shapes", lambda: _plotting().slidercrank_nl_shapes_figure(
+        figures.append(Figure("shapes", lambda: _figures().slidercrank_nl_shapes_figure(
             [(f"{c.omega:g} rad/s", c.shape_deg, c.shapes) for c in okn], model.length,
             f"{params.material}: lateral deflection at the worst crank angles")))
-    figures.append(Figure("lateral_per_revolution", lambda: _plotting().slidercrank_nl_revolutions_figure(
+    figures.append(Figure("lateral_per_revolution", lambda: _figures().slidercrank_nl_revolutions_figure(
         [(f"{c.omega:g} rad/s", c.rev_lat[:max(c.steps_done - 1, 0) // c.steps_per_rev + 1] * 1e3)
          for c in nls if c.steps_done], f"{params.material}: peak lateral deflection per revolution")))
     return Result(text="\n".join(text) + "\n", tidy=_tidy(params.material, pairs),
                   summary=_summary(pairs, tol, limit, onset), warnings=warnings, failure=failure, figures=figures)
+
+
+@keyword_signature(_keywords.slidercrank, SPEC)
+@keyword_run
+def run(params: Params, progress: bool = False) -> Result:
+    """Run one &slidercrank deck: the paper's linear KED model (:func:`run_linear`), or with
+    ``model = 'nonlinear'`` the co-rotational rod beside it (:func:`run_nonlinear`)."""
+    if params.model == "nonlinear":
+        return run_nonlinear(params, progress)
+    return run_linear(params, progress)

@@ -6,22 +6,16 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Collection, Mapping
-from typing import Any
+from typing import Any, Collection, Mapping
 
 import numpy as np
 import pandas as pd
 
 from driver.deck import Params
-from driver.kernels import (
-    UJOINT_MODELS,
-    UJOINT_OBJECTIVES,
-    UJOINT_PASSES,
-    UJOINT_SUMMARY_COLUMNS,
-    ujoint_geometry,
-    ujoint_summaries,
-)
+from driver.ujoint.kernel import (UJOINT_MODELS, UJOINT_OBJECTIVES, UJOINT_PASSES, UJOINT_SUMMARY_COLUMNS, ujoint_geometry,
+                            ujoint_summaries)
 from driver.ujoint.spec import _KEYS, DEG
+
 
 #: deck keys a batch may vary (one value per design); list keys as one value per design (a
 #: single-element list, as a sweep sets them), a (designs, k) array of whole lists, or element
@@ -100,7 +94,6 @@ def _list_column(base: Mapping[str, Any], key: str, whole: Any, elements: dict[i
 def _choice_column(base: Mapping[str, Any], key: str, columns: dict[str, Any], nd: int) -> np.ndarray:
     v = np.broadcast_to(np.asarray(columns.get(key, base[key]), dtype=object), (nd,))
     allowed = _KEYS[key].choices
-    assert allowed is not None   # called for the choice keys only
     bad = ~np.isin(v, allowed)
     if bad.any():
         raise _bad(base, key, f"must be one of {', '.join(map(repr, allowed))} (got {v[np.argmax(bad)]!r})")
@@ -181,14 +174,13 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
         raise _bad(base, "axes", "the base deck's 'axes' fix the joint and plane angles; a batch cannot vary "
                                  "'beta' or 'rho' then")
     if axes:   # as _geometry (the base deck is valid): kernel radians -> degrees
-        b_rad, r_rad, _ = ujoint_geometry(np.asarray(base["axes"], dtype=np.float64).reshape(-1, 3))
-        beta: np.ndarray = np.broadcast_to(b_rad / DEG, (nd, b_rad.size))
-        rho: np.ndarray | None = np.broadcast_to(r_rad / DEG, (nd, r_rad.size))
+        b, r, _ = ujoint_geometry(np.asarray(base["axes"], dtype=np.float64).reshape(-1, 3))
+        beta = np.broadcast_to(b / DEG, (nd, b.size))
+        rho = np.broadcast_to(r / DEG, (nd, r.size))
     else:
-        given_beta = _list_column(base, "beta", cols.get("beta"), elems.get("beta", {}), nd)
-        if given_beta is None:
+        beta = _list_column(base, "beta", cols.get("beta"), elems.get("beta", {}), nd)
+        if beta is None:
             raise _bad(base, None, "give the joint angles 'beta' (deg) or the shaft directions 'axes'")
-        beta = given_beta
         rho = _list_column(base, "rho", cols.get("rho"), elems.get("rho", {}), nd)
     n = beta.shape[1]
     bad = ~((beta > -90.0) & (beta < 90.0))
@@ -202,9 +194,7 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
                                   "(0 = in phase), not both")
     if given:
         key = given.pop()
-        given_phi = _list_column(base, key, cols.get(key), elems.get(key, {}), nd)
-        assert given_phi is not None   # the key is given
-        phi = given_phi
+        phi = _list_column(base, key, cols.get(key), elems.get(key, {}), nd)
         if phi.shape[1] != n - 1:
             raise _bad(base, key, f"a chain of {n} joint(s) has {n - 1} intermediate shaft(s), so "
                                   f"{n - 1} phase(s); got {phi.shape[1]}")
@@ -230,7 +220,6 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     res = np.empty((nd, len(UJOINT_SUMMARY_COLUMNS)))
     rho_rad = None if rho is None else rho * DEG
     layout = np.stack([code, kind, grid])
-    groups: list[tuple[np.ndarray, slice | np.ndarray]]
     if nd == 0:
         groups = []
     elif (layout == layout[:, :1]).all():
