@@ -354,6 +354,19 @@ class _slidercrank_nl:
     ) -> tuple[NDArray[np.float64], NDArray[np.float64], float, float, float]:
         """``f,kt,eps,kap,en = element_corot(le,ea,ei,p,want_k)``; shapes f(6), kt(6,6)"""
         ...
+    @staticmethod
+    def element_corot_d(
+        le: float,
+        ea: float,
+        ei: float,
+        p: NDArray[np.float64],
+        pd: NDArray[np.float64],
+        bd: float,
+        cd: float,
+        want_k: int,
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], float, float, float]:
+        """``f,kt,eps,kap,en = element_corot_d(le,ea,ei,p,pd,bd,cd,want_k)``; shapes f(6), kt(6,6)"""
+        ...
     nl_bad_args: NDArray[np.int32]
     nl_limit: NDArray[np.int32]
     nl_no_convergence: NDArray[np.int32]
