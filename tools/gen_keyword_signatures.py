@@ -23,7 +23,7 @@ def specs() -> list:
     out = []
     for _, study in sorted(available_studies().items()):
         spec = getattr(study, "spec", None)   # a study package's 'spec' may be its spec module
-        out.append(spec if isinstance(spec, GroupSpec) else study.SPEC)
+        out.append(spec if isinstance(spec, GroupSpec) else getattr(study, "SPEC"))  # noqa: B009 - a study module
     return out
 
 

@@ -5,7 +5,7 @@ Strains are printed in microstrain, angles in degrees, forces in N.
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Literal, TypedDict
 
 import numpy as np
 import pandas as pd
@@ -18,14 +18,27 @@ from driver.slidercrank.analysis import Case, _run_case, static_onset
 from driver.slidercrank.spec import (EULER_WARN, MIN_STEPS_PER_BENDING_PERIOD, MIN_STEPS_PER_REV, SIMEON1996, STATUS_TEXT,
                                      Model, _model, _shape, rayleigh)
 from driver.study import Figure, Result
-from driver.table import Column, render_table
+from driver.table import Cell, Column, render_table
 
 
 def _f(x: float, d: int = 3) -> str:
     return f"{x:.{d}f}"
 
 
-def _header(params: Params, model: Model, derived: dict[str, float]) -> list[str]:
+class Derived(TypedDict):
+    """Constants of the model for the report header: first bending and axial frequencies
+    [rad/s], Euler load [N], Rayleigh alpha [1/s] and beta [s], static buckling onset (crank
+    speed [rad/s], crank angle [deg]) or None."""
+
+    w_bend: float
+    w_axial: float
+    p_euler: float
+    alpha: float
+    beta: float
+    onset: tuple[float, float] | None
+
+
+def _header(params: Params, model: Model, derived: Derived) -> list[str]:
     mat = params.material if params.material != "custom" else "custom (section from the deck)"
     src = model.sources
     rows = [
@@ -84,11 +97,13 @@ def _status_text(c: Case, why: bool = True) -> str:
 
 
 def _unsettled(c: Case, tol: float) -> bool:
-    return c.settle_strain is not None and max(c.settle_strain, c.settle_mid) > tol
+    return c.settle_strain is not None and c.settle_mid is not None and max(c.settle_strain, c.settle_mid) > tol
 
 
 def _settle_text(c: Case) -> str:
-    return "-" if c.settle_strain is None else f"{100 * max(c.settle_strain, c.settle_mid):.3f}"
+    if c.settle_strain is None or c.settle_mid is None:   # set together, for runs of two revolutions or more
+        return "-"
+    return f"{100 * max(c.settle_strain, c.settle_mid):.3f}"
 
 
 def _peak_table(cases: list[Case], tol: float) -> list[str]:
@@ -96,7 +111,8 @@ def _peak_table(cases: list[Case], tol: float) -> list[str]:
             Column("el", "i", 4), Column("compress", "f", 9, 2), Column("theta2", "f", 7, 2),
             Column("el", "i", 4), Column("outer", "f", 9, 2), Column("middefl", "f", 8, 4),
             Column("N/P_E", "f", 6, 3), Column("settle%", "s", 8)]
-    rows, trailers = [], []
+    rows: list[list[Cell]] = []
+    trailers: list[str] = []
     for c in cases:
         if c.ok:
             t, ta, te = c.peak(+1)
@@ -146,9 +162,14 @@ def _convergence_table(conv: dict[float, list[Case]], length: float) -> list[str
             Column("change%", "f", 8, 3), Column("compress", "f", 9, 3), Column("change%", "f", 8, 3),
             Column("tens@pin", "f", 9, 3), Column("change%", "f", 8, 3), Column("comp@pin", "f", 9, 3),
             Column("change%", "f", 8, 3)]
-    change = lambda new, old: "-" if old is None else 100 * (new - old) / old
+
+    def change(new: float, old: float | None) -> Cell:
+        return "-" if old is None else 100 * (new - old) / old
+
     for omega, cases in conv.items():
-        rows, trailers, prev = [], [], None
+        rows: list[list[Cell]] = []
+        trailers: list[str] = []
+        prev: tuple[float, ...] | None = None
         for c in cases:
             le = 1e3 * length / c.n_elements
             if not c.ok:
@@ -157,7 +178,7 @@ def _convergence_table(conv: dict[float, list[Case]], length: float) -> list[str
                 prev = None
                 continue
             vals = (c.peak(+1)[0] * 1e6, c.peak(-1)[0] * 1e6, c.crank_end_peak(+1) * 1e6, c.crank_end_peak(-1) * 1e6)
-            old = prev or (None,) * 4
+            old: tuple[float | None, ...] = prev or (None,) * 4
             rows.append([c.n_elements, le] + [x for v, o in zip(vals, old) for x in (v, change(v, o))])
             trailers.append("")
             prev = vals
@@ -242,7 +263,8 @@ def _benchmark_lines(params: Params, case: Case) -> list[str]:
         return lines + [f"  {_status_text(case)}"]
     kin = kernel.slidercrank_rigid(np.array([case.omega * case.time[-1]]), case.omega,
                                     params.crank_radius, params.rod_length)[0]
-    vals = [("midpoint deflection from the chord (q1)", "m", float(case.mid[-1]), "q1"),
+    vals: list[tuple[str, str, float, Literal["q1", "q4", "x3", "phi2"]]] = [
+            ("midpoint deflection from the chord (q1)", "m", float(case.mid[-1]), "q1"),
             ("rod elongation (q4)", "m", float(case.elong[-1]), "q4"),
             ("slider position (x3)", "m", float(case.slider[-1]), "x3"),
             ("rod angle, rigid (phi2)", "rad", float(kin[0]), "phi2")]
@@ -251,7 +273,7 @@ def _benchmark_lines(params: Params, case: Case) -> list[str]:
         cols += [Column("Simeon 1996", "s", 16), Column("diff %", "f", 8, 3)]
     rows = []
     for name, unit, v, ref in vals:
-        row = [name, unit, f"{v:.9e}"]
+        row: list[Cell] = [name, unit, f"{v:.9e}"]
         if params.benchmark == "simeon1996":
             r = SIMEON1996[ref]
             row += [f"{r:.9e}", 100 * (v - r) / abs(r)]
@@ -276,7 +298,7 @@ def run_linear(params: Params, progress: bool = False) -> Result:
     w_bend, w_axial, p_euler = model.frequencies()
     alpha, beta = rayleigh(params.damping_ratio, w_bend, w_axial)
     counts = list(params.element_counts) if params.element_counts else [params.n_elements]
-    derived = dict(w_bend=w_bend, w_axial=w_axial, p_euler=p_euler, alpha=alpha, beta=beta,
+    derived = Derived(w_bend=w_bend, w_axial=w_axial, p_euler=p_euler, alpha=alpha, beta=beta,
                    onset=static_onset(model, counts[-1]))
     jobs = [(w, n) for w in params.speeds for n in counts]
     done: dict[tuple[float, int], Case] = {}
@@ -303,7 +325,7 @@ def run_linear(params: Params, progress: bool = False) -> Result:
                 msg += "; the linear model cannot show buckling: rerun with geometric_stiffness = .true."
             warnings.append(msg)
     for c in cases:
-        if c.ok and _unsettled(c, params.settle_tolerance):
+        if c.ok and _unsettled(c, params.settle_tolerance) and c.settle_strain is not None and c.settle_mid is not None:
             warnings.append(f"crank speed {c.omega:g} rad/s: the reported revolution has not settled: strain "
                             f"changes {100 * c.settle_strain:.3f} % and midpoint deflection "
                             f"{100 * c.settle_mid:.3f} % of their peaks between the last two revolutions "

@@ -19,11 +19,11 @@ from driver.deck import Params
 from driver.export import with_units
 from driver.slidercrank.analysis import Case, _run_case, static_onset
 from driver.slidercrank.nonlinear import IRREGULAR, NLCase, onset_search, run_nl_case
-from driver.slidercrank.report import _figures, _header, _status_text, run_linear
+from driver.slidercrank.report import Derived, _figures, _header, _status_text, run_linear
 from driver.slidercrank.spec import _model, rayleigh
 from driver.study import Figure, Result, keyword_run
 from driver.slidercrank.spec import SPEC
-from driver.table import Column, render_table
+from driver.table import Cell, Column, render_table
 
 NL_STATUS_TEXT = {
     "limit": ("COLLAPSE", "the lateral deflection passed L/2: the rod has folded up"),
@@ -58,7 +58,8 @@ def _side_by_side(pairs: list[tuple[Case, NLCase]], tol: float, limit: float) ->
             Column("lin comp", "f", 9, 2), Column("nl comp", "f", 9, 2), Column("lin outer", "f", 9, 1),
             Column("nl outer", "f", 9, 1), Column("lin lat", "f", 8, 3), Column("nl lat", "f", 8, 3),
             Column("N/P_E", "f", 6, 3), Column("growth%", "f", 8, 2), Column("spread%", "f", 8, 1)]
-    rows, trailers = [], []
+    rows: list[list[Cell]] = []
+    trailers: list[str] = []
     for lin, nl in pairs:
         row: list[Any] = [nl.omega]
         lin_vals = ([lin.peak(+1)[0] * 1e6, lin.peak(-1)[0] * 1e6, lin.outer_peak() * 1e6,
@@ -83,7 +84,8 @@ def _side_by_side(pairs: list[tuple[Case, NLCase]], tol: float, limit: float) ->
 def _per_revolution(cases: list[NLCase]) -> list[str]:
     nrev = max(len(c.rev_lat) for c in cases)
     cols = [Column("omega", "f", 7, 2)] + [Column(f"rev {k + 1}", "f", 8, 3) for k in range(nrev)]
-    rows, trailers = [], []
+    rows: list[list[Cell]] = []
+    trailers: list[str] = []
     for c in cases:
         done = min(nrev, max(c.steps_done - 1, 0) // c.steps_per_rev + 1) if c.steps_done else 0
         rows.append([c.omega] + [float(c.rev_lat[k]) * 1e3 if k < done else "-" for k in range(nrev)])
@@ -95,7 +97,8 @@ def _per_revolution(cases: list[NLCase]) -> list[str]:
 def _newton_table(cases: list[NLCase], params: Params) -> list[str]:
     cols = [Column("omega", "f", 7, 2), Column("steps", "i", 7), Column("solves", "i", 8),
             Column("per step", "f", 8, 3), Column("max", "i", 4), Column("cuts", "i", 5), Column("deepest", "i", 7)]
-    rows, trailers = [], []
+    rows: list[list[Cell]] = []
+    trailers: list[str] = []
     for c in cases:
         rows.append([c.omega, c.steps_done, c.solves, c.solves / max(c.steps_done, 1), c.max_solves, c.cuts,
                      c.deepest_cut])
@@ -197,7 +200,7 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
     alpha, beta = rayleigh(params.damping_ratio, w_bend, w_axial)
     n = params.n_elements
     static = static_onset(model, n)
-    derived = dict(w_bend=w_bend, w_axial=w_axial, p_euler=p_euler, alpha=alpha, beta=beta, onset=static)
+    derived = Derived(w_bend=w_bend, w_axial=w_axial, p_euler=p_euler, alpha=alpha, beta=beta, onset=static)
     tol, limit = params.growth_tolerance, params.large_deflection * model.length
     pairs: list[tuple[Case, NLCase]] = []
     for w in tqdm(params.speeds, desc="slidercrank nonlinear", unit="speed", disable=not progress):

@@ -94,6 +94,7 @@ def _list_column(base: Mapping[str, Any], key: str, whole: Any, elements: dict[i
 def _choice_column(base: Mapping[str, Any], key: str, columns: dict[str, Any], nd: int) -> np.ndarray:
     v = np.broadcast_to(np.asarray(columns.get(key, base[key]), dtype=object), (nd,))
     allowed = _KEYS[key].choices
+    assert allowed is not None   # called for the choice keys only
     bad = ~np.isin(v, allowed)
     if bad.any():
         raise _bad(base, key, f"must be one of {', '.join(map(repr, allowed))} (got {v[np.argmax(bad)]!r})")
@@ -174,13 +175,14 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
         raise _bad(base, "axes", "the base deck's 'axes' fix the joint and plane angles; a batch cannot vary "
                                  "'beta' or 'rho' then")
     if axes:   # as _geometry (the base deck is valid): kernel radians -> degrees
-        b, r, _ = ujoint_geometry(np.asarray(base["axes"], dtype=np.float64).reshape(-1, 3))
-        beta = np.broadcast_to(b / DEG, (nd, b.size))
-        rho = np.broadcast_to(r / DEG, (nd, r.size))
+        b_rad, r_rad, _ = ujoint_geometry(np.asarray(base["axes"], dtype=np.float64).reshape(-1, 3))
+        beta: np.ndarray = np.broadcast_to(b_rad / DEG, (nd, b_rad.size))
+        rho: np.ndarray | None = np.broadcast_to(r_rad / DEG, (nd, r_rad.size))
     else:
-        beta = _list_column(base, "beta", cols.get("beta"), elems.get("beta", {}), nd)
-        if beta is None:
+        given_beta = _list_column(base, "beta", cols.get("beta"), elems.get("beta", {}), nd)
+        if given_beta is None:
             raise _bad(base, None, "give the joint angles 'beta' (deg) or the shaft directions 'axes'")
+        beta = given_beta
         rho = _list_column(base, "rho", cols.get("rho"), elems.get("rho", {}), nd)
     n = beta.shape[1]
     bad = ~((beta > -90.0) & (beta < 90.0))
@@ -194,7 +196,9 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
                                   "(0 = in phase), not both")
     if given:
         key = given.pop()
-        phi = _list_column(base, key, cols.get(key), elems.get(key, {}), nd)
+        given_phi = _list_column(base, key, cols.get(key), elems.get(key, {}), nd)
+        assert given_phi is not None   # the key is given
+        phi = given_phi
         if phi.shape[1] != n - 1:
             raise _bad(base, key, f"a chain of {n} joint(s) has {n - 1} intermediate shaft(s), so "
                                   f"{n - 1} phase(s); got {phi.shape[1]}")
@@ -220,6 +224,7 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     res = np.empty((nd, len(UJOINT_SUMMARY_COLUMNS)))
     rho_rad = None if rho is None else rho * DEG
     layout = np.stack([code, kind, grid])
+    groups: list[tuple[np.ndarray, slice | np.ndarray]]
     if nd == 0:
         groups = []
     elif (layout == layout[:, :1]).all():
