@@ -33,8 +33,9 @@ def _echo(p: Params) -> list[str]:
     return [f"  {name:<24}{fortran_f(v, 12, 4)} {u}".rstrip() for name, v, u in rows]
 
 
-def listing_text(p: Params, table: np.ndarray, status: np.ndarray) -> list[str]:
-    """The listing's output file: its header (format 15), column line and rows (format 25)."""
+def listing_text(p: Params, table: np.ndarray, status: np.ndarray) -> tuple[list[str], list[Column]]:
+    """The listing's output file: its header (format 15), column line and rows (format 25);
+    and the table's columns."""
     head = ["", "", "",
             f"  panjang OA-OB (fixed link):  {fortran_f(p.fixed_link, 5, 2, 'legacy')}",
             f"  panjang poros engkol (crank/driver):  {fortran_f(p.crank, 5, 2, 'legacy')}",

@@ -324,7 +324,7 @@ def run_optimize_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, 
     if not quiet:
         for path in oc.written:
             print(f"wrote {path}")
-        if oc.best is not None:
+        if oc.best is not None and oc.x is not None:   # x is the best design's
             word = "optimum" if oc.success else "best design (not converged)"
             print(f"{deck.path}: {word} {p_obj(oc)} after {oc.nfev} designs: "
                   + ", ".join(f"{k} = {v:.6g}" for k, v in oc.x.items()))

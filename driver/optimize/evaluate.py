@@ -21,17 +21,20 @@ import re
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
 
 from driver import blas, expr, limits
-from driver.deck import DeckError, Params, RawGroup, validate
 from driver._study import load_study
+from driver.deck import DeckError, Params, RawGroup, validate
 from driver.optimize import journal as journal_file
 from driver.optimize.problem import Problem
 from driver.runner import NUMERICAL, CaseFailure, compute, numerical_error
+
+if TYPE_CHECKING:   # pragma: no cover - dask is an optional dependency
+    from dask.distributed import Client
 
 __all__ = ["Evaluator", "evaluate_cases", "FAILED_VIOLATION"]
 
@@ -80,6 +83,8 @@ def evaluate_cases(group: str, deck_path: str, raw: RawGroup, keys: list[str], k
     before it runs, numerical failures in words, no NaN/inf/'****' in what it would write.
     """
     module = load_study(group)
+    if module is None:   # the problem was built from this study's deck
+        raise ValueError(f"no study reads namelist group &{group}")
     out: list[tuple[str, str, dict]] = []
     for x in xs:
         try:
@@ -167,7 +172,7 @@ class Evaluator:
                  resumed: list[dict] | None = None, scheduler: Any = None):
         self.problem = problem
         self.scheduler = scheduler      # a Dask scheduler address or Client: batches go to its workers
-        self._client = None
+        self._client: Client | None = None
         self.jobs = jobs if jobs > 0 else (os.cpu_count() or 1)
         self.records: list[Record] = []
         self.cache: dict[tuple[float, ...], int] = {}
@@ -175,7 +180,7 @@ class Evaluator:
         self.keys = _slots(problem)
         self.kinds = [problem.study.spec.keys[v.key].kind for v in problem.variables]
         self.journal = journal
-        self._journal_fh = None
+        self._journal_fh: IO[str] | None = None
         #: what a resume found wrong with the records it was given (driver.optimize.journal), or ''
         self.resume_note = ""
         self._pool: cf.ProcessPoolExecutor | None = None
@@ -201,7 +206,7 @@ class Evaluator:
             self._journal_fh.close()
             self._journal_fh = None
 
-    def __enter__(self) -> "Evaluator":
+    def __enter__(self) -> Evaluator:
         return self
 
     def __exit__(self, *exc: Any) -> None:
@@ -327,6 +332,7 @@ class Evaluator:
         for c in p.constraints:
             numeric = c.numeric
             if numeric:
+                assert c.left is not None and c.right is not None   # set on every numeric constraint
                 try:
                     a, b = _values(c.left, frame), _values(c.right, frame)
                 except expr.ExprError:      # 'a == b' over text columns: a condition after all

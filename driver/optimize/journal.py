@@ -85,7 +85,7 @@ def table_records(frame: Any, names: list[str]) -> list[dict]:
     for rec in frame.to_dict("records"):
         summary = {c[len("summary."):]: (None if isinstance(rec[c], float) and math.isnan(rec[c]) else rec[c])
                    for c in summ}
-        summary = {k: (v.item() if hasattr(v, "item") else v) for k, v in summary.items()}
+        summary = {k: (v.item() if v is not None and hasattr(v, "item") else v) for k, v in summary.items()}
         reason = rec["case_error"]
         out.append(record(str(rec["base"]), [rec[n] for n in names], str(rec["status"]),
                           "" if reason is None or (isinstance(reason, float) and math.isnan(reason)) else str(reason),
