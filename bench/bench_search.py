@@ -121,7 +121,7 @@ def dask_estimate(tmp: Path, linkages: int) -> None:
     """The driver's CPU per phase on a loopback Dask cluster, and the 10^9 estimate."""
     sys.path.insert(0, str(ROOT / "bench"))
     import bench_dask_cluster as bdc
-    from driver import sweep_batch
+    from driver.sweep import batch as sweep_batch
     cranks = -(-linkages // PER_CRANK)
     n = cranks * PER_CRANK
     deck = tmp / "dask.dat"

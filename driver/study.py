@@ -41,7 +41,7 @@ __all__ = ["Figure", "PLOT_FORMATS", "Result", "code_digest", "column_label", "e
 
 _CORE = {"cli", "limits", "deck", "study", "table", "export", "plotting", "atomic", "kernels", "sweep", "runner", "expr",
          "optimize", "synthesis", "published", "compare", "extras", "example_decks", "examples", "api",
-         "sweep_batch", "blas", "report_page"}
+         "blas", "report_page"}
 
 
 #: file formats of ``--plot`` figures (``--plot-format``); the first is the default

@@ -28,10 +28,12 @@ the deck: a deck naming a scheduler is refused), in chunks sized so that schedul
 costs little (:mod:`driver.sweep.engine`); results are ordered by case whatever the
 scheduling.  ``--resume`` skips cases whose row is in the resume record and whose files
 are all there.  A study with a batch path runs its summary-only sweeps on
-:mod:`driver.sweep_batch`.
+:mod:`driver.sweep.batch`.
 
 The package: :mod:`~driver.sweep.spec` (the &sweep keys, the grid, cases, validation),
-:mod:`~driver.sweep.engine` (workers and scheduling), :mod:`~driver.sweep.store` (case
+:mod:`~driver.sweep.keep` (the keep filter), :mod:`~driver.sweep.engine` (the per-case
+engine: workers and scheduling), :mod:`~driver.sweep.batch` (the batch engine),
+:mod:`~driver.sweep.pool` (the local worker pool of both), :mod:`~driver.sweep.store` (case
 files and the resume record), :mod:`~driver.sweep.report` (summary tables and text).
 """
 from __future__ import annotations
@@ -47,13 +49,15 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from driver import expr, sweep_batch
+from driver import expr
 from driver.atomic import refuse_link, remove_stale_temporaries
 from driver.deck import Deck, Params, RawGroup, validate
 from driver.extras import require
 from driver.runner import compute, output_stem, study_of
 from driver.study import load_study
+from driver.sweep import batch as batch_path
 from driver.sweep import engine, store
+from driver.sweep.keep import check_keep, keep_columns
 from driver.sweep.engine import Task, auto_chunk, run_task
 from driver.sweep.report import Warnings, summary_frame, sweep_text, write_sweep_files
 from driver.sweep.spec import (EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, FULL_VALIDATION, MAX_CASES, MAX_KEYS, SPEC, Case,
@@ -101,8 +105,8 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
     grid = grid_of(sw, base_params.group, module.SPEC)
     names = grid.names
     axes = list(zip(grid.names, grid.values))
-    batchable = sweep_batch.batchable(module, names, sw.keep, sw.case_outputs)
-    limit = sweep_batch.MAX_CASES if batchable else MAX_CASES
+    batchable = batch_path.batchable(module, names, sw.keep, sw.case_outputs)
+    limit = batch_path.MAX_CASES if batchable else MAX_CASES
     if grid.n > limit:
         sizes = " x ".join(f"{len(v)} ({n})" for n, v in axes)
         raise sw.error("key1", f"{grid.n} cases ({sizes}) is beyond the {limit} cases one sweep deck "
@@ -117,10 +121,13 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
         kinds = {**expr.kinds_of({n: v[0] for n, v in axes if len(v)}), **expr.kinds_of(probe), "case": "number"}
         for key, text in named:
             try:
+                if key == "keep":
+                    check_keep(text, columns, kinds)   # one number or logical per case, before any case runs
+                    continue
                 e = expr.parse(text, columns)
-                if key == "keep" or text.strip() not in columns:   # a plotted column may hold text
-                    e.check_kinds(kinds)   # one number or logical per case, before any case runs
-                if key != "keep" and not e.names:
+                if text.strip() not in columns:   # a plotted column may hold text
+                    e.check_kinds(kinds)
+                if not e.names:
                     raise expr.ExprError("reads no column: a plot shows a column or an expression of columns",
                                          text[:60])
             except expr.ExprError as exc:
@@ -132,7 +139,7 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
                 raise sw.error("summary_columns", f"'{unknown[0]}' is not a summary column of &{base_params.group} "
                                f"(summary columns: {', '.join(probe)})")
             # what the tables show: the columns asked for, and those the filter and the plot read
-            read = {n for _, text in named for n in expr.parse(text, columns).names}
+            read = {n for k, text in named if k != "keep" for n in expr.parse(text, columns).names} | keep_columns(sw.keep)
             shown_columns = [c for c in probe if c in set(sw.summary_columns) | read]
     stem_path = output_stem(outdir, deck.path)
     scheduler = scheduler or _configured_scheduler()
@@ -147,9 +154,9 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
     run = _Run(deck, sw, base_params, module, grid, outdir, stem_path.name, layout, task_of, plot, progress, quiet,
                jobs, scheduler, resume)
     run.shown_columns = shown_columns
-    sig = store.signature(raw, names, str(deck.path), sw.keep, sw.case_outputs, formats, case_plot, module)
+    sig = store.case_signature(raw, names, str(deck.path), sw.keep, sw.case_outputs, formats, case_plot, module)
     if batchable:
-        bplan = sweep_batch.plan(module, raw, str(deck.path), grid, sw.keep, sw.summary_rows,
+        bplan = batch_path.plan(module, raw, str(deck.path), grid, sw.keep, sw.summary_rows,
                                  plotted=[v for k, v in named if k != "keep"], shown=shown_columns)
     else:
         bplan = None
@@ -346,7 +353,7 @@ class _Run:
 
     # ------------------------------------------------------------------ batch path
     def batch(self, bplan, signature: str) -> int:
-        """A sweep on the study's batch path (driver.sweep_batch); same outputs as case by case.
+        """A sweep on the study's batch path (driver.sweep.batch); same outputs as case by case.
         With case_outputs = 'kept' the kept cases then run case by case for their files, with
         their own resume record ``<stem>.sweep/cases/`` (:mod:`driver.sweep.store`)."""
         sw, names, n = self.sw, self.grid.names, bplan.grid.n
@@ -358,7 +365,7 @@ class _Run:
             if self.resume and not self.quiet:
                 print(f"resume: {resumed} of {n} cases complete, {n - resumed} to run")
 
-        rows, counts, chunk = sweep_batch.run(bplan, self.outdir / f"{self.stem}.sweep", self.jobs, self.scheduler,
+        rows, counts, chunk = batch_path.run(bplan, self.outdir / f"{self.stem}.sweep", self.jobs, self.scheduler,
                                               self.resume, self.progress, sw.chunk, announce)
         c_run = time.process_time()
         # the driver's CPU per phase (bench/bench_search.py): merging the chunks, then the tables

@@ -9,7 +9,7 @@ to worker processes or a Dask cluster.
   by one and the chunk size is chosen from the fastest of them once ``workers + 1`` have
   returned: some worker has then run its second case, so the time is a warm one (a worker's
   first case pays its cold imports).  On Dask ``workers`` is the cluster's threads.
-* Local worker processes exit when the driver dies (:func:`driver.sweep_batch.worker_init`)
+* Local worker processes exit when the driver dies (:func:`driver.sweep.pool.worker_init`)
   and ignore Ctrl-C: the driver cancels queued chunks and lets the running ones finish.
 * A worker that dies (SIGKILL, out of memory, a crash in a kernel) breaks the pool: every chunk
   then in flight is retried once, alone, in a fresh process.  A chunk that kills that process
@@ -35,15 +35,15 @@ from typing import Any, Callable, Iterable
 import numpy as np
 import pandas as pd
 
-from driver import expr
 from driver.atomic import output_set, own_folder, write_text
 from driver.deck import DeckError, Params, RawGroup, validate
 from driver.export import write_tidy
 from driver.runner import compute, write_outputs
 from driver.study import load_study
-from driver.sweep.spec import EXIT_FAILED, EXIT_OK, Case, CaseResult, _case_deck_text, _case_raw, iter_cases
+from driver.sweep.keep import keep_mask
+from driver.sweep.pool import run_pool, worker_init
+from driver.sweep.spec import EXIT_FAILED, EXIT_OK, Case, CaseResult, Grid, _case_deck_text, _case_raw, iter_cases
 from driver.sweep.store import Layout, json_default
-from driver.sweep_batch import Grid, run_pool, worker_init
 
 __all__ = ["Task", "run_task", "auto_chunk", "execute", "cluster_workers", "check_shared_folder", "DIED"]
 
@@ -72,26 +72,13 @@ class Task:
 
 # ----------------------------------------------------------------------------- worker side
 
-def _keep_mask(keep: str, rows: pd.DataFrame) -> np.ndarray:
-    """The deck's ``keep`` filter (safe expression language, :mod:`driver.expr`) on summary rows.
-
-    A row whose figures are missing (a failed case) is not kept.
-    """
-    if not keep:
-        return np.ones(len(rows), dtype=bool)
-    try:
-        return expr.parse(keep).mask(rows)
-    except expr.ExprError:   # a column absent from every row of this chunk: nothing kept
-        return np.zeros(len(rows), dtype=bool)
-
-
 def _kept_many(keep: str, results: list[CaseResult]) -> list[bool]:
     """The keep filter on a chunk of cases at once (vectorised over the chunk)."""
     ok = [r.status == EXIT_OK for r in results]
     if not keep or not results:
         return ok
     rows = pd.DataFrame([{**r.values, **r.summary} for r in results])
-    return [o and bool(k) for o, k in zip(ok, _keep_mask(keep, rows))]
+    return [o and bool(k) for o, k in zip(ok, keep_mask(keep, rows))]
 
 
 def _compute(task: Task, case: Case, module) -> tuple[CaseResult, Any, Params | None]:

@@ -15,7 +15,6 @@ import numpy as np
 
 from driver import limits
 from driver.deck import DeckError, GroupSpec, Key, Params, RawGroup, shown_value, validate
-from driver.sweep_batch import Grid
 
 __all__ = ["SPEC", "Case", "CaseResult", "MAX_KEYS", "MAX_CASES", "FULL_VALIDATION", "build_cases", "grid_of", "case_at", "iter_cases",
            "case_count", "validate_sweep", "EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT"]
@@ -100,6 +99,34 @@ def _spec() -> GroupSpec:
 
 
 SPEC = _spec()
+
+
+@dataclass
+class Grid:
+    """The swept axes: names ('group.key'), values per axis, full grid or zipped."""
+
+    names: list[str]
+    values: list[list]
+    zipped: bool
+
+    @property
+    def n(self) -> int:
+        return len(self.values[0]) if self.zipped else int(np.prod([len(v) for v in self.values]))
+
+    def indices(self, start: int, stop: int) -> list[np.ndarray]:
+        """Per axis, the value index of cases start..stop-1 (0-based; product order)."""
+        idx = np.arange(start, stop, dtype=np.int64)
+        if self.zipped:
+            return [idx] * len(self.names)
+        return list(np.unravel_index(idx, [len(v) for v in self.values]))
+
+    def columns(self, start: int, stop: int) -> dict[str, np.ndarray]:
+        return {name: _array(vals)[ix] for name, vals, ix in zip(self.names, self.values, self.indices(start, stop))}
+
+
+def _array(vals: list) -> np.ndarray:
+    a = np.asarray(vals)
+    return a if a.dtype.kind in "fiub" else np.asarray(vals, dtype=object)
 
 
 @dataclass
