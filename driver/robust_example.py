@@ -30,7 +30,8 @@ import pandas as pd
 from driver.deck import GroupSpec, Key, Params, non_empty, positive
 from driver.export import with_units
 from driver.limits import Estimate
-from driver.study import Figure, Result, keyword_run
+from driver.runner import keyword_run
+from driver.study import Figure, Result
 from driver.table import Column, render_table
 
 __all__ = ["SPEC", "run", "quadratic_fit", "analyse", "MODE_REASONS", "NOT_REPRODUCIBLE"]

@@ -6,7 +6,7 @@ defines
 
 * ``SPEC``: a :class:`driver.deck.GroupSpec` for its keys, and
 * ``run(params, progress=False) -> Result``: the physics (through its kernel),
-  decorated with :func:`keyword_run` so that Python users can also call
+  decorated with :func:`driver.runner.keyword_run` so that Python users can also call
   ``driver.<group>.run(key=value, ...)`` with the deck's keys as keyword arguments;
 
 and may define, for figures of sweeps over it,
@@ -22,13 +22,12 @@ deck selects the module.
 """
 from __future__ import annotations
 
-import functools
 import importlib
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
-from typing import TYPE_CHECKING, Any, Callable, Iterable
+from typing import TYPE_CHECKING, Any, Callable
 
 if TYPE_CHECKING:   # annotations only: keeps `python -m driver --help` light
     import pandas as pd
@@ -36,11 +35,12 @@ if TYPE_CHECKING:   # annotations only: keeps `python -m driver --help` light
 if TYPE_CHECKING:
     import matplotlib.figure
 
-__all__ = ["Figure", "PLOT_FORMATS", "Result", "code_digest", "column_label", "expression_label", "keyword_run", "load_study", "plot_format",
+__all__ = ["Figure", "PLOT_FORMATS", "Result", "code_digest", "column_label", "expression_label", "load_study", "plot_format",
            "study_names"]
 
 _CORE = {"cli", "limits", "deck", "study", "table", "export", "plotting", "atomic", "kernels", "sweep", "runner", "expr",
          "optimize", "synthesis", "published", "compare", "extras", "example_decks", "examples", "api",
+         "dispatch", "outcome", "pydeck",
          "blas", "report_page"}
 
 
@@ -136,48 +136,11 @@ class Result:
                 return f.draw()
         raise LookupError(f"no figure {name!r}; this result draws {', '.join(self.figure_names)}")
 
-    def write(self, outdir: str | Path, formats: Iterable[str] = (), plot: bool = False,
-              json: bool = False, name: str | None = None, report: bool = False) -> list[Path]:
-        """Write the outputs the command line writes: ``<outdir>/<name>.out`` and extra files,
-        tidy tables in ``formats`` ('csv', 'parquet'), PNG figures with ``plot``, the
-        summary as ``<name>.json`` with ``json``, and the self-contained report page
-        ``<name>.html`` with ``report`` (:mod:`driver.report_page`, as ``--report``).  Every
-        file is written atomically; ``outdir`` is created when missing.  Returns the paths written."""
-        from driver.runner import write_outputs
-        stem = name or self.name or self.study or "result"
-        if Path(stem).name != stem or stem in ("", ".", ".."):
-            raise ValueError(f"output name {stem!r} must be a plain file stem, not a path")
-        written = write_outputs(self, Path(outdir) / stem, list(formats), plot, summary_json=json)
-        if report:
-            from driver import report_page
-            page = report_page.page_for_result(self, None, self.params)
-            written.append(report_page.write_report(Path(outdir) / f"{stem}.html", page))
-        return written
-
     def __repr__(self) -> str:
         state = "ok" if self.ok else f"failed: {self.failure}"
         return (f"<Result {self.study or '?'} {self.name!r}: {state}; .out {len(self.text.splitlines())} lines, "
                 f"tidy {self.tidy.shape[0]}x{self.tidy.shape[1]}, summary {len(self.summary)} values, "
                 f"{len(self.warnings)} warning(s), figures {self.figure_names}>")
-
-
-def keyword_run(run: Callable[..., Result]) -> Callable[..., Result]:
-    """Decorator for a study's ``run``: accept validated Params (the runner's call) or the deck's
-    keys as keyword arguments, e.g. ``driver.fourbar.run(fixed_link=12, crank=5, coupler=15,
-    rocker=9, step_deg=20)``.  Keywords are validated by the study's SPEC exactly like a deck
-    (errors are :class:`driver.deck.DeckError`); the result is the runner's, as for a deck."""
-    group = run.__module__.rpartition(".")[2]
-
-    @functools.wraps(run)
-    def wrapper(params: Any = None, /, progress: bool = False, **keys: Any) -> Result:
-        if params is not None:
-            if keys:
-                raise TypeError(f"{group}.run() takes validated params or deck keys, not both")
-            return run(params, progress=progress)
-        from driver.api import run as api_run
-        return api_run({group: keys}, progress=progress)
-
-    return wrapper
 
 
 def load_study(group: str) -> ModuleType | None:

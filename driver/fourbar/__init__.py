@@ -22,7 +22,8 @@ from driver import kernels
 from driver.limits import Estimate
 from driver.deck import GroupSpec, Key, Params, positive
 from driver.export import with_units
-from driver.study import Figure, Result, keyword_run
+from driver.runner import keyword_run
+from driver.study import Figure, Result
 from driver.table import Column, fortran_f, render_table
 
 __all__ = ["SPEC", "run", "summarise", "summarise_batch", "BATCH_KEYS", "grashof", "limit_angles", "exact_grid",

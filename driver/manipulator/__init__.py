@@ -38,7 +38,8 @@ from driver.manipulator import report as _report
 from driver.manipulator.report import TIDY_UNITS, table_frame
 from driver.manipulator.spec import LABELS, RENAMED, SPEC, SWEEP_BEST, SWEEP_PLOT, estimate
 from driver.manipulator.tables import NOT_REPRODUCIBLE, REASONS, TEXT_REASONS, TIDY_NAMES, Table
-from driver.study import Result, keyword_run
+from driver.runner import keyword_run
+from driver.study import Result
 
 __all__ = ["SPEC", "run", "Workspace", "tolerance_box", "round_half_up", "REASONS", "NOT_REPRODUCIBLE", "TEXT_REASONS",
            "TIDY_NAMES", "TIDY_UNITS", "table_frame", "LABELS", "SWEEP_PLOT", "SWEEP_BEST", "estimate", "optima",

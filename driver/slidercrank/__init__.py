@@ -29,7 +29,8 @@ from driver.slidercrank.report import (_benchmark_lines, _convergence_table, _cr
 from driver.slidercrank.spec import (EULER_WARN, LABELS, MATERIALS, MIN_STEPS_PER_BENDING_PERIOD, MIN_STEPS_PER_REV,
                                      PAPER_SPEEDS, SIMEON1996, SPEC, STATUS_TEXT, SWEEP_PLOT, Model, _model, _shape,
                                      min_steps_per_rev, rayleigh)
-from driver.study import Figure, Result, keyword_run
+from driver.runner import keyword_run
+from driver.study import Figure, Result
 
 __all__ = ["SPEC", "run", "estimate", "MATERIALS", "PAPER_SPEEDS", "SIMEON1996", "simeon_initial_state",
            "min_steps_per_rev", "rayleigh", "static_onset", "STATUS_TEXT", "Model", "Case", "LABELS", "SWEEP_PLOT"]

@@ -31,21 +31,17 @@ import contextlib
 import hashlib
 import itertools
 import json
-import os
 import re
-import sys
-import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Iterator
+from typing import Any, Iterator
 
 import numpy as np
 import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-import driver
 from driver import expr
 from driver.atomic import DIGEST_CHARS, atomic_open, file_digest, own_folder, refuse_link
 from driver.deck import DeckError, RawGroup, validate
@@ -446,8 +442,9 @@ def _execute_dask(p: BatchPlan, todo: list[tuple[int, int]], scheduler: Any, on_
 
 def run(p: BatchPlan, folder: Path, jobs: int, scheduler: Any, resume: bool, progress: bool,
         chunk: int = 0, announce=None) -> tuple[pd.DataFrame, dict[str, int], int]:
-    """Run the whole batch sweep; returns (rows, counts, chunk size).  ``announce(resumed)``
-    is called with the number of cases found complete before anything runs."""
+    """Run the whole batch sweep; returns (rows, counts, chunk size).  ``announce(resumed, damaged)``
+    is called before anything runs with the number of cases found complete in the record and the
+    case counts of its parts that failed their checksum (dropped: their cases run again)."""
     from tqdm import tqdm
     n = p.grid.n
     # the layout depends on the grid only (not on the workers), so --resume works with any -j
@@ -460,9 +457,6 @@ def run(p: BatchPlan, folder: Path, jobs: int, scheduler: Any, resume: bool, pro
     for s in set(done) - complete:
         Path(done[s]["path"]).unlink(missing_ok=True)
     paths = {s: Path(done[s]["path"]) for s in complete}
-    if damaged:
-        print(f"warning: resume: {sum(damaged)} cases redone: {len(damaged)} record part(s) failed their "
-              "checksum (the record is verified, never believed)", file=sys.stderr)
     counts = {"ok": 0, "kept": 0, "failed": 0}
     for s in complete:
         for k in counts:
@@ -470,7 +464,7 @@ def run(p: BatchPlan, folder: Path, jobs: int, scheduler: Any, resume: bool, pro
     resumed = sum(min(s + size, n) - s for s in complete)
     todo = [r for r in ranges if r[0] not in complete]
     if announce:
-        announce(resumed)
+        announce(resumed, damaged)
     own_folder(folder, folder.parent)
     bar = tqdm(total=n, initial=resumed, unit="case", disable=not progress, dynamic_ncols=True)
 

@@ -15,9 +15,10 @@ import numpy as np
 
 from driver import limits
 from driver.deck import DeckError, GroupSpec, Key, Params, RawGroup, shown_value, validate
+from driver.outcome import ExitCode
 
 __all__ = ["SPEC", "Case", "CaseResult", "MAX_KEYS", "MAX_CASES", "FULL_VALIDATION", "build_cases", "grid_of", "case_at", "iter_cases",
-           "case_count", "validate_sweep", "EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT"]
+           "case_count", "validate_sweep"]
 
 MAX_KEYS = 9
 #: most cases one per-case sweep deck may have (a batch sweep lists no case: driver.sweep_batch.MAX_CASES)
@@ -26,7 +27,6 @@ MAX_CASES = 1_000_000
 MAX_AXIS_VALUES = 10_000_000
 #: sweeps up to this many cases have every case validated before anything runs
 FULL_VALIDATION = 5_000
-EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
 
 def _no_scheduler_in_deck(value: str) -> str:
     """Key check of ``scheduler``: a deck never chooses where the tool connects."""
@@ -135,7 +135,7 @@ class CaseResult:
 
     index: int
     values: dict[str, Any]
-    status: int = EXIT_OK
+    status: int = ExitCode.OK
     error: str = ""
     summary: dict[str, Any] = field(default_factory=dict)
     kept: bool = True

@@ -31,7 +31,8 @@ import numpy as np
 
 from driver.deck import Params
 from driver.limits import Estimate
-from driver.study import Figure, Result, keyword_run
+from driver.runner import keyword_run
+from driver.study import Figure, Result
 from driver.ujoint.analysis import (BOUND_TOL, CLUSTER_TOL, PHASE_PERIOD, SADDLE_NUDGE, SYM_TOL, TIE_RTOL, Chain,
                                     Design, StartRun, _chain, _free_index, _starts, evaluate, objective_scale,
                                     optimise, phases_for, pick_best, yoke_shifts)
