@@ -13,7 +13,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import math
-import textwrap
+import re
 import warnings
 from pathlib import Path
 from typing import Any, Callable, Iterator, Sequence, TypeVar
@@ -47,6 +47,28 @@ def plain_text(text: Any) -> str:
     builder passes deck text through this one function."""
     text = "".join(ch for ch in str(text) if ch.isprintable() or ch == "\n")
     return text.replace("$", r"\$")
+
+
+def wrap(text: str, width: int) -> str:
+    """``text`` filled to lines of about ``width`` characters like :func:`textwrap.fill`, but a
+    mathtext span (``$|\\tau_1| + |\\tau_2|$``) is never broken across lines: matplotlib
+    parses each line on its own, and half a span would be drawn as its raw source."""
+    tokens = re.findall(r"(?:[^\s$\\]|\\.|(?<!\\)\$(?:[^$\\]|\\.)*\$)+", text)
+    if re.sub(r"\s+", "", "".join(tokens)) != re.sub(r"\s+", "", text):   # an unpaired $: no span to keep whole
+        import textwrap
+        return textwrap.fill(text, width)
+    lines: list[str] = []
+    line = ""
+    for tok in tokens:
+        shown = len(re.sub(r"\\[A-Za-z]+|[{}_^$]", "", tok)) or 1
+        if line and len(re.sub(r"\\[A-Za-z]+|[{}_^$]", "", line)) + 1 + shown > width:
+            lines.append(line)
+            line = tok
+        else:
+            line = f"{line} {tok}" if line else tok
+    if line:
+        lines.append(line)
+    return "\n".join(lines)
 
 
 @contextlib.contextmanager
@@ -414,7 +436,7 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
     labels = labels or {}
     only_points = False
     # a label that is the column's own name may be deck text (an expression): drawn literally
-    label = lambda c: textwrap.fill(labels.get(c, c) if labels.get(c, c) != c else plain_text(c), 28)  # noqa: E731
+    label = lambda c: wrap(labels.get(c, c) if labels.get(c, c) != c else plain_text(c), 28)  # noqa: E731
     x = x or next((k for k in keys if pd.api.types.is_numeric_dtype(frame[k])), "case")
     if ys:
         ys = list(ys)
@@ -749,7 +771,7 @@ def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, 
         if a.get_subplotspec() is None or a.get_subplotspec().is_first_col() or n == 1:
             a.set_ylabel(lab(ky))
     if brow is not None and best_text:   # the best design's values, under the panels
-        fig.supxlabel("\u2605 " + textwrap.fill(best_text, 110), fontsize=8.5, color="0.15")
+        fig.supxlabel("\u2605 " + wrap(best_text, 110), fontsize=8.5, color="0.15")
     cb = fig.colorbar(image, ax=list(axes[:n]), shrink=0.9, pad=0.02)
     cb.set_label(lab(metric))
     _plain_numbers(cb.ax)
@@ -783,7 +805,7 @@ def convergence_plot(history, evals, objective: str, sense: str = "minimize", ti
     else:
         fig = axes[0].figure
     a1, a2, a3 = axes
-    objective = textwrap.fill(objective, 40)
+    objective = wrap(objective, 40)
     ev = evals.sort_values("eval")
     feas = ev[ev["feasible"].astype(bool)]
     sign = -1.0 if sense.startswith("max") else 1.0

@@ -25,7 +25,6 @@ import math
 import platform
 import re
 import sys
-import textwrap
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Iterable, Sequence
@@ -73,6 +72,9 @@ def plain(label: str) -> str:
     an escaped ``\\$`` (deck text) as the dollar sign it stands for."""
     def math(m: re.Match) -> str:
         t = m.group(1)
+        t = re.sub(r"\\overline\{([^{}]*)\}", r"mean(\1)", t)   # \overline{d^2}: the mean of d^2
+        t = re.sub(r"\\sqrt\{([^{}]*)\}", "\u221a\\1", t)
+        t = re.sub(r"\^\{?2\}?", "\u00b2", t)
         t = re.sub(r"\\([A-Za-z]+)", lambda g: _GREEK.get(g.group(1), g.group(1)), t)
         t = re.sub(r"_\{([0-9]+)\}|_([0-9])", lambda g: (g.group(1) or g.group(2)).translate(_SUB), t)
         return t.replace("{", "").replace("}", "")
@@ -737,7 +739,7 @@ def _evaluated_map(frame: "pd.DataFrame", design: Sequence[str], objective: str,
                         cmap="viridis", label="feasible designs", rasterized=len(feas) > 2000)
         ax.plot([frame.loc[opt, x]], [frame.loc[opt, y]], "*", ms=16, color="C3", mec="k", label="optimum")
         cb = fig.colorbar(sc, ax=ax)
-        cb.set_label(textwrap.fill(objective, 40))
+        cb.set_label(plotting.wrap(objective, 40))
         plotting._plain_numbers(cb.ax)
         ax.set_xlabel(labels.get(x, x))
         ax.set_ylabel(labels.get(y, objective) if y != "objective" else objective)

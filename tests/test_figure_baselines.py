@@ -65,7 +65,20 @@ def _convergence():
     from driver import plotting
     history = pd.read_csv(ROOT / "outputs" / "optimize_manipulator_torque_history.csv")
     evals = pd.read_parquet(ROOT / "outputs" / "optimize_manipulator_torque_evals.parquet")
-    return plotting.convergence_plot(history, evals, "design torque sum [N m]", "minimize", title="convergence")
+    from driver.study import expression_label   # the label the optimiser gives it (mathtext symbols)
+    return plotting.convergence_plot(history, evals, expression_label(driver.manipulator, "design_torque_demand_Nm"),
+                                     "minimize", title="convergence")
+
+
+def _manipulator_search():
+    """The shipped manipulator design search's map (its labels carry mathtext symbols)."""
+    from driver import plotting
+    from driver.study import column_label
+    frame = pd.read_parquet(ROOT / "outputs" / "manipulator_design_search_summary.parquet")
+    labels = {c: column_label(driver.manipulator, c) for c in frame.columns}
+    return plotting.sweep_maps(frame, ["manipulator.designs_l1", "manipulator.designs_l2"],
+                               ["design_torque_demand_Nm"], labels, driver.manipulator.SWEEP_BEST,
+                               "manipulator design search", True)[0]
 
 
 def _sweep_strips():
@@ -108,6 +121,7 @@ KINDS = {
     "design_space_2_keys": lambda: _design_map(2),
     "design_space_3_keys": lambda: _design_map(3),
     "convergence": _convergence,
+    "manipulator_design_search": _manipulator_search,
     "sweep_strips": _sweep_strips,
     "ujoint_speed": lambda: _result_figure("ujoint_option1.dat", "speed"),
     "ujoint_polar": lambda: _result_figure("ujoint_option1.dat", "polar"),

@@ -133,3 +133,65 @@ def test_figure_functions_draw_into_a_users_axes():
     out, st = exact_grid(r.params, theta)
     assert plotting.fourbar_curves(tidy_frame("exact", theta, _exact_columns(out, st), st), None, "",
                                    axes=axes3) is fig3
+
+
+def test_manipulator_labels_set_their_symbols_in_mathtext():
+    """The manipulator's summary labels name l1, l2, tau1, tau2, RI2, C_rob as mathtext symbols
+    (the renamed torque columns included), render, and the design-search map shows them."""
+    import matplotlib.pyplot as plt
+    import pandas as pd
+
+    from conftest import ROOT
+    from driver import plotting
+    from driver.study import column_label
+    m = driver.manipulator
+    want = {"design_tau_sum_signed_Nm": r"$\tau_1 + \tau_2$", "design_torque_demand_Nm": r"$|\tau_1| + |\tau_2|$",
+            "design_peak_torque_Nm": r"$\max(|\tau_1|, |\tau_2|)$", "sweep_min_tau_sum_signed_Nm": r"$\tau_1 + \tau_2$",
+            "design_l1_m": "$l_1$", "design_l2_m": "$l_2$", "design_ri2": "$RI_2$", "crob_radius_m": "$C_{rob}$",
+            "designs_l1": "$l_1$", "designs_l2": "$l_2$", "design_ri2_excess": r"$RI_2 - \sqrt{n}$"}
+    fig = plt.figure()
+    for name, symbol in want.items():
+        label = column_label(m, name)
+        assert symbol in label, (name, label)
+        t = fig.text(0, 0, label)
+        assert _is_math(t)
+    fig.canvas.draw()   # every label parses as mathtext
+    import re
+    for name, (words, units) in m.LABELS.items():   # no ASCII symbol left outside the mathtext
+        outside = re.sub(r"\$[^$]*\$", "", f"{words} [{units}]")
+        for ascii_ in ("tau", " l1", " l2", "RI", "C_rob", "sqrt", "^"):
+            assert ascii_ not in outside, (name, words, units)
+    plt.close(fig)
+    frame = pd.read_parquet(ROOT / "outputs" / "manipulator_design_search_summary.parquet")
+    keys = ["manipulator.designs_l1", "manipulator.designs_l2"]
+    labels = {c: column_label(m, c) for c in frame.columns}
+    fig = plotting.sweep_maps(frame, keys, ["design_torque_demand_Nm"], labels, m.SWEEP_BEST, "search", True)[0]
+    fig.canvas.draw()
+    texts = [a.get_xlabel() for a in fig.axes] + [a.get_ylabel() for a in fig.axes]
+    assert "design link length $l_1$ [m]" in texts and "design link length $l_2$ [m]" in texts
+    assert any(r"$|\tau_1| + |\tau_2|$" in t for t in texts)   # the colour bar
+
+
+def test_report_page_writes_manipulator_symbols_as_unicode():
+    from driver.report_page import plain
+    from driver.study import column_label
+    m = driver.manipulator
+    assert plain(column_label(m, "design_torque_demand_Nm")) == \
+        "design torque demand |\u03c4\u2081| + |\u03c4\u2082| at the target [N m]"
+    assert plain(column_label(m, "design_ri2_excess")) == "design RI\u2082 - \u221an [-]"
+    assert plain(column_label(m, "crob_c_m2")) == "C_rob: l\u2081\u00b2 + l\u2082\u00b2 [m\u00b2]"
+    assert plain(r"cost \$x\$ of $\omega_2$") == "cost $x$ of \u03c9\u2082"
+
+
+def test_a_wrapped_label_keeps_each_mathtext_span_on_one_line():
+    """Long labels are wrapped onto lines; each line is parsed on its own, so a span
+    ($|\\tau_1| + |\\tau_2|$) cut in two would be drawn as raw source."""
+    from driver import plotting
+    label = driver.study.column_label(driver.manipulator, "design_torque_demand_Nm")
+    for width in (10, 20, 30, 40):
+        lines = plotting.wrap(label, width).split("\n")
+        assert len(lines) > 1
+        for line in lines:
+            assert line.replace(r"\$", "").count("$") % 2 == 0, line
+        assert " ".join(lines) == label
+    assert plotting.wrap("cost $ more than a long line", 10).replace("\n", " ") == "cost $ more than a long line"

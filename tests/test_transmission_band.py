@@ -89,3 +89,72 @@ def test_the_synthesised_linkage_carries_the_synthesis_band(tmp_path):
     assert syn.linkage["transmission_band_deg"] == [p.transmission_min_deg, p.transmission_max_deg]
     assert f"{p.transmission_min_deg:g}-{p.transmission_max_deg:g} deg band" in syn.study_result.text
     assert "/" not in syn.linkage["title"] and "synthesis_path" in syn.linkage["title"]   # no file path in the title
+
+
+def _parquet_band(path) -> list[float]:
+    """The band recorded in a Parquet table's schema metadata (read with pyarrow, not pandas:
+    any reader of the file sees it)."""
+    import json
+
+    import pyarrow.parquet as pq
+    meta = pq.read_schema(path).metadata or {}
+    return json.loads(meta[b"PANDAS_ATTRS"])["summary_settings"]["transmission_band_deg"]
+
+
+@pytest.mark.parametrize("case_outputs, path", [("none", "batch"), ("all", "case")])
+def test_the_summary_table_records_the_band_it_was_judged_by(tmp_path, case_outputs, path):
+    """The Parquet summary carries the band its meets_transmission_band column used, on both
+    engines (batch path and case by case), and the column agrees with that band by the closed form."""
+    import pandas as pd
+    cranks = [2.0, 3.0, 4.0, 5.0]
+    out = tmp_path / "o"
+    driver.run_sweep({"fourbar": dict(fixed_link=12.0, crank=3.0, coupler=15.0, rocker=9.0, step_deg=10,
+                                      transmission_band_deg=[30, 150])},
+                     grid={"crank": cranks}, case_outputs=case_outputs, jobs=1, outdir=out, name="bandsweep")
+    parts = [p.name for p in (out / "bandsweep.sweep").glob("part-*.parquet")]
+    assert parts and (all(n.startswith("part-r") for n in parts) == (path == "case"))
+    f = out / "bandsweep_summary.parquet"
+    lo, hi = _parquet_band(f)
+    assert (lo, hi) == (30.0, 150.0)
+    table = pd.read_parquet(f)
+    assert table.attrs["summary_settings"] == {"transmission_band_deg": [30.0, 150.0]}
+    for a, met in zip(table["fourbar.crank"], table["meets_transmission_band"]):
+        lo_mu, hi_mu = _mu_extremes(12.0, a, 15.0, 9.0)
+        assert met is (lo <= lo_mu and hi_mu <= hi)
+    assert "transmission_band_deg        30, 150" in (out / "bandsweep.out").read_text()
+
+
+def test_a_swept_band_is_a_column_not_table_metadata():
+    from driver import fourbar
+    from driver.sweep.report import summary_settings
+    base = {"crank": 3.0, "transmission_band_deg": [30, 150]}
+    assert summary_settings(fourbar, base) == {"transmission_band_deg": [30.0, 150.0]}
+    assert summary_settings(fourbar, base, {"transmission_band_deg"}) == {}
+
+
+def test_shipped_outputs_record_the_band():
+    """The committed summary and evals tables of the four-bar sweeps and optimisations state the
+    band (the paper's 40-120 deg: their decks give no other)."""
+    from conftest import ROOT
+    for name in ("fourbar_design_search_summary", "fourbar_paper_sweep_summary",
+                 "optimize_fourbar_design_evals", "optimize_crank_rocker_evals"):
+        assert _parquet_band(ROOT / "outputs" / f"{name}.parquet") == [40.0, 120.0]
+    text = (ROOT / "outputs" / "optimize_fourbar_design.out").read_text()
+    assert "transmission_band_deg = 40, 120   (base deck; used by meets_transmission_band)" in text
+
+
+def test_an_optimisation_states_the_band_it_constrains_by(tmp_path):
+    """An optimisation constrained by meets_transmission_band with a 30-150 deg band says so in
+    its .out and records the band in its _evals table."""
+    from driver.optimize import optimize
+    deck = tmp_path / "opt.dat"
+    deck.write_text("&fourbar\n fixed_link = 12, crank = 3, coupler = 15, rocker = 9, step_deg = 10\n"
+                    " transmission_band_deg = 30, 150\n/\n"
+                    "&optimize\n var1 = 'fourbar.crank', lower1 = 1, upper1 = 4\n"
+                    " maximize = 'mu_min_deg'\n constraint1 = 'meets_transmission_band'\n"
+                    " method = 'grid', grid_count = 7\n/\n")
+    oc = optimize(deck, outdir=tmp_path / "o")
+    text = (tmp_path / "o" / "opt.out").read_text()
+    assert "transmission_band_deg = 30, 150   (base deck; used by meets_transmission_band)" in text
+    assert _parquet_band(tmp_path / "o" / "opt_evals.parquet") == [30.0, 150.0]
+    assert oc.best is not None

@@ -93,8 +93,9 @@ LABELS = {"crank": ("crank length", "length units"), "coupler": ("coupler length
 #: which way a summary column is better (the design-space maps star the best kept design)
 SWEEP_BEST = {"mu_min_deg": "max", "mu_max_deg": "min", "rocker_swing_deg": "max", "omega3_peak_rad_s": "min",
               "omega2_peak_rad_s": "min"}
-#: keys of the base deck a sweep's .out states because summary columns depend on them
-SUMMARY_SETTINGS = ("transmission_band_deg",)
+#: keys of the base deck the summary columns depend on -> those columns: a sweep's .out and an
+#: optimisation's .out state them, and the summary/evals Parquet tables record them in their metadata
+SUMMARY_SETTINGS = {"transmission_band_deg": ("meets_transmission_band",)}
 #: what a sweep summary plots when its deck names no plot_y
 SWEEP_PLOT = ("mu_min_deg", "mu_max_deg", "rocker_swing_deg", "omega3_peak_rad_s", "omega2_peak_rad_s",
               "assembled_fraction")

@@ -69,23 +69,25 @@ def _cross_check(p: Params) -> None:
 
 
 #: axis labels of summary columns and deck keys (driver.study.column_label): name -> (words, units)
-LABELS = {"r_m": ("inner workspace radius r", "m"), "R_m": ("outer workspace radius R", "m"),
-          "mean_d2_m2": ("mean squared point distance", "m^2"), "crob_radius_m": ("C_rob radius", "m"),
-          "crob_c_m2": ("C_rob l1^2 + l2^2", "m^2"), "ri2_min": ("minimum RI2", "-"),
-          "dexterity_l1_m": ("dexterity optimum l1", "m"), "dexterity_l2_m": ("dexterity optimum l2", "m"),
-          "manipulability_l1_m": ("manipulability optimum l1", "m"),
-          "manipulability_l2_m": ("manipulability optimum l2", "m"),
-          "sweep_min_tau_sum_signed_Nm": ("least signed tau1 + tau2 along C_rob (the report's total torque)", "N m"),
-          "sweep_min_l1_m": ("l1 of the least torque", "m"), "sweep_min_l2_m": ("l2 of the least torque", "m"),
-          "mass_per_length": ("link mass per length", "kg/m"), "gravity": ("gravity", "m/s^2"),
-          "design_l1_m": ("design l1", "m"), "design_l2_m": ("design l2", "m"), "design_ri1": ("design RI1", "-"),
-          "design_ri2": ("design RI2", "-"), "design_ri3": ("design RI3", "-"),
-          "design_ri2_excess": ("design RI2 - sqrt(n)", "-"),
-          "design_crob_residual_m2": ("design l1^2 + l2^2 - mean d^2", "m^2"),
-          "design_tau_sum_signed_Nm": ("design signed tau1 + tau2 at the target (not a demand)", "N m"),
-          "design_torque_demand_Nm": ("design torque demand |tau1| + |tau2| at the target", "N m"),
-          "design_peak_torque_Nm": ("design peak joint torque max(|tau1|, |tau2|) at the target", "N m"),
-          "designs_l1": ("design link length l1", "m"), "designs_l2": ("design link length l2", "m")}
+LABELS = {"r_m": ("inner workspace radius $r$", "m"), "R_m": ("outer workspace radius $R$", "m"),
+          "mean_d2_m2": ("mean squared point distance $\\overline{d^2}$", "m$^2$"),
+          "crob_radius_m": ("$C_{rob}$ radius", "m"),
+          "crob_c_m2": ("$C_{rob}$: $l_1^2 + l_2^2$", "m$^2$"), "ri2_min": ("minimum $RI_2$", "-"),
+          "dexterity_l1_m": ("dexterity optimum $l_1$", "m"), "dexterity_l2_m": ("dexterity optimum $l_2$", "m"),
+          "manipulability_l1_m": ("manipulability optimum $l_1$", "m"),
+          "manipulability_l2_m": ("manipulability optimum $l_2$", "m"),
+          "sweep_min_tau_sum_signed_Nm": ("least signed $\\tau_1 + \\tau_2$ along $C_{rob}$ (the report's total torque)",
+                                          "N m"),
+          "sweep_min_l1_m": ("$l_1$ of the least torque", "m"), "sweep_min_l2_m": ("$l_2$ of the least torque", "m"),
+          "mass_per_length": ("link mass per length", "kg/m"), "gravity": ("gravity $g$", "m/s$^2$"),
+          "design_l1_m": ("design $l_1$", "m"), "design_l2_m": ("design $l_2$", "m"),
+          "design_ri1": ("design $RI_1$", "-"), "design_ri2": ("design $RI_2$", "-"), "design_ri3": ("design $RI_3$", "-"),
+          "design_ri2_excess": ("design $RI_2 - \\sqrt{n}$", "-"),
+          "design_crob_residual_m2": ("design $l_1^2 + l_2^2 - \\overline{d^2}$", "m$^2$"),
+          "design_tau_sum_signed_Nm": ("design signed $\\tau_1 + \\tau_2$ at the target (not a demand)", "N m"),
+          "design_torque_demand_Nm": ("design torque demand $|\\tau_1| + |\\tau_2|$ at the target", "N m"),
+          "design_peak_torque_Nm": ("design peak joint torque $\\max(|\\tau_1|, |\\tau_2|)$ at the target", "N m"),
+          "designs_l1": ("design link length $l_1$", "m"), "designs_l2": ("design link length $l_2$", "m")}
 #: summary columns renamed (old -> new): a deck naming an old one is told the new name
 RENAMED = {"design_total_torque_Nm": "design_tau_sum_signed_Nm (signed; the demand is design_torque_demand_Nm)",
            "sweep_min_total_torque_Nm": "sweep_min_tau_sum_signed_Nm"}

@@ -305,6 +305,8 @@ def _write(oc: OptimizeOutcome, stem: Path, params, formats: list[str], plot: bo
         written += write_outputs(oc.study_result, opt_stem, formats, plot)
     evals = ev.frame()
     evals.insert(1, "base", p.fingerprint())
+    if report.settings_of(p):   # the band behind summary.meets_transmission_band, with the table
+        evals.attrs["summary_settings"] = report.settings_of(p)
     hist = report.history_frame(p, oc.history)
     text = report.report_text(p, ev, oc.method, oc.history, oc.best, oc.check, files,
                               ev.jobs, list(oc.study_result.warnings) if oc.study_result is not None else [])

@@ -59,7 +59,7 @@ from driver.sweep import batch as batch_path
 from driver.sweep import engine, store
 from driver.sweep.keep import check_keep, keep_columns
 from driver.sweep.engine import Task, auto_chunk, run_task
-from driver.sweep.report import Warnings, summary_frame, sweep_text, write_sweep_files
+from driver.sweep.report import Warnings, summary_frame, summary_settings, sweep_text, write_sweep_files
 from driver.sweep.spec import (FULL_VALIDATION, MAX_CASES, MAX_KEYS, SPEC, Case,
                                CaseResult, _axes, _configured_scheduler, build_cases, case_count, grid_of,
                                validate_sweep)
@@ -315,7 +315,8 @@ class _Run:
         text = sweep_text(self.deck, sw, self.base, self.axes, n, frame, n_kept,
                           [(r.index, r.values, r.error) for r in failed], sw.summary_rows)
         cases = pieces.table(written)
-        write_sweep_files(self.outdir, self.stem, table, cases, text, self.plot, sw, names, self.module, frame)
+        write_sweep_files(self.outdir, self.stem, table, cases, text, self.plot, sw, names, self.module, frame,
+                          self._settings())
         store.remove_stale_case_files(layout, has_files)
         store.clean_temporaries(layout)   # of workers of a killed earlier run that outlived its start
         oc.phases["finish_cpu"] = time.process_time() - c_end
@@ -329,6 +330,10 @@ class _Run:
         self._failed([(r.index, r.values, r.error, r.status) for r in failed])
         oc.written += [self.outdir / f"{self.stem}.out", *(self.outdir / f"{self.stem}_summary.{fmt}" for fmt in ("csv", "parquet"))]
         return oc
+
+    def _settings(self) -> dict:
+        """The base deck's settings the summary columns depend on (recorded with the table)."""
+        return summary_settings(self.module, self.base, {name.partition(".")[2] for name, _ in self.axes})
 
     def _say_redone(self, record: store.Record, what: str = "cases") -> None:
         """One warning when a resume found record parts or case files that failed their
@@ -415,7 +420,8 @@ class _Run:
         text = sweep_text(self.deck, sw, self.base, self.axes, n, rows, int(rows["kept"].sum()),
                           [f[:3] for f in failed], sw.summary_rows)
         remove_stale_temporaries(self.outdir, self.stem)
-        write_sweep_files(self.outdir, self.stem, rows, cases, text, self.plot, sw, names, self.module, rows)
+        write_sweep_files(self.outdir, self.stem, rows, cases, text, self.plot, sw, names, self.module, rows,
+                          self._settings())
         if has_files is not None:
             store.remove_stale_case_files(self.layout, has_files)
         oc.phases["finish_cpu"] = time.process_time() - c_run

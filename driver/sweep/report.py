@@ -18,7 +18,33 @@ from driver.study import column_label
 from driver.sweep.spec import CaseResult
 from driver.table import Column, render_table
 
-__all__ = ["summary_frame", "sweep_text", "Warnings", "write_sweep_files"]
+__all__ = ["summary_frame", "summary_settings", "sweep_text", "Warnings", "write_sweep_files"]
+
+
+def summary_settings(module: Any, base: Params, swept: set[str] | None = None) -> dict[str, Any]:
+    """The base deck's settings the study's summary columns depend on (``module.SUMMARY_SETTINGS``,
+    e.g. the four-bar's ``transmission_band_deg`` behind ``meets_transmission_band``), as
+    {key: value}; keys in ``swept`` (swept per case, so in the table's own columns) are left out.
+    The sweep's ``.out`` prints them and its Parquet summary records them in its metadata."""
+    swept = swept or set()
+    out: dict[str, Any] = {}
+    for key in getattr(module, "SUMMARY_SETTINGS", ()):
+        if key in base and key not in swept:
+            v = base[key]
+            out[key] = [float(x) for x in v] if isinstance(v, (list, tuple)) else v
+    return out
+
+
+def with_settings(frame: pd.DataFrame, settings: dict[str, Any]) -> pd.DataFrame:
+    """``frame`` recording ``settings`` in ``frame.attrs["summary_settings"]`` (Parquet keeps
+    attrs in its schema metadata, key ``PANDAS_ATTRS``, so the table states the band its
+    ``meets_transmission_band`` column was computed with).  A shallow copy: the caller's frame
+    is left as it was."""
+    if not settings:
+        return frame
+    out = frame.copy(deep=False)
+    out.attrs = {**frame.attrs, "summary_settings": dict(settings)}
+    return out
 
 
 def summary_frame(results: list[CaseResult], names: list[str]) -> pd.DataFrame:
@@ -99,10 +125,13 @@ class Warnings:
 
 
 def write_sweep_files(outdir: Path, stem: str, table: pd.DataFrame, cases: Any, text: str,
-                      plot: bool | str, sw: Params, names: list[str], module: Any, shown: pd.DataFrame) -> None:
+                      plot: bool | str, sw: Params, names: list[str], module: Any, shown: pd.DataFrame,
+                      settings: dict[str, Any] | None = None) -> None:
     """The sweep's own files, all renamed into place together or none: ``<stem>_summary`` tables,
     ``<stem>_cases`` tables (``cases``: a DataFrame, an (Arrow table, CSV bytes) pair, or None),
-    ``<stem>.out`` and, with ``plot``, the summary figure."""
+    ``<stem>.out`` and, with ``plot``, the summary figure.  ``settings`` (:func:`summary_settings`)
+    go into the summary's Parquet metadata."""
+    table = with_settings(table, settings or {})
     with output_set(outdir):
         for fmt in ("csv", "parquet"):
             write_tidy(table, outdir / f"{stem}_summary", fmt)
@@ -149,11 +178,9 @@ def sweep_text(deck: Deck, sw: Params, base: Params, axes: list[tuple[str, list]
         lines.append(f"    {name:<28} {shown}")
     from driver.study import load_study   # settings of the base deck the summary columns depend on
     swept = {name.partition(".")[2] for name, _ in axes}
-    for key in getattr(load_study(base.group), "SUMMARY_SETTINGS", ()):
-        if key in base and key not in swept:
-            v = base[key]
-            lines.append(f"    {key:<28} " + (", ".join(f"{x:g}" for x in v) if isinstance(v, (list, tuple)) else f"{v}")
-                         + "   (base deck; used by the summary columns)")
+    for key, v in summary_settings(load_study(base.group), base, swept).items():
+        lines.append(f"    {key:<28} " + (", ".join(f"{x:g}" for x in v) if isinstance(v, (list, tuple)) else f"{v}")
+                     + "   (base deck; used by the summary columns)")
     lines += [f"    {'cases':<28} {n_cases} ({'zipped' if sw.zip else 'full grid'})",
               f"    {'case outputs':<28} {sw.case_outputs}" + (f"   keep: {sw.keep}" if sw.keep else ""),
               f"    {'kept':<28} {n_kept}",
