@@ -85,6 +85,9 @@ import json, resource, sys, time
 from pathlib import Path
 from driver import kernels, sweep
 from driver.deck import read_deck
+if sys.argv[4] == "pool":    # the worker pool even for a small sweep (the measurement before the small-sweep rule)
+    from driver.sweep import batch as sweep_batch
+    sweep_batch.POOL_MIN_SECONDS = 0.0
 if sys.argv[4] == "dense":   # the previous peak search, in this process and in the forked workers
     real = kernels.fourbar_summaries
     kernels.fourbar_summaries = lambda params, passes=7: real(params, passes | (kernels.FOURBAR_PASSES["dense_scan"]
@@ -172,7 +175,10 @@ def main(argv: list[str] | None = None) -> None:
         tmp = Path(d)
         cpu = report("shipped design search (target <= 2 us)", 25 * PER_CRANK,
                      end_to_end(tmp, "shipped", DECK.read_text()))
-        print(f"    -> {'meets' if cpu <= 2e-6 else 'misses'} the 2 us target")
+        print(f"    -> {'meets' if cpu <= 2e-6 else 'misses'} the 2 us target (a sweep this small runs in the driver: "
+              "the pool would cost more than it saves)")
+        report("the same, worker pool forced (2 workers)", 25 * PER_CRANK,
+               end_to_end(tmp, "shipped", DECK.read_text(), mode="pool"))
         n6 = 245 * PER_CRANK
         new = report("peak speeds in the filter, refined search", n6, end_to_end(tmp, "peaks", deck_text(245, PEAK_KEEP)))
         old = report("peak speeds in the filter, previous 1 deg scan", n6,

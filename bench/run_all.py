@@ -106,6 +106,19 @@ def fourbar(n: int, repeat: int) -> list[Row]:
     rows = [Row("four-bar exact states (reused buffers)", "ns/position", tk / n, tb / n, 20e-9, 5.0,
                 "writes 92 B/position (11 float64 + int32 status); 1 sincos + 3 atan2 + 20 divisions (9 of them in the atan2) + 1 sqrt",
                 floor / n)]
+    # issue 27: the default path (no out=) gets the previous call's output memory back when the
+    # caller dropped it; the baseline is the same call on fresh memory (first touch: page faults)
+    def fresh():
+        kernels.release_spares()
+        return kernels.fourbar_exact(theta, *link)
+    kernels.fourbar_exact(theta, *link, out=out, status=sts)   # (the floor above zeroed it)
+    np.testing.assert_array_equal(kernels.fourbar_exact(theta, *link)[0], out)
+    tk, tb = interleaved(lambda: kernels.fourbar_exact(theta, *link), fresh, repeat)
+    rows.append(Row("four-bar exact, default path vs fresh arrays", "ns/position",
+                    tk / n, tb / n, None, 1.3 if 92 * n >= kernels.SPARE_MIN_BYTES else None,
+                    "default path (no out=): the previous call's output memory again when the caller dropped it; "
+                    "the baseline's extra cost is the first touch of 92 B/position of new memory (page faults)",
+                    floor / n))
     u, v = 4.0, 2.0
 
     def coupler_numpy():
@@ -224,8 +237,22 @@ def slidercrank(n_el: int, spr: int, base_steps: int, repeat: int) -> list[Row]:
     ref = kernel(base_steps)["eps_ax"][0]
     np.testing.assert_allclose(base.run(base_steps), ref, rtol=1e-6, atol=1e-12 * np.abs(ref).max())
     tk, tb = interleaved(kernel, lambda: base.run(base_steps), repeat)
-    return [Row(f"slider-crank: {n_el} elements, {spr} steps", "ms/revolution", tk, tb / base_steps * spr,
+    rows = [Row(f"slider-crank: {n_el} elements, {spr} steps", "ms/revolution", tk, tb / base_steps * spr,
                 100e-3, 10.0, "sequential banded triangular solves (latency of 2 x 6 multiply-adds per unknown)")]
+
+    # issue 27: the study records the per-step profile it prints, not the three strain/force fields
+    def profile() -> dict:
+        return kernels.slidercrank_simulate(n_el, r2, length, rho_a, ea, ei, 1.5e-3, ms, omega, dt, spr, 1,
+                                            spr, alpha, beta, fields=False)
+    full = kernel()
+    np.testing.assert_array_equal(profile()["eps_max"], full["eps_ax"].max(axis=0))
+    del full
+    tk, tb = interleaved(profile, kernel, repeat)
+    rows.append(Row("slider-crank: study's record vs all fields", "ms/revolution", tk, tb, None,
+                    1.2 if 24 * n_el * spr >= 8 << 20 else None,
+                    f"the baseline writes 3 x 8 B per element and step ({24 * n_el * spr / 2**20:.0f} MiB per call, "
+                    "fresh memory: page faults); the profile 9 x 8 B per step"))
+    return rows
 
 
 SCALE = {"ns/position": 1e9, "ns/sample": 1e9, "us/config": 1e6, "us/objective": 1e6, "us/design": 1e6,

@@ -7,6 +7,8 @@ study; each kernel's physics and units are documented in ``fortran/<study>.f90``
 """
 from __future__ import annotations
 
+import sys
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -24,7 +26,7 @@ except ImportError as _exc:
     raise ImportError(f"the Fortran kernels (driver._kernels) cannot be loaded: {_exc}; reinstall "
                       f"mechanism-driver (see docs/install.md)") from _exc
 
-__all__ = ["farray", "fourbar_listing", "fourbar_exact", "fourbar_coupler_point", "fourbar_summaries",
+__all__ = ["farray", "release_spares", "fourbar_listing", "fourbar_exact", "fourbar_coupler_point", "fourbar_summaries",
            "fourbar_joint_forces", "fourbar_berkof_lowen", "fourbar_force_summaries", "FOURBAR_FORCE_SUMMARY_COLUMNS",
            "FOURBAR_SUMMARY_COLUMNS", "FOURBAR_GRASHOF", "FOURBAR_STATUS",
            "MANIPULATOR_STATUS", "manipulator_arm_states", "manipulator_torques", "manipulator_ik",
@@ -32,7 +34,7 @@ __all__ = ["farray", "fourbar_listing", "fourbar_exact", "fourbar_coupler_point"
            "MANIPULATOR_SUMMARY_PARAMS", "MANIPULATOR_SUMMARY_COLUMNS",
            "UJOINT_MODELS", "UJOINT_OBJECTIVES", "ujoint_speed", "ujoint_objective",
            "ujoint_equivalent", "ujoint_geometry", "ujoint_summaries", "UJOINT_SUMMARY_COLUMNS",
-           "SLIDERCRANK_STATUS", "slidercrank_simulate", "slidercrank_matrices", "slidercrank_rigid",
+           "SLIDERCRANK_STATUS", "SLIDERCRANK_PROFILE", "slidercrank_simulate", "slidercrank_matrices", "slidercrank_rigid",
            "slidercrank_axial_force", "slidercrank_frequencies",
            "SLIDERCRANK_NL_STATUS", "slidercrank_nl_simulate", "slidercrank_column_static",
            "slidercrank_corot_element"]
@@ -47,6 +49,43 @@ def farray(x, ndim: int | None = None) -> np.ndarray:
     if ndim is not None and a.ndim != ndim:
         raise ValueError(f"expected a {ndim}-D array, got shape {a.shape}")
     return a
+
+
+# ----------------------------------------------------------------------------- output buffers
+
+#: outputs at least this large [bytes] are kept for the next call of the same shape (smaller
+#: ones come from numpy's own cache and cost no page faults)
+SPARE_MIN_BYTES = 1 << 20
+_spares: dict[str, np.ndarray] = {}
+_spares_lock = threading.Lock()
+
+
+def _spare(name: str, shape: tuple[int, ...], dtype: type) -> np.ndarray:
+    """A fresh-to-the-caller output array of ``shape`` (Fortran order) for kernel output ``name``.
+
+    A large output array (``SPARE_MIN_BYTES`` or more) is remembered; the next call of the
+    same output and shape gets the same memory back when nobody holds it any more -- no
+    reference to it or to a view of it (numpy views and pandas columns built without a copy
+    hold their base) -- instead of new memory whose first touch costs a page fault per 4 KiB
+    (at 10^6 four-bar positions, 88 MB: most of the call).  An array still held anywhere is
+    never handed out again: the caller then gets new memory, which becomes the spare."""
+    dtype = np.dtype(dtype)
+    if int(np.prod(shape)) * dtype.itemsize < SPARE_MIN_BYTES:
+        return np.empty(shape, dtype=dtype, order="F")
+    with _spares_lock:
+        a = _spares.get(name)
+        # held only by the dict, the local name and getrefcount's argument: nobody else has it
+        if a is not None and a.shape == shape and a.dtype == dtype and sys.getrefcount(a) == 3:
+            return a
+        a = np.empty(shape, dtype=dtype, order="F")
+        _spares[name] = a
+        return a
+
+
+def release_spares() -> None:
+    """Forget the remembered output arrays (their memory is freed once nobody holds them)."""
+    with _spares_lock:
+        _spares.clear()
 
 
 # ----------------------------------------------------------------------------- four-bar
@@ -83,12 +122,12 @@ def fourbar_exact(theta: np.ndarray, p: float, q: float, r: float, s: float, ome
     theta = farray(np.atleast_1d(theta), 1)
     n = theta.shape[0]
     if out is None:
-        out = np.empty((n, 11), dtype=np.float64, order="F")
+        out = _spare("fourbar_exact.out", (n, 11), np.float64)
     elif not (out.flags.f_contiguous and out.dtype == np.float64 and out.shape == (n, 11)):
         raise ValueError("out must be a Fortran-ordered float64 array of shape (n, 11); "
                          "f2py would otherwise work on a hidden copy")
     if status is None:
-        status = np.empty(n, dtype=np.int32)
+        status = _spare("fourbar_exact.status", (n,), np.int32)
     elif not (status.dtype == np.int32 and status.shape == (n,)):
         raise ValueError("status must be an int32 array of shape (n,)")
     return _kernels.fourbar.exact_states(theta, p, q, r, s, omega, alpha, int(branch), out, status)
@@ -450,12 +489,18 @@ SLIDERCRANK_STATUS = {"ok": int(_kernels.slidercrank.st_ok), "buckled": int(_ker
 _SC_START = {"rest": 0, "quasistatic": 1, "given": 2}
 
 
+#: rows of slidercrank_simulate's per-step profile (fortran/slidercrank.f90 prof_*)
+SLIDERCRANK_PROFILE = ("eps_1", "eps_2", "eps_max", "eps_max_el", "eps_min", "eps_min_el", "outer_max",
+                       "n_avg_1", "lag_change")
+
+
 def slidercrank_simulate(n_elements: int, crank_radius: float, rod_length: float, rho_a: float,
                          ea: float, ei: float, half_depth: float, slider_mass: float, omega: float,
                          dt: float, n_steps: int, rec_start: int, n_rec: int, alpha: float = 0.0,
                          beta: float = 0.0, start: str = "quasistatic", dynamic: bool = True,
                          geometric_stiffness: bool = False, fast: bool = True,
-                         q_init: np.ndarray | None = None, qd_init: np.ndarray | None = None) -> dict:
+                         q_init: np.ndarray | None = None, qd_init: np.ndarray | None = None,
+                         fields: bool = True, lag: int = 0) -> dict:
     """Elastic connecting rod of a slider-crank, whole time loop in Fortran.
 
     SI units: lengths [m], rho_a mass per length [kg/m], ea [N], ei [N m^2], masses [kg],
@@ -465,20 +510,36 @@ def slidercrank_simulate(n_elements: int, crank_radius: float, rod_length: float
     Records steps rec_start .. rec_start + n_rec - 1 (step 0 is the start).
 
     Returns a dict: eps_ax, eps_of (n_elements, n_rec) axial and outer-fibre strain [-];
-    n_avg (n_elements, n_rec) element-averaged rigid-body axial force [N]; mid midpoint
-    deflection from the chord [m]; slider position [m]; elong rod elongation [m];
+    n_avg (n_elements, n_rec) element-averaged rigid-body axial force [N] -- these three only
+    with ``fields`` (else None: a study that prints the profile below need not record 3 x 8
+    bytes per element and step); mid midpoint deflection from the chord [m]; slider position
+    [m]; elong rod elongation [m]; the per-step profile of the fields, always: eps_1, eps_2
+    axial strain of elements 1 and 2, eps_max / eps_min the largest / smallest axial strain
+    with eps_max_el / eps_min_el the (first, 0-based) element holding it, outer_max the
+    largest outer-fibre strain, n_avg_1 element 1's rigid-body force [N], and with ``lag`` > 0
+    lag_change: max over elements of |eps_ax[:, j] - eps_ax[:, j - lag]| (0 for j < lag);
     q_end, qd_end final state; status (a SLIDERCRANK_STATUS value) and fail_step.
     """
     nq = 3 * int(n_elements)
     q0 = farray(np.zeros(nq) if q_init is None else q_init, 1)
     qd0 = farray(np.zeros(nq) if qd_init is None else qd_init, 1)
     out = _kernels.slidercrank.simulate(
-        int(n_elements), int(n_rec), crank_radius, rod_length, rho_a, ea, ei, half_depth, slider_mass,
-        omega, dt, int(n_steps), int(rec_start), alpha, beta, _SC_START[start], int(bool(dynamic)),
-        int(bool(geometric_stiffness)), int(bool(fast)), q0, qd0)
-    names = ("eps_ax", "eps_of", "n_avg", "mid", "slider", "elong", "q_end", "qd_end", "status", "fail_step")
+        int(n_elements), int(n_rec), int(n_rec) if fields else 0, crank_radius, rod_length, rho_a, ea, ei,
+        half_depth, slider_mass, omega, dt, int(n_steps), int(rec_start), alpha, beta, _SC_START[start],
+        int(bool(dynamic)), int(bool(geometric_stiffness)), int(bool(fast)), int(lag), q0, qd0)
+    names = ("eps_ax", "eps_of", "n_avg", "mid", "slider", "elong", "prof", "q_end", "qd_end", "status",
+             "fail_step")
     res = dict(zip(names, out))
     res["status"], res["fail_step"] = int(res["status"]), int(res["fail_step"])
+    prof = res.pop("prof")
+    for k, name in enumerate(SLIDERCRANK_PROFILE):
+        res[name] = prof[k]
+    res["eps_max_el"] = res["eps_max_el"].astype(np.int64) - 1
+    res["eps_min_el"] = res["eps_min_el"].astype(np.int64) - 1
+    if not lag:
+        del res["lag_change"]
+    if not fields:
+        res["eps_ax"] = res["eps_of"] = res["n_avg"] = None
     return res
 
 

@@ -115,7 +115,9 @@ class SweepOutcome(Outcome):
                ``n_failed`` of them
     n_resumed  cases found complete in the resume record (``--resume``) and not run again;
                ``n_redone`` cases run again because their record or files failed a check
-    failed     the failed cases: (case, {swept key: value}, error, exit status)
+    failed     the failed cases: (case, {swept key: value}, error); all of them, or the first
+               ones when the batch path streamed its tables (``n_failed`` counts them all);
+               ``bad_input``: some had bad values
     batch      True when the study's batch path ran the sweep (else case by case)
     workers    where the cases ran ("2 worker(s)", "dask ADDRESS"); ``chunk`` cases per task
     seconds    wall time of the cases [s]
@@ -136,7 +138,9 @@ class SweepOutcome(Outcome):
     n_kept: int = 0
     n_resumed: int = 0
     n_redone: int = 0
-    failed: list[tuple[int, dict, str, int]] = field(default_factory=list)
+    n_failed: int = 0
+    failed: list[tuple[int, dict, str]] = field(default_factory=list)
+    bad_input: bool = False
     batch: bool = False
     workers: str = ""
     chunk: int = 0
@@ -147,13 +151,10 @@ class SweepOutcome(Outcome):
     text: str = ""
 
     @property
-    def n_failed(self) -> int:
-        return len(self.failed)
-
-    @property
     def exit_code(self) -> ExitCode:
         """0 every case ok, 2 a case had bad values, else 1 a case failed."""
-        return max([super().exit_code, *(ExitCode(f[3]) for f in self.failed)])
+        worst = ExitCode.BAD_INPUT if self.bad_input else ExitCode.FAILED if self.n_failed else ExitCode.OK
+        return max(super().exit_code, worst)
 
     @property
     def warnings(self) -> list[str]:

@@ -48,6 +48,10 @@ module slidercrank
   !> status codes shared with driver/kernels.py (SLIDERCRANK_STATUS) and driver/slidercrank/
   integer, parameter, public :: st_ok = 0, st_buckled = 1, st_diverged = 2, st_not_spd = 3, &
                                 st_bad_args = 4
+  !> rows of simulate's per-step profile prof(n_prof, nrec)
+  integer, parameter, public :: prof_eps_1 = 1, prof_eps_2 = 2, prof_eps_max = 3, prof_eps_max_el = 4, &
+                                prof_eps_min = 5, prof_eps_min_el = 6, prof_outer_max = 7, &
+                                prof_n_avg_1 = 8, prof_lag_change = 9, n_prof = 9
   real(dp), parameter :: pi = 3.14159265358979323846_dp
 
 contains
@@ -512,21 +516,29 @@ contains
   !> Recorded for steps k = rec_start .. rec_start + nrec - 1 (k = 0 is the start):
   !> eps_ax(e, j) element axial strain (u_e - u_{e-1})/le; eps_of(e, j) outer-fibre
   !> strain |eps| + c |kappa| with kappa = (th_e - th_{e-1})/le; n_avg(e, j) element-averaged
-  !> rigid-body axial force [N]; mid(j) midpoint deflection from the chord A-C [m];
-  !> slider(j) slider position x4 + U_X [m]; elong(j) rod elongation u_n [m].
+  !> rigid-body axial force [N] -- these three fields only when nrf = nrec (nrf = 0: not
+  !> recorded, the profile below is what a study prints); mid(j) midpoint deflection from the
+  !> chord A-C [m]; slider(j) slider position x4 + U_X [m]; elong(j) rod elongation u_n [m];
+  !> prof(:, j) the per-step profile of the fields (rows prof_*): axial strain of elements 1
+  !> and 2 (element 1 again when nel = 1), the largest and smallest axial strain and their
+  !> elements (the first such element, as a real), the largest outer-fibre strain, n_avg of
+  !> element 1; with lag > 0 also prof_lag_change: max over e of |eps_ax(e, j) - eps_ax(e, j - lag)|
+  !> (recorded steps; 0 for j <= lag), from a ring of the last lag strain columns.
   !> q_end, qd_end: final state.  status: st_ok, st_buckled (static tangent lost
   !> definiteness), st_diverged (elastic translation > L/20, rotation > 0.25 rad, or NaN), st_not_spd, st_bad_args;
   !> fail_step: the step where it happened.
-  subroutine simulate(nel, nq, nrec, r2, rl, rhoa, ea, ei, half_depth, msl, omega, dt, nsteps, &
-                      rec_start, alpha, beta, start_mode, dynamic, geom, fast, q_init, qd_init, &
-                      eps_ax, eps_of, n_avg, mid, slider, elong, q_end, qd_end, status, fail_step)
+  subroutine simulate(nel, nq, nrec, nrf, r2, rl, rhoa, ea, ei, half_depth, msl, omega, dt, nsteps, &
+                      rec_start, alpha, beta, start_mode, dynamic, geom, fast, lag, q_init, qd_init, &
+                      eps_ax, eps_of, n_avg, mid, slider, elong, prof, q_end, qd_end, status, fail_step)
     !f2py threadsafe
-    integer, intent(in) :: nel, nq, nrec, nsteps, rec_start, start_mode, dynamic, geom, fast
+    integer, intent(in) :: nel, nq, nrec, nrf, nsteps, rec_start, start_mode, dynamic, geom, fast, lag
     real(dp), intent(in) :: r2, rl, rhoa, ea, ei, half_depth, msl, omega, dt, alpha, beta
     real(dp), intent(in) :: q_init(nq), qd_init(nq)
-    real(dp), intent(out) :: eps_ax(nel, nrec), eps_of(nel, nrec), n_avg(nel, nrec)
+    real(dp), intent(out) :: eps_ax(nel, nrf), eps_of(nel, nrf), n_avg(nel, nrf)
     real(dp), intent(out) :: mid(nrec), slider(nrec), elong(nrec), q_end(nq), qd_end(nq)
+    real(dp), intent(out) :: prof(9, nrec)   ! 9 = n_prof (f2py needs the literal)
     integer, intent(out) :: status, fail_step
+    real(dp), allocatable :: ring(:, :)
 
     real(dp), allocatable :: q(:), qd(:), qdd(:), qn(:), r(:), w1(:), w2(:), zero(:)
     real(dp), allocatable :: ab(:, :), at(:, :), afac(:, :), zu(:), zv(:), eu(:), ev(:), tmp(:)
@@ -546,12 +558,15 @@ contains
     mid = 0
     slider = 0
     elong = 0
+    prof = 0
     q_end = 0
     qd_end = 0
-    if (nel < 1 .or. nq /= 3*nel .or. nsteps < 0 .or. dt <= 0) then
+    if (nel < 1 .or. nq /= 3*nel .or. nsteps < 0 .or. dt <= 0 .or. (nrf /= 0 .and. nrf /= nrec) &
+        .or. lag < 0) then
       status = st_bad_args
       return
     end if
+    allocate (ring(nel, max(lag, 1)))
     use_g = geom /= 0
     dyn = dynamic /= 0
     use_fast = fast /= 0 .and. .not. use_g
@@ -665,8 +680,8 @@ contains
       end if
       call band_solve(nq, at, qdd)
     end if
-    if (rec_start == 0) call record_step(nel, nq, nrec, 1, q, kin, le, rl, rhoa, msl, half_depth, &
-                                         eps_ax, eps_of, n_avg, mid, slider, elong)
+    if (rec_start == 0) call record_step(nel, nq, nrec, nrf, 1, q, kin, le, rl, rhoa, msl, half_depth, &
+                                         eps_ax, eps_of, n_avg, mid, slider, elong, prof, lag, ring)
 
     ! ---- time loop
     do k = 1, nsteps
@@ -739,8 +754,8 @@ contains
         exit
       end if
       if (k >= rec_start .and. k < rec_start + nrec) &
-        call record_step(nel, nq, nrec, k - rec_start + 1, q, kin, le, rl, rhoa, msl, &
-                          half_depth, eps_ax, eps_of, n_avg, mid, slider, elong)
+        call record_step(nel, nq, nrec, nrf, k - rec_start + 1, q, kin, le, rl, rhoa, msl, &
+                          half_depth, eps_ax, eps_of, n_avg, mid, slider, elong, prof, lag, ring)
     end do
     q_end = q
     qd_end = qd
@@ -796,15 +811,19 @@ contains
     call band_solve(nq, at, qs)
   end subroutine quasi_static_solve
 
-  !> Store the outputs of one recorded step in column j (see simulate).
-  subroutine record_step(nel, nq, nrec, j, q, kin, le, rl, rhoa, msl, half_depth, &
-                         eps_ax, eps_of, n_avg, mid, slider, elong)
-    integer, intent(in) :: nel, nq, nrec, j
+  !> Store the outputs of one recorded step in column j (see simulate): the fields when
+  !> nrf > 0, always the scalars and the profile; ring(:, mod(j - 1, lag) + 1) holds the
+  !> strain column of recorded step j - lag on entry (lag > 0) and that of step j on return.
+  subroutine record_step(nel, nq, nrec, nrf, j, q, kin, le, rl, rhoa, msl, half_depth, &
+                         eps_ax, eps_of, n_avg, mid, slider, elong, prof, lag, ring)
+    integer, intent(in) :: nel, nq, nrec, nrf, j, lag
     real(dp), intent(in) :: q(nq), kin(7), le, rl, rhoa, msl, half_depth
-    real(dp), intent(inout) :: eps_ax(nel, nrec), eps_of(nel, nrec), n_avg(nel, nrec)
-    real(dp), intent(inout) :: mid(nrec), slider(nrec), elong(nrec)
-    integer :: ee, m
+    real(dp), intent(inout) :: eps_ax(nel, nrf), eps_of(nel, nrf), n_avg(nel, nrf)
+    real(dp), intent(inout) :: mid(nrec), slider(nrec), elong(nrec), prof(9, nrec)   ! 9 = n_prof
+    real(dp), intent(inout) :: ring(nel, max(lag, 1))
+    integer :: ee, m, emax, emin, slot
     real(dp) :: ua, ub, ta, tb, ep, ka, vn, va, vb, cc, ss, nc(3), inv, c1, c2, third
+    real(dp) :: ecol(nel), ocol(nel), vmax, vmin, omax, dmax
     call axial_coeffs(kin, rl, rhoa, msl, nc)
     cc = cos(kin(1))
     ss = sin(kin(1))
@@ -812,17 +831,19 @@ contains
     third = 1.0_dp/3
     c1 = nc(2)*le
     c2 = nc(3)*le*le
-    ! hot-loop: slidercrank record_step axial force
-    do ee = 1, nel
-      ! element average of N over [(ee-1) le, ee le]: sa^2 + sa sb + sb^2 = le^2 (3 ee^2 - 3 ee + 1)
-      n_avg(ee, j) = nc(1) + c1*(ee - 0.5_dp) + c2*(real(ee, dp)*(ee - 1) + third)
-    end do
+    if (nrf > 0) then
+      ! hot-loop: slidercrank record_step axial force
+      do ee = 1, nel
+        ! element average of N over [(ee-1) le, ee le]: sa^2 + sa sb + sb^2 = le^2 (3 ee^2 - 3 ee + 1)
+        n_avg(ee, j) = nc(1) + c1*(ee - 0.5_dp) + c2*(real(ee, dp)*(ee - 1) + third)
+      end do
+    end if
     ! hot-loop: slidercrank record_step strains
     do ee = 2, nel - 1
       ep = (q(3*ee - 1) - q(3*ee - 4))*inv
       ka = (q(3*ee + 1) - q(3*ee - 2))*inv
-      eps_ax(ee, j) = ep
-      eps_of(ee, j) = abs(ep) + half_depth*abs(ka)
+      ecol(ee) = ep
+      ocol(ee) = abs(ep) + half_depth*abs(ka)
     end do
     do ee = 1, nel, max(1, nel - 1)      ! the two end elements (one when nel = 1)
       ua = 0
@@ -841,9 +862,49 @@ contains
       end if
       ep = (ub - ua)*inv
       ka = (tb - ta)*inv
-      eps_ax(ee, j) = ep
-      eps_of(ee, j) = abs(ep) + half_depth*abs(ka)
+      ecol(ee) = ep
+      ocol(ee) = abs(ep) + half_depth*abs(ka)
     end do
+    if (nrf > 0) then
+      eps_ax(:, j) = ecol
+      eps_of(:, j) = ocol
+    end if
+    ! the profile: extremes with the first element reaching them (numpy's argmax order)
+    vmax = ecol(1)
+    vmin = ecol(1)
+    omax = ocol(1)
+    emax = 1
+    emin = 1
+    do ee = 2, nel
+      if (ecol(ee) > vmax) then
+        vmax = ecol(ee)
+        emax = ee
+      end if
+      if (ecol(ee) < vmin) then
+        vmin = ecol(ee)
+        emin = ee
+      end if
+      omax = max(omax, ocol(ee))
+    end do
+    prof(prof_eps_1, j) = ecol(1)
+    prof(prof_eps_2, j) = ecol(min(2, nel))
+    prof(prof_eps_max, j) = vmax
+    prof(prof_eps_max_el, j) = emax
+    prof(prof_eps_min, j) = vmin
+    prof(prof_eps_min_el, j) = emin
+    prof(prof_outer_max, j) = omax
+    prof(prof_n_avg_1, j) = nc(1) + c1*0.5_dp + c2*third
+    if (lag > 0) then
+      slot = mod(j - 1, lag) + 1
+      dmax = 0
+      if (j > lag) then
+        do ee = 1, nel
+          dmax = max(dmax, abs(ecol(ee) - ring(ee, slot)))
+        end do
+      end if
+      prof(prof_lag_change, j) = dmax
+      ring(:, slot) = ecol
+    end if
     vn = -ss*q(nq)
     if (mod(nel, 2) == 0) then
       m = nel/2

@@ -54,6 +54,9 @@ def fingerprint() -> dict[str, str]:
     assert sc["status"] == k.SLIDERCRANK_STATUS["ok"], sc["status"]
     out["slidercrank_simulate"] = _h(*(sc[n] for n in ("eps_ax", "eps_of", "n_avg", "mid", "slider", "elong")),
                                      sc["status"])
+    pr = k.slidercrank_simulate(16, 0.15, 0.3, 7870 * 64e-6, 2e11 * 64e-6, 2e11 * 3.413333333e-10, 0.004,
+                                0.075552, 150.0, 2.5e-5, 800, 400, 400, alpha=1.0, beta=1e-6, fields=False, lag=100)
+    out["slidercrank_simulate_profile"] = _h(*(pr[n] for n in k.SLIDERCRANK_PROFILE), pr["status"])
     out.update(_batch_and_auxiliary_kernels(rng, theta))
     return out
 

@@ -34,6 +34,9 @@ def test_run_all_smoke(run_all, capsys):
     assert targets["2R manipulator"] == (0.04e-6, None)
     assert targets["Hooke joint"] == (5e-6, None)
     assert targets["slider-crank"] == (100e-3, 10.0)
+    # issue 27 (targets only above the sizes where fresh memory costs page faults: not at --smoke sizes)
+    assert "four-bar exact, default path vs fresh arrays" in names
+    assert "slider-crank: study's record vs all fields" in names
     for r in rows:
         assert r.kernel_s > 0 and r.baseline_s > 0 and r.limit
         assert r.name in text

@@ -161,7 +161,7 @@ def run(params: Params, progress: bool = False) -> Result:
         missing = [f"{c.omega:g} rad/s: {_status_text(c).split(' (')[0].lower()}, not drawn" for c in cases if not c.ok]
         stiffness = "K + K_G" if params.geometric_stiffness else "linear model"
         figures.append(Figure("strain", lambda: _plotting().slidercrank_strain_figure(
-            [(f"{c.omega:g} rad/s", c.angle_deg, c.eps_ax[0] * 1e6) for c in good],
+            [(f"{c.omega:g} rad/s", c.angle_deg, c.eps_1 * 1e6) for c in good],
             f"{params.material}: crank-end element axial strain ({stiffness})", above=above, missing=missing)))
         figures.append(Figure("deflection", lambda: _plotting().slidercrank_strain_figure(
             [(f"{c.omega:g} rad/s", c.angle_deg, c.mid * 1e3) for c in good],

@@ -95,9 +95,18 @@ class Case:
     fail_rev: int | None = None
     angle_deg: np.ndarray | None = None
     time: np.ndarray | None = None
-    eps_ax: np.ndarray | None = None
-    eps_of: np.ndarray | None = None
-    n_avg: np.ndarray | None = None
+    # the per-step profile of the strain fields (what the study prints; the kernel records no
+    # field, see kernels.slidercrank_simulate): element 1 and 2 axial strain [-], the largest
+    # and smallest axial strain and their (0-based) elements, the largest outer-fibre strain,
+    # element 1's rigid-body axial force [N]
+    eps_1: np.ndarray | None = None
+    eps_2: np.ndarray | None = None
+    eps_max: np.ndarray | None = None
+    eps_max_el: np.ndarray | None = None
+    eps_min: np.ndarray | None = None
+    eps_min_el: np.ndarray | None = None
+    outer_max: np.ndarray | None = None
+    n_avg_1: np.ndarray | None = None
     mid: np.ndarray | None = None
     slider: np.ndarray | None = None
     elong: np.ndarray | None = None
@@ -114,14 +123,21 @@ class Case:
         """Peak strain [-] at the crank pin itself (s = 0), recovered by linear extrapolation
         of the first two element strains (midpoints L/2n, 3L/2n); exact for a strain field
         linear in s.  Element averages converge as 1/n where N(s) varies; this converges fast."""
-        e = self.eps_ax[0] if self.eps_ax.shape[0] < 2 else 1.5 * self.eps_ax[0] - 0.5 * self.eps_ax[1]
+        e = self.eps_1 if self.n_elements < 2 else 1.5 * self.eps_1 - 0.5 * self.eps_2
         return float(np.max(sign * e) * sign)
 
     def peak(self, sign: int) -> tuple[float, float, int]:
-        """Peak tensile (sign=+1) or compressive (-1) axial strain [-], crank angle [deg], element."""
-        flat = np.argmax(sign * self.eps_ax)
-        e, j = np.unravel_index(flat, self.eps_ax.shape)
-        return float(self.eps_ax[e, j]), float(self.angle_deg[j] % 360.0), int(e) + 1
+        """Peak tensile (sign=+1) or compressive (-1) axial strain [-], crank angle [deg], element.
+        Where several elements and steps reach it: the lowest element, then its first step (the
+        order of numpy's argmax over the (element, step) field)."""
+        vals, els = (self.eps_max, self.eps_max_el) if sign > 0 else (self.eps_min, self.eps_min_el)
+        hit = np.flatnonzero(vals == (vals.max() if sign > 0 else vals.min()))
+        j = int(hit[np.argmin(els[hit])])
+        return float(vals[j]), float(self.angle_deg[j] % 360.0), int(els[j]) + 1
+
+    def outer_peak(self) -> float:
+        """The largest outer-fibre strain [-] over the recorded steps."""
+        return float(self.outer_max.max())
 
 
 def _run_case(model: Model, params: Params, omega: float, n_el: int, alpha: float, beta: float,
@@ -137,11 +153,13 @@ def _run_case(model: Model, params: Params, omega: float, n_el: int, alpha: floa
         two = params.revolutions >= 2     # record the last two revolutions to judge settling
         rec_start, n_rec = (params.revolutions - (2 if two else 1)) * spr, (2 if two else 1) * spr + 1
     start, q0, qd0 = _start_state(params.start, n_el, model.length)
+    settle = params.end_time <= 0 and params.revolutions >= 2
     res = kernels.slidercrank_simulate(
         n_el, model.r2, model.length, model.rho_a, model.ea, model.ei, model.depth / 2, model.m_s, omega,
         dt, n_steps, rec_start, n_rec, alpha, beta, start=start, dynamic=params.analysis == "dynamic",
-        geometric_stiffness=params.geometric_stiffness, q_init=q0, qd_init=qd0)
-    if params.end_time <= 0 and params.revolutions >= 2:
+        geometric_stiffness=params.geometric_stiffness, q_init=q0, qd_init=qd0, fields=False,
+        lag=spr if settle else 0)
+    if settle:
         res = _settle(res, spr)
         rec_start, n_rec = rec_start + spr, spr + 1
     steps = rec_start + np.arange(n_rec)
@@ -160,26 +178,31 @@ def _run_case(model: Model, params: Params, omega: float, n_el: int, alpha: floa
     case.time = dt * steps
     case.angle_deg = np.degrees(theta) - 360.0 * (params.revolutions - 1) if params.end_time <= 0 \
         else np.degrees(theta)
-    for name in ("eps_ax", "eps_of", "n_avg", "mid", "slider", "elong"):
+    for name in (*PROFILE, "mid", "slider", "elong"):
         setattr(case, name, res[name])
     case.settle_strain, case.settle_mid = res.get("settle_strain"), res.get("settle_mid")
     return case
 
 
+#: the kernel's per-step profile entries a Case keeps (kernels.SLIDERCRANK_PROFILE)
+PROFILE = ("eps_1", "eps_2", "eps_max", "eps_max_el", "eps_min", "eps_min_el", "outer_max", "n_avg_1")
+
+
 def _settle(res: dict, spr: int) -> dict:
     """Split a two-revolution record: keep the last revolution, and measure how far it is from
     periodic: the largest change of the strain field and of the midpoint deflection between
-    the two revolutions, relative to their peak in the last one."""
+    the two revolutions, relative to their peak in the last one.  The strain field's change
+    is the kernel's ``lag_change`` (a revolution apart, element by element), its peak the
+    largest |strain| of the last revolution."""
     out = dict(res)
-    for name in ("eps_ax", "eps_of", "n_avg"):
-        out[name] = res[name][:, spr:]
-    for name in ("mid", "slider", "elong"):
+    for name in (*PROFILE, "mid", "slider", "elong"):
         out[name] = res[name][spr:]
 
     def change(a: np.ndarray, b: np.ndarray) -> float:
         peak = float(np.abs(b).max())
         return float(np.abs(b - a).max()) / peak if peak > 0 else 0.0
-    out["settle_strain"] = change(res["eps_ax"][:, :spr + 1], out["eps_ax"])
+    peak = max(float(np.abs(out["eps_max"]).max()), float(np.abs(out["eps_min"]).max()))
+    out["settle_strain"] = float(res["lag_change"][spr:].max()) / peak if peak > 0 else 0.0
     out["settle_mid"] = change(res["mid"][:spr + 1], out["mid"])
     return out
 
@@ -197,7 +220,7 @@ def history(model: Model, params: Params, omega: float, n_el: int, alpha: float,
     res = kernels.slidercrank_simulate(
         n_el, model.r2, model.length, model.rho_a, model.ea, model.ei, model.depth / 2, model.m_s, omega,
         dt, n_steps, 0, n_steps + 1, alpha, beta, start=start, dynamic=params.analysis == "dynamic",
-        geometric_stiffness=params.geometric_stiffness, q_init=q0, qd_init=qd0)
+        geometric_stiffness=params.geometric_stiffness, q_init=q0, qd_init=qd0, fields=False)
     if res["status"] != kernels.SLIDERCRANK_STATUS["ok"]:
         return {k: np.empty(0) for k in ("time", "mid", "elong", "slider")}
     return {"time": dt * np.arange(n_steps + 1), "mid": np.asarray(res["mid"]), "elong": np.asarray(res["elong"]),

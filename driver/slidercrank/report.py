@@ -97,7 +97,7 @@ def _peak_table(cases: list[Case], tol: float) -> list[str]:
         if c.ok:
             t, ta, te = c.peak(+1)
             p, pa, pe = c.peak(-1)
-            rows.append([c.omega, t * 1e6, ta, te, p * 1e6, pa, pe, float(c.eps_of.max()) * 1e6,
+            rows.append([c.omega, t * 1e6, ta, te, p * 1e6, pa, pe, c.outer_peak() * 1e6,
                          float(np.abs(c.mid).max()) * 1e3, c.euler_ratio, _settle_text(c)])
             notes = (["NOT SETTLED"] if _unsettled(c, tol) else []) + \
                 (["warning: N/P_E > 0.8"] if c.euler_ratio > EULER_WARN else [])
@@ -120,7 +120,7 @@ def _crank_end_table(cases: list[Case], every_deg: float = 10.0) -> list[str]:
     series = []
     for c in cases:
         if c.ok:
-            series.append(np.interp(grid, c.angle_deg, c.eps_ax[0]) * 1e6)
+            series.append(np.interp(grid, c.angle_deg, c.eps_1) * 1e6)
         else:
             series.append(None)
     rows = [[g] + [("-" if s is None else float(s[k])) for s in series] for k, g in enumerate(grid)]
@@ -173,11 +173,11 @@ def _tidy(model_name: str, cases: list[Case]) -> pd.DataFrame:
         frames.append(pd.DataFrame({
             "material": model_name, "omega_rad_s": c.omega, "n_elements": c.n_elements,
             "crank_angle_deg": c.angle_deg, "time_s": c.time,
-            "eps_crank_end_microstrain": c.eps_ax[0] * 1e6,
-            "eps_max_microstrain": c.eps_ax.max(axis=0) * 1e6,
-            "eps_min_microstrain": c.eps_ax.min(axis=0) * 1e6,
-            "outer_fibre_max_microstrain": c.eps_of.max(axis=0) * 1e6,
-            "n_rigid_crank_end_N": c.n_avg[0],
+            "eps_crank_end_microstrain": c.eps_1 * 1e6,
+            "eps_max_microstrain": c.eps_max * 1e6,
+            "eps_min_microstrain": c.eps_min * 1e6,
+            "outer_fibre_max_microstrain": c.outer_max * 1e6,
+            "n_rigid_crank_end_N": c.n_avg_1,
             "midpoint_deflection_mm": c.mid * 1e3,
             "slider_position_m": c.slider,
             "rod_elongation_um": c.elong * 1e6,

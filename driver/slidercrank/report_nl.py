@@ -57,7 +57,7 @@ def _side_by_side(pairs: list[tuple[Case, NLCase]], tol: float, limit: float) ->
     rows, trailers = [], []
     for lin, nl in pairs:
         row: list[Any] = [nl.omega]
-        lin_vals = ([lin.peak(+1)[0] * 1e6, lin.peak(-1)[0] * 1e6, float(lin.eps_of.max()) * 1e6,
+        lin_vals = ([lin.peak(+1)[0] * 1e6, lin.peak(-1)[0] * 1e6, lin.outer_peak() * 1e6,
                      float(np.abs(lin.mid).max()) * 1e3] if lin.ok else ["-"] * 4)
         nl_vals = ([nl.peak(+1)[0] * 1e6, nl.peak(-1)[0] * 1e6, float(nl.eps_of.max()) * 1e6,
                     nl.peak_lateral * 1e3] if nl.ok else ["-"] * 4)
@@ -108,7 +108,7 @@ def _strain_curves(pairs: list[tuple[Case, NLCase]], every_deg: float = 30.0) ->
     series = []
     for lin, nl in pairs:
         cols += [Column(f"L{lin.omega:g}", "f", 9, 2), Column(f"N{nl.omega:g}", "f", 9, 2)]
-        series += [np.interp(grid, lin.angle_deg, lin.eps_ax[0]) * 1e6 if lin.ok else None,
+        series += [np.interp(grid, lin.angle_deg, lin.eps_1) * 1e6 if lin.ok else None,
                    np.interp(grid, nl.angle_deg, nl.eps_ax[0]) * 1e6 if nl.ok else None]
     rows = [[g] + ["-" if s is None else float(s[k]) for s in series] for k, g in enumerate(grid)]
     return ["Table 8  Axial strain of the crank-end element vs crank angle, last revolution (microstrain):",
@@ -150,7 +150,7 @@ def _tidy(material: str, pairs: list[tuple[Case, NLCase]]) -> pd.DataFrame:
             "lateral_max_nonlinear_mm": nl.lat_max * 1e3,
             "midspan_nonlinear_mm": nl.mid * 1e3})
         if lin.ok and len(lin.angle_deg) == len(nl.angle_deg):
-            frame["eps_crank_end_linear_microstrain"] = lin.eps_ax[0] * 1e6
+            frame["eps_crank_end_linear_microstrain"] = lin.eps_1 * 1e6
             frame["midpoint_linear_mm"] = lin.mid * 1e3
         frames.append(frame)
     if not frames:
@@ -247,7 +247,7 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
     good = [(lin, nl) for lin, nl in pairs if nl.ok and lin.ok]
     if good:
         figures.append(Figure("strain_linear_nonlinear", lambda: _plotting().slidercrank_nl_strain_figure(
-            [(f"{nl.omega:g} rad/s", lin.angle_deg, lin.eps_ax[0] * 1e6, nl.eps_ax[0] * 1e6) for lin, nl in good],
+            [(f"{nl.omega:g} rad/s", lin.angle_deg, lin.eps_1 * 1e6, nl.eps_ax[0] * 1e6) for lin, nl in good],
             f"{params.material}: crank-end axial strain, linear (dashed) and nonlinear (solid)")))
     okn = [nl for nl in nls if nl.ok]
     if okn:

@@ -56,7 +56,7 @@ from driver.outcome import ExitCode, SweepOutcome
 from driver.runner import compute, output_stem, study_of
 from driver.study import load_study
 from driver.sweep import batch as batch_path
-from driver.sweep import engine, store
+from driver.sweep import engine, store, stream
 from driver.sweep.keep import check_keep, keep_columns
 from driver.sweep.engine import Task, auto_chunk, run_task
 from driver.sweep.report import Warnings, summary_frame, summary_settings, sweep_text, write_sweep_files
@@ -327,9 +327,26 @@ class _Run:
         for text in warnings.lines(self.deck.path, n):
             oc.warn(text)
         oc.n_ok, oc.n_kept, oc.seconds, oc.chunk = n_ok, n_kept, elapsed, chunk
-        self._failed([(r.index, r.values, r.error, r.status) for r in failed])
+        self._failed([(r.index, r.values, r.error) for r in failed],
+                     bad_input=any(r.status == ExitCode.BAD_INPUT for r in failed))
         oc.written += [self.outdir / f"{self.stem}.out", *(self.outdir / f"{self.stem}_summary.{fmt}" for fmt in ("csv", "parquet"))]
         return oc
+
+    def _batch_streamed(self, rows: batch_path.StreamedRows, n: int, elapsed: float, chunk: int) -> bool:
+        """The tables of a batch sweep written part by part from the record (:mod:`driver.sweep.stream`),
+        on the outcome; False when the parts cannot be streamed (nothing written then)."""
+        sw, names, oc = self.sw, self.grid.names, self.outcome
+        remove_stale_temporaries(self.outdir, self.stem)
+        res = stream.write_streamed(self.outdir, self.stem, rows.paths, self.deck, sw, self.base, self.axes, names, n,
+                                    self.plot, self.module, self._settings())
+        if res is None:
+            return False
+        if n <= 10 * store.SHARD * store.SHARD:
+            store.remove_stale_case_files(self.layout, np.zeros(n + 1, dtype=bool))
+        oc.n_ok, oc.n_kept, oc.seconds, oc.chunk = n - res.n_failed, res.n_kept, elapsed, chunk
+        self._failed(res.failed, n_failed=res.n_failed, bad_input=res.bad_input)
+        oc.written += [self.outdir / f"{self.stem}.out", *(self.outdir / f"{self.stem}_summary.{fmt}" for fmt in ("csv", "parquet"))]
+        return True
 
     def _settings(self) -> dict:
         """The base deck's settings the summary columns depend on (recorded with the table)."""
@@ -349,15 +366,17 @@ class _Run:
         self.outcome.warn(f"{self.deck.path}: resume: {k} {what} redone ({parts}{why}): the record is verified, "
                           "never believed")
 
-    def _failed(self, failed: list[tuple[int, dict, str, int]], most: int = FAILED_SHOWN) -> None:
-        """The failed cases: on the outcome, and an error message for each of the first ``most``."""
+    def _failed(self, failed: list[tuple[int, dict, str]], n_failed: int | None = None, bad_input: bool = False,
+                most: int = FAILED_SHOWN) -> None:
+        """The failed cases on the outcome (``failed`` lists them, or the first ones of ``n_failed``;
+        ``bad_input``: some had bad values), and an error message for each of the first ``most``."""
         oc = self.outcome
-        oc.failed = failed
-        for index, values, error, _ in failed[:most]:
+        oc.failed, oc.n_failed, oc.bad_input = failed, len(failed) if n_failed is None else n_failed, bad_input
+        for index, values, error in failed[:most]:
             vals = ", ".join(f"{k} = {v!r}" for k, v in values.items())
             oc.error(f"{self.deck.path}: case {index} ({vals}): {error}")
-        if len(failed) > most:
-            oc.error(f"{self.deck.path}: ... and {len(failed) - most} more failed cases (see {self.stem}.out)")
+        if oc.n_failed > most:
+            oc.error(f"{self.deck.path}: ... and {oc.n_failed - most} more failed cases (see {self.stem}.out)")
 
     # ------------------------------------------------------------------ batch path
     def batch(self, bplan, signature: str) -> SweepOutcome:
@@ -380,12 +399,20 @@ class _Run:
             if self.resume:
                 oc.notes.append(f"resume: {resumed} of {n} cases complete, {n - resumed} to run")
 
+        # rows beyond STREAM_ROWS stay in the record's parts (driver memory flat); not with
+        # case_outputs = 'kept', whose kept cases' failures rewrite their rows
         rows, counts, chunk = batch_path.run(bplan, self.outdir / f"{self.stem}.sweep", self.jobs, self.scheduler,
-                                             self.resume, self.progress, sw.chunk, announce)
+                                             self.resume, self.progress, sw.chunk, announce,
+                                             stream_rows=stream.STREAM_ROWS if sw.case_outputs == "none" else 0)
         c_run = time.process_time()
         # the driver's CPU per phase (bench/bench_search.py): merging the chunks, then the tables
         oc.phases.update(run_cpu=c_run - c_start, chunk=chunk, chunks=-(-n // chunk), rows=len(rows))
         elapsed = time.perf_counter() - t_start
+        if isinstance(rows, batch_path.StreamedRows):
+            if self._batch_streamed(rows, n, elapsed, chunk):
+                oc.phases["finish_cpu"] = time.process_time() - c_run
+                return oc
+            rows = stream.read_columns(rows.paths)   # parts of differing column types: in memory after all
         if rows.empty:
             rows = pd.DataFrame(columns=["case", *names, "status", "kept", "error"])
         cases = None
@@ -415,10 +442,9 @@ class _Run:
                 if r.status != ExitCode.OK:
                     rows.loc[rows["case"] == r.index, ["status", "kept", "error"]] = ["failed", False, r.error]
         bad = rows[rows["status"] != "ok"]
-        failed = [(int(r["case"]), {k: r[k] for k in names}, r["error"],
-                   ExitCode.BAD_INPUT if r["status"] == "bad input" else ExitCode.FAILED) for _, r in bad.iterrows()]
-        text = sweep_text(self.deck, sw, self.base, self.axes, n, rows, int(rows["kept"].sum()),
-                          [f[:3] for f in failed], sw.summary_rows)
+        failed = [(int(r["case"]), {k: r[k] for k in names}, r["error"]) for _, r in bad.iterrows()]
+        text = sweep_text(self.deck, sw, self.base, self.axes, n, rows, int(rows["kept"].sum()), failed,
+                          sw.summary_rows)
         remove_stale_temporaries(self.outdir, self.stem)
         write_sweep_files(self.outdir, self.stem, rows, cases, text, self.plot, sw, names, self.module, rows,
                           self._settings())
@@ -426,7 +452,7 @@ class _Run:
             store.remove_stale_case_files(self.layout, has_files)
         oc.phases["finish_cpu"] = time.process_time() - c_run
         oc.n_ok, oc.n_kept, oc.seconds, oc.chunk = n - len(failed), int(rows["kept"].sum()), elapsed, chunk
-        self._failed(failed)
+        self._failed(failed, bad_input=bool((bad["status"] == "bad input").any()))
         oc.written += [self.outdir / f"{self.stem}.out", *(self.outdir / f"{self.stem}_summary.{fmt}" for fmt in ("csv", "parquet"))]
         return oc
 

@@ -52,12 +52,20 @@ from driver.sweep.keep import keep_columns, keep_mask
 from driver.sweep.pool import run_pool, worker_init
 from driver.sweep.spec import Grid
 
-__all__ = ["Grid", "BatchPlan", "batchable", "plan", "run", "worker_init", "chunk_rows", "MAX_CASES"]
+__all__ = ["Grid", "BatchPlan", "batchable", "plan", "run", "worker_init", "chunk_rows", "MAX_CASES", "StreamedRows"]
 
-#: cases per task: ~0.3-0.6 s of kernel time on one core for the four-bar
-CHUNK = 16384
+#: largest number of cases per task below MAX_CHUNKS chunks: 0.05 s of four-bar kernel time on one
+#: core for the filter's passes, 0.2 s with the peak speeds; smaller sweeps have 8 chunks
+CHUNK = 65536
+#: chunks of a sweep below CHUNK * 8 cases (at least 64 cases each)
+MIN_CHUNKS = 8
+#: a sweep of at most this many cases may run in the driver's process when it is cheap
+#: (:func:`execute`): a crash in a kernel then ends the driver, so only small ones
+SMALL_SWEEP = 1 << 18
+#: below this much CPU time [s] for the chunks after the first, the worker pool is not started
+POOL_MIN_SECONDS = 0.25
 #: above CHUNK * MAX_CHUNKS cases the chunks grow instead of multiplying: the driver's work (a
-#: result to merge, a part in the record) is per chunk, so 10^9 cases are 4096 chunks, not 61 035
+#: result to merge, a part in the record) is per chunk, so 10^9 cases are 4096 chunks, not 15 259
 MAX_CHUNKS = 4096
 #: largest batch sweep (no case is listed, so only the grid's size is limited)
 MAX_CASES = 10**10
@@ -90,7 +98,7 @@ def chunk_size(n: int) -> int:
     workers), so ``--resume`` works with any ``-j``; at most :data:`MAX_CHUNKS` chunks."""
     if n > CHUNK * MAX_CHUNKS:
         return -(-n // MAX_CHUNKS)
-    return min(CHUNK, max(64, -(-n // 16)))
+    return min(CHUNK, max(64, -(-n // MIN_CHUNKS)))
 
 
 def _signature(raw: RawGroup, grid: Grid, keep: str, rows: str, module, shown: list[str] | None = None) -> str:
@@ -189,6 +197,7 @@ class ChunkResult:
     seconds: float = 0.0
     errors: list[str] = field(default_factory=list)
     written: bool = False       # its part is in the record already (the worker wrote it)
+    path: str = ""              # ... at this path
 
 
 def _summaries(module, base, cols: dict[str, np.ndarray], rows: np.ndarray, wanted: list[str] | None,
@@ -281,7 +290,7 @@ def chunk_rows(p: BatchPlan, start: int, stop: int, folder: str = "") -> ChunkRe
 def _finish(res: ChunkResult, p: BatchPlan, folder: str, t0: float) -> ChunkResult:
     """Write the chunk's part when the worker owns the record's folder; time the chunk."""
     if folder:
-        write_part(Path(folder), res, p.signature)
+        res.path = str(write_part(Path(folder), res, p.signature))
         res.written = True
     res.seconds = time.perf_counter() - t0
     return res
@@ -344,7 +353,7 @@ def clean(folder: Path, signature: str, resume: bool, damaged: list[int] | None 
 def write_part(folder: Path, res: ChunkResult, signature: str) -> Path:
     table = pa.Table.from_pandas(res.frame, preserve_index=False)
     meta = {"signature": signature, "start": res.start, "stop": res.stop, "n_ok": res.n_ok,
-            "n_kept": res.n_kept, "n_failed": res.n_failed}
+            "n_kept": res.n_kept, "n_failed": res.n_failed, "n_rows": len(res.frame)}
     table = table.replace_schema_metadata({**(table.schema.metadata or {}), b"sweep": json.dumps(meta).encode()})
     own_folder(folder, folder.parent)
     buf = pa.BufferOutputStream()
@@ -384,10 +393,13 @@ def _alone(p: BatchPlan, start: int, stop: int, folder: str = "") -> ChunkResult
 
 
 def execute(p: BatchPlan, todo: list[tuple[int, int]], jobs: int, scheduler: Any,
-            on_result, in_flight: int = 0, folder: str = "") -> None:
+            on_result, in_flight: int = 0, folder: str = "", adaptive: bool = False) -> None:
     """Run chunks ``todo`` [(start, stop)]; ``on_result(ChunkResult)`` as each completes.
     ``folder``: the record's folder, where the workers write their chunks' parts (on Dask only
-    when every worker sees it; otherwise the result comes back unwritten)."""
+    when every worker sees it; otherwise the result comes back unwritten).  ``adaptive`` (the
+    deck sets no chunk size): a sweep of at most :data:`SMALL_SWEEP` cases runs its first chunk
+    in this process and the rest too when, at that chunk's CPU time, they would take less than
+    :data:`POOL_MIN_SECONDS` (the worker pool is started only when it pays)."""
     if not todo:
         return
     if scheduler:
@@ -397,6 +409,16 @@ def execute(p: BatchPlan, todo: list[tuple[int, int]], jobs: int, scheduler: Any
         for s, e in todo:
             on_result(chunk_rows(p, s, e, folder))
         return
+    if adaptive and p.grid.n <= SMALL_SWEEP and POOL_MIN_SECONDS > 0:
+        # a small sweep: the first chunk here, timed; the rest here too when the pool would not pay
+        # for starting its workers (forking them costs tens of ms of CPU each)
+        c0 = time.process_time()
+        on_result(chunk_rows(p, *todo[0], folder))
+        todo = todo[1:]
+        if (time.process_time() - c0) * len(todo) < POOL_MIN_SECONDS:
+            for s, e in todo:
+                on_result(chunk_rows(p, s, e, folder))
+            return
     queue: Iterator[tuple[int, int]] = iter(todo)
     run_pool(lambda: next(queue, None), lambda pool, rng: pool.submit(chunk_rows, p, *rng, folder),
              lambda rng: _alone(p, *rng, folder), lambda rng, res, pending: on_result(res), jobs,
@@ -440,12 +462,28 @@ def _execute_dask(p: BatchPlan, todo: list[tuple[int, int]], scheduler: Any, on_
             client.close()
 
 
+@dataclass
+class StreamedRows:
+    """The rows of a batch sweep too many to hold in the driver: the record's parts that hold
+    rows, in case order (each a Parquet file of the rows its chunk returned)."""
+
+    paths: list[Path]
+    n_rows: int
+
+    def __len__(self) -> int:
+        return self.n_rows
+
+
 def run(p: BatchPlan, folder: Path, jobs: int, scheduler: Any, resume: bool, progress: bool,
-        chunk: int = 0, announce=None) -> tuple[pd.DataFrame, dict[str, int], int]:
+        chunk: int = 0, announce=None, stream_rows: int = 0
+        ) -> tuple[pd.DataFrame | StreamedRows, dict[str, int], int]:
     """Run the whole batch sweep; returns (rows, counts, chunk size).  ``announce(resumed, damaged)``
     is called before anything runs with the number of cases found complete in the record and the
-    case counts of its parts that failed their checksum (dropped: their cases run again)."""
-    from tqdm import tqdm
+    case counts of its parts that failed their checksum (dropped: their cases run again).
+
+    ``stream_rows``: above this many returned rows (kept and failed ones with ``rows = 'kept'``)
+    the driver stops holding them and returns a :class:`StreamedRows` (the record's parts, read
+    back one at a time by the table writers: driver memory stays flat); 0: always a DataFrame."""
     n = p.grid.n
     # the layout depends on the grid only (not on the workers), so --resume works with any -j
     size = chunk or chunk_size(n)
@@ -458,34 +496,59 @@ def run(p: BatchPlan, folder: Path, jobs: int, scheduler: Any, resume: bool, pro
         Path(done[s]["path"]).unlink(missing_ok=True)
     paths = {s: Path(done[s]["path"]) for s in complete}
     counts = {"ok": 0, "kept": 0, "failed": 0}
+    n_rows = 0   # rows of the resumed chunks and those returned
     for s in complete:
         for k in counts:
             counts[k] += int(done[s][f"n_{k}"])
+        n_rows += int(done[s]["n_rows"]) if "n_rows" in done[s] else _part_rows(Path(done[s]["path"]))
     resumed = sum(min(s + size, n) - s for s in complete)
     todo = [r for r in ranges if r[0] not in complete]
     if announce:
         announce(resumed, damaged)
     own_folder(folder, folder.parent)
-    bar = tqdm(total=n, initial=resumed, unit="case", disable=not progress, dynamic_ncols=True)
+    bar = _progress(n, resumed, progress)
 
-    merged: dict[int, pd.DataFrame] = {}   # the rows each chunk returned (kept and failed with rows = 'kept')
+    merged: dict[int, pd.DataFrame] | None = {}   # the rows each chunk returned; None: streamed
+    if stream_rows and n_rows > stream_rows:
+        merged = None
 
     def on_result(res: ChunkResult) -> None:
-        if not res.written:   # a chunk whose worker died, or Dask workers that do not see the folder
-            write_part(folder, res, p.signature)
-        merged[res.start] = res.frame
+        nonlocal merged, n_rows
+        path = res.path if res.written else str(write_part(folder, res, p.signature))
+        paths[res.start] = Path(path)   # a chunk whose worker died, or Dask workers that do not see the folder
+        n_rows += len(res.frame)
+        if merged is not None:
+            merged[res.start] = res.frame
+            if stream_rows and n_rows > stream_rows:   # too many to hold: the parts are the rows from now on
+                merged = None
         counts["ok"] += res.n_ok
         counts["kept"] += res.n_kept
         counts["failed"] += res.n_failed
-        bar.update(res.stop - res.start)
+        if bar is not None:
+            bar.update(res.stop - res.start)
 
     try:
-        execute(p, todo, jobs, scheduler, on_result, folder=str(folder))
+        execute(p, todo, jobs, scheduler, on_result, folder=str(folder), adaptive=not chunk)
     finally:
-        bar.close()
+        if bar is not None:
+            bar.close()
+    if merged is None:
+        return StreamedRows([paths[s] for s in sorted(paths) if _part_rows(paths[s])], n_rows), counts, size
     # the rows: those of the resumed chunks from the record, the others as the workers returned them
-    frames = {s: pq.read_table(paths[s]).to_pandas() for s in sorted(paths)}
+    frames = {s: pq.read_table(paths[s]).to_pandas() for s in sorted(complete)}
     frames.update(merged)
     parts = [frames[s] for s in sorted(frames) if len(frames[s])]
     rows = pd.DataFrame() if not parts else parts[0] if len(parts) == 1 else pd.concat(parts, ignore_index=True)
     return rows, counts, size
+
+
+def _part_rows(path: Path) -> int:
+    return pq.read_metadata(path).num_rows
+
+
+def _progress(n: int, initial: int, progress: bool):
+    """A tqdm bar, or None without progress (tqdm is not even imported then)."""
+    if not progress:
+        return None
+    from tqdm import tqdm
+    return tqdm(total=n, initial=initial, unit="case", dynamic_ncols=True)

@@ -66,6 +66,20 @@ def _summary_table(frame: pd.DataFrame, limit: int = 2000, n_cases: int | None =
     cases; ``frame`` may hold only those already, then ``n_cases`` is the study's total)."""
     n_cases = len(frame) if n_cases is None else n_cases
     show = frame if n_cases <= limit else frame[frame["kept"] | (frame["status"] != "ok")]
+    cols, keys = table_columns(frame)
+    lines = render_table(cols, table_values(show, cols, keys))
+    if len(show) < n_cases:
+        lines.append(not_listed_line(n_cases - len(show), rows))
+    return lines
+
+
+def not_listed_line(count: int, rows: str) -> str:
+    where = "are in the _summary table only" if rows == "all" else "are not listed (summary_rows = 'kept')"
+    return f"  ({count} cases not kept {where})"
+
+
+def table_columns(frame: pd.DataFrame) -> tuple[list[Column], list[str]]:
+    """The .out table's columns of a summary frame (kind and width from each column's dtype)."""
     cols, keys = [], []
     for name in frame.columns:
         if name in ("error",):
@@ -81,6 +95,11 @@ def _summary_table(frame: pd.DataFrame, limit: int = 2000, n_cases: int | None =
         else:
             cols.append(Column(name, "s", max(6, len(name)), 0))
         keys.append(name)
+    return cols, keys
+
+
+def table_values(show: pd.DataFrame, cols: list[Column], keys: list[str]) -> list[list]:
+    """The .out table's rows of ``show``: values, '-' for a missing or non-finite one."""
     rows = []
     for values in zip(*(show[k].tolist() for k in keys)):   # column-wise: no Series per row
         row = []
@@ -94,11 +113,7 @@ def _summary_table(frame: pd.DataFrame, limit: int = 2000, n_cases: int | None =
             else:
                 row.append(v)
         rows.append(row)
-    lines = render_table(cols, rows)
-    if len(show) < n_cases:
-        where = "are in the _summary table only" if rows == "all" else "are not listed (summary_rows = 'kept')"
-        lines.append(f"  ({n_cases - len(show)} cases not kept {where})")
-    return lines
+    return rows
 
 
 class Warnings:
@@ -147,28 +162,42 @@ def write_sweep_files(outdir: Path, stem: str, table: pd.DataFrame, cases: Any, 
                 write_tidy(cases, outdir / f"{stem}_cases", fmt)
         write_text(outdir / f"{stem}.out", text)
         if plot:   # the summary only (the cases' own figures with case_plots = .true.)
-            from driver.plotting import save_figure, sweep_summary
-            shown = shown.copy()
-            for name in [sw.plot_x, *sw.plot_y]:   # a plotted expression becomes a column
-                if name and name not in shown.columns:
-                    shown[name] = expr.parse(name).evaluate(shown)
-            labels = {c: column_label(module, c) for c in shown.columns}
-            from driver.plotting import is_grid, sweep_maps
-            if is_grid(shown, names) and not sw.zip:   # a design space: maps over the keys, not strips
-                ys = [y for y in sw.plot_y if y in shown] or [c for c in getattr(module, "SWEEP_PLOT", ())
-                                                             if c in shown][:1]
-                for k, fig in enumerate(sweep_maps(shown, names, ys[:3], labels, getattr(module, "SWEEP_BEST", {}),
-                                                   stem, sw.summary_rows == "kept")):
-                    save_figure(fig, outdir / f"{stem}_summary{'' if k == 0 else f'_{k + 1}'}.png", plot)
-            else:
-                save_figure(sweep_summary(shown, names, sw.plot_x, sw.plot_y, stem, labels,
-                                          getattr(module, "SWEEP_PLOT", ())), outdir / f"{stem}_summary.png", plot)
+            write_sweep_plot(outdir, stem, plot, sw, names, module, shown)
+
+
+def write_sweep_plot(outdir: Path, stem: str, plot: bool | str, sw: Params, names: list[str], module: Any,
+                     shown: pd.DataFrame) -> None:
+    """The sweep's summary figure(s) of the rows ``shown``."""
+    from driver.plotting import save_figure, sweep_summary
+    shown = shown.copy()
+    for name in [sw.plot_x, *sw.plot_y]:   # a plotted expression becomes a column
+        if name and name not in shown.columns:
+            shown[name] = expr.parse(name).evaluate(shown)
+    labels = {c: column_label(module, c) for c in shown.columns}
+    from driver.plotting import is_grid, sweep_maps
+    if is_grid(shown, names) and not sw.zip:   # a design space: maps over the keys, not strips
+        ys = [y for y in sw.plot_y if y in shown] or [c for c in getattr(module, "SWEEP_PLOT", ())
+                                                     if c in shown][:1]
+        for k, fig in enumerate(sweep_maps(shown, names, ys[:3], labels, getattr(module, "SWEEP_BEST", {}),
+                                           stem, sw.summary_rows == "kept")):
+            save_figure(fig, outdir / f"{stem}_summary{'' if k == 0 else f'_{k + 1}'}.png", plot)
+    else:
+        save_figure(sweep_summary(shown, names, sw.plot_x, sw.plot_y, stem, labels,
+                                  getattr(module, "SWEEP_PLOT", ())), outdir / f"{stem}_summary.png", plot)
 
 
 def sweep_text(deck: Deck, sw: Params, base: Params, axes: list[tuple[str, list]], n_cases: int,
                 frame: pd.DataFrame, n_kept: int, failed: list[tuple[int, dict, str]], rows: str) -> str:
     """The sweep's fixed-format .out: axes, counts, the summary table, failed cases."""
+    lines = head_lines(deck, sw, base, axes, n_cases, n_kept, len(failed))
+    lines += _summary_table(frame, n_cases=n_cases, rows=rows)
+    lines += failed_lines(failed, len(failed))
+    return "\n".join(lines) + "\n"
 
+
+def head_lines(deck: Deck, sw: Params, base: Params, axes: list[tuple[str, list]], n_cases: int,
+               n_kept: int, n_failed: int) -> list[str]:
+    """The .out's lines before the summary table: axes, settings, counts."""
     lines = [f"  sweep over &{base.group} from deck {deck.path}", ""]
     for name, values in axes:
         vals = list(dict.fromkeys(values))   # deck order
@@ -184,13 +213,23 @@ def sweep_text(deck: Deck, sw: Params, base: Params, axes: list[tuple[str, list]
     lines += [f"    {'cases':<28} {n_cases} ({'zipped' if sw.zip else 'full grid'})",
               f"    {'case outputs':<28} {sw.case_outputs}" + (f"   keep: {sw.keep}" if sw.keep else ""),
               f"    {'kept':<28} {n_kept}",
-              f"    {'failed':<28} {len(failed)}", ""]
-    lines += _summary_table(frame, n_cases=n_cases, rows=rows)
-    if failed:
-        lines += ["", "  Failed cases"]
-        for index, values, error in failed[:1000]:
-            vals = ", ".join(f"{k} = {v!r}" for k, v in values.items())
-            lines.append(f"    case {index} ({vals}): {error}")
-        if len(failed) > 1000:
-            lines.append(f"    ... and {len(failed) - 1000} more (status column of the _summary table)")
-    return "\n".join(lines) + "\n"
+              f"    {'failed':<28} {n_failed}", ""]
+    return lines
+
+
+#: the .out lists at most this many failed cases (all are in the _summary table's status column)
+FAILED_LISTED = 1000
+
+
+def failed_lines(failed: list[tuple[int, dict, str]], n_failed: int) -> list[str]:
+    """The .out's lines after the table: the first :data:`FAILED_LISTED` of ``n_failed`` failed
+    cases (``failed``: at least those, in case order)."""
+    if not n_failed:
+        return []
+    lines = ["", "  Failed cases"]
+    for index, values, error in failed[:FAILED_LISTED]:
+        vals = ", ".join(f"{k} = {v!r}" for k, v in values.items())
+        lines.append(f"    case {index} ({vals}): {error}")
+    if n_failed > FAILED_LISTED:
+        lines.append(f"    ... and {n_failed - FAILED_LISTED} more (status column of the _summary table)")
+    return lines

@@ -21,7 +21,7 @@ __all__ = ["SPEC", "Case", "CaseResult", "MAX_KEYS", "MAX_CASES", "FULL_VALIDATI
            "case_count", "validate_sweep"]
 
 MAX_KEYS = 9
-#: most cases one per-case sweep deck may have (a batch sweep lists no case: driver.sweep_batch.MAX_CASES)
+#: most cases one per-case sweep deck may have (a batch sweep lists no case: driver.sweep.batch.MAX_CASES)
 MAX_CASES = 1_000_000
 #: most values one start/stop/count axis may have (about 0.3 GB as Python floats)
 MAX_AXIS_VALUES = 10_000_000
@@ -84,7 +84,9 @@ def _spec() -> GroupSpec:
         "scheduler": Key("str", check=_no_scheduler_in_deck,
                          doc="refused: the scheduler comes from --scheduler or Dask's configuration"),
         "chunk": Key("int", default=0, check=lambda v: "must not be negative" if v < 0 else None,
-                     doc="cases per task; 0 = chosen from the time of a warm case (not a worker's first)"),
+                     doc="cases per task; 0 = chosen by the tool (case by case: from the time of a warm case, "
+                         "not a worker's first; batch path: from the case count, and a small sweep runs in "
+                         "the driver when workers would not pay)"),
         "case_plots": Key("bool", default=False,
                           doc="with --plot, also draw every written case's own figures (by default --plot "
                               "draws the sweep's summary only: per-case figures cost more than the sweep)"),
@@ -241,7 +243,7 @@ def iter_cases(grid: Grid, indices: Iterable[int] | None = None) -> Iterator[Cas
 
 
 def grid_of(sw: Params, study_group: str, study_spec: GroupSpec) -> Grid:
-    """The swept axes of the &sweep group as a :class:`~driver.sweep_batch.Grid` (no case is built)."""
+    """The swept axes of the &sweep group as a :class:`Grid` (no case is built)."""
     axes = _axes(sw, study_group, study_spec)
     _check_zip(sw, axes)
     return Grid([a[0] for a in axes], [a[1] for a in axes], bool(sw.zip))
