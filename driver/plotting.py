@@ -239,7 +239,8 @@ def _runs(ok: np.ndarray) -> list[np.ndarray]:
 def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.ndarray,
                     listing, title: str, n_poses: int = 6, point: np.ndarray | None = None,
                     units: str = "length units", output: str = "rocker",
-                    limits: Sequence[tuple[float, np.ndarray]] = (), ax=None) -> Figure:
+                    limits: Sequence[tuple[float, np.ndarray]] = (), ax=None,
+                    motions: Sequence[dict] | None = None) -> Figure:
     """The linkage drawn at a few crank angles with the paths of A and B (exact), and the
     path of a coupler point (``point``: (n, 2) positions) when the deck defines one, the
     coupler then drawn as the plate A-B-P in every pose.
@@ -248,14 +249,21 @@ def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.nd
     turn); the crank pin's path is drawn only where the linkage assembles, so a crank that
     cannot turn shows the arc it swings through, not a circle.  Separate assembly intervals
     are drawn and named as separate motions.  ``limits``: (crank angle [deg], kernel row)
-    of the limit (toggle) positions, drawn dashed and labelled.  ``output`` names the output
-    link.  Coordinates in the deck's length ``units``, crank pivot at the origin, ground along
+    of the limit (toggle) positions, drawn dashed and labelled.  ``motions``: for a crank that
+    cannot turn (driver.fourbar.rocking_motions), per motion a dict of ``lo``, ``hi`` [deg],
+    ``theta``, ``out`` (kernel rows), ``stroke`` (0 forward, 1 back), ``branch`` (+1 open, -1
+    crossed) and ``point`` (coupler point positions or None): then the linkage is drawn rocking
+    between its limit positions, out on one assembly branch and back on the other, each
+    motion (a separate assembly interval) on its own.  ``output`` names the output link.  Coordinates in the deck's length ``units``, crank pivot at the origin, ground along
     +x; the legend sits beside the drawing.
     """
     if ax is None:
         fig, (ax,) = new_figure(1, 1, figsize=(8.6, 5.2))
     else:
         fig = ax.figure
+    if motions:
+        _rocking_drawing(ax, ground, motions, title, units, output)
+        return fig
     runs = _runs(ok)
     full = bool(ok.all()) and np.ptp(theta) >= 359.0
     for j, r in enumerate(runs if not full else [np.arange(len(ok))]):
@@ -284,8 +292,7 @@ def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.nd
         xs = [0.0, row[3], row[5], ground]
         ys = [0.0, row[4], row[6], 0.0]
         ax.plot(xs, ys, "--", color="k", lw=1.1, label="limit (toggle) positions" if j == 0 else None)
-        ax.annotate(rf"$\theta_2$ = {angle:.1f}°", (row[3], row[4]), xytext=(4, -10), textcoords="offset points",
-                    fontsize=8)
+        _limit_label(ax, row, rf"$\theta_2$ = {angle:.1f}°")
     ax.plot([0.0, ground], [0.0, 0.0], color="k", lw=2.5)
     ax.plot([0.0, ground], [0.0, 0.0], "^", color="k", ms=9, label="ground pivots $O_2$, $O_4$")
     ax.set_aspect("equal")
@@ -299,6 +306,90 @@ def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.nd
         what += f"\nassembles over {len(runs)} separate crank intervals ({spans}): separate motions"
     ax.set_title(f"{plain_text(title)}: {what}" if title else what)
     return fig
+
+
+def _deg(value: float, digits: int = 1) -> str:
+    """An angle [deg] as printed in a figure: ``digits`` decimals, no '-0'."""
+    text = f"{value:.{digits}f}"
+    return text[1:] if text.lstrip("-").strip("0.") == "" and text.startswith("-") else text
+
+
+def _limit_label(ax, row: np.ndarray, text: str) -> None:
+    """A limit position's label beside its crank pin A, pushed outward (away from the crank
+    pivot) on a white ground so it does not sit on the pose lines."""
+    x, y = float(row[3]), float(row[4])
+    r = math.hypot(x, y) or 1.0
+    ux, uy = x / r, y / r
+    ax.annotate(text, (x, y), xytext=(14 * ux, 14 * uy), textcoords="offset points", fontsize=8,
+                ha="left" if ux > 0.3 else "right" if ux < -0.3 else "center",
+                va="bottom" if uy > 0.3 else "top" if uy < -0.3 else "center",
+                bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.85), zorder=6)
+
+
+def _rocking_drawing(ax, ground: float, motions: Sequence[dict], title: str, units: str, output: str) -> None:
+    """The linkage of a crank that cannot turn, rocking between its limit positions (see
+    :func:`fourbar_linkage`): per motion the crank pin's arc, B's path out (solid, the first
+    branch) and back (dashed, the other branch), the coupler point's likewise, a few poses of
+    each stroke and the two limit positions dashed black and labelled."""
+    cmap = matplotlib.colormaps["viridis"]
+    word = {1: "open", -1: "crossed"}
+    n_m = len(motions)
+    for i, m in enumerate(motions):
+        out, stroke, theta = np.asarray(m["out"]), np.asarray(m["stroke"]), np.asarray(m["theta"])
+        first = int(np.asarray(m["branch"])[0])
+        tag = "" if n_m == 1 else f" (motion {i + 1})"
+        fwd, back = np.flatnonzero(stroke == 0), np.flatnonzero(stroke == 1)
+        ax.plot(out[fwd, 3], out[fwd, 4], color="0.55", lw=0.9, label="path of A (crank pin): an arc" if i == 0 else None)
+        ax.plot(out[fwd, 5], out[fwd, 6], color="C3", lw=1.3,
+                label=f"path of B, out on the {word[first]} assembly" if i == 0 else None)
+        ax.plot(out[back, 5], out[back, 6], color="C3", lw=1.3, ls="--",
+                label=f"path of B, back on the {word[-first]} assembly" if i == 0 else None)
+        pt = m.get("point")
+        if pt is not None:
+            pt = np.asarray(pt)
+            ax.plot(pt[fwd, 0], pt[fwd, 1], color="C4", lw=1.2, label="path of coupler point P" if i == 0 else None)
+            ax.plot(pt[back, 0], pt[back, 1], color="C4", lw=1.2, ls="--")
+        # poses: three inside each stroke (the limits are drawn on their own)
+        at = [1 / 3, 2 / 3] if n_m > 1 else [0.2, 0.5, 0.8]   # fractions of a stroke's samples
+        picks = [fwd[int(f * (len(fwd) - 1))] for f in at] + [back[int(f * (len(back) - 1))] for f in at]
+        for j, k in enumerate(picks):
+            c = cmap((j + 0.5) / len(picks))
+            back_pose = stroke[k] == 1
+            xs = [0.0, out[k, 3], out[k, 5], ground]
+            ys = [0.0, out[k, 4], out[k, 6], 0.0]
+            arrow = "\u2192" if not back_pose else "\u2190"
+            ax.plot(xs, ys, "-o", color=c, ms=3, lw=1.4, ls=":" if back_pose else "-", alpha=0.95,
+                    label=(rf"$\theta_2$ = {_deg(theta[k], 0)}° {arrow} {word[int(np.asarray(m['branch'])[k])]}"
+                           + tag))
+            if pt is not None:
+                tri = np.array([[out[k, 3], out[k, 4]], [out[k, 5], out[k, 6]], pt[k], [out[k, 3], out[k, 4]]])
+                ax.fill(tri[:, 0], tri[:, 1], color=c, alpha=0.12, lw=0)
+                ax.plot(tri[:, 0], tri[:, 1], color=c, lw=0.9, ls=":" if back_pose else "-")
+        for end, angle in ((fwd[0], m["lo"]), (fwd[-1], m["hi"])):
+            row = out[end]
+            ax.plot([0.0, row[3], row[5], ground], [0.0, row[4], row[6], 0.0], "--", color="k", lw=1.1,
+                    label="limit positions (the crank reverses)" if i == 0 and end == fwd[0] else None)
+            ax.plot([row[3]], [row[4]], "o", color="k", ms=4)
+            _limit_label(ax, row, rf"limit $\theta_2$ = {_deg(angle)}°")
+    ax.plot([0.0, ground], [0.0, 0.0], color="k", lw=2.5)
+    ax.plot([0.0, ground], [0.0, 0.0], "^", color="k", ms=9, label="ground pivots $O_2$, $O_4$")
+    ax.set_aspect("equal")
+    ax.margins(0.1)   # room for the limit labels
+    ax.set_xlabel(f"x [{units}]")
+    ax.set_ylabel(f"y [{units}]")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
+    first = word[int(np.asarray(motions[0]["branch"])[0])]
+    other = word[-int(np.asarray(motions[0]["branch"])[0])]
+    what = "the crank rocks between its limit positions"
+    if n_m == 1:
+        m = motions[0]
+        what += (f"\n$\\theta_2$ = {_deg(m['lo'])}° to {_deg(m['hi'])}°: out on the {first} assembly, "
+                 f"back on the {other}")
+    else:
+        spans = " and ".join(f"{_deg(m['lo'])}-{_deg(m['hi'])}°" for m in motions)
+        what += (f"\n{n_m} separate motions (mirror assemblies, $\\theta_2$ = {spans}),"
+                 f"\neach out on the {first} assembly, back on the {other}")
+    ax.set_title(f"{plain_text(title)}: {what}" if title else what)
 
 
 # ----------------------------------------------------------------------------- manipulator
@@ -589,20 +680,82 @@ def slidercrank_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray
 
 
 @styled
-def slidercrank_convergence_figure(series: dict[str, tuple[list[int], list[float]]], title: str) -> Figure:
-    """Peak strain against element count and its percentage change (the paper's Figures 8-9)."""
-    fig, axes = new_figure(2, 1, sharex=True, figsize=(7.0, 5.0))
-    for label, (n, peak) in series.items():
-        n, peak = np.asarray(n, dtype=float), np.asarray(peak, dtype=float)
-        axes[0].plot(n, peak, "o-", ms=3, label=label)
-        if n.size > 1:
-            axes[1].plot(n[1:], 100 * np.diff(peak) / peak[:-1], "o-", ms=3, label=label)
-    axes[0].set_xscale("log")
-    axes[0].set_ylabel("peak tensile strain [microstrain]")
-    axes[1].set_ylabel("change from previous count [%]")
-    axes[1].set_xlabel("number of elements")
-    axes[0].legend()
-    fig.suptitle(plain_text(title))
+def slidercrank_convergence_figure(series: dict[str, Any], title: str, axes=None) -> Figure:
+    """An element-convergence study as an engineer reads it (the paper's Figures 8-9 redrawn).
+
+    ``series``: per crank speed (its label) either ``(n, element)`` or ``(n, element, pin)``:
+    the element counts and the peak tensile strain [microstrain] of the crank-end element (the
+    paper's quantity, an element average) and, optionally, at the crank pin recovered from the
+    first two elements.  Left: the strain against the number of elements (log axis), the
+    finest mesh's value dotted.  Right: the size of the difference from the finest mesh [%] on
+    log-log axes, with a slope -1 guide (an element average converges as 1/N) and the 0.1 %
+    line.  ``axes``: two axes of the caller's figure to draw into."""
+    if axes is None:
+        fig, axes = new_figure(1, 2, figsize=(10.0, 4.8))
+    else:
+        fig = axes[0].figure
+    ax_q, ax_e = axes[0], axes[1]
+    one = len(series) == 1
+    n_all: list[float] = []
+    for k, (label, data) in enumerate(series.items()):
+        n = np.asarray(data[0], dtype=float)
+        kinds = [("crank-end element (the paper's quantity)", np.asarray(data[1], dtype=float), "-", "o")]
+        if len(data) > 2 and data[2] is not None:
+            kinds.append(("at the crank pin (recovered from two elements)", np.asarray(data[2], dtype=float), "--", "s"))
+        colour = f"C{k % 10}"
+        for j, (what, v, ls, mk) in enumerate(kinds):
+            name = what if one else f"{label}: {what}"
+            if n.size > 1:   # where it settles: every finer mesh within 0.1 % of the finest
+                err_ = 100 * np.abs(v - v[np.argmax(n)]) / abs(v[np.argmax(n)])
+                order = np.argsort(n)
+                bad = np.nonzero(err_[order] > 0.1)[0]
+                n_ok = n[order][bad[-1] + 1] if bad.size else n[order][0]
+                name += f", within 0.1 % from N = {n_ok:g}" if n_ok < n.max() else ""
+            ax_q.plot(n, v, ls=ls, marker=mk, ms=4, color=colour if one is False else f"C{j}", label=name,
+                      mfc="white" if j else None)
+            if n.size > 1:
+                finest = v[np.argmax(n)]
+                err = 100 * np.abs(v - finest) / abs(finest)
+                use = (n < n.max()) & (err > 0)
+                ax_e.plot(n[use], err[use], ls=ls, marker=mk, ms=4, color=colour if one is False else f"C{j}",
+                          mfc="white" if j else None, label=name)
+                if j == 0:
+                    ax_q.axhline(finest, color="0.45", lw=0.8, ls=":", zorder=0,
+                                 label=f"{'' if one else label + ': '}finest mesh, N = {n.max():g}: "
+                                       f"{finest:.4g} microstrain")
+        n_all += list(n)
+    from matplotlib.ticker import FuncFormatter
+    for ax in (ax_q, ax_e):
+        ax.set_xscale("log")
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.set_xlabel("number of rod elements $N$")
+    ax_q.set_ylabel("peak tensile strain [microstrain]")
+    ax_q.set_title("peak strain against mesh size")
+    ax_e.set_yscale("log")
+    ax_e.set_ylabel("|difference from the finest mesh| [%]")
+    ax_e.set_title("difference from the finest mesh")
+    lines = [ln for ln in ax_e.lines if len(ln.get_xdata())]
+    if lines:
+        x0 = min(float(np.min(ln.get_xdata())) for ln in lines)
+        y0 = max(float(ln.get_ydata()[0]) for ln in lines)
+        xs = np.array([x0, max(n_all) / 2])
+        ax_e.plot(xs, y0 * x0 / xs, color="0.5", lw=0.9, ls="-.", label="slope $-1$ (error $\\propto 1/N$)")
+        pins = [ln for ln in lines if ln.get_linestyle() == "--" and len(ln.get_xdata()) > 1]
+        if pins:   # the recovered pin strain is second order: a slope -2 guide through its second point
+            x1, y1 = float(pins[0].get_xdata()[1]), float(pins[0].get_ydata()[1])
+            xs2 = np.array([x1, max(n_all) / 2])
+            ax_e.plot(xs2, 0.6 * y1 * (x1 / xs2) ** 2, color="0.5", lw=0.9, ls=(0, (1, 1.5)),
+                      label="slope $-2$ (error $\\propto 1/N^2$)")
+        ax_e.axhline(0.1, color="0.6", lw=0.8, ls=":")
+        ax_e.annotate("0.1 %", (0.0, 0.1), xycoords=("axes fraction", "data"), xytext=(4, 3),
+                      textcoords="offset points", fontsize=8, color="0.35")
+    handles, names = ax_q.get_legend_handles_labels()
+    more = [(h, t) for h, t in zip(*ax_e.get_legend_handles_labels()) if t.startswith("slope")]
+    handles, names = handles + [h for h, _ in more], names + [t for _, t in more]
+    fig.legend(handles, names, loc="outside lower center", ncol=1 if max(map(len, names)) > 60 else 2,
+               frameon=False)
+    if title:
+        fig.suptitle(plain_text(title))
     return fig
 
 
@@ -617,16 +770,27 @@ def slidercrank_history_figure(time: np.ndarray, series: dict[str, np.ndarray], 
         fig, axes = new_figure(len(series), 1, sharex=True, figsize=(7.4, 2.4 * len(series) + 0.8))
     else:
         fig = axes[0].figure
+    import re as _re
+    model_label = "this model (linear KED, Newmark)"
     for ax, (key, y) in zip(axes, series.items()):
-        ax.plot(time, y, color="C0", lw=1.2, label="this model (linear KED, Newmark)")
+        ax.plot(time, y, color="C0", lw=1.2, label=model_label)
         if key in reference:
             t, v = reference[key]
             ax.plot([t], [v], "D", ms=7, mfc="white", mec="C3", mew=1.5, label=reference_label or "reference")
-            ax.annotate(f"{v:.4g}", (t, v), xytext=(-6, 8), textcoords="offset points", ha="right", fontsize=8,
-                        color="C3")
+            m = _re.search(r"\[([^\]]+)\]\s*$", labels.get(key, ""))
+            unit = f" {m.group(1)}" if m else ""
+            mine = float(np.interp(t, time, y))
+            # the two end values side by side, in the figure's own font, on a white ground beside the marker
+            span = float(np.nanmax(time) - np.nanmin(time)) or 1.0
+            ax.set_xlim(right=max(float(np.nanmax(time)), t) + 0.24 * span)   # room right of the curves
+            ax.annotate(f"reference {v:.4g}{unit}\nthis model {mine:.4g}{unit}", (t, v), xytext=(12, 0),
+                        textcoords="offset points", ha="left", va="center", fontsize=8.5, color="0.15",
+                        bbox=dict(boxstyle="round,pad=0.3", fc="white", ec="C3", lw=0.8, alpha=0.9),
+                        arrowprops=dict(arrowstyle="-", color="C3", lw=0.8), zorder=6)
         ax.set_ylabel(labels.get(key, key))
-        ax.legend(loc="best")
     axes[-1].set_xlabel("time $t$ [s]")
+    handles, names = axes[0].get_legend_handles_labels()
+    fig.legend(handles, names, loc="outside lower center", ncol=2, frameon=False)
     if title:
         fig.suptitle(plain_text(title))
     return fig
@@ -839,7 +1003,8 @@ def convergence_plot(history, evals, objective: str, sense: str = "minimize", ti
     a1.set_ylabel(objective)
     a1.set_title(f"best feasible ({'largest' if sign < 0 else 'smallest'})")
     a1.legend(loc="best")
-    a2.set_ylabel("|best so far - final best|")
+    unit = re.search(r"\[([^\[\]]+)\]\s*$", objective)   # the objective's unit, when its label has one
+    a2.set_ylabel("|best so far - final best|" + (f" [{unit.group(1)}]" if unit else ""))
     a2.set_title("gap to the final best")
     viol = pd.to_numeric(ev["violation"], errors="coerce").to_numpy(dtype=float) if "violation" in ev else np.array([])
     if viol.size and np.nanmax(viol) > 0:

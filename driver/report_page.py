@@ -144,8 +144,26 @@ def _figures_html(result: "Result", skip: Iterable[str] = ()) -> tuple[str, list
 
 def _fourbar_frames(params: "Params") -> dict[str, Any] | None:
     from driver import fourbar
-    theta = np.linspace(0.0, 360.0, ANIMATION_FRAMES, endpoint=False)
-    out, status = fourbar.exact_grid(params, theta)
+    motions = fourbar.rocking_motions(params, max(8, ANIMATION_FRAMES // 2 // max(
+        1, len(fourbar.assembly_intervals(params.fixed_link, params.crank, params.coupler, params.rocker) or [1]))))
+    extra: dict[str, Any] = {}
+    if motions:   # a crank that cannot turn: it rocks between its limit positions, out on one
+        # assembly branch and back on the other; each assembly interval a motion of its own
+        theta = np.concatenate([m.theta for m in motions])
+        out = np.vstack([m.out for m in motions])
+        status = np.concatenate([m.status for m in motions])
+        word = {1: "open", -1: "crossed"}
+        tag = (lambda i: "") if len(motions) == 1 else (lambda i: f", motion {i + 1} of {len(motions)}")
+        arrow = {0: "\u2192", 1: "\u2190"}   # forward stroke, return stroke
+        extra["phase"] = [f"{arrow[int(st)]} {word[int(b)]} assembly{tag(i)}"
+                          for i, m in enumerate(motions) for st, b in zip(m.stroke, m.branch)]
+        starts = np.cumsum([0] + [len(m.theta) for m in motions])
+        extra["segments"] = [[int(a), int(b)] for a, b in zip(starts[:-1], starts[1:])]
+        extra["limits"] = [[np.round(m.out[k, 3:7], 5).tolist() for k in (0, len(m.theta) // 2 - 1)] for m in motions]
+        extra["limit_angles"] = [[m.lo, m.hi] for m in motions]
+    else:
+        theta = np.linspace(0.0, 360.0, ANIMATION_FRAMES, endpoint=False)
+        out, status = fourbar.exact_grid(params, theta)
     ok = (status != fourbar.ST["no_assembly"]) & (status != fourbar.ST["indeterminate"])
     cp = fourbar.coupler_point(params, theta, out, status)
     g = params.fixed_link
@@ -153,7 +171,8 @@ def _fourbar_frames(params: "Params") -> dict[str, Any] | None:
               "A": np.round(out[:, 3:5], 5).tolist(), "B": np.round(np.where(ok[:, None], out[:, 5:7], 0.0), 5).tolist(),
               "P": None if cp is None else np.round(np.where(ok[:, None], cp[:, :2], 0.0), 5).tolist(),
               "ground": [[0.0, 0.0], [g, 0.0]], "kind": "fourbar",
-              "names": {"crank": "crank", "out": "rocker"}}
+              "names": {"crank": "crank", "out": "rocker"}, **extra}
+    frames["theta"] = np.round(theta, 6).tolist()
     pts = [out[:, 3:5], out[ok][:, 5:7], np.array([[0.0, 0.0], [g, 0.0]])]
     if cp is not None:
         pts.append(cp[ok][:, :2])
@@ -223,7 +242,7 @@ _ANIM_JS = r"""
   function show(k){
     var A = F.A[k], B = F.B[k], ok = F.ok[k] === 1, G = F.ground;
     line(crank, G[0], A); dot(pa, A);
-    label.textContent = F.theta[k].toFixed(0) + "\u00b0";
+    label.textContent = F.theta[k].toFixed(0) + "\u00b0" + (F.phase ? " " + F.phase[k] : "");
     [coupler, out, pb, pp, block].forEach(function(e){ if (e) e.style.visibility = ok ? "visible" : "hidden"; });
     note.style.visibility = ok ? "hidden" : "visible";
     if (!ok) return;
@@ -269,7 +288,22 @@ def mechanism_animation(params: "Params", anim_id: str = "anim", caption: str = 
     flip = f"translate(0,{2 * y0 + h:.6g}) scale(1,-1)"   # y up, as the figures draw it
     ok = np.array(F["ok"], bool)
     paths = []
-    if ok.any():
+    if F.get("segments"):   # a rocking crank: per motion B's (and P's) loop, A's arc, the limits dashed
+        for a, b in F["segments"]:
+            for name, key, colour in (("path of B", "B", "#c0392b"), ("path of P", "P", "#8e44ad")):
+                if F[key] is None:
+                    continue
+                d = " ".join(f"{p[0]:.5g},{p[1]:.5g}" for p in np.array(F[key])[a:b])
+                paths.append(f'<polyline points="{d}" fill="none" stroke="{colour}" stroke-width="{lw / 3:.4g}" '
+                             f'stroke-dasharray="{lw:.4g},{lw / 2:.4g}"><title>{name}</title></polyline>')
+        g1 = F["ground"][1]
+        for (lo, hi), rows in zip(F["limit_angles"], F["limits"]):
+            for ang, r in zip((lo, hi), rows):
+                d = f"0,0 {r[0]:.5g},{r[1]:.5g} {r[2]:.5g},{r[3]:.5g} {g1[0]:.5g},{g1[1]:.5g}"
+                paths.append(f'<polyline data-part="limit" points="{d}" fill="none" stroke="#000" '
+                             f'stroke-width="{lw / 4:.4g}" stroke-dasharray="{lw / 2:.4g},{lw / 2:.4g}">'
+                             f'<title>limit position: crank angle {ang:.1f}\u00b0 (the crank reverses)</title></polyline>')
+    elif ok.any():
         for name, key, colour in (("path of B", "B", "#c0392b"), ("path of P", "P", "#8e44ad")):
             if F[key] is None or (F["kind"] == "slidercrank"):
                 continue
@@ -283,7 +317,11 @@ def mechanism_animation(params: "Params", anim_id: str = "anim", caption: str = 
                     paths.append(f'<{tag} points="{d}" fill="none" stroke="{colour}" stroke-width="{lw / 3:.4g}" '
                                  f'stroke-dasharray="{lw:.4g},{lw / 2:.4g}"><title>{name}</title></{tag}>')
     a_pts = np.array(F["A"])
-    if ok.all() or F["kind"] == "slidercrank":
+    if F.get("segments"):   # the crank pin's arc, once per motion (the forward stroke covers it)
+        a_path = "".join('<polyline points="' + " ".join(f"{p[0]:.5g},{p[1]:.5g}" for p in a_pts[a:(a + b) // 2]) +
+                         f'" fill="none" stroke="#999" stroke-width="{lw / 4:.4g}"><title>path of A</title></polyline>'
+                         for a, b in F["segments"])
+    elif ok.all() or F["kind"] == "slidercrank":
         a_path = ('<polygon points="' + " ".join(f"{p[0]:.5g},{p[1]:.5g}" for p in a_pts) + f'" fill="none" '
                   f'stroke="#999" stroke-width="{lw / 4:.4g}"><title>path of A</title></polygon>')
     else:   # a crank that cannot turn: its pin's path only where the linkage assembles

@@ -116,6 +116,7 @@ KINDS = {
     "fourbar_linkage": lambda: _fourbar("crank5.dat", "linkage"),
     "fourbar_linkage_coupler_point": lambda: _fourbar("crank5_coupler_point.dat", "linkage"),
     "fourbar_linkage_nongrashof": lambda: _fourbar("nongrashof.dat", "linkage"),
+    "fourbar_linkage_doublerocker": lambda: _fourbar("doublerocker.dat", "linkage"),
     "fourbar_curves_double_crank": lambda: _fourbar("doublecrank.dat", "curves"),
     "design_space_1_key": lambda: _design_map(1),
     "design_space_2_keys": lambda: _design_map(2),
@@ -130,6 +131,9 @@ KINDS = {
     "robust_example_fits": lambda: _result_figure("robust_example.dat", "fits"),
     "slidercrank_strain": lambda: _slidercrank("strain"),
     "slidercrank_deflection": lambda: _slidercrank("deflection"),
+    "slidercrank_convergence": lambda: driver.run(
+        "&slidercrank\n material = 'aluminium'\n speeds = 29.32\n element_counts = 1, 2, 4, 8, 16, 32\n"
+        " steps_per_rev = 360, revolutions = 2\n/\n", name="convergence_small").figure("convergence"),
     "slidercrank_simeon_history": lambda: _result_figure("slidercrank_simeon1996.dat", "history"),
     "line_panels": _function_error,
 }

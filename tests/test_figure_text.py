@@ -99,6 +99,12 @@ def test_simeon_benchmark_draws_its_history():
     assert elong_ax.lines[0].get_ydata()[-1] == pytest.approx(table["(q4)"] * 1e6, rel=1e-9)   # [um]
     assert ref.get_xdata()[0] == SIMEON1996["t"] and ref.get_ydata()[0] == pytest.approx(SIMEON1996["q1"] * 1e3)
     assert q1[-1] == pytest.approx(ref.get_ydata()[0], rel=5e-3)
+    # the end values written beside the marker, with units, in the figure's own font and size
+    note = mid_ax.texts[0]
+    assert note.get_text() == f"reference {SIMEON1996['q1'] * 1e3:.4g} mm\nthis model {q1[-1]:.4g} mm"
+    assert elong_ax.texts[0].get_text().endswith(r"$\mu$m") and "this model" in elong_ax.texts[0].get_text()
+    assert note.get_fontname() == mid_ax.yaxis.label.get_fontname() and note.get_fontsize() >= 8.5
+    assert ref.get_xdata()[0] < mid_ax.get_xlim()[1] - 0.1 * (mid_ax.get_xlim()[1] - mid_ax.get_xlim()[0])   # room for it
 
 
 def test_report_page_text_of_a_label():

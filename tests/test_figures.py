@@ -340,3 +340,4 @@ def test_optimisation_convergence_figure_names_its_objective_with_units(tmp_path
     fig = report.convergence_figure(oc.problem, report.history_frame(oc.problem, oc.history),
                                     oc.evaluator.frame(), "opt")
     assert fig.axes[0].get_ylabel() == "rocker swing [deg]"
+    assert fig.axes[1].get_ylabel() == "|best so far - final best| [deg]"   # the gap in the objective's unit

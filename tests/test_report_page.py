@@ -145,7 +145,7 @@ def _move(browser, k: int) -> None:
 
 @pytest.mark.parametrize("stem, lengths", [
     ("crank5", dict(ground=12.0, crank=5.0, coupler=15.0, rocker=9.0)),
-    ("nongrashof", None),
+    ("nongrashof", dict(ground=10.0, crank=6.0, coupler=7.0, rocker=8.0, rocking=True)),
     ("slidercrank_small", dict(crank=0.125, rod=0.505)),
 ])
 def test_animation_follows_the_slider(pages, browser, stem, lengths):
@@ -164,8 +164,13 @@ def test_animation_follows_the_slider(pages, browser, stem, lengths):
     for k in (0, n // 8, n // 3, n // 2, (3 * n) // 4):
         _move(browser, k)
         p = _parts(browser)
-        theta = 360.0 * k / n
-        assert p["theta"] == f"{theta:.0f}\u00b0"
+        if lengths and lengths.get("rocking"):   # the frame's crank angle, then the stroke and branch
+            theta = float(browser.eval(f"JSON.parse(document.querySelector('.anim script[type=\\'application/json\\']')"
+                                       f".textContent).theta[{k}]"))
+            assert p["theta"].startswith(f"{theta:.0f}\u00b0 ") and "assembly" in p["theta"]
+        else:
+            theta = 360.0 * k / n
+            assert p["theta"] == f"{theta:.0f}\u00b0"
         seen.append(p)
         if lengths is None:
             continue
@@ -196,12 +201,28 @@ def test_animation_follows_the_slider(pages, browser, stem, lengths):
     # the drawing changes with the slider
     assert len({tuple(p["A"]) for p in seen}) == len(seen)
     assert browser.errors() == []
-    if lengths is None:   # the non-Grashof linkage: somewhere in the turn it cannot be assembled, and says so
+    if lengths and lengths.get("rocking"):
+        # the non-Grashof linkage cannot turn: it rocks between its closed-form limit angles, out
+        # on the open assembly and back on the crossed, always assembled (no "cannot be assembled")
+        F = browser.eval("JSON.parse(document.querySelector(\".anim script[type='application/json']\").textContent)")
+        g, a, b, c = (lengths[k] for k in ("ground", "crank", "coupler", "rocker"))
+        limit = math.degrees(math.acos((g * g + a * a - (b + c) ** 2) / (2 * g * a)))
+        th = np.array(F["theta"])
+        assert th.max() == pytest.approx(limit, abs=1e-4) and th.min() == pytest.approx(-limit, abs=1e-4)
+        top = int(np.argmax(th))
+        assert np.all(np.diff(th[:top + 1]) > 0) and np.all(np.diff(th[top + 1:]) < 0)   # reverses once, at the limit
+        assert all("open" in f for f in F["phase"][:top + 1]) and all("crossed" in f for f in F["phase"][top + 1:])
         states = []
         for k in range(0, n, 3):
             _move(browser, k)
-            states.append(_parts(browser)["note"])
-        assert "visible" in states and "hidden" in states
+            q = _parts(browser)
+            states.append(q["note"])
+            A, B = np.array(q["A"]), np.array(q["B"])
+            assert math.isclose(np.hypot(*(B - A)), b, rel_tol=1e-4)
+            assert math.isclose(np.hypot(B[0] - g, B[1]), c, rel_tol=1e-4)
+        assert set(states) == {"hidden"}
+        limits = browser.eval("document.querySelectorAll(\".anim [data-part='limit']\").length")
+        assert limits == 2
 
 
 def test_play_button_moves_the_mechanism(pages, browser):

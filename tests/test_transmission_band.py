@@ -140,7 +140,7 @@ def test_shipped_outputs_record_the_band():
                  "optimize_fourbar_design_evals", "optimize_crank_rocker_evals"):
         assert _parquet_band(ROOT / "outputs" / f"{name}.parquet") == [40.0, 120.0]
     text = (ROOT / "outputs" / "optimize_fourbar_design.out").read_text()
-    assert "transmission_band_deg = 40, 120   (base deck; used by meets_transmission_band)" in text
+    assert "transmission_band_deg = 40, 120   (base deck; used by the summary columns)" in text
 
 
 def test_an_optimisation_states_the_band_it_constrains_by(tmp_path):
@@ -155,6 +155,6 @@ def test_an_optimisation_states_the_band_it_constrains_by(tmp_path):
                     " method = 'grid', grid_count = 7\n/\n")
     oc = optimize(deck, outdir=tmp_path / "o")
     text = (tmp_path / "o" / "opt.out").read_text()
-    assert "transmission_band_deg = 30, 150   (base deck; used by meets_transmission_band)" in text
+    assert "transmission_band_deg = 30, 150   (base deck; used by the summary columns)" in text
     assert _parquet_band(tmp_path / "o" / "opt_evals.parquet") == [30.0, 150.0]
     assert oc.best is not None

@@ -93,9 +93,9 @@ LABELS = {"crank": ("crank length", "length units"), "coupler": ("coupler length
 #: which way a summary column is better (the design-space maps star the best kept design)
 SWEEP_BEST = {"mu_min_deg": "max", "mu_max_deg": "min", "rocker_swing_deg": "max", "omega3_peak_rad_s": "min",
               "omega2_peak_rad_s": "min"}
-#: keys of the base deck the summary columns depend on -> those columns: a sweep's .out and an
-#: optimisation's .out state them, and the summary/evals Parquet tables record them in their metadata
-SUMMARY_SETTINGS = {"transmission_band_deg": ("meets_transmission_band",)}
+#: keys of the base deck the summary columns depend on (transmission_band_deg: meets_transmission_band):
+#: a sweep's and an optimisation's .out state them, their summary/evals Parquet tables record them
+SUMMARY_SETTINGS = ("transmission_band_deg",)
 #: what a sweep summary plots when its deck names no plot_y
 SWEEP_PLOT = ("mu_min_deg", "mu_max_deg", "rocker_swing_deg", "omega3_peak_rad_s", "omega2_peak_rad_s",
               "assembled_fraction")
@@ -172,6 +172,74 @@ def limit_angles(p: float, q: float, r: float, s: float) -> list[float]:
             a = math.degrees(math.acos(c))
             out += [a, (360.0 - a) % 360.0]
     return sorted(set(round(a, 10) for a in out))
+
+
+def assembly_intervals(p: float, q: float, r: float, s: float) -> list[tuple[float, float]] | None:
+    """Crank-angle intervals [deg] over which the linkage assembles, from the closed form
+    (r - s)^2 <= |A O_B|^2 = p^2 + q^2 - 2 p q cos(theta) <= (r + s)^2; each ends at two limit
+    (toggle) positions.  None when the crank turns fully; [] when it cannot be assembled at all.
+    An interval through 0 deg is one interval (lo < 0 < hi), not two; a Grashof double-rocker
+    gives two, mirror images about the ground line (separate motions: one cannot reach the
+    other without taking the linkage apart)."""
+    c_lo = (p * p + q * q - (r + s) ** 2) / (2 * p * q)   # cos(theta) at |A O_B| = r + s
+    c_hi = (p * p + q * q - (r - s) ** 2) / (2 * p * q)   # cos(theta) at |A O_B| = |r - s|
+    eps = 1e-12
+    if c_lo <= -1.0 + eps and c_hi >= 1.0 - eps:
+        return None
+    if c_lo > c_hi or c_lo > 1.0 or c_hi < -1.0:
+        return []
+    t1 = math.degrees(math.acos(max(-1.0, min(1.0, c_lo))))   # extended limit (r + s)
+    t2 = math.degrees(math.acos(max(-1.0, min(1.0, c_hi))))   # folded limit |r - s|
+    if c_lo > -1.0 + eps and c_hi >= 1.0 - eps:
+        return [(-t1, t1)]                  # rocks through 0 deg between its extended limits
+    if c_lo <= -1.0 + eps:
+        return [(t2, 360.0 - t2)]           # rocks through 180 deg between its folded limits
+    return [(t2, t1), (360.0 - t1, 360.0 - t2)]
+
+
+@dataclass
+class Motion:
+    """One motion of a linkage whose crank cannot turn: the crank swings from ``lo`` to ``hi``
+    on the deck's assembly branch, reverses at the limit position and swings back on the other
+    branch (at a limit the two branches meet: B lies on the line A-O_B).
+
+    ``theta`` [deg] the crank angles in the order they are passed, ``out``/``status`` the
+    kernel's states there, ``branch`` +1 (open) or -1 (crossed) per sample, ``stroke`` 0 for
+    the forward swing and 1 for the return."""
+
+    lo: float
+    hi: float
+    theta: np.ndarray
+    out: np.ndarray
+    status: np.ndarray
+    branch: np.ndarray
+    stroke: np.ndarray
+
+
+def rocking_motions(p: Params, n_stroke: int = 181) -> list[Motion] | None:
+    """The motions of the deck's linkage when its crank cannot turn fully (None when it can):
+    per assembly interval (:func:`assembly_intervals`), ``n_stroke`` samples forward on the
+    deck's branch and ``n_stroke`` back on the other, the ends a hair inside the limit angles
+    (at the limit itself round-off may put A a ulp beyond reach).  Positions only: the
+    kernel's velocities assume the deck's constant crank speed (reversed on the return)."""
+    spans = assembly_intervals(p.fixed_link, p.crank, p.coupler, p.rocker)
+    if spans is None:
+        return None
+    first = 1 if p.branch == "open" else -1
+    motions = []
+    for lo, hi in spans:
+        pad = 1e-7 * max(1.0, hi - lo)
+        # cosine spacing: samples gather at the limits, where B moves fast for a little crank
+        # motion (and a crank driven to and fro slows there to reverse)
+        fwd = lo + pad + (hi - lo - 2 * pad) * 0.5 * (1.0 - np.cos(np.linspace(0.0, math.pi, n_stroke)))
+        o1, s1 = kernels.fourbar_exact(np.radians(fwd), p.fixed_link, p.crank, p.coupler, p.rocker,
+                                       p.omega, p.alpha, first)
+        o2, s2 = kernels.fourbar_exact(np.radians(fwd[::-1]), p.fixed_link, p.crank, p.coupler, p.rocker,
+                                       -p.omega, p.alpha, -first)
+        motions.append(Motion(lo, hi, np.concatenate([fwd, fwd[::-1]]), np.vstack([o1, o2]),
+                              np.concatenate([s1, s2]),
+                              np.repeat([first, -first], n_stroke), np.repeat([0, 1], n_stroke)))
+    return motions
 
 
 def crank_angles(p: Params) -> np.ndarray:
@@ -644,6 +712,15 @@ def _figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> list[F
         theta = np.linspace(lo, hi, 721) if hi - lo < 360.0 else np.linspace(0.0, 360.0, 721)
         out, st = exact_grid(p, theta)
         cp = coupler_point(p, theta, out, st)
+        motions = rocking_motions(p) if hi - lo >= 360.0 else None
+        if motions:   # a crank that cannot turn: it rocks between its limit positions
+            drawn = []
+            for m in motions:
+                mp = coupler_point(p, m.theta, m.out, m.status)
+                drawn.append({"lo": m.lo, "hi": m.hi, "theta": m.theta, "out": m.out, "stroke": m.stroke,
+                              "branch": m.branch, "point": None if mp is None else mp[:, :2]})
+            return plotting.fourbar_linkage(p.fixed_link, theta, out, st == ST["ok"], None, stem_title,
+                                            output=output_name(p), motions=drawn)
         limits = []
         for a in limit_angles(p.fixed_link, p.crank, p.coupler, p.rocker):
             if theta[0] - 1e-9 <= a <= theta[-1] + 1e-9 or hi - lo >= 360.0:

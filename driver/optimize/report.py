@@ -75,8 +75,8 @@ def x_text(p: Problem, i: int, v: float, on_lattice: bool) -> str:
 
 def settings_of(p: Problem) -> dict[str, Any]:
     """The base deck's settings the study's summary columns depend on (the four-bar's
-    ``transmission_band_deg``) that are not design variables: the .out states those the
-    problem's objective or constraints use; the _evals table records them all in its metadata."""
+    ``transmission_band_deg``) that are not design variables: the .out states them and the
+    _evals table records them in its metadata."""
     from driver.sweep.report import summary_settings
     return summary_settings(p.study, p.base, {v.key for v in p.variables})
 
@@ -106,12 +106,9 @@ def report_text(p: Problem, ev: Evaluator, mres: MethodResult, history: list[His
         kind = ("equality, met within its tolerance" if c.equality else
                 "inequality, margin in its units" if c.sense else "condition, met or not")
         L.append(f"    constraint ........... {c.text}   ({kind})")
-    texts = " ".join([p.objective_text, *(c.text for c in p.constraints)])
-    for key, v in settings_of(p).items():   # a setting of the deck behind a column the problem uses
-        if any(col in texts for col in p.study.SUMMARY_SETTINGS[key]):
-            shown = ", ".join(f"{x:g}" for x in v) if isinstance(v, (list, tuple)) else f"{v}"
-            L.append(f"    setting .............. {key} = {shown}   (base deck; used by "
-                     f"{', '.join(p.study.SUMMARY_SETTINGS[key])})")
+    for key, v in settings_of(p).items():   # a setting of the deck the summary columns depend on
+        shown = ", ".join(f"{x:g}" for x in v) if isinstance(v, (list, tuple)) else f"{v}"
+        L.append(f"    setting .............. {key} = {shown}   (base deck; used by the summary columns)")
     if any(c.numeric for c in p.constraints):
         L.append(f"    feasibility .......... a constraint a >= b, a <= b or a == b is met when violated by at most "
                  f"constraint_tol x max(1, |a|, |b|), constraint_tol = {o.constraint_tol:g}")

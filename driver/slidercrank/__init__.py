@@ -172,10 +172,12 @@ def run(params: Params, progress: bool = False) -> Result:
         ref = SIMEON1996 if params.benchmark == "simeon1996" else None
         figures.append(Figure("history", lambda: _history_figure(model, params, c0, alpha, beta, ref)))
     if conv:
-        series = {f"{w:g} rad/s": ([c.n_elements for c in cs if c.ok], [c.peak(+1)[0] * 1e6 for c in cs if c.ok])
+        series = {f"{w:g} rad/s": ([c.n_elements for c in cs if c.ok], [c.peak(+1)[0] * 1e6 for c in cs if c.ok],
+                                   [c.crank_end_peak(+1) * 1e6 for c in cs if c.ok])
                   for w, cs in conv.items()}
+        speeds = ", ".join(series)
         figures.append(Figure("convergence", lambda: plotting().slidercrank_convergence_figure(
-            series, f"{params.material}: element convergence")))
+            series, f"{params.material} rod at {speeds}: convergence of the peak tensile strain with the mesh")))
     return Result(text="\n".join(text) + "\n", tidy=_tidy(params.material, list(done.values())),
                   summary=_summary(cases, model if _shape(params)[1] else None), warnings=warnings, failure=failure, figures=figures)
 

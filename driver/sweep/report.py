@@ -28,7 +28,8 @@ def summary_settings(module: Any, base: Params, swept: set[str] | None = None) -
     The sweep's ``.out`` prints them and its Parquet summary records them in its metadata."""
     swept = swept or set()
     out: dict[str, Any] = {}
-    for key in getattr(module, "SUMMARY_SETTINGS", ()):
+    keys = getattr(module, "SUMMARY_SETTINGS", None)
+    for key in keys if keys is not None else getattr(module, "summary_settings", ()):   # a module or a Study
         if key in base and key not in swept:
             v = base[key]
             out[key] = [float(x) for x in v] if isinstance(v, (list, tuple)) else v
