@@ -13,7 +13,8 @@ import os
 
 import numpy as np
 
-from driver import kernels
+from driver.fourbar import kernel as fourbar_kernel
+from driver.kernels import release_spares
 from timing import median_time
 
 
@@ -45,17 +46,17 @@ def main() -> None:
     args = ap.parse_args()
     theta = np.linspace(0.0, 2 * np.pi, args.n)
     link = (12.0, 5.0, 15.0, 9.0, 5.0, 0.0)
-    out, _ = kernels.fourbar_exact(theta, *link)
+    out, _ = fourbar_kernel.fourbar_exact(theta, *link)
     ref = numpy_baseline(theta, *link, 1)
     assert np.allclose(out[:, 8], ref[8]) and np.allclose(out[:, 10], ref[10])
     buf = np.empty((args.n, 11), order="F")
     sts = np.empty(args.n, dtype=np.int32)
     def fresh():
-        kernels.release_spares()      # the default path's remembered output memory forgotten: new memory
-        return kernels.fourbar_exact(theta, *link)
+        release_spares()      # the default path's remembered output memory forgotten: new memory
+        return fourbar_kernel.fourbar_exact(theta, *link)
     t_a = median_time(fresh, args.repeat)
-    t_d = median_time(lambda: kernels.fourbar_exact(theta, *link), args.repeat)
-    t_r = median_time(lambda: kernels.fourbar_exact(theta, *link, out=buf, status=sts), args.repeat)
+    t_d = median_time(lambda: fourbar_kernel.fourbar_exact(theta, *link), args.repeat)
+    t_r = median_time(lambda: fourbar_kernel.fourbar_exact(theta, *link, out=buf, status=sts), args.repeat)
     t_n = median_time(lambda: numpy_baseline(theta, *link, 1), args.repeat)
     ns_a, ns_d, ns_r, ns_n = (1e9 * t / args.n for t in (t_a, t_d, t_r, t_n))
     print(f"four-bar exact kernel, {args.n} positions, median of {args.repeat} (cpu count {os.cpu_count()}, one thread)")

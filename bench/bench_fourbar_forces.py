@@ -16,7 +16,7 @@ import time
 
 import numpy as np
 
-from driver import kernels
+from driver.fourbar import kernel as fourbar_kernel
 
 LINK = (0.30, 0.10, 0.35, 0.25, 20.0, 3.0)
 PROPS = np.array([0.5, 1.2, 0.9, 4e-4, 1.2e-2, 4.7e-3, 0.05, 0.175, 0.125, 0.1, 0.2, -0.3, 9.81, 5.0, 10.0, -20.0,
@@ -76,13 +76,13 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     args = ap.parse_args(argv)
     theta = np.linspace(0.0, 2 * np.pi, args.n)
     p, q, r, s, w, al = LINK
-    out, st = kernels.fourbar_exact(theta, *LINK, 1)
-    f = kernels.fourbar_joint_forces(out, st, *LINK, PROPS)
+    out, st = fourbar_kernel.fourbar_exact(theta, *LINK, 1)
+    f = fourbar_kernel.fourbar_joint_forces(out, st, *LINK, PROPS)
     ok = st == 0
     ref = numpy_forces(out, *LINK, PROPS)
     assert np.allclose(f[ok], ref[ok], rtol=1e-12, atol=1e-9)
-    t_kin, t_force, t_np = interleaved([lambda: kernels.fourbar_exact(theta, *LINK, 1),
-                                        lambda: kernels.fourbar_joint_forces(out, st, *LINK, PROPS),
+    t_kin, t_force, t_np = interleaved([lambda: fourbar_kernel.fourbar_exact(theta, *LINK, 1),
+                                        lambda: fourbar_kernel.fourbar_joint_forces(out, st, *LINK, PROPS),
                                         lambda: numpy_forces(out, *LINK, PROPS)], args.repeat)
     ns = {k: 1e9 * t / args.n for k, t in (("kinematics", t_kin), ("forces", t_force), ("numpy", t_np))}
     ratio = t_force / t_kin

@@ -1,7 +1,7 @@
 """Benchmark of the 2R manipulator kernels (issue 5): not a test.
 
 1. Jacobian + manipulability + condition number + Craig torques on 10^5 configurations:
-   Fortran kernel (driver.kernels.manipulator_arm_states) vs a plain numpy baseline, same run.
+   Fortran kernel (driver.manipulator_kernel.manipulator_arm_states) vs a plain numpy baseline, same run.
    Target: at most 0.04 us per configuration (issue 12; was 0.05).
 2. Monte Carlo tolerance check with 10^6 samples (sampling + positioning errors at the 4
    workspace points + max and 99th percentile): kernel vs numpy.  Target: under 1 s.
@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from driver import kernels
+from driver.manipulator import kernel as manipulator_kernel
 from timing import median_time as timeit
 
 DECK = Path(__file__).resolve().parents[1] / "inputs" / "optimize_manipulator_torque.dat"
@@ -104,12 +104,12 @@ def main() -> None:
     qdd = np.asfortranarray(rng.uniform(-2, 2, (n, 2)))
     m1, m2 = 10 * l1, 10 * l2
 
-    ker = kernels.manipulator_arm_states(l1, l2, th1, th2, qd, qdd, m1, m2, 9.8)
+    ker = manipulator_kernel.manipulator_arm_states(l1, l2, th1, th2, qd, qdd, m1, m2, 9.8)
     ref = numpy_arm_states(l1, l2, th1, th2, qd, qdd, m1, m2, 9.8)
     for a, b in zip(ker, ref):
         np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-9)
 
-    tk = timeit(lambda: kernels.manipulator_arm_states(l1, l2, th1, th2, qd, qdd, m1, m2, 9.8), args.repeat)
+    tk = timeit(lambda: manipulator_kernel.manipulator_arm_states(l1, l2, th1, th2, qd, qdd, m1, m2, 9.8), args.repeat)
     tn = timeit(lambda: numpy_arm_states(l1, l2, th1, th2, qd, qdd, m1, m2, 9.8), args.repeat)
     per_k, per_n = tk / n * 1e6, tn / n * 1e6
     print(f"Jacobian + manipulability + condition number + torques, {n} configurations "
@@ -121,14 +121,14 @@ def main() -> None:
 
     # Monte Carlo tolerance check, case 1 dexterity design, 4 workspace points
     x, y = np.array([1.0, 2, 3, 4]), np.array([5.0, 7, 7, 6])
-    a1, a2, _ = kernels.manipulator_ik(5.61, 3.97, x, y, 1)
+    a1, a2, _ = manipulator_kernel.manipulator_ik(5.61, 3.97, x, y, 1)
     ri2 = np.sqrt(4 + abs(np.cos(a2).sum()))
     dl = 0.01 / (np.sqrt(2) * ri2)
     ns = args.samples
 
     def mc_kernel():
         u = np.random.default_rng(1).uniform(-dl, dl, (ns, 2))
-        e = kernels.manipulator_position_errors(a1, a2, u)[:, 0]
+        e = manipulator_kernel.manipulator_position_errors(a1, a2, u)[:, 0]
         return e.max(), np.percentile(e, 99)
 
     def mc_numpy():

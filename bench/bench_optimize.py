@@ -11,8 +11,8 @@ Measured in this process:
   (outputs/fourbar_design_search_summary.csv, a fresh run of that deck) -- rerun it with
   ``--grid`` to recompute it here (about 2 minutes on two cores);
 * kernel time of the whole optimisation: time inside every Fortran kernel wrapper of
-  driver.kernels (the population's summaries go through the batch kernel
-  kernels.fourbar_summaries, the optimum's check run through kernels.fourbar_exact), the
+  every study's kernel module (the population's summaries go through the batch kernel
+  fourbar_summaries, the optimum's check run through fourbar_exact), the
   rest being Python around them; printed per kernel;
 * the same for every seed 1..5 (median), so one lucky seed proves nothing.
 
@@ -30,7 +30,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from driver import kernels
+from driver._study import registered
+
 from driver.deck import read_deck
 from driver.optimize import optimize
 
@@ -39,18 +40,19 @@ GRID_EVALS = 25 * 64 * 64
 
 
 class KernelClock:
-    """Wraps every kernel of driver.kernels (the f2py wrappers) to add up the time spent in them.
+    """Wraps every kernel wrapper of every study's kernel module (``Study.kernel``) to add up the
+    time spent in them.
 
-    Callers reach the kernels as ``kernels.name`` at call time, so patching the module's
+    Callers reach the kernels as ``kernel.name`` at call time, so patching the module's
     attributes sees every call; a kernel called from inside another is not counted twice.
     """
 
     def __init__(self) -> None:
         self.seconds: dict[str, float] = {}
         self.calls: dict[str, int] = {}
-        self._orig = {name: getattr(kernels, name) for name in kernels.__all__
-                      if callable(getattr(kernels, name)) and name != "farray"
-                      and not isinstance(getattr(kernels, name), type)}
+        mods = [s.kernel for s in registered().values() if s.kernel is not None]
+        self._orig = {(mod, name): getattr(mod, name) for mod in mods for name in mod.__all__
+                      if callable(getattr(mod, name)) and not isinstance(getattr(mod, name), type)}
         self._depth = 0
 
     @property
@@ -58,8 +60,8 @@ class KernelClock:
         return sum(self.seconds.values())
 
     def __enter__(self) -> "KernelClock":
-        for name, fn in self._orig.items():
-            setattr(kernels, name, self._timed(name, fn))
+        for (mod, name), fn in self._orig.items():
+            setattr(mod, name, self._timed(name, fn))
         return self
 
     def _timed(self, name, fn):
@@ -77,8 +79,8 @@ class KernelClock:
         return timed
 
     def __exit__(self, *exc) -> None:
-        for name, fn in self._orig.items():
-            setattr(kernels, name, fn)
+        for (mod, name), fn in self._orig.items():
+            setattr(mod, name, fn)
 
 
 def grid_best(recompute: bool) -> float:

@@ -61,11 +61,11 @@ def deck_text(cranks: int, keep: str | None = None) -> str:
 
 def kernel_rates() -> dict[str, float]:
     """CPU seconds per linkage of the batch kernel over the shipped designs (median of 3)."""
-    from driver import kernels
+    from driver.fourbar import kernel as fourbar_kernel
     c, k, r = np.meshgrid(np.linspace(1, 7, 25), np.linspace(6, 20, 64), np.linspace(4, 16, 64), indexing="ij")
     m = np.empty((c.size, 8), order="F")
     m[:, 0], m[:, 1], m[:, 2], m[:, 3], m[:, 4], m[:, 5], m[:, 6], m[:, 7] = 12, c.ravel(), k.ravel(), r.ravel(), 5, 0, 360, 1
-    P = kernels.FOURBAR_PASSES
+    P = fourbar_kernel.FOURBAR_PASSES
     modes = {"filter passes (transmission + rocker)": P["transmission"] | P["rocker"],
              "all passes, refined peak search": P["transmission"] | P["rocker"] | P["peaks"],
              "all passes, previous 1 deg scan": P["transmission"] | P["rocker"] | P["peaks"] | P["dense_scan"]}
@@ -74,7 +74,7 @@ def kernel_rates() -> dict[str, float]:
         times = []
         for _ in range(3):
             t0 = time.process_time()
-            kernels.fourbar_summaries(m, bits)
+            fourbar_kernel.fourbar_summaries(m, bits)
             times.append(time.process_time() - t0)
         out[name] = statistics.median(times) / len(m)
     return out
@@ -83,14 +83,15 @@ def kernel_rates() -> dict[str, float]:
 RUN = """
 import json, resource, sys, time
 from pathlib import Path
-from driver import kernels, sweep
+from driver import sweep
+from driver.fourbar import kernel as fourbar_kernel
 from driver.deck import read_deck
 if sys.argv[4] == "pool":    # the worker pool even for a small sweep (the measurement before the small-sweep rule)
     from driver.sweep import batch as sweep_batch
     sweep_batch.POOL_MIN_SECONDS = 0.0
 if sys.argv[4] == "dense":   # the previous peak search, in this process and in the forked workers
-    real = kernels.fourbar_summaries
-    kernels.fourbar_summaries = lambda params, passes=7: real(params, passes | (kernels.FOURBAR_PASSES["dense_scan"]
+    real = fourbar_kernel.fourbar_summaries
+    fourbar_kernel.fourbar_summaries = lambda params, passes=7: real(params, passes | (fourbar_kernel.FOURBAR_PASSES["dense_scan"]
                                                                               if passes & 4 else 0))
 deck = read_deck(Path(sys.argv[1]))
 t0, c0 = time.perf_counter(), time.process_time()

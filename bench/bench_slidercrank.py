@@ -21,7 +21,7 @@ import math
 import numpy as np
 from scipy.linalg import solveh_banded
 
-from driver import kernels as K
+from driver.slidercrank import kernel as slidercrank_kernel
 from timing import median_time  # noqa: E402
 from driver.slidercrank import MATERIALS, rayleigh
 
@@ -135,12 +135,12 @@ def main() -> None:
     mat = MATERIALS["aluminium"]
     rho_a, ea, ei = mat["density"] * mat["area"], mat["youngs_modulus"] * mat["area"], \
         mat["youngs_modulus"] * mat["second_moment"]
-    wb, wa, _ = K.slidercrank_frequencies(rho_a, ea, ei, LEN, M_S)
+    wb, wa, _ = slidercrank_kernel.slidercrank_frequencies(rho_a, ea, ei, LEN, M_S)
     alpha, beta = rayleigh(0.02, wb, wa)
     dt = 2 * math.pi / (OMEGA * SPR)
 
     def kernel(n_steps: int = SPR, rec: int = SPR) -> dict:
-        return K.slidercrank_simulate(N_EL, R2, LEN, rho_a, ea, ei, 1.5e-3, M_S, OMEGA, dt, n_steps, 1, rec,
+        return slidercrank_kernel.slidercrank_simulate(N_EL, R2, LEN, rho_a, ea, ei, 1.5e-3, M_S, OMEGA, dt, n_steps, 1, rec,
                                       alpha, beta)
 
     base = NumpyKED(N_EL, rho_a, ea, ei, OMEGA, dt, alpha, beta)

@@ -27,7 +27,7 @@ from scipy.optimize import minimize
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from driver.kernels import UJOINT_MODELS, UJOINT_OBJECTIVES, ujoint_objective  # noqa: E402
+from driver.ujoint.kernel import UJOINT_MODELS, UJOINT_OBJECTIVES, ujoint_objective  # noqa: E402
 from driver import ujoint  # noqa: E402
 from driver.deck import RawGroup, validate  # noqa: E402
 from driver.ujoint import Chain, optimise  # noqa: E402

@@ -6,7 +6,8 @@ measured in the same run, and the target.
 
 Kernel and baseline calls are interleaved (kernel, baseline, kernel, ...), timed by the
 process's CPU time, and the median of each is taken, so a machine whose load changes
-during the run slows both alike and the ratio stays meaningful.  Each baseline is checked against its kernel before timing.  The
+during the run slows both alike and the ratio stays meaningful.  Each baseline is checked against its kernel before timing
+(except the nonlinear rod's, whose baseline is the other model: tests/test_slidercrank_nonlinear.py compares them).  The
 detailed per-study benchmarks (bench_<study>.py) remain for the wider measurements
 (fresh vs reused buffers, searches, sweeps).  Exit status 0 whether or not targets are met:
 this reports, the test suite guards (tests/test_vectorisation.py).
@@ -32,8 +33,13 @@ import bench_fourbar  # noqa: E402
 import bench_fourbar_forces  # noqa: E402
 import bench_manipulator  # noqa: E402
 import bench_slidercrank  # noqa: E402
+import bench_slidercrank_nl  # noqa: E402
 import bench_ujoint  # noqa: E402
 from driver import kernels  # noqa: E402
+from driver.fourbar import kernel as fourbar_kernel  # noqa: E402
+from driver.manipulator import kernel as manipulator_kernel  # noqa: E402
+from driver.slidercrank import kernel as slidercrank_kernel  # noqa: E402
+from driver.ujoint import kernel as ujoint_kernel  # noqa: E402
 from driver import ujoint as ujoint_study  # noqa: E402
 from driver.slidercrank import MATERIALS, rayleigh  # noqa: E402
 
@@ -96,11 +102,11 @@ def fourbar(n: int, repeat: int) -> list[Row]:
     link = (12.0, 5.0, 15.0, 9.0, 5.0, 0.0)
     out = np.empty((n, 11), order="F")
     sts = np.empty(n, dtype=np.int32)
-    kernels.fourbar_exact(theta, *link, out=out, status=sts)
+    fourbar_kernel.fourbar_exact(theta, *link, out=out, status=sts)
     ref = bench_fourbar.numpy_baseline(theta, *link, 1)
     for j in range(11):
         np.testing.assert_allclose(out[:, j], ref[j], rtol=1e-9, atol=1e-9)
-    tk, tb = interleaved(lambda: kernels.fourbar_exact(theta, *link, out=out, status=sts),
+    tk, tb = interleaved(lambda: fourbar_kernel.fourbar_exact(theta, *link, out=out, status=sts),
                          lambda: bench_fourbar.numpy_baseline(theta, *link, 1), repeat)
     floor = write_floor(lambda: (out.fill(0.0), sts.fill(0)), repeat)
     rows = [Row("four-bar exact states (reused buffers)", "ns/position", tk / n, tb / n, 20e-9, 5.0,
@@ -110,10 +116,10 @@ def fourbar(n: int, repeat: int) -> list[Row]:
     # caller dropped it; the baseline is the same call on fresh memory (first touch: page faults)
     def fresh():
         kernels.release_spares()
-        return kernels.fourbar_exact(theta, *link)
-    kernels.fourbar_exact(theta, *link, out=out, status=sts)   # (the floor above zeroed it)
-    np.testing.assert_array_equal(kernels.fourbar_exact(theta, *link)[0], out)
-    tk, tb = interleaved(lambda: kernels.fourbar_exact(theta, *link), fresh, repeat)
+        return fourbar_kernel.fourbar_exact(theta, *link)
+    fourbar_kernel.fourbar_exact(theta, *link, out=out, status=sts)   # (the floor above zeroed it)
+    np.testing.assert_array_equal(fourbar_kernel.fourbar_exact(theta, *link)[0], out)
+    tk, tb = interleaved(lambda: fourbar_kernel.fourbar_exact(theta, *link), fresh, repeat)
     rows.append(Row("four-bar exact, default path vs fresh arrays", "ns/position",
                     tk / n, tb / n, None, 1.3 if 92 * n >= kernels.SPARE_MIN_BYTES else None,
                     "default path (no out=): the previous call's output memory again when the caller dropped it; "
@@ -130,10 +136,10 @@ def fourbar(n: int, repeat: int) -> list[Row]:
         return (out[:, 3] + rx, out[:, 4] + ry, -q * om * s - w2 * ry, q * om * c + w2 * rx,
                 -q * om * om * c - a2 * ry - w2 * w2 * rx, -q * om * om * s + a2 * rx - w2 * w2 * ry)
 
-    got = kernels.fourbar_coupler_point(theta, out, sts, link[1], link[4], link[5], u, v)
+    got = fourbar_kernel.fourbar_coupler_point(theta, out, sts, link[1], link[4], link[5], u, v)
     for j, col in enumerate(coupler_numpy()):
         np.testing.assert_allclose(got[:, j], col, rtol=1e-9, atol=1e-9)
-    tk, tb = interleaved(lambda: kernels.fourbar_coupler_point(theta, out, sts, link[1], link[4], link[5], u, v),
+    tk, tb = interleaved(lambda: fourbar_kernel.fourbar_coupler_point(theta, out, sts, link[1], link[4], link[5], u, v),
                          coupler_numpy, repeat)
     floor = write_floor(lambda: np.empty((n, 6), order="F").fill(0.0), repeat)
     rows.append(Row("four-bar coupler point", "ns/position", tk / n, tb / n, None, None,
@@ -142,12 +148,12 @@ def fourbar(n: int, repeat: int) -> list[Row]:
     # both with fresh output arrays; target ratio 0.5 = forces cost at most 2x the kinematics
     lk = (0.30, 0.10, 0.35, 0.25, 20.0, 3.0)
     pr = bench_fourbar_forces.PROPS
-    st_out, st_sts = kernels.fourbar_exact(theta, *lk, 1)
-    f = kernels.fourbar_joint_forces(st_out, st_sts, *lk, pr)
+    st_out, st_sts = fourbar_kernel.fourbar_exact(theta, *lk, 1)
+    f = fourbar_kernel.fourbar_joint_forces(st_out, st_sts, *lk, pr)
     ok = st_sts == 0
     np.testing.assert_allclose(f[ok], bench_fourbar_forces.numpy_forces(st_out, *lk, pr)[ok], rtol=1e-9, atol=1e-9)
-    tk, tb = interleaved(lambda: kernels.fourbar_joint_forces(st_out, st_sts, *lk, pr),
-                         lambda: kernels.fourbar_exact(theta, *lk, 1), repeat)
+    tk, tb = interleaved(lambda: fourbar_kernel.fourbar_joint_forces(st_out, st_sts, *lk, pr),
+                         lambda: fourbar_kernel.fourbar_exact(theta, *lk, 1), repeat)
     floor = write_floor(lambda: np.empty((n, 12), order="F").fill(0.0), repeat)
     rows.append(Row("four-bar joint forces (baseline: exact states)", "ns/position", tk / n, tb / n, None, 0.5,
                     "reads 64 B, writes 96 B/position (fresh array); no transcendental function, 6 divisions",
@@ -162,24 +168,24 @@ def manipulator(n: int, samples: int, repeat: int) -> list[Row]:
     qd = np.asfortranarray(rng.uniform(-2, 2, (n, 2)))
     qdd = np.asfortranarray(rng.uniform(-2, 2, (n, 2)))
     m1, m2 = 10 * l1, 10 * l2
-    ker = kernels.manipulator_arm_states(l1, l2, th1, th2, qd, qdd, m1, m2, 9.8)
+    ker = manipulator_kernel.manipulator_arm_states(l1, l2, th1, th2, qd, qdd, m1, m2, 9.8)
     ref = bench_manipulator.numpy_arm_states(l1, l2, th1, th2, qd, qdd, m1, m2, 9.8)
     for a, b in zip(ker, ref):
         np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-9)
     bufs = tuple(np.empty(shape, order="F") for shape in ((n, 4), n, n, (n, 2)))
-    tk, tb = interleaved(lambda: kernels.manipulator_arm_states(l1, l2, th1, th2, qd, qdd, m1, m2, 9.8, out=bufs),
+    tk, tb = interleaved(lambda: manipulator_kernel.manipulator_arm_states(l1, l2, th1, th2, qd, qdd, m1, m2, 9.8, out=bufs),
                          lambda: bench_manipulator.numpy_arm_states(l1, l2, th1, th2, qd, qdd, m1, m2, 9.8),
                          repeat)
-    fresh = write_floor(lambda: kernels.manipulator_arm_states(l1, l2, th1, th2, qd, qdd, m1, m2, 9.8), repeat)
+    fresh = write_floor(lambda: manipulator_kernel.manipulator_arm_states(l1, l2, th1, th2, qd, qdd, m1, m2, 9.8), repeat)
     floor = write_floor(lambda: [b.fill(0.0) for b in bufs], repeat)
     rows = [Row("2R manipulator: Jacobian, w, kappa, torques", "us/config", tk / n, tb / n, 0.04e-6, None,
                 f"reused buffers; reads 80 B, writes 64 B/config; 2 sincos + 1 division + 1 sqrt; "
                 f"with fresh output arrays {1e6 * fresh / n:.3f} us/config (their page faults)", floor / n)]
     a1, a2 = rng.uniform(-np.pi, np.pi, 4), rng.uniform(-np.pi, np.pi, 4)
     dl = np.asfortranarray(rng.uniform(-1e-3, 1e-3, (samples, 2)))
-    np.testing.assert_allclose(kernels.manipulator_position_errors(a1, a2, dl),
+    np.testing.assert_allclose(manipulator_kernel.manipulator_position_errors(a1, a2, dl),
                                bench_manipulator.numpy_position_errors(a1, a2, dl), rtol=1e-12)
-    tk, tb = interleaved(lambda: kernels.manipulator_position_errors(a1, a2, dl),
+    tk, tb = interleaved(lambda: manipulator_kernel.manipulator_position_errors(a1, a2, dl),
                          lambda: bench_manipulator.numpy_position_errors(a1, a2, dl), repeat)
     rows.append(Row("2R manipulator: position errors, 4 points", "ns/sample", tk / samples, tb / samples,
                     None, None, "reads 16 B, writes 16 B/sample; 4 x 10 flops"))
@@ -193,11 +199,11 @@ def manipulator(n: int, samples: int, repeat: int) -> list[Row]:
 
 def ujoint(repeat: int) -> list[Row]:
     m, beta, phi, rho = bench_ujoint.M, bench_ujoint.BETA, bench_ujoint.PHI, bench_ujoint.RHO
-    code = kernels.UJOINT_MODELS["exact"]
-    f = kernels.ujoint_objective(code, 0, beta, phi, rho, m, grad=False)
+    code = ujoint_kernel.UJOINT_MODELS["exact"]
+    f = ujoint_kernel.ujoint_objective(code, 0, beta, phi, rho, m, grad=False)
     f = f[0] if isinstance(f, tuple) else f
     assert math.isclose(f, bench_ujoint.numpy_objective("exact", beta, phi, rho), rel_tol=1e-10)
-    tk, tb = interleaved(lambda: kernels.ujoint_objective(code, 0, beta, phi, rho, m, grad=False),
+    tk, tb = interleaved(lambda: ujoint_kernel.ujoint_objective(code, 0, beta, phi, rho, m, grad=False),
                          lambda: bench_ujoint.numpy_objective("exact", beta, phi, rho), repeat,
                          kernel_per_round=200, baseline_per_round=20)
     rows = [Row("Hooke joint: objective, 3 joints x 360 angles", "us/objective", tk, tb, 5e-6, None,
@@ -206,7 +212,7 @@ def ujoint(repeat: int) -> list[Row]:
     # the batch path of sweeps and &optimize against the per-design kernel calls it replaces
     nd = 64 if repeat <= 2 else 2000
     base, phis = bench_ujoint.batch_designs(nd)
-    chain = ujoint_study.Chain(code, kernels.UJOINT_OBJECTIVES["mean_square"],
+    chain = ujoint_study.Chain(code, ujoint_kernel.UJOINT_OBJECTIVES["mean_square"],
                                np.asarray(base["rho"]) * ujoint_study.DEG, m, 25.0)
     bdeg = np.asarray(base["beta"])
     frame = ujoint_study.summarise_batch(base, {"phi": phis})
@@ -225,12 +231,12 @@ def slidercrank(n_el: int, spr: int, base_steps: int, repeat: int) -> list[Row]:
     rho_a, ea = mat["density"] * mat["area"], mat["youngs_modulus"] * mat["area"]
     ei = mat["youngs_modulus"] * mat["second_moment"]
     omega, r2, length, ms = bench_slidercrank.OMEGA, bench_slidercrank.R2, bench_slidercrank.LEN, bench_slidercrank.M_S
-    wb, wa, _ = kernels.slidercrank_frequencies(rho_a, ea, ei, length, ms)
+    wb, wa, _ = slidercrank_kernel.slidercrank_frequencies(rho_a, ea, ei, length, ms)
     alpha, beta = rayleigh(0.02, wb, wa)
     dt = 2 * math.pi / (omega * spr)
 
     def kernel(n_steps: int = spr) -> dict:
-        return kernels.slidercrank_simulate(n_el, r2, length, rho_a, ea, ei, 1.5e-3, ms, omega, dt, n_steps, 1,
+        return slidercrank_kernel.slidercrank_simulate(n_el, r2, length, rho_a, ea, ei, 1.5e-3, ms, omega, dt, n_steps, 1,
                                             n_steps, alpha, beta)
 
     base = bench_slidercrank.NumpyKED(n_el, rho_a, ea, ei, omega, dt, alpha, beta)
@@ -242,7 +248,7 @@ def slidercrank(n_el: int, spr: int, base_steps: int, repeat: int) -> list[Row]:
 
     # issue 27: the study records the per-step profile it prints, not the three strain/force fields
     def profile() -> dict:
-        return kernels.slidercrank_simulate(n_el, r2, length, rho_a, ea, ei, 1.5e-3, ms, omega, dt, spr, 1,
+        return slidercrank_kernel.slidercrank_simulate(n_el, r2, length, rho_a, ea, ei, 1.5e-3, ms, omega, dt, spr, 1,
                                             spr, alpha, beta, fields=False)
     full = kernel()
     np.testing.assert_array_equal(profile()["eps_max"], full["eps_ax"].max(axis=0))
@@ -253,6 +259,22 @@ def slidercrank(n_el: int, spr: int, base_steps: int, repeat: int) -> list[Row]:
                     f"the baseline writes 3 x 8 B per element and step ({24 * n_el * spr / 2**20:.0f} MiB per call, "
                     "fresh memory: page faults); the profile 9 x 8 B per step"))
     return rows
+
+
+def slidercrank_nl(n_el: int, revs: int, repeat: int) -> list[Row]:
+    """The nonlinear (co-rotational) rod against the linear KED kernel on the same case (issue 29:
+    at most 25x the linear model's time); the 'baseline' here is the linear kernel."""
+    linear, nonlinear = bench_slidercrank_nl.case(n_el, revs)
+    res = nonlinear()
+    assert res["status"] == 0, res["status"]
+    tk, tb = interleaved(nonlinear, linear, repeat)
+    solves = res["stats"][0] / (revs * bench_slidercrank_nl.SPR)
+    return [Row("slider-crank nonlinear rod (baseline: linear)", "ms/revolution", tk / revs, tb / revs, None,
+                1 / bench_slidercrank_nl.TARGET_RATIO,
+                f"{n_el} elements at {bench_slidercrank_nl.OMEGA} rad/s, {revs} revolution(s): nonlinear/linear time "
+                f"{tk / tb:.1f}x (target <= {bench_slidercrank_nl.TARGET_RATIO:g}x); {solves:.2f} Newton solves per "
+                "step, each residual the element forces (a sqrt and an atan2 each), each solve the tangent and a "
+                "band LU (a latency chain like the linear model's solves)")]
 
 
 SCALE = {"ns/position": 1e9, "ns/sample": 1e9, "us/config": 1e6, "us/objective": 1e6, "us/design": 1e6,
@@ -283,16 +305,16 @@ def main(argv: list[str] | None = None) -> list[Row]:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smaller sizes, fewer repeats")
     ap.add_argument("--smoke", action="store_true", help="tiny sizes (the test suite's check that this runs)")
-    ap.add_argument("--only", choices=["fourbar", "manipulator", "ujoint", "slidercrank"], action="append",
-                    help="run only these studies (repeatable)")
+    ap.add_argument("--only", choices=["fourbar", "manipulator", "ujoint", "slidercrank", "slidercrank_nl"],
+                    action="append", help="run only these studies (repeatable)")
     args = ap.parse_args(argv)
-    only = set(args.only or ["fourbar", "manipulator", "ujoint", "slidercrank"])
+    only = set(args.only or ["fourbar", "manipulator", "ujoint", "slidercrank", "slidercrank_nl"])
     if args.smoke:
-        sizes = dict(n=2048, samples=4096, n_el=20, spr=72, base_steps=4, repeat=2)
+        sizes = dict(n=2048, samples=4096, n_el=20, spr=72, base_steps=4, repeat=2, nl_el=20, nl_revs=1)
     elif args.quick:
-        sizes = dict(n=200_000, samples=200_000, n_el=700, spr=1440, base_steps=20, repeat=5)
+        sizes = dict(n=200_000, samples=200_000, n_el=700, spr=1440, base_steps=20, repeat=5, nl_el=700, nl_revs=2)
     else:
-        sizes = dict(n=1_000_000, samples=1_000_000, n_el=700, spr=1440, base_steps=60, repeat=9)
+        sizes = dict(n=1_000_000, samples=1_000_000, n_el=700, spr=1440, base_steps=60, repeat=9, nl_el=700, nl_revs=4)
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     print(f"bench/run_all.py: cpu count {os.cpu_count()}, load average {load:.2f} at start, one thread, CPU time, "
           f"medians of {sizes['repeat']} interleaved rounds\n")
@@ -305,6 +327,8 @@ def main(argv: list[str] | None = None) -> list[Row]:
         rows += ujoint(sizes["repeat"])
     if "slidercrank" in only:
         rows += slidercrank(sizes["n_el"], sizes["spr"], sizes["base_steps"], max(3, sizes["repeat"] // 3))
+    if "slidercrank_nl" in only:
+        rows += slidercrank_nl(sizes["nl_el"], sizes["nl_revs"], max(3, sizes["repeat"] // 3))
     print_table(rows)
     return rows
 

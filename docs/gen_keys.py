@@ -23,13 +23,13 @@ MARK = re.compile(r"(<!-- keys:(?P<group>[a-z_]+) begin -->\n)(?P<body>.*?)(<!--
 def spec_of(group: str):
     """The GroupSpec of a study or control group (sweep, optimize, synthesis)."""
     from driver.runner import CONTROL_GROUPS
-    from driver.study import load_study
+    from driver._study import load_study
     if group in CONTROL_GROUPS:
         return importlib.import_module(f"driver.{group}").SPEC
-    module = load_study(group)
-    if module is None:
+    study = load_study(group)
+    if study is None:
         raise SystemExit(f"gen_keys: no namelist group &{group}")
-    return module.SPEC
+    return study.spec
 
 
 def _cell(text: str) -> str:

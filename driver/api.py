@@ -81,20 +81,20 @@ def write(result: Result, outdir: str | os.PathLike, formats: Iterable[str] = ()
 
 def studies() -> dict[str, str]:
     """The study groups this tool runs, with one line on each."""
-    return {g: m.SPEC.doc for g, m in sorted(available_studies().items())}
+    return {g: m.spec.doc for g, m in sorted(available_studies().items())}
 
 
 def keys(group: str) -> pd.DataFrame:
     """The keys of a study group (the deck's and the keyword arguments'): kind, units, default,
     whether required, allowed values and what each means; one row per key."""
-    from driver.study import load_study
+    from driver._study import load_study
     module = load_study(group.lstrip("&").lower())
     if module is None:
         raise KeyError(f"no study group &{group} (known: {', '.join(studies())})")
     rows = [{"key": k, "kind": key.kind, "units": key.units, "required": key.required,
              "default": None if key.required else key.default,
              "choices": ", ".join(map(str, key.choices)) if key.choices else "", "doc": key.doc}
-            for k, key in module.SPEC.keys.items()]
+            for k, key in module.spec.keys.items()]
     return pd.DataFrame(rows).set_index("key")
 
 

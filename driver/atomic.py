@@ -8,8 +8,10 @@ The files of one deck form a set (:func:`output_set`): every file is first writt
 to its temporary, and only when all are complete are they renamed into place; a
 failure or interrupt (Ctrl-C, SIGTERM, a full disk) removes all the temporaries, so a
 new ``.out`` never stands beside an old ``.csv``.  Every path written inside a set is
-checked to lie inside the set's output folder.  Temporaries are named
-``.<file name>.<pid>.<random>.tmp``; a process killed by SIGKILL cannot remove its
+checked to lie inside the set's output folder, and every name to fit NAME_MAX (255 bytes:
+:class:`NameTooLong` before the file is opened).  Temporaries are named
+``.<first 40 characters of the file name>.<pid>.<random>.tmp`` (at most 62 bytes, whatever the
+output's name); a process killed by SIGKILL cannot remove its
 own, so :func:`remove_stale_temporaries` removes those of processes no longer alive
 (the next run of the same deck calls it).
 """
@@ -24,7 +26,21 @@ from pathlib import Path
 from typing import IO, Iterator
 
 __all__ = ["atomic_open", "write_text", "output_set", "OutputSet", "inside", "remove_stale_temporaries",
-           "file_digest", "DIGEST_CHARS", "own_folder", "refuse_link", "LinkRefused"]
+           "file_digest", "DIGEST_CHARS", "own_folder", "refuse_link", "LinkRefused", "NAME_MAX", "NameTooLong"]
+
+#: the longest file name the file systems we write to take [bytes]
+NAME_MAX = 255
+
+
+class NameTooLong(OSError):
+    """An output file's name is longer than :data:`NAME_MAX` bytes: refused before its file (or
+    its temporary) is created; inside an output set nothing of the set is renamed into place."""
+
+    def __init__(self, path: str | Path):
+        import errno
+        n = len(os.fsencode(Path(path).name))
+        super().__init__(errno.ENAMETOOLONG, f"the name has {n} bytes and a file name may have {NAME_MAX}",
+                         str(path))
 
 
 class OutputSet:
@@ -58,6 +74,8 @@ def atomic_open(path: str | Path, mode: str = "w") -> Iterator[IO]:
     Inside :func:`output_set` the rename waits until the whole set is complete.
     """
     path = Path(path)
+    if len(os.fsencode(path.name)) > NAME_MAX:
+        raise NameTooLong(path)
     current = _CURRENT.get()
     if current is not None and not inside(current.root, path):
         raise PermissionError(1, f"refusing to write outside the output folder {current.root}", str(path))

@@ -22,8 +22,9 @@ from pathlib import Path
 from driver import __version__, limits
 from driver.export import FORMATS
 from driver.extras import MissingExtra, require
+from driver._study import study_names
 from driver.outcome import ExitCode, Outcome, RunOutcome, SweepOutcome
-from driver.study import PLOT_FORMATS, study_names
+from driver.study import PLOT_FORMATS
 
 __all__ = ["main", "run_deck", "say", "ExitCode"]
 
@@ -58,8 +59,10 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool | str, pro
     ``<stem>.json``.  ``report`` also writes the deck's report page ``<stem>.html``
     (:mod:`driver.report_page`) once its run has written its outputs.
     """
+    from driver.atomic import NameTooLong
     from driver.deck import DeckError, read_deck
     from driver.dispatch import run_deck as run_by_engine
+    from driver.runner import name_too_long
     try:
         deck = read_deck(path)
         given = [opt for opt, key in (("-j/--jobs", "jobs"), ("--scheduler", "scheduler"), ("--resume", "resume"))
@@ -68,6 +71,12 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool | str, pro
                                 **(sweep_options or {}))
     except DeckError as exc:
         print(f"error: {exc}", file=sys.stderr)
+        return ExitCode.BAD_INPUT
+    except NameTooLong as exc:   # an output name known only once computed (a figure's): nothing was written
+        stem, name = Path(path).stem, Path(exc.filename).name
+        what = (name_too_long(len(os.fsencode(stem)), name[len(stem):]) if name.startswith(stem)
+                else f"cannot write {exc.filename}: {exc.strerror}")
+        print(f"error: {path}: {what}; nothing written", file=sys.stderr)
         return ExitCode.BAD_INPUT
     except MissingExtra as exc:
         print(f"error: {path}: {exc}", file=sys.stderr)
@@ -136,11 +145,11 @@ def keys_help(group: str) -> str | None:
         import importlib
         spec = importlib.import_module(f"driver.{group}").SPEC
     else:
-        from driver.study import load_study
-        module = load_study(group)
-        if module is None:
+        from driver._study import load_study
+        study = load_study(group)
+        if study is None:
             return None
-        spec = module.SPEC
+        spec = study.spec
     lines = [f"&{spec.name}: {spec.doc}".rstrip(": "), ""]
     for name, key in spec.keys.items():
         req = "required" if key.required else f"default {key.default!r}"

@@ -39,6 +39,8 @@ def run_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, pro
     sweeps and optimisations.  Returns the engine's outcome; raises DeckError for bad input
     (nothing written) and :class:`~driver.extras.MissingExtra` for a missing optional package."""
     kind = engine_of(deck)
+    if report:   # the page's name is known now: refused before the run, not after it
+        output_stem(outdir, deck.path, (".html",))
     outcome: Outcome
     if kind == "synthesis":
         from driver import synthesis
@@ -67,7 +69,7 @@ def _report(deck: Deck, outdir: Path, kind: str, outcome: Outcome) -> None:
     For a single run a failure to build it is a run failure (it propagates); for a sweep,
     optimisation or synthesis it is an error message, and the deck's exit status becomes 1."""
     from driver import report_page
-    stem = output_stem(outdir, deck.path)
+    stem = output_stem(outdir, deck.path, (".html",))
     path = stem.with_name(stem.name + ".html")
     if isinstance(outcome, RunOutcome):
         _, params = study_of(deck)

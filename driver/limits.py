@@ -1,6 +1,6 @@
 """Budgets: absurd requests are refused before they allocate or start.
 
-Every study module defines ``estimate(params) -> Estimate``: from the validated keys alone
+Every study declares ``estimate(params) -> Estimate`` (:class:`driver._study.Study`, required): from the validated keys alone
 (nothing allocated, nothing computed) the memory a run needs and its work, in seconds of one
 core of an ordinary 2020s machine, with the key that drives each.  :func:`check` compares the
 estimate with the budget and raises a :class:`~driver.deck.DeckError` naming that key, the
@@ -21,9 +21,12 @@ import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 from driver.deck import DeckError, Params
+
+if TYPE_CHECKING:
+    from driver._study import Study
 
 __all__ = ["Estimate", "Budget", "budget", "configure", "restore", "check", "parse_size", "parse_seconds",
            "DEFAULT_WORK", "ENV_MEMORY", "ENV_WORK"]
@@ -158,16 +161,14 @@ def _time(s: float) -> str:
     return f"{s:.3g} s"
 
 
-def check(module: Any, params: Params, what: str = "", lim: Budget | None = None) -> Estimate | None:
+def check(study: Study, params: Params, what: str = "", lim: Budget | None = None) -> Estimate:
     """Raise DeckError when the study's estimate for ``params`` exceeds the budget.
 
     ``lim``: the budget to apply (default :func:`budget`, this process's); a caller that sends
     cases to other machines (a Dask cluster does not inherit this process's environment) passes
     its own.
     """
-    if not hasattr(module, "estimate"):
-        return None
-    est = module.estimate(params)
+    est = study.estimate(params)
     lim = lim or budget()
     detail = f" ({est.detail})" if est.detail else ""
     if est.bytes > lim.memory:

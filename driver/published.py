@@ -8,18 +8,26 @@ table belongs to, e.g. ``match: fourbar fixed_link=12 crank=5 coupler=15 rocker=
 :class:`Published` table of printed cells.  The test suite reads its expected values through
 this module too, so the published record has one source of truth.
 
-Nothing here computes anything; :mod:`driver.compare` puts these cells beside a run.
+Nothing here computes anything.  Each study's ``published.py`` (its ``Study.published``) puts
+the printed cells of its tables beside a run with the cell primitives at the end of this module
+(:func:`cell`, :func:`numeric_cell`, :func:`agrees_printed`); :mod:`driver.compare` runs the
+comparison and reports it.
 """
 from __future__ import annotations
 
+import math
 import re
+from decimal import Decimal, InvalidOperation
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
+import numpy as np
 import pandas as pd
 
 __all__ = ["PUBLISHED_DIR", "Published", "PublishedError", "match_line", "records", "read_listing",
-           "read_blocks", "matches", "listing_rows", "LISTING_COLUMNS"]
+           "read_blocks", "matches", "listing_rows", "LISTING_COLUMNS", "agrees_printed", "cell", "numeric_cell",
+           "one_digit_apart", "decimals"]
 
 def _published_dir() -> Path:
     """The installed copy (``driver/published_record/``, a wheel or ``pip install .``) when there is
@@ -187,3 +195,64 @@ def read_blocks(path: Path) -> Published:
     if not recs:
         raise PublishedError(f"{path}: no table found")
     return Published(path.stem, path, group, match, pd.DataFrame.from_records(recs))
+
+
+# ----------------------------------------------------------------------------- cells of a comparison
+
+def agrees_printed(computed: float, printed: str) -> bool:
+    """|computed - printed| <= half a unit of the printed last digit (+1e-9)."""
+    try:
+        exp = Decimal(printed.strip()).as_tuple().exponent
+    except InvalidOperation:
+        return False
+    half = 0.5 * 10.0 ** int(exp)  # type: ignore[arg-type]
+    return math.isfinite(computed) and abs(float(computed) - float(printed)) <= half + 1e-9
+
+
+def decimals(printed: str) -> int:
+    """The number of decimals ``printed`` shows."""
+    exp = Decimal(printed.strip()).as_tuple().exponent
+    return max(0, -int(exp))  # type: ignore[arg-type]
+
+
+def cell(table: str, row: Any, column: str, printed: str, computed: str, status: str, reason: str = "") -> dict:
+    """One row of a comparison (the columns of :data:`driver.compare.COLUMNS` but the deck)."""
+    return {"table": table, "row": str(row), "column": column, "printed": printed, "computed": computed,
+            "status": status, "reason": reason}
+
+
+def numeric_cell(table: str, row: str, column: str, printed: str, value: float | None,
+                 flagged: str | None, departs: str | None) -> dict:
+    """One printed number against a computed one (None/NaN: the run leaves the cell blank).
+
+    ``flagged``: why the printed value is known not to be reproducible; ``departs``: why the
+    deck's correct answer differs (None when the deck reproduces the published conventions).
+    """
+    blank = value is None or not np.isfinite(value)
+    if printed == "":
+        comp = "" if blank else f"{value:g}"
+        return cell(table, row, column, "", comp, "identical" if blank else "differs",
+                    "" if blank else "the report leaves this cell blank (target out of reach)")
+    if blank:
+        return cell(table, row, column, printed, "", "not reproducible" if flagged else
+                    ("departs" if departs else "differs"), flagged or departs or "the run leaves this cell blank")
+    comp = f"{value:.{decimals(printed)}f}"
+    if comp.startswith("-") and float(comp) == 0.0:
+        comp = comp[1:]
+    if agrees_printed(value, printed):
+        return cell(table, row, column, printed, comp, "identical" if comp == printed else "agrees")
+    if flagged:
+        return cell(table, row, column, printed, comp, "not reproducible", flagged)
+    if departs:
+        return cell(table, row, column, printed, comp, "departs", departs)
+    return cell(table, row, column, printed, comp, "differs", "")
+
+
+def one_digit_apart(a: str, b: str, column: str) -> bool:
+    """Whether two printed values differ by at most one unit of the printed last digit
+    (a whole degree for the truncated angle columns)."""
+    try:
+        unit = 1.0 if column in ("epsl", "phi", "beta") else 10.0 ** Decimal(b).as_tuple().exponent  # type: ignore
+        return abs(float(a) - float(b)) <= unit * (1 + 1e-9)
+    except (ValueError, InvalidOperation):
+        return False

@@ -142,83 +142,6 @@ def _figures_html(result: "Result", skip: Iterable[str] = ()) -> tuple[str, list
 
 # ----------------------------------------------------------------------------- animation
 
-def _fourbar_frames(params: "Params") -> dict[str, Any] | None:
-    from driver import fourbar
-    motions = fourbar.rocking_motions(params, max(8, ANIMATION_FRAMES // 2 // max(
-        1, len(fourbar.assembly_intervals(params.fixed_link, params.crank, params.coupler, params.rocker) or [1]))))
-    extra: dict[str, Any] = {}
-    if motions:   # a crank that cannot turn: it rocks between its limit positions, out on one
-        # assembly branch and back on the other; each assembly interval a motion of its own
-        theta = np.concatenate([m.theta for m in motions])
-        out = np.vstack([m.out for m in motions])
-        status = np.concatenate([m.status for m in motions])
-        word = {1: "open", -1: "crossed"}
-        tag = (lambda i: "") if len(motions) == 1 else (lambda i: f", motion {i + 1} of {len(motions)}")
-        arrow = {0: "\u2192", 1: "\u2190"}   # forward stroke, return stroke
-        extra["phase"] = [f"{arrow[int(st)]} {word[int(b)]} assembly{tag(i)}"
-                          for i, m in enumerate(motions) for st, b in zip(m.stroke, m.branch)]
-        starts = np.cumsum([0] + [len(m.theta) for m in motions])
-        extra["segments"] = [[int(a), int(b)] for a, b in zip(starts[:-1], starts[1:])]
-        extra["limits"] = [[np.round(m.out[k, 3:7], 5).tolist() for k in (0, len(m.theta) // 2 - 1)] for m in motions]
-        extra["limit_angles"] = [[m.lo, m.hi] for m in motions]
-    else:
-        theta = np.linspace(0.0, 360.0, ANIMATION_FRAMES, endpoint=False)
-        out, status = fourbar.exact_grid(params, theta)
-    ok = (status != fourbar.ST["no_assembly"]) & (status != fourbar.ST["indeterminate"])
-    cp = fourbar.coupler_point(params, theta, out, status)
-    g = params.fixed_link
-    frames = {"theta": theta.tolist(), "ok": ok.astype(int).tolist(),
-              "A": np.round(out[:, 3:5], 5).tolist(), "B": np.round(np.where(ok[:, None], out[:, 5:7], 0.0), 5).tolist(),
-              "P": None if cp is None else np.round(np.where(ok[:, None], cp[:, :2], 0.0), 5).tolist(),
-              "ground": [[0.0, 0.0], [g, 0.0]], "kind": "fourbar",
-              "names": {"crank": "crank", "out": "rocker"}, **extra}
-    frames["theta"] = np.round(theta, 6).tolist()
-    pts = [out[:, 3:5], out[ok][:, 5:7], np.array([[0.0, 0.0], [g, 0.0]])]
-    if cp is not None:
-        pts.append(cp[ok][:, :2])
-    frames["box"] = _box(np.vstack(pts))
-    return frames
-
-
-def _slidercrank_frames(params: "Params", result: "Result | None" = None) -> dict[str, Any] | None:
-    from driver import kernels
-    from driver.slidercrank.spec import _model
-    model = _model(params)
-    r, length = float(model.r2), float(model.length)
-    theta = np.linspace(0.0, 360.0, ANIMATION_FRAMES, endpoint=False)
-    states = kernels.slidercrank_rigid(np.radians(theta), 1.0, r, length)
-    a = np.column_stack([r * np.cos(np.radians(theta)), r * np.sin(np.radians(theta))])
-    b = np.column_stack([states[:, 3], np.zeros_like(theta)])
-    frames = {"theta": theta.tolist(), "ok": [1] * len(theta), "A": np.round(a, 6).tolist(),
-              "B": np.round(b, 6).tolist(), "P": None, "ground": [[0.0, 0.0], [float(b[:, 0].max()), 0.0]],
-              "kind": "slidercrank", "names": {"crank": "crank", "out": "slider"}}
-    frames["box"] = _box(np.vstack([a, b, [[0.0, 0.0]]]), pad_y=0.25 * r)
-    frames["bow"], frames["bow_note"] = _rod_bow(result, theta, length)
-    return frames
-
-
-def _rod_bow(result: "Result | None", theta: np.ndarray, length: float) -> tuple[list[float] | None, str]:
-    """The elastic rod's midpoint deflection [m] at the animation's crank angles, magnified so
-    its largest is 6 % of the rod (from the run's tidy table: the fastest crank speed that ran),
-    and the words saying so; (None, '') without one."""
-    tidy = getattr(result, "tidy", None)
-    if tidy is None or "midpoint_deflection_mm" not in tidy or not len(tidy):
-        return None, ""
-    w = float(tidy["omega_rad_s"].max())
-    rows = tidy[tidy["omega_rad_s"] == w]
-    ang = np.mod(rows["crank_angle_deg"].to_numpy(dtype=float), 360.0)
-    mid = rows["midpoint_deflection_mm"].to_numpy(dtype=float) * 1e-3
-    order = np.argsort(ang)
-    ang, mid = ang[order], mid[order]
-    peak = float(np.max(np.abs(mid)))
-    if not np.isfinite(peak) or peak <= 0:
-        return None, ""
-    scale = 0.06 * length / peak
-    bow = np.interp(theta, ang, mid, period=360.0) * scale
-    return np.round(bow, 7).tolist(), (f"rod deflection magnified {scale:.3g} times "
-                                       f"(midpoint deflection at {w:g} rad/s, largest {peak * 1e3:.3g} mm)")
-
-
 def _box(pts: np.ndarray, pad_y: float = 0.0) -> list[float]:
     pts = pts[np.all(np.isfinite(pts), axis=1)]
     lo, hi = pts.min(axis=0), pts.max(axis=0)
@@ -246,7 +169,7 @@ _ANIM_JS = r"""
     [coupler, out, pb, pp, block].forEach(function(e){ if (e) e.style.visibility = ok ? "visible" : "hidden"; });
     note.style.visibility = ok ? "hidden" : "visible";
     if (!ok) return;
-    if (F.kind === "slidercrank") {
+    if (F.kind === "slider") {
       var dx = B[0] - A[0], dy = B[1] - A[1], L = Math.sqrt(dx * dx + dy * dy), b = F.bow ? 2 * F.bow[k] : 0;
       var C = [(A[0] + B[0]) / 2 - b * dy / L, (A[1] + B[1]) / 2 + b * dx / L];
       coupler.setAttribute("d", "M" + A.join(",") + " Q" + C.join(",") + " " + B.join(","));
@@ -254,7 +177,7 @@ _ANIM_JS = r"""
     else coupler.setAttribute("points", [A, B].map(function(p){ return p.join(","); }).join(" "));
     dot(pb, B);
     if (F.P) dot(pp, F.P[k]);
-    if (F.kind === "fourbar") line(out, G[1], B);
+    if (F.kind === "rocker") line(out, G[1], B);
     else { var w = parseFloat(block.getAttribute("width")), h = parseFloat(block.getAttribute("height"));
            block.setAttribute("x", B[0] - w / 2); block.setAttribute("y", B[1] - h / 2); }
   }
@@ -271,17 +194,17 @@ _ANIM_JS = r"""
 
 def mechanism_animation(params: "Params", anim_id: str = "anim", caption: str = "",
                         result: "Result | None" = None) -> str | None:
-    """The animation of a four-bar or slider-crank deck over one crank turn (inline SVG, JSON
-    positions from the kernel and a few lines of JavaScript), or None for another study.  A
-    slider-crank ``result`` adds its elastic rod's midpoint deflection, magnified."""
-    if params.group == "fourbar":
-        F = _fourbar_frames(params)
-    elif params.group == "slidercrank":
-        F = _slidercrank_frames(params, result)
-    else:
-        return None
+    """The animation of a deck's mechanism over one crank turn (inline SVG, JSON positions from the
+    study's ``Study.animation``, and a few lines of JavaScript), or None for a study without one.
+    The positions' ``kind`` says what the crank drives: a coupler and a ``'rocker'`` (four-bar) or a
+    rod and a ``'slider'`` (a slider-crank ``result`` adds its elastic rod's midpoint deflection,
+    magnified, as ``bow``)."""
+    from driver._study import load_study
+    study = load_study(params.group)
+    F = study.animation(params, result, ANIMATION_FRAMES) if study is not None and study.animation else None
     if F is None:
         return None
+    F["box"] = _box(np.asarray(F.pop("box_points"), float), F.pop("pad_y", 0.0))
     x0, y0, w, h = F["box"]
     s = max(w, h)
     lw, rad = 0.012 * s, 0.014 * s
@@ -305,7 +228,7 @@ def mechanism_animation(params: "Params", anim_id: str = "anim", caption: str = 
                              f'<title>limit position: crank angle {ang:.1f}\u00b0 (the crank reverses)</title></polyline>')
     elif ok.any():
         for name, key, colour in (("path of B", "B", "#c0392b"), ("path of P", "P", "#8e44ad")):
-            if F[key] is None or (F["kind"] == "slidercrank"):
+            if F[key] is None or (F["kind"] == "slider"):
                 continue
             pts = np.array(F[key])
             runs = np.split(np.arange(len(ok)), np.flatnonzero(np.diff(ok.astype(int))) + 1)
@@ -321,7 +244,7 @@ def mechanism_animation(params: "Params", anim_id: str = "anim", caption: str = 
         a_path = "".join('<polyline points="' + " ".join(f"{p[0]:.5g},{p[1]:.5g}" for p in a_pts[a:(a + b) // 2]) +
                          f'" fill="none" stroke="#999" stroke-width="{lw / 4:.4g}"><title>path of A</title></polyline>'
                          for a, b in F["segments"])
-    elif ok.all() or F["kind"] == "slidercrank":
+    elif ok.all() or F["kind"] == "slider":
         a_path = ('<polygon points="' + " ".join(f"{p[0]:.5g},{p[1]:.5g}" for p in a_pts) + f'" fill="none" '
                   f'stroke="#999" stroke-width="{lw / 4:.4g}"><title>path of A</title></polygon>')
     else:   # a crank that cannot turn: its pin's path only where the linkage assembles
@@ -331,8 +254,8 @@ def mechanism_animation(params: "Params", anim_id: str = "anim", caption: str = 
                          for run in runs if ok[run[0]] and len(run) > 1)
     g0, g1 = F["ground"]
     pivots = "".join(f'<path d="M{p[0] - 2 * rad:.5g},{p[1] - 2.2 * rad:.5g} L{p[0] + 2 * rad:.5g},{p[1] - 2.2 * rad:.5g} '
-                     f'L{p[0]:.5g},{p[1]:.5g} Z" fill="#555"/>' for p in ([g0, g1] if F["kind"] == "fourbar" else [g0]))
-    if F["kind"] == "fourbar":
+                     f'L{p[0]:.5g},{p[1]:.5g} Z" fill="#555"/>' for p in ([g0, g1] if F["kind"] == "rocker" else [g0]))
+    if F["kind"] == "rocker":
         guide = f'<line x1="{g0[0]}" y1="{g0[1]}" x2="{g1[0]}" y2="{g1[1]}" stroke="#555" stroke-width="{lw / 2:.4g}"/>'
         out = f'<line data-part="out" stroke="#e67e22" stroke-width="{lw:.4g}" stroke-linecap="round"/>'
         block = ""
@@ -343,7 +266,7 @@ def mechanism_animation(params: "Params", anim_id: str = "anim", caption: str = 
         out = ""
         block = (f'<rect data-part="block" width="{6 * rad:.5g}" height="{3 * rad:.5g}" fill="#e67e22" '
                  f'fill-opacity="0.85" stroke="#333" stroke-width="{lw / 4:.4g}"/>')
-    if F["kind"] == "slidercrank":   # the rod: a curve A-B (bowed by the elastic deflection when known)
+    if F["kind"] == "slider":   # the rod: a curve A-B (bowed by the elastic deflection when known)
         coupler = (f'<path data-part="coupler" fill="none" stroke="#2980b9" stroke-width="{lw:.4g}" '
                    'stroke-linecap="round"/>')
     else:
@@ -570,9 +493,9 @@ def page_for_result(result: "Result", deck: "Deck | None" = None, params: "Param
 
 
 def _subtitle(study: str, params: "Params | None") -> str:
-    from driver.study import load_study
+    from driver._study import load_study
     module = load_study(study) if study else None
-    doc = getattr(getattr(module, "SPEC", None), "doc", "") if module is not None else ""
+    doc = module.spec.doc if module is not None else ""
     t = getattr(params, "get", lambda k, d=None: d)("title", "") if params is not None else ""
     return " — ".join(x for x in (doc, t) if x)
 
@@ -612,7 +535,7 @@ def _namelist(group: str, values: dict[str, Any]) -> str:
 def page_for_sweep(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> str:
     """The page of a sweep deck, from the files the sweep wrote: the design-space maps of the
     plotted summary columns (kept designs outlined; the best kept design by the first plotted
-    column marked where the study says which way is better, its ``SWEEP_BEST``, else the first
+    column marked where the study says which way is better, its ``sweep_best``, else the first
     kept design), that design's drawing and animation, the summary .out, the deck."""
     import pandas as pd
 
@@ -631,11 +554,11 @@ def page_for_sweep(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> st
     numeric = [c for c in summary.columns if c not in keys and c not in ("case", "kept") and
                pd.api.types.is_numeric_dtype(summary[c]) and not pd.api.types.is_bool_dtype(summary[c])]
     wanted = [y for y in (sw.plot_y or []) if y in numeric] or \
-        [c for c in getattr(module, "SWEEP_PLOT", ()) if c in numeric][:2] or numeric[:1]
+        [c for c in module.sweep_plot if c in numeric][:2] or numeric[:1]
     labels = _labels(module, list(summary.columns))
     ok = summary[summary["status"] == "ok"] if "status" in summary else summary
     kept = ok[ok["kept"].astype(bool)] if "kept" in ok else ok
-    senses = getattr(module, "SWEEP_BEST", {})
+    senses = module.sweep_best
     sections: list[Section] = []
     notes: list[str] = []
     numeric_keys = [k for k in keys if pd.api.types.is_numeric_dtype(summary[k])]
@@ -653,7 +576,7 @@ def page_for_sweep(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> st
             maps += [_figure_block(f, f"{labels[y]} over the swept keys") for f, y in zip(figs, wanted)]
         else:   # one key, zipped keys or a kept set that is no grid: the --plot summary (lines, strips)
             fig = plotting.sweep_summary(ok, keys, sw.plot_x, sw.plot_y, stem, labels,
-                                         getattr(module, "SWEEP_PLOT", ()))
+                                         module.sweep_plot)
             maps.append(_figure_block(fig, "the sweep's summary columns against the swept keys"))
     except Exception as exc:
         notes.append(f"the design-space maps could not be drawn: {exc.__class__.__name__}: {exc}")

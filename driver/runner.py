@@ -7,24 +7,23 @@ exits; it raises :class:`~driver.deck.DeckError` for bad input and returns what 
 from __future__ import annotations
 
 import functools
-import pkgutil
+import os
 import re
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from typing import Any
 from pathlib import Path
-from types import ModuleType
 
 import numpy as np
 
-import driver
 from driver import blas, limits
-from driver.atomic import inside, output_set, remove_stale_temporaries, write_text
+from driver._study import REGISTRY, Study, load_study, registered, study_names
+from driver.atomic import NAME_MAX, inside, output_set, remove_stale_temporaries, write_text
 from driver.deck import Deck, DeckError, Params
 from driver.deck import validate
 from driver.export import FORMATS, summary_json_text, write_tidy
 from driver.outcome import RunOutcome
 from driver.pydeck import deck_of
-from driver.study import Result, load_study
+from driver.study import Result
 from driver.table import TableValueError
 
 __all__ = ["CONTROL_GROUPS", "CaseFailure", "RunOutcome", "available_studies", "study_of", "run_study", "write_outputs",
@@ -35,39 +34,37 @@ __all__ = ["CONTROL_GROUPS", "CaseFailure", "RunOutcome", "available_studies", "
 CONTROL_GROUPS = ("sweep", "optimize", "synthesis")
 
 
-def available_studies() -> dict[str, ModuleType]:
-    """Every study module in the package, by group name."""
-    found = {}
-    for info in pkgutil.iter_modules(driver.__path__):
-        module = load_study(info.name)
-        if module is not None:
-            found[info.name] = module
-    return found
+def available_studies() -> dict[str, Study]:
+    """Every registered study (:data:`driver._study.REGISTRY`), by group name."""
+    return registered()
 
 
-def study_of(deck: Deck) -> tuple[ModuleType, Params]:
+def study_of(deck: Deck) -> tuple[Study, Params]:
     """The single study group of a deck, validated; DeckError otherwise."""
     studies = []
     for name, raw in deck.groups.items():
         if name in CONTROL_GROUPS:
             continue
-        module = load_study(name)
-        if module is None:
-            known = ", ".join(f"&{g}" for g in sorted(available_studies()) + list(CONTROL_GROUPS))
+        study = load_study(name)
+        if study is None:
+            known = ", ".join(f"&{g}" for g in study_names() + list(CONTROL_GROUPS))
             raise DeckError(deck.path, raw.line, None, f"unknown group &{name} (known groups: {known})")
-        studies.append((module, raw))
+        studies.append((study, raw))
     if not studies:
         raise DeckError(deck.path, None, None, "deck has no study group")
     if len(studies) > 1:
         names = ", ".join(f"&{raw.name} (line {raw.line})" for _, raw in studies)
         raise DeckError(deck.path, studies[1][1].line, None,
                         f"a deck describes one study; found {names}")
-    module, raw = studies[0]
-    return module, validate(raw, module.SPEC, deck.path)
+    study, raw = studies[0]
+    return study, validate(raw, study.spec, deck.path)
 
 
-def output_stem(outdir: str | Path, deck_path: str | Path) -> Path:
-    """``OUTDIR/<deck stem>``, refused (DeckError) unless every output named after it stays in OUTDIR.
+def output_stem(outdir: str | Path, deck_path: str | Path, suffixes: Iterable[str] = (".out",)) -> Path:
+    """``OUTDIR/<deck stem>``, refused (DeckError) unless every output named after it stays in OUTDIR
+    and fits a file name: ``suffixes`` are what the run appends to the stem that it knows before
+    running (the longest counts); a name known only later (a figure's) is checked when its file
+    is opened (:class:`driver.atomic.NameTooLong`, before anything is renamed into place).
 
     A deck named ``..dat`` has the stem ``.``, ``...dat`` the stem ``..``: their outputs would
     land beside or above OUTDIR.
@@ -78,16 +75,24 @@ def output_stem(outdir: str | Path, deck_path: str | Path) -> Path:
     if not stem or stem.strip(".") == "" or "/" in stem or "\\" in stem or not inside(outdir, candidate):
         raise DeckError(deck_path, None, None, f"outputs are named after the deck file, and {name!r} would name "
                         f"them outside the output folder {outdir}: rename the deck (e.g. case.dat)")
-    if len(stem.encode("utf-8", "surrogateescape")) + OUTPUT_SUFFIX_BYTES > NAME_MAX:
-        raise DeckError(deck_path, None, None, f"the deck's file name is {len(stem.encode('utf-8', 'surrogateescape'))} "
-                        f"bytes without its suffix; outputs are named after it with up to {OUTPUT_SUFFIX_BYTES} more "
-                        f"(e.g. <name>_summary.parquet) and a file name may have {NAME_MAX} bytes: rename the deck "
-                        f"(at most {NAME_MAX - OUTPUT_SUFFIX_BYTES} bytes before '.dat')")
+    longest = max(suffixes, key=lambda s: len(os.fsencode(s)))
+    n, extra = len(os.fsencode(stem)), len(os.fsencode(longest))
+    if n + extra > NAME_MAX:
+        raise DeckError(deck_path, None, None, name_too_long(n, longest))
     return candidate
 
 
-#: the longest file name a file system takes [bytes], and the most the tool appends to a deck's stem
-NAME_MAX, OUTPUT_SUFFIX_BYTES = 255, 24
+def name_too_long(stem_bytes: int, suffix: str) -> str:
+    """The words of the refusal of an output name: the stem's length, the suffix, the limit."""
+    extra = len(os.fsencode(suffix))
+    return (f"the deck's file name is {stem_bytes} bytes without '.dat'; its output <name>{suffix} would have "
+            f"{stem_bytes + extra} and a file name may have {NAME_MAX} bytes: rename the deck (at most "
+            f"{NAME_MAX - extra} bytes before '.dat' for this run)")
+
+
+def study_suffixes(formats: list[str], summary_json: bool) -> tuple[str, ...]:
+    """What a single-case run appends to the stem, known before it runs (figures' names are not)."""
+    return (".out", *(f".{fmt}" for fmt in formats), *((".json",) if summary_json else ()))
 
 
 def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool | str,
@@ -119,7 +124,7 @@ def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool | s
     # the set replaces an earlier run's: its tidy tables in formats not written now go
     for fmt in FORMATS:
         old = stem.with_name(f"{stem.name}.{fmt}")
-        if fmt not in formats and old.is_file():
+        if fmt not in formats and len(os.fsencode(old.name)) <= NAME_MAX and old.is_file():   # else it cannot exist
             old.unlink()
     return written
 
@@ -148,11 +153,11 @@ class CaseFailure(DeckError):
 def numerical_error(params: Params, exc: BaseException) -> CaseFailure:
     """The deck error for a numerical failure reached from ``params``.
 
-    A study may define ``blame(params, exc) -> (key, message) | None`` to name the key; otherwise
+    A study may declare ``blame(params, exc) -> (key, message) | None`` to name the key; otherwise
     the error is placed at the group and lists the keys the deck gave.
     """
-    module = load_study(params.group)
-    blamed = module.blame(params, exc) if module is not None and hasattr(module, "blame") else None
+    study = load_study(params.group)
+    blamed = study.blame(params, exc) if study is not None and study.blame is not None else None
     if blamed:
         e = params.error(*blamed)
     else:
@@ -180,15 +185,15 @@ def check_finite(result: Result, params: Params) -> Result:
     return result
 
 
-def compute(module: ModuleType, params: Params, progress: bool = False,
+def compute(study: Study, params: Params, progress: bool = False,
             budget: limits.Budget | None = None) -> Result:
-    """``module.run(params)`` within the budget (:mod:`driver.limits`; ``budget`` default this
+    """``study.run(params)`` within the budget (:mod:`driver.limits`; ``budget`` default this
     process's), with numerical failures turned into deck errors and the result checked for
     non-finite numbers (no NaN, inf or '****' ever reaches a table)."""
-    limits.check(module, params, lim=budget)   # absurd requests are refused before anything is allocated
+    limits.check(study, params, lim=budget)   # absurd requests are refused before anything is allocated
     try:
         with np.errstate(all="ignore"), blas.one_thread():   # one BLAS thread: the same digits on any machine
-            result = module.run(params, progress=progress)
+            result = study.run(params, progress=progress)
     except DeckError:
         raise
     except NUMERICAL as exc:
@@ -205,11 +210,12 @@ def run_study(deck: Deck, outdir: Path | None, formats: list[str], plot: bool,
 
     Raises DeckError for bad input (nothing is written then); other exceptions are run failures.
     """
-    module, params = study_of(deck)
-    result = compute(module, params, progress=progress)
+    study, params = study_of(deck)
+    result = compute(study, params, progress=progress)
     result.name, result.study = name or Path(deck.path).stem, params.group
     written = [] if outdir is None else write_outputs(
-        result, output_stem(outdir, deck.path if name is None else f"{name}.dat"), formats, plot, summary_json)
+        result, output_stem(outdir, deck.path if name is None else f"{name}.dat", study_suffixes(formats, summary_json)),
+        formats, plot, summary_json)
     outcome = RunOutcome(result=result, written=written)
     for w in result.warnings:
         if w != result.failure:   # a failure is reported once, as the error
@@ -225,10 +231,9 @@ def keyword_run(run: Callable[..., Result]) -> Callable[..., Result]:
     rocker=9, step_deg=20)``.  Keywords are validated by the study's SPEC exactly like a deck
     (errors are :class:`driver.deck.DeckError`); the result is the runner's, as for a deck
     (:func:`run_study`, the outputs named after the study group)."""
-    group = run.__module__.rpartition(".")[2]
-
     @functools.wraps(run)
     def wrapper(params: Any = None, /, progress: bool = False, **keys: Any) -> Result:
+        group = _group_of(run.__module__)
         if params is not None:
             if keys:
                 raise TypeError(f"{group}.run() takes validated params or deck keys, not both")
@@ -236,3 +241,12 @@ def keyword_run(run: Callable[..., Result]) -> Callable[..., Result]:
         return run_study(deck_of({group: keys}, None), None, [], False, progress=progress).result
 
     return wrapper
+
+
+def _group_of(module: str) -> str:
+    """The registered study group whose package holds module ``module`` (its own name's last part
+    when none does: a study being written that is not registered yet)."""
+    for group, package in REGISTRY.items():
+        if module == package or module.startswith(package + "."):
+            return group
+    return module.rpartition(".")[2]

@@ -1,33 +1,20 @@
-"""What a study is, and how the driver finds one.
+"""What a study returns: :class:`Result` and its :class:`Figure` s; labels.
 
-A study is a module ``driver/<group>.py`` (or a package ``driver/<group>/``, split by job
-when it grows: spec, analysis, report, batch) named after its namelist group.  It
-defines
-
-* ``SPEC``: a :class:`driver.deck.GroupSpec` for its keys, and
-* ``run(params, progress=False) -> Result``: the physics (through its kernel),
-  decorated with :func:`driver.runner.keyword_run` so that Python users can also call
-  ``driver.<group>.run(key=value, ...)`` with the deck's keys as keyword arguments;
-
-and may define, for figures of sweeps over it,
-
-* ``LABELS``: ``{name: (words, units)}`` for summary columns and deck keys, the
-  axis labels a reader sees instead of identifiers (``{i}`` in a name stands for a
-  case number, e.g. ``peak_tensile_{i}_deg``); deck keys default to their
-  ``SPEC`` units, and
-* ``SWEEP_PLOT``: the summary columns a sweep summary plots when the deck names none.
-
-Nothing else in the driver changes when a study is added: the group name of a
-deck selects the module.
+What a study *is* (the :class:`~driver._study.Study` every study package declares as ``STUDY``)
+and the registry of studies are in :mod:`driver._study`.  This module holds what a study's run
+produces (:class:`Result`), the code digest that signs resume records, and the axis labels of
+summary columns from a study's ``labels``; the decorator that gives ``run`` its keyword form is
+:func:`driver.runner.keyword_run`.
 """
 from __future__ import annotations
 
-import importlib
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
 from typing import TYPE_CHECKING, Any, Callable
+
+from driver._study import Study
 
 if TYPE_CHECKING:   # annotations only: keeps `python -m driver --help` light
     import pandas as pd
@@ -35,13 +22,7 @@ if TYPE_CHECKING:   # annotations only: keeps `python -m driver --help` light
 if TYPE_CHECKING:
     import matplotlib.figure
 
-__all__ = ["Figure", "PLOT_FORMATS", "Result", "code_digest", "column_label", "expression_label", "load_study", "plot_format",
-           "study_names"]
-
-_CORE = {"cli", "limits", "deck", "study", "table", "export", "plotting", "atomic", "kernels", "sweep", "runner", "expr",
-         "optimize", "synthesis", "published", "compare", "extras", "example_decks", "examples", "api",
-         "dispatch", "outcome", "pydeck",
-         "blas", "report_page"}
+__all__ = ["Figure", "PLOT_FORMATS", "Result", "code_digest", "column_label", "expression_label", "plot_format"]
 
 
 #: file formats of ``--plot`` figures (``--plot-format``); the first is the default
@@ -143,24 +124,9 @@ class Result:
                 f"{len(self.warnings)} warning(s), figures {self.figure_names}>")
 
 
-def load_study(group: str) -> ModuleType | None:
-    """The study module for namelist group ``group``, or None if there is none."""
-    if not re.fullmatch(r"[a-z_][a-z0-9_]*", group) or group in _CORE or group.startswith("_"):
-        return None
-    try:
-        module = importlib.import_module(f"driver.{group}")
-    except ModuleNotFoundError as exc:
-        if exc.name == f"driver.{group}":
-            return None
-        raise
-    if not (hasattr(module, "SPEC") and hasattr(module, "run")):
-        return None
-    return module
-
-
-def code_digest(module: ModuleType | None, *others: ModuleType | None) -> bytes:
-    """SHA-256 of the source of study ``module`` -- every ``.py`` file of its package when it
-    is one, so an edit to any module of the study counts -- of the other modules ``others``,
+def code_digest(module: Study | ModuleType | None, *others: ModuleType | None) -> bytes:
+    """SHA-256 of the source of study ``module`` (a :class:`~driver._study.Study` or its package)
+    -- every ``.py`` file of its package when it is one, so an edit to any module of the study counts -- of the other modules ``others``,
     and of the compiled kernels.  Both kinds of sweep resume record (batch and per-case) carry
     it in their signature: a record made by other code is redone, never believed."""
     import hashlib
@@ -175,6 +141,8 @@ def code_digest(module: ModuleType | None, *others: ModuleType | None) -> bytes:
             return sorted(p.parent.rglob("*.py"))
         return [p]
 
+    if isinstance(module, Study):
+        module = module.module
     h = hashlib.sha256()
     kernels = sys.modules.get("driver._kernels")
     for mod in (module, *others, kernels):
@@ -187,32 +155,23 @@ def code_digest(module: ModuleType | None, *others: ModuleType | None) -> bytes:
     return h.digest()
 
 
-def study_names() -> list[str]:
-    """Group names of every study module in the package, found without importing them."""
-    import pkgutil
-
-    import driver
-    return sorted(info.name for info in pkgutil.iter_modules(driver.__path__)
-                  if info.name not in _CORE and not info.name.startswith("_"))
-
-
-def column_label(module: ModuleType | None, name: str) -> str:
+def column_label(study: Study | None, name: str) -> str:
     """The axis label of summary column or deck key ``name`` (``group.key`` or ``key``) of
-    study ``module``: words and units from its ``LABELS``, else the key's ``SPEC`` units, else
+    ``study``: words and units from its ``labels``, else the key's ``SPEC`` units, else
     units read off the name's suffix (``_deg``, ``_rad_s``, ...).  E.g. ``'crank speed [rad/s]'``."""
     if not re.fullmatch(r"([a-z_][a-z0-9_]*\.)?[A-Za-z_][A-Za-z0-9_]*", name):
         return name   # an expression of columns (driver.expr) is its own label
     group, _, key = name.rpartition(".")
-    if module is not None and group and group != getattr(module.SPEC, "name", group):
-        module = None
-    labels: dict = getattr(module, "LABELS", {}) if module is not None else {}
+    if study is not None and group and group != study.name:
+        study = None
+    labels = study.labels if study is not None else {}
     entry = labels.get(key)
     for pattern, value in labels.items() if entry is None else ():
         m = re.fullmatch(re.escape(pattern).replace(r"\{i\}", "([0-9]+)"), key) if "{i}" in pattern else None
         if m:
             entry = (value[0].replace("{i}", m.group(1)), value[1])
             break
-    spec_key = getattr(module.SPEC, "keys", {}).get(key) if module is not None else None
+    spec_key = study.spec.keys.get(key) if study is not None else None
     if entry is None:
         words, units = key, ""
         from driver.export import SUFFIX_UNITS   # the one suffix table (tidy units and labels)
@@ -228,13 +187,14 @@ def column_label(module: ModuleType | None, name: str) -> str:
     return f"{words} [{units}]" if units else words
 
 
-def expression_label(module: ModuleType | None, text: str) -> str:
+def expression_label(study: Study | None, text: str) -> str:
     """The axis words of an objective: a summary column's words and unit, or for an expression
     the expression in words with the unit its columns share (``min(mu_min_deg, ...) [deg]``)."""
     from driver.export import SUFFIX_UNITS
     if re.fullmatch(r"[A-Za-z_][A-Za-z0-9_.]*", text.strip()):
-        return column_label(module, text.strip())
+        return column_label(study, text.strip())
     names = set(re.findall(r"[A-Za-z_][A-Za-z0-9_]*", text)) - {"min", "max", "abs", "sqrt", "and", "or", "not"}
+    labels = study.labels if study is not None else {}
     units = set()
     for n in names:
         for suffix, u in SUFFIX_UNITS:
@@ -242,12 +202,11 @@ def expression_label(module: ModuleType | None, text: str) -> str:
                 units.add(u)
                 break
         else:
-            labels = getattr(module, "LABELS", {})
             if n in labels:
                 units.add(labels[n][1])
     words = text.strip().replace("$", r"\$")   # the deck's text is never mathtext (driver.plotting.plain_text)
     for n in sorted(names, key=len, reverse=True):
-        entry = getattr(module, "LABELS", {}).get(n)
+        entry = labels.get(n)
         if entry:
             words = re.sub(rf"\b{re.escape(n)}\b", entry[0], words)
     return f"{words} [{units.pop()}]" if len(units) == 1 and "" not in units else words

@@ -41,7 +41,7 @@ module slidercrank
   public :: simulate, assemble_matrices, rigid_states, axial_force_at, analytic_frequencies
   !> building blocks shared with the geometrically nonlinear rod (fortran/slidercrank_nl.f90)
   !> (not wrapped for Python: fortran/meson.build lists them after f2py's skip:)
-  public :: rigid_kin, element_matrices, apply_ops, band_cholesky, band_solve
+  public :: rigid_kin, element_matrices, element_map, apply_ops, band_cholesky, band_solve
 
   !> half bandwidth of the banded matrices in q ordering
   integer, parameter, public :: kd = 5
@@ -213,8 +213,8 @@ contains
   end subroutine symmetrize
 
   !> q indices and coefficients of the six local DOFs of element e (1..nel).
-  !> idx = 0 marks a constrained DOF (crank pin u, v).
-  subroutine element_map(e, nel, c3, s3, idx, cf)
+  !> idx = 0 marks a constrained DOF (crank pin u, v).  Shared with slidercrank_nl.f90.
+  pure subroutine element_map(e, nel, c3, s3, idx, cf)
     integer, intent(in) :: e, nel
     real(dp), intent(in) :: c3, s3
     integer, intent(out) :: idx(6)
@@ -378,7 +378,16 @@ contains
       end if
       ajj = 1/sqrt(ajj)
       ab(1, j) = ajj
-      kn = min(kd, n - j)
+      if (j <= n - kd) then     ! full-width column: fixed trip counts (unrolled), same operations
+        ab(2:kd + 1, j) = ab(2:kd + 1, j)*ajj
+        do i = 1, kd
+          do k = i, kd
+            ab(1 + k - i, j + i) = ab(1 + k - i, j + i) - ab(1 + k, j)*ab(1 + i, j)
+          end do
+        end do
+        cycle
+      end if
+      kn = n - j
       ab(2:kn + 1, j) = ab(2:kn + 1, j)*ajj
       do i = 1, kn
         do k = i, kn

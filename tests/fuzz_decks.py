@@ -257,7 +257,7 @@ def campaign(count: int, seed: int, max_work: str, workdir: Path) -> dict:
     from driver.runner import available_studies
     from driver import sweep, synthesis
 
-    specs = {name: m.SPEC for name, m in available_studies().items()}
+    specs = {name: m.spec for name, m in available_studies().items()}
     specs["sweep"] = sweep.SPEC
     specs["synthesis"] = synthesis.SPEC
     bases = sorted(p for p in INPUTS.glob("*.dat"))

@@ -34,6 +34,8 @@ def test_run_all_smoke(run_all, capsys):
     assert targets["2R manipulator"] == (0.04e-6, None)
     assert targets["Hooke joint"] == (5e-6, None)
     assert targets["slider-crank"] == (100e-3, 10.0)
+    nl, = [r for r in rows if r.name.startswith("slider-crank nonlinear rod")]
+    assert nl.target_s is None and nl.target_ratio == pytest.approx(1 / 25)   # issue 29: <= 25x the linear time
     # issue 27 (targets only above the sizes where fresh memory costs page faults: not at --smoke sizes)
     assert "four-bar exact, default path vs fresh arrays" in names
     assert "slider-crank: study's record vs all fields" in names

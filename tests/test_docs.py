@@ -68,7 +68,7 @@ def test_study_pages_have_the_required_sections_and_every_group_has_a_key_table(
     finally:
         sys.path.pop(0)
     from driver.runner import CONTROL_GROUPS
-    from driver.study import study_names
+    from driver._study import study_names
     assert set(study_names()) | set(CONTROL_GROUPS) <= gen_keys.groups_documented()
     for page in ("fourbar", "ujoint", "slidercrank", "manipulator"):
         text = (ROOT / "docs" / f"{page}.md").read_text()

@@ -52,7 +52,7 @@ def _design_map(keys: int):
                          grid=grid, keep="meets_transmission_band", case_outputs="none", jobs=1)
     frame = s.summary
     names = [f"fourbar.{k}" for k in grid]
-    labels = {c: column_label(driver.fourbar, c) for c in frame.columns}
+    labels = {c: column_label(driver.fourbar.STUDY, c) for c in frame.columns}
     if keys == 1:
         best = plotting.best_index(frame, "mu_min_deg", "max")
         return plotting.design_space_map(frame, names, "mu_min_deg", labels, best=best, best_text="best",
@@ -66,7 +66,7 @@ def _convergence():
     history = pd.read_csv(ROOT / "outputs" / "optimize_manipulator_torque_history.csv")
     evals = pd.read_parquet(ROOT / "outputs" / "optimize_manipulator_torque_evals.parquet")
     from driver.study import expression_label   # the label the optimiser gives it (mathtext symbols)
-    return plotting.convergence_plot(history, evals, expression_label(driver.manipulator, "design_torque_demand_Nm"),
+    return plotting.convergence_plot(history, evals, expression_label(driver.manipulator.STUDY, "design_torque_demand_Nm"),
                                      "minimize", title="convergence")
 
 
@@ -75,7 +75,7 @@ def _manipulator_search():
     from driver import plotting
     from driver.study import column_label
     frame = pd.read_parquet(ROOT / "outputs" / "manipulator_design_search_summary.parquet")
-    labels = {c: column_label(driver.manipulator, c) for c in frame.columns}
+    labels = {c: column_label(driver.manipulator.STUDY, c) for c in frame.columns}
     return plotting.sweep_maps(frame, ["manipulator.designs_l1", "manipulator.designs_l2"],
                                ["design_torque_demand_Nm"], labels, driver.manipulator.SWEEP_BEST,
                                "manipulator design search", True)[0]

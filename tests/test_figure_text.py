@@ -51,11 +51,11 @@ def test_an_expression_label_is_drawn_literally():
     frame = pd.DataFrame({"case": [1, 2, 3], "fourbar.crank": [2.0, 3.0, 4.0], "kept": [True] * 3,
                           expr: [40.0, 33.0, 26.0]})
     fig = plotting.sweep_summary(frame, ["fourbar.crank"], ys=[expr],
-                                 labels={c: column_label(driver.fourbar, c) for c in frame.columns})
+                                 labels={c: column_label(driver.fourbar.STUDY, c) for c in frame.columns})
     fig.canvas.draw() if fig.canvas is not None else None
     ylabel = fig.axes[0].yaxis.label
     assert not _is_math(ylabel) and "$" in ylabel._preprocess_math(ylabel.get_text())[0]
-    lab = expression_label(driver.fourbar, "min(mu_min_deg, 180 - mu_max_deg)")
+    lab = expression_label(driver.fourbar.STUDY, "min(mu_min_deg, 180 - mu_max_deg)")
     assert lab == "min(minimum transmission angle, 180 - maximum transmission angle) [deg]"
 
 
@@ -122,11 +122,14 @@ def test_figure_functions_draw_into_a_users_axes():
     from matplotlib.figure import Figure
 
     from driver import plotting
+    from driver.fourbar import figures as fourbar_figures
+    from driver.slidercrank import figures as slidercrank_figures
+    from driver.ujoint import figures as ujoint_figures
     fig = Figure(layout="constrained")
     a, b = fig.subplots(1, 2)
     theta = np.linspace(0.0, 360.0, 73)
-    assert plotting.ujoint_speed_figure(theta, 25.0, {"optimum": 25 + np.sin(np.radians(2 * theta))}, ax=a) is fig
-    assert plotting.slidercrank_strain_figure([("10 rad/s", theta, np.cos(np.radians(theta)))], "t", ax=b) is fig
+    assert ujoint_figures.ujoint_speed_figure(theta, 25.0, {"optimum": 25 + np.sin(np.radians(2 * theta))}, ax=a) is fig
+    assert slidercrank_figures.slidercrank_strain_figure([("10 rad/s", theta, np.cos(np.radians(theta)))], "t", ax=b) is fig
     assert a.lines and b.lines
     fig2 = Figure()
     axes = fig2.subplots(2, 1)
@@ -135,9 +138,9 @@ def test_figure_functions_draw_into_a_users_axes():
     fig3 = Figure()
     axes3 = fig3.subplots(3, 1)
     r = driver.fourbar.run(fixed_link=12.0, crank=5.0, coupler=15.0, rocker=9.0, step_deg=20)
-    from driver.fourbar import exact_grid, tidy_frame, _exact_columns
+    from driver.fourbar.analysis import exact_columns, exact_grid, tidy_frame
     out, st = exact_grid(r.params, theta)
-    assert plotting.fourbar_curves(tidy_frame("exact", theta, _exact_columns(out, st), st), None, "",
+    assert fourbar_figures.fourbar_curves(tidy_frame("exact", theta, exact_columns(out, st), st), None, "",
                                    axes=axes3) is fig3
 
 
@@ -150,7 +153,7 @@ def test_manipulator_labels_set_their_symbols_in_mathtext():
     from conftest import ROOT
     from driver import plotting
     from driver.study import column_label
-    m = driver.manipulator
+    m = driver.manipulator.STUDY
     want = {"design_tau_sum_signed_Nm": r"$\tau_1 + \tau_2$", "design_torque_demand_Nm": r"$|\tau_1| + |\tau_2|$",
             "design_peak_torque_Nm": r"$\max(|\tau_1|, |\tau_2|)$", "sweep_min_tau_sum_signed_Nm": r"$\tau_1 + \tau_2$",
             "design_l1_m": "$l_1$", "design_l2_m": "$l_2$", "design_ri2": "$RI_2$", "crob_radius_m": "$C_{rob}$",
@@ -163,7 +166,7 @@ def test_manipulator_labels_set_their_symbols_in_mathtext():
         assert _is_math(t)
     fig.canvas.draw()   # every label parses as mathtext
     import re
-    for name, (words, units) in m.LABELS.items():   # no ASCII symbol left outside the mathtext
+    for name, (words, units) in m.labels.items():   # no ASCII symbol left outside the mathtext
         outside = re.sub(r"\$[^$]*\$", "", f"{words} [{units}]")
         for ascii_ in ("tau", " l1", " l2", "RI", "C_rob", "sqrt", "^"):
             assert ascii_ not in outside, (name, words, units)
@@ -171,7 +174,7 @@ def test_manipulator_labels_set_their_symbols_in_mathtext():
     frame = pd.read_parquet(ROOT / "outputs" / "manipulator_design_search_summary.parquet")
     keys = ["manipulator.designs_l1", "manipulator.designs_l2"]
     labels = {c: column_label(m, c) for c in frame.columns}
-    fig = plotting.sweep_maps(frame, keys, ["design_torque_demand_Nm"], labels, m.SWEEP_BEST, "search", True)[0]
+    fig = plotting.sweep_maps(frame, keys, ["design_torque_demand_Nm"], labels, m.sweep_best, "search", True)[0]
     fig.canvas.draw()
     texts = [a.get_xlabel() for a in fig.axes] + [a.get_ylabel() for a in fig.axes]
     assert "design link length $l_1$ [m]" in texts and "design link length $l_2$ [m]" in texts
@@ -181,7 +184,7 @@ def test_manipulator_labels_set_their_symbols_in_mathtext():
 def test_report_page_writes_manipulator_symbols_as_unicode():
     from driver.report_page import plain
     from driver.study import column_label
-    m = driver.manipulator
+    m = driver.manipulator.STUDY
     assert plain(column_label(m, "design_torque_demand_Nm")) == \
         "design torque demand |\u03c4\u2081| + |\u03c4\u2082| at the target [N m]"
     assert plain(column_label(m, "design_ri2_excess")) == "design RI\u2082 - \u221an [-]"
@@ -193,7 +196,7 @@ def test_a_wrapped_label_keeps_each_mathtext_span_on_one_line():
     """Long labels are wrapped onto lines; each line is parsed on its own, so a span
     ($|\\tau_1| + |\\tau_2|$) cut in two would be drawn as raw source."""
     from driver import plotting
-    label = driver.study.column_label(driver.manipulator, "design_torque_demand_Nm")
+    label = driver.study.column_label(driver.manipulator.STUDY, "design_torque_demand_Nm")
     for width in (10, 20, 30, 40):
         lines = plotting.wrap(label, width).split("\n")
         assert len(lines) > 1

@@ -20,9 +20,12 @@ from matplotlib.figure import Figure as MplFigure
 
 from conftest import INPUTS
 from driver import plotting
+from driver.fourbar import figures as fourbar_figures
+from driver.ujoint import figures as ujoint_figures
 from driver.deck import read_deck
 from driver.runner import compute, study_of
-from driver.study import column_label, load_study, plot_format
+from driver._study import load_study
+from driver.study import column_label, plot_format
 
 
 @lru_cache(maxsize=None)
@@ -95,7 +98,7 @@ def test_sweep_summary_labels_and_no_trivial_panels():
     module = load_study("slidercrank")
     labels = {c: column_label(module, c) for c in frame.columns}
     fig = plotting.sweep_summary(frame, ["slidercrank.material", "slidercrank.speeds"], title="t", labels=labels,
-                                 preferred=module.SWEEP_PLOT)
+                                 preferred=module.sweep_plot)
     ylabels = [ax.get_ylabel().replace("\n", " ") for ax in fig.axes]
     # omega_1 repeats x, the angles and n_buckled are constants, the _1 columns repeat the totals
     assert ylabels == ["peak tensile strain [microstrain]", "peak compression / Euler load [-]"]
@@ -146,7 +149,7 @@ def test_ujoint_trial_and_optimum_on_one_panel_with_the_paper_band():
 def test_ujoint_small_fluctuation_fills_the_polar_radius():
     theta = np.arange(0.0, 361.0)
     w = 25.0 + 0.4 * np.sin(np.radians(2 * theta))
-    fig = plotting.ujoint_speed_figure(theta, 25.0, {"optimum": w}, polar=True)
+    fig = ujoint_figures.ujoint_speed_figure(theta, 25.0, {"optimum": w}, polar=True)
     lo, hi = fig.axes[0].get_ylim()
     assert lo > 24.0 and hi < 26.0 and (0.8 / (hi - lo)) > 0.5
 
@@ -156,7 +159,7 @@ def test_ujoint_small_fluctuation_fills_the_polar_radius():
 
 def _figure() -> MplFigure:
     theta = np.arange(0.0, 361.0)
-    return plotting.ujoint_speed_figure(theta, 25.0, {"trial": 25 + np.sin(np.radians(2 * theta))},
+    return ujoint_figures.ujoint_speed_figure(theta, 25.0, {"trial": 25 + np.sin(np.radians(2 * theta))},
                                         band=(24.0, 26.0), title="t")
 
 
@@ -200,7 +203,7 @@ def test_cli_plot_format_svg_and_repeatable(tmp_path):
 def test_break_wraps_breaks_only_at_the_wrap():
     x = np.arange(6.0)
     y = np.array([350.0, 355.0, 2.0, 8.0, 10.0, 12.0])
-    bx, by = plotting.break_wraps(x, y)
+    bx, by = fourbar_figures.break_wraps(x, y)
     assert np.isnan(by[2]) and np.count_nonzero(np.isnan(by)) == 1
     assert np.allclose(by[~np.isnan(by)], y)
 

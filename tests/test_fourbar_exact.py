@@ -13,15 +13,15 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from driver import kernels
+from driver.fourbar import kernel as fourbar_kernel
 from driver.fourbar import grashof, limit_angles
 
-OK = kernels.FOURBAR_STATUS["ok"]
+OK = fourbar_kernel.FOURBAR_STATUS["ok"]
 length = st.floats(0.5, 10.0, allow_nan=False)
 
 
 def states(theta, p, q, r, s, omega=1.0, alpha=0.0, branch=1):
-    return kernels.fourbar_exact(np.asarray(theta, float), p, q, r, s, omega, alpha, branch)
+    return fourbar_kernel.fourbar_exact(np.asarray(theta, float), p, q, r, s, omega, alpha, branch)
 
 
 @settings(max_examples=150, deadline=None)
@@ -40,10 +40,10 @@ def test_loop_closure_and_branch_side(p, q, r, s, branch):
     # rows that cannot be assembled are exactly those with |A O_B| outside [|r-s|, r+s]
     d = np.hypot(p - q * np.cos(theta), q * np.sin(theta))
     clear = (d < abs(r - s) - 1e-9 * scale) | (d > r + s + 1e-9 * scale)
-    assert np.all(status[clear & (d > 1e-12 * scale)] == kernels.FOURBAR_STATUS["no_assembly"])
+    assert np.all(status[clear & (d > 1e-12 * scale)] == fourbar_kernel.FOURBAR_STATUS["no_assembly"])
     # A on O_B (p = q at theta = 0): B is indeterminate, never reported as a position
     if r == s:
-        assert np.all(status[d < 1e-12 * scale] == kernels.FOURBAR_STATUS["indeterminate"])
+        assert np.all(status[d < 1e-12 * scale] == fourbar_kernel.FOURBAR_STATUS["indeterminate"])
     inside = (d > abs(r - s) + 1e-6 * scale) & (d < r + s - 1e-6 * scale) & (d > 1e-6 * scale)
     assert np.all(status[inside] == OK)
 
@@ -73,7 +73,7 @@ def test_velocity_and_acceleration_are_derivatives_of_position(p, q, r, s, branc
 @pytest.mark.parametrize("crank", [2, 3, 4, 5])
 def test_exact_agrees_with_listing_from_0_to_180(crank):
     """The listing is right for 0..180 deg: truncated angles, positions and speeds agree."""
-    table, lst = kernels.fourbar_listing(12.0, crank, 15.0, 9.0, 5.0, 0, 20, 10)   # 0..180
+    table, lst = fourbar_kernel.fourbar_listing(12.0, crank, 15.0, 9.0, 5.0, 0, 20, 10)   # 0..180
     out, st_ = states(table[:, 0] * 0.0174532, 12.0, crank, 15.0, 9.0, 5.0)  # the listing's own degree constant
     assert np.all(lst == OK) and np.all(st_ == OK)
     ang = np.column_stack([np.degrees(out[:, 0]) % 360, np.degrees(out[:, 1]) % 360, np.degrees(out[:, 2])])
@@ -118,7 +118,7 @@ def test_assembly_changes_exactly_at_the_closed_form_limit_angles(lengths):
     for a in lims:
         t = np.radians([a - 1e-4, a + 1e-4])
         _, st_ = states(t, *lengths)
-        assert sorted(st_) == [OK, kernels.FOURBAR_STATUS["no_assembly"]]
+        assert sorted(st_) == [OK, fourbar_kernel.FOURBAR_STATUS["no_assembly"]]
 
 
 def test_kinds_dp_is_double():
@@ -160,7 +160,7 @@ def test_coupler_point_is_rigid_with_the_coupler_and_its_derivatives(p, q, r, s,
 
     def point(t):
         o, st_ = states(t, p, q, r, s, omega, alpha, branch)
-        return kernels.fourbar_coupler_point(t, o, st_, q, omega, alpha, u, v), o, st_
+        return fourbar_kernel.fourbar_coupler_point(t, o, st_, q, omega, alpha, u, v), o, st_
 
     cp, out, st0 = point(theta)
     ok = (st0 == OK) & (np.sin(out[:, 2]) > 0.2)

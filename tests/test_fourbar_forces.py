@@ -26,7 +26,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
 from driver.fourbar import forces
-from driver import kernels
+from driver.fourbar import kernel as fourbar_kernel
 from driver.api import run
 from driver.cli import main
 from conftest import INPUTS
@@ -145,8 +145,8 @@ def oracle_forces(theta, p, q, r, s, w, al, branch, pr):
 # ----------------------------------------------------------------------------- helpers
 
 def tool_forces(theta, p, q, r, s, w, al, branch, pr):
-    out, status = kernels.fourbar_exact(theta, p, q, r, s, w, al, branch)
-    return kernels.fourbar_joint_forces(out, status, p, q, r, s, w, al, pr), out, status
+    out, status = fourbar_kernel.fourbar_exact(theta, p, q, r, s, w, al, branch)
+    return fourbar_kernel.fourbar_joint_forces(out, status, p, q, r, s, w, al, pr), out, status
 
 
 def good_positions(theta, p, q, r, s, branch, out, status):
@@ -327,7 +327,7 @@ def test_berkof_lowen_makes_the_centre_of_mass_stationary(case, k1, k3):
     pr = pr.copy()
     pr[12:16] = 0.0
     radii = (k1 * q, k3 * s)
-    pb, cw = kernels.fourbar_berkof_lowen(q, r, s, pr, radii)
+    pb, cw = fourbar_kernel.fourbar_berkof_lowen(q, r, s, pr, radii)
     theta = np.radians(np.arange(0.0, 360.0, 6.0))
     f, out, status = tool_forces(theta, p, q, r, s, w, al, branch, pr)
     good = good_positions(theta, p, q, r, s, branch, out, status)

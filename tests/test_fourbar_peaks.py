@@ -18,9 +18,11 @@ import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from driver import fourbar, kernels
+from driver import fourbar
 
-PASSES = kernels.FOURBAR_PASSES
+from driver.fourbar import kernel as fourbar_kernel
+
+PASSES = fourbar_kernel.FOURBAR_PASSES
 ALL = PASSES["transmission"] | PASSES["rocker"] | PASSES["peaks"]
 DENSE = ALL | PASSES["dense_scan"]       # the previous search: every 1 deg grid point
 
@@ -45,7 +47,7 @@ def oracle_speeds(p: float, q: float, r: float, s: float, theta: np.ndarray, bra
 
 
 def summary(p, q, r, s, lo, hi, branch, passes=ALL) -> np.ndarray:
-    return kernels.fourbar_summaries(np.array([[p, q, r, s, 1.0, lo, hi, branch]]), passes)[0]
+    return fourbar_kernel.fourbar_summaries(np.array([[p, q, r, s, 1.0, lo, hi, branch]]), passes)[0]
 
 
 def check_peaks(p, q, r, s, lo, hi, branch) -> None:
@@ -125,8 +127,8 @@ def test_shipped_search_peaks_as_the_1deg_scan_except_near_toggle(shipped):
     scan found the extremum; the only differences are 5 linkages whose transmission angle touches
     0 deg at the range's end (toggle at 0/360 deg within rounding), where the 1 deg scan reported
     0 (no extremum found) and the refined one a peak by the toggle -- none passes the deck's filter."""
-    new = kernels.fourbar_summaries(shipped, ALL)
-    old = kernels.fourbar_summaries(shipped, DENSE)
+    new = fourbar_kernel.fourbar_summaries(shipped, ALL)
+    old = fourbar_kernel.fourbar_summaries(shipped, DENSE)
     assert np.array_equal(new[:, :14], old[:, :14]) and np.array_equal(new[:, 18], old[:, 18])
     differ = np.flatnonzero((new[:, 14:18] != old[:, 14:18]).any(axis=1))
     assert differ.tolist() == [19470, 49400, 51271, 52835, 85027]
@@ -145,9 +147,9 @@ def test_passes_compute_only_their_columns_with_the_same_bits(shipped):
     cols = {PASSES["transmission"]: [3, 4, 5, 6], PASSES["rocker"]: [7, 8, 9, 10, 11, 12, 18],
             PASSES["peaks"]: [14, 15, 16, 17]}
     for params in (rows, other):
-        full = kernels.fourbar_summaries(params, ALL)
+        full = fourbar_kernel.fourbar_summaries(params, ALL)
         for bits in range(8):
-            res = kernels.fourbar_summaries(params, bits)
+            res = fourbar_kernel.fourbar_summaries(params, bits)
             mine = always + [c for b, cs in cols.items() if bits & b for c in cs]
             rest = [c for c in range(19) if c not in mine]
             assert np.array_equal(res[:, mine], full[:, mine]), bits

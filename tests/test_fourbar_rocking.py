@@ -15,11 +15,12 @@ import numpy as np
 import pytest
 
 import driver
-from driver import fourbar, kernels
+from driver import fourbar
+from driver.fourbar import kernel as fourbar_kernel
 from conftest import INPUTS
 
-OK = kernels.FOURBAR_STATUS["ok"]
-NO = kernels.FOURBAR_STATUS["no_assembly"]
+OK = fourbar_kernel.FOURBAR_STATUS["ok"]
+NO = fourbar_kernel.FOURBAR_STATUS["no_assembly"]
 
 
 def _closed_form_limit(p: float, q: float, d: float) -> float | None:
@@ -60,7 +61,7 @@ def test_assembly_intervals_are_the_closed_form_limits(lengths, name):
     for lo, hi in spans:
         for k in (-1, 0, 1):
             near |= (np.abs(theta - lo - 360 * k) < 1e-6) | (np.abs(theta - hi - 360 * k) < 1e-6)
-    _, st = kernels.fourbar_exact(np.radians(theta), p, q, r, s, 1.0)
+    _, st = fourbar_kernel.fourbar_exact(np.radians(theta), p, q, r, s, 1.0)
     assert np.all((st[~near] != NO) == inside[~near])
     if len(spans) == 2:   # a Grashof double-rocker or rocker-crank: mirror images about the ground line
         (a, b), (c, d) = spans

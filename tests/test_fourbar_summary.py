@@ -18,11 +18,11 @@ import pandas as pd
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from driver import kernels
+from driver.fourbar import kernel as fourbar_kernel
 from driver.deck import DeckError, Params
 from driver.fourbar import SPEC, grashof, limit_angles, summarise, summarise_batch
 
-OK, TOG = kernels.FOURBAR_STATUS["ok"], kernels.FOURBAR_STATUS["toggle"]
+OK, TOG = fourbar_kernel.FOURBAR_STATUS["ok"], fourbar_kernel.FOURBAR_STATUS["toggle"]
 
 
 def params(**kw) -> Params:
@@ -36,7 +36,7 @@ def oracle(p, q, r, s, lo=0.0, hi=360.0, branch=1, omega=1.0, step=0.01):
     """Brute-force summary on a fine grid (test oracle only)."""
     lims = [a + 360.0 * k for a in limit_angles(p, q, r, s) for k in range(-2, 3)]
     grid = np.unique(np.concatenate([np.arange(lo, hi, step), [hi], [t for t in lims if lo <= t <= hi]]))
-    out, stt = kernels.fourbar_exact(np.radians(grid), p, q, r, s, omega, 0.0, branch)
+    out, stt = fourbar_kernel.fourbar_exact(np.radians(grid), p, q, r, s, omega, 0.0, branch)
     placed = (stt == OK) | (stt == TOG)
     d = np.hypot(p - q * np.cos(np.radians(grid)), q * np.sin(np.radians(grid)))
     eps = 1e-9 * (p + q + r + s)   # the limit angles themselves are assemblable (rounded in limit_angles)
@@ -142,7 +142,7 @@ def test_partial_ranges_and_long_ranges():
         o = oracle(12.0, 5.0, 15.0, 9.0, lo, hi, omega=5.0) if hi > lo else None
         row = f.iloc[i]
         if o is None:   # one crank angle: every extreme at it
-            one, _ = kernels.fourbar_exact(np.radians([lo]), 12.0, 5.0, 15.0, 9.0, 5.0)
+            one, _ = fourbar_kernel.fourbar_exact(np.radians([lo]), 12.0, 5.0, 15.0, 9.0, 5.0)
             assert row["omega3_peak_rad_s"] == pytest.approx(one[0, 8], rel=1e-12)
             assert row["rocker_swing_deg"] == 0.0 and row["omega3_peak_at_deg"] == lo
             continue
@@ -207,3 +207,18 @@ def test_batch_input_errors():
         summarise_batch(dict(base), {"branch": ["open", "sideways"]})
     f = summarise_batch(base, {"crank": np.linspace(1, 5, 5), "step_deg": 7.0, "branch": ["open"] * 5})
     assert len(f) == 5 and f["assemblable"].all()
+
+
+def test_a_run_calls_the_summary_kernel_once_and_reports_its_row(monkeypatch):
+    """The .out's headline figures (transmission, rocker, peaks) and the summary come from one call
+    of the summary kernel: the same row, so they cannot disagree, and it is not computed twice."""
+    import driver.fourbar
+    calls = []
+    real = fourbar_kernel.fourbar_summaries
+    monkeypatch.setattr(fourbar_kernel, "fourbar_summaries", lambda *a, **k: (calls.append(1), real(*a, **k))[1])
+    res = driver.fourbar.run(fixed_link=12.0, crank=5.0, coupler=15.0, rocker=9.0, omega=5.0, step_deg=20)
+    assert len(calls) == 1
+    s = res.summary
+    assert f"min {s['mu_min_deg']:.2f} deg" in res.text and f"max {s['mu_max_deg']:.2f} deg" in res.text
+    assert f"swing {s['rocker_swing_deg']:.3f} deg" in res.text
+    assert f"peak rocker speed .... {s['omega3_peak_rad_s']:.4f} rad/s" in res.text

@@ -315,19 +315,54 @@ def test_concurrent_processes_one_waits_out(tmp_path):
     assert any(rc == 0 for rc, _ in results)
 
 
-def test_long_deck_names(tmp_path, capsys):
-    name = "a" * 231 + ".dat"   # the longest stem whose every output name fits; the temporaries must too
-    deck = tmp_path / name
-    deck.write_text(FOURBAR + "&sweep key1 = 'fourbar.crank', values1 = 2, 3 /\n")
-    assert main([str(deck), "-o", str(tmp_path / "o"), "-q", "-j", "1", "--plot"]) == 0
-    assert (tmp_path / "o" / ("a" * 231 + "_summary.parquet")).is_file()
-    sweep = tmp_path / ("b" * 245 + ".dat")   # its <name>_summary.parquet cannot exist: said before running
-    sweep.write_text(SWEEP_DECK)
+OPTIMIZE_DECK = FOURBAR + """&optimize
+  var1 = 'fourbar.coupler', lower1 = 10, upper1 = 20
+  maximize = 'mu_min_deg', method = 'grid', grid_count = 3
+/
+"""
+
+
+def _named(tmp_path, text: str, stem_bytes: int) -> Path:
+    deck = tmp_path / ("a" * stem_bytes + ".dat")
+    deck.write_text(text)
+    return deck
+
+
+@pytest.mark.parametrize("text, options, longest", [
+    (FOURBAR, ["--format", "parquet"], ".parquet"),         # a single case's tidy table
+    (FOURBAR, ["--plot"], "_linkage.png"),                  # a figure's name, known only once computed
+    (SWEEP_DECK, [], "_summary.parquet"),                   # a sweep's longest
+    (OPTIMIZE_DECK, [], "_evals.parquet"),                  # an optimisation's longest (also .journal.jsonl)
+])
+def test_long_deck_names_at_the_limit(tmp_path, capsys, text, options, longest):
+    """Only a deck whose outputs would have names over 255 bytes (NAME_MAX) is refused: its
+    longest output name at exactly 255 bytes runs (the temporaries' names stay short); one byte
+    more is exit 2 naming the deck and the limit, and nothing is written."""
+    n = 255 - len(longest)
+    (tmp_path / "fits").mkdir()
+    deck = _named(tmp_path / "fits", text, n)
+    out = tmp_path / "o"
+    jobs = ["-j", "1"] if text != FOURBAR else []
+    assert main([str(deck), "-o", str(out), "-q", *jobs, *options]) == 0
+    assert (out / (deck.stem + longest)).is_file() and len((deck.stem + longest).encode()) == 255
+    assert not [p for p in out.rglob("*") if p.name.endswith(".tmp")]
+    (tmp_path / "over").mkdir()
+    deck = _named(tmp_path / "over", text, n + 1)
+    out = tmp_path / "o2"
     capsys.readouterr()
-    assert main([str(sweep), "-o", str(tmp_path / "o2"), "-q", "-j", "1"]) == 2
+    assert main([str(deck), "-o", str(out), "-q", *jobs, *options]) == 2
     err = capsys.readouterr().err
-    assert "255 bytes" in err and ".tmp" not in err
-    assert not (tmp_path / "o2").exists() or not any((tmp_path / "o2").rglob("*"))
+    assert err.startswith(f"error: {deck}: ") and f"<name>{longest} would have 256" in err and "255 bytes" in err, err
+    assert ".tmp" not in err and err.count("\n") == 1
+    assert not out.exists() or not any(out.rglob("*")), sorted(out.rglob("*"))
+
+
+def test_a_long_name_below_the_old_fixed_allowance_runs(tmp_path):
+    """Stems of 232-251 bytes were refused whatever the outputs (a fixed 24-byte allowance): a single
+    case's .out of a 251-byte stem (the longest a .dat file can have) fits, exactly 255 bytes."""
+    deck = _named(tmp_path, FOURBAR, 251)
+    assert main([str(deck), "-o", str(tmp_path / "o"), "-q"]) == 0
+    assert (tmp_path / "o" / (deck.stem + ".out")).is_file()
 
 
 @pytest.mark.parametrize("char", ["\x1b", "\x00", "\x07", "\u2028"])

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from driver import kernels
+from driver.fourbar import kernel as fourbar_kernel
 
 LINK = (12.0, 5.0, 15.0, 9.0, 5.0, 0.0)
 
@@ -23,17 +24,17 @@ def test_default_path_values_and_reuse():
     theta = np.linspace(0.0, 2 * np.pi, n)
     ref = np.empty((n, 11), order="F")
     rst = np.empty(n, dtype=np.int32)
-    kernels.fourbar_exact(theta, *LINK, out=ref, status=rst)
+    fourbar_kernel.fourbar_exact(theta, *LINK, out=ref, status=rst)
     kernels.release_spares()
-    out, st = kernels.fourbar_exact(theta, *LINK)
+    out, st = fourbar_kernel.fourbar_exact(theta, *LINK)
     np.testing.assert_array_equal(out, ref)
     np.testing.assert_array_equal(st, rst)
     where = _addr(out), _addr(st)
     del out, st
-    out, st = kernels.fourbar_exact(theta * 0.5, *LINK)      # dropped: the same memory again
+    out, st = fourbar_kernel.fourbar_exact(theta * 0.5, *LINK)      # dropped: the same memory again
     assert (_addr(out), _addr(st)) == where
     half = np.empty((n, 11), order="F")
-    kernels.fourbar_exact(theta * 0.5, *LINK, out=half, status=np.empty(n, dtype=np.int32))
+    fourbar_kernel.fourbar_exact(theta * 0.5, *LINK, out=half, status=np.empty(n, dtype=np.int32))
     np.testing.assert_array_equal(out, half)
 
 
@@ -41,15 +42,15 @@ def test_held_arrays_and_views_are_never_overwritten():
     n = 300_000
     theta = np.linspace(0.0, 2 * np.pi, n)
     kernels.release_spares()
-    a, sa = kernels.fourbar_exact(theta, *LINK)
+    a, sa = fourbar_kernel.fourbar_exact(theta, *LINK)
     a_copy = a.copy()
-    b, sb = kernels.fourbar_exact(theta + 1.0, *LINK)        # a is held: new memory
+    b, sb = fourbar_kernel.fourbar_exact(theta + 1.0, *LINK)        # a is held: new memory
     assert not np.shares_memory(a, b) and not np.shares_memory(sa, sb)
     np.testing.assert_array_equal(a, a_copy)
     col = b[:, 7]                                            # only a view of b survives
     col_copy = col.copy()
     del b, sb
-    c, _ = kernels.fourbar_exact(theta + 2.0, *LINK)
+    c, _ = fourbar_kernel.fourbar_exact(theta + 2.0, *LINK)
     assert not np.shares_memory(c, col)
     np.testing.assert_array_equal(col, col_copy)
 
@@ -57,5 +58,5 @@ def test_held_arrays_and_views_are_never_overwritten():
 def test_small_outputs_are_not_kept():
     theta = np.linspace(0.0, 1.0, 100)
     kernels.release_spares()
-    out, _ = kernels.fourbar_exact(theta, *LINK)
+    out, _ = fourbar_kernel.fourbar_exact(theta, *LINK)
     assert out.nbytes < kernels.SPARE_MIN_BYTES and not kernels._spares

@@ -10,7 +10,9 @@ import tracemalloc
 import numpy as np
 import pytest
 
-from driver import kernels
+from driver.fourbar import kernel as fourbar_kernel
+
+from driver.manipulator import kernel as manipulator_kernel
 
 
 def peak_alloc(fn) -> int:
@@ -28,23 +30,23 @@ def test_fourbar_reused_buffers_are_not_copied():
     theta = np.linspace(0, 2 * np.pi, n)
     out = np.empty((n, 11), order="F")
     status = np.empty(n, dtype=np.int32)
-    kernels.fourbar_exact(theta, 12, 5, 15, 9, 5, out=out, status=status)   # warm up
-    assert peak_alloc(lambda: kernels.fourbar_exact(theta, 12, 5, 15, 9, 5, out=out, status=status)) < out.nbytes // 20
+    fourbar_kernel.fourbar_exact(theta, 12, 5, 15, 9, 5, out=out, status=status)   # warm up
+    assert peak_alloc(lambda: fourbar_kernel.fourbar_exact(theta, 12, 5, 15, 9, 5, out=out, status=status)) < out.nbytes // 20
 
 
 def test_fourbar_refuses_a_c_ordered_buffer_instead_of_copying_it():
     n = 1000
     out = np.empty((n, 11))               # C order: f2py must not silently work on a copy
     with pytest.raises(ValueError):
-        kernels.fourbar_exact(np.zeros(n), 12, 5, 15, 9, 5, out=out, status=np.empty(n, dtype=np.int32))
+        fourbar_kernel.fourbar_exact(np.zeros(n), 12, 5, 15, 9, 5, out=out, status=np.empty(n, dtype=np.int32))
 
 
 def test_manipulator_monte_carlo_samples_are_not_copied():
     ns = 400_000
     dl = np.asfortranarray(np.random.default_rng(0).uniform(-1e-3, 1e-3, (ns, 2)))
     th1, th2 = np.radians([30.0, 50.0, 70.0]), np.radians([60.0, 40.0, 20.0])
-    kernels.manipulator_position_errors(th1, th2, dl)
-    peak = peak_alloc(lambda: kernels.manipulator_position_errors(th1, th2, dl))
+    manipulator_kernel.manipulator_position_errors(th1, th2, dl)
+    peak = peak_alloc(lambda: manipulator_kernel.manipulator_position_errors(th1, th2, dl))
     assert peak < 1.5 * dl.nbytes          # the (ns, 2) result only, no copy of the input
 
 
@@ -53,13 +55,13 @@ def test_manipulator_arm_states_reused_buffers_are_not_copied():
     rng = np.random.default_rng(2)
     l1, l2 = rng.uniform(1, 7, n), rng.uniform(1, 7, n)
     th1, th2 = rng.uniform(-np.pi, np.pi, n), rng.uniform(-np.pi, np.pi, n)
-    fresh = kernels.manipulator_arm_states(l1, l2, th1, th2)
+    fresh = manipulator_kernel.manipulator_arm_states(l1, l2, th1, th2)
     out = (np.empty((n, 4), order="F"), np.empty(n), np.empty(n), np.empty((n, 2), order="F"))
-    got = kernels.manipulator_arm_states(l1, l2, th1, th2, out=out)
+    got = manipulator_kernel.manipulator_arm_states(l1, l2, th1, th2, out=out)
     assert all(a is b for a, b in zip(got, out))                     # returned in place
     for a, b in zip(got, fresh):
         assert np.array_equal(a, b)
     # only the broadcast inputs (qd, qdd, masses: 6 columns) are allocated, no output
-    assert peak_alloc(lambda: kernels.manipulator_arm_states(l1, l2, th1, th2, out=out)) < 7 * 8 * n
+    assert peak_alloc(lambda: manipulator_kernel.manipulator_arm_states(l1, l2, th1, th2, out=out)) < 7 * 8 * n
     with pytest.raises(ValueError):
-        kernels.manipulator_arm_states(l1, l2, th1, th2, out=(np.empty((n, 4)),) + out[1:])   # C order
+        manipulator_kernel.manipulator_arm_states(l1, l2, th1, th2, out=(np.empty((n, 4)),) + out[1:])   # C order

@@ -21,7 +21,9 @@ import pandas as pd
 import pytest
 from hypothesis import HealthCheck, assume, given, settings, strategies as st
 
-from driver import kernels, manipulator
+from driver import manipulator
+
+from driver.manipulator import kernel as manipulator_kernel
 from driver.cli import main
 from driver.deck import DeckError, Params
 from driver.manipulator import BATCH_KEYS, SPEC, summarise, summarise_batch
@@ -165,7 +167,7 @@ def test_monte_carlo_against_numpy():
                                   ("global", 100000, (6.1, 3.3)), ("per_point", 100000, (4.2, 5.9))]:
         b = params(designs_l1=[l1], designs_l2=[l2], mc_samples=ns, mc_seed=7, error_measure=measure)
         row = summarise_batch(b).iloc[0]
-        th1, th2, st_ = kernels.manipulator_ik(l1, l2, b.points_x, b.points_y, b.elbow)
+        th1, th2, st_ = manipulator_kernel.manipulator_ik(l1, l2, b.points_x, b.points_y, b.elbow)
         unit = np.random.default_rng(7).uniform(-1.0, 1.0, size=(ns, 2)) * row["design_1_dl_m"]
         ex = unit[:, :1] * np.cos(th1) + unit[:, 1:] * np.cos(th1 + th2)
         ey = unit[:, :1] * np.sin(th1) + unit[:, 1:] * np.sin(th1 + th2)
@@ -253,7 +255,7 @@ def test_sweep_with_unreachable_designs(tmp_path):
 def test_optimiser_evaluates_populations_in_one_call(tmp_path, monkeypatch):
     from driver.optimize import evaluate
     calls = []
-    real = kernels.manipulator_design_summaries
+    real = manipulator_kernel.manipulator_design_summaries
 
     def counted(x, y, prm, *a, **kw):
         calls.append(len(prm))
@@ -262,7 +264,7 @@ def test_optimiser_evaluates_populations_in_one_call(tmp_path, monkeypatch):
     def never(*a, **kw):
         raise AssertionError("a design evaluated case by case")
 
-    monkeypatch.setattr(kernels, "manipulator_design_summaries", counted)
+    monkeypatch.setattr(manipulator_kernel, "manipulator_design_summaries", counted)
     monkeypatch.setattr(evaluate, "evaluate_cases", never)
     out = tmp_path / "o"
     monkeypatch.chdir(ROOT)     # the deck named as the committed run named it (the .out quotes it)

@@ -9,10 +9,11 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from driver import kernels
+from driver.manipulator import kernel as manipulator_kernel
 from driver.runner import study_of
 from driver.deck import read_deck
-from driver.manipulator import _sensitivity_blocks, table_frame, tolerance_box
+from driver.manipulator import table_frame, tolerance_box
+from driver.manipulator.analysis import _sensitivity_blocks
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -96,7 +97,7 @@ rates = st.floats(-3.0, 3.0, allow_nan=False)
 @settings(max_examples=60, deadline=None)
 @given(lengths, lengths, angles, angles, rates, rates, rates, rates, st.floats(0.1, 50.0), st.floats(0.1, 50.0))
 def test_kernel_torques_property(l1, l2, t1, t2, w1, w2, a1, a2, m1, m2):
-    tau = kernels.manipulator_torques(l1, l2, t1, t2, (w1, w2), (a1, a2), m1, m2, 9.81)
+    tau = manipulator_kernel.manipulator_torques(l1, l2, t1, t2, (w1, w2), (a1, a2), m1, m2, 9.81)
     ref = newton_euler(l1, l2, m1, m2, 9.81, (t1, t2), (w1, w2), (a1, a2))
     np.testing.assert_allclose(tau[0], ref, rtol=1e-10, atol=1e-9)
 
@@ -104,7 +105,7 @@ def test_kernel_torques_property(l1, l2, t1, t2, w1, w2, a1, a2, m1, m2):
 @settings(max_examples=60, deadline=None)
 @given(lengths, lengths, angles, angles)
 def test_jacobian_manipulability_condition(l1, l2, t1, t2):
-    jac, w, kappa, tau = kernels.manipulator_arm_states(l1, l2, t1, t2)
+    jac, w, kappa, tau = manipulator_kernel.manipulator_arm_states(l1, l2, t1, t2)
     h = 1e-6
     J = np.array([[(fk(l1, l2, t1 + h, t2)[i] - fk(l1, l2, t1 - h, t2)[i]) / (2 * h),
                    (fk(l1, l2, t1, t2 + h)[i] - fk(l1, l2, t1, t2 - h)[i]) / (2 * h)] for i in range(2)])
@@ -122,7 +123,7 @@ def test_ik_round_trip(l1, l2, t1, t2, branch):
     x, y = fk(l1, l2, t1, t2)
     if math.hypot(x, y) < 1e-6:
         return
-    th1, th2, status = kernels.manipulator_ik(l1, l2, x, y, branch)
+    th1, th2, status = manipulator_kernel.manipulator_ik(l1, l2, x, y, branch)
     assert status[0] == 0
     xx, yy = fk(l1, l2, th1[0], th2[0])
     assert xx == pytest.approx(x, abs=1e-6 * (l1 + l2)) and yy == pytest.approx(y, abs=1e-6 * (l1 + l2))
@@ -130,16 +131,16 @@ def test_ik_round_trip(l1, l2, t1, t2, branch):
 
 
 def test_ik_status_out_of_reach_and_degenerate():
-    th1, th2, status = kernels.manipulator_ik([1.0, 1.0, 0.0], [1.0, 1.0, 1.0], [5.0, 0.0, 1.0], [0.0, 0.0, 0.0], 1)
+    th1, th2, status = manipulator_kernel.manipulator_ik([1.0, 1.0, 0.0], [1.0, 1.0, 1.0], [5.0, 0.0, 1.0], [0.0, 0.0, 0.0], 1)
     assert list(status) == [1, 2, 2]
 
 
 def test_design_indices_match_svd():
     x, y = np.array([1.0, 2, 4, 5]), np.array([4.0, 8, 8, 4])
     l1, l2 = np.array([5.85, 3.0, 6.5]), np.array([4.16, 6.52, 3.04])
-    ri, sumc2, reach = kernels.manipulator_design_indices(x, y, l1, l2)
+    ri, sumc2, reach = manipulator_kernel.manipulator_design_indices(x, y, l1, l2)
     for k in range(3):
-        th1, th2, st_ = kernels.manipulator_ik(l1[k], l2[k], x, y, 1)
+        th1, th2, st_ = manipulator_kernel.manipulator_ik(l1[k], l2[k], x, y, 1)
         Jx = _sensitivity_blocks(th1, th2).reshape(-1, 2)
         s = np.linalg.svd(Jx, compute_uv=False)
         assert ri[k, 1] == pytest.approx(s[0], rel=1e-12)
@@ -152,7 +153,7 @@ def test_design_indices_match_svd():
 def test_tolerance_box_worst_corner_on_bound_and_monte_carlo(measure):
     x, y = np.array([1.0, 2, 3, 4]), np.array([5.0, 7, 7, 6])
     eps = 0.01
-    th1, th2, _ = kernels.manipulator_ik(5.61, 3.97, x, y, 1)
+    th1, th2, _ = manipulator_kernel.manipulator_ik(5.61, 3.97, x, y, 1)
     blocks = _sensitivity_blocks(th1, th2)
     box = tolerance_box(blocks, eps, measure)
     dl = box["closed"]
@@ -168,10 +169,10 @@ def test_tolerance_box_worst_corner_on_bound_and_monte_carlo(measure):
     assert err.max() == pytest.approx(eps, rel=1e-12)
     # Monte Carlo through the kernel stays within the bound
     rng = np.random.default_rng(1)
-    e = kernels.manipulator_position_errors(th1, th2, rng.uniform(-1, 1, (20000, 2)) * dl)
+    e = manipulator_kernel.manipulator_position_errors(th1, th2, rng.uniform(-1, 1, (20000, 2)) * dl)
     assert e[:, 0 if measure == "global" else 1].max() <= eps * (1 + 1e-12)
     # and a slightly larger box breaks it at a corner
-    e = kernels.manipulator_position_errors(th1, th2, corners * 1.001)
+    e = manipulator_kernel.manipulator_position_errors(th1, th2, corners * 1.001)
     assert e[:, 0 if measure == "global" else 1].max() > eps
 
 
@@ -196,7 +197,7 @@ def test_tolerance_box_property(points, l1, l2, measure):
     d = np.hypot(x, y)
     if (d < abs(l1 - l2) + 1e-3).any() or (d > l1 + l2 - 1e-3).any() or (d < 1e-3).any():
         return
-    th1, th2, status = kernels.manipulator_ik(l1, l2, x, y, 1)
+    th1, th2, status = manipulator_kernel.manipulator_ik(l1, l2, x, y, 1)
     assert (status == 0).all()
     blocks = _sensitivity_blocks(th1, th2)
     box = tolerance_box(blocks, 0.02, measure)

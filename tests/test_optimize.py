@@ -259,15 +259,15 @@ def test_grid_started_local_search_and_partial_journal_resume(tmp_path):
     evals = pd.read_parquet(out / "opt_evals.parquet")
     assert list(evals["fourbar.coupler"].iloc[:6]) == pytest.approx(list(np.linspace(10, 20, 6)))
     # an interrupted run: a journal holding the first half of the evaluations (as the run appends them)
-    import json
+    from driver.optimize import journal
     half = evals.iloc[: len(evals) // 2]
-    lines = [json.dumps({"base": oc.problem.fingerprint(), "x": [float(v)], "status": "ok", "reason": "",
-                         "summary": {k[len("summary."):]: (None if isinstance(row[k], float) and math.isnan(row[k])
-                                                           else (row[k].item() if hasattr(row[k], "item") else row[k]))
-                                     for k in evals.columns if k.startswith("summary.")}})
+    lines = [journal.line(journal.record(oc.problem.fingerprint(), [float(v)], "ok", "",
+                          {k[len("summary."):]: (None if isinstance(row[k], float) and math.isnan(row[k])
+                                                 else (row[k].item() if hasattr(row[k], "item") else row[k]))
+                           for k in evals.columns if k.startswith("summary.")}))
              for v, (_, row) in zip(half["fourbar.coupler"], half.iterrows())]
     (out / "opt_evals.parquet").unlink()
-    (out / "opt.journal.jsonl").write_text("\n".join(lines) + "\n{\"cut by an interrupt")
+    (out / "opt.journal.jsonl").write_text("".join(lines) + "{\"cut by an interrupt")
     again = optimize(path, out, jobs=1, resume=True)
     assert again.evaluator.computed == len(evals) - len(half)
     assert again.x == oc.x and again.nfev == oc.nfev
@@ -369,8 +369,7 @@ def test_over_budget_and_non_finite_designs_are_infeasible_with_reasons(tmp_path
     def run_nan(params, progress=False):   # a slow design writes a NaN into its table
         result = run(params, progress)
         return dataclasses.replace(result, text=result.text + "   nan\n") if params.speeds[0] < 12 else result
-    monkeypatch.setattr(slidercrank, "estimate", estimate)
-    monkeypatch.setattr(slidercrank, "run", run_nan)
+    monkeypatch.setattr(slidercrank, "STUDY", dataclasses.replace(slidercrank.STUDY, estimate=estimate, run=run_nan))
     oc = optimize(path, tmp_path / "out", jobs=1)
     nan = [r for r in oc.evaluator.records if r.x[2] < 12 and r.status != "bad_input"]
     assert nan and all(r.status == "failed" and "not a finite number" in r.reason for r in nan)

@@ -91,7 +91,7 @@ def test_example_command_line(tmp_path):
 
 def test_study_names_without_import_match_the_studies():
     from driver.runner import available_studies
-    from driver.study import study_names
+    from driver._study import study_names
     assert study_names() == sorted(available_studies())
 
 
@@ -119,11 +119,12 @@ def test_build_backend_finds_meson_and_ninja_of_its_own_environment_without_acti
 
 def test_kernel_fingerprint_covers_every_kernel_wrapper():
     """tests/kernel_fingerprint.py (the native-vs-portable bit comparison of test_install) calls every
-    public wrapper of driver.kernels: a new kernel cannot escape the CPU-independence check."""
+    public wrapper of every study's kernel module (``Study.kernel``): a new kernel cannot escape the
+    CPU-independence check."""
     import inspect
-    from driver import kernels
-    wrappers = [n for n in kernels.__all__ if inspect.isfunction(getattr(kernels, n))
-                and n not in ("farray", "release_spares")]   # helpers, not kernels
+    from driver._study import registered
+    wrappers = [f"{name}_kernel.{n}(" for name, s in registered().items() if s.kernel is not None
+                for n in s.kernel.__all__ if inspect.isfunction(getattr(s.kernel, n))]
     source = (ROOT / "tests" / "kernel_fingerprint.py").read_text()
     assert len(wrappers) >= 20
-    assert [n for n in wrappers if f"k.{n}(" not in source] == []
+    assert [w for w in wrappers if w not in source] == []

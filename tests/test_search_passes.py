@@ -19,25 +19,31 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from driver import kernels, manipulator, ujoint
+from driver import manipulator, ujoint
+
+from driver.fourbar import kernel as fourbar_kernel
+
+from driver.manipulator import kernel as manipulator_kernel
+
+from driver.ujoint import kernel as ujoint_kernel
 from driver.cli import main
 from driver.deck import Params
 
 ROOT = Path(__file__).resolve().parents[1]
-P = kernels.FOURBAR_PASSES
+P = fourbar_kernel.FOURBAR_PASSES
 
 
 @pytest.fixture
 def spy(monkeypatch):
     """Every fourbar_summaries call of this process: [(rows, passes)]."""
     calls: list[tuple[int, int]] = []
-    real = kernels.fourbar_summaries
+    real = fourbar_kernel.fourbar_summaries
 
     def wrapped(params, passes=7):
         calls.append((len(params), int(passes)))
         return real(params, passes)
 
-    monkeypatch.setattr(kernels, "fourbar_summaries", wrapped)
+    monkeypatch.setattr(fourbar_kernel, "fourbar_summaries", wrapped)
     return calls
 
 
@@ -112,7 +118,7 @@ def test_ujoint_wanted_columns_have_the_full_bits_and_run_their_passes(monkeypat
         part = ujoint.summarise_batch(b, cols, wanted=[c])
         assert list(part.columns) == [c]
         pd.testing.assert_series_equal(part[c], full[c])
-        need = {kernels.UJOINT_PASSES[p] for p in ujoint.BATCH_PASSES.get(c, ())}
+        need = {ujoint_kernel.UJOINT_PASSES[p] for p in ujoint.BATCH_PASSES.get(c, ())}
         assert seen == [sum(need)], c
 
 
@@ -124,8 +130,8 @@ def test_manipulator_wanted_columns_have_the_full_bits_and_run_their_passes(monk
     cols = {"designs_l1": rng.uniform(0.2, 1.2, 200), "designs_l2": rng.uniform(0.2, 1.2, 200)}
     full = manipulator.summarise_batch(base, cols)
     seen: list[int] = []
-    real = kernels.manipulator_design_summaries
-    monkeypatch.setattr(kernels, "manipulator_design_summaries",
+    real = manipulator_kernel.manipulator_design_summaries
+    monkeypatch.setattr(manipulator_kernel, "manipulator_design_summaries",
                         lambda *a, passes=7, **k: (seen.append(passes), real(*a, passes=passes, **k))[1])
     for c in full.columns:
         seen.clear()
@@ -133,7 +139,7 @@ def test_manipulator_wanted_columns_have_the_full_bits_and_run_their_passes(monk
         assert list(part.columns) == [c]
         pd.testing.assert_series_equal(part[c], full[c])
         need = manipulator.batch._passes([c]) - {"walk"}
-        assert seen == [sum(kernels.MANIPULATOR_PASSES[p] for p in need)], c
+        assert seen == [sum(manipulator_kernel.MANIPULATOR_PASSES[p] for p in need)], c
 
 
 def test_optimize_runs_only_the_passes_of_its_objective_constraints_and_summary_columns(tmp_path, spy, monkeypatch):

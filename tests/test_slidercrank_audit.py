@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from scipy.linalg import eigh
 
-from driver import kernels
+from driver.slidercrank import kernel as slidercrank_kernel
 from driver.cli import main
 from driver.deck import read_deck
 from driver.runner import run_study
@@ -59,8 +59,8 @@ def test_static_onset_agrees_with_a_dense_generalised_eigensolver():
     args = (n, model.r2, model.length, model.rho_a, model.ea, model.ei, model.m_s)
     best = math.inf
     for t in np.radians(np.arange(th - 3.0, th + 3.0, 0.02)):
-        k = _dense(kernels.slidercrank_matrices(*args, t, 0.0, False)[1])
-        g = _dense(kernels.slidercrank_matrices(*args, t, 1.0, True)[1]) - k
+        k = _dense(slidercrank_kernel.slidercrank_matrices(*args, t, 0.0, False)[1])
+        g = _dense(slidercrank_kernel.slidercrank_matrices(*args, t, 1.0, True)[1]) - k
         mu = eigh(-g, k, eigvals_only=True).max()
         if mu > 0:
             best = min(best, math.sqrt(1.0 / mu))

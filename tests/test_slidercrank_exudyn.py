@@ -25,7 +25,7 @@ import math
 import numpy as np
 import pytest
 
-from driver import kernels
+from driver.slidercrank import kernel as slidercrank_kernel
 
 exu = pytest.importorskip("exudyn")
 # Exudyn renames settings between releases; the old names still work and are what >= 1.9 has
@@ -93,7 +93,7 @@ def exudyn_run(omega: float, h: float = 2e-4) -> dict[str, float]:
 def ours(omega: float) -> dict[str, float]:
     spr = 1440
     dt = 2 * math.pi / (omega * spr)
-    r = kernels.slidercrank_nl_simulate(N_EL, R2, L, RHOA, EA, EI, 1.5e-3, MS, omega, dt, REVS * spr, spr,
+    r = slidercrank_kernel.slidercrank_nl_simulate(N_EL, R2, L, RHOA, EA, EI, 1.5e-3, MS, omega, dt, REVS * spr, spr,
                                         (REVS - 2) * spr, 2 * spr + 1, 0.0, BETA, hht=0.0, start="rest")
     assert r["status"] == 0
     e = r["eps_ax"][0]

@@ -15,7 +15,7 @@ from scipy.integrate import quad
 from scipy.linalg import eigh
 from scipy.optimize import brentq
 
-from driver import kernels as K
+from driver.slidercrank import kernel as slidercrank_kernel
 from driver.slidercrank import MATERIALS
 
 from driver.published import PUBLISHED_DIR, read_blocks
@@ -132,7 +132,7 @@ def test_materials_follow_table_1a():
 @pytest.mark.parametrize("theta2", [0.0, 0.7, 1.9, math.pi, 4.1, 5.9])
 def test_rigid_kinematics(theta2):
     w = 21.99
-    out = K.slidercrank_rigid(np.array([theta2]), w, R2, L)[0]
+    out = slidercrank_kernel.slidercrank_rigid(np.array([theta2]), w, R2, L)[0]
     ref = rigid_oracle(theta2, w, R2, L)
     assert out[0] == pytest.approx(ref["th3"], abs=1e-14)
     assert out[1] == pytest.approx(ref["th3d"], rel=1e-12, abs=1e-12)
@@ -149,7 +149,7 @@ def test_axial_force_matches_statics(name):
     rho_a, _, _ = _rod(name)
     th = np.array([0.0, 1.0, 2.5, math.pi, 5.0])
     s = np.array([0.0, 0.1, 0.3, L])
-    out = K.slidercrank_axial_force(th, s, 29.32, R2, L, rho_a, MS)
+    out = slidercrank_kernel.slidercrank_axial_force(th, s, 29.32, R2, L, rho_a, MS)
     for j, t in enumerate(th):
         for i, x in enumerate(s):
             assert out[i, j] == pytest.approx(axial_force_oracle(x, t, 29.32, R2, L, rho_a, MS), rel=1e-10, abs=1e-9)
@@ -164,7 +164,7 @@ def test_quasistatic_limit_is_rigid_body_statics(name):
     rho_a, ea, ei = _rod(name)
     n, w, spr = 8, 29.32, 72
     dt = 2 * math.pi / (w * spr)
-    res = K.slidercrank_simulate(n, R2, L, rho_a, ea, ei, 1e-3, MS, w, dt, spr, 0, spr + 1, dynamic=False)
+    res = slidercrank_kernel.slidercrank_simulate(n, R2, L, rho_a, ea, ei, 1e-3, MS, w, dt, spr, 0, spr + 1, dynamic=False)
     assert res["status"] == 0
     le = L / n
     worst = 0.0
@@ -185,7 +185,7 @@ def test_quasistatic_limit_of_a_very_stiff_rod():
     stiff = 1e4
     n, w, spr = 4, 29.32, 1440
     dt = 2 * math.pi / (w * spr)
-    res = K.slidercrank_simulate(n, R2, L, rho_a, ea * stiff, ei * stiff, 1e-3, MS, w, dt, spr, spr - 40, 41)
+    res = slidercrank_kernel.slidercrank_simulate(n, R2, L, rho_a, ea * stiff, ei * stiff, 1e-3, MS, w, dt, spr, spr - 40, 41)
     le = L / n
     for j in (0, 20, 40):
         th = w * dt * (spr - 40 + j)
@@ -200,8 +200,8 @@ def test_fast_and_general_paths_agree(n):
     w, spr = 25.13, 360
     dt = 2 * math.pi / (w * spr)
     args = (n, R2, L, rho_a, ea, ei, 1.25e-3, MS, w, dt, 2 * spr, spr, spr + 1, 6.0, 2e-5)
-    a = K.slidercrank_simulate(*args, fast=True)
-    b = K.slidercrank_simulate(*args, fast=False)
+    a = slidercrank_kernel.slidercrank_simulate(*args, fast=True)
+    b = slidercrank_kernel.slidercrank_simulate(*args, fast=False)
     for key in ("eps_ax", "eps_of", "mid", "slider"):
         assert np.allclose(a[key], b[key], rtol=1e-10, atol=1e-12 * np.abs(b[key]).max())
 
@@ -214,7 +214,7 @@ def test_first_natural_frequencies(name):
     """Discrete rod at theta2 = 0: first bending (pinned-pinned) and first axial (fixed, tip mass)."""
     rho_a, ea, ei = _rod(name)
     n = 16
-    mb, kb = K.slidercrank_matrices(n, R2, L, rho_a, ea, ei, MS, 0.0)
+    mb, kb = slidercrank_kernel.slidercrank_matrices(n, R2, L, rho_a, ea, ei, MS, 0.0)
 
 
     m, k = dense(mb), dense(kb)
@@ -231,7 +231,7 @@ def test_first_natural_frequencies(name):
     w_axial = _axial_frequency(rho_a, ea, L, MS)
     assert w_bend_fe == pytest.approx(w_bend, rel=1e-5)
     assert w_axial_fe == pytest.approx(w_axial, rel=1e-5)
-    wb, wa, pe = K.slidercrank_frequencies(rho_a, ea, ei, L, MS)
+    wb, wa, pe = slidercrank_kernel.slidercrank_frequencies(rho_a, ea, ei, L, MS)
     assert wb == pytest.approx(w_bend, rel=1e-13)
     assert wa == pytest.approx(w_axial, rel=1e-12)
     assert pe == pytest.approx(math.pi ** 2 * ei / L ** 2, rel=1e-13)
@@ -263,7 +263,7 @@ def test_simeon_benchmark_at_0p1_s(start):
     length = s["rod_length_m"]
     q0 = _simeon_nodes(n, s["q0"], length)
     qd0 = _simeon_nodes(n, s["qd0"], length)
-    res = K.slidercrank_simulate(n, s["crank_radius_m"], length, rho_a, ea, ei, s["height_m"] / 2,
+    res = slidercrank_kernel.slidercrank_simulate(n, s["crank_radius_m"], length, rho_a, ea, ei, s["height_m"] / 2,
                                  s["slider_mass_kg"], s["omega_rad_s"], s["t_ref_s"] / steps, steps, steps, 1,
                                  start=start, q_init=q0, qd_init=qd0)
     assert res["status"] == 0
@@ -280,7 +280,7 @@ def test_quasistatic_start_matches_simeon_consistent_axial_value():
     s = SIMEON
     a = s["width_m"] * s["height_m"]
     i = s["width_m"] * s["height_m"] ** 3 / 12
-    res = K.slidercrank_simulate(8, s["crank_radius_m"], s["rod_length_m"], s["density_kg_m3"] * a,
+    res = slidercrank_kernel.slidercrank_simulate(8, s["crank_radius_m"], s["rod_length_m"], s["density_kg_m3"] * a,
                                  s["youngs_modulus_pa"] * a, s["youngs_modulus_pa"] * i, 4e-3, s["slider_mass_kg"],
                                  s["omega_rad_s"], 1e-5, 0, 0, 1)
     assert res["elong"][0] == pytest.approx(s["q0"][3], rel=1e-6)
@@ -294,12 +294,12 @@ def test_convergence_monotone_and_below_half_percent_beyond_8(name):
     rho_a, ea, ei = _rod(name)
     w, spr = 29.32, 720
     dt = 2 * math.pi / (w * spr)
-    wb, wa, _ = K.slidercrank_frequencies(rho_a, ea, ei, L, MS)
+    wb, wa, _ = slidercrank_kernel.slidercrank_frequencies(rho_a, ea, ei, L, MS)
     alpha, beta = 0.04 * wb * wa / (wb + wa), 0.04 / (wb + wa)
     counts = [1, 2, 4, 8, 10, 16, 20, 32, 50, 64]
     tens, comp = [], []
     for n in counts:
-        r = K.slidercrank_simulate(n, R2, L, rho_a, ea, ei, 1e-3, MS, w, dt, 3 * spr, 2 * spr, spr + 1, alpha, beta)
+        r = slidercrank_kernel.slidercrank_simulate(n, R2, L, rho_a, ea, ei, 1e-3, MS, w, dt, 3 * spr, 2 * spr, spr + 1, alpha, beta)
         tens.append(r["eps_ax"].max())
         comp.append(r["eps_ax"].min())
     tens, comp = np.array(tens), np.array(comp)
@@ -316,10 +316,10 @@ def test_rest_start_overshoots_then_forgets():
     and after three damped revolutions the last one no longer depends on the start."""
     rho_a, ea, ei = _rod("aluminium")
     w, spr, zeta = 29.32, 720, 0.02
-    wb, wa, _ = K.slidercrank_frequencies(rho_a, ea, ei, L, MS)
+    wb, wa, _ = slidercrank_kernel.slidercrank_frequencies(rho_a, ea, ei, L, MS)
     alpha, beta = 2 * zeta * wb * wa / (wb + wa), 2 * zeta / (wb + wa)
     dt = 2 * math.pi / (w * spr)
-    runs = {st: K.slidercrank_simulate(8, R2, L, rho_a, ea, ei, 1e-3, MS, w, dt, 4 * spr, 0, 4 * spr + 1, alpha, beta,
+    runs = {st: slidercrank_kernel.slidercrank_simulate(8, R2, L, rho_a, ea, ei, 1e-3, MS, w, dt, 4 * spr, 0, 4 * spr + 1, alpha, beta,
                                        start=st)["eps_ax"][0] for st in ("quasistatic", "rest")}
     qs, rest = runs["quasistatic"], runs["rest"]
     ratio = rest[:spr].max() / qs[:spr].max()
@@ -341,7 +341,7 @@ def test_geometric_stiffness_buckles_at_the_rayleigh_load(name):
     w_crit = w0 * math.sqrt(math.pi ** 2 * ei / L ** 2 / weighted)
 
     def lowest(w: float) -> float:
-        _, kb = K.slidercrank_matrices(16, R2, L, rho_a, ea, ei, MS, math.pi, w, geometric_stiffness=True)
+        _, kb = slidercrank_kernel.slidercrank_matrices(16, R2, L, rho_a, ea, ei, MS, math.pi, w, geometric_stiffness=True)
         return float(np.linalg.eigvalsh(dense(kb))[0])
 
     assert lowest(0.99 * w_crit) > 0

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from driver import kernels
+from driver.slidercrank import kernel as slidercrank_kernel
 from driver.slidercrank.analysis import PROFILE, Case, _settle
 
 STEEL = dict(crank_radius=0.15, rod_length=0.3, rho_a=7870 * 64e-6, ea=2e11 * 64e-6, ei=2e11 * 3.413333333e-10,
@@ -23,8 +23,8 @@ STEEL = dict(crank_radius=0.15, rod_length=0.3, rho_a=7870 * 64e-6, ea=2e11 * 64
 @pytest.mark.parametrize("lag", [0, 37])
 def test_profile_equals_the_fields_reduced(nel, lag):
     kw = dict(STEEL, n_elements=nel, n_steps=300, rec_start=50, n_rec=200, alpha=1.0, beta=1e-6)
-    full = kernels.slidercrank_simulate(**kw)
-    prof = kernels.slidercrank_simulate(**kw, fields=False, lag=lag)
+    full = slidercrank_kernel.slidercrank_simulate(**kw)
+    prof = slidercrank_kernel.slidercrank_simulate(**kw, fields=False, lag=lag)
     assert full["status"] == prof["status"] == 0
     assert prof["eps_ax"] is None and prof["eps_of"] is None and prof["n_avg"] is None
     e, o = full["eps_ax"], full["eps_of"]
@@ -81,8 +81,8 @@ def test_settling_from_the_profile_equals_the_field_formula():
     spr = 60
     kw = dict(STEEL, n_elements=8, n_steps=3 * spr, rec_start=spr, n_rec=2 * spr + 1, alpha=0.0, beta=0.0,
               start="rest")
-    full = kernels.slidercrank_simulate(**kw)
-    prof = kernels.slidercrank_simulate(**kw, fields=False, lag=spr)
+    full = slidercrank_kernel.slidercrank_simulate(**kw)
+    prof = slidercrank_kernel.slidercrank_simulate(**kw, fields=False, lag=spr)
     e = full["eps_ax"]
 
     def change(a, b):

@@ -95,7 +95,7 @@ def test_interior_bad_combination_of_a_large_grid_is_a_failed_case(tmp_path):
     sw = validate(d.groups["sweep"], sweep.SPEC, d.path)
     axes = sweep._axes(sw, "fourbar", fourbar.SPEC)
     grid = sweep_batch.Grid([a[0] for a in axes], [a[1] for a in axes], False)
-    p = sweep_batch.plan(fourbar, d.groups["fourbar"], str(path), grid, "", "all")
+    p = sweep_batch.plan(fourbar.STUDY, d.groups["fourbar"], str(path), grid, "", "all")
     res = sweep_batch.chunk_rows(p, 0, grid.n)
     f = res.frame
     bad = (f["fourbar.start_deg"] == 300) & (f["fourbar.stop_deg"] == 200)

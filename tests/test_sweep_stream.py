@@ -102,7 +102,7 @@ def test_bad_input_rows(tmp_path, monkeypatch, order, streamed):
 
 def test_run_stops_holding_rows_above_the_threshold(tmp_path):
     from driver.deck import read_deck
-    from driver.study import load_study
+    from driver._study import load_study
     from driver.sweep.spec import SPEC, grid_of
     from driver.deck import validate
     deck = tmp_path / "s.dat"
@@ -110,7 +110,7 @@ def test_run_stops_holding_rows_above_the_threshold(tmp_path):
     d = read_deck(deck)
     module = load_study("fourbar")
     sw = validate(d.groups["sweep"], SPEC, deck)
-    grid = grid_of(sw, "fourbar", module.SPEC)
+    grid = grid_of(sw, "fourbar", module.spec)
     p = sweep_batch.plan(module, d.groups["fourbar"], str(deck), grid, sw.keep, sw.summary_rows)
     rows, counts, _ = sweep_batch.run(p, tmp_path / "rec", 1, None, False, False, stream_rows=10)
     assert isinstance(rows, sweep_batch.StreamedRows) and len(rows) == counts["kept"] > 10

@@ -14,7 +14,9 @@ import math
 import numpy as np
 import pytest
 
-from driver import fourbar, kernels
+from driver import fourbar
+
+from driver.fourbar import kernel as fourbar_kernel
 from driver.cli import main
 from driver.deck import DeckError, RawGroup, validate
 from driver.synthesis import crank_rocker as cr
@@ -25,7 +27,7 @@ D, A, B, C = 1.0, 0.45, 1.1, 0.9     # a crank-rocker (Grashof: 0.45 + 1.1 < 1.0
 
 
 def _rocker_deg(theta_deg, branch=1):
-    out, st = kernels.fourbar_exact(np.radians(theta_deg), D, A, B, C, 1.0, 0.0, branch)
+    out, st = fourbar_kernel.fourbar_exact(np.radians(theta_deg), D, A, B, C, 1.0, 0.0, branch)
     assert np.all(st == 0)
     return np.degrees(out[:, 1])
 
@@ -89,7 +91,7 @@ def test_chebyshev_log10_error_vanishes_at_precision_points(tmp_path):
     # kernel: the rocker at the three Chebyshev crank angles equals the desired angles
     xs = chebyshev(1.0, 2.0, 3)
     crank = fd.crank_start_deg + (xs - 1.0) / 1.0 * 60.0
-    out, st = kernels.fourbar_exact(np.radians(crank), 1.0, fd.crank, fd.coupler, fd.rocker, 1.0, 0.0, 1)
+    out, st = fourbar_kernel.fourbar_exact(np.radians(crank), 1.0, fd.crank, fd.coupler, fd.rocker, 1.0, 0.0, 1)
     want = fd.rocker_start_deg + np.log10(xs) / math.log10(2.0) * 90.0
     assert np.all(st == 0)
     assert ((np.degrees(out[:, 1]) - want + 180) % 360 - 180) == pytest.approx(0.0, abs=1e-9)
@@ -160,8 +162,8 @@ def test_path_generation_through_five_points_verified_by_the_kernel(tmp_path):
     targets = np.column_stack([syn.params.target_x, syn.params.target_y])
     # independent re-measurement: the coupler point at the reported crank angles, moved to the world frame
     th = np.radians(syn.design.theta_at_targets_deg)
-    out, st = kernels.fourbar_exact(th, q["ground"], q["crank"], q["coupler"], q["rocker"], 1.0, 0.0, 1)
-    cp = kernels.fourbar_coupler_point(th, out, st, q["crank"], 1.0, 0.0, q["u"], q["v"])[:, :2]
+    out, st = fourbar_kernel.fourbar_exact(th, q["ground"], q["crank"], q["coupler"], q["rocker"], 1.0, 0.0, 1)
+    cp = fourbar_kernel.fourbar_coupler_point(th, out, st, q["crank"], 1.0, 0.0, q["u"], q["v"])[:, :2]
     g = math.radians(q["gamma_deg"])
     world = np.column_stack([q["x0"] + math.cos(g) * cp[:, 0] - math.sin(g) * cp[:, 1],
                              q["y0"] + math.sin(g) * cp[:, 0] + math.cos(g) * cp[:, 1]])

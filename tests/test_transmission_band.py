@@ -128,8 +128,8 @@ def test_a_swept_band_is_a_column_not_table_metadata():
     from driver import fourbar
     from driver.sweep.report import summary_settings
     base = {"crank": 3.0, "transmission_band_deg": [30, 150]}
-    assert summary_settings(fourbar, base) == {"transmission_band_deg": [30.0, 150.0]}
-    assert summary_settings(fourbar, base, {"transmission_band_deg"}) == {}
+    assert summary_settings(fourbar.STUDY, base) == {"transmission_band_deg": [30.0, 150.0]}
+    assert summary_settings(fourbar.STUDY, base, {"transmission_band_deg"}) == {}
 
 
 def test_shipped_outputs_record_the_band():

@@ -13,7 +13,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from driver.kernels import (UJOINT_MODELS, UJOINT_OBJECTIVES, ujoint_equivalent, ujoint_geometry,
+from driver.ujoint.kernel import (UJOINT_MODELS, UJOINT_OBJECTIVES, ujoint_equivalent, ujoint_geometry,
                             ujoint_objective, ujoint_speed)
 
 D = math.pi / 180.0

@@ -11,7 +11,7 @@ import pytest
 
 from driver.runner import study_of
 from driver.deck import read_deck
-from driver.kernels import UJOINT_MODELS, ujoint_speed
+from driver.ujoint.kernel import UJOINT_MODELS, ujoint_speed
 
 from driver.published import PUBLISHED_DIR, read_blocks
 

@@ -19,7 +19,7 @@ from typing import Any, Mapping
 import numpy as np
 import pandas as pd
 
-from driver import kernels
+from driver.fourbar import kernel
 from driver.deck import Key, Params, non_negative
 from driver.study import Figure
 from driver.table import Column, fortran_f, render_table
@@ -27,7 +27,7 @@ from driver.table import Column, fortran_f, render_table
 __all__ = ["KEYS", "check", "active", "props", "ForceAnalysis", "analyse", "COLUMNS", "tidy_columns",
            "table_lines", "summary_lines", "summary", "summarise_force_batch", "BATCH_KEYS", "figures"]
 
-ST_OK = kernels.FOURBAR_STATUS["ok"]
+ST_OK = kernel.FOURBAR_STATUS["ok"]
 LINKS = ("crank", "coupler", "rocker")
 #: a link length [m] beyond this with masses given is taken for a unit mistake (millimetres)
 MAX_LENGTH_M = 100.0
@@ -182,7 +182,7 @@ class Counterweights:
 def counterweights(p: Mapping[str, Any]) -> Counterweights:
     """The Berkof-Lowen counterweights of the deck's linkage (kernel berkof_lowen)."""
     radii = cw_radii(p)
-    pb, cw = kernels.fourbar_berkof_lowen(p["crank"], p["coupler"], p["rocker"], props(p), radii)
+    pb, cw = kernel.fourbar_berkof_lowen(p["crank"], p["coupler"], p["rocker"], props(p), radii)
     ang = np.degrees([cw[1], cw[3]])
     ang = np.where(np.abs(ang) < 1e-9, 0.0, ang)
     return Counterweights((float(cw[0]), float(cw[2])), (float(ang[0]), float(ang[1])), radii,
@@ -209,7 +209,7 @@ class ForceAnalysis:
 
 def forces_at(p: Mapping[str, Any], out: np.ndarray, status: np.ndarray, pr: np.ndarray) -> np.ndarray:
     """Kernel forces for states ``out``/``status`` (from the deck's exact grid) and props ``pr``."""
-    return kernels.fourbar_joint_forces(out, status, p["fixed_link"], p["crank"], p["coupler"], p["rocker"],
+    return kernel.fourbar_joint_forces(out, status, p["fixed_link"], p["crank"], p["coupler"], p["rocker"],
                                         p["omega"], p["alpha"], pr)
 
 
@@ -306,7 +306,7 @@ LABELS = {name: (doc.rsplit(" [", 1)[0], doc.rsplit(" [", 1)[1].rstrip("]")) for
 
 def frame_from_kernel(res: np.ndarray, prefix: str = "") -> pd.DataFrame:
     """Kernel rows -> summary columns (NaN where a figure does not exist)."""
-    c = dict(zip(kernels.FOURBAR_FORCE_SUMMARY_COLUMNS, res.T))
+    c = dict(zip(kernel.FOURBAR_FORCE_SUMMARY_COLUMNS, res.T))
     anyok = c["defined_fraction"] > 0
     full = c["defined_fraction"] >= 1.0
     out: dict[str, np.ndarray] = {}
@@ -358,10 +358,10 @@ def summarise_force_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | 
         rows[i] = _row(d)
     if not np.all(np.isfinite(rows)):
         raise ValueError("batch values must be finite")
-    frame = frame_from_kernel(kernels.fourbar_force_summaries(rows))
+    frame = frame_from_kernel(kernel.fourbar_force_summaries(rows))
     if rows[:, 28].any():   # balanced designs: the figures without counterweights follow
         rows[:, 28] = 0.0
-        frame = pd.concat([frame, frame_from_kernel(kernels.fourbar_force_summaries(rows), "unbalanced_")], axis=1)
+        frame = pd.concat([frame, frame_from_kernel(kernel.fourbar_force_summaries(rows), "unbalanced_")], axis=1)
     return frame
 
 

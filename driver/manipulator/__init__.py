@@ -22,33 +22,31 @@ report mode the .out lists every cell where the two modes differ, and why.
 
 Physics (IK, Jacobian, indices, torques, positioning errors) is in fortran/manipulator.f90.
 
-The package splits the study by job: :mod:`.spec` (deck keys and checks), :mod:`.analysis`
+The package splits the study by job: :mod:`.spec` (deck keys, checks, the budget estimate), :mod:`.analysis`
 (conventions, optima, joint angles, tolerance synthesis), :mod:`.tables` (the tables and the
-report/exact differences), :mod:`.report` (the run: text, tidy table, summary, figures) and
-:mod:`.batch` (the design summary of many designs in one kernel call).
+report/exact differences), :mod:`.report` (the run: text, tidy table, summary) and
+:mod:`.batch` (the design summary of many designs in one kernel call), :mod:`.figures`,
+:mod:`.published` (the report's printed tables) and :mod:`.kernel` (the Fortran wrappers).
 """
 from __future__ import annotations
 
-from driver.deck import Params
-from driver.manipulator.analysis import (DESIGN_STATUS, SIGNIFICANT, STATUS, Conv, Workspace, _sensitivity_blocks,
-                                         optima, round_half_up, tolerance_box)
+from driver._study import BatchSummary, Study
+from driver.manipulator import kernel, published
+from driver.manipulator.analysis import DESIGN_STATUS, Workspace, optima, round_half_up, tolerance_box
 from driver.manipulator.batch import (BATCH_IGNORED, BATCH_INDEPENDENT, BATCH_KEYS, BATCH_PASS_SUFFIXES, BATCH_PASSES,
                                       batch_refusal, summarise, summarise_batch)
-from driver.manipulator import report as _report
-from driver.manipulator.report import TIDY_UNITS, table_frame
+from driver.manipulator.report import TIDY_UNITS, run, table_frame
 from driver.manipulator.spec import LABELS, RENAMED, SPEC, SWEEP_BEST, SWEEP_PLOT, estimate
-from driver.manipulator.tables import NOT_REPRODUCIBLE, REASONS, TEXT_REASONS, TIDY_NAMES, Table
-from driver.runner import keyword_run
-from driver.study import Result
+from driver.manipulator.tables import NOT_REPRODUCIBLE, REASONS, TEXT_REASONS, TIDY_NAMES
 
 __all__ = ["SPEC", "run", "Workspace", "tolerance_box", "round_half_up", "REASONS", "NOT_REPRODUCIBLE", "TEXT_REASONS",
            "TIDY_NAMES", "TIDY_UNITS", "table_frame", "LABELS", "SWEEP_PLOT", "SWEEP_BEST", "estimate", "optima",
            "summarise", "summarise_batch", "BATCH_KEYS", "BATCH_PASSES", "BATCH_PASS_SUFFIXES", "BATCH_IGNORED",
-           "BATCH_INDEPENDENT", "DESIGN_STATUS"]
+           "BATCH_INDEPENDENT", "DESIGN_STATUS", "STUDY", "kernel"]
 
-
-@keyword_run
-def run(params: Params, progress: bool = False) -> Result:
-    """Run one &manipulator deck (see the package docstring): validated Params, or the deck's
-    keys as keyword arguments (``driver.manipulator.run(points_x=[...], points_y=[...])``)."""
-    return _report.run(params, progress=progress)
+STUDY = Study(name="manipulator", package=__name__, spec=SPEC, run=run, estimate=estimate, summarise=summarise,
+              batch=BatchSummary(summarise_batch, keys=BATCH_KEYS, ignored=BATCH_IGNORED,
+                                 independent=BATCH_INDEPENDENT, passes=BATCH_PASSES,
+                                 pass_names=("indices", "target", "tolerance", "walk"), refusal=batch_refusal),
+              labels=LABELS, sweep_plot=SWEEP_PLOT, sweep_best=SWEEP_BEST, renamed=RENAMED,
+              published=published.compare, figures=f"{__name__}.figures", kernel=kernel)

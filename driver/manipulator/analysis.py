@@ -14,13 +14,13 @@ from typing import Any
 import numpy as np
 from scipy.optimize import minimize
 
-from driver import kernels
+from driver.manipulator import kernel
 from driver.deck import Params
 
 __all__ = ["STATUS", "SIGNIFICANT", "DESIGN_STATUS", "round_half_up", "Workspace", "Conv", "optima", "tolerance_box",
            "design_status"]
 
-STATUS = kernels.MANIPULATOR_STATUS
+STATUS = kernel.MANIPULATOR_STATUS
 #: significant digits of every number column outside report mode (the report's fixed decimals
 #: would print a 1e-7 m tolerance as 0.000000 and a g of 3.71 as 3.7)
 SIGNIFICANT = 6
@@ -179,7 +179,7 @@ def _target(p: Params, ws: Workspace) -> tuple[float, float]:
 def _design_angles(p: Params, conv: Conv, l1: np.ndarray, l2: np.ndarray) -> dict[str, np.ndarray]:
     """Joint angles [deg] of the designs at the target: printed (Table 4.5) and used for torques."""
     tx, ty = _target(p, conv.ws)
-    th1, th2, st = kernels.manipulator_ik(l1, l2, tx, ty, p.elbow)
+    th1, th2, st = kernel.manipulator_ik(l1, l2, tx, ty, p.elbow)
     t1, t2 = np.degrees(th1), np.degrees(th2)
     if conv.report:
         shown2 = 180.0 - np.abs(t2)             # interior angle between the links

@@ -23,7 +23,7 @@ from typing import Any, Collection, Mapping
 import numpy as np
 import pandas as pd
 
-from driver import kernels
+from driver.manipulator import kernel
 from driver.deck import Params
 from driver.manipulator.analysis import STATUS, Conv, Workspace, _design_list, design_status, round_half_up
 from driver.manipulator.report import design_torque_columns, sweep_columns, workspace_columns
@@ -49,9 +49,9 @@ BATCH_INDEPENDENT = ("mass_per_length", "gravity", "tolerance_bound", "title", "
 BATCH_PASSES: dict[str, tuple[str, ...]] = {
     "design_l1_m": (), "design_l2_m": (), "design_ri1": ("indices",), "design_ri2": ("indices",),
     "design_ri3": ("indices",), "design_ri2_excess": ("indices",), "design_reaches_all": ("indices",),
-    "design_crob_residual_m2": (), "design_total_torque_Nm": ("target",), "design_tau_sum_signed_Nm": ("target",),
+    "design_crob_residual_m2": (), "design_tau_sum_signed_Nm": ("target",),
     "design_torque_demand_Nm": ("target",), "design_peak_torque_Nm": ("target",),
-    "design_status": ("indices", "target"), "sweep_min_total_torque_Nm": ("walk",), "sweep_min_l1_m": ("walk",),
+    "design_status": ("indices", "target"), "sweep_min_l1_m": ("walk",),
     "sweep_min_l2_m": ("walk",), "sweep_min_row": ("walk",), "sweep_min_reaches_workspace": ("walk",),
 }
 BATCH_PASS_SUFFIXES: dict[str, tuple[str, ...]] = {
@@ -214,9 +214,9 @@ def _arrays(base: Mapping[str, Any], columns: Mapping[str, Any] | None,
         prm[:, j] = np.repeat(v, k)
     rates = [*p.joint_rates, *p.joint_accels]
     unit = _mc_samples(p.mc_seed, p.mc_samples)
-    bits = sum(b for k, b in kernels.MANIPULATOR_PASSES.items() if k in passes)
-    res = kernels.manipulator_design_summaries(ws.x, ws.y, prm, p.elbow, rates, p.error_measure, unit, passes=bits)
-    r = {c: res[:, i].reshape(n, k) for i, c in enumerate(kernels.MANIPULATOR_SUMMARY_COLUMNS)}
+    bits = sum(b for k, b in kernel.MANIPULATOR_PASSES.items() if k in passes)
+    res = kernel.manipulator_design_summaries(ws.x, ws.y, prm, p.elbow, rates, p.error_measure, unit, passes=bits)
+    r = {c: res[:, i].reshape(n, k) for i, c in enumerate(kernel.MANIPULATOR_SUMMARY_COLUMNS)}
     ok = r["target_status"] == STATUS["ok"]
     tau1, tau2 = r["tau1"], r["tau2"]
     if conv.report and "target" in passes:
@@ -308,7 +308,7 @@ def _report_torques(p: Params, prm: np.ndarray, r: dict[str, np.ndarray], n: int
     tau = np.empty((n * k, 2))
     for gv in np.unique(prm[:, 5]):      # the torque kernel takes one g per call
         m = prm[:, 5] == gv
-        tau[m] = kernels.manipulator_torques(prm[m, 0], prm[m, 1], np.radians(used[m, 0]), np.radians(used[m, 1]),
+        tau[m] = kernel.manipulator_torques(prm[m, 0], prm[m, 1], np.radians(used[m, 0]), np.radians(used[m, 1]),
                                              p.joint_rates, p.joint_accels, prm[m, 4] * prm[m, 0],
                                              prm[m, 4] * prm[m, 1], float(gv))
     return tau[:, 0].reshape(n, k), tau[:, 1].reshape(n, k)

@@ -9,12 +9,13 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from driver import kernels
+from driver.manipulator import kernel
 from driver.deck import Params
 from driver.export import with_units
 from driver.manipulator.analysis import (SIGNIFICANT, Conv, Workspace, _design_list, _target, design_status, optima,
                                          round_half_up)
 from driver.manipulator.tables import TIDY_NAMES, Table, _differences, _tables, _tolerance
+from driver.runner import keyword_run
 from driver.study import Figure, Result
 from driver.table import fortran_f
 
@@ -153,7 +154,7 @@ def _summary(p: Params, ws: Workspace, conv: Conv, used: dict, sweep: dict, tol:
         s[f"{key}_reaches_workspace"] = not rec["reason"]
     # design measures of the first design (what an &optimize deck varies: designs_l1, designs_l2)
     l1, l2 = float(used["l1"][0]), float(used["l2"][0])
-    ri, _, reach = kernels.manipulator_design_indices(ws.x, ws.y, [l1], [l2])
+    ri, _, reach = kernel.manipulator_design_indices(ws.x, ws.y, [l1], [l2])
     s.update({"design_l1_m": l1, "design_l2_m": l2, "design_ri1": float(ri[0, 0]) if ri[0, 0] > 0 else None,
               "design_ri2": float(ri[0, 1]), "design_ri3": float(ri[0, 2]),
               "design_ri2_excess": float(ri[0, 1]) - math.sqrt(ws.n),
@@ -164,9 +165,10 @@ def _summary(p: Params, ws: Workspace, conv: Conv, used: dict, sweep: dict, tol:
     return s
 
 
+@keyword_run
 def run(params: Params, progress: bool = False) -> Result:
-    """Run one &manipulator deck (see the package docstring); ``driver.manipulator.run`` is this
-    function behind :func:`driver.study.keyword_run` (which names the group after its module)."""
+    """Run one &manipulator deck (see the package docstring): validated Params, or the deck's
+    keys as keyword arguments (``driver.manipulator.run(points_x=[...], points_y=[...])``)."""
     p = params
     ws = Workspace(np.array(p.points_x, float), np.array(p.points_y, float))
     conv = Conv(p.mode == "report", ws)
@@ -199,8 +201,8 @@ def run(params: Params, progress: bool = False) -> Result:
     if warnings:
         lines += ["Warnings", "--------"] + [f"  {w}" for w in warnings] + [""]
     tidy = _tidy(tables, tol, sweep, used)
-    figures = [Figure("design_space", lambda: _fig_design(p, ws, conv, used)),
-               Figure("torque_crob", lambda: _fig_torque(sweep, conv, p.title or p.path.stem))]
+    figures = [Figure("design_space", lambda: _figures().design_space_figure(p, ws, conv, used)),
+               Figure("torque_crob", lambda: _figures().torque_figure(sweep, conv, p.title or p.path.stem))]
     return Result(text="\n".join(lines).rstrip() + "\n", tidy=tidy, summary=_summary(p, ws, conv, used, sweep, tol),
                   warnings=warnings, figures=figures)
 
@@ -210,7 +212,7 @@ def _check_designs(p: Params, ws: Workspace, conv: Conv) -> None:
     if p.designs_l1 is None:
         return
     _, l1, l2 = _design_list(p, conv)
-    ri = kernels.manipulator_design_indices(ws.x, ws.y, l1, l2)
+    ri = kernel.manipulator_design_indices(ws.x, ws.y, l1, l2)
     for i in np.flatnonzero(ri[2] == 0):
         raise p.error("designs_l1", f"design {i + 1} (l1 = {l1[i]:g}, l2 = {l2[i]:g}) violates the reach "
                                     f"conditions |l1 - l2| <= r = {ws.r:.4f} and l1 + l2 >= R = {ws.R:.4f}: "
@@ -265,21 +267,7 @@ def _design_notes(p: Params, conv: Conv, used: dict) -> list[str]:
     return lines
 
 
-# ----------------------------------------------------------------------------- figures
-
-def _fig_design(p: Params, ws: Workspace, conv: Conv, used: dict):
-    from driver.plotting import manipulator_design_space
-    field_l = np.linspace(0.05, ws.R + 1.0, 161)
-    L1, L2 = np.meshgrid(field_l, field_l)
-    ri = kernels.manipulator_design_indices(ws.x, ws.y, L1.ravel(), L2.ravel())[0][:, 1].reshape(L1.shape)
-    levels = p.ri2_levels or [math.sqrt(ws.n)]
-    return manipulator_design_space(ws.r, ws.R, math.sqrt(conv.c_pairs), L1, L2, ri, float(ws.d2.sum()), ws.n,
-                                    levels, optima(conv.c_pairs), used["names"], used["l1"], used["l2"],
-                                    title=p.title or p.path.stem)
-
-
-def _fig_torque(sweep: dict, conv: Conv, title: str = ""):
-    from driver.plotting import manipulator_torque_crob
-    return manipulator_torque_crob(sweep["l1"], np.where(sweep["ok"], sweep["tau"][:, 0], np.nan),
-                                   np.where(sweep["ok"], sweep["tau"][:, 1], np.nan), conv.c_sweep,
-                                   violates=sweep["ok"] & ~sweep["reach_all"], title=title)
+def _figures():
+    """The study's figure module, imported when a figure is drawn (matplotlib is the optional [plot] extra)."""
+    from driver.manipulator import figures
+    return figures

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from driver import kernels
+from driver.manipulator import kernel
 from driver.deck import Params
 from driver.manipulator.analysis import (STATUS, Conv, Workspace, _design_angles, _design_list, _sensitivity_blocks,
                                          _sweep_l1, _target, optima, round_half_up, tolerance_box)
@@ -73,7 +73,7 @@ def _t42(p: Params, conv: Conv) -> Table:
     l1s = p.crob_l1 or [float(v) for v in range(int(math.floor(radius)), 0, -1)]
     rows, trailers = [], []
     valid = [v for v in l1s if v < math.sqrt(c)]
-    ri = kernels.manipulator_design_indices(conv.ws.x, conv.ws.y, valid, [math.sqrt(c - v * v) for v in valid]) \
+    ri = kernel.manipulator_design_indices(conv.ws.x, conv.ws.y, valid, [math.sqrt(c - v * v) for v in valid]) \
         if valid else None
     j = 0
     for i, v in enumerate(l1s):
@@ -96,7 +96,7 @@ def _t42(p: Params, conv: Conv) -> Table:
 def _t44(p: Params, conv: Conv) -> Table:
     opt = optima(conv.c_pairs)
     d = 2 if conv.report else 4
-    ri = kernels.manipulator_design_indices(conv.ws.x, conv.ws.y, [opt["dexterity"][0], opt["manipulability"][0]],
+    ri = kernel.manipulator_design_indices(conv.ws.x, conv.ws.y, [opt["dexterity"][0], opt["manipulability"][0]],
                                             [opt["dexterity"][1], opt["manipulability"][1]])
     rows = []
     for j, (name, key) in enumerate((("Dexterity", "dexterity"), ("Workspace", "manipulability"))):
@@ -123,7 +123,7 @@ def _torque_tables(p: Params, conv: Conv) -> tuple[Table, Table, Table, dict[str
                                   f"(d = {math.hypot(tx, ty):.4f} m); choose a point inside |l1-l2| <= d <= l1+l2")
     mpl, g = p.mass_per_length, p.gravity
     m1, m2 = mpl * l1, mpl * l2
-    tau = kernels.manipulator_torques(l1, l2, np.radians(ang["used1"]), np.radians(ang["used2"]),
+    tau = kernel.manipulator_torques(l1, l2, np.radians(ang["used1"]), np.radians(ang["used2"]),
                                       p.joint_rates, p.joint_accels, m1, m2, g)
     why = "target out of reach of this design"
     r45, r46, r47, tr = [], [], [], []
@@ -169,10 +169,10 @@ def _torque_tables(p: Params, conv: Conv) -> tuple[Table, Table, Table, dict[str
 def _designs_table(p: Params, conv: Conv) -> Table:
     """Robustness indices of the designs and their manipulability/condition number at the target."""
     names, l1, l2 = _design_list(p, conv)
-    ri, sumc2, reach = kernels.manipulator_design_indices(conv.ws.x, conv.ws.y, l1, l2)
+    ri, sumc2, reach = kernel.manipulator_design_indices(conv.ws.x, conv.ws.y, l1, l2)
     tx, ty = _target(p, conv.ws)
-    th1, th2, st = kernels.manipulator_ik(l1, l2, tx, ty, p.elbow)
-    _, w, kappa, _ = kernels.manipulator_arm_states(l1, l2, th1, th2)
+    th1, th2, st = kernel.manipulator_ik(l1, l2, tx, ty, p.elbow)
+    _, w, kappa, _ = kernel.manipulator_arm_states(l1, l2, th1, th2)
     rows, trailers = [], []
     for i, name in enumerate(names):
         ok = st[i] == STATUS["ok"]
@@ -200,15 +200,15 @@ def _t48(p: Params, conv: Conv) -> tuple[Table, dict[str, Any]]:
     inside = l1 <= math.sqrt(c) + 1e-12
     l2 = np.sqrt(np.where(inside, c - np.minimum(l1, math.sqrt(c)) ** 2, 0.0))
     safe1, safe2 = np.where(l1 > 0, l1, 1.0), np.where(l2 > 0, l2, 1.0)
-    th1, th2, st = kernels.manipulator_ik(safe1, safe2, tx, ty, p.elbow)
+    th1, th2, st = kernel.manipulator_ik(safe1, safe2, tx, ty, p.elbow)
     st = np.where((l1 > 0) & (l2 > 0) & inside, st, STATUS["degenerate"])
     t2 = np.degrees(th2)
     t1 = round_half_up(math.degrees(math.atan2(ty, tx)), 2) - t2 if conv.report else np.degrees(th1)
     mpl, g = p.mass_per_length, p.gravity
     m1, m2 = mpl * l1, mpl * l2
-    tau = kernels.manipulator_torques(safe1, safe2, np.radians(t1), np.radians(t2), p.joint_rates,
+    tau = kernel.manipulator_torques(safe1, safe2, np.radians(t1), np.radians(t2), p.joint_rates,
                                       p.joint_accels, m1, m2, g)
-    ri = kernels.manipulator_design_indices(conv.ws.x, conv.ws.y, safe1, safe2)
+    ri = kernel.manipulator_design_indices(conv.ws.x, conv.ws.y, safe1, safe2)
     rows, trailers = [], []
     for i in range(l1.size):
         ok = st[i] == STATUS["ok"]
@@ -253,7 +253,7 @@ def _tolerance(p: Params, ws: Workspace, names: list[str], l1: np.ndarray, l2: n
     rows, out = [], []
     trailers = []
     for i, name in enumerate(names):
-        th1, th2, st = kernels.manipulator_ik(l1[i], l2[i], ws.x, ws.y, p.elbow)
+        th1, th2, st = kernel.manipulator_ik(l1[i], l2[i], ws.x, ws.y, p.elbow)
         bad = np.flatnonzero(st != STATUS["ok"])
         if bad.size:
             d = np.hypot(ws.x[bad], ws.y[bad])
@@ -270,8 +270,8 @@ def _tolerance(p: Params, ws: Workspace, names: list[str], l1: np.ndarray, l2: n
         box = tolerance_box(blocks, eps, p.error_measure)
         dl = box["closed"] if box["closed"] is not None else box["u"]
         corners = np.array([[1, 1], [1, -1], [-1, 1], [-1, -1]], float) * dl
-        worst = kernels.manipulator_position_errors(th1, th2, corners)[:, col].max()
-        err = kernels.manipulator_position_errors(th1, th2, unit * dl)[:, col]
+        worst = kernel.manipulator_position_errors(th1, th2, corners)[:, col].max()
+        err = kernel.manipulator_position_errors(th1, th2, unit * dl)[:, col]
         ri2 = math.sqrt(ws.n + abs(np.cos(th2).sum()))
         rec = {"name": name, "l1": float(l1[i]), "l2": float(l2[i]), "ri2": ri2, "dl1": float(dl[0]),
                "dl2": float(dl[1]), "slsqp_dl1": float(box["u"][0]), "slsqp_dl2": float(box["u"][1]),

@@ -14,7 +14,9 @@ See :mod:`driver.optimize.problem` for the deck keys.  Outputs for a deck ``<ste
 
 While a run goes, each evaluation is appended to ``<stem>.journal.jsonl``; ``--resume``
 replays the (deterministic) run from the journal, or from a finished run's ``_evals``
-table, computing only designs not evaluated before.  The journal is removed when the
+table, computing only designs not evaluated before.  Every journal line and table row carries
+a checksum of its content, verified on resume: what fails is computed again, and the command
+line says how many and why (:mod:`driver.optimize.journal`).  The journal is removed when the
 outputs are complete.
 
 Python API: :func:`optimize` returns an :class:`OptimizeOutcome` (``scipy.optimize``-like
@@ -40,6 +42,7 @@ from driver.outcome import ExitCode, Outcome
 from driver.optimize.evaluate import Evaluator, Record, design_params
 from driver.optimize.methods import HistoryRow, MethodResult, run_method
 from driver.optimize.problem import SPEC, Problem, problem_of
+from driver.optimize import journal as journal_file
 from driver.optimize import report
 from driver.runner import compute, output_stem, write_outputs
 
@@ -130,7 +133,7 @@ class OptimizeOutcome(Outcome):
         """The result as plain data (the ``--json`` record): scipy's fields, the constraints at x,
         the starts of a local method and the polish of differential evolution."""
         p = self.problem
-        rec = {"study": p.study.SPEC.name, "deck": str(p.deck.path), "objective": p.objective_text,
+        rec = {"study": p.study.spec.name, "deck": str(p.deck.path), "objective": p.objective_text,
                "x": None if self.x is None else [float(v) for v in self.x.values()], "x_names": p.names,
                "fun": self.fun, "success": self.success, "status": self.status, "message": self.message,
                "nit": self.nit, "nfev": self.nfev, "constraint_tol": p.opts.constraint_tol,
@@ -164,7 +167,7 @@ def _probe(problem: Problem) -> None:
     x = [base_value(problem, v) for v in problem.variables]
     try:
         params = design_params(problem, np.array(x))
-        if hasattr(problem.study, "summarise"):
+        if problem.study.summarise is not None:
             summary, clean = dict(problem.study.summarise(params)), True
         else:       # through the runner: the budget and the finite-number checks apply here too
             result = compute(problem.study, params)
@@ -185,7 +188,7 @@ def _probe(problem: Problem) -> None:
                                          f"(columns: {', '.join(frame.columns)})")
     for key, e in exprs:
         missing = [name for name in sorted(e.names) if name not in frame]
-        renamed = getattr(problem.study, "RENAMED", {})
+        renamed = problem.study.renamed
         if missing and missing[0] in renamed:
             raise o.error(key, f"summary column '{missing[0]}' of &{problem.raw.name} is now "
                                f"{renamed[missing[0]]}")
@@ -210,36 +213,6 @@ def base_value(problem: Problem, v) -> float:
     return float(val)
 
 
-def _resumed(problem: Problem, stem: Path) -> list[dict]:
-    """Evaluations of an earlier run of the same problem: its journal, or a finished run's table."""
-    fp = problem.fingerprint()
-    rows: list[dict] = []
-    journal = stem.with_name(stem.name + ".journal.jsonl")
-    if journal.exists():
-        for line in journal.read_text().splitlines():
-            try:
-                row = json.loads(line)
-            except json.JSONDecodeError:     # a line cut by an interrupt
-                continue
-            if row.get("base") == fp and len(row.get("x", ())) == len(problem.variables):
-                rows.append(row)
-    table = stem.with_name(stem.name + "_evals.parquet")
-    if table.exists():
-        try:
-            frame = pd.read_parquet(table)
-        except Exception:
-            frame = None
-        if frame is not None and "base" in frame and set(problem.names) <= set(frame.columns):
-            summ = [c for c in frame.columns if c.startswith("summary.")]
-            for rec in frame[frame["base"] == fp].to_dict("records"):
-                summary = {c[len("summary."):]: (None if isinstance(rec[c], float) and math.isnan(rec[c]) else rec[c])
-                           for c in summ}
-                summary = {k: (v.item() if hasattr(v, "item") else v) for k, v in summary.items()}
-                rows.append({"x": [rec[n] for n in problem.names], "status": rec["status"],
-                             "reason": rec["case_error"] or "", "summary": summary})
-    return rows
-
-
 @blas.one_thread()
 def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[str] | None = None,
              plot: bool = False, jobs: int | None = None, resume: bool = False,
@@ -256,9 +229,10 @@ def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[
     problem = problem_of(deck)
     _probe(problem)
     formats = list(formats or [])
-    stem = None if outdir is None else output_stem(outdir, deck.path)
-    journal = None if stem is None else stem.with_name(stem.name + ".journal.jsonl")
-    resumed = _resumed(problem, stem) if (resume and stem is not None) else []
+    stem = None if outdir is None else output_stem(outdir, deck.path, _suffixes(formats, plot))
+    journal = None if stem is None else journal_file.journal_path(stem)
+    found = journal_file.read(problem.fingerprint(), problem.names, stem) if (resume and stem is not None) \
+        else journal_file.Resumed()
     if journal is not None and journal.exists() and not resume:
         journal.unlink()
     njobs = jobs if jobs is not None else problem.opts.jobs
@@ -266,7 +240,8 @@ def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[
     if scheduler is None:
         from driver.sweep import _configured_scheduler
         scheduler = _configured_scheduler() or None
-    with Evaluator(problem, njobs, journal, resumed, scheduler) as ev:
+    with Evaluator(problem, njobs, journal, found.rows, scheduler) as ev:
+        ev.resume_note = found.note()
         mres = run_method(ev, history)
     best = mres.best if mres.best is not None else (ev.best() if o_method(problem) in DETERMINISTIC else None)
     if best is None and o_method(problem) not in DETERMINISTIC and mres.starts:
@@ -293,6 +268,13 @@ def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[
     return outcome
 
 
+def _suffixes(formats: list[str], plot: bool) -> tuple[str, ...]:
+    """What a run appends to the deck's stem, known before it runs (the optimum's figures are not)."""
+    return (".out", ".optimum.dat", ".optimum.out", "_history.csv", "_evals.parquet", journal_file.SUFFIX,
+            *(s for fmt in formats for s in (f"_evals.{fmt}", f"_history.{fmt}", f".optimum.{fmt}")),
+            *(("_convergence.png",) if plot else ()))
+
+
 def _write(oc: OptimizeOutcome, stem: Path, params, formats: list[str], plot: bool, jobs: int) -> list[Path]:
     p, ev = oc.problem, oc.evaluator
     written: list[Path] = []
@@ -305,6 +287,7 @@ def _write(oc: OptimizeOutcome, stem: Path, params, formats: list[str], plot: bo
         written += write_outputs(oc.study_result, opt_stem, formats, plot)
     evals = ev.frame()
     evals.insert(1, "base", p.fingerprint())
+    evals.attrs[journal_file.DIGEST_KEY] = journal_file.table_digests(evals, p.names)   # verified on --resume
     if report.settings_of(p):   # the band behind summary.meets_transmission_band, with the table
         evals.attrs["summary_settings"] = report.settings_of(p)
     hist = report.history_frame(p, oc.history)
@@ -337,9 +320,11 @@ def run_optimize_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, 
         require("dask")
     oc = optimize(deck, outdir, formats, plot, jobs, resume, scheduler or None)
     if summary_json:
-        stem = output_stem(outdir, deck.path)
+        stem = output_stem(outdir, deck.path, (".json",))
         oc.written.append(write_text(stem.with_name(stem.name + ".json"),
                                      json.dumps(oc.to_dict(), indent=1, allow_nan=False) + "\n"))
+    if oc.evaluator.resume_note:
+        oc.warn(f"{deck.path}: resume: {oc.evaluator.resume_note}")
     if oc.study_result is not None:
         for w in oc.study_result.warnings:
             oc.warn(f"{deck.path}: optimum: {w}")

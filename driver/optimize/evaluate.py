@@ -15,7 +15,6 @@ Every design the optimiser asks for goes through :class:`Evaluator`, which
 from __future__ import annotations
 
 import concurrent.futures as cf
-import json
 import math
 import os
 import re
@@ -29,7 +28,8 @@ import pandas as pd
 
 from driver import blas, expr, limits
 from driver.deck import DeckError, Params, RawGroup, validate
-from driver.study import load_study
+from driver._study import load_study
+from driver.optimize import journal as journal_file
 from driver.optimize.problem import Problem
 from driver.runner import NUMERICAL, CaseFailure, compute, numerical_error
 
@@ -63,9 +63,9 @@ def _design_raw(raw: RawGroup, keys: list[str], kinds: list[str], x: np.ndarray)
 
 def design_params(problem: Problem, x: np.ndarray) -> Params:
     """The validated study group of design ``x`` (DeckError if the design is not a valid deck)."""
-    kinds = [problem.study.SPEC.keys[v.key].kind for v in problem.variables]
+    kinds = [problem.study.spec.keys[v.key].kind for v in problem.variables]
     raw = _design_raw(problem.raw, _slots(problem), kinds, x)
-    return validate(raw, problem.study.SPEC, problem.deck.path)
+    return validate(raw, problem.study.spec, problem.deck.path)
 
 
 @blas.one_thread()
@@ -83,7 +83,7 @@ def evaluate_cases(group: str, deck_path: str, raw: RawGroup, keys: list[str], k
     out: list[tuple[str, str, dict]] = []
     for x in xs:
         try:
-            params = validate(_design_raw(raw, keys, kinds, np.asarray(x)), module.SPEC, deck_path)
+            params = validate(_design_raw(raw, keys, kinds, np.asarray(x)), module.spec, deck_path)
         except DeckError as exc:
             out.append(("bad_input", _deck_reason(exc), {}))
             continue
@@ -93,7 +93,7 @@ def evaluate_cases(group: str, deck_path: str, raw: RawGroup, keys: list[str], k
             out.append(("refused", _deck_reason(exc), {}))
             continue
         try:
-            if hasattr(module, "summarise"):
+            if module.summarise is not None:
                 try:
                     with np.errstate(all="ignore"):
                         summary = dict(module.summarise(params))
@@ -173,9 +173,11 @@ class Evaluator:
         self.cache: dict[tuple[float, ...], int] = {}
         self.replayed: dict[tuple[float, ...], dict] = {}
         self.keys = _slots(problem)
-        self.kinds = [problem.study.SPEC.keys[v.key].kind for v in problem.variables]
+        self.kinds = [problem.study.spec.keys[v.key].kind for v in problem.variables]
         self.journal = journal
         self._journal_fh = None
+        #: what a resume found wrong with the records it was given (driver.optimize.journal), or ''
+        self.resume_note = ""
         self._pool: cf.ProcessPoolExecutor | None = None
         self.seconds_per_case: float | None = None
         self.compute_seconds = 0.0
@@ -282,11 +284,11 @@ class Evaluator:
             if self._journal_fh is None:
                 self.journal.parent.mkdir(parents=True, exist_ok=True)
                 self._journal_fh = open(self.journal, "a")
+            fp = self.problem.fingerprint()
             for r, j in zip(recs, journal):
-                if j:
-                    self._journal_fh.write(json.dumps({"base": self.problem.fingerprint(), "x": list(r.x),
-                                                       "status": r.status, "reason": r.reason,
-                                                       "summary": r.summary}, default=_plain) + "\n")
+                if j:   # one checksummed line per computed design (driver.optimize.journal)
+                    self._journal_fh.write(journal_file.line(journal_file.record(fp, r.x, r.status, r.reason,
+                                                                                 r.summary)))
             self._journal_fh.flush()
 
     def _score(self, recs: list[Record]) -> None:
@@ -414,17 +416,16 @@ def _slots(problem: Problem) -> list[str]:
 
 
 def _batch_summaries(problem: Problem, xs: list[tuple[float, ...]]) -> list[tuple[str, str, dict]] | None:
-    """The study's batch path (``summarise_batch``), when it has one; None otherwise."""
-    fn = getattr(problem.study, "summarise_batch", None)
-    elements = getattr(problem.study, "BATCH_ELEMENTS", ())   # list keys whose elements a batch may set
-    if fn is None or not xs or any(v.index is not None and v.key not in elements for v in problem.variables):
+    """The study's batch path (``Study.batch``), when it has one; None otherwise."""
+    batch = problem.study.batch
+    if batch is None or not xs or any(v.index is not None and v.key not in batch.elements for v in problem.variables):
         return None
-    applies = getattr(problem.study, "batch_applies", None)
+    fn, applies = batch.fn, batch.applies
     if applies is not None and not applies(problem.base):
         return None
     columns = {slot: np.array([x[i] for x in xs]) for i, slot in enumerate(_slots(problem))}
     wanted = None
-    if problem.opts.summary_columns and hasattr(problem.study, "BATCH_PASSES"):
+    if problem.opts.summary_columns and batch.passes is not None:
         # only what the objective, the constraints and summary_columns read: only their passes run
         wanted = sorted(_names(problem) | set(problem.opts.summary_columns))
     try:
@@ -434,7 +435,7 @@ def _batch_summaries(problem: Problem, xs: list[tuple[float, ...]]) -> list[tupl
     rows = frame.to_dict("records") if hasattr(frame, "to_dict") else list(frame)
     # a design the study's own run refuses (DeckError case by case, e.g. an arm that cannot reach) is
     # a batch row with a status: infeasible here too, so the optimum is a design the study accepts
-    refusal = getattr(problem.study, "batch_refusal", None)
+    refusal = batch.refusal
     out = []
     for row in rows:
         row = {k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in row.items()}
@@ -478,11 +479,3 @@ def _short(text: str, n: int = 90) -> str:
     """A reason to count: one line, numbers replaced by '#' (so the same failure counts once)."""
     text = _NUMBER.sub("#", " ".join(str(text).split()))
     return text if len(text) <= n else text[: n - 3] + "..."
-
-
-def _plain(o: Any) -> Any:
-    if isinstance(o, (np.floating, np.integer)):
-        return o.item()
-    if isinstance(o, np.bool_):
-        return bool(o)
-    return str(o)

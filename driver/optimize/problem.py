@@ -137,7 +137,7 @@ class Problem:
     """A validated optimisation problem over one study."""
 
     deck: Deck
-    study: Any                 # the study module
+    study: Any                 # the study (driver._study.Study)
     raw: RawGroup              # the study group as written (variables replaced per design)
     base: Params               # the study group as validated (the starting design)
     opts: Params               # the &optimize group
@@ -253,7 +253,7 @@ def problem_of(deck: Deck) -> Problem:
     if "sweep" in deck.groups:
         raise DeckError(deck.path, deck.groups["sweep"].line, None,
                         "a deck has either &sweep or &optimize, not both")
-    raw = deck.groups[study.SPEC.name]
+    raw = deck.groups[study.spec.name]
     variables: list[Variable] = []
     for k in range(1, MAX_VARS + 1):
         name = opts[f"var{k}"]
@@ -264,14 +264,14 @@ def problem_of(deck: Deck) -> Problem:
             continue
         group, _, key = name.lower().replace(" ", "").partition(".")
         if not key:
-            raise opts.error(f"var{k}", f"write the key as 'group.key' (e.g. '{study.SPEC.name}.{name}')")
+            raise opts.error(f"var{k}", f"write the key as 'group.key' (e.g. '{study.spec.name}.{name}')")
         index = None
         m = re.fullmatch(r"([a-z_][a-z0-9_]*)\((\d+)\)", key)
         if m:
             key, index = m.group(1), int(m.group(2))
-        if group != study.SPEC.name:
-            raise opts.error(f"var{k}", f"group '{group}' is not this deck's study group &{study.SPEC.name}")
-        spec_key = study.SPEC.keys.get(key)
+        if group != study.spec.name:
+            raise opts.error(f"var{k}", f"group '{group}' is not this deck's study group &{study.spec.name}")
+        spec_key = study.spec.keys.get(key)
         if spec_key is None:
             raise opts.error(f"var{k}", f"&{group} has no key '{key}'")
         if spec_key.kind not in ("float", "floats"):

@@ -40,7 +40,7 @@ def method_line(p: Problem) -> str:
 def optimum_deck(p: Problem, params: Params, rec: Record, converged: bool) -> str:
     """A complete deck of the optimum: the validated study group with the variables set."""
     values = {k: v for k, v in params.items() if v is not None and v != [] and v != ""}
-    nml = f90nml.Namelist({p.study.SPEC.name: values})
+    nml = f90nml.Namelist({p.study.name: values})
     word = "optimum" if converged else "best design found (NOT converged)"
     head = [f"! {word} of optimisation deck {p.deck.path}",
             f"! {p.objective_text} = {_g(rec.objective)}; " + ", ".join(f"{n} = {_g(x)}" for n, x in zip(p.names, rec.x))]
@@ -97,7 +97,7 @@ def report_text(p: Problem, ev: Evaluator, mres: MethodResult, history: list[His
     on_lat = best is not None and not (o.method == "differential_evolution" and
                                        (mres.polish is None or mres.polish.get("record") is None))
     on_lat = on_lat and o.method != "grid"
-    L = [f"  optimisation of &{p.study.SPEC.name} from deck {p.deck.path}", ""]
+    L = [f"  optimisation of &{p.study.name} from deck {p.deck.path}", ""]
     epi = "   (max-min form: solved as its epigraph by the gradient method)" if p.terms and o.method in (
         "slsqp", "trust-constr") or (p.terms and o.polish) else ""
     L += [f"    method ............... {method_line(p)}",

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import LinAlgError, cholesky_banded
 
-from driver import kernels
+from driver.slidercrank import kernel
 from driver.deck import Params
 from driver.slidercrank.spec import SIMEON1996, Model
 
@@ -54,8 +54,8 @@ def static_onset(model: Model, n_elements: int, step_deg: float = 10.0) -> tuple
 
     def omega_at(theta_deg: float) -> float:
         th = math.radians(theta_deg)
-        k0 = kernels.slidercrank_matrices(*args, th, 0.0, False)[1]
-        g = kernels.slidercrank_matrices(*args, th, 1.0, True)[1] - k0
+        k0 = kernel.slidercrank_matrices(*args, th, 0.0, False)[1]
+        g = kernel.slidercrank_matrices(*args, th, 1.0, True)[1] - k0
 
         def definite(t: float) -> bool:
             try:
@@ -96,7 +96,7 @@ class Case:
     angle_deg: np.ndarray | None = None
     time: np.ndarray | None = None
     # the per-step profile of the strain fields (what the study prints; the kernel records no
-    # field, see kernels.slidercrank_simulate): element 1 and 2 axial strain [-], the largest
+    # field, see kernel.slidercrank_simulate): element 1 and 2 axial strain [-], the largest
     # and smallest axial strain and their (0-based) elements, the largest outer-fibre strain,
     # element 1's rigid-body axial force [N]
     eps_1: np.ndarray | None = None
@@ -154,7 +154,7 @@ def _run_case(model: Model, params: Params, omega: float, n_el: int, alpha: floa
         rec_start, n_rec = (params.revolutions - (2 if two else 1)) * spr, (2 if two else 1) * spr + 1
     start, q0, qd0 = _start_state(params.start, n_el, model.length)
     settle = params.end_time <= 0 and params.revolutions >= 2
-    res = kernels.slidercrank_simulate(
+    res = kernel.slidercrank_simulate(
         n_el, model.r2, model.length, model.rho_a, model.ea, model.ei, model.depth / 2, model.m_s, omega,
         dt, n_steps, rec_start, n_rec, alpha, beta, start=start, dynamic=params.analysis == "dynamic",
         geometric_stiffness=params.geometric_stiffness, q_init=q0, qd_init=qd0, fields=False,
@@ -166,9 +166,9 @@ def _run_case(model: Model, params: Params, omega: float, n_el: int, alpha: floa
     theta = omega * dt * steps
     # peak rod compression from rigid-body statics over the reported revolution (N is quadratic in s)
     s = np.linspace(0.0, model.length, 41)
-    n_rigid = kernels.slidercrank_axial_force(theta, s, omega, model.r2, model.length, model.rho_a, model.m_s)
+    n_rigid = kernel.slidercrank_axial_force(theta, s, omega, model.r2, model.length, model.rho_a, model.m_s)
     peak_c = max(0.0, float(-n_rigid.min()))
-    status = {v: k for k, v in kernels.SLIDERCRANK_STATUS.items()}[res["status"]]
+    status = {v: k for k, v in kernel.SLIDERCRANK_STATUS.items()}[res["status"]]
     case = Case(omega, n_el, status, dt, euler_ratio=peak_c / p_euler, peak_compression=peak_c)
     if status != "ok":
         t_fail = max(res["fail_step"], 0) * dt
@@ -184,7 +184,7 @@ def _run_case(model: Model, params: Params, omega: float, n_el: int, alpha: floa
     return case
 
 
-#: the kernel's per-step profile entries a Case keeps (kernels.SLIDERCRANK_PROFILE)
+#: the kernel's per-step profile entries a Case keeps (kernel.SLIDERCRANK_PROFILE)
 PROFILE = ("eps_1", "eps_2", "eps_max", "eps_max_el", "eps_min", "eps_min_el", "outer_max", "n_avg_1")
 
 
@@ -217,11 +217,11 @@ def history(model: Model, params: Params, omega: float, n_el: int, alpha: float,
     n_steps = max(1, round(params.end_time / dt))
     dt = params.end_time / n_steps
     start, q0, qd0 = _start_state(params.start, n_el, model.length)
-    res = kernels.slidercrank_simulate(
+    res = kernel.slidercrank_simulate(
         n_el, model.r2, model.length, model.rho_a, model.ea, model.ei, model.depth / 2, model.m_s, omega,
         dt, n_steps, 0, n_steps + 1, alpha, beta, start=start, dynamic=params.analysis == "dynamic",
         geometric_stiffness=params.geometric_stiffness, q_init=q0, qd_init=qd0, fields=False)
-    if res["status"] != kernels.SLIDERCRANK_STATUS["ok"]:
+    if res["status"] != kernel.SLIDERCRANK_STATUS["ok"]:
         return {k: np.empty(0) for k in ("time", "mid", "elong", "slider")}
     return {"time": dt * np.arange(n_steps + 1), "mid": np.asarray(res["mid"]), "elong": np.asarray(res["elong"]),
             "slider": np.asarray(res["slider"])}

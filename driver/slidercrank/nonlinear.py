@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from driver import kernels
+from driver.slidercrank import kernel
 from driver.deck import Params
 from driver.slidercrank.spec import Model
 
@@ -127,11 +127,11 @@ def run_nl_case(model: Model, params: Params, omega: float, n_el: int, alpha: fl
     dt = 2 * math.pi / (omega * spr)
     n_steps = revs * spr
     rec_start = (revs - 1) * spr
-    res = kernels.slidercrank_nl_simulate(
+    res = kernel.slidercrank_nl_simulate(
         n_el, model.r2, model.length, model.rho_a, model.ea, model.ei, model.depth / 2, model.m_s, omega, dt,
         n_steps, spr, rec_start, spr + 1, alpha, beta, hht=params.hht_alpha, start=params.start, tol=params.newton_tolerance,
         max_iterations=params.newton_max_iterations, max_cuts=params.max_step_cuts, energy=energy)
-    status = {v: k for k, v in kernels.SLIDERCRANK_NL_STATUS.items()}[res["status"]]
+    status = {v: k for k, v in kernel.SLIDERCRANK_NL_STATUS.items()}[res["status"]]
     st = res["stats"]
     case = NLCase(omega, n_el, status, dt, spr, solves=int(st[0]), max_solves=int(st[1]), cuts=int(st[2]),
                   deepest_cut=int(st[3]), steps_done=int(st[4]), fail_step=res["fail_step"],

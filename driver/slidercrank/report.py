@@ -1,4 +1,5 @@
-"""Slider-crank study: the fixed-format .out sections, the tidy table, the summary and the plotting hook.
+"""Slider-crank study: a deck run (every crank speed and element count), the fixed-format .out
+sections, the tidy table, the summary and the plotting hook.
 
 Strains are printed in microstrain, angles in degrees, forces in N.
 """
@@ -8,12 +9,15 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+from tqdm import tqdm
 
-from driver import kernels
 from driver.deck import Params
 from driver.export import with_units
-from driver.slidercrank.analysis import Case
-from driver.slidercrank.spec import EULER_WARN, SIMEON1996, STATUS_TEXT, Model
+from driver.slidercrank import kernel
+from driver.slidercrank.analysis import Case, _run_case, static_onset
+from driver.slidercrank.spec import (EULER_WARN, MIN_STEPS_PER_BENDING_PERIOD, MIN_STEPS_PER_REV, SIMEON1996, STATUS_TEXT,
+                                     Model, _model, _shape, rayleigh)
+from driver.study import Figure, Result
 from driver.table import Column, render_table
 
 
@@ -236,7 +240,7 @@ def _benchmark_lines(params: Params, case: Case) -> list[str]:
     lines = ["Table 4  End state at t = " + f"{params.end_time:g} s", ""]
     if not case.ok:
         return lines + [f"  {_status_text(case)}"]
-    kin = kernels.slidercrank_rigid(np.array([case.omega * case.time[-1]]), case.omega,
+    kin = kernel.slidercrank_rigid(np.array([case.omega * case.time[-1]]), case.omega,
                                     params.crank_radius, params.rod_length)[0]
     vals = [("midpoint deflection from the chord (q1)", "m", float(case.mid[-1]), "q1"),
             ("rod elongation (q4)", "m", float(case.elong[-1]), "q4"),
@@ -259,7 +263,157 @@ def _benchmark_lines(params: Params, case: Case) -> list[str]:
     return lines
 
 
-def _plotting():
-    """driver.plotting, imported only when a figure is drawn (matplotlib is optional)."""
-    from driver import plotting
-    return plotting
+def _figures():
+    """The study's figure module, imported when a figure is drawn (matplotlib is the optional [plot] extra)."""
+    from driver.slidercrank import figures
+    return figures
+
+
+def run_linear(params: Params, progress: bool = False) -> Result:
+    """Run every crank speed (and element count) of a linear-model deck (``model = 'linear'``):
+    the paper's KED model; see the package docstring."""
+    model = _model(params)
+    w_bend, w_axial, p_euler = model.frequencies()
+    alpha, beta = rayleigh(params.damping_ratio, w_bend, w_axial)
+    counts = list(params.element_counts) if params.element_counts else [params.n_elements]
+    derived = dict(w_bend=w_bend, w_axial=w_axial, p_euler=p_euler, alpha=alpha, beta=beta,
+                   onset=static_onset(model, counts[-1]))
+    jobs = [(w, n) for w in params.speeds for n in counts]
+    done: dict[tuple[float, int], Case] = {}
+    for w, n in tqdm(jobs, desc="slidercrank", unit="case", disable=not progress):
+        done[(w, n)] = _run_case(model, params, w, n, alpha, beta, p_euler)
+    main_n = counts[-1] if params.element_counts else params.n_elements
+    cases = [done[(w, main_n)] for w in params.speeds]
+
+    text = _header(params, model, derived) + [""]
+    warnings: list[str] = []
+    failure = None
+    if params.end_time > 0:
+        text += _benchmark_lines(params, cases[0]) + [""]
+    else:
+        text += _peak_table(cases, params.settle_tolerance) + [""] + _crank_end_table(cases) + [""]
+    conv = {w: [done[(w, n)] for n in counts] for w in params.speeds} if params.element_counts else {}
+    if conv:
+        text += _convergence_table(conv, model.length) + [""]
+    for c in cases:
+        if c.euler_ratio > EULER_WARN:
+            msg = (f"crank speed {c.omega:g} rad/s: peak rod compression {c.peak_compression:.1f} N is "
+                   f"{c.euler_ratio:.2f} of the Euler load {p_euler:.1f} N (> {EULER_WARN})")
+            if not params.geometric_stiffness:
+                msg += "; the linear model cannot show buckling: rerun with geometric_stiffness = .true."
+            warnings.append(msg)
+    for c in cases:
+        if c.ok and _unsettled(c, params.settle_tolerance):
+            warnings.append(f"crank speed {c.omega:g} rad/s: the reported revolution has not settled: strain "
+                            f"changes {100 * c.settle_strain:.3f} % and midpoint deflection "
+                            f"{100 * c.settle_mid:.3f} % of their peaks between the last two revolutions "
+                            f"(> {100 * params.settle_tolerance:g} %); run more revolutions")
+    onset = derived["onset"]
+    for c in done.values():
+        if not c.ok:
+            if params.geometric_stiffness and c.status in ("buckled", "diverged"):
+                warnings.append(f"crank speed {c.omega:g} rad/s, {c.n_elements} elements: "
+                                f"{_status_text(c)}")
+            else:
+                failure = f"crank speed {c.omega:g} rad/s, {c.n_elements} elements: {_status_text(c)}"
+                warnings.append(failure)
+    le = model.length / max(counts)
+    notes = ["Notes"]
+    if params.end_time <= 0:
+        notes += ["  * Strains: element axial strain (u_e - u_e-1)/le (the paper's 'regangan aksial'); tension",
+                  "    positive."] + _peak_notes(cases) + [
+                  "  * The paper publishes figures only; validation is against closed forms (quasi-static",
+                  "    limit N(s)/EA, natural frequencies) and the Simeon (1996) benchmark (see tests).",
+                  "  * Damping is not given in the paper: Rayleigh damping at the first bending and axial modes."]
+    else:
+        notes += [f"  * Benchmark mode: integrated from t = 0 to end_time with the time step {cases[0].dt:.6g} s.",
+                  "  * Midpoint deflection is measured from the chord A-C; elongation is the axial elastic",
+                  "    displacement of the slider end of the rod."]
+    notes.append(f"  * Time-step criterion: >= {MIN_STEPS_PER_BENDING_PERIOD} steps per period of the first "
+                 f"bending mode and >= {MIN_STEPS_PER_REV} per revolution.")
+    if le < model.depth:
+        notes.append(f"  * Elements ({le * 1e3:.3f} mm) are shorter than the section depth "
+                     f"({model.depth * 1e3:g} mm), as in the paper's")
+        notes.append("    700-element mesh; Euler-Bernoulli elements are used regardless (shear neglected).")
+    notes.append("  * A case stops, and its numbers are not reported, on one of two named triggers: STATIC")
+    notes.append("    INSTABILITY when the tangent stiffness K + K_G of the rigid-body axial force loses")
+    notes.append("    definiteness (geometric stiffness on only), LIMIT L/20 when the elastic deflection exceeds")
+    notes.append("    L/20 (or a rotation 0.25 rad), where the small-motion model is no longer valid.")
+    if onset is not None:
+        notes.append(f"  * Static buckling onset {onset[0]:.2f} rad/s (Model above): the lowest constant crank speed at")
+        notes.append("    which K + K_G loses definiteness at some crank angle; it is a property of the rod, not of")
+        notes.append("    the small-motion guard, which can trip earlier through dynamic amplification.")
+    if params.geometric_stiffness:
+        notes.append("  * Geometric stiffness on: K_G of the rigid-body axial force is part of the model.")
+    else:
+        notes.append("  * Geometric stiffness off (the paper's linear model, which cannot buckle); N/P_E is reported")
+        notes.append("    for every case.")
+    text += notes
+    if warnings:
+        text += ["", "Warnings"] + [f"  * {w}" for w in warnings]
+    figures = []
+    good = [c for c in cases if c.ok]
+    if good and params.end_time <= 0:
+        above = {f"{c.omega:g} rad/s": c.euler_ratio for c in good if c.euler_ratio > 1.0}
+        missing = [f"{c.omega:g} rad/s: {_status_text(c).split(' (')[0].lower()}, not drawn" for c in cases if not c.ok]
+        stiffness = "K + K_G" if params.geometric_stiffness else "linear model"
+        figures.append(Figure("strain", lambda: _figures().slidercrank_strain_figure(
+            [(f"{c.omega:g} rad/s", c.angle_deg, c.eps_1 * 1e6) for c in good],
+            f"{params.material}: crank-end element axial strain ({stiffness})", above=above, missing=missing)))
+        figures.append(Figure("deflection", lambda: _figures().slidercrank_strain_figure(
+            [(f"{c.omega:g} rad/s", c.angle_deg, c.mid * 1e3) for c in good],
+            f"{params.material}: midpoint deflection ({stiffness})", ylabel="midpoint deflection [mm]",
+            above=above, missing=missing)))
+    if params.end_time > 0 and cases[0].ok:   # a benchmark run: its time history against the reference
+        c0 = cases[0]
+        ref = SIMEON1996 if params.benchmark == "simeon1996" else None
+        figures.append(Figure("history", lambda: _figures().history_figure(model, params, c0, alpha, beta, ref)))
+    if conv:
+        series = {f"{w:g} rad/s": ([c.n_elements for c in cs if c.ok], [c.peak(+1)[0] * 1e6 for c in cs if c.ok],
+                                   [c.crank_end_peak(+1) * 1e6 for c in cs if c.ok])
+                  for w, cs in conv.items()}
+        speeds = ", ".join(series)
+        figures.append(Figure("convergence", lambda: _figures().slidercrank_convergence_figure(
+            series, f"{params.material} rod at {speeds}: convergence of the peak tensile strain with the mesh")))
+    return Result(text="\n".join(text) + "\n", tidy=_tidy(params.material, list(done.values())),
+                  summary=_summary(cases, model if _shape(params)[1] else None), warnings=warnings, failure=failure, figures=figures)
+
+
+def animation_frames(params: Params, result: Result | None = None, n: int = 180) -> dict[str, Any] | None:
+    """The mechanism's positions at ``n`` crank angles over one turn, for the report page's animation
+    (:func:`driver.report_page.mechanism_animation`): crank pin A, slider B, and with ``result`` the
+    elastic rod's midpoint deflection, magnified."""
+    model = _model(params)
+    r, length = float(model.r2), float(model.length)
+    theta = np.linspace(0.0, 360.0, n, endpoint=False)
+    states = kernel.slidercrank_rigid(np.radians(theta), 1.0, r, length)
+    a = np.column_stack([r * np.cos(np.radians(theta)), r * np.sin(np.radians(theta))])
+    b = np.column_stack([states[:, 3], np.zeros_like(theta)])
+    frames = {"theta": theta.tolist(), "ok": [1] * len(theta), "A": np.round(a, 6).tolist(),
+              "B": np.round(b, 6).tolist(), "P": None, "ground": [[0.0, 0.0], [float(b[:, 0].max()), 0.0]],
+              "kind": "slider", "names": {"crank": "crank", "out": "slider"}}
+    frames["box_points"], frames["pad_y"] = np.vstack([a, b, [[0.0, 0.0]]]), 0.25 * r
+    frames["bow"], frames["bow_note"] = _rod_bow(result, theta, length)
+    return frames
+
+
+def _rod_bow(result: Result | None, theta: np.ndarray, length: float) -> tuple[list[float] | None, str]:
+    """The elastic rod's midpoint deflection [m] at the animation's crank angles, magnified so
+    its largest is 6 % of the rod (from the run's tidy table: the fastest crank speed that ran),
+    and the words saying so; (None, '') without one."""
+    tidy = getattr(result, "tidy", None)
+    if tidy is None or "midpoint_deflection_mm" not in tidy or not len(tidy):
+        return None, ""
+    w = float(tidy["omega_rad_s"].max())
+    rows = tidy[tidy["omega_rad_s"] == w]
+    ang = np.mod(rows["crank_angle_deg"].to_numpy(dtype=float), 360.0)
+    mid = rows["midpoint_deflection_mm"].to_numpy(dtype=float) * 1e-3
+    order = np.argsort(ang)
+    ang, mid = ang[order], mid[order]
+    peak = float(np.max(np.abs(mid)))
+    if not np.isfinite(peak) or peak <= 0:
+        return None, ""
+    scale = 0.06 * length / peak
+    bow = np.interp(theta, ang, mid, period=360.0) * scale
+    return np.round(bow, 7).tolist(), (f"rod deflection magnified {scale:.3g} times "
+                                       f"(midpoint deflection at {w:g} rad/s, largest {peak * 1e3:.3g} mm)")

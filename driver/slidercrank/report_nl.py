@@ -1,4 +1,5 @@
-"""Slider-crank, ``model = 'nonlinear'``: runs every speed in both models and writes the .out
+"""Slider-crank: a deck's run (:func:`run`: the linear model, or with ``model = 'nonlinear'`` both).
+The nonlinear run takes every speed in both models and writes the .out
 sections (linear and nonlinear side by side, per-revolution deflection, Newton statistics,
 onset search), the tidy table, the summary and the figures.
 
@@ -16,8 +17,9 @@ from driver.deck import Params
 from driver.export import with_units
 from driver.slidercrank.analysis import Case, _run_case, static_onset
 from driver.slidercrank.nonlinear import IRREGULAR, NLCase, onset_search, run_nl_case
-from driver.slidercrank.report import _header, _plotting, _status_text
+from driver.slidercrank.report import _figures, _header, _status_text, run_linear
 from driver.slidercrank.spec import _model, rayleigh
+from driver.runner import keyword_run
 from driver.study import Figure, Result
 from driver.table import Column, render_table
 
@@ -205,7 +207,8 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
     text = _header(params, model, derived)
     text += ["  nonlinear rod: co-rotational Euler-Bernoulli frame elements (same mesh, masses, damping and",
              "  inertia loading); Newmark average acceleration with Newton iterations on the consistent",
-             "  tangent, a step halved when Newton fails; banded Cholesky solves (fortran/slidercrank_nl.f90)",
+             "  tangent (the damping's included), a step halved when Newton fails; banded LU solves",
+             "  (fortran/slidercrank_nl.f90)",
              f"  time integration: HHT-alpha, alpha = {params.hht_alpha:g}"
              + (" (Newmark average acceleration)" if params.hht_alpha == 0 else
                 " (damps the unresolved high frequencies; 0 = Newmark average acceleration)"),
@@ -246,16 +249,25 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
     figures = []
     good = [(lin, nl) for lin, nl in pairs if nl.ok and lin.ok]
     if good:
-        figures.append(Figure("strain_linear_nonlinear", lambda: _plotting().slidercrank_nl_strain_figure(
+        figures.append(Figure("strain_linear_nonlinear", lambda: _figures().slidercrank_nl_strain_figure(
             [(f"{nl.omega:g} rad/s", lin.angle_deg, lin.eps_1 * 1e6, nl.eps_ax[0] * 1e6) for lin, nl in good],
             f"{params.material}: crank-end axial strain, linear (dashed) and nonlinear (solid)")))
     okn = [nl for nl in nls if nl.ok]
     if okn:
-        figures.append(Figure("shapes", lambda: _plotting().slidercrank_nl_shapes_figure(
+        figures.append(Figure("shapes", lambda: _figures().slidercrank_nl_shapes_figure(
             [(f"{c.omega:g} rad/s", c.shape_deg, c.shapes) for c in okn], model.length,
             f"{params.material}: lateral deflection at the worst crank angles")))
-    figures.append(Figure("lateral_per_revolution", lambda: _plotting().slidercrank_nl_revolutions_figure(
+    figures.append(Figure("lateral_per_revolution", lambda: _figures().slidercrank_nl_revolutions_figure(
         [(f"{c.omega:g} rad/s", c.rev_lat[:max(c.steps_done - 1, 0) // c.steps_per_rev + 1] * 1e3)
          for c in nls if c.steps_done], f"{params.material}: peak lateral deflection per revolution")))
     return Result(text="\n".join(text) + "\n", tidy=_tidy(params.material, pairs),
                   summary=_summary(pairs, tol, limit, onset), warnings=warnings, failure=failure, figures=figures)
+
+
+@keyword_run
+def run(params: Params, progress: bool = False) -> Result:
+    """Run one &slidercrank deck: the paper's linear KED model (:func:`run_linear`), or with
+    ``model = 'nonlinear'`` the co-rotational rod beside it (:func:`run_nonlinear`)."""
+    if params.model == "nonlinear":
+        return run_nonlinear(params, progress)
+    return run_linear(params, progress)

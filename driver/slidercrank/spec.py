@@ -9,7 +9,8 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
-from driver import kernels
+from driver.slidercrank import kernel
+from driver.limits import Estimate
 from driver.deck import GroupSpec, Key, Params, non_negative, positive
 
 
@@ -200,7 +201,7 @@ class Model:
 
     def frequencies(self) -> tuple[float, float, float]:
         """First bending, first axial frequency [rad/s] and Euler load [N] (closed forms, kernel)."""
-        return kernels.slidercrank_frequencies(self.rho_a, self.ea, self.ei, self.length, self.m_s)
+        return kernel.slidercrank_frequencies(self.rho_a, self.ea, self.ei, self.length, self.m_s)
 
 
 def _shape(params: Params) -> tuple[dict[str, float], str]:
@@ -340,3 +341,35 @@ SWEEP_PLOT = ("peak_tensile_microstrain", "peak_compressive_microstrain", "euler
 SPEC = GroupSpec("slidercrank", _KEYS,
                  "slider-crank with a rigid crank and an elastic connecting rod (KED finite elements, Newmark)",
                  check=_cross_check)
+
+
+def estimate(params: Params) -> Estimate:
+    """Memory and work of a run from the keys alone (driver.limits): every (speed, element count)
+    integrates n_steps Newmark steps over 3 (n + 1) degrees of freedom (banded, about 0.2 us per
+    dof and step) and records the last two revolutions of states (to judge settling); the static
+    buckling onset factors K + K_G some 2000 times (about 0.3 ms per dof in all)."""
+    p = params
+    counts = list(p.element_counts) if p.element_counts else [p.n_elements]
+    work, mem, steps_max = 0.0, 0.0, 0.0
+    for w in p.speeds:
+        if p.end_time > 0:
+            steps = p.end_time * w * p.steps_per_rev / (2 * math.pi) + 1.0
+            rec = 1.0
+        else:
+            steps = float(p.revolutions) * p.steps_per_rev
+            rec = (2.0 if p.revolutions >= 2 else 1.0) * p.steps_per_rev + 1.0
+        steps_max = max(steps_max, steps)
+        for n in counts:
+            dof = 3.0 * (n + 1)
+            work += 2e-7 * dof * steps
+            mem = max(mem, dof * 8.0 * 40 + rec * (dof * 8.0 * 3 + 400.0))
+    if p.model == "nonlinear":   # Newton, 1-2 solves of the assembled tangent a step: about 3.5e-7 s per
+        work *= 3.0              # dof and step (the linear rate above is a generous bound), plus the linear
+        grid = len(p.onset_speeds or ())    # run beside it; the onset search runs onset_elements, ~14 bisections
+        work += (grid + 14 if grid else 0) * 6e-7 * 3.0 * (p.onset_elements + 1) * p.revolutions * p.steps_per_rev
+    work += 3e-4 * 3.0 * (counts[-1] + 1)      # static_onset on the reported mesh
+    key = "end_time" if p.end_time > 0 else ("steps_per_rev" if p.steps_per_rev > 100_000 else
+                                             ("element_counts" if p.element_counts else "n_elements"))
+    wkey = key if key != "n_elements" or len(p.speeds) < 100 else "speeds"
+    return Estimate(mem + 5e6, work + 0.1, key, wkey,
+                    f"{len(p.speeds)} speed(s) x {len(counts)} element count(s), up to {steps_max:.4g} time steps")

@@ -49,12 +49,12 @@ import numpy as np
 import pandas as pd
 
 from driver import expr
+from driver._study import load_study
 from driver.atomic import refuse_link, remove_stale_temporaries
 from driver.deck import Deck, Params, RawGroup, validate
 from driver.extras import require
 from driver.outcome import ExitCode, SweepOutcome
 from driver.runner import compute, output_stem, study_of
-from driver.study import load_study
 from driver.sweep import batch as batch_path
 from driver.sweep import engine, store, stream
 from driver.sweep.keep import check_keep, keep_columns
@@ -101,7 +101,7 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
     study_raw = {n: g for n, g in deck.groups.items() if n != "sweep"}
     module, base_params = study_of(Deck(deck.path, study_raw))   # the base deck must be valid on its own
     raw = study_raw[base_params.group]
-    grid = grid_of(sw, base_params.group, module.SPEC)
+    grid = grid_of(sw, base_params.group, module.spec)
     names = grid.names
     axes = list(zip(grid.names, grid.values))
     batchable = batch_path.batchable(module, names, sw.keep, sw.case_outputs)
@@ -114,7 +114,7 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
     named = [(k, v) for k, v in [("keep", sw.keep), ("plot_x", sw.plot_x)] + [("plot_y", y) for y in sw.plot_y] if v]
     shown_columns: list[str] | None = None
     if named or sw.summary_columns:   # check the filter and plotted columns on the base deck's summary first
-        probe = (module.summarise(base_params) if hasattr(module, "summarise")
+        probe = (module.summarise(base_params) if module.summarise is not None
                  else compute(module, base_params).summary)
         columns = [*names, *probe, "case"]
         kinds = {**expr.kinds_of({n: v[0] for n, v in axes if len(v)}), **expr.kinds_of(probe), "case": "number"}
@@ -140,7 +140,9 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
             # what the tables show: the columns asked for, and those the filter and the plot read
             read = {n for k, text in named if k != "keep" for n in expr.parse(text, columns).names} | keep_columns(sw.keep)
             shown_columns = [c for c in probe if c in set(sw.summary_columns) | read]
-    stem_path = output_stem(outdir, deck.path)
+    # every name the sweep gives its files and folders, known before it runs (the longest counts)
+    stem_path = output_stem(outdir, deck.path, (".out", ".sweep", "_summary.csv", "_summary.parquet", "_cases.csv",
+                                                "_cases.parquet", *(("_summary.png",) if plot else ())))
     scheduler = scheduler or _configured_scheduler()
     jobs = jobs or os.cpu_count() or 1
     layout = store.layout_for(stem_path, grid.n)

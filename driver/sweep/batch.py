@@ -43,9 +43,9 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from driver import expr
+from driver._study import load_study
 from driver.atomic import DIGEST_CHARS, atomic_open, file_digest, own_folder, refuse_link
 from driver.deck import DeckError, RawGroup, validate
-from driver.study import load_study
 from driver.sweep import store
 from driver.sweep.engine import check_shared_folder
 from driver.sweep.keep import keep_columns, keep_mask
@@ -116,19 +116,18 @@ def _swap(raw: RawGroup, values: dict[str, Any]) -> RawGroup:
 
 def batchable(module, names: list[str], keep: str, case_outputs: str) -> bool:
     """Whether a sweep over ``names`` ('group.key') can take the study's batch path."""
-    if not hasattr(module, "summarise_batch") or case_outputs == "all" or (case_outputs == "kept" and not keep):
+    if module.batch is None or case_outputs == "all" or (case_outputs == "kept" and not keep):
         return False
-    batch_keys = set(getattr(module, "BATCH_KEYS", ())) | set(getattr(module, "BATCH_IGNORED", ()))
-    return all(n.partition(".")[2] in batch_keys for n in names)
+    return all(n.partition(".")[2] in module.batch.accepted for n in names)
 
 
 def wanted_columns(module, keep: str, plotted: list[str], shown: list[str] | None
                    ) -> tuple[list[str] | None, list[str] | None]:
     """(columns every case needs, columns the shown rows need) of the study's batch summary,
-    from its column -> pass table ``BATCH_PASSES``: the filter's columns for every case; the
+    from its column -> pass table (``Study.batch.passes``): the filter's columns for every case; the
     shown rows also the plotted ones and ``shown`` (summary_columns; None: every column).
     (None, None) when the study declares no table (everything is computed)."""
-    table = getattr(module, "BATCH_PASSES", None)
+    table = module.batch.passes if module.batch is not None else None
     if table is None:
         return None, None
     def names(text: str) -> set[str]:   # summary columns a plotted expression reads (as the filter's)
@@ -145,11 +144,11 @@ def plan(module, raw: RawGroup, deck_path: str, grid: Grid, keep: str, rows: str
          plotted: list[str] | None = None, shown: list[str] | None = None) -> BatchPlan | None:
     """A batch plan for this sweep (see :func:`batchable`), or None when it must run case by case.
     ``plotted``: the plot_x/plot_y expressions; ``shown``: summary_columns (None: all)."""
-    applies = getattr(module, "batch_applies", None)   # e.g. not for a base deck that optimises per case
-    if applies is not None and not applies(validate(raw, module.SPEC, deck_path)):
+    applies = module.batch.applies   # e.g. not for a base deck that optimises per case
+    if applies is not None and not applies(validate(raw, module.spec, deck_path)):
         return None
     keys = [n.partition(".")[2] for n in grid.names]
-    independent = set(getattr(module, "BATCH_INDEPENDENT", ()))
+    independent = set(module.batch.independent)
     single: dict[str, dict[int, str]] = {}
     coupled = [i for i, k in enumerate(keys) if k not in independent]
     for i, (name, vals) in enumerate(zip(grid.names, grid.values)):
@@ -158,7 +157,7 @@ def plan(module, raw: RawGroup, deck_path: str, grid: Grid, keep: str, rows: str
         errs = {}
         for j, v in enumerate(vals):
             try:
-                validate(_swap(raw, {name: v}), module.SPEC, deck_path)
+                validate(_swap(raw, {name: v}), module.spec, deck_path)
             except DeckError as exc:
                 errs[j] = str(exc)
         single[name] = errs
@@ -173,7 +172,7 @@ def plan(module, raw: RawGroup, deck_path: str, grid: Grid, keep: str, rows: str
         for combo in dict.fromkeys(combos):
             vals = {grid.names[i]: grid.values[i][j] for i, j in zip(coupled, combo)}
             try:
-                validate(_swap(raw, vals), module.SPEC, deck_path)
+                validate(_swap(raw, vals), module.spec, deck_path)
             except DeckError as exc:
                 coupled_errors[combo] = str(exc)
     p = BatchPlan(deck_path, raw, grid, keep, rows, single, coupled, coupled_errors)
@@ -206,7 +205,7 @@ def _summaries(module, base, cols: dict[str, np.ndarray], rows: np.ndarray, want
     where the case is bad input: a row of None), columns ``wanted`` (None: all)."""
     good = rows if bad is None else rows[~bad[rows]]
     sub = {k.partition(".")[2]: v[good] for k, v in cols.items()}
-    summ = module.summarise_batch(base, sub) if wanted is None else module.summarise_batch(base, sub, wanted=wanted)
+    summ = module.batch.fn(base, sub) if wanted is None else module.batch.fn(base, sub, wanted=wanted)
     if bad is not None and bad[rows].any():
         summ = summ.astype(object)
         full = pd.DataFrame(None, index=range(len(rows)), columns=summ.columns, dtype=object)
@@ -248,7 +247,7 @@ def chunk_rows(p: BatchPlan, start: int, stop: int, folder: str = "") -> ChunkRe
                 bad[k] = True
     if err is None:
         err = np.full(n, "", dtype=object)
-    base = validate(p.raw, module.SPEC, p.deck_path)
+    base = validate(p.raw, module.spec, p.deck_path)
     every = np.arange(n)
     two_step = bool(p.keep) and p.rows == "kept" and p.filter_columns is not None
     if two_step and not bad.any():   # the common case: the filter on plain arrays, no full frame

@@ -34,12 +34,12 @@ from typing import Any, Callable, Iterable
 
 import pandas as pd
 
+from driver._study import load_study
 from driver.atomic import output_set, own_folder, write_text
 from driver.deck import DeckError, Params, RawGroup, validate
 from driver.export import write_tidy
 from driver.outcome import ExitCode
 from driver.runner import compute, write_outputs
-from driver.study import load_study
 from driver.sweep.keep import keep_mask
 from driver.sweep.pool import run_pool, worker_init
 from driver.sweep.spec import Case, CaseResult, Grid, _case_deck_text, _case_raw, iter_cases
@@ -87,9 +87,9 @@ def _compute(task: Task, case: Case, module) -> tuple[CaseResult, Any, Params | 
     res = CaseResult(case.index, case.values)
     result, params = None, None
     try:
-        params = validate(_case_raw(task.raw, case), module.SPEC, task.deck_path)
+        params = validate(_case_raw(task.raw, case), module.spec, task.deck_path)
         full = task.case_outputs == "all" or (task.case_outputs == "kept" and not task.keep)
-        if full or not hasattr(module, "summarise"):
+        if full or module.summarise is None:
             result = compute(module, params)
             res.summary = dict(result.summary)
             if result.failure:

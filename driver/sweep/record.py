@@ -15,7 +15,7 @@ __all__ = ["write_sweep_json"]
 def write_sweep_json(deck: Deck, outdir: Path, exit_status: int) -> Path:
     """Write ``<stem>.json``: the deck, exit status, cases summarised (by status, and kept by the
     filter), the swept keys and the summary table's columns and file; returns its path."""
-    stem = output_stem(outdir, deck.path)
+    stem = output_stem(outdir, deck.path, (".json",))
     table = stem.with_name(stem.name + "_summary.parquet")
     rec: dict = {"kind": "sweep", "deck": str(deck.path), "ok": exit_status == 0, "exit_status": exit_status,
                  "summary_table": table.name if table.exists() else None}

@@ -22,14 +22,13 @@ __all__ = ["summary_frame", "summary_settings", "sweep_text", "Warnings", "write
 
 
 def summary_settings(module: Any, base: Params, swept: set[str] | None = None) -> dict[str, Any]:
-    """The base deck's settings the study's summary columns depend on (``module.SUMMARY_SETTINGS``,
+    """The base deck's settings the study's summary columns depend on (``Study.summary_settings``,
     e.g. the four-bar's ``transmission_band_deg`` behind ``meets_transmission_band``), as
     {key: value}; keys in ``swept`` (swept per case, so in the table's own columns) are left out.
     The sweep's ``.out`` prints them and its Parquet summary records them in its metadata."""
     swept = swept or set()
     out: dict[str, Any] = {}
-    keys = getattr(module, "SUMMARY_SETTINGS", None)
-    for key in keys if keys is not None else getattr(module, "summary_settings", ()):   # a module or a Study
+    for key in module.summary_settings if module is not None else ():
         if key in base and key not in swept:
             v = base[key]
             out[key] = [float(x) for x in v] if isinstance(v, (list, tuple)) else v
@@ -177,14 +176,14 @@ def write_sweep_plot(outdir: Path, stem: str, plot: bool | str, sw: Params, name
     labels = {c: column_label(module, c) for c in shown.columns}
     from driver.plotting import is_grid, sweep_maps
     if is_grid(shown, names) and not sw.zip:   # a design space: maps over the keys, not strips
-        ys = [y for y in sw.plot_y if y in shown] or [c for c in getattr(module, "SWEEP_PLOT", ())
+        ys = [y for y in sw.plot_y if y in shown] or [c for c in module.sweep_plot
                                                      if c in shown][:1]
-        for k, fig in enumerate(sweep_maps(shown, names, ys[:3], labels, getattr(module, "SWEEP_BEST", {}),
+        for k, fig in enumerate(sweep_maps(shown, names, ys[:3], labels, module.sweep_best,
                                            stem, sw.summary_rows == "kept")):
             save_figure(fig, outdir / f"{stem}_summary{'' if k == 0 else f'_{k + 1}'}.png", plot)
     else:
         save_figure(sweep_summary(shown, names, sw.plot_x, sw.plot_y, stem, labels,
-                                  getattr(module, "SWEEP_PLOT", ())), outdir / f"{stem}_summary.png", plot)
+                                  module.sweep_plot), outdir / f"{stem}_summary.png", plot)
 
 
 def sweep_text(deck: Deck, sw: Params, base: Params, axes: list[tuple[str, list]], n_cases: int,
@@ -206,7 +205,7 @@ def head_lines(deck: Deck, sw: Params, base: Params, axes: list[tuple[str, list]
         shown = (", ".join(map(fmt, vals[:8])) if len(vals) <= 8 else
                  f"{fmt(vals[0])}, {fmt(vals[1])}, ..., {fmt(vals[-1])} ({len(vals)} values)")
         lines.append(f"    {name:<28} {shown}")
-    from driver.study import load_study   # settings of the base deck the summary columns depend on
+    from driver._study import load_study   # settings of the base deck the summary columns depend on
     swept = {name.partition(".")[2] for name, _ in axes}
     for key, v in summary_settings(load_study(base.group), base, swept).items():
         lines.append(f"    {key:<28} " + (", ".join(f"{x:g}" for x in v) if isinstance(v, (list, tuple)) else f"{v}")

@@ -287,7 +287,7 @@ def validate_sweep(sw: Params, raw: RawGroup, module: Any, grid: Grid) -> dict[i
     and the study estimates its work (the engine runs the longest cases first), else {}."""
     def check(values: dict[str, Any], case_no: int | None) -> limits.Estimate | None:
         try:
-            return limits.check(module, validate(_case_raw(raw, Case(0, values)), module.SPEC, sw.path), "each case ")
+            return limits.check(module, validate(_case_raw(raw, Case(0, values)), module.spec, sw.path), "each case ")
         except DeckError as exc:
             name = next((n for n in values if n.partition(".")[2] == exc.key), next(iter(values)))
             key, line = _axis_line(sw, name)

@@ -30,7 +30,8 @@ import f90nml
 import numpy as np
 import pandas as pd
 
-from driver import blas, expr, fourbar, kernels
+from driver import blas, expr, fourbar
+from driver.fourbar import kernel as fourbar_kernel
 from driver.atomic import output_set, write_text
 from driver.deck import Deck, DeckError, GroupSpec, Key, Params, RawGroup, positive, read_deck, validate
 from driver.export import write_tidy
@@ -41,7 +42,7 @@ from driver.synthesis.function import FunctionDesign, chebyshev, freudenstein, l
 
 __all__ = ["SPEC", "Synthesis", "synthesise", "run_synthesis_deck"]
 
-ST = kernels.FOURBAR_STATUS
+ST = fourbar_kernel.FOURBAR_STATUS
 
 
 def _check(p: Params) -> None:
@@ -279,7 +280,7 @@ def _function(p: Params) -> Synthesis:
         sgn = 1 if p.branch == "open" else -1
         x = np.linspace(x0, xf, p.error_points)
         crank_deg = fd.crank_start_deg + (x - x0) / (xf - x0) * p.crank_range_deg
-        out, st = kernels.fourbar_exact(np.radians(crank_deg), d, fd.crank, fd.coupler, fd.rocker, 1.0, 0.0, sgn)
+        out, st = fourbar_kernel.fourbar_exact(np.radians(crank_deg), d, fd.crank, fd.coupler, fd.rocker, 1.0, 0.0, sgn)
         desired_psi = fd.rocker_start_deg + (curve(x) - y0) / (yf - y0) * p.rocker_range_deg
         err = wrap180(np.degrees(out[:, 1]) - desired_psi)
         err = np.where(st == ST["ok"], err, np.nan)
@@ -288,7 +289,7 @@ def _function(p: Params) -> Synthesis:
         pc = fd.crank_start_deg + (xs - x0) / (xf - x0) * p.crank_range_deg
         pr = fd.rocker_start_deg + (ys - y0) / (yf - y0) * p.rocker_range_deg
         for s, attr in ((sgn, "point_error_deg"), (-sgn, "other_branch_point_error_deg")):
-            o2, s2 = kernels.fourbar_exact(np.radians(pc), d, fd.crank, fd.coupler, fd.rocker, 1.0, 0.0, s)
+            o2, s2 = fourbar_kernel.fourbar_exact(np.radians(pc), d, fd.crank, fd.coupler, fd.rocker, 1.0, 0.0, s)
             setattr(fd, attr, np.where(s2 == ST["ok"], wrap180(np.degrees(o2[:, 1]) - pr), np.nan))
         worst = int(np.nanargmax(np.abs(err))) if np.isfinite(err).any() else 0
         tol_deg = 1e-6 if len(xs) == 3 else math.inf
@@ -509,13 +510,14 @@ def synthesise(deck: Deck | str | Path) -> Synthesis:
 def _path_figure(syn: Synthesis, path: Path, title: str, fmt: bool | str = True) -> Path:
     """The linkage, its coupler curve and the target points, in the linkage deck's frame."""
     from driver import plotting
+    from driver.fourbar import figures as fourbar_figures
     from driver.synthesis import path as pg
     q = syn.design.parts
     theta = np.linspace(0.0, 360.0, 721)
-    out, st = kernels.fourbar_exact(np.radians(theta), q["ground"], q["crank"], q["coupler"], q["rocker"], 1.0, 0.0,
+    out, st = fourbar_kernel.fourbar_exact(np.radians(theta), q["ground"], q["crank"], q["coupler"], q["rocker"], 1.0, 0.0,
                                     1 if syn.params.branch == "open" else -1)
-    cp = kernels.fourbar_coupler_point(np.radians(theta), out, st, q["crank"], 1.0, 0.0, q["u"], q["v"])
-    fig = plotting.fourbar_linkage(q["ground"], theta, out, st == ST["ok"], None, title, point=cp[:, :2])
+    cp = fourbar_kernel.fourbar_coupler_point(np.radians(theta), out, st, q["crank"], 1.0, 0.0, q["u"], q["v"])
+    fig = fourbar_figures.fourbar_linkage(q["ground"], theta, out, st == ST["ok"], None, title, point=cp[:, :2])
     targets = np.column_stack([syn.params.target_x, syn.params.target_y]).astype(float)
     pp = pg.PathProblem(targets, None, 1, False, (0.0, 180.0), 1.0, 1.0)
     tk = pg._to_kernel(pp, syn.design.x)
@@ -539,7 +541,10 @@ def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool,
     failure as data (:class:`~driver.outcome.FilesOutcome`, the :class:`Synthesis` as ``value``).
     DeckError propagates."""
     syn = synthesise(deck)
-    stem = output_stem(outdir, deck.path)
+    stem = output_stem(outdir, deck.path, (".out", ".linkage.dat", ".linkage.out", f"{syn.table_name}.csv",
+                                           *(f".linkage.{fmt}" for fmt in formats),
+                                           *((".json",) if summary_json else ()),
+                                           *(("_error.png", "_path.png") if plot else ())))
     written = []
     with output_set(stem.parent):   # the deck's files all together, or none
         if syn.linkage is not None:

@@ -21,11 +21,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import differential_evolution
 
-from driver import kernels
+from driver.fourbar import kernel as fourbar_kernel
 
 __all__ = ["PathProblem", "PathDesign", "solve", "evaluate"]
 
-ST_OK = kernels.FOURBAR_STATUS["ok"]
+ST_OK = fourbar_kernel.FOURBAR_STATUS["ok"]
 PENALTY = 1e3
 #: weight of the pull towards the start in the least-squares stage (see polish)
 REG = 1e-6
@@ -90,8 +90,8 @@ def evaluate(pp: PathProblem, x: np.ndarray) -> PathDesign:
     theta = np.linspace(0.0, 360.0, pp.samples, endpoint=False)
     if pp.timing_deg is not None:
         theta = np.concatenate([theta, x[9] + pp.timing_deg])
-    out, st = kernels.fourbar_exact(np.radians(theta), d, a, b, c, 1.0, 0.0, pp.branch)
-    cp = kernels.fourbar_coupler_point(np.radians(theta), out, st, a, 1.0, 0.0, u, v)
+    out, st = fourbar_kernel.fourbar_exact(np.radians(theta), d, a, b, c, 1.0, 0.0, pp.branch)
+    cp = fourbar_kernel.fourbar_coupler_point(np.radians(theta), out, st, a, 1.0, 0.0, u, v)
     ok = st == ST_OK
     tk = _to_kernel(pp, x)
     n = len(tk)
@@ -143,10 +143,10 @@ def refine(pp: PathProblem, design: PathDesign) -> PathDesign:
     for (tx, ty), t0, e0 in zip(tk, design.theta_at_targets_deg, design.errors):
         def dist(t: float) -> float:
             th = np.radians([t])
-            out, st = kernels.fourbar_exact(th, d, a, b, c, 1.0, 0.0, pp.branch)
+            out, st = fourbar_kernel.fourbar_exact(th, d, a, b, c, 1.0, 0.0, pp.branch)
             if st[0] != ST_OK:
                 return math.inf
-            p = kernels.fourbar_coupler_point(th, out, st, a, 1.0, 0.0, u, v)[0]
+            p = fourbar_kernel.fourbar_coupler_point(th, out, st, a, 1.0, 0.0, u, v)[0]
             return math.hypot(p[0] - tx, p[1] - ty)
         r = minimize_scalar(dist, bounds=(t0 - step, t0 + step), method="bounded", options={"xatol": 1e-10})
         if r.fun < e0:
@@ -183,8 +183,8 @@ def polish(pp: PathProblem, design: PathDesign) -> PathDesign:
         th = z[n9:] if pp.timing_deg is None else z[n9] + pp.timing_deg
         d, a, bb, c, u, v = x[3:9]
         rad = np.radians(th)
-        out, st = kernels.fourbar_exact(rad, d, a, bb, c, 1.0, 0.0, pp.branch)
-        cp = kernels.fourbar_coupler_point(rad, out, st, a, 1.0, 0.0, u, v)[:, :2]
+        out, st = fourbar_kernel.fourbar_exact(rad, d, a, bb, c, 1.0, 0.0, pp.branch)
+        cp = fourbar_kernel.fourbar_coupler_point(rad, out, st, a, 1.0, 0.0, u, v)[:, :2]
         r = cp - _to_kernel(pp, np.concatenate([x, [0.0]]))
         r[st != ST_OK] = 10 * pp.length_max
         return r.ravel()

@@ -13,7 +13,7 @@ from scipy.optimize import minimize
 from tqdm import tqdm
 
 from driver.deck import Params
-from driver.kernels import UJOINT_MODELS, UJOINT_OBJECTIVES, ujoint_equivalent, ujoint_objective, ujoint_speed
+from driver.ujoint.kernel import UJOINT_MODELS, UJOINT_OBJECTIVES, ujoint_equivalent, ujoint_objective, ujoint_speed
 from driver.ujoint.spec import DEG
 
 
@@ -250,3 +250,9 @@ def _starts(params: Params, option: int, beta: np.ndarray, phi: np.ndarray, lb: 
     rng = np.random.default_rng(params.seed)
     rand = lb + (ub - lb) * rng.random((params.n_starts - 1, lb.size))
     return np.vstack([x0, rand]), notes
+
+
+def output_speed(chain: Chain, d: Design, theta_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(omega_out [rpm], alpha_out [rad/s^2], theta_out [deg]) of design d at theta_deg."""
+    r, dr, to = ujoint_speed(chain.model, d.beta * DEG, d.phi * DEG, chain.rho, theta_deg * DEG)
+    return chain.rpm * r, chain.omega ** 2 * dr, to / DEG

@@ -12,7 +12,7 @@ import numpy as np
 import pandas as pd
 
 from driver.deck import Params
-from driver.kernels import (UJOINT_MODELS, UJOINT_OBJECTIVES, UJOINT_PASSES, UJOINT_SUMMARY_COLUMNS, ujoint_geometry,
+from driver.ujoint.kernel import (UJOINT_MODELS, UJOINT_OBJECTIVES, UJOINT_PASSES, UJOINT_SUMMARY_COLUMNS, ujoint_geometry,
                             ujoint_summaries)
 from driver.ujoint.spec import _KEYS, DEG
 

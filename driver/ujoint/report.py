@@ -1,4 +1,5 @@
-"""Hooke-joint study: the fixed-format .out, the tidy table, the summary, result.dat and figures.
+"""Hooke-joint study: a deck run (analyse or optimise), the fixed-format .out, the tidy table, the
+summary and result.dat.
 
 Units as printed: angles in degrees, speeds in rpm, accelerations in rad/s^2.
 """
@@ -11,11 +12,14 @@ import numpy as np
 import pandas as pd
 
 from driver.deck import Params
+from driver.runner import keyword_run
+from driver.study import Figure, Result
 from driver.export import with_units
-from driver.kernels import UJOINT_MODELS, ujoint_speed
+from driver.ujoint.kernel import UJOINT_MODELS
 from driver.table import Column, fortran_f, render_table
-from driver.ujoint.analysis import TIE_RTOL, Chain, Design, StartRun, _free_index, evaluate, phases_for, yoke_shifts
-from driver.ujoint.spec import BAND_TOL, CONVENTIONS, DEG, OPTIONS, _per
+from driver.ujoint.analysis import (TIE_RTOL, Chain, Design, StartRun, _chain, _free_index, _starts, evaluate,
+                                    objective_scale, optimise, output_speed, phases_for, pick_best, yoke_shifts)
+from driver.ujoint.spec import BAND_TOL, CONVENTIONS, DEG, OPTIONS, _geometry, _per, _phases
 
 
 def _model_text(params: Params) -> str:
@@ -30,12 +34,6 @@ def _model_text(params: Params) -> str:
 def _table_theta(params: Params) -> np.ndarray:
     """Input angles of the speed table [deg]: 0 to 360 in table_step."""
     return np.arange(0.0, 360.0 + 1e-9, params.table_step)
-
-
-def _speed(chain: Chain, d: Design, theta_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(omega_out [rpm], alpha_out [rad/s^2], theta_out [deg]) of design d at theta_deg."""
-    r, dr, to = ujoint_speed(chain.model, d.beta * DEG, d.phi * DEG, chain.rho, theta_deg * DEG)
-    return chain.rpm * r, chain.omega ** 2 * dr, to / DEG
 
 
 def _fmt(x: float | None, d: int = 4) -> str:
@@ -263,7 +261,7 @@ def _render_speed_table(params: Params, chain: Chain, designs: list[Design], exa
     cols = [Column("theta_in", "f", 9, 2)]
     data = []
     for d in shown:
-        w, a, to = _speed(chain, d, th)
+        w, a, to = output_speed(chain, d, th)
         tag = {"optimum": "opt", "last iterate": "last", "fixed design": "fixed"}.get(d.label, d.label)
         cols += [Column(f"{tag} w_out", "f", 12, 5), Column(f"{tag} ratio", "f", 11, 7),
                  Column(f"{tag} acc", "f", 11, 6)]
@@ -282,7 +280,7 @@ def _tidy(chain: Chain, designs: list[Design]) -> pd.DataFrame:
     theta = np.arange(chain.m) * (360.0 / chain.m)
     frames = []
     for d in designs:
-        w, a, to = _speed(chain, d, theta)
+        w, a, to = output_speed(chain, d, theta)
         frame = pd.DataFrame({"design": d.label, "theta_in_deg": theta, "omega_in_rpm": chain.rpm,
                               "omega_out_rpm": w, "ratio": w / chain.rpm, "alpha_out_rad_s2": a})
         if chain.model == UJOINT_MODELS["exact"]:
@@ -323,16 +321,80 @@ def _result_dat(params: Params, chain: Chain, designs: list[Design], best: Desig
                else [] if pick.success else ["% NOT CONVERGED: x is the last iterate, not an optimum"]),
              "% theta_in_deg  omega_in_rpm  omega_out_trial_rpm  omega_out_optimum_rpm"]
     th = np.arange(0.0, 360.0 + 1e-9, 1.0)
-    w0 = _speed(chain, designs[0], th)[0]
-    w1 = _speed(chain, best, th)[0]
+    w0 = output_speed(chain, designs[0], th)[0]
+    w1 = output_speed(chain, best, th)[0]
     lines += [f"{fortran_f(t, 8, 2)} {fortran_f(params.rpm, 12, 6)} {fortran_f(a, 14, 8)} {fortran_f(b, 14, 8)}"
               for t, a, b in zip(th, w0, w1)]
     return "\n".join(lines) + "\n"
 
 
-def _figure(chain: Chain, designs: list[Design], polar: bool, band: list[float] | None = None, title: str = ""):
-    """The speed figure: every design overlaid, the paper's trial band (``paper_band``) shaded."""
-    from driver.plotting import ujoint_speed_figure
-    theta = np.arange(0.0, 360.0 + 1e-9, 1.0)
-    curves = {d.label: _speed(chain, d, theta)[0] for d in designs}
-    return ujoint_speed_figure(theta, chain.rpm, curves, polar=polar, band=band, title=title)
+@keyword_run
+def run(params: Params, progress: bool = False) -> Result:
+    """Analyse (option 0) or optimise (options 1-3) the chain of the deck."""
+    beta, rho = _geometry(params)
+    n = beta.size
+    phi = _phases(params, n)
+    chain = _chain(params, rho, n)
+    trial = evaluate(chain, "trial" if params.option else "design", beta, phi)
+    designs = [trial]
+    warnings: list[str] = []
+    notes: list[str] = []
+    runs: list[StartRun] = []
+    failure = None
+    best = None
+    option = params.option
+    if option:
+        free = _free_index(option, n)
+        lo = np.concatenate([_per(params, "beta_lower", n, "joints"),
+                             _per(params, "phi_lower", n - 1, "phases") if n > 1 else []])
+        hi = np.concatenate([_per(params, "beta_upper", n, "joints"),
+                             _per(params, "phi_upper", n - 1, "phases") if n > 1 else []])
+        lb, ub = lo[free] * DEG, hi[free] * DEG
+        beta_max = max(np.max(np.abs(beta)), np.max(np.abs(hi[:n])) if option in (2, 3) else 0.0)
+        scale = objective_scale(chain, trial.objective, beta_max)
+        z = np.concatenate([beta, phi])
+        if np.all(lb == ub):
+            z[free] = lb / DEG
+            best = evaluate(chain, "fixed design", z[:n], z[n:])
+            best.extra = {"run": None, "index": None}
+            designs.append(best)
+            notes.append("equal bounds fix every free variable: the fixed design is evaluated, "
+                         "not optimised (no multi-start)")
+        else:
+            starts, start_notes = _starts(params, option, beta, phi, lb, ub, chain)
+            notes += start_notes
+            runs = optimise(chain, option, beta * DEG, phi * DEG, lb, ub, starts, params.maxiter,
+                            params.ftol, scale, progress)
+            ok = any(r.success for r in runs)
+            ipick = pick_best(runs, int(np.sum(free < n)))
+            pick = runs[ipick]
+            z[free] = pick.x / DEG
+            best = evaluate(chain, "optimum" if ok else "last iterate", z[:n], z[n:])
+            best.extra = {"run": pick, "index": ipick + 1, "scale": scale,
+                          "resolution": params.ftol * scale}
+            designs.append(best)
+            if not ok:
+                failure = (f"the optimiser did not converge from any of {len(runs)} start(s) "
+                           f"(best start: {pick.message}); no optimum is reported")
+                warnings.append(failure)
+    printed = None
+    if params.paper_beta is not None or params.paper_phi is not None:
+        pb = np.asarray(params.paper_beta if params.paper_beta is not None else beta, float)
+        pp = _phases(params, n, "paper_phi") if params.paper_phi is not None else phi
+        printed = evaluate(chain, "paper printed", pb, pp)
+        designs.append(printed)
+    text = _render(params, chain, beta, rho, designs, runs, notes, warnings, failure)
+    tidy = _tidy(chain, designs)
+    summary = _summary(trial, best, runs, failure)
+    extra = {".result.dat": _result_dat(params, chain, designs, best, runs)} if best is not None else {}
+    title = params.path.stem if getattr(params, "path", None) else ""
+    figures = [Figure("speed", lambda: _figures().speed_figure(chain, designs, False, params.paper_band, title)),
+               Figure("polar", lambda: _figures().speed_figure(chain, designs, True, params.paper_band, title))]
+    return Result(text=text, tidy=tidy, summary=summary, warnings=warnings, failure=failure,
+                  figures=figures, extra=extra)
+
+
+def _figures():
+    """The study's figure module, imported when a figure is drawn (matplotlib is the optional [plot] extra)."""
+    from driver.ujoint import figures
+    return figures

@@ -10,7 +10,8 @@ import math
 import numpy as np
 
 from driver.deck import GroupSpec, Key, Params, non_empty, positive
-from driver.kernels import ujoint_geometry
+from driver.limits import Estimate
+from driver.ujoint.kernel import ujoint_geometry
 
 
 DEG = math.pi / 180.0
@@ -239,3 +240,26 @@ SWEEP_PLOT = ("omega_out_min_rpm", "omega_out_max_rpm", "pp_ratio", "beta_e_deg"
 SPEC = GroupSpec("ujoint", _KEYS, check=cross_check,
                  doc="Hooke-joint shaft chain: speed fluctuation, exact 3-D kinematics, SSO options 0-3. "
                  "Conventions: " + CONVENTIONS)
+
+
+def estimate(params: Params) -> Estimate:
+    """Memory and work of a run from the keys alone (driver.limits).
+
+    Per input angle of the grid and joint about 200 bytes of kernel arrays and 20 ns per
+    objective evaluation; SLSQP evaluates objective and gradient about (variables + 1) times per
+    iteration for every start; each speed-table row costs about 1 KB and 20 us to format.
+    """
+    p = params
+    joints = max(len(p.beta or []), len(p.phi or []) + 1, 2)
+    m = float(p.n_grid)
+    try:
+        rows = math.floor(360.0 / p.table_step + 1e-9) + 1.0
+    except (OverflowError, ZeroDivisionError):
+        rows = math.inf
+    evals = 0.0 if p.option == 0 else float(p.n_starts) * p.maxiter * (2 * joints + 1)
+    mem = Estimate(200.0 * m * joints + 5e6, 2e-8 * m * joints * (evals + 10), "n_grid",
+                   "n_starts" if p.option else "n_grid", f"{m:.4g} grid angles x {joints} joints"
+                   + (f", about {evals:.3g} objective evaluations" if evals else ""))
+    table = Estimate(1000.0 * rows * joints, 2e-5 * rows * joints, "table_step", "table_step",
+                     f"{rows:.4g} speed-table rows")
+    return mem + table

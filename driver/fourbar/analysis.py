@@ -1,0 +1,258 @@
+"""Four-bar analysis: Grashof class, limit (toggle) angles, the closed-loop and listing states
+through the kernel, the extremes over the crank range, and the tidy columns of the states."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from driver.deck import Params
+from driver.export import with_units
+from driver.fourbar import kernel
+from driver.fourbar.batch import summary_rows
+
+__all__ = ['ST', 'Grashof', 'grashof', 'limit_angles', 'assembly_intervals', 'Motion', 'rocking_motions', 'crank_angles', 'exact_grid', 'coupler_point', 'listing_grid', 'deg360', 'Extremes', 'toggles_in_range', 'extremes', 'TIDY_UNITS', 'tidy_frame', 'exact_columns', 'blame']
+
+
+ST = kernel.FOURBAR_STATUS
+
+
+@dataclass
+class Grashof:
+    """Grashof classification of a four-bar (Norton's classes)."""
+
+    name: str
+    condition: str
+    full_crank_rotation: bool
+
+
+def grashof(p: float, q: float, r: float, s: float) -> Grashof:
+    """Class from link lengths (p ground, q crank, r coupler, s rocker)."""
+    links = {"ground": p, "crank": q, "coupler": r, "rocker": s}
+    srt = sorted(links.values())
+    short, long_ = srt[0], srt[-1]
+    lhs, rhs = short + long_, srt[1] + srt[2]
+    tol = 1e-12 * rhs
+    cond = f"S + L = {short:g} + {long_:g} = {lhs:g} {'<' if lhs < rhs - tol else ('=' if abs(lhs - rhs) <= tol else '>')} P + Q = {rhs:g}"
+    if lhs > rhs + tol:
+        return Grashof("non-Grashof triple-rocker", cond, False)
+    if abs(lhs - rhs) <= tol:
+        return Grashof("change-point (special Grashof)", cond, True)
+    shortest = min(links, key=lambda k: (links[k], ["ground", "crank", "rocker", "coupler"].index(k)))
+    names = {"ground": ("double-crank (drag link)", True), "crank": ("crank-rocker", True),
+             "rocker": ("rocker-crank", False), "coupler": ("Grashof double-rocker", False)}
+    name, full = names[shortest]
+    return Grashof(name, cond, full)
+
+
+def limit_angles(p: float, q: float, r: float, s: float) -> list[float]:
+    """Crank angles [deg, 0..360) where |A O_B| = r + s or |r - s| (toggle / assembly limits)."""
+    out = []
+    for d in (r + s, abs(r - s)):
+        c = (p * p + q * q - d * d) / (2 * p * q)
+        if -1.0 <= c <= 1.0:
+            a = math.degrees(math.acos(c))
+            out += [a, (360.0 - a) % 360.0]
+    return sorted(set(round(a, 10) for a in out))
+
+
+def assembly_intervals(p: float, q: float, r: float, s: float) -> list[tuple[float, float]] | None:
+    """Crank-angle intervals [deg] over which the linkage assembles, from the closed form
+    (r - s)^2 <= |A O_B|^2 = p^2 + q^2 - 2 p q cos(theta) <= (r + s)^2; each ends at two limit
+    (toggle) positions.  None when the crank turns fully; [] when it cannot be assembled at all.
+    An interval through 0 deg is one interval (lo < 0 < hi), not two; a Grashof double-rocker
+    gives two, mirror images about the ground line (separate motions: one cannot reach the
+    other without taking the linkage apart)."""
+    c_lo = (p * p + q * q - (r + s) ** 2) / (2 * p * q)   # cos(theta) at |A O_B| = r + s
+    c_hi = (p * p + q * q - (r - s) ** 2) / (2 * p * q)   # cos(theta) at |A O_B| = |r - s|
+    eps = 1e-12
+    if c_lo <= -1.0 + eps and c_hi >= 1.0 - eps:
+        return None
+    if c_lo > c_hi or c_lo > 1.0 or c_hi < -1.0:
+        return []
+    t1 = math.degrees(math.acos(max(-1.0, min(1.0, c_lo))))   # extended limit (r + s)
+    t2 = math.degrees(math.acos(max(-1.0, min(1.0, c_hi))))   # folded limit |r - s|
+    if c_lo > -1.0 + eps and c_hi >= 1.0 - eps:
+        return [(-t1, t1)]                  # rocks through 0 deg between its extended limits
+    if c_lo <= -1.0 + eps:
+        return [(t2, 360.0 - t2)]           # rocks through 180 deg between its folded limits
+    return [(t2, t1), (360.0 - t1, 360.0 - t2)]
+
+
+@dataclass
+class Motion:
+    """One motion of a linkage whose crank cannot turn: the crank swings from ``lo`` to ``hi``
+    on the deck's assembly branch, reverses at the limit position and swings back on the other
+    branch (at a limit the two branches meet: B lies on the line A-O_B).
+
+    ``theta`` [deg] the crank angles in the order they are passed, ``out``/``status`` the
+    kernel's states there, ``branch`` +1 (open) or -1 (crossed) per sample, ``stroke`` 0 for
+    the forward swing and 1 for the return."""
+
+    lo: float
+    hi: float
+    theta: np.ndarray
+    out: np.ndarray
+    status: np.ndarray
+    branch: np.ndarray
+    stroke: np.ndarray
+
+
+def rocking_motions(p: Params, n_stroke: int = 181) -> list[Motion] | None:
+    """The motions of the deck's linkage when its crank cannot turn fully (None when it can):
+    per assembly interval (:func:`assembly_intervals`), ``n_stroke`` samples forward on the
+    deck's branch and ``n_stroke`` back on the other, the ends a hair inside the limit angles
+    (at the limit itself round-off may put A a ulp beyond reach).  Positions only: the
+    kernel's velocities assume the deck's constant crank speed (reversed on the return)."""
+    spans = assembly_intervals(p.fixed_link, p.crank, p.coupler, p.rocker)
+    if spans is None:
+        return None
+    first = 1 if p.branch == "open" else -1
+    motions = []
+    for lo, hi in spans:
+        pad = 1e-7 * max(1.0, hi - lo)
+        # cosine spacing: samples gather at the limits, where B moves fast for a little crank
+        # motion (and a crank driven to and fro slows there to reverse)
+        fwd = lo + pad + (hi - lo - 2 * pad) * 0.5 * (1.0 - np.cos(np.linspace(0.0, math.pi, n_stroke)))
+        o1, s1 = kernel.fourbar_exact(np.radians(fwd), p.fixed_link, p.crank, p.coupler, p.rocker,
+                                      p.omega, p.alpha, first)
+        o2, s2 = kernel.fourbar_exact(np.radians(fwd[::-1]), p.fixed_link, p.crank, p.coupler, p.rocker,
+                                      -p.omega, p.alpha, -first)
+        motions.append(Motion(lo, hi, np.concatenate([fwd, fwd[::-1]]), np.vstack([o1, o2]),
+                              np.concatenate([s1, s2]),
+                              np.repeat([first, -first], n_stroke), np.repeat([0, 1], n_stroke)))
+    return motions
+
+
+def crank_angles(p: Params) -> np.ndarray:
+    """The requested crank angles [deg] (Fortran DO semantics: start, start+step, ... <= stop)."""
+    n = int(math.floor((p.stop_deg - p.start_deg) / p.step_deg + 1e-9)) + 1
+    return p.start_deg + p.step_deg * np.arange(n)
+
+
+def exact_grid(p: Params, theta_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Closed-loop states at ``theta_deg`` (kernel columns, see kernel.fourbar_exact)."""
+    return kernel.fourbar_exact(np.radians(theta_deg), p.fixed_link, p.crank, p.coupler, p.rocker,
+                                 p.omega, p.alpha, 1 if p.branch == "open" else -1)
+
+
+def coupler_point(p: Params, theta_deg: np.ndarray, out: np.ndarray, status: np.ndarray) -> np.ndarray | None:
+    """Position, velocity and acceleration of the deck's coupler point (None if it has none)."""
+    if not p.coupler_point:
+        return None
+    u, v = p.coupler_point
+    return kernel.fourbar_coupler_point(np.radians(theta_deg), out, status, p.crank, p.omega, p.alpha, u, v)
+
+
+def listing_grid(p: Params) -> tuple[np.ndarray, np.ndarray]:
+    """The published program's rows for the deck's crank angles."""
+    start, step = int(p.start_deg), int(p.step_deg)
+    n = len(crank_angles(p))
+    return kernel.fourbar_listing(p.fixed_link, p.crank, p.coupler, p.rocker, p.omega, start, step, n)
+
+
+def deg360(rad: np.ndarray) -> np.ndarray:
+    """Radians -> degrees in [0, 360), with values that round to 360.0 folded to 0."""
+    d = np.mod(np.degrees(rad), 360.0)
+    return np.where(d >= 359.95, d - 360.0, d)
+
+
+@dataclass
+class Extremes:
+    """Headline figures over the analysed crank range (exact solution), from the batch kernel."""
+
+    mu_min: float
+    mu_min_at: float
+    mu_max: float
+    mu_max_at: float
+    rocker_min: float
+    rocker_min_at: float
+    rocker_max: float
+    rocker_max_at: float
+    w3_peak: float
+    w3_peak_at: float
+    w2_peak: float
+    w2_peak_at: float
+    assembled_fraction: float
+    rocker_turns: bool = False
+    toggles: tuple[float, ...] = ()
+    rocker_swing: float = 0.0
+
+
+def toggles_in_range(p: float, q: float, r: float, s: float, lo: float, hi: float) -> tuple[float, ...]:
+    """Limit (toggle) crank angles [deg] inside [lo, hi], every turn (a + 360 k), ascending."""
+    out = []
+    for a in limit_angles(p, q, r, s):
+        k0, k1 = math.ceil((lo - a) / 360.0), math.floor((hi - a) / 360.0)
+        out += [a + 360.0 * k for k in range(k0, min(k1, k0 + 1000) + 1)]
+    return tuple(sorted(out))
+
+
+def extremes(p: Params, row: np.ndarray | None = None) -> Extremes | None:
+    """Transmission-angle, rocker-position and speed extremes over the deck's crank range.
+
+    One row of the batch kernel (fortran/fourbar_summary.f90, see :func:`summarise_batch`),
+    so a single run and a sweep report the same figures: transmission-angle and rocker
+    extremes in closed form, peak speeds from a 1 deg scan refined to 1e-12 rad.
+    None when the linkage cannot be assembled anywhere in the range.  ``row``: the deck's row
+    of the summary kernel when the caller has it (:func:`driver.fourbar.batch.summary_rows`).
+    """
+    lo, hi = sorted((p.start_deg, p.stop_deg))
+    if row is None:
+        row = summary_rows(p)[0]
+    if not row[1]:
+        return None
+    toggles = toggles_in_range(p.fixed_link, p.crank, p.coupler, p.rocker, lo, hi)
+    return Extremes(row[3], row[4], row[5], row[6], row[7], row[8], row[9], row[10],
+                    row[14], row[15], row[16], row[17], row[2], bool(row[12]), toggles, row[11])
+
+
+#: units of the tidy columns whose names do not say them ('length': the deck's length unit)
+TIDY_UNITS = {"xa": "length", "ya": "length", "xb": "length", "yb": "length", "xp": "length", "yp": "length",
+              "ab_error": "length"}
+
+
+def tidy_frame(method: str, theta: np.ndarray, cols: dict[str, np.ndarray], status: np.ndarray,
+               not_closed: np.ndarray | None = None) -> pd.DataFrame:
+    """One row per crank angle; status in words ('loop_not_closed' where ``not_closed``: a
+    listing row whose |AB| is not the coupler length); unassemblable cells left empty (NaN)."""
+    words = np.array(["ok", "cannot_assemble", "toggle", "indeterminate", "loop_not_closed"])[
+        np.where(not_closed, 4, status) if not_closed is not None else status]
+    frame = pd.DataFrame({"method": method, "theta_deg": theta, **cols, "status": words})
+    return with_units(frame, TIDY_UNITS)
+
+
+def exact_columns(out: np.ndarray, status: np.ndarray, cp: np.ndarray | None = None,
+                   coupler: float | None = None) -> dict[str, np.ndarray]:
+    vals = {"coupler_deg": deg360(out[:, 0]), "rocker_deg": deg360(out[:, 1]),
+            "transmission_deg": np.degrees(out[:, 2]), "xa": out[:, 3], "ya": out[:, 4],
+            "xb": out[:, 5], "yb": out[:, 6], "omega2_rad_s": out[:, 7], "omega3_rad_s": out[:, 8],
+            "alpha2_rad_s2": out[:, 9], "alpha3_rad_s2": out[:, 10]}
+    if coupler is not None:   # loop closure of the solution: |AB| - coupler (round-off only)
+        vals["ab_error"] = np.hypot(out[:, 5] - out[:, 3], out[:, 6] - out[:, 4]) - coupler
+    if cp is not None:
+        vals.update({"xp": cp[:, 0], "yp": cp[:, 1], "vxp_per_s": cp[:, 2], "vyp_per_s": cp[:, 3],
+                     "axp_per_s2": cp[:, 4], "ayp_per_s2": cp[:, 5]})
+    nope = (status == ST["no_assembly"]) | (status == ST["indeterminate"])
+    tog = status == ST["toggle"]
+    for k, v in vals.items():
+        v = v.copy()
+        if k not in ("xa", "ya"):
+            v[nope] = np.nan
+        if k.startswith(("omega", "alpha", "vxp", "vyp", "axp", "ayp")):
+            v[tog] = np.nan
+        vals[k] = v
+    return vals
+
+
+def blame(params: Params, exc: BaseException) -> tuple[str, str] | None:
+    """The key and words for a numerical failure of a run (driver.runner.numerical_error)."""
+    p = params
+    g = grashof(p.fixed_link, p.crank, p.coupler, p.rocker)
+    if p.method == "listing" and g.name.startswith("change-point"):
+        return ("method", f"the listing's formulas divide 0 by 0 for this change-point linkage ({g.condition}) "
+                          "where it folds flat, so its table has no finite value there; use method = 'exact' "
+                          "(the closed-loop solution names both branches at the fold)")
+    return None

@@ -1,0 +1,309 @@
+"""The study contract (driver._study): every registered study declares what it offers in one
+:class:`~driver._study.Study`, the engines reach it only through that object, and adding a study
+is one folder plus one registry line (shown with the example study in tests/example_study/).
+
+Truth used here: the contract's own rules (types, required fields, batch keys that are deck
+keys); for every shipped deck the budget estimate of its study; for each batch summary, the pass
+table against the full summary (asking for one column computes exactly the value the full
+summary has); and for the example pendulum an independent integration of its equation of motion
+(scipy's solve_ivp on theta'' = -(3g / 2L) sin theta, written apart from its elliptic-integral
+"kernel") and the textbook period ratio 2K(1/2)/pi = 1.1803406 at 90 deg amplitude.
+"""
+from __future__ import annotations
+
+import ast
+import importlib
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy.integrate import solve_ivp
+
+import driver
+from driver import deck as deck_module, limits
+from driver.sweep import batch as sweep_batch
+from driver._study import REGISTRY, BatchSummary, Study, load_study, study_names
+from driver.deck import DeckError, GroupSpec, Key, read_deck
+from driver.limits import Estimate
+from driver.runner import CONTROL_GROUPS, compute, study_of
+
+ROOT = Path(__file__).resolve().parents[1]
+INPUTS = ROOT / "inputs"
+EXAMPLE = Path(__file__).resolve().parent / "example_study" / "pendulum"
+
+STUDIES = ("fourbar", "manipulator", "robust_example", "slidercrank", "ujoint")
+
+
+def _decks_of(group: str) -> list[Path]:
+    """Shipped single-study decks of ``group`` (no &sweep/&optimize/&synthesis)."""
+    out = []
+    for path in sorted(INPUTS.glob("*.dat")):
+        groups = read_deck(path).groups
+        if group in groups and not set(groups) & set(CONTROL_GROUPS):
+            out.append(path)
+    return out
+
+
+# ----------------------------------------------------------------------------- the registry
+
+def test_the_registry_is_an_explicit_list_and_names_every_study():
+    assert study_names() == sorted(REGISTRY) == list(STUDIES)
+    for name in ("cli", "deck", "sweep", "optimize", "plotting", "kernels", "study", "_study", "fourbar.forces"):
+        assert load_study(name) is None          # no module-name probing: what is not listed is no study
+    assert set(driver.studies()) == set(STUDIES)
+
+
+def test_a_registered_package_without_a_study_is_an_error_not_skipped(monkeypatch):
+    monkeypatch.setitem(REGISTRY, "table", "driver.table")
+    with pytest.raises(TypeError, match="binds no STUDY"):
+        load_study("table")
+
+
+# ----------------------------------------------------------------------------- every registered study
+
+@pytest.mark.parametrize("name", STUDIES)
+def test_every_registered_study_satisfies_the_contract(name):
+    s = load_study(name)
+    assert isinstance(s, Study) and s.name == name and s.spec.name == name
+    assert s.module.STUDY is s and s.package == REGISTRY[name]
+    assert isinstance(s.spec, GroupSpec) and s.spec.keys and all(isinstance(k, Key) for k in s.spec.keys.values())
+    assert callable(s.run) and callable(s.estimate)
+    assert set(s.summary_settings) <= set(s.spec.keys)
+    assert set(s.sweep_best.values()) <= {"max", "min"}
+    for words, units in s.labels.values():
+        assert isinstance(words, str) and words and isinstance(units, str)
+    if s.batch is not None:
+        assert set(s.batch.keys) | set(s.batch.ignored) | set(s.batch.independent) <= set(s.spec.keys)
+        assert set(s.batch.elements) <= set(s.batch.keys)
+        assert s.batch.passes is None or {p for ps in s.batch.passes.values() for p in ps} <= set(s.batch.pass_names)
+
+
+@pytest.mark.parametrize("name", STUDIES)
+def test_estimate_gives_sane_numbers_for_every_shipped_deck_of_the_study(name):
+    s = load_study(name)
+    decks = _decks_of(name)
+    assert decks, f"no example deck of &{name} in inputs/"
+    for path in decks:
+        study, params = study_of(read_deck(path))
+        assert study is s
+        est = s.estimate(params)
+        assert isinstance(est, Estimate), path
+        assert math.isfinite(est.bytes) and math.isfinite(est.seconds), path
+        assert 1e3 < est.bytes < 2**31 and 0 < est.seconds < limits.DEFAULT_WORK, (path, est)
+        assert est.memory_key is None or est.memory_key in s.spec.keys, (path, est.memory_key)
+        assert est.work_key is None or est.work_key in s.spec.keys, (path, est.work_key)
+        assert limits.check(s, params) == est
+
+
+#: the files every study package has (plus kernel.py with a kernel, batch.py with a batch path)
+LAYOUT = {"__init__.py", "spec.py", "analysis.py", "report.py", "figures.py", "published.py"}
+
+
+@pytest.mark.parametrize("name", STUDIES)
+def test_every_study_has_the_one_layout(name):
+    s = load_study(name)
+    folder = Path(s.module.__file__).parent
+    files = {p.name for p in folder.glob("*.py")}
+    need = LAYOUT | ({"kernel.py"} if s.kernel is not None else set()) | ({"batch.py"} if s.batch is not None else set())
+    assert need <= files, sorted(need - files)
+    assert s.figures == f"{s.package}.figures" and importlib.import_module(s.figures).__file__
+    assert s.published is not None and s.published.__module__ == f"{s.package}.published"
+    assert s.kernel is None or s.kernel.__name__ == f"{s.package}.kernel"
+    assert s.run.__module__.startswith(f"{s.package}.report") and s.estimate.__module__ == f"{s.package}.spec"
+    assert len((folder / "__init__.py").read_text().splitlines()) <= 60   # public names and STUDY
+
+
+def test_shared_modules_hold_no_per_study_code():
+    """plotting keeps the house style and the shared figures, compare the comparison machinery,
+    kernels the loader: no study group is named in their code (docstrings aside)."""
+    for module in ("plotting", "compare", "kernels", "published", "runner", "limits", "report_page"):
+        tree = ast.parse((ROOT / "driver" / f"{module}.py").read_text())
+        for node in ast.walk(tree):
+            body = getattr(node, "body", None)
+            if isinstance(body, list) and body and isinstance(body[0], ast.Expr) \
+                    and isinstance(body[0].value, ast.Constant) and isinstance(body[0].value.value, str):
+                body[0].value.value = ""   # the docstring
+        code = ast.unparse(tree)
+        for name in STUDIES:
+            assert not re.search(rf"\b{name}\b", code), (module, name)
+
+
+def _same(a: pd.Series, b: pd.Series) -> bool:
+    if pd.api.types.is_numeric_dtype(a) and pd.api.types.is_numeric_dtype(b):
+        return bool(np.array_equal(a.to_numpy(float), b.to_numpy(float), equal_nan=True))
+    return a.astype(object).where(a.notna(), None).tolist() == b.astype(object).where(b.notna(), None).tolist()
+
+
+@pytest.mark.parametrize("name", [n for n in STUDIES if n in ("fourbar", "manipulator", "ujoint")])
+def test_batch_pass_table_agrees_with_the_summary_columns(name):
+    """Each column a pass table names, asked for alone, has the value the full summary gives it
+    (a column whose pass the table forgot would come back zero or missing); the headline
+    columns a study plots and ranks are columns of its summary."""
+    s = load_study(name)
+    assert s.batch is not None and s.batch.passes is not None
+    checked = 0
+    for path in _decks_of(name):
+        _, params = study_of(read_deck(path))
+        if s.batch.applies is not None and not s.batch.applies(params):
+            continue
+        full = s.batch.fn(params, {})
+        tabled = [c for c in full.columns if c in s.batch.passes]
+        assert tabled, path
+        assert not [c for c in s.batch.passes if c not in full.columns and not _optional(s, c)], path
+        for c in tabled:
+            alone = s.batch.fn(params, {}, wanted=[c])
+            assert list(alone.columns) == [c], (path, c)
+            assert _same(alone[c], full[c]), (path, c)
+        for c in (*s.sweep_plot, *s.sweep_best):
+            assert c in full.columns, (path, c)
+        checked += 1
+    assert checked
+
+
+def _optional(s: Study, column: str) -> bool:
+    """Columns of a pass table a deck may not produce: the four-bar's detail columns and its
+    force columns (decks that give masses); the manipulator's C_rob walk minimum."""
+    if s.name == "fourbar":
+        from driver.fourbar.batch import DETAIL
+        return column in DETAIL or s.batch.passes[column] == ("forces",)
+    return False
+
+
+@pytest.mark.parametrize("name", ["fourbar", "manipulator"])
+def test_summarise_gives_the_run_summary(name):
+    s = load_study(name)
+    assert s.summarise is not None
+    study, params = study_of(read_deck(_decks_of(name)[0]))
+    quick, full = s.summarise(params), compute(study, params).summary
+    assert list(quick) == list(full)
+    for k, v in quick.items():   # floats to 1e-12: the manipulator's Monte Carlo maximum differs in the last bit
+        if isinstance(v, float) and isinstance(full[k], float):
+            assert v == pytest.approx(full[k], rel=1e-12, abs=0.0, nan_ok=True), k
+        else:
+            assert v == full[k], k
+
+
+# ----------------------------------------------------------------------------- the contract's own checks
+
+def _spec(name: str = "toy") -> GroupSpec:
+    return GroupSpec(name, {"a": Key("float", default=1.0), "b": Key("float", default=2.0)})
+
+
+def _run(params, progress=False):
+    raise AssertionError("not run")
+
+
+def _est(params):
+    return Estimate(1e6, 0.1)
+
+
+def test_a_study_without_estimate_cannot_register():
+    with pytest.raises(TypeError, match="estimate is required"):
+        Study(name="toy", package=__name__, spec=_spec(), run=_run, estimate=None)  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match="run is required"):
+        Study(name="toy", package=__name__, spec=_spec(), run="run", estimate=_est)  # type: ignore[arg-type]
+
+
+def test_misspelt_names_raise_when_the_study_is_declared():
+    fn = lambda base, columns=None, wanted=None: pd.DataFrame()
+    with pytest.raises(ValueError, match="'c' is not a key"):
+        Study(name="toy", package=__name__, spec=_spec(), run=_run, estimate=_est, batch=BatchSummary(fn, keys=("a", "c")))
+    with pytest.raises(ValueError, match="not a key"):
+        Study(name="toy", package=__name__, spec=_spec(), run=_run, estimate=_est,
+              batch=BatchSummary(fn, keys=("a",), independent=("bb",)))
+    with pytest.raises(ValueError, match="pass 'peak' is not one of"):
+        BatchSummary(fn, keys=("a",), passes={"x": ("peak",)}, pass_names=("peaks",))
+    with pytest.raises(ValueError, match="both a batch key and ignored"):
+        BatchSummary(fn, keys=("a",), ignored=("a",))
+    with pytest.raises(ValueError, match="declares group &other"):
+        Study(name="toy", package=__name__, spec=_spec("other"), run=_run, estimate=_est)
+    with pytest.raises(ValueError, match="'max' or 'min'"):
+        Study(name="toy", package=__name__, spec=_spec(), run=_run, estimate=_est, sweep_best={"x": "best"})
+    with pytest.raises(ValueError, match="not a key"):
+        Study(name="toy", package=__name__, spec=_spec(), run=_run, estimate=_est, summary_settings=("band",))
+    with pytest.raises(TypeError, match=r"labels\['x'\]"):
+        Study(name="toy", package=__name__, spec=_spec(), run=_run, estimate=_est, labels={"x": "words"})
+    s = Study(name="toy", package=__name__, spec=_spec(), run=_run, estimate=_est, labels={"a": ("aa", "m")})
+    with pytest.raises(Exception):
+        s.name = "other"                                   # frozen
+    with pytest.raises(TypeError):
+        s.labels["b"] = ("bb", "s")                        # read-only mapping
+
+
+# ----------------------------------------------------------------------------- the example study
+
+@pytest.fixture
+def pendulum(monkeypatch):
+    """Register the example study: the one line a new study adds to driver._study.REGISTRY."""
+    monkeypatch.syspath_prepend(str(EXAMPLE.parents[1]))
+    monkeypatch.setitem(REGISTRY, "pendulum", "example_study.pendulum")
+    yield load_study("pendulum")
+    deck_module._KNOWN.pop("pendulum", None)
+
+
+def _ode_period_and_swing(length: float, g: float, theta0: float, t: np.ndarray) -> tuple[float, np.ndarray]:
+    """Independent truth: integrate I theta'' = -m g (L/2) sin theta, I = m L^2 / 3, from rest."""
+    w2 = 1.5 * g / length
+    quarter = lambda _t, y: y[0]
+    quarter.terminal, quarter.direction = True, -1
+    sol = solve_ivp(lambda _t, y: [y[1], -w2 * math.sin(y[0])], (0.0, 100.0), [theta0, 0.0], events=quarter,
+                    rtol=1e-12, atol=1e-14, dense_output=True)
+    period = 4.0 * sol.t_events[0][0]
+    half = solve_ivp(lambda _t, y: [y[1], -w2 * math.sin(y[0])], (0.0, float(t[-1])), [theta0, 0.0], t_eval=t,
+                     rtol=1e-12, atol=1e-14)
+    return period, half.y[0]
+
+
+def test_adding_a_study_is_one_folder_and_one_registry_line(pendulum):
+    """The example lives in one folder of the house layout; no file of driver/ names it."""
+    files = sorted(p.name for p in EXAMPLE.glob("*.py"))
+    assert files == ["__init__.py", "batch.py", "figures.py", "kernel.py", "report.py", "spec.py"]
+    for src in (ROOT / "driver").rglob("*.py"):
+        assert "pendulum" not in src.read_text(), src
+    assert isinstance(pendulum, Study) and pendulum.name in study_names()
+    assert pendulum.kernel is not None and pendulum.figures is not None
+    assert "pendulum" in driver.studies() and list(driver.keys("pendulum").index)[:3] == ["length", "gravity",
+                                                                                           "amplitude_deg"]
+
+
+@pytest.mark.parametrize("amplitude", [5.0, 90.0, 170.0])
+def test_example_study_runs_through_the_driver_and_matches_the_equation_of_motion(pendulum, amplitude):
+    import example_study.pendulum as pkg
+    res = pkg.run(length=0.8, amplitude_deg=amplitude, points=9)    # keyword form: through the runner
+    assert res.ok and res.study == "pendulum"
+    period, theta = _ode_period_and_swing(0.8, 9.80665, math.radians(amplitude), res.tidy["time_s"].to_numpy())
+    assert res.summary["period_s"] == pytest.approx(period, rel=1e-9)
+    assert res.summary["small_angle_period_s"] == pytest.approx(2 * math.pi * math.sqrt(0.8 / 1.5 / 9.80665), rel=1e-14)
+    assert np.allclose(res.tidy["theta_deg"], np.degrees(theta), atol=1e-6)
+    assert res.tidy["theta_deg"].iloc[-1] == pytest.approx(-amplitude, abs=1e-6)   # half a period: the other side
+    if amplitude == 90.0:
+        assert res.summary["period_ratio"] == pytest.approx(1.1803406, abs=5e-8)   # 2 K(1/2) / pi, textbooks
+
+
+def test_example_study_deck_sweep_budget_and_figures(pendulum, tmp_path):
+    from driver.cli import main
+    deck = tmp_path / "swing.dat"
+    deck.write_text("&pendulum length = 0.5, amplitude_deg = 60, title = 'example' /\n")
+    assert main([str(deck), "-o", str(tmp_path / "out"), "-q", "--plot"]) == 0
+    out = (tmp_path / "out" / "swing.out").read_text()
+    assert "period" in out and (tmp_path / "out" / "swing_swing.png").is_file()
+    bad = tmp_path / "bad.dat"
+    bad.write_text("&pendulum length = 0.5, amplitude_deg = 200 /\n")
+    assert main([str(bad), "-o", str(tmp_path / "bad"), "-q"]) == 2
+    _, params = study_of(read_deck(deck))
+    with pytest.raises(DeckError) as exc:                  # the budget applies to the new study too
+        limits.check(pendulum, params, lim=limits.Budget(memory=1e3, work=1.0))
+    assert exc.value.key == "points"
+    grid = {"amplitude_deg": [10.0, 45.0, 90.0, 135.0], "length": [0.5, 2.0]}
+    assert sweep_batch.batchable(pendulum, [f"pendulum.{k}" for k in grid], "", "none")
+    fast = driver.run_sweep(str(deck), grid, jobs=1).summary
+    slow = driver.run_sweep(str(deck), grid, jobs=1, case_outputs="all").summary     # case by case
+    assert len(fast) == 8 and (fast["status"] == "ok").all()
+    for c in ("period_s", "small_angle_period_s", "period_ratio"):
+        assert np.allclose(fast[c].to_numpy(float), slow[c].to_numpy(float), rtol=1e-14, atol=0), c
+    ode = [_ode_period_and_swing(L, 9.80665, math.radians(a), np.array([0.0, 0.1]))[0]
+           for a, L in zip(fast["pendulum.amplitude_deg"], fast["pendulum.length"])]
+    assert np.allclose(fast["period_s"], ode, rtol=1e-9)
