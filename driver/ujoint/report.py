@@ -12,7 +12,8 @@ import numpy as np
 import pandas as pd
 
 from driver.deck import Params
-from driver.study import Figure, Result, keyword_run
+from driver.runner import keyword_run
+from driver.study import Figure, Result
 from driver.export import with_units
 from driver.ujoint.kernel import UJOINT_MODELS
 from driver.table import Column, fortran_f, render_table
