@@ -22,8 +22,9 @@ import contextvars
 import os
 import re
 import tempfile
+from collections.abc import Iterator
 from pathlib import Path
-from typing import IO, Iterator
+from typing import IO
 
 __all__ = ["atomic_open", "write_text", "output_set", "OutputSet", "inside", "remove_stale_temporaries",
            "file_digest", "DIGEST_CHARS", "own_folder", "refuse_link", "LinkRefused", "NAME_MAX", "NameTooLong"]
@@ -133,10 +134,11 @@ def output_set(root: str | Path) -> Iterator[OutputSet]:
     """Write a set of files inside folder ``root`` all or nothing (see the module docstring)."""
     s = OutputSet(Path(root))
     token = _CURRENT.set(s)
+    current = True   # this set is the current one until reset
     try:
         yield s
         _CURRENT.reset(token)
-        token = None
+        current = False
         done = 0
         try:
             for tmp, path in s.pending:
@@ -155,7 +157,7 @@ def output_set(root: str | Path) -> Iterator[OutputSet]:
                 os.unlink(tmp)
         raise
     finally:
-        if token is not None:
+        if current:
             _CURRENT.reset(token)
 
 
@@ -181,7 +183,7 @@ def _alive(pid: int) -> bool:
 def remove_stale_temporaries(folder: str | Path, stem: str) -> list[Path]:
     """Remove this tool's temporaries for outputs ``<stem>*`` in ``folder`` whose writer is dead."""
     folder = Path(folder)
-    removed = []
+    removed: list[Path] = []
     try:
         entries = list(os.scandir(folder))
     except OSError:

@@ -13,8 +13,9 @@ restores the previous setting afterwards: it is a scope, never a global switch.
 from __future__ import annotations
 
 import functools
+from collections.abc import Iterator
 from contextlib import contextmanager
-from typing import Any, Iterator
+from typing import Any
 
 __all__ = ["one_thread"]
 

@@ -23,10 +23,10 @@ import re
 import stat
 import unicodedata
 import warnings
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any
 
 import f90nml
 
@@ -241,7 +241,7 @@ def _value_tokens(text: str) -> Iterator[str]:
         i = j
 
 
-def _check_values(path: Path, it: "_Item") -> None:
+def _check_values(path: Path, it: _Item) -> None:
     """Every value of ``it`` is a number, a logical or a quoted string as Fortran list-directed
     input reads them, with at most one repeat count; anything else is a DeckError naming the
     token (f90nml would read ``5.0_8`` as 5.08, ``4+1`` as 40 and ``2*1*4.0`` as 1, 1, 4)."""
@@ -307,7 +307,9 @@ def _known_keys(group: str) -> frozenset[str] | None:
     no module declares it (the runner then refuses the group itself)."""
     if group not in _KNOWN:
         import importlib
+        from types import ModuleType
         keys = None
+        module: ModuleType | None
         try:
             if group in ("sweep", "optimize", "synthesis"):
                 spec = importlib.import_module(f"driver.{group}").SPEC
@@ -341,8 +343,8 @@ def _prescan(path: Path, text: str) -> tuple[list[tuple[str, int]], list[_Item]]
         try:
             code, raw = _code_mask(path, n, raw_line)
         except DeckError as exc:   # name the key whose value holds the character
-            prefix = raw_line[:int(re.match(r"column (\d+)", exc.message).group(1)) - 1] \
-                if exc.message.startswith("column ") else ""
+            column = re.match(r"column (\d+)", exc.message)
+            prefix = raw_line[:int(column.group(1)) - 1] if column else ""
             here = list(_NAME_EQ.finditer(prefix))
             key = here[-1].group(1).lower() if here else (item.key if item is not None and current else None)
             raise DeckError(path, n, key, exc.message) from None
@@ -350,6 +352,7 @@ def _prescan(path: Path, text: str) -> tuple[list[tuple[str, int]], list[_Item]]
         while pos < len(code):
             if current is None:
                 m = re.compile(r"\s*").match(code, pos)
+                assert m is not None   # r"\s*" matches everywhere
                 pos = m.end()
                 if pos >= len(code):
                     break
@@ -534,8 +537,8 @@ def read_deck(path: str | Path, text: str | None = None) -> Deck:
         text = _read_text(path)
     text = _normalise(text)
     if _is_legacy_shape(text):   # non-ASCII is an error in legacy decks too (namelist decks: in the pre-scan)
-        for n, line in enumerate(text.split("\n"), start=1):
-            _code_mask(path, n, line)
+        for n, text_line in enumerate(text.split("\n"), start=1):
+            _code_mask(path, n, text_line)
     if _is_legacy(text):
         return _read_legacy(path, text)
     order, items = _prescan(path, text)
@@ -688,9 +691,9 @@ def validate(raw: RawGroup, spec: GroupSpec, path: str | Path) -> Params:
         except (ArithmeticError, ValueError) as exc:   # a cross-key check overflowing on extreme values
             if isinstance(exc, DeckError):
                 raise
-            given = ", ".join(sorted(given)) or "none"
+            given_keys = ", ".join(sorted(given)) or "none"
             raise DeckError(path, raw.line, None, f"the values of &{spec.name} are out of the range its checks "
-                            f"can compute ({exc}); look for extreme values among: {given}") from None
+                            f"can compute ({exc}); look for extreme values among: {given_keys}") from None
     return params
 
 

@@ -27,9 +27,9 @@ import ast
 import math
 import re
 import unicodedata
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
@@ -134,7 +134,7 @@ def _segment(text: str, node: ast.AST) -> str:
     return seg if seg else node.__class__.__name__
 
 
-def _dotted(node: ast.Attribute) -> str | None:
+def _dotted(node: ast.expr) -> str | None:
     parts = []
     while isinstance(node, ast.Attribute):
         parts.append(node.attr)
@@ -273,7 +273,7 @@ def _check(node: ast.AST, source: str, aliases: dict[str, str], names: set[str])
         names.add(dotted)   # a dotted column name such as fourbar.crank, never an attribute
     elif isinstance(node, ast.Call):
         fname = node.func.id if isinstance(node.func, ast.Name) else None
-        if fname not in FUNCTIONS or node.func.id in aliases:
+        if fname is None or fname not in FUNCTIONS or fname in aliases:
             raise ExprError(f"call of '{tok(node.func)}' is not allowed "
                             f"(functions: {', '.join(sorted(FUNCTIONS))})", tok(node.func))
         if node.keywords:
@@ -395,7 +395,7 @@ class _Kinds:
             return "number"
         if isinstance(node, ast.Compare):
             left = node.left
-            for op, right in zip(node.ops, node.comparators):
+            for right in node.comparators:
                 a, b = self.of(left), self.of(right)
                 if "any" not in (a, b) and (a == "text") != (b == "text"):
                     txt, num = (left, right) if a == "text" else (right, left)
@@ -404,8 +404,9 @@ class _Kinds:
                 left = right
             return "bool"
         if isinstance(node, ast.Call):
-            for a in node.args:
-                self.numeric(a, f"{node.func.id}()")   # type: ignore[attr-defined]
+            fname = node.func.id if isinstance(node.func, ast.Name) else "?"   # _check admitted names only
+            for arg in node.args:
+                self.numeric(arg, f"{fname}()")
             return "number"
         raise ExprError(f"{type(node).__name__} is not allowed", self.tok(node))
 
@@ -478,12 +479,13 @@ class _Evaluator(ast.NodeVisitor):
 
     def visit_Compare(self, node: ast.Compare) -> np.ndarray:
         left = self.visit(node.left)
-        out = None
+        out: np.ndarray | None = None
         for op, comp in zip(node.ops, node.comparators):
             right = self.visit(comp)
             part = self._compare(op, left, right)
             out = part if out is None else out & part
             left = right
+        assert out is not None   # a Compare node has at least one operator
         return out
 
     @staticmethod
@@ -517,9 +519,12 @@ class _Evaluator(ast.NodeVisitor):
         return self.columns[self.aliases.get(node.id, node.id)]
 
     def visit_Attribute(self, node: ast.Attribute) -> np.ndarray:
-        return self.columns[_dotted(node)]
+        dotted = _dotted(node)
+        assert dotted is not None   # _check admitted only dotted names
+        return self.columns[dotted]
 
     def visit_Call(self, node: ast.Call) -> np.ndarray:
+        assert isinstance(node.func, ast.Name)   # _check admitted only calls of FUNCTIONS by name
         fn, _ = FUNCTIONS[node.func.id]
         return fn(*(_number(self.visit(a)) for a in node.args))
 

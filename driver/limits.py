@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from driver.deck import DeckError, Params
+from driver.deck import Params
 
 if TYPE_CHECKING:
     from driver._study import Study
@@ -46,7 +46,7 @@ class Estimate:
     work_key: str | None = None
     detail: str = ""
 
-    def __add__(self, other: "Estimate") -> "Estimate":
+    def __add__(self, other: Estimate) -> Estimate:
         big_m = self if self.bytes >= other.bytes else other
         big_w = self if self.seconds >= other.seconds else other
         return Estimate(self.bytes + other.bytes, self.seconds + other.seconds, big_m.memory_key,

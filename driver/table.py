@@ -15,9 +15,22 @@ raises :class:`TableValueError` (a kernel must mark such rows in words).
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from decimal import ROUND_HALF_UP, Context, Decimal, localcontext
-from typing import Iterable, Sequence
+from typing import Protocol, TypeAlias
+
+
+class _Number(Protocol):
+    """A Python or numpy number: what a numeric table cell holds."""
+
+    def __float__(self) -> float: ...
+
+    def __int__(self) -> int: ...
+
+
+#: a table cell: a number, preformatted text, or None for a blank cell
+Cell: TypeAlias = "_Number | str | None"
 
 __all__ = ["TableValueError", "Column", "fortran_f", "fortran_i", "significant", "render_table"]
 
@@ -105,7 +118,7 @@ class Column:
     style: str = "modern"
     widened: bool = field(default=False, init=False)
 
-    def cell(self, value: object) -> str:
+    def cell(self, value: Cell) -> str:
         """Format one value without padding to the width."""
         if value is None:
             return ""
@@ -120,7 +133,7 @@ class Column:
         return str(value)
 
 
-def render_table(columns: Sequence[Column], rows: Iterable[Sequence[object]],
+def render_table(columns: Sequence[Column], rows: Iterable[Sequence[Cell]],
                  trailers: Sequence[str] | None = None, header: bool = True) -> list[str]:
     """Render rows into fixed-format lines.
 

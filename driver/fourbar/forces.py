@@ -13,8 +13,9 @@ balances the linkage; here are the keys, checks, tables and figures.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -324,7 +325,7 @@ def summary(p: Params) -> dict[str, Any]:
     """Force summary of one deck (one row of the batch kernel, of the balanced linkage with
     ``balance = 'force'``; then also the figures of the linkage as given, prefixed ``unbalanced_``)."""
     d = summarise_force_batch(p).iloc[0].to_dict()
-    return {k: (None if isinstance(v, float) and math.isnan(v) else float(v)) for k, v in d.items()}
+    return {str(k): (None if isinstance(v, float) and math.isnan(v) else float(v)) for k, v in d.items()}
 
 
 def summarise_force_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None = None) -> pd.DataFrame:

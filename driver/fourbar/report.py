@@ -8,6 +8,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from driver import _keywords
+from driver._signatures import keyword_signature
 from driver.deck import Params
 from driver.export import with_units
 from driver.fourbar import forces
@@ -18,6 +20,7 @@ from driver.fourbar.batch import summary_of, summary_rows
 from driver.fourbar.spec import band_of
 from driver.runner import keyword_run
 from driver.study import Figure, Result
+from driver.fourbar.spec import SPEC
 from driver.table import Column, fortran_f, render_table
 
 __all__ = ["run", "listing_text", "exact_table", "summary_lines", "audit", "deck_figures", "output_name", "animation_frames"]
@@ -162,6 +165,7 @@ def audit(p: Params, theta: np.ndarray, table: np.ndarray, lst_status: np.ndarra
     return lines, warn, frame
 
 
+@keyword_signature(_keywords.fourbar, SPEC)
 @keyword_run
 def run(params: Params, progress: bool = False) -> Result:
     """Analyse one four-bar deck (see module docstring)."""

@@ -155,9 +155,19 @@ def tolerance_box(blocks: np.ndarray, eps: float, measure: str = "global") -> di
         closed = min(cand, key=lambda u: float(np.prod(u)))
         closed = closed * min(1.0, eps / math.sqrt(worst(closed).max()))
     scale = eps / math.sqrt(max(m.trace() for m in mats))     # work with v = u / scale ~ 1
-    res = minimize(lambda v: -np.sum(np.log(v)), np.full(l, 0.5), method="SLSQP",
-                   jac=lambda v: -1.0 / v,
-                   constraints=[{"type": "ineq", "fun": lambda v: 1.0 - worst(v * scale) / eps ** 2}],
+
+    def neg_log_volume(v: np.ndarray) -> float:
+        return -np.sum(np.log(v))
+
+    def neg_log_volume_grad(v: np.ndarray) -> np.ndarray:
+        return -1.0 / v
+
+    def inside(v: np.ndarray) -> np.ndarray:
+        return 1.0 - worst(v * scale) / eps ** 2
+
+    # scipy-stubs types a constraint dict's 'fun' as scalar-valued; SLSQP takes a vector of them
+    res = minimize(neg_log_volume, np.full(l, 0.5), method="SLSQP", jac=neg_log_volume_grad,  # type: ignore[call-overload]
+                   constraints=[{"type": "ineq", "fun": inside}],
                    bounds=[(1e-9, None)] * l, options={"ftol": 1e-13, "maxiter": 500})
     res.x = res.x * scale
     return {"u": np.asarray(res.x), "closed": closed, "converged": bool(res.success),

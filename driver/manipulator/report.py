@@ -9,14 +9,16 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from driver import _keywords
+from driver._signatures import keyword_signature
 from driver.manipulator import kernel
 from driver.deck import Params
 from driver.export import with_units
-from driver.manipulator.analysis import (SIGNIFICANT, Conv, Workspace, _design_list, _target, design_status, optima,
-                                         round_half_up)
+from driver.manipulator.analysis import SIGNIFICANT, Conv, Workspace, _design_list, _target, design_status, optima, round_half_up
 from driver.manipulator.tables import TIDY_NAMES, Table, _differences, _tables, _tolerance
 from driver.runner import keyword_run
 from driver.study import Figure, Result
+from driver.manipulator.spec import SPEC
 from driver.table import fortran_f
 
 __all__ = ["run", "TIDY_UNITS", "table_frame"]
@@ -165,6 +167,7 @@ def _summary(p: Params, ws: Workspace, conv: Conv, used: dict, sweep: dict, tol:
     return s
 
 
+@keyword_signature(_keywords.manipulator, SPEC)
 @keyword_run
 def run(params: Params, progress: bool = False) -> Result:
     """Run one &manipulator deck (see the package docstring): validated Params, or the deck's
@@ -258,7 +261,9 @@ def _design_notes(p: Params, conv: Conv, used: dict) -> list[str]:
         pa = np.array(p.printed_angles_deg, float).reshape(-1, 2)
         for i, name in enumerate(used["names"]):
             for j, key in ((0, "shown1"), (1, "shown2")):
-                half = 0.5 * 10.0 ** Decimal(repr(float(pa[i, j]))).as_tuple().exponent  # half a printed unit
+                exponent = Decimal(repr(float(pa[i, j]))).as_tuple().exponent
+                assert isinstance(exponent, int)   # a finite number's ('n'/'N'/'F' are NaN and inf)
+                half = 0.5 * 10.0 ** exponent   # half a printed unit
                 if used["ok"][i] and abs(pa[i, j] - used[key][i]) > half + 1e-9:
                     lines.append(f"  design {name}: printed theta{j + 1} = {pa[i, j]:g} deg but the report's IK gives "
                                  f"{used[key][i]:.2f} deg (not reproducible; used as printed for Table 4.7)")

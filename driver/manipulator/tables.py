@@ -10,8 +10,19 @@ import numpy as np
 
 from driver.manipulator import kernel
 from driver.deck import Params
-from driver.manipulator.analysis import (STATUS, Conv, Workspace, _design_angles, _design_list, _sensitivity_blocks,
-                                         _sweep_l1, _target, optima, round_half_up, tolerance_box)
+from driver.manipulator.analysis import (
+    STATUS,
+    Conv,
+    Workspace,
+    _design_angles,
+    _design_list,
+    _sensitivity_blocks,
+    _sweep_l1,
+    _target,
+    optima,
+    round_half_up,
+    tolerance_box,
+)
 from driver.table import Column, fortran_f, render_table
 
 __all__ = ["Table", "REASONS", "NOT_REPRODUCIBLE", "TEXT_REASONS", "TIDY_NAMES"]
@@ -29,7 +40,7 @@ class Table:
     notes: list[str] = field(default_factory=list)
     labels: list[str] = field(default_factory=list)
 
-    def significant(self, digits: int) -> "Table":
+    def significant(self, digits: int) -> Table:
         """The same table with every fixed-decimal number column printed to ``digits`` significant
         digits (outside report mode); returns self."""
         self.columns = [Column(c.header, "g", c.width, digits, c.sep) if c.kind == "f" else c
@@ -82,6 +93,7 @@ def _t42(p: Params, conv: Conv) -> Table:
             trailers.append(f"l1 >= C_rob radius {radius:.3f}: no l2 on C_rob")
             continue
         l2 = math.sqrt(c - v * v)
+        assert ri is not None   # v is valid, so there are valid designs
         ok = bool(ri[2][j])
         rows.append([f"{i + 1}.", float(ri[0][j, 1]), v, l2, "yes" if ok else "no"])
         trailers.append("" if ok else "violates the reach conditions (4.4)")

@@ -92,8 +92,11 @@ def _de(ev: Evaluator, history: list[HistoryRow]) -> MethodResult:
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")   # scipy notes when polishing cannot improve; reported below
+        # vectorized=True: 'energies' maps a population (n, S) to S values, and bounds are (min, max)
+        # per variable; scipy-stubs types both for the scalar call with one (lower, upper) pair
         res = differential_evolution(
-            energies, list(zip(p.lower, p.upper)), constraints=NonlinearConstraint(violations, -np.inf, 0.0),
+            energies, list(zip(p.lower, p.upper)),  # type: ignore[arg-type]
+            constraints=NonlinearConstraint(violations, -np.inf, 0.0),
             strategy="best1bin", maxiter=o.maxiter, popsize=o.popsize, tol=o.tol, atol=o.atol,
             mutation=(0.5, 1.0), recombination=0.7, rng=o.seed, polish=False, init="latinhypercube",
             updating="deferred", vectorized=True, callback=callback)
@@ -161,13 +164,13 @@ def _starts(ev: Evaluator) -> np.ndarray:
     """Start points in normalised coordinates: the deck's design, then Sobol' or grid points."""
     p, o = ev.problem, ev.problem.opts
     lo, hi = p.lower, p.upper
-    base = []
+    base_values: list[float] = []
     for v in p.variables:
         val = p.base[v.key]
         if isinstance(val, list):
             val = val[(v.index or 1) - 1]
-        base.append(float(val) if val is not None else math.nan)
-    base = np.array(base)
+        base_values.append(float(val) if val is not None else math.nan)
+    base = np.array(base_values)
     starts = []
     if np.all(np.isfinite(base)) and np.all((base >= lo) & (base <= hi)):
         starts.append((base - lo) / (hi - lo))
@@ -382,12 +385,12 @@ def _local_runs(ev: Evaluator, starts: np.ndarray, history: list[HistoryRow], me
             z0 = np.concatenate([z0, [s0]])
             lb, ub = np.concatenate([lb, [-np.inf]]), np.concatenate([ub, [np.inf]])
 
-        def callback(*args, **kw) -> None:
-            it[0] += 1
-            _snapshot(ev, f"{label} {s} iteration {it[0]}", history)
+        def callback(*args, **kw) -> None:   # called only by this start's minimize below
+            it[0] += 1  # noqa: B023
+            _snapshot(ev, f"{label} {s} iteration {it[0]}", history)  # noqa: B023
 
         kw = {}
-        cons = []
+        cons: list[dict[str, object] | NonlinearConstraint] = []
         has_ineq = bool(ineq) or epi
         if method == "SLSQP":
             if has_ineq:
@@ -408,7 +411,8 @@ def _local_runs(ev: Evaluator, starts: np.ndarray, history: list[HistoryRow], me
             options.update({"gtol": max(o.tol * 1e-3, 1e-10), "xtol": 1e-10})
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            res = minimize(fun, z0, jac=jac, bounds=Bounds(lb, ub), method=method,
+            # method, constraints and options are chosen at run time: no single scipy-stubs overload
+            res = minimize(fun, z0, jac=jac, bounds=Bounds(lb, ub), method=method,  # type: ignore[call-overload]
                            callback=callback, options=options, **kw)
         end = one(res.x)
         # the end and the best feasible design this start evaluated: the polish starts from the

@@ -21,9 +21,9 @@ from __future__ import annotations
 
 import ast
 import hashlib
-import re
 import json
 import math
+import re
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -203,7 +203,7 @@ class Problem:
         return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 
-def _sub(e: expr.Expr, node: ast.AST) -> expr.Expr:
+def _sub(e: expr.Expr, node: ast.expr) -> expr.Expr:
     """The sub-expression ``node`` of ``e`` (reads a subset of e's columns)."""
     return expr.Expr(e.text, e.names, ast.Expression(body=node), e._source, e._aliases)
 

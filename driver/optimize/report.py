@@ -102,7 +102,7 @@ def report_text(p: Problem, ev: Evaluator, mres: MethodResult, history: list[His
         "slsqp", "trust-constr") or (p.terms and o.polish) else ""
     L += [f"    method ............... {method_line(p)}",
           f"    objective ............ {p.objective_text}{epi}"]
-    for k, c in enumerate(p.constraints):
+    for c in p.constraints:
         kind = ("equality, met within its tolerance" if c.equality else
                 "inequality, margin in its units" if c.sense else "condition, met or not")
         L.append(f"    constraint ........... {c.text}   ({kind})")
@@ -177,9 +177,8 @@ def report_text(p: Problem, ev: Evaluator, mres: MethodResult, history: list[His
               + ("  -- agrees with the evaluation" if same else "  -- DIFFERS from the evaluation")]
         L += [f"    warning: {w}" for w in (warnings or [])] + [""]
     if mres.starts:
-        top = mres.best.objective if mres.best is not None else None
         L += ["  Local starts (where each ended follows the method's floating-point path: the _history table has it)",
-              f"    reached = its end, polished on the lattice, is feasible and within tol x max(1, |f|) of the best"]
+              "    reached = its end, polished on the lattice, is feasible and within tol x max(1, |f|) of the best"]
         cols = [Column("start", "s", 5, 0, 4)] + [Column(f"{n} (start)", "s", 16, 0, 2) for n in p.names] + [
             Column("outcome", "s", 40, 0, 2)]
         rows = []

@@ -8,12 +8,15 @@ from decimal import Decimal
 import numpy as np
 import pandas as pd
 
+from driver import _keywords
+from driver._signatures import keyword_signature
 from driver.deck import Params
 from driver.export import with_units
 from driver.robust_example.analysis import analyse, tmin
 from driver.robust_example.published import MODE_REASONS
 from driver.runner import keyword_run
 from driver.study import Figure, Result
+from driver.robust_example.spec import SPEC
 from driver.table import Column, render_table
 
 __all__ = ["run", "TIDY_UNITS"]
@@ -65,6 +68,7 @@ def _compare(name: str, printed: list[float] | None, computed: np.ndarray,
 TIDY_UNITS = {"index": "1", "value": "unit of item"}
 
 
+@keyword_signature(_keywords.robust_example, SPEC)
 @keyword_run
 def run(params: Params, progress: bool = False) -> Result:
     """Run one &robust_example deck."""

@@ -6,7 +6,7 @@ SI units; strains are dimensionless here (the report prints microstrain).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.linalg import LinAlgError, cholesky_banded
@@ -83,9 +83,15 @@ def static_onset(model: Model, n_elements: int, step_deg: float = 10.0) -> tuple
     return float(min(w[k], min(omega_at(t) for t in fine))), float(grid[k] % 360.0)
 
 
+def no_record() -> np.ndarray:
+    """The record of a run that failed (or was not asked for): empty."""
+    return np.empty(0)
+
+
 @dataclass
 class Case:
-    """One run: crank speed, element count and its last-revolution (or end-state) results."""
+    """One run: crank speed, element count and its last-revolution (or end-state) results
+    (the records are empty unless the run is ``ok``)."""
 
     omega: float
     n_elements: int
@@ -93,23 +99,23 @@ class Case:
     dt: float = 0.0
     fail_angle_deg: float | None = None
     fail_rev: int | None = None
-    angle_deg: np.ndarray | None = None
-    time: np.ndarray | None = None
+    angle_deg: np.ndarray = field(default_factory=no_record)
+    time: np.ndarray = field(default_factory=no_record)
     # the per-step profile of the strain fields (what the study prints; the kernel records no
     # field, see kernel.slidercrank_simulate): element 1 and 2 axial strain [-], the largest
     # and smallest axial strain and their (0-based) elements, the largest outer-fibre strain,
     # element 1's rigid-body axial force [N]
-    eps_1: np.ndarray | None = None
-    eps_2: np.ndarray | None = None
-    eps_max: np.ndarray | None = None
-    eps_max_el: np.ndarray | None = None
-    eps_min: np.ndarray | None = None
-    eps_min_el: np.ndarray | None = None
-    outer_max: np.ndarray | None = None
-    n_avg_1: np.ndarray | None = None
-    mid: np.ndarray | None = None
-    slider: np.ndarray | None = None
-    elong: np.ndarray | None = None
+    eps_1: np.ndarray = field(default_factory=no_record)
+    eps_2: np.ndarray = field(default_factory=no_record)
+    eps_max: np.ndarray = field(default_factory=no_record)
+    eps_max_el: np.ndarray = field(default_factory=no_record)
+    eps_min: np.ndarray = field(default_factory=no_record)
+    eps_min_el: np.ndarray = field(default_factory=no_record)
+    outer_max: np.ndarray = field(default_factory=no_record)
+    n_avg_1: np.ndarray = field(default_factory=no_record)
+    mid: np.ndarray = field(default_factory=no_record)
+    slider: np.ndarray = field(default_factory=no_record)
+    elong: np.ndarray = field(default_factory=no_record)
     euler_ratio: float = 0.0
     peak_compression: float = 0.0
     settle_strain: float | None = None    # relative change between the last two revolutions

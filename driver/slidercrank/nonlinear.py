@@ -17,34 +17,36 @@ the last revolution exceeds ``large_deflection`` x L.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from driver.slidercrank import kernel
 from driver.deck import Params
+from driver.slidercrank.analysis import no_record
 from driver.slidercrank.spec import Model
 
 
 @dataclass
 class NLCase:
-    """One nonlinear run: crank speed, element count, last-revolution records and statistics."""
+    """One nonlinear run: crank speed, element count, last-revolution records (empty unless
+    the run is ``ok``; the per-revolution peaks ``rev_lat``/``rev_eps`` always) and statistics."""
 
     omega: float
     n_elements: int
     status: str
     dt: float
     steps_per_rev: int
-    angle_deg: np.ndarray | None = None
-    eps_ax: np.ndarray | None = None
-    eps_of: np.ndarray | None = None
-    lat_max: np.ndarray | None = None
-    mid: np.ndarray | None = None
-    energy: np.ndarray | None = None
-    rev_lat: np.ndarray | None = None
-    rev_eps: np.ndarray | None = None
-    shapes: np.ndarray | None = None
-    shape_deg: tuple[float, float] = (0.0, 0.0)
+    angle_deg: np.ndarray = field(default_factory=no_record)
+    eps_ax: np.ndarray = field(default_factory=no_record)
+    eps_of: np.ndarray = field(default_factory=no_record)
+    lat_max: np.ndarray = field(default_factory=no_record)
+    mid: np.ndarray = field(default_factory=no_record)
+    energy: np.ndarray = field(default_factory=no_record)
+    rev_lat: np.ndarray = field(default_factory=no_record)
+    rev_eps: np.ndarray = field(default_factory=no_record)
+    shapes: np.ndarray = field(default_factory=no_record)
+    shape_deg: tuple[float, ...] = (0.0, 0.0)
     solves: int = 0
     max_solves: int = 0
     cuts: int = 0

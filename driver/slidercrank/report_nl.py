@@ -13,6 +13,8 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
+from driver import _keywords
+from driver._signatures import keyword_signature
 from driver.deck import Params
 from driver.export import with_units
 from driver.slidercrank.analysis import Case, _run_case, static_onset
@@ -21,6 +23,7 @@ from driver.slidercrank.report import _figures, _header, _status_text, run_linea
 from driver.slidercrank.spec import _model, rayleigh
 from driver.runner import keyword_run
 from driver.study import Figure, Result
+from driver.slidercrank.spec import SPEC
 from driver.table import Column, render_table
 
 NL_STATUS_TEXT = {
@@ -264,6 +267,7 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
                   summary=_summary(pairs, tol, limit, onset), warnings=warnings, failure=failure, figures=figures)
 
 
+@keyword_signature(_keywords.slidercrank, SPEC)
 @keyword_run
 def run(params: Params, progress: bool = False) -> Result:
     """Run one &slidercrank deck: the paper's linear KED model (:func:`run_linear`), or with

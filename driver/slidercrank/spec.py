@@ -7,12 +7,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, TypedDict
 
 from driver.slidercrank import kernel
 from driver.limits import Estimate
 from driver.deck import GroupSpec, Key, Params, non_negative, positive
-
 
 #: Table 1a of the paper (columns re-ordered, docs/slidercrank.md); the depth is the
 #: in-plane section depth used for the outer-fibre strain (weak axis in plane).
@@ -46,7 +45,24 @@ STATUS_TEXT = {
 #: Simeon (1996) / IVP test set "crank": published initial values (ini = 1, consistent) of the
 #: modal coordinates q1, q2 (lateral sin(pi x), sin(2 pi x)), q3, q4 (axial, quadratic: midpoint
 #: and end node) and their rates, and the reference solution at t = 0.1 s (MEBDFI, tol 1e-14).
-SIMEON1996 = {
+class Simeon1996(TypedDict):
+    """The Simeon (1996) benchmark: geometry [m], crank speed [rad/s], initial modal state
+    q0 [m, m, m, rad]-like amplitudes and rates qd0, and the end state at t [s]: q1, q4 [m],
+    slider x3 [m], rod angle phi2 [rad]."""
+
+    crank_radius: float
+    rod_length: float
+    speed: float
+    q0: tuple[float, float, float, float]
+    qd0: tuple[float, float, float, float]
+    t: float
+    q1: float
+    q4: float
+    x3: float
+    phi2: float
+
+
+SIMEON1996: Simeon1996 = {
     "crank_radius": 0.15, "rod_length": 0.30, "speed": 150.0,
     "q0": (0.0, 0.0, 0.103339863e-04, 0.169327969e-04),
     "qd0": (0.444896105, 0.463434311e-02, -0.178591076e-05, -0.268938672e-05),

@@ -155,7 +155,7 @@ class Synthesis:
     """A synthesis result: the linkage deck, the study run of it, and the report."""
 
     params: Params
-    linkage: dict[str, Any]
+    linkage: dict[str, Any] | None   # the linkage deck's values; None when no linkage was found
     text: str
     failure: str | None
     table: pd.DataFrame
@@ -359,13 +359,17 @@ def _crank_rocker(p: Params) -> Synthesis:
              f"  deck: {p.path}" + (f" -- {p.title}" if p.title else ""), "",
              f"    rocker swing ......... {p.swing_deg:g} deg",
              f"    time ratio ........... {p.time_ratio:g}  (crank turns 180 + {al:.6g} and 180 - {al:.6g} deg)",
-             f"    family ............... O_A on the {'line through the rocker extremes' if al <= 1e-12 else 'circle through the rocker extremes seeing them under alpha'}; "
+             "    family ............... O_A on the "
+             + ("line through the rocker extremes" if al <= 1e-12 else
+                "circle through the rocker extremes seeing them under alpha")
+             + "; "
              f"{len(members)} members scanned ({p.family_points} per arc)",
              f"    crank-rockers ........ {sum(m.crank_rocker for m in members)} of them", ""]
     table = pd.DataFrame([{"arc": m.arc, "t": m.t, "crank": m.crank * p.fixed_link / m.ground,
                            "coupler": m.coupler * p.fixed_link / m.ground, "rocker": m.rocker * p.fixed_link / m.ground,
                            "fixed_link": p.fixed_link, "crank_rocker": m.crank_rocker, "mu_min_deg": m.mu_min_deg,
                            "mu_max_deg": m.mu_max_deg, "quality_deg": m.quality_deg} for m in members])
+    failure: str | None
     if best is None:
         failure = ("no member of the family is a crank-rocker" if free is None else
                    f"no crank-rocker member has every link at least min_link_fraction = {frac:g} of the ground")

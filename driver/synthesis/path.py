@@ -141,7 +141,7 @@ def refine(pp: PathProblem, design: PathDesign) -> PathDesign:
     step = 360.0 / pp.samples
     errs, ats = [], []
     for (tx, ty), t0, e0 in zip(tk, design.theta_at_targets_deg, design.errors):
-        def dist(t: float) -> float:
+        def dist(t: float, tx: float = tx, ty: float = ty) -> float:
             th = np.radians([t])
             out, st = fourbar_kernel.fourbar_exact(th, d, a, b, c, 1.0, 0.0, pp.branch)
             if st[0] != ST_OK:
@@ -224,11 +224,13 @@ def solve(pp: PathProblem, seed: int, maxiter: int, popsize: int,
             seen.append((val, tuple(x)))
         return val
 
-    res = differential_evolution(fun, bounds(pp), rng=seed, maxiter=maxiter, popsize=popsize, tol=1e-10,
+    # scipy-stubs types 'bounds' as one (lower, upper) pair; scipy takes (min, max) per variable, as here
+    res = differential_evolution(fun, bounds(pp),  # type: ignore[arg-type]
+                                 rng=seed, maxiter=maxiter, popsize=popsize, tol=1e-10,
                                  atol=1e-12, polish=False, init="sobol", mutation=(0.5, 1.0), recombination=0.9,
                                  strategy="best1bin")
     starts, keys = [], set()
-    for val, x in sorted(seen, key=lambda s: s[0]):
+    for _val, x in sorted(seen, key=lambda s: s[0]):
         key = tuple(np.round(np.asarray(x[3:9]) / pp.length_max, 2))
         if key not in keys:
             keys.add(key)
@@ -236,8 +238,8 @@ def solve(pp: PathProblem, seed: int, maxiter: int, popsize: int,
         if len(starts) >= polish_starts:
             break
     best = refine(pp, evaluate(pp, res.x))
-    for x in starts:
-        cand = polish(pp, refine(pp, evaluate(pp, x)))
+    for x0 in starts:
+        cand = polish(pp, refine(pp, evaluate(pp, x0)))
         if cand.violation <= best.violation and cand.rms < best.rms:
             best = cand
     return best, bool(res.success), str(res.message), int(res.nfev)

@@ -16,7 +16,6 @@ from driver.deck import Params
 from driver.ujoint.kernel import UJOINT_MODELS, UJOINT_OBJECTIVES, ujoint_equivalent, ujoint_objective, ujoint_speed
 from driver.ujoint.spec import DEG
 
-
 #: phases within this of a symmetric assembly count as sitting on it [rad]
 SYM_TOL = 1e-7
 #: how far a start is moved off the symmetric saddle [deg]
@@ -183,11 +182,13 @@ def pick_best(runs: list[StartRun], n_beta: int) -> int:
     """Index of the reported optimum among the starts (TIE RULE, deterministic).
 
     Converged starts within TIE_RTOL (relative) of the best objective tie (mirror optima
-    agree to rounding; along a continuous family of optima the most converged start wins).  Among them the trial start (index 0) wins if it is there (so feeding an
-    optimum back as the trial reproduces it); otherwise the smallest phases, compared
+    agree to rounding; along a continuous family of optima the most converged start wins).
+    Among them the trial start (index 0) wins if it is there (so feeding an optimum back as
+    the trial reproduces it); otherwise the smallest phases, compared
     lexicographically at 1e-6 deg, then the smallest joint angles; the tied starts within
     CLUSTER_TOL of that end point are one optimum, and the one of them with the lowest
-    objective is reported (then the start order).  With no converged start, the lowest objective (a last iterate, reported as such).
+    objective is reported (then the start order).  With no converged start, the lowest
+    objective (a last iterate, reported as such).
     """
     ok = [k for k, r in enumerate(runs) if r.success]
     if not ok:

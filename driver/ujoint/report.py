@@ -11,9 +11,12 @@ import textwrap
 import numpy as np
 import pandas as pd
 
+from driver import _keywords
+from driver._signatures import keyword_signature
 from driver.deck import Params
 from driver.runner import keyword_run
 from driver.study import Figure, Result
+from driver.ujoint.spec import SPEC
 from driver.export import with_units
 from driver.ujoint.kernel import UJOINT_MODELS
 from driver.table import Column, fortran_f, render_table
@@ -328,6 +331,7 @@ def _result_dat(params: Params, chain: Chain, designs: list[Design], best: Desig
     return "\n".join(lines) + "\n"
 
 
+@keyword_signature(_keywords.ujoint, SPEC)
 @keyword_run
 def run(params: Params, progress: bool = False) -> Result:
     """Analyse (option 0) or optimise (options 1-3) the chain of the deck."""

@@ -13,7 +13,6 @@ from driver.deck import GroupSpec, Key, Params, non_empty, positive
 from driver.limits import Estimate
 from driver.ujoint.kernel import ujoint_geometry
 
-
 DEG = math.pi / 180.0
 OPTIONS = {0: "analyse only", 1: "phases free, joint angles fixed",
            2: "joint angles free, phases fixed", 3: "joint angles and phases free"}
@@ -137,12 +136,12 @@ def _geometry(params: Params) -> tuple[np.ndarray, np.ndarray | None]:
             if not np.linalg.norm(v) > 0.0:
                 raise params.error("axes", f"shaft {k} direction ({', '.join(map(str, v))}) has zero "
                                            "length; every shaft needs a nonzero direction")
-        beta, rho, status = ujoint_geometry(a)
+        beta_rad, rho_rad, status = ujoint_geometry(a)
         if status != 0:
-            k = int(np.argmax(beta >= 0.5 * math.pi))
-            raise params.error("axes", f"joint {k + 1} bends by {beta[k] / DEG:.4f} deg; a joint angle "
+            k = int(np.argmax(beta_rad >= 0.5 * math.pi))
+            raise params.error("axes", f"joint {k + 1} bends by {beta_rad[k] / DEG:.4f} deg; a joint angle "
                                        "must lie strictly between -90 and 90 deg")
-        return beta / DEG, rho / DEG
+        return beta_rad / DEG, rho_rad / DEG
     if params.beta is None:
         raise params.error(None, "give the joint angles 'beta' (deg) or the shaft directions 'axes'")
     beta = np.asarray(params.beta, float)
@@ -194,16 +193,16 @@ def cross_check(params: Params) -> None:
         if msg:
             raise params.error(key, msg.replace("a joint angle", "a joint-angle bound"))
     if np.any(blo > bhi):
-        k = int(np.argmax(blo > bhi))
-        raise params.error("beta_lower", f"lower bound {blo[k]} deg exceeds upper bound {bhi[k]} deg "
-                                         f"for joint {k + 1}; need beta_lower <= beta_upper")
+        j = int(np.argmax(blo > bhi))
+        raise params.error("beta_lower", f"lower bound {blo[j]} deg exceeds upper bound {bhi[j]} deg "
+                                         f"for joint {j + 1}; need beta_lower <= beta_upper")
     if n > 1:
         plo = _per(params, "phi_lower", n - 1, "phases")
         phi_hi = _per(params, "phi_upper", n - 1, "phases")
         if np.any(plo > phi_hi):
-            k = int(np.argmax(plo > phi_hi))
-            raise params.error("phi_lower", f"lower bound {plo[k]} deg exceeds upper bound {phi_hi[k]} "
-                                            f"deg for phase {k + 1}; need phi_lower <= phi_upper")
+            j = int(np.argmax(plo > phi_hi))
+            raise params.error("phi_lower", f"lower bound {plo[j]} deg exceeds upper bound {phi_hi[j]} "
+                                            f"deg for phase {j + 1}; need phi_lower <= phi_upper")
     if params.option == 1 and n < 2:
         raise params.error("option", "option 1 optimises phases, but a single joint has none; "
                                      "use option 0 or 2")

@@ -1,0 +1,190 @@
+"""Typed keyword signatures of the studies' ``run``, from each study's SPEC.
+
+A study's ``run`` takes validated :class:`~driver.deck.Params` (the runner's call) or the
+deck's keys as keyword arguments (:func:`driver.study.keyword_run`).  The keys are declared
+once, in the study's :class:`~driver.deck.GroupSpec`; this module turns that declaration into
+
+- the run's runtime signature and numpydoc docstring (every key with its type, units,
+  default or "required", and allowed values), so ``help(driver.fourbar.run)``, IDEs and
+  :func:`inspect.signature` list the keys -- :func:`keyword_signature` attaches them;
+- the static signatures of ``driver/_keywords.py`` (``tools/gen_keyword_signatures.py``
+  writes it; tests/test_keyword_signatures.py fails while it is stale), so a type checker
+  refuses a misspelt key: ``driver.fourbar.run(fixed_lnik=12)`` is a mypy error.
+
+Types follow what the deck reader accepts: ``float``/``int``/``str``/``bool`` keys their
+scalar (an int for a float), list keys a scalar, a sequence or a numpy array, keys with
+allowed values a ``Literal`` of them (a deck also accepts them in any case).
+"""
+from __future__ import annotations
+
+import inspect
+import textwrap
+from collections.abc import Callable, Sequence
+from typing import Any, TypeVar
+
+from driver.deck import GroupSpec, Key
+
+__all__ = ["NOT_GIVEN", "key_type", "run_docstring", "run_signature", "keyword_signature", "render_module"]
+
+#: the Python type of each Key.kind, as annotation text (driver/_keywords.py imports these names)
+KIND_TYPES = {
+    "float": "float",
+    "int": "int",
+    "str": "str",
+    "bool": "bool",
+    "floats": "float | Sequence[float] | NDArray[Any]",
+    "ints": "int | Sequence[int] | NDArray[Any]",
+    "strs": "str | Sequence[str]",
+    "list": "Sequence[Any]",
+}
+#: the same in numpydoc words
+KIND_WORDS = {"float": "float", "int": "int", "str": "str", "bool": "bool",
+              "floats": "float or sequence of float", "ints": "int or sequence of int",
+              "strs": "str or sequence of str", "list": "sequence"}
+
+
+class _NotGiven:
+    """Default of a key the deck may leave out and whose default the study works out itself."""
+
+    def __repr__(self) -> str:
+        return "<not given>"
+
+
+#: the signature's default of a key without a fixed default value (leave the key out)
+NOT_GIVEN: Any = _NotGiven()
+
+
+def key_type(key: Key) -> str:
+    """Annotation text of one deck key (``Literal[...]`` when it has allowed values)."""
+    if key.choices and key.kind in ("str", "int", "bool"):
+        return f"Literal[{', '.join(_py(c) for c in key.choices)}]"
+    if key.choices and key.kind in ("strs", "ints"):
+        lit = f"Literal[{', '.join(_py(c) for c in key.choices)}]"
+        return f"{lit} | Sequence[{lit}]"
+    return KIND_TYPES[key.kind]
+
+
+def _py(value: Any) -> str:
+    """``repr`` of a default or an allowed value, strings in double quotes (the code's style)."""
+    if isinstance(value, str) and '"' not in value and "\\" not in value:
+        return f'"{value}"'
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_py(v) for v in value) + "]"
+    return repr(value)
+
+
+def _has_default(key: Key) -> bool:
+    return not key.required and key.default is not None
+
+
+def _default_text(key: Key) -> str:
+    return _py(key.default)
+
+
+def _entry(name: str, key: Key) -> list[str]:
+    """The numpydoc entry of one key: ``name : type, default X`` and its description with units."""
+    if key.choices:
+        kind = "{" + ", ".join(_py(c) for c in key.choices) + "}"
+        if key.kind in ("strs", "list"):
+            kind += " or sequence of them"
+    else:
+        kind = KIND_WORDS[key.kind]
+    head = f"{name} : {kind}" + (f", default {_default_text(key)}" if _has_default(key) else
+                                  "" if key.required else ", optional")
+    text = key.doc or name.replace("_", " ")
+    if key.units and key.units != "1":
+        text += f" [{key.units}]"
+    elif key.units == "1":
+        text += " [-]"
+    text += "." if not text.endswith(".") else ""
+    if key.required:
+        text += " Required."
+    body = textwrap.wrap(text, 84, break_on_hyphens=False)
+    return [head] + [f"    {line}" for line in body]
+
+
+def run_docstring(spec: GroupSpec, summary: str = "") -> str:
+    """Numpydoc docstring of a study's ``run``: ``summary``, then every key of ``spec``."""
+    head = inspect.cleandoc(summary) or f"Run the &{spec.name} study: {spec.doc}."
+    lines = [head, "",
+             f"Give either validated ``params`` (the runner's call) or the keys of a ``&{spec.name}``",
+             "deck group as keyword arguments: they are checked exactly like a deck (a bad value",
+             "raises :class:`driver.deck.DeckError` naming the key).", "",
+             "Parameters", "----------",
+             "params : Params, optional",
+             f"    Validated values of a ``&{spec.name}`` group (positional only; then no keys).",
+             "progress : bool, default False",
+             "    Show a progress bar on the terminal."]
+    for name, key in spec.keys.items():
+        lines += _entry(name, key)
+    lines += ["", "Returns", "-------", "Result",
+              "    The run's fixed-format text, tidy table, summary, figures and warnings",
+              "    (:class:`driver.study.Result`)."]
+    return "\n".join(lines) + "\n"
+
+
+def run_signature(spec: GroupSpec) -> inspect.Signature:
+    """Runtime signature of a study's ``run``: ``(params=None, /, progress=False, *, <keys>)``."""
+    P = inspect.Parameter
+    params = [P("params", P.POSITIONAL_ONLY, default=None, annotation="Params | None"),
+              P("progress", P.POSITIONAL_OR_KEYWORD, default=False, annotation="bool")]
+    for name, key in spec.keys.items():
+        default = P.empty if key.required else (key.default if _has_default(key) else NOT_GIVEN)
+        params.append(P(name, P.KEYWORD_ONLY, default=default, annotation=key_type(key)))
+    return inspect.Signature(params, return_annotation="Result")
+
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+def keyword_signature(typed: F, spec: GroupSpec) -> Callable[[Callable[..., Any]], F]:
+    """Decorator for a study's ``run`` (outside :func:`driver.study.keyword_run`): type it as
+    ``typed``, its generated signature in ``driver/_keywords.py`` (for type checkers), and give it
+    the signature and docstring of ``spec``'s keys at run time (for ``help()`` and IDEs)."""
+    def apply(run: Callable[..., Any]) -> F:
+        run.__signature__ = run_signature(spec)  # type: ignore[attr-defined]
+        run.__doc__ = run_docstring(spec, run.__doc__ or "")
+        return run  # type: ignore[return-value]   # the same callable; ``typed`` is its static signature
+    return apply
+
+
+def render_module(specs: Sequence[GroupSpec]) -> str:
+    """Text of ``driver/_keywords.py``: per study, an overloaded ``run`` signature (validated
+    Params, or the keys as keyword-only arguments with their types and defaults)."""
+    out = ['"""Static signatures of the studies\' ``run`` (type checkers and IDEs).  GENERATED from each',
+           "study's SPEC by tools/gen_keyword_signatures.py (driver._signatures.render_module): do not",
+           'edit; tests/test_keyword_signatures.py fails while it is stale."""',
+           "from __future__ import annotations",
+           "",
+           "from collections.abc import Sequence",
+           "from typing import Any, Literal, overload",
+           "",
+           "from numpy.typing import NDArray",
+           "",
+           "from driver.deck import Params",
+           "from driver.study import Result",
+           "",
+           f"__all__ = [{', '.join(_py(s.name) for s in specs)}]"]
+    for spec in specs:
+        keys = []
+        for name, key in spec.keys.items():
+            scalar_default = _has_default(key) and not isinstance(key.default, (list, tuple))
+            keys.append(f"    {name}: {key_type(key)}" + ("" if key.required else
+                                                           f" = {_default_text(key)}" if scalar_default else " = ..."))
+        out += ["", "",
+                "@overload",
+                f"def {spec.name}(params: Params, /, progress: bool = False) -> Result: ...",
+                "",
+                "",
+                "@overload",
+                f"def {spec.name}(",
+                "    *,",
+                "    progress: bool = False,"]
+        out += [k + "," for k in keys]
+        out += [") -> Result: ...",
+                "",
+                "",
+                f"def {spec.name}(params: Params | None = None, /, progress: bool = False, **keys: Any) -> Result:",
+                f'    """The signature of ``driver.{spec.name}.run`` (its docstring has the keys)."""',
+                f'    raise NotImplementedError("a signature only: call driver.{spec.name}.run")']
+    return "\n".join(out) + "\n"
