@@ -16,7 +16,7 @@ baselines measured in the same run:
    * ``--big``: 10^7 linkages on 2 workers (target < 15 s wall on two idle cores);
    * ``--huge``: 10^8 linkages on 2 workers (target < 3 min, driver memory flat < 300 MiB).
 3. ``--dask``: a 10^7-linkage search on a loopback Dask cluster (bench_dask_cluster.py's
-   scheduler and 2 single-threaded workers): the driver's CPU time per phase (sweep.LAST_RUN:
+   scheduler and 2 single-threaded workers): the driver's CPU time per phase (the outcome's phases:
    preparing, receiving and merging the chunks, writing the tables), and from it the driver
    time of a 10^9-linkage search: the preparation, plus the measured cost per chunk times the
    chunks the layout gives at 10^9, plus the measured cost per kept row times the kept rows
@@ -87,7 +87,7 @@ from driver import sweep
 from driver.fourbar import kernel as fourbar_kernel
 from driver.deck import read_deck
 if sys.argv[4] == "pool":    # the worker pool even for a small sweep (the measurement before the small-sweep rule)
-    from driver import sweep_batch
+    from driver.sweep import batch as sweep_batch
     sweep_batch.POOL_MIN_SECONDS = 0.0
 if sys.argv[4] == "dense":   # the previous peak search, in this process and in the forked workers
     real = fourbar_kernel.fourbar_summaries
@@ -95,7 +95,7 @@ if sys.argv[4] == "dense":   # the previous peak search, in this process and in 
                                                                               if passes & 4 else 0))
 deck = read_deck(Path(sys.argv[1]))
 t0, c0 = time.perf_counter(), time.process_time()
-status = sweep.run_sweep_deck(deck, Path(sys.argv[2]), [], False, False, quiet=True, jobs=int(sys.argv[3]))
+status = sweep.run_sweep_deck(deck, Path(sys.argv[2]), [], False, False, jobs=int(sys.argv[3])).status
 wall, me = time.perf_counter() - t0, time.process_time() - c0
 kids = resource.getrusage(resource.RUSAGE_CHILDREN)
 print(json.dumps({"status": status, "wall": wall, "driver_cpu": me, "workers_cpu": kids.ru_utime + kids.ru_stime,
@@ -125,7 +125,7 @@ def dask_estimate(tmp: Path, linkages: int) -> None:
     """The driver's CPU per phase on a loopback Dask cluster, and the 10^9 estimate."""
     sys.path.insert(0, str(ROOT / "bench"))
     import bench_dask_cluster as bdc
-    from driver import sweep_batch
+    from driver.sweep import batch as sweep_batch
     cranks = -(-linkages // PER_CRANK)
     n = cranks * PER_CRANK
     deck = tmp / "dask.dat"
@@ -136,9 +136,9 @@ def dask_estimate(tmp: Path, linkages: int) -> None:
         code = ("import json, resource, sys, time\nfrom pathlib import Path\nfrom driver import sweep\n"
                 "from driver.deck import read_deck\nd = read_deck(Path(sys.argv[1]))\n"
                 "t0, c0 = time.perf_counter(), time.process_time()\n"
-                "s = sweep.run_sweep_deck(d, Path(sys.argv[2]), [], False, False, quiet=True, scheduler=sys.argv[3])\n"
-                "print(json.dumps({'status': s, 'wall': time.perf_counter() - t0, 'cpu': time.process_time() - c0,"
-                " 'rss': resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 'phases': sweep.LAST_RUN}))")
+                "s = sweep.run_sweep_deck(d, Path(sys.argv[2]), [], False, False, scheduler=sys.argv[3])\n"
+                "print(json.dumps({'status': s.status, 'wall': time.perf_counter() - t0, 'cpu': time.process_time() - c0,"
+                " 'rss': resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 'phases': s.phases}))")
         res = subprocess.run([sys.executable, "-c", code, str(deck), str(tmp / "dask_out"), address],
                              capture_output=True, text=True, cwd=ROOT, check=True)
         r = json.loads(res.stdout.strip().splitlines()[-1])

@@ -21,8 +21,6 @@ wall time), the sweep rates are wall time; both are printed with the load averag
 from __future__ import annotations
 
 import argparse
-import contextlib
-import io
 import json
 import os
 import statistics
@@ -49,7 +47,7 @@ def design_columns(deck: Path) -> tuple[object, dict[str, np.ndarray]]:
     sw = validate(d.groups["sweep"], sweep.SPEC, d.path)
     base = validate(d.groups["fourbar"], fourbar.SPEC, d.path)
     axes = sweep._axes(sw, "fourbar", fourbar.SPEC)
-    from driver.sweep_batch import Grid
+    from driver.sweep.spec import Grid
     g = Grid([a[0] for a in axes], [a[1] for a in axes], False)
     return base, {k.partition(".")[2]: v for k, v in g.columns(0, g.n).items()}
 
@@ -69,8 +67,7 @@ def timed_sweep(path: Path, out: Path, jobs: int, cpu: bool = False) -> float:
     deck = read_deck(path)
     clock = time.process_time if cpu else time.perf_counter
     t0 = clock()
-    with contextlib.redirect_stderr(io.StringIO()), contextlib.redirect_stdout(io.StringIO()):
-        status = sweep.run_sweep_deck(deck, out, [], False, False, quiet=True, jobs=jobs)
+    status = sweep.run_sweep_deck(deck, out, [], False, False, jobs=jobs).status
     assert status in (0, 1), status
     return clock() - t0
 
@@ -82,7 +79,7 @@ from driver import sweep
 from driver.deck import read_deck
 deck = read_deck(Path(sys.argv[1]))
 t0 = time.perf_counter()
-status = sweep.run_sweep_deck(deck, Path(sys.argv[2]), [], False, False, quiet=True, jobs=2)
+status = sweep.run_sweep_deck(deck, Path(sys.argv[2]), [], False, False, jobs=2).status
 me, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
 print(json.dumps({"seconds": time.perf_counter() - t0, "status": status, "maxrss_kib": me.ru_maxrss,
                   "cpu": me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime}))
@@ -98,7 +95,8 @@ from driver.deck import read_deck
 deck = read_deck(Path(sys.argv[1]))
 out, jobs = Path(sys.argv[2]), int(sys.argv[3])
 t0, c0 = time.perf_counter(), time.process_time()
-status = sweep.run_sweep_deck(deck, out, [], False, False, quiet=True, jobs=jobs)
+outcome = sweep.run_sweep_deck(deck, out, [], False, False, jobs=jobs)
+status = outcome.status
 wall, me = time.perf_counter() - t0, time.process_time() - c0
 kids = resource.getrusage(resource.RUSAGE_CHILDREN)
 rows = {}
@@ -106,7 +104,7 @@ for p in sorted((out / (deck.path.stem + ".sweep")).glob("part-*.parquet")):
     t = pq.read_table(p, columns=["case", "cpu", "seconds"]).to_pydict()
     rows.update({c: (cpu, s) for c, cpu, s in zip(t["case"], t["cpu"], t["seconds"])})
 print(json.dumps({"status": status, "wall": wall, "driver_cpu": me, "workers_cpu": kids.ru_utime + kids.ru_stime,
-                  "cases": rows, "phases": sweep.LAST_RUN}))
+                  "cases": rows, "phases": outcome.phases}))
 """
 
 
@@ -147,7 +145,7 @@ def slidercrank_matrix(tmp: Path) -> None:
     total2 = med(two, lambda r: sum(cases(r)))
     extra2 = med(two, lambda r: r["workers_cpu"] - sum(cases(r)))
     span2 = med(two, lambda r: list_schedule(cases(r), 2))
-    print(f"  CPU time [s]     prepare   cases (sum)   driver while running   workers beyond cases   finish")
+    print("  CPU time [s]     prepare   cases (sum)   driver while running   workers beyond cases   finish")
     print(f"  1 worker         {prep1:7.2f}   {run1:11.2f}   (in the cases)         -                      {fin1:6.2f}")
     print(f"  2 workers        {prep2:7.2f}   {total2:11.2f}   {drv2:20.2f}   {extra2:20.2f}   {fin2:6.2f}")
     run2 = max(span2, (total2 + drv2 + max(extra2, 0.0)) / 2)
@@ -180,7 +178,7 @@ def main() -> None:
               f"sweep / kernel CPU time {c1 / k:4.2f} (target <= 2)")
         print(f"  1 worker, wall time : {t1:7.2f} s  {n / t1:9.0f} linkages/s (best of 2)")
         print(f"  -j 2, wall time     : {t2:7.2f} s  {n / t2:9.0f} linkages/s (best of 2; a search this small runs "
-              "in the driver when the worker pool would not pay, see sweep_batch.POOL_MIN_SECONDS)")
+              "in the driver when the worker pool would not pay, see driver.sweep.batch.POOL_MIN_SECONDS)")
         print(f"  targets: >= 100 000 linkages/s on 2 cores: wall {'met' if n / t2 >= 1e5 else 'NOT met'}, "
               f"from CPU time (2 idle cores) {'met' if 2 * n / c1 >= 1e5 else 'NOT met'}; "
               f"sweep within 2x of the kernel: {'met' if c1 <= 2 * k else 'NOT met'}")

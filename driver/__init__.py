@@ -5,7 +5,8 @@ Batch: ``python -m driver inputs/crank5.dat`` (see :mod:`driver.cli`).  Python::
     import driver
     r = driver.run("inputs/crank5.dat")           # or deck text, or {"fourbar": {...}}
     r = driver.fourbar.run(fixed_link=12, crank=5, coupler=15, rocker=9, step_deg=20)
-    r.out, r.tidy, r.summary, r.summary_frame, r.figure("linkage"), r.warnings, r.write("out")
+    r.out, r.tidy, r.summary, r.summary_frame, r.figure("linkage"), r.warnings
+    driver.write(r, "out", formats=["csv"], json=True)   # the files the command line writes
     s = driver.run_sweep("inputs/fourbar_paper_sweep.dat", jobs=1); s.summary
     driver.studies(), driver.keys("fourbar")
 
@@ -25,13 +26,14 @@ try:
 except ImportError:   # a source checkout that was never built (driver.kernels says what to do)
     __version__ = "unknown (unbuilt source checkout)"
 
-__all__ = ["run", "run_sweep", "studies", "keys", "Result", "SweepResult", "DeckError"]
+__all__ = ["run", "run_sweep", "write", "studies", "keys", "Result", "SweepResult", "DeckError"]
 
-_API = {"run": "driver.api", "run_sweep": "driver.api", "studies": "driver.api", "keys": "driver.api",
+_API = {"run": "driver.api", "run_sweep": "driver.api", "write": "driver.api", "studies": "driver.api",
+        "keys": "driver.api",
         "Result": "driver.study", "SweepResult": "driver.api", "DeckError": "driver.deck"}
 
 if TYPE_CHECKING:   # pragma: no cover - for type checkers and IDEs only
-    from driver.api import SweepResult, keys, run, run_sweep, studies
+    from driver.api import SweepResult, keys, run, run_sweep, studies, write
     from driver.deck import DeckError
     from driver.study import Result
 

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 from types import MappingProxyType, ModuleType
 from typing import TYPE_CHECKING, Any
 
-from driver.deck import GroupSpec
+from driver.groupspec import GroupSpec
 
 if TYPE_CHECKING:
     from driver.deck import Params

@@ -23,11 +23,10 @@ from driver import __version__, limits
 from driver.export import FORMATS
 from driver.extras import MissingExtra, require
 from driver._study import study_names
+from driver.outcome import ExitCode, Outcome, RunOutcome, SweepOutcome
 from driver.study import PLOT_FORMATS
 
-__all__ = ["main", "run_deck", "EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT"]
-
-EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+__all__ = ["main", "run_deck", "say", "ExitCode"]
 
 
 def _fs_error(exc: OSError) -> str:
@@ -62,109 +61,73 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool | str, pro
     """
     from driver.atomic import NameTooLong
     from driver.deck import DeckError, read_deck
-    from driver.runner import name_too_long, output_stem, run_study
+    from driver.dispatch import run_deck as run_by_engine
+    from driver.runner import name_too_long
     try:
         deck = read_deck(path)
-        if report:   # the page's name is known now: refused before the run, not after it
-            output_stem(outdir, deck.path, (".html",))
         given = [opt for opt, key in (("-j/--jobs", "jobs"), ("--scheduler", "scheduler"), ("--resume", "resume"))
                  if (sweep_options or {}).get(key) and not ({"sweep", "optimize"} & set(deck.groups))]
-        if "synthesis" in deck.groups:
-            from driver import synthesis
-            status = synthesis.run_synthesis_deck(deck, outdir, formats, plot, progress, quiet,
-                                                  summary_json=summary_json)
-            return _report(deck, outdir, "synthesis", status, quiet) if report else status
-        if "optimize" in deck.groups:
-            from driver import optimize
-            status = optimize.run_optimize_deck(deck, outdir, formats, plot, progress, quiet,
-                                                summary_json=summary_json, **(sweep_options or {}))
-            return _report(deck, outdir, "optimize", status, quiet) if report else status
-        if "sweep" in deck.groups:
-            require("parquet")   # sweeps keep their cases in Parquet: say so before importing them
-            from driver import sweep
-            status = sweep.run_sweep_deck(deck, outdir, formats, plot, progress, quiet, **(sweep_options or {}))
-            if summary_json:
-                from driver.sweep.record import write_sweep_json
-                path_ = write_sweep_json(deck, outdir, status)
-                if not quiet:
-                    print(f"wrote {path_}")
-            return _report(deck, outdir, "sweep", status, quiet) if report else status
-        outcome = run_study(deck, outdir, formats, plot, progress, summary_json=summary_json)
-        if report:
-            outcome.written.append(_report_page(deck, outdir, outcome.result))
+        outcome = run_by_engine(deck, outdir, formats, plot, progress, summary_json=summary_json, report=report,
+                                **(sweep_options or {}))
     except DeckError as exc:
         print(f"error: {exc}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+        return ExitCode.BAD_INPUT
     except NameTooLong as exc:   # an output name known only once computed (a figure's): nothing was written
         stem, name = Path(path).stem, Path(exc.filename).name
         what = (name_too_long(len(os.fsencode(stem)), name[len(stem):]) if name.startswith(stem)
                 else f"cannot write {exc.filename}: {exc.strerror}")
         print(f"error: {path}: {what}; nothing written", file=sys.stderr)
-        return EXIT_BAD_INPUT
+        return ExitCode.BAD_INPUT
     except MissingExtra as exc:
         print(f"error: {path}: {exc}", file=sys.stderr)
-        return EXIT_FAILED
+        return ExitCode.FAILED
     except (KeyboardInterrupt, BrokenPipeError):
         raise
     except OSError as exc:   # the file system: one line naming the path, then the next deck
         print(f"error: {path}: {_fs_error(exc)}", file=sys.stderr)
-        return EXIT_FAILED
+        return ExitCode.FAILED
     except MemoryError:
         print(f"error: {path}: out of memory (see --max-memory)", file=sys.stderr)
-        return EXIT_FAILED
+        return ExitCode.FAILED
     except Exception as exc:  # a bug or an unexpected numerical failure: say so plainly
         print(f"error: {path}: run failed: {exc.__class__.__name__}: {exc}", file=sys.stderr)
         if os.environ.get("DRIVER_DEBUG"):
             traceback.print_exc()
-        return EXIT_FAILED
-    result = outcome.result
-    if given:   # reported once the deck is known to be valid (bad input gets its error line only)
+        return ExitCode.FAILED
+    if given and isinstance(outcome, RunOutcome):   # once the deck is known to be valid (not after bad input)
         print(f"warning: {path}: {', '.join(given)} apply to sweep and optimisation decks "
               f"(a &sweep or &optimize group) only; ignored for this deck", file=sys.stderr)
-    for w in result.warnings:
-        if w != result.failure:   # a failure is printed once, as the error below
-            print(f"warning: {path}: {w}", file=sys.stderr)
-    if not quiet:
-        for p in outcome.written:
-            print(f"wrote {p}")
-    if result.failure:
-        print(f"error: {path}: {result.failure}", file=sys.stderr)
-        return EXIT_FAILED
-    return EXIT_OK
+    say(outcome, quiet)
+    return outcome.exit_code
 
 
-def _report_page(deck, outdir: Path, result) -> Path:
-    """Write the report page of a single-case run (``<stem>.html``); returns its path."""
-    from driver import report_page
-    from driver.runner import output_stem, study_of
-    _, params = study_of(deck)
-    stem = output_stem(outdir, deck.path, (".html",))
-    page = report_page.page_for_result(result, deck, params)
-    return report_page.write_report(stem.with_name(stem.name + ".html"), page)
+def say(outcome: Outcome, quiet: bool = False) -> None:
+    """Print an engine's outcome: its warnings and errors on stderr, in order; unless ``quiet``,
+    its progress notes, its summary line and the files written on stdout."""
+    for message in outcome.messages:
+        print(message, file=sys.stderr)
+    if quiet:
+        return
+    for line in _stdout_lines(outcome):
+        print(line)
 
 
-def _report(deck, outdir: Path, kind: str, status: int, quiet: bool) -> int:
-    """Write the report page of a sweep, optimisation or synthesis deck after its run (not after
-    bad input: nothing is written then); a page that cannot be built is an error line, and the
-    deck's status becomes 1."""
-    if status == EXIT_BAD_INPUT:
-        return status
-    from driver import report_page
-    from driver.runner import output_stem
-    stem = output_stem(outdir, deck.path, (".html",))
-    build = {"sweep": report_page.page_for_sweep, "optimize": report_page.page_for_optimize,
-             "synthesis": report_page.page_for_synthesis}[kind]
-    try:
-        path = report_page.write_report(stem.with_name(stem.name + ".html"), build(deck, outdir, stem.name, status))
-    except (KeyboardInterrupt, BrokenPipeError):
-        raise
-    except Exception as exc:
-        print(f"error: {deck.path}: the report page could not be written: {exc.__class__.__name__}: {exc}",
-              file=sys.stderr)
-        return max(status, EXIT_FAILED)
-    if not quiet:
-        print(f"wrote {path}")
-    return status
+def _stdout_lines(outcome: Outcome) -> list[str]:
+    """What a deck's run says on stdout: for a sweep its notes, its summary line and the files
+    written (its own tables in one line); otherwise the files written, then the notes (an
+    optimisation's result and the designs it computed)."""
+    if isinstance(outcome, SweepOutcome):
+        oc, out = outcome, outcome.outdir or Path(".")
+        own = [out / f"{oc.name}.out", out / f"{oc.name}_summary.csv", out / f"{oc.name}_summary.parquet"]
+        if oc.batch:
+            speed = (f"{oc.seconds:.2f} s, {oc.n_cases / max(oc.seconds, 1e-9):.0f} cases/s "
+                     f"({oc.workers}, batch path, chunk {oc.chunk})")
+        else:
+            speed = f"{oc.seconds:.2f} s ({oc.workers}, chunk {oc.chunk})"
+        return [*oc.notes, f"sweep {oc.deck}: {oc.n_ok} of {oc.n_cases} cases ok, {oc.n_kept} kept, {speed}",
+                f"wrote {own[0]} and {out / oc.name}_summary.{{csv,parquet}}",
+                *(f"wrote {p}" for p in oc.written if p not in own)]
+    return [*(f"wrote {p}" for p in outcome.written), *outcome.notes]
 
 
 class Terminated(KeyboardInterrupt):
@@ -214,13 +177,13 @@ def _examples(args: argparse.Namespace) -> int:
             print(f"copied {target}; run it with: python -m driver {target}")
     except KeyError as exc:
         print(f"error: {exc.args[0]}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+        return ExitCode.BAD_INPUT
     except BrokenPipeError:   # e.g. piped into head
         sys.stderr.close()
     except OSError as exc:
         print(f"error: {exc}", file=sys.stderr)
-        return EXIT_FAILED
-    return EXIT_OK
+        return ExitCode.FAILED
+    return ExitCode.OK
 
 
 def _positive_int(text: str) -> int:
@@ -297,7 +260,7 @@ def main(argv: list[str] | None = None) -> int:
         return _main(parser, args)
     except ImportError as exc:   # e.g. the kernels are not built: driver.kernels says what to do
         print(f"error: {exc}", file=sys.stderr)
-        return EXIT_FAILED
+        return ExitCode.FAILED
 
 
 def _main(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
@@ -308,12 +271,12 @@ def _main(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
             from driver.runner import CONTROL_GROUPS
             known = ", ".join(f"&{g}" for g in (*study_names(), *CONTROL_GROUPS))
             print(f"error: --keys: no namelist group &{group} (known groups: {known})", file=sys.stderr)
-            return EXIT_BAD_INPUT
+            return ExitCode.BAD_INPUT
         try:
             print(text)
         except BrokenPipeError:  # e.g. piped into head
             sys.stderr.close()
-        return EXIT_OK
+        return ExitCode.OK
     if args.examples or args.example:
         return _examples(args)
     if not args.decks:
@@ -324,7 +287,7 @@ def _main(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
             return compare_decks(args.decks)
         except BrokenPipeError:
             sys.stderr.close()
-            return EXIT_OK
+            return ExitCode.OK
     try:
         configured = limits.configure(args.max_memory, args.max_work)
     except ValueError as exc:
@@ -342,7 +305,7 @@ def _main(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
     progress = sys.stderr.isatty() and not args.quiet and not os.environ.get("CI")
     plot: bool | str = args.plot_format or args.plot
     sweep_options = {"jobs": args.jobs, "scheduler": args.scheduler, "resume": args.resume}
-    status = EXIT_OK
+    status = ExitCode.OK
     handlers = _install_signals()
     try:
         for deck in args.decks:
@@ -355,7 +318,7 @@ def _main(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
     except KeyboardInterrupt as exc:
         what = "terminated" if isinstance(exc, Terminated) else "interrupted"
         print(f"{what}: finished outputs are complete; no partial file was left", file=sys.stderr)
-        return 143 if isinstance(exc, Terminated) else 130
+        return ExitCode.TERMINATED if isinstance(exc, Terminated) else ExitCode.INTERRUPTED
     finally:
         _restore_signals(handlers)
         limits.restore(configured)

@@ -23,16 +23,17 @@ import re
 import stat
 import unicodedata
 import warnings
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import f90nml
 
+from driver.groupspec import GroupSpec, Key
+
 __all__ = ["DeckError", "Key", "GroupSpec", "Params", "RawGroup", "Deck", "read_deck", "validate"]
 
-KINDS = ("float", "int", "str", "bool", "floats", "ints", "strs", "list")
 #: magnitudes no deck value of any study needs; larger ones only overflow the kernels
 MAX_FLOAT, MAX_INT = 1e15, 10**9
 
@@ -52,42 +53,6 @@ class DeckError(ValueError):
         where = f"{self.path}:{self.line}" if self.line else self.path
         what = f"key '{self.key}': " if self.key else ""
         return f"{where}: {what}{self.message}"
-
-
-@dataclass(frozen=True)
-class Key:
-    """Declaration of one deck key.
-
-    kind      one of float, int, str, bool (scalars) or floats, ints, strs (lists;
-              a single value is accepted as a list of one); ``list`` is a list of
-              scalars of any one type, left uncoerced (sweep values)
-    required  the deck must give it; otherwise ``default`` is used
-    choices   allowed values (strings compared case-insensitively, stored lower-case)
-    check     extra test: returns an error message or None
-    units     for --help and docs, e.g. 'rad/s'
-    """
-
-    kind: str
-    required: bool = False
-    default: Any = None
-    choices: tuple | None = None
-    check: Callable[[Any], str | None] | None = None
-    units: str = ""
-    doc: str = ""
-
-    def __post_init__(self) -> None:
-        if self.kind not in KINDS:
-            raise ValueError(f"unknown key kind {self.kind!r}")
-
-
-@dataclass(frozen=True)
-class GroupSpec:
-    """A namelist group of a study: its keys and a cross-key check on the Params."""
-
-    name: str
-    keys: dict[str, Key]
-    doc: str = ""
-    check: Callable[[Params], None] | None = None
 
 
 @dataclass

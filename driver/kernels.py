@@ -51,6 +51,17 @@ _spares: dict[str, np.ndarray] = {}
 _spares_lock = threading.Lock()
 
 
+def _refs(store: dict[str, np.ndarray], name: str) -> int:
+    """References to ``store[name]`` as this function sees them (for :data:`_FREE_REFS`)."""
+    a = store.get(name)
+    return sys.getrefcount(a)
+
+
+#: what :func:`_refs` counts for an array only ``store`` holds, measured on this interpreter (the
+#: count of the dict entry, the local name and getrefcount's argument differs between versions)
+_FREE_REFS = _refs({"probe": np.empty(1)}, "probe")
+
+
 def _spare(name: str, shape: tuple[int, ...], dtype: type) -> np.ndarray:
     """A fresh-to-the-caller output array of ``shape`` (Fortran order) for kernel output ``name``.
 
@@ -64,10 +75,11 @@ def _spare(name: str, shape: tuple[int, ...], dtype: type) -> np.ndarray:
     if int(np.prod(shape)) * dtype.itemsize < SPARE_MIN_BYTES:
         return np.empty(shape, dtype=dtype, order="F")
     with _spares_lock:
-        a = _spares.get(name)
-        # held only by the dict, the local name and getrefcount's argument: nobody else has it
-        if a is not None and a.shape == shape and a.dtype == dtype and sys.getrefcount(a) == 3:
-            return a
+        # held only by the dict (counted as for the probe array at import): nobody else has it
+        if name in _spares and _refs(_spares, name) == _FREE_REFS:
+            a = _spares[name]
+            if a.shape == shape and a.dtype == dtype:
+                return a
         a = np.empty(shape, dtype=dtype, order="F")
         _spares[name] = a
         return a

@@ -6,24 +6,28 @@ exits; it raises :class:`~driver.deck.DeckError` for bad input and returns what 
 """
 from __future__ import annotations
 
+import functools
 import os
 import re
-from collections.abc import Iterable
-from dataclasses import dataclass, field
+from collections.abc import Callable, Iterable
+from typing import Any
 from pathlib import Path
 
 import numpy as np
 
 from driver import blas, limits
-from driver._study import Study, load_study, registered, study_names
+from driver._study import REGISTRY, Study, load_study, registered, study_names
 from driver.atomic import NAME_MAX, inside, output_set, remove_stale_temporaries, write_text
 from driver.deck import Deck, DeckError, Params
 from driver.deck import validate
 from driver.export import FORMATS, summary_json_text, write_tidy
+from driver.outcome import RunOutcome
+from driver.pydeck import deck_of
 from driver.study import Result
 from driver.table import TableValueError
 
-__all__ = ["CONTROL_GROUPS", "CaseFailure", "Outcome", "available_studies", "study_of", "run_study", "write_outputs",
+__all__ = ["CONTROL_GROUPS", "CaseFailure", "RunOutcome", "available_studies", "study_of", "run_study", "write_outputs",
+           "keyword_run",
            "output_stem", "check_finite", "compute", "numerical_error"]
 
 #: groups handled by the driver itself rather than by a study module
@@ -198,18 +202,11 @@ def compute(study: Study, params: Params, progress: bool = False,
     return check_finite(result, params)
 
 
-@dataclass
-class Outcome:
-    """What one single-case run did: its result and the files written (for the caller to report)."""
-
-    result: Result
-    written: list[Path] = field(default_factory=list)
-
-
 def run_study(deck: Deck, outdir: Path | None, formats: list[str], plot: bool,
-              progress: bool = False, summary_json: bool = False, name: str | None = None) -> Outcome:
+              progress: bool = False, summary_json: bool = False, name: str | None = None) -> RunOutcome:
     """Validate and run the deck's study; write its outputs to ``outdir`` (None: write nothing)
-    as ``<name>.*`` (default: the deck's file stem).
+    as ``<name>.*`` (default: the deck's file stem).  Returns the result, the files written, and
+    the result's warnings and failure as messages naming the deck.
 
     Raises DeckError for bad input (nothing is written then); other exceptions are run failures.
     """
@@ -219,4 +216,37 @@ def run_study(deck: Deck, outdir: Path | None, formats: list[str], plot: bool,
     written = [] if outdir is None else write_outputs(
         result, output_stem(outdir, deck.path if name is None else f"{name}.dat", study_suffixes(formats, summary_json)),
         formats, plot, summary_json)
-    return Outcome(result, written)
+    outcome = RunOutcome(result=result, written=written)
+    for w in result.warnings:
+        if w != result.failure:   # a failure is reported once, as the error
+            outcome.warn(f"{deck.path}: {w}")
+    if result.failure:
+        outcome.error(f"{deck.path}: {result.failure}")
+    return outcome
+
+
+def keyword_run(run: Callable[..., Result]) -> Callable[..., Result]:
+    """Decorator for a study's ``run``: accept validated Params (the runner's call) or the deck's
+    keys as keyword arguments, e.g. ``driver.fourbar.run(fixed_link=12, crank=5, coupler=15,
+    rocker=9, step_deg=20)``.  Keywords are validated by the study's SPEC exactly like a deck
+    (errors are :class:`driver.deck.DeckError`); the result is the runner's, as for a deck
+    (:func:`run_study`, the outputs named after the study group)."""
+    @functools.wraps(run)
+    def wrapper(params: Any = None, /, progress: bool = False, **keys: Any) -> Result:
+        group = _group_of(run.__module__)
+        if params is not None:
+            if keys:
+                raise TypeError(f"{group}.run() takes validated params or deck keys, not both")
+            return run(params, progress=progress)
+        return run_study(deck_of({group: keys}, None), None, [], False, progress=progress).result
+
+    return wrapper
+
+
+def _group_of(module: str) -> str:
+    """The registered study group whose package holds module ``module`` (its own name's last part
+    when none does: a study being written that is not registered yet)."""
+    for group, package in REGISTRY.items():
+        if module == package or module.startswith(package + "."):
+            return group
+    return module.rpartition(".")[2]

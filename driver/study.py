@@ -1,18 +1,18 @@
-"""What a study returns: :class:`Result` and its :class:`Figure` s; ``keyword_run``; labels.
+"""What a study returns: :class:`Result` and its :class:`Figure` s; labels.
 
 What a study *is* (the :class:`~driver._study.Study` every study package declares as ``STUDY``)
 and the registry of studies are in :mod:`driver._study`.  This module holds what a study's run
-produces (:class:`Result`), the decorator that gives ``run`` its keyword form, the code digest
-that signs resume records, and the axis labels of summary columns from a study's ``labels``.
+produces (:class:`Result`), the code digest that signs resume records, and the axis labels of
+summary columns from a study's ``labels``; the decorator that gives ``run`` its keyword form is
+:func:`driver.runner.keyword_run`.
 """
 from __future__ import annotations
 
-import functools
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
-from typing import TYPE_CHECKING, Any, Callable, Iterable
+from typing import TYPE_CHECKING, Any, Callable
 
 from driver._study import Study
 
@@ -22,8 +22,7 @@ if TYPE_CHECKING:   # annotations only: keeps `python -m driver --help` light
 if TYPE_CHECKING:
     import matplotlib.figure
 
-__all__ = ["Figure", "PLOT_FORMATS", "Result", "code_digest", "column_label", "expression_label", "keyword_run",
-           "plot_format"]
+__all__ = ["Figure", "PLOT_FORMATS", "Result", "code_digest", "column_label", "expression_label", "plot_format"]
 
 
 #: file formats of ``--plot`` figures (``--plot-format``); the first is the default
@@ -118,57 +117,11 @@ class Result:
                 return f.draw()
         raise LookupError(f"no figure {name!r}; this result draws {', '.join(self.figure_names)}")
 
-    def write(self, outdir: str | Path, formats: Iterable[str] = (), plot: bool = False,
-              json: bool = False, name: str | None = None, report: bool = False) -> list[Path]:
-        """Write the outputs the command line writes: ``<outdir>/<name>.out`` and extra files,
-        tidy tables in ``formats`` ('csv', 'parquet'), PNG figures with ``plot``, the
-        summary as ``<name>.json`` with ``json``, and the self-contained report page
-        ``<name>.html`` with ``report`` (:mod:`driver.report_page`, as ``--report``).  Every
-        file is written atomically; ``outdir`` is created when missing.  Returns the paths written."""
-        from driver.runner import write_outputs
-        stem = name or self.name or self.study or "result"
-        if Path(stem).name != stem or stem in ("", ".", ".."):
-            raise ValueError(f"output name {stem!r} must be a plain file stem, not a path")
-        written = write_outputs(self, Path(outdir) / stem, list(formats), plot, summary_json=json)
-        if report:
-            from driver import report_page
-            page = report_page.page_for_result(self, None, self.params)
-            written.append(report_page.write_report(Path(outdir) / f"{stem}.html", page))
-        return written
-
     def __repr__(self) -> str:
         state = "ok" if self.ok else f"failed: {self.failure}"
         return (f"<Result {self.study or '?'} {self.name!r}: {state}; .out {len(self.text.splitlines())} lines, "
                 f"tidy {self.tidy.shape[0]}x{self.tidy.shape[1]}, summary {len(self.summary)} values, "
                 f"{len(self.warnings)} warning(s), figures {self.figure_names}>")
-
-
-def keyword_run(run: Callable[..., Result]) -> Callable[..., Result]:
-    """Decorator for a study's ``run``: accept validated Params (the runner's call) or the deck's
-    keys as keyword arguments, e.g. ``driver.fourbar.run(fixed_link=12, crank=5, coupler=15,
-    rocker=9, step_deg=20)``.  Keywords are validated by the study's SPEC exactly like a deck
-    (errors are :class:`driver.deck.DeckError`); the result is the runner's, as for a deck."""
-    @functools.wraps(run)
-    def wrapper(params: Any = None, /, progress: bool = False, **keys: Any) -> Result:
-        group = _group_of(run.__module__)
-        if params is not None:
-            if keys:
-                raise TypeError(f"{group}.run() takes validated params or deck keys, not both")
-            return run(params, progress=progress)
-        from driver.api import run as api_run
-        return api_run({group: keys}, progress=progress)
-
-    return wrapper
-
-
-def _group_of(module: str) -> str:
-    """The registered study group whose package holds module ``module`` (its own name's last part
-    when none does: a study being written that is not registered yet)."""
-    from driver._study import REGISTRY
-    for group, package in REGISTRY.items():
-        if module == package or module.startswith(package + "."):
-            return group
-    return module.rpartition(".")[2]
 
 
 def code_digest(module: Study | ModuleType | None, *others: ModuleType | None) -> bytes:

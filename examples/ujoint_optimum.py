@@ -23,7 +23,7 @@ def main(outdir: Path) -> driver.Result:
     print(f"optimum phases {s['phi_1_deg']:.4f}, {s['phi_2_deg']:.4f} deg; output speed "
           f"{s['omega_out_min_rpm']:.4f} .. {s['omega_out_max_rpm']:.4f} rpm "
           f"(trial objective {s['objective_trial']:.3e} -> {s['objective']:.3e})")
-    for path in r.write(outdir, json=True, name="ujoint_option1_api"):
+    for path in driver.write(r, outdir, json=True, name="ujoint_option1_api"):
         print(f"wrote {path}")
     return r
 

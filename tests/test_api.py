@@ -52,7 +52,7 @@ def test_import_driver_is_cheap_and_exports_a_small_documented_surface():
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True)
     heavy, names = res.stdout.splitlines()
     assert heavy == "[]"
-    assert eval(names) == sorted(["run", "run_sweep", "studies", "keys", "Result", "SweepResult", "DeckError"])
+    assert eval(names) == sorted(["run", "run_sweep", "write", "studies", "keys", "Result", "SweepResult", "DeckError"])
     for name in driver.__all__:
         obj = getattr(driver, name)
         assert obj.__doc__ and len(obj.__doc__) > 40, name
@@ -148,12 +148,12 @@ def test_figures_on_demand_and_write(tmp_path):
     assert type(fig).__name__ == "Figure" and fig.get_dpi() == 150
     with pytest.raises(LookupError):
         r.figure("nope")
-    written = r.write(tmp_path / "new", formats=["csv", "parquet"], plot=True, json=True, name="c5")
+    written = driver.write(r, tmp_path / "new", formats=["csv", "parquet"], plot=True, json=True, name="c5")
     names = sorted(p.name for p in written)
     assert names == ["c5.csv", "c5.json", "c5.out", "c5.parquet", "c5_curves.png", "c5_linkage.png"]
     assert (tmp_path / "new" / "c5.out").read_text() == r.out
     with pytest.raises(ValueError):
-        r.write(tmp_path, name="../escape")
+        driver.write(r, tmp_path, name="../escape")
 
 
 def test_summary_json_from_the_command_line(tmp_path):
@@ -174,7 +174,7 @@ def test_summary_json_from_the_command_line(tmp_path):
     assert uj["summary"]["converged"] is True
     # no NaN ever reaches the JSON: missing figures are null
     nan = driver.fourbar.run(fixed_link=1, crank=5, coupler=1, rocker=1, step_deg=90)
-    assert "NaN" not in nan.write(tmp_path, json=True)[-1].read_text()
+    assert "NaN" not in driver.write(nan, tmp_path, json=True)[-1].read_text()
 
 
 # ----------------------------------------------------------------------------- API == command line
@@ -186,7 +186,7 @@ def test_api_and_command_line_write_identical_files(path, tmp_path, monkeypatch)
     a, b = tmp_path / "cli", tmp_path / "api"
     assert cli.main([str(path), "-o", str(a), "-q", "--csv", "--format", "parquet", "--json"]) in (0, 1)
     r = driver.run(path)
-    r.write(b, formats=["csv", "parquet"], json=True)
+    driver.write(r, b, formats=["csv", "parquet"], json=True)
     fa, fb = _files(a), _files(b)
     assert list(fa) == list(fb)
     for name in fa:
@@ -256,7 +256,7 @@ def test_plotting_leaves_the_users_backend_and_rcparams_alone(tmp_path):
         import driver
         r = driver.run({str(INPUTS / 'crank5.dat')!r})
         figs = [r.figure(n) for n in r.figure_names]
-        r.write({str(tmp_path)!r}, plot=True)
+        driver.write(r, {str(tmp_path)!r}, plot=True)
         assert matplotlib.get_backend() == "svg", matplotlib.get_backend()
         after = dict(matplotlib.rcParams)
         changed = {{k for k in before if before[k] != after[k] and not (before[k] != before[k])}}

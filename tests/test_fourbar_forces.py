@@ -414,9 +414,9 @@ def test_batch_summary_equals_single_runs():
 
 def _params(text: str):
     from driver import fourbar
-    from driver.api import _deck
+    from driver.pydeck import deck_of
     from driver.deck import validate
-    deck = _deck(text, None)
+    deck = deck_of(text, None)
     return validate(deck.groups["fourbar"], fourbar.SPEC, str(deck.path))
 
 

@@ -250,10 +250,10 @@ def test_published_comparison_on_the_page(pages, browser):
 
 
 def test_result_write_report(tmp_path, browser):
-    """The Python API writes the same page: Result.write(..., report=True)."""
+    """The Python API writes the same page: driver.write(result, ..., report=True)."""
     import driver
     r = driver.run(str(INPUTS / "crank2.dat"))
-    written = r.write(tmp_path, report=True)
+    written = driver.write(r, tmp_path, report=True)
     page = tmp_path / "crank2.html"
     assert page in written
     browser.events.clear()

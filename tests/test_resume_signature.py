@@ -1,6 +1,11 @@
 """Both kinds of sweep resume record (batch parts and per-case parts) are invalidated by an edit
 to *any* module of a study package, not only its ``__init__.py`` (an edit to a study's report
-module changes what the tables say, so a record made before it must be redone)."""
+module changes what the tables say, so a record made before it must be redone).
+
+Both kinds carry the one signature :func:`driver.sweep.store.signature`; checked on the
+functions (a synthetic study package edited on disk) and end to end (a Hooke-joint sweep run
+on the batch path and case by case, resumed before and after an edit of
+``driver/ujoint/report.py`` as the digest reads it)."""
 from __future__ import annotations
 
 import importlib.util
@@ -9,10 +14,11 @@ from pathlib import Path
 
 import pytest
 
+from driver.cli import main
 from driver.deck import RawGroup
 from driver.study import code_digest
 from driver.sweep import store
-from driver import sweep_batch
+from driver.sweep import batch as sweep_batch
 
 
 @pytest.fixture
@@ -38,7 +44,7 @@ def fake_study(tmp_path: Path):
 
 def _both(mod) -> tuple[str, str]:
     raw = RawGroup("fakestudy", {"a": 1.0, "b": 2.0}, {"a": 2, "b": 3}, 1)
-    per_case = store.signature(raw, ["fakestudy.a"], "deck.dat", "", "none", [], False, mod)
+    per_case = store.case_signature(raw, ["fakestudy.a"], "deck.dat", "", "none", [], False, mod)
     grid = sweep_batch.Grid(["fakestudy.a"], [[1.0, 2.0]], False)
     batch = sweep_batch._signature(raw, grid, "", "all", mod)
     return per_case, batch
@@ -60,3 +66,43 @@ def test_code_digest_covers_every_module_of_a_real_study_package():
     assert any(f.name == "report.py" for f in files)
     assert len(code_digest(uj)) == 32
     assert code_digest(uj) != code_digest(None)
+
+
+DECK = """&ujoint
+  model = 'exact'
+  beta = 25.0, 25.0
+  phi = 90.0
+  rho = 0.0
+  rpm = 25.0
+/
+&sweep
+  key1 = 'ujoint.rho', values1 = 0, 30
+  key2 = 'ujoint.phi', values2 = 0, 90, 120
+  keep = 'pp_ratio < 1e-9'
+  case_outputs = '{outputs}'
+/
+"""
+
+
+def _resumed(capsys, deck: Path, out: Path) -> str:
+    capsys.readouterr()
+    assert main([str(deck), "-o", str(out), "-j", "1", "--resume"]) == 0
+    return [line for line in capsys.readouterr().out.splitlines() if line.startswith("resume:")][0]
+
+
+@pytest.mark.parametrize("outputs, engine", [("none", "batch"), ("all", "case")])
+def test_an_edit_of_the_report_module_redoes_a_resumed_sweep(tmp_path, capsys, monkeypatch, outputs, engine):
+    import driver.ujoint.report as report
+    deck = tmp_path / "usw.dat"
+    deck.write_text(DECK.format(outputs=outputs))
+    out = tmp_path / "out"
+    assert main([str(deck), "-o", str(out), "-q", "-j", "1"]) == 0
+    parts = [p.name for p in (out / "usw.sweep").glob("part-*.parquet")]
+    assert parts and all(n.startswith("part-r") == (engine == "case") for n in parts), parts
+    assert _resumed(capsys, deck, out) == "resume: 6 of 6 cases complete, 0 to run"
+    target = Path(report.__file__).resolve()
+    real = Path.read_bytes
+    monkeypatch.setattr(Path, "read_bytes",
+                        lambda self: real(self) + (b"\n# edited\n" if self.resolve() == target else b""))
+    assert _resumed(capsys, deck, out) == "resume: 0 of 6 cases complete, 6 to run"
+    assert _resumed(capsys, deck, out) == "resume: 6 of 6 cases complete, 0 to run"

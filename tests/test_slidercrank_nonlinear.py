@@ -74,21 +74,21 @@ def test_damped_element_tangent_is_the_derivative_of_the_damped_force():
     le, ea, ei, bd = 0.02, 1e6, 2.0, 3e-3
     p = np.array([1e-4, 2e-3, 0.3, -2e-4, 5e-3, -0.1])
     pd = np.array([0.3, -1.2, 40.0, -0.5, 2.0, -25.0])      # fast turns: the buckled rod's rates
-    f, kt, _, _, _ = kernels.slidercrank_corot_element(le, ea, ei, p, True, pd, bd)
-    f_el, _, _, _, _ = kernels.slidercrank_corot_element(le, ea, ei, p, False)
+    f, kt, _, _, _ = slidercrank_kernel.slidercrank_corot_element(le, ea, ei, p, True, pd, bd)
+    f_el, _, _, _, _ = slidercrank_kernel.slidercrank_corot_element(le, ea, ei, p, False)
     assert np.abs(f - f_el).max() > 1e-3 * np.abs(f_el).max()            # the damping force counts here
     h = 1e-7
     fd_p, fd_pd = np.zeros((6, 6)), np.zeros((6, 6))
     for j in range(6):
         dp = np.zeros(6)
         dp[j] = h
-        fd_p[:, j] = (kernels.slidercrank_corot_element(le, ea, ei, p + dp, False, pd, bd)[0]
-                      - kernels.slidercrank_corot_element(le, ea, ei, p - dp, False, pd, bd)[0]) / (2 * h)
-        fd_pd[:, j] = (kernels.slidercrank_corot_element(le, ea, ei, p, False, pd + dp, bd)[0]
-                       - kernels.slidercrank_corot_element(le, ea, ei, p, False, pd - dp, bd)[0]) / (2 * h)
+        fd_p[:, j] = (slidercrank_kernel.slidercrank_corot_element(le, ea, ei, p + dp, False, pd, bd)[0]
+                      - slidercrank_kernel.slidercrank_corot_element(le, ea, ei, p - dp, False, pd, bd)[0]) / (2 * h)
+        fd_pd[:, j] = (slidercrank_kernel.slidercrank_corot_element(le, ea, ei, p, False, pd + dp, bd)[0]
+                       - slidercrank_kernel.slidercrank_corot_element(le, ea, ei, p, False, pd - dp, bd)[0]) / (2 * h)
     np.testing.assert_allclose(kt, fd_p, rtol=1e-5, atol=1e-6 * np.abs(kt).max())
     assert np.abs(kt - kt.T).max() > 1e-4 * np.abs(kt).max()              # not symmetric
-    kt1 = kernels.slidercrank_corot_element(le, ea, ei, p, True, pd, bd, rate_weight=1.0)[1]
+    kt1 = slidercrank_kernel.slidercrank_corot_element(le, ea, ei, p, True, pd, bd, rate_weight=1.0)[1]
     np.testing.assert_allclose(bd * (kt1 - kt), fd_pd, rtol=1e-5, atol=1e-6 * np.abs(fd_pd).max())
 
 
@@ -102,10 +102,10 @@ def test_newton_converges_quadratically_on_the_buckled_rod():
     for mat, omega in (("aluminium", 21.99), ("aluminium", 25.13), ("medium_carbon_steel", 29.32)):
         m = MATERIALS[mat]
         ea, ei, rhoa = m["youngs_modulus"] * m["area"], m["youngs_modulus"] * m["second_moment"], m["density"] * m["area"]
-        al, be = rayleigh(0.02, *kernels.slidercrank_frequencies(rhoa, ea, ei, L, MS)[:2])
+        al, be = rayleigh(0.02, *slidercrank_kernel.slidercrank_frequencies(rhoa, ea, ei, L, MS)[:2])
         spr, revs = 1440, 3
         dt = 2 * math.pi / (omega * spr)
-        r = kernels.slidercrank_nl_simulate(40, R2, L, rhoa, ea, ei, m["section_depth"] / 2, MS, omega, dt, revs * spr,
+        r = slidercrank_kernel.slidercrank_nl_simulate(40, R2, L, rhoa, ea, ei, m["section_depth"] / 2, MS, omega, dt, revs * spr,
                                             spr, (revs - 1) * spr, spr + 1, al, be, hht=-0.05)
         assert r["status"] == 0
         out[mat, omega] = r["stats"][0] / (revs * spr)

@@ -23,7 +23,8 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import driver
-from driver import deck as deck_module, limits, sweep_batch
+from driver import deck as deck_module, limits
+from driver.sweep import batch as sweep_batch
 from driver._study import REGISTRY, BatchSummary, Study, load_study, study_names
 from driver.deck import DeckError, GroupSpec, Key, read_deck
 from driver.limits import Estimate

@@ -1,4 +1,4 @@
-"""The streaming batch sweep engine (driver/sweep_batch.py): same tables as case by case, on one
+"""The streaming batch sweep engine (driver/sweep/batch.py): same tables as case by case, on one
 process, two workers and Dask; exact resume after SIGKILL; a dying worker costs its chunk only;
 workers never outlive the driver; bad values found without validating every case."""
 from __future__ import annotations
@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from driver import sweep_batch
+from driver.sweep import batch as sweep_batch
 from driver.cli import main
 
 BASE = """&fourbar

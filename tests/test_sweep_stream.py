@@ -15,7 +15,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from driver import sweep_batch
+from driver.sweep import batch as sweep_batch
 from driver.cli import main
 from driver.sweep import stream
 

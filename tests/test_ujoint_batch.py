@@ -187,7 +187,7 @@ def _sweep(tmp_path: Path, outputs: str, option: int = 0) -> Path:
 
 def _path_taken(out: Path, stem: str = "usw") -> str:
     """'batch' or 'case': the parts of the resume record <stem>.sweep/ say which engine ran
-    (driver.sweep_batch: part-<first case>.parquet; driver.sweep: part-r<run>-<seq>.parquet)."""
+    (driver.sweep.batch: part-<first case>.parquet; driver.sweep: part-r<run>-<seq>.parquet)."""
     parts = [p.name for p in (out / f"{stem}.sweep").glob("part-*.parquet")]
     assert parts
     return "case" if all(n.startswith("part-r") for n in parts) else "batch"

@@ -18,7 +18,8 @@ from driver.fourbar.analysis import (ST, TIDY_UNITS, Extremes, Grashof, coupler_
                                      listing_grid, rocking_motions, tidy_frame)
 from driver.fourbar.batch import summary_of, summary_rows
 from driver.fourbar.spec import band_of
-from driver.study import Figure, Result, keyword_run
+from driver.runner import keyword_run
+from driver.study import Figure, Result
 from driver.fourbar.spec import SPEC
 from driver.table import Column, fortran_f, render_table
 

@@ -1,5 +1,5 @@
 """Design summaries of many &manipulator designs in one kernel call: the batch path of sweeps
-(driver.sweep_batch) and optimisations (driver.optimize.evaluate).
+(driver.sweep.batch) and optimisations (driver.optimize.evaluate).
 
 :func:`summarise_batch` returns, one row per design deck, the columns of the single run's
 summary (``run(...).summary``) plus nothing else: the workspace and C_rob figures, the torques

@@ -16,7 +16,8 @@ from driver.deck import Params
 from driver.export import with_units
 from driver.manipulator.analysis import SIGNIFICANT, Conv, Workspace, _design_list, _target, design_status, optima, round_half_up
 from driver.manipulator.tables import TIDY_NAMES, Table, _differences, _tables, _tolerance
-from driver.study import Figure, Result, keyword_run
+from driver.runner import keyword_run
+from driver.study import Figure, Result
 from driver.manipulator.spec import SPEC
 from driver.table import fortran_f
 

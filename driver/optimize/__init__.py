@@ -26,8 +26,7 @@ from __future__ import annotations
 
 import json
 import math
-import sys
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -39,6 +38,7 @@ from driver import blas
 from driver.deck import Deck, read_deck
 from driver.export import write_tidy
 from driver.extras import require
+from driver.outcome import ExitCode, Outcome
 from driver.optimize.evaluate import Evaluator, Record, design_params
 from driver.optimize.methods import HistoryRow, MethodResult, run_method
 from driver.optimize.problem import SPEC, Problem, problem_of
@@ -48,7 +48,6 @@ from driver.runner import compute, output_stem, write_outputs
 
 __all__ = ["SPEC", "OptimizeOutcome", "optimize", "run_optimize_deck", "problem_of"]
 
-EXIT_OK, EXIT_FAILED = 0, 1
 #: methods whose every step is free of BLAS (their evaluations are the deterministic kernel's): the
 #: best design they evaluated is the same on every machine
 DETERMINISTIC = ("differential_evolution", "grid")
@@ -71,8 +70,9 @@ class DesignVector(dict):
 
 
 @dataclass
-class OptimizeOutcome:
-    """Result of an optimisation, shaped like ``scipy.optimize.OptimizeResult``.
+class OptimizeOutcome(Outcome):
+    """Result of an optimisation, shaped like ``scipy.optimize.OptimizeResult`` (and an
+    :class:`~driver.outcome.Outcome`: files written, warnings and errors as messages, notes).
 
     x            best feasible design: a :class:`DesignVector` ({'group.key': value}, and an
                  array by ``np.asarray(x)`` with ``x.names``); None when none is feasible
@@ -96,12 +96,18 @@ class OptimizeOutcome:
     method: MethodResult
     history: list[HistoryRow]
     evaluator: Evaluator
-    written: list[Path] = field(default_factory=list)
     study_result: Any = None
 
     @property
     def status(self) -> int:
         return 0 if self.success else (2 if self.x is None else 1)
+
+    @property
+    def exit_code(self) -> ExitCode:
+        """1 when the method did not converge or the optimum's full run failed, else 0."""
+        failed = not self.success or (self.check is not None and self.study_result is not None
+                                      and bool(self.study_result.failure))
+        return ExitCode.FAILED if failed else super().exit_code
 
     @property
     def nit(self) -> int:
@@ -301,9 +307,10 @@ def _write(oc: OptimizeOutcome, stem: Path, params, formats: list[str], plot: bo
 
 
 def run_optimize_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool = False,
-                      quiet: bool = False, jobs: int | None = None, resume: bool = False,
-                      scheduler: Any = None, summary_json: bool = False, **_: Any) -> int:
-    """Command-line entry: run, report written files, return the exit status (DeckError propagates).
+                      jobs: int | None = None, resume: bool = False,
+                      scheduler: Any = None, summary_json: bool = False, **_: Any) -> OptimizeOutcome:
+    """Command-line entry: run and write (``summary_json``: also ``<stem>.json``); returns the
+    outcome with its warnings, errors and progress notes as data (DeckError propagates).
 
     Raises :class:`~driver.extras.MissingExtra` before running when pyarrow is missing (the
     evaluation journal is Parquet) or, with a scheduler, Dask.
@@ -317,31 +324,26 @@ def run_optimize_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, 
         oc.written.append(write_text(stem.with_name(stem.name + ".json"),
                                      json.dumps(oc.to_dict(), indent=1, allow_nan=False) + "\n"))
     if oc.evaluator.resume_note:
-        print(f"warning: {deck.path}: resume: {oc.evaluator.resume_note}", file=sys.stderr)
+        oc.warn(f"{deck.path}: resume: {oc.evaluator.resume_note}")
     if oc.study_result is not None:
         for w in oc.study_result.warnings:
-            print(f"warning: {deck.path}: optimum: {w}", file=sys.stderr)
-    if not quiet:
-        for path in oc.written:
-            print(f"wrote {path}")
-        if oc.best is not None and oc.x is not None:   # x is the best design's
-            word = "optimum" if oc.success else "best design (not converged)"
-            print(f"{deck.path}: {word} {p_obj(oc)} after {oc.nfev} designs: "
-                  + ", ".join(f"{k} = {v:.6g}" for k, v in oc.x.items()))
-        ev = oc.evaluator
-        if ev.computed:
-            names = {"batch": "batch path", "dask": f"dask {ev.scheduler}", "processes": f"{ev.jobs} processes",
-                     "serial": "this process"}
-            how = ", ".join(f"{names[r]}: {n}" if len(ev.routes) > 1 else names[r] for r, n in ev.routes.items())
-            print(f"{deck.path}: {ev.computed} designs computed ({len(ev.records) - ev.computed} replayed), "
-                  f"{1e3 * ev.compute_seconds / ev.computed:.3f} ms per design ({how})")
+            oc.warn(f"{deck.path}: optimum: {w}")
+    if oc.best is not None and oc.x is not None:   # x is the best design's
+        word = "optimum" if oc.success else "best design (not converged)"
+        oc.notes.append(f"{deck.path}: {word} {p_obj(oc)} after {oc.nfev} designs: "
+                        + ", ".join(f"{k} = {v:.6g}" for k, v in oc.x.items()))
+    ev = oc.evaluator
+    if ev.computed:
+        names = {"batch": "batch path", "dask": f"dask {ev.scheduler}", "processes": f"{ev.jobs} processes",
+                 "serial": "this process"}
+        how = ", ".join(f"{names[r]}: {n}" if len(ev.routes) > 1 else names[r] for r, n in ev.routes.items())
+        oc.notes.append(f"{deck.path}: {ev.computed} designs computed ({len(ev.records) - ev.computed} replayed), "
+                        f"{1e3 * ev.compute_seconds / ev.computed:.3f} ms per design ({how})")
     if not oc.success:
-        print(f"error: {deck.path}: optimisation did not converge: {oc.message}", file=sys.stderr)
-        return EXIT_FAILED
-    if oc.check is not None and oc.study_result is not None and oc.study_result.failure:
-        print(f"error: {deck.path}: the optimum's full run failed: {oc.study_result.failure}", file=sys.stderr)
-        return EXIT_FAILED
-    return EXIT_OK
+        oc.error(f"{deck.path}: optimisation did not converge: {oc.message}")
+    elif oc.check is not None and oc.study_result is not None and oc.study_result.failure:
+        oc.error(f"{deck.path}: the optimum's full run failed: {oc.study_result.failure}")
+    return oc
 
 
 def p_obj(oc: OptimizeOutcome) -> str:

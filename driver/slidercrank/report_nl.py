@@ -21,7 +21,8 @@ from driver.slidercrank.analysis import Case, _run_case, static_onset
 from driver.slidercrank.nonlinear import IRREGULAR, NLCase, onset_search, run_nl_case
 from driver.slidercrank.report import Derived, _figures, _header, _status_text, run_linear
 from driver.slidercrank.spec import _model, rayleigh
-from driver.study import Figure, Result, keyword_run
+from driver.runner import keyword_run
+from driver.study import Figure, Result
 from driver.slidercrank.spec import SPEC
 from driver.table import Cell, Column, render_table
 

@@ -28,10 +28,12 @@ the deck: a deck naming a scheduler is refused), in chunks sized so that schedul
 costs little (:mod:`driver.sweep.engine`); results are ordered by case whatever the
 scheduling.  ``--resume`` skips cases whose row is in the resume record and whose files
 are all there.  A study with a batch path runs its summary-only sweeps on
-:mod:`driver.sweep_batch`.
+:mod:`driver.sweep.batch`.
 
 The package: :mod:`~driver.sweep.spec` (the &sweep keys, the grid, cases, validation),
-:mod:`~driver.sweep.engine` (workers and scheduling), :mod:`~driver.sweep.store` (case
+:mod:`~driver.sweep.keep` (the keep filter), :mod:`~driver.sweep.engine` (the per-case
+engine: workers and scheduling), :mod:`~driver.sweep.batch` (the batch engine),
+:mod:`~driver.sweep.pool` (the local worker pool of both), :mod:`~driver.sweep.store` (case
 files and the resume record), :mod:`~driver.sweep.report` (summary tables and text).
 """
 from __future__ import annotations
@@ -39,7 +41,6 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -47,21 +48,24 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from driver import expr, sweep_batch
+from driver import expr
+from driver._study import load_study
 from driver.atomic import refuse_link, remove_stale_temporaries
 from driver.deck import Deck, Params, RawGroup, validate
 from driver.extras import require
+from driver.outcome import ExitCode, SweepOutcome
 from driver.runner import compute, output_stem, study_of
-from driver._study import load_study
+from driver.sweep import batch as batch_path
 from driver.sweep import engine, store, stream
+from driver.sweep.keep import check_keep, keep_columns
 from driver.sweep.engine import Task, auto_chunk, run_task
 from driver.sweep.report import Warnings, summary_frame, summary_settings, sweep_text, write_sweep_files
-from driver.sweep.spec import (EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, FULL_VALIDATION, MAX_CASES, MAX_KEYS, SPEC, Case,
+from driver.sweep.spec import (FULL_VALIDATION, MAX_CASES, MAX_KEYS, SPEC, Case,
                                CaseResult, _axes, _configured_scheduler, build_cases, case_count, grid_of,
                                validate_sweep)
 
 __all__ = ["SPEC", "Case", "build_cases", "run_sweep_deck", "run_task", "auto_chunk", "MAX_KEYS", "MAX_CASES",
-           "summary_frame", "case_count", "CASES_TABLE_MAX"]
+           "summary_frame", "case_count", "CASES_TABLE_MAX", "SweepOutcome"]
 
 #: the combined ``<stem>_cases`` tables are written up to this many written cases (above, the
 #: cases' own Parquet files are the table: ``pyarrow.dataset.dataset(<stem>/, format="parquet")``)
@@ -70,10 +74,8 @@ CASES_TABLE_MAX = 2000
 CASES_TABLE_BYTES = 256 * 2**20
 #: the sweep's .out lists every case up to this many cases (above: the kept and failed ones)
 TABLE_ALL_MAX = 2000
-#: CPU-time accounting of the last per-case sweep run in this process [s] (bench/bench_sweep.py):
-#: prepare_cpu (deck, validation, imports, resume scan), run_cpu (the driver's CPU while the
-#: cases ran; with one worker, the cases themselves), run_wall, finish_cpu (tables and files)
-LAST_RUN: dict[str, float] = {}
+#: the most failed cases a sweep reports one by one (the others are counted; all are in the .out)
+FAILED_SHOWN = 20
 
 
 def _base_hash(raw: RawGroup) -> str:
@@ -81,16 +83,17 @@ def _base_hash(raw: RawGroup) -> str:
     return hashlib.sha256(f"{raw.name}:{text}".encode()).hexdigest()[:16]
 
 
-def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool,
-                   quiet: bool = False, jobs: int | None = None, scheduler: Any = None,
-                   resume: bool = False) -> int:
-    """Run a deck with a &sweep group; returns the exit status (see driver.cli).
+def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool = False,
+                   jobs: int | None = None, scheduler: Any = None, resume: bool = False) -> SweepOutcome:
+    """Run a deck with a &sweep group; returns what it did (:class:`~driver.outcome.SweepOutcome`:
+    counts, failed cases, warnings as data, files written, the driver's CPU per phase).  Prints
+    nothing (a progress bar on stderr with ``progress``).
 
-    Raises :class:`~driver.extras.MissingExtra` before running anything when pyarrow (case
-    files and summaries are Parquet) or, with a scheduler, Dask is not installed.
+    Raises DeckError for bad input before any case runs, and
+    :class:`~driver.extras.MissingExtra` before running anything when pyarrow (case files and
+    summaries are Parquet) or, with a scheduler, Dask is not installed.
     """
-    LAST_RUN.clear()
-    LAST_RUN["start_cpu"] = time.process_time()
+    start_cpu = time.process_time()
     sw = validate(deck.groups["sweep"], SPEC, deck.path)
     require("parquet")
     if scheduler or sw.scheduler:
@@ -101,8 +104,8 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
     grid = grid_of(sw, base_params.group, module.spec)
     names = grid.names
     axes = list(zip(grid.names, grid.values))
-    batchable = sweep_batch.batchable(module, names, sw.keep, sw.case_outputs)
-    limit = sweep_batch.MAX_CASES if batchable else MAX_CASES
+    batchable = batch_path.batchable(module, names, sw.keep, sw.case_outputs)
+    limit = batch_path.MAX_CASES if batchable else MAX_CASES
     if grid.n > limit:
         sizes = " x ".join(f"{len(v)} ({n})" for n, v in axes)
         raise sw.error("key1", f"{grid.n} cases ({sizes}) is beyond the {limit} cases one sweep deck "
@@ -117,10 +120,13 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
         kinds = {**expr.kinds_of({n: v[0] for n, v in axes if len(v)}), **expr.kinds_of(probe), "case": "number"}
         for key, text in named:
             try:
+                if key == "keep":
+                    check_keep(text, columns, kinds)   # one number or logical per case, before any case runs
+                    continue
                 e = expr.parse(text, columns)
-                if key == "keep" or text.strip() not in columns:   # a plotted column may hold text
-                    e.check_kinds(kinds)   # one number or logical per case, before any case runs
-                if key != "keep" and not e.names:
+                if text.strip() not in columns:   # a plotted column may hold text
+                    e.check_kinds(kinds)
+                if not e.names:
                     raise expr.ExprError("reads no column: a plot shows a column or an expression of columns",
                                          text[:60])
             except expr.ExprError as exc:
@@ -132,7 +138,7 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
                 raise sw.error("summary_columns", f"'{unknown[0]}' is not a summary column of &{base_params.group} "
                                f"(summary columns: {', '.join(probe)})")
             # what the tables show: the columns asked for, and those the filter and the plot read
-            read = {n for _, text in named for n in expr.parse(text, columns).names}
+            read = {n for k, text in named if k != "keep" for n in expr.parse(text, columns).names} | keep_columns(sw.keep)
             shown_columns = [c for c in probe if c in set(sw.summary_columns) | read]
     # every name the sweep gives its files and folders, known before it runs (the longest counts)
     stem_path = output_stem(outdir, deck.path, (".out", ".sweep", "_summary.csv", "_summary.parquet", "_cases.csv",
@@ -146,12 +152,12 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
         return Task(str(deck.path), raw, grid, indices, layout, sw.keep, case_outputs, formats, case_plot,
                     _base_hash(raw))
 
-    run = _Run(deck, sw, base_params, module, grid, outdir, stem_path.name, layout, task_of, plot, progress, quiet,
-               jobs, scheduler, resume)
+    run = _Run(deck, sw, base_params, module, grid, outdir, stem_path.name, layout, task_of, plot, progress,
+               jobs, scheduler, resume, start_cpu)
     run.shown_columns = shown_columns
-    sig = store.signature(raw, names, str(deck.path), sw.keep, sw.case_outputs, formats, case_plot, module)
+    sig = store.case_signature(raw, names, str(deck.path), sw.keep, sw.case_outputs, formats, case_plot, module)
     if batchable:
-        bplan = sweep_batch.plan(module, raw, str(deck.path), grid, sw.keep, sw.summary_rows,
+        bplan = batch_path.plan(module, raw, str(deck.path), grid, sw.keep, sw.summary_rows,
                                  plotted=[v for k, v in named if k != "keep"], shown=shown_columns)
     else:
         bplan = None
@@ -211,14 +217,16 @@ class _Run:
     """One sweep run: the per-case path (:meth:`cases`) or the batch path (:meth:`batch`)."""
 
     def __init__(self, deck: Deck, sw: Params, base: Params, module, grid, outdir: Path, stem: str,
-                 layout: store.Layout, task_of, plot, progress: bool, quiet: bool, jobs: int, scheduler: Any,
-                 resume: bool):
+                 layout: store.Layout, task_of, plot, progress: bool, jobs: int, scheduler: Any,
+                 resume: bool, start_cpu: float):
         self.deck, self.sw, self.base, self.module, self.grid = deck, sw, base, module, grid
         self.outdir, self.stem, self.layout, self.task_of = outdir, stem, layout, task_of
-        self.plot, self.progress, self.quiet, self.jobs, self.scheduler, self.resume = (
-            plot, progress, quiet, jobs, scheduler, resume)
+        self.plot, self.progress, self.jobs, self.scheduler, self.resume = plot, progress, jobs, scheduler, resume
         self.axes = list(zip(grid.names, grid.values))
         self.shown_columns: list[str] | None = None   # summary_columns given: the columns the tables show
+        self.start_cpu = start_cpu
+        self.outcome = SweepOutcome(deck=str(deck.path), name=stem, outdir=outdir, n_cases=grid.n,
+                                    workers=self._where())
 
     def _where(self) -> str:
         return f"dask {self.scheduler}" if self.scheduler else f"{self.jobs} worker(s)"
@@ -243,9 +251,10 @@ class _Run:
                   Path(self.layout.root)):
             refuse_link(p)
 
-    def cases(self, signature: str, estimates: dict[int, float]) -> int:
+    def cases(self, signature: str, estimates: dict[int, float]) -> SweepOutcome:
         sw, grid, layout, n = self.sw, self.grid, self.layout, self.grid.n
         names = grid.names
+        oc = self.outcome
         self._refuse_links()
         store.clean_temporaries(layout)   # left by a killed earlier run of this deck
         remove_stale_temporaries(self.outdir, self.stem)
@@ -253,9 +262,9 @@ class _Run:
         record.start(self.resume)
         done = record.scan(grid, layout) if self.resume else np.zeros(n + 1, dtype=bool)
         n_done = int(done[1:].sum())
-        if self.resume and not self.quiet:
-            print(f"resume: {n_done} of {n} cases complete, {n - n_done} to run")
+        oc.n_resumed = n_done
         if self.resume:
+            oc.notes.append(f"resume: {n_done} of {n} cases complete, {n - n_done} to run")
             self._say_redone(record)
         self._check_workers_see(sw.case_outputs != "none" and n_done < n)
         if estimates and len(set(estimates.values())) > 1:   # longest first: the last case to start is short
@@ -272,14 +281,14 @@ class _Run:
             pieces.add([r.index for r in results if r.files])   # while the workers compute
 
         t_start, c_start = time.perf_counter(), time.process_time()
-        LAST_RUN["prepare_cpu"] = c_start - LAST_RUN.get("start_cpu", c_start)
+        oc.phases["prepare_cpu"] = c_start - self.start_cpu
         try:
             chunk = engine.execute(order, n - n_done, self.task_of, self.jobs, self.scheduler, sw.chunk, on_result)
         finally:
             bar.close()
         elapsed = time.perf_counter() - t_start
         c_end = time.process_time()
-        LAST_RUN.update(run_wall=elapsed, run_cpu=c_end - c_start, chunk=chunk)
+        oc.phases.update(run_wall=elapsed, run_cpu=c_end - c_start, chunk=chunk)
 
         # the tables, from the resume record (memory: the rows shown, not every case's result)
         retain_all = sw.summary_rows == "all" or n <= TABLE_ALL_MAX
@@ -293,9 +302,9 @@ class _Run:
             if r.files:
                 written.append(r.index)
             warnings.add(r)
-            n_ok += r.status == EXIT_OK
-            n_kept += bool(r.kept and r.status == EXIT_OK)
-            if retain_all or r.kept or r.status != EXIT_OK:
+            n_ok += r.status == ExitCode.OK
+            n_kept += bool(r.kept and r.status == ExitCode.OK)
+            if retain_all or r.kept or r.status != ExitCode.OK:
                 shown.append(r)
         shown.sort(key=lambda r: r.index)
         written.sort()
@@ -304,7 +313,7 @@ class _Run:
             fixed = {"case", "status", "kept", "error", *names}
             frame = frame[[c for c in frame.columns if c in fixed or c in set(self.shown_columns)]]
         table = frame if sw.summary_rows == "all" else frame[frame["kept"] | (frame["status"] != "ok")]
-        failed = [r for r in shown if r.status != EXIT_OK]
+        failed = [r for r in shown if r.status != ExitCode.OK]
         text = sweep_text(self.deck, sw, self.base, self.axes, n, frame, n_kept,
                           [(r.index, r.values, r.error) for r in failed], sw.summary_rows)
         cases = pieces.table(written)
@@ -312,94 +321,99 @@ class _Run:
                           self._settings())
         store.remove_stale_case_files(layout, has_files)
         store.clean_temporaries(layout)   # of workers of a killed earlier run that outlived its start
-        LAST_RUN["finish_cpu"] = time.process_time() - c_end
+        oc.phases["finish_cpu"] = time.process_time() - c_end
         if cases is None and written:
             old = [self.outdir / f"{self.stem}_cases.{fmt}" for fmt in ("csv", "parquet")]
             for p in old:   # an earlier, smaller run's table would no longer match the cases
                 p.unlink(missing_ok=True)
-        for line in warnings.lines(self.deck.path, n):
-            print(line, file=sys.stderr)
-        self._print_failed([(r.index, r.values, r.error) for r in failed])
-        if not self.quiet:
-            print(f"sweep {self.deck.path}: {n_ok} of {n} cases ok, {n_kept} kept, "
-                  f"{elapsed:.2f} s ({self._where()}, chunk {chunk})")
-            print(f"wrote {self.outdir / (self.stem + '.out')} and {self.outdir / self.stem}_summary.{{csv,parquet}}")
-        return max([EXIT_OK] + [r.status for r in failed])
+        for text in warnings.lines(self.deck.path, n):
+            oc.warn(text)
+        oc.n_ok, oc.n_kept, oc.seconds, oc.chunk = n_ok, n_kept, elapsed, chunk
+        self._failed([(r.index, r.values, r.error) for r in failed],
+                     bad_input=any(r.status == ExitCode.BAD_INPUT for r in failed))
+        oc.written += [self.outdir / f"{self.stem}.out", *(self.outdir / f"{self.stem}_summary.{fmt}" for fmt in ("csv", "parquet"))]
+        return oc
 
-    def _batch_streamed(self, rows: sweep_batch.StreamedRows, n: int, elapsed: float, chunk: int) -> int | None:
-        """The tables of a batch sweep written part by part from the record (:mod:`driver.sweep.stream`);
-        None when the parts cannot be streamed (nothing written then)."""
-        sw, names = self.sw, self.grid.names
+    def _batch_streamed(self, rows: batch_path.StreamedRows, n: int, elapsed: float, chunk: int) -> bool:
+        """The tables of a batch sweep written part by part from the record (:mod:`driver.sweep.stream`),
+        on the outcome; False when the parts cannot be streamed (nothing written then)."""
+        sw, names, oc = self.sw, self.grid.names, self.outcome
         remove_stale_temporaries(self.outdir, self.stem)
         res = stream.write_streamed(self.outdir, self.stem, rows.paths, self.deck, sw, self.base, self.axes, names, n,
                                     self.plot, self.module, self._settings())
         if res is None:
-            return None
+            return False
         if n <= 10 * store.SHARD * store.SHARD:
             store.remove_stale_case_files(self.layout, np.zeros(n + 1, dtype=bool))
-        self._print_failed(res.failed, n_failed=res.n_failed)
-        if not self.quiet:
-            print(f"sweep {self.deck.path}: {n - res.n_failed} of {n} cases ok, {res.n_kept} kept, "
-                  f"{elapsed:.2f} s, {n / max(elapsed, 1e-9):.0f} cases/s ({self._where()}, batch path, chunk {chunk})")
-            print(f"wrote {self.outdir / (self.stem + '.out')} and {self.outdir / self.stem}_summary.{{csv,parquet}}")
-        if res.n_failed:
-            return EXIT_BAD_INPUT if res.bad_input else EXIT_FAILED
-        return EXIT_OK
+        oc.n_ok, oc.n_kept, oc.seconds, oc.chunk = n - res.n_failed, res.n_kept, elapsed, chunk
+        self._failed(res.failed, n_failed=res.n_failed, bad_input=res.bad_input)
+        oc.written += [self.outdir / f"{self.stem}.out", *(self.outdir / f"{self.stem}_summary.{fmt}" for fmt in ("csv", "parquet"))]
+        return True
 
     def _settings(self) -> dict:
         """The base deck's settings the summary columns depend on (recorded with the table)."""
         return summary_settings(self.module, self.base, {name.partition(".")[2] for name, _ in self.axes})
 
     def _say_redone(self, record: store.Record, what: str = "cases") -> None:
-        """One warning line when a resume found record parts or case files that failed their
+        """One warning when a resume found record parts or case files that failed their
         checksum: how many cases run again, and why."""
         redone = record.redone()
         if not redone and not record.damaged_parts:
             return
         k = sum(redone.values())
+        self.outcome.n_redone += k
         why = "; ".join(f"{c} because {w}" for w, c in redone.items())
         parts = (f"{record.damaged_parts} damaged record part(s) dropped" + ("; " if why else "")
                  if record.damaged_parts else "")
-        print(f"warning: {self.deck.path}: resume: {k} {what} redone ({parts}{why}): the record is verified, "
-              "never believed", file=sys.stderr)
+        self.outcome.warn(f"{self.deck.path}: resume: {k} {what} redone ({parts}{why}): the record is verified, "
+                          "never believed")
 
-    def _print_failed(self, failed: list[tuple[int, dict, str]], most: int = 20, n_failed: int | None = None) -> None:
-        n_failed = len(failed) if n_failed is None else n_failed
+    def _failed(self, failed: list[tuple[int, dict, str]], n_failed: int | None = None, bad_input: bool = False,
+                most: int = FAILED_SHOWN) -> None:
+        """The failed cases on the outcome (``failed`` lists them, or the first ones of ``n_failed``;
+        ``bad_input``: some had bad values), and an error message for each of the first ``most``."""
+        oc = self.outcome
+        oc.failed, oc.n_failed, oc.bad_input = failed, len(failed) if n_failed is None else n_failed, bad_input
         for index, values, error in failed[:most]:
             vals = ", ".join(f"{k} = {v!r}" for k, v in values.items())
-            print(f"error: {self.deck.path}: case {index} ({vals}): {error}", file=sys.stderr)
-        if n_failed > most:
-            print(f"error: {self.deck.path}: ... and {n_failed - most} more failed cases (see {self.stem}.out)",
-                  file=sys.stderr)
+            oc.error(f"{self.deck.path}: case {index} ({vals}): {error}")
+        if oc.n_failed > most:
+            oc.error(f"{self.deck.path}: ... and {oc.n_failed - most} more failed cases (see {self.stem}.out)")
 
     # ------------------------------------------------------------------ batch path
-    def batch(self, bplan, signature: str) -> int:
-        """A sweep on the study's batch path (driver.sweep_batch); same outputs as case by case.
+    def batch(self, bplan, signature: str) -> SweepOutcome:
+        """A sweep on the study's batch path (driver.sweep.batch); same outputs as case by case.
         With case_outputs = 'kept' the kept cases then run case by case for their files, with
         their own resume record ``<stem>.sweep/cases/`` (:mod:`driver.sweep.store`)."""
         sw, names, n = self.sw, self.grid.names, bplan.grid.n
+        oc = self.outcome
+        oc.batch = True
         self._refuse_links()
         t_start, c_start = time.perf_counter(), time.process_time()
-        LAST_RUN["prepare_cpu"] = c_start - LAST_RUN.get("start_cpu", c_start)
+        oc.phases["prepare_cpu"] = c_start - self.start_cpu
 
-        def announce(resumed: int) -> None:
-            if self.resume and not self.quiet:
-                print(f"resume: {resumed} of {n} cases complete, {n - resumed} to run")
+        def announce(resumed: int, damaged: list[int]) -> None:
+            oc.n_resumed = resumed
+            if damaged:
+                oc.n_redone += sum(damaged)
+                oc.warn(f"resume: {sum(damaged)} cases redone: {len(damaged)} record part(s) failed their "
+                        "checksum (the record is verified, never believed)")
+            if self.resume:
+                oc.notes.append(f"resume: {resumed} of {n} cases complete, {n - resumed} to run")
 
         # rows beyond STREAM_ROWS stay in the record's parts (driver memory flat); not with
         # case_outputs = 'kept', whose kept cases' failures rewrite their rows
-        rows, counts, chunk = sweep_batch.run(bplan, self.outdir / f"{self.stem}.sweep", self.jobs, self.scheduler,
-                                              self.resume, self.progress, sw.chunk, announce,
-                                              stream_rows=stream.STREAM_ROWS if sw.case_outputs == "none" else 0)
+        rows, counts, chunk = batch_path.run(bplan, self.outdir / f"{self.stem}.sweep", self.jobs, self.scheduler,
+                                             self.resume, self.progress, sw.chunk, announce,
+                                             stream_rows=stream.STREAM_ROWS if sw.case_outputs == "none" else 0)
         c_run = time.process_time()
         # the driver's CPU per phase (bench/bench_search.py): merging the chunks, then the tables
-        LAST_RUN.update(run_cpu=c_run - c_start, chunk=chunk, chunks=-(-n // chunk), rows=len(rows))
+        oc.phases.update(run_cpu=c_run - c_start, chunk=chunk, chunks=-(-n // chunk), rows=len(rows))
         elapsed = time.perf_counter() - t_start
-        if isinstance(rows, sweep_batch.StreamedRows):
-            status = self._batch_streamed(rows, n, elapsed, chunk)
-            if status is not None:
-                LAST_RUN["finish_cpu"] = time.process_time() - c_run
-                return status
+        if isinstance(rows, batch_path.StreamedRows):
+            if self._batch_streamed(rows, n, elapsed, chunk):
+                oc.phases["finish_cpu"] = time.process_time() - c_run
+                return oc
             rows = stream.read_columns(rows.paths)   # parts of differing column types: in memory after all
         if rows.empty:
             rows = pd.DataFrame(columns=["case", *names, "status", "kept", "error"])
@@ -414,8 +428,9 @@ class _Run:
                 record.scan(self.grid, self.layout)
                 self._say_redone(record, "kept cases' files")
             todo = [k for k in kept if not record.complete(k)]
-            if self.resume and not self.quiet:
-                print(f"resume: {len(kept) - len(todo)} of {len(kept)} kept cases' files complete, {len(todo)} to write")
+            if self.resume:
+                oc.notes.append(f"resume: {len(kept) - len(todo)} of {len(kept)} kept cases' files complete, "
+                                f"{len(todo)} to write")
             self._check_workers_see(bool(todo))
             engine.execute(todo, len(todo), self.task_of, self.jobs, self.scheduler, 0,
                            lambda res: record.append(res, self.layout))
@@ -426,7 +441,7 @@ class _Run:
                 has_files[written] = True
             cases = _CasesTable(self.layout).table(written)
             for r in results:
-                if r.status != EXIT_OK:
+                if r.status != ExitCode.OK:
                     rows.loc[rows["case"] == r.index, ["status", "kept", "error"]] = ["failed", False, r.error]
         bad = rows[rows["status"] != "ok"]
         failed = [(int(r["case"]), {k: r[k] for k in names}, r["error"]) for _, r in bad.iterrows()]
@@ -437,12 +452,9 @@ class _Run:
                           self._settings())
         if has_files is not None:
             store.remove_stale_case_files(self.layout, has_files)
-        LAST_RUN["finish_cpu"] = time.process_time() - c_run
-        self._print_failed(failed)
-        if not self.quiet:
-            print(f"sweep {self.deck.path}: {n - len(failed)} of {n} cases ok, {int(rows['kept'].sum())} kept, "
-                  f"{elapsed:.2f} s, {n / max(elapsed, 1e-9):.0f} cases/s ({self._where()}, batch path, chunk {chunk})")
-            print(f"wrote {self.outdir / (self.stem + '.out')} and {self.outdir / self.stem}_summary.{{csv,parquet}}")
-        if failed:
-            return EXIT_BAD_INPUT if (bad["status"] == "bad input").any() else EXIT_FAILED
-        return EXIT_OK
+        oc.phases["finish_cpu"] = time.process_time() - c_run
+        oc.n_ok, oc.n_kept, oc.seconds, oc.chunk = n - len(failed), int(rows["kept"].sum()), elapsed, chunk
+        self._failed(failed, bad_input=bool((bad["status"] == "bad input").any()))
+        oc.written += [self.outdir / f"{self.stem}.out", *(self.outdir / f"{self.stem}_summary.{fmt}" for fmt in ("csv", "parquet"))]
+        return oc
+

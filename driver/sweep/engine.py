@@ -9,7 +9,7 @@ to worker processes or a Dask cluster.
   by one and the chunk size is chosen from the fastest of them once ``workers + 1`` have
   returned: some worker has then run its second case, so the time is a warm one (a worker's
   first case pays its cold imports).  On Dask ``workers`` is the cluster's threads.
-* Local worker processes exit when the driver dies (:func:`driver.sweep_batch.worker_init`)
+* Local worker processes exit when the driver dies (:func:`driver.sweep.pool.worker_init`)
   and ignore Ctrl-C: the driver cancels queued chunks and lets the running ones finish.
 * A worker that dies (SIGKILL, out of memory, a crash in a kernel) breaks the pool: every chunk
   then in flight is retried once, alone, in a fresh process.  A chunk that kills that process
@@ -32,18 +32,18 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Iterable
 
-import numpy as np
 import pandas as pd
 
-from driver import expr
+from driver._study import load_study
 from driver.atomic import output_set, own_folder, write_text
 from driver.deck import DeckError, Params, RawGroup, validate
 from driver.export import write_tidy
+from driver.outcome import ExitCode
 from driver.runner import compute, write_outputs
-from driver._study import load_study
-from driver.sweep.spec import EXIT_FAILED, EXIT_OK, Case, CaseResult, _case_deck_text, _case_raw, iter_cases
+from driver.sweep.keep import keep_mask
+from driver.sweep.pool import run_pool, worker_init
+from driver.sweep.spec import Case, CaseResult, Grid, _case_deck_text, _case_raw, iter_cases
 from driver.sweep.store import Layout, json_default
-from driver.sweep_batch import Grid, run_pool, worker_init
 
 __all__ = ["Task", "run_task", "auto_chunk", "execute", "cluster_workers", "check_shared_folder", "DIED"]
 
@@ -72,26 +72,13 @@ class Task:
 
 # ----------------------------------------------------------------------------- worker side
 
-def _keep_mask(keep: str, rows: pd.DataFrame) -> np.ndarray:
-    """The deck's ``keep`` filter (safe expression language, :mod:`driver.expr`) on summary rows.
-
-    A row whose figures are missing (a failed case) is not kept.
-    """
-    if not keep:
-        return np.ones(len(rows), dtype=bool)
-    try:
-        return expr.parse(keep).mask(rows)
-    except expr.ExprError:   # a column absent from every row of this chunk: nothing kept
-        return np.zeros(len(rows), dtype=bool)
-
-
 def _kept_many(keep: str, results: list[CaseResult]) -> list[bool]:
     """The keep filter on a chunk of cases at once (vectorised over the chunk)."""
-    ok = [r.status == EXIT_OK for r in results]
+    ok = [r.status == ExitCode.OK for r in results]
     if not keep or not results:
         return ok
     rows = pd.DataFrame([{**r.values, **r.summary} for r in results])
-    return [o and bool(k) for o, k in zip(ok, _keep_mask(keep, rows))]
+    return [o and bool(k) for o, k in zip(ok, keep_mask(keep, rows))]
 
 
 def _compute(task: Task, case: Case, module) -> tuple[CaseResult, Any, Params | None]:
@@ -106,13 +93,13 @@ def _compute(task: Task, case: Case, module) -> tuple[CaseResult, Any, Params | 
             result = compute(module, params)
             res.summary = dict(result.summary)
             if result.failure:
-                res.status, res.error = EXIT_FAILED, result.failure
+                res.status, res.error = ExitCode.FAILED, result.failure
         else:
             res.summary = dict(module.summarise(params))
     except DeckError as exc:   # bad input is refused before a sweep runs (validate_sweep): a case
-        res.status, res.error = EXIT_FAILED, f"bad input: {exc}"   # failing here fails, the others go on
+        res.status, res.error = ExitCode.FAILED, f"bad input: {exc}"   # failing here fails, the others go on
     except Exception as exc:  # a case that fails is reported, the others go on
-        res.status, res.error = EXIT_FAILED, f"{exc.__class__.__name__}: {exc}"
+        res.status, res.error = ExitCode.FAILED, f"{exc.__class__.__name__}: {exc}"
     res.seconds, res.cpu = time.perf_counter() - t0, time.process_time() - c0
     return res, result, params
 
@@ -128,7 +115,7 @@ def _write_case(task: Task, case: Case, res: CaseResult, result, params: Params,
         if result is None:
             result = compute(module, params)
             if result.failure:
-                res.status, res.error = EXIT_FAILED, result.failure
+                res.status, res.error = ExitCode.FAILED, result.failure
         res.warnings = list(result.warnings)
         stem = task.layout.stem(case.index)
         tidy = result.tidy.copy()
@@ -147,7 +134,7 @@ def _write_case(task: Task, case: Case, res: CaseResult, result, params: Params,
         res.files = sorted({_rel(p, task.layout.root) for p in written})
         res.written = True
     except Exception as exc:
-        res.status, res.error, res.kept = EXIT_FAILED, f"{exc.__class__.__name__}: {exc}", False
+        res.status, res.error, res.kept = ExitCode.FAILED, f"{exc.__class__.__name__}: {exc}", False
     res.seconds += time.perf_counter() - t0
     res.cpu += time.process_time() - c0
 
@@ -155,7 +142,7 @@ def _write_case(task: Task, case: Case, res: CaseResult, result, params: Params,
 def run_task(task: Task) -> list[CaseResult]:
     """Run a chunk of cases (the unit of work sent to a process or a Dask worker)."""
     module = load_study(task.raw.name)
-    writable = lambda res, result, params: params is not None and (result is not None or res.status == EXIT_OK)
+    writable = lambda res, result, params: params is not None and (result is not None or res.status == ExitCode.OK)
     cases = list(iter_cases(task.grid, task.indices))
     if task.case_outputs == "all":
         # write each case as soon as it is computed: an interrupt loses at most one case
@@ -180,7 +167,7 @@ def run_task(task: Task) -> list[CaseResult]:
 
 def died(task: Task, reason: str = DIED) -> list[CaseResult]:
     """The cases of a chunk whose worker died: failed, with their values and the reason."""
-    return [CaseResult(c.index, c.values, EXIT_FAILED, reason, kept=False) for c in iter_cases(task.grid, task.indices)]
+    return [CaseResult(c.index, c.values, ExitCode.FAILED, reason, kept=False) for c in iter_cases(task.grid, task.indices)]
 
 
 # ----------------------------------------------------------------------------- file system of Dask workers
@@ -305,7 +292,7 @@ class _Feed:
     def returned(self, task: Task, results: list[CaseResult], pending: int) -> None:
         if self.chunk:
             return
-        if len(task.indices) == 1 and results and results[0].status == EXIT_OK:
+        if len(task.indices) == 1 and results and results[0].status == ExitCode.OK:
             self.times.append(results[0].seconds)
         if len(self.times) >= min(self.workers + 1, self.n_probes) or (not pending and not self.probes):
             # a warm case: choose the chunk once

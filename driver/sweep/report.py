@@ -13,8 +13,9 @@ from driver import expr
 from driver.atomic import atomic_open, output_set, write_text
 from driver.deck import Deck, Params
 from driver.export import write_tidy
+from driver.outcome import ExitCode
 from driver.study import column_label
-from driver.sweep.spec import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, CaseResult
+from driver.sweep.spec import CaseResult
 from driver.table import Column, render_table
 
 __all__ = ["summary_frame", "summary_settings", "sweep_text", "Warnings", "write_sweep_files"]
@@ -51,8 +52,8 @@ def summary_frame(results: list[CaseResult], names: list[str]) -> pd.DataFrame:
     rows = []
     for r in results:
         row = {"case": r.index, **{n: r.values[n] for n in names},
-               "status": {EXIT_OK: "ok", EXIT_FAILED: "failed", EXIT_BAD_INPUT: "bad input"}[r.status],
-               "kept": bool(r.kept and r.status == EXIT_OK)}
+               "status": {ExitCode.OK: "ok", ExitCode.FAILED: "failed", ExitCode.BAD_INPUT: "bad input"}[r.status],
+               "kept": bool(r.kept and r.status == ExitCode.OK)}
         row.update(r.summary)
         row["error"] = r.error
         rows.append(row)
@@ -129,11 +130,12 @@ class Warnings:
             c[1], c[2] = min(c[1], r.index), max(c[2], r.index)
 
     def lines(self, path: Path, n_cases: int) -> list[str]:
+        """One warning text per distinct warning: the deck, the cases that gave it, the words."""
         out = []
         for w, (count, lo, hi) in self.by_text.items():
             where = (f"case {lo}" if count == 1 else
                      f"{count} cases ({lo}..{hi})" if count < n_cases else f"all {count} cases")
-            out.append(f"warning: {path}: {where}: {w}")
+            out.append(f"{path}: {where}: {w}")
         return out
 
 

@@ -15,19 +15,18 @@ import numpy as np
 
 from driver import limits
 from driver.deck import DeckError, GroupSpec, Key, Params, RawGroup, shown_value, validate
-from driver.sweep_batch import Grid
+from driver.outcome import ExitCode
 
 __all__ = ["SPEC", "Case", "CaseResult", "MAX_KEYS", "MAX_CASES", "FULL_VALIDATION", "build_cases", "grid_of", "case_at", "iter_cases",
-           "case_count", "validate_sweep", "EXIT_OK", "EXIT_FAILED", "EXIT_BAD_INPUT"]
+           "case_count", "validate_sweep"]
 
 MAX_KEYS = 9
-#: most cases one per-case sweep deck may have (a batch sweep lists no case: driver.sweep_batch.MAX_CASES)
+#: most cases one per-case sweep deck may have (a batch sweep lists no case: driver.sweep.batch.MAX_CASES)
 MAX_CASES = 1_000_000
 #: most values one start/stop/count axis may have (about 0.3 GB as Python floats)
 MAX_AXIS_VALUES = 10_000_000
 #: sweeps up to this many cases have every case validated before anything runs
 FULL_VALIDATION = 5_000
-EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
 
 def _no_scheduler_in_deck(value: str) -> str:
     """Key check of ``scheduler``: a deck never chooses where the tool connects."""
@@ -105,12 +104,40 @@ SPEC = _spec()
 
 
 @dataclass
+class Grid:
+    """The swept axes: names ('group.key'), values per axis, full grid or zipped."""
+
+    names: list[str]
+    values: list[list]
+    zipped: bool
+
+    @property
+    def n(self) -> int:
+        return len(self.values[0]) if self.zipped else int(np.prod([len(v) for v in self.values]))
+
+    def indices(self, start: int, stop: int) -> list[np.ndarray]:
+        """Per axis, the value index of cases start..stop-1 (0-based; product order)."""
+        idx = np.arange(start, stop, dtype=np.int64)
+        if self.zipped:
+            return [idx] * len(self.names)
+        return list(np.unravel_index(idx, [len(v) for v in self.values]))
+
+    def columns(self, start: int, stop: int) -> dict[str, np.ndarray]:
+        return {name: _array(vals)[ix] for name, vals, ix in zip(self.names, self.values, self.indices(start, stop))}
+
+
+def _array(vals: list) -> np.ndarray:
+    a = np.asarray(vals)
+    return a if a.dtype.kind in "fiub" else np.asarray(vals, dtype=object)
+
+
+@dataclass
 class CaseResult:
     """What a worker returns for one case (``files``: what it wrote, relative to the case folder)."""
 
     index: int
     values: dict[str, Any]
-    status: int = EXIT_OK
+    status: int = ExitCode.OK
     error: str = ""
     summary: dict[str, Any] = field(default_factory=dict)
     kept: bool = True
@@ -216,7 +243,7 @@ def iter_cases(grid: Grid, indices: Iterable[int] | None = None) -> Iterator[Cas
 
 
 def grid_of(sw: Params, study_group: str, study_spec: GroupSpec) -> Grid:
-    """The swept axes of the &sweep group as a :class:`~driver.sweep_batch.Grid` (no case is built)."""
+    """The swept axes of the &sweep group as a :class:`Grid` (no case is built)."""
     axes = _axes(sw, study_group, study_spec)
     _check_zip(sw, axes)
     return Grid([a[0] for a in axes], [a[1] for a in axes], bool(sw.zip))

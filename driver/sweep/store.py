@@ -39,10 +39,9 @@ import numpy as np
 import driver
 from driver.atomic import DIGEST_CHARS, atomic_open, file_digest, own_folder, refuse_link, remove_stale_temporaries
 from driver.deck import RawGroup
-from driver.sweep.spec import CaseResult, case_at
-from driver.sweep_batch import Grid
+from driver.sweep.spec import CaseResult, Grid, case_at
 
-__all__ = ["Layout", "layout_for", "Record", "signature", "json_default", "remove_stale_case_files",
+__all__ = ["Layout", "layout_for", "Record", "signature", "case_signature", "json_default", "remove_stale_case_files",
            "clean_temporaries", "SHARD", "FLAT_MAX"]
 
 #: sweeps up to this many cases keep every case's files in one folder <stem>/
@@ -92,18 +91,27 @@ def layout_for(case_dir: str | Path, n_cases: int) -> Layout:
     return Layout(str(case_dir), max(4, len(str(n_cases))), SHARD if n_cases > FLAT_MAX else 0)
 
 
-def signature(raw: RawGroup, swept: list[str], deck_path: str, keep: str, case_outputs: str,
-              formats: list[str], case_plot: bool | str, module: Any) -> str:
-    """The hash that a part of the resume record must carry to count (module docstring)."""
-    keys = {n.partition(".")[2] for n in swept}
+def signature(identity: list, module: Any) -> str:
+    """The signature a part of a resume record must carry to count, for both kinds of record
+    (per case, :func:`case_signature`; batch, :func:`driver.sweep.batch.plan`): a hash of
+    ``identity`` (what the rows depend on: the base deck, the sweep's options), the package
+    version, and the bytes of every module of the study's package, of the runner, table and
+    export modules and of the kernel extension (:func:`driver.study.code_digest`)."""
     h = hashlib.sha256()
-    h.update(json.dumps(["per-case", raw.name, {k: v for k, v in raw.values.items() if k not in keys}, deck_path,
-                         keep, case_outputs, sorted(formats), str(case_plot), driver.__version__],
-                        sort_keys=True, default=str).encode())
+    h.update(json.dumps([*identity, driver.__version__], sort_keys=True, default=str).encode())
     from driver import export, runner, table
     from driver.study import code_digest
     h.update(code_digest(module, runner, table, export))
     return h.hexdigest()[:20]
+
+
+def case_signature(raw: RawGroup, swept: list[str], deck_path: str, keep: str, case_outputs: str,
+                   formats: list[str], case_plot: bool | str, module: Any) -> str:
+    """The per-case record's signature (module docstring): :func:`signature` of the base deck's
+    study group without the swept keys, the deck path, keep, case_outputs, formats and figures."""
+    keys = {n.partition(".")[2] for n in swept}
+    return signature(["per-case", raw.name, {k: v for k, v in raw.values.items() if k not in keys}, deck_path,
+                      keep, case_outputs, sorted(formats), str(case_plot)], module)
 
 
 class SweepBusy(OSError):

@@ -2,8 +2,8 @@
 
 A batch sweep's rows (with ``summary_rows = 'kept'`` its kept and failed cases) are in the
 parts of its resume record, one Parquet file per chunk, in case order.  Above
-``STREAM_ROWS`` rows the driver stops holding them (:func:`driver.sweep_batch.run` returns a
-:class:`~driver.sweep_batch.StreamedRows`) and :func:`write_streamed` writes the ``.out``, the
+``STREAM_ROWS`` rows the driver stops holding them (:func:`driver.sweep.batch.run` returns a
+:class:`~driver.sweep.batch.StreamedRows`) and :func:`write_streamed` writes the ``.out``, the
 ``_summary`` CSV and the ``_summary`` Parquet file reading one part at a time, so the driver's
 memory does not grow with the rows.  The files are those the in-memory path writes: the same
 ``.out`` and CSV bytes, the same Parquet table (in one row group per part); the

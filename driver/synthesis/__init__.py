@@ -22,7 +22,6 @@ branch, cannot be assembled over the range, not a crank-rocker) is reported and 
 from __future__ import annotations
 
 import math
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -36,6 +35,7 @@ from driver.fourbar import kernel as fourbar_kernel
 from driver.atomic import output_set, write_text
 from driver.deck import Deck, DeckError, GroupSpec, Key, Params, RawGroup, positive, read_deck, validate
 from driver.export import write_tidy
+from driver.outcome import FilesOutcome
 from driver.runner import compute, output_stem, write_outputs
 from driver.synthesis import crank_rocker as cr
 from driver.synthesis.function import FunctionDesign, chebyshev, freudenstein, links_from_k, wrap180
@@ -540,8 +540,10 @@ def synthesis_record(syn: Synthesis) -> dict[str, Any]:
 
 
 def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool = False,
-                       quiet: bool = False, summary_json: bool = False, **_: Any) -> int:
-    """Command-line entry: synthesise, write, return the exit status (DeckError propagates)."""
+                       summary_json: bool = False, **_: Any) -> FilesOutcome:
+    """Command-line entry: synthesise and write; returns the files written, the warnings and the
+    failure as data (:class:`~driver.outcome.FilesOutcome`, the :class:`Synthesis` as ``value``).
+    DeckError propagates."""
     syn = synthesise(deck)
     stem = output_stem(outdir, deck.path, (".out", ".linkage.dat", ".linkage.out", f"{syn.table_name}.csv",
                                            *(f".linkage.{fmt}" for fmt in formats),
@@ -582,12 +584,9 @@ def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool,
             written.append(plotting.save_figure(fig, stem.with_name(stem.name + "_error.png"), plot))
     if plot and syn.params.task == "path" and syn.design is not None:
         written.append(_path_figure(syn, stem.with_name(stem.name + "_path.png"), Path(deck.path).stem, plot))
-    if not quiet:
-        for w in written:
-            print(f"wrote {w}")
-    for msg in syn.warnings:
-        print(f"warning: {deck.path}: {msg}", file=sys.stderr)
+    outcome = FilesOutcome(written=written, failure=syn.failure, value=syn)
+    for w in syn.warnings:
+        outcome.warn(f"{deck.path}: {w}")
     if syn.failure:
-        print(f"error: {deck.path}: {syn.failure}", file=sys.stderr)
-        return 1
-    return 0
+        outcome.error(f"{deck.path}: {syn.failure}")
+    return outcome

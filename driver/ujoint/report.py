@@ -14,7 +14,8 @@ import pandas as pd
 from driver import _keywords
 from driver._signatures import keyword_signature
 from driver.deck import Params
-from driver.study import Figure, Result, keyword_run
+from driver.runner import keyword_run
+from driver.study import Figure, Result
 from driver.ujoint.spec import SPEC
 from driver.export import with_units
 from driver.ujoint.kernel import UJOINT_MODELS

@@ -6,7 +6,8 @@ import pandas as pd
 
 from driver.deck import Params
 from driver.export import with_units
-from driver.study import Figure, Result, keyword_run
+from driver.runner import keyword_run
+from driver.study import Figure, Result
 from driver.table import Column, render_table
 
 from . import kernel

@@ -31,26 +31,26 @@ import contextlib
 import hashlib
 import itertools
 import json
-import os
 import re
-import sys
-import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Iterator
+from typing import Any, Iterator
 
 import numpy as np
 import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-import driver
 from driver import expr
+from driver._study import load_study
 from driver.atomic import DIGEST_CHARS, atomic_open, file_digest, own_folder, refuse_link
 from driver.deck import DeckError, RawGroup, validate
-from driver._study import load_study
-from driver.study import code_digest
+from driver.sweep import store
+from driver.sweep.engine import check_shared_folder
+from driver.sweep.keep import keep_columns, keep_mask
+from driver.sweep.pool import run_pool, worker_init
+from driver.sweep.spec import Grid
 
 __all__ = ["Grid", "BatchPlan", "batchable", "plan", "run", "worker_init", "chunk_rows", "MAX_CASES", "StreamedRows"]
 
@@ -72,34 +72,6 @@ MAX_CASES = 10**10
 #: largest number of combinations of coupled swept keys validated one by one
 MAX_COMBOS = 20000
 DIED = "worker process died twice computing this chunk (killed, out of memory or a crash in a kernel)"
-
-
-@dataclass
-class Grid:
-    """The swept axes: names ('group.key'), values per axis, full grid or zipped."""
-
-    names: list[str]
-    values: list[list]
-    zipped: bool
-
-    @property
-    def n(self) -> int:
-        return len(self.values[0]) if self.zipped else int(np.prod([len(v) for v in self.values]))
-
-    def indices(self, start: int, stop: int) -> list[np.ndarray]:
-        """Per axis, the value index of cases start..stop-1 (0-based; product order)."""
-        idx = np.arange(start, stop, dtype=np.int64)
-        if self.zipped:
-            return [idx] * len(self.names)
-        return list(np.unravel_index(idx, [len(v) for v in self.values]))
-
-    def columns(self, start: int, stop: int) -> dict[str, np.ndarray]:
-        return {name: _array(vals)[ix] for name, vals, ix in zip(self.names, self.values, self.indices(start, stop))}
-
-
-def _array(vals: list) -> np.ndarray:
-    a = np.asarray(vals)
-    return a if a.dtype.kind in "fiub" else np.asarray(vals, dtype=object)
 
 
 @dataclass
@@ -130,11 +102,9 @@ def chunk_size(n: int) -> int:
 
 
 def _signature(raw: RawGroup, grid: Grid, keep: str, rows: str, module, shown: list[str] | None = None) -> str:
-    h = hashlib.sha256()
-    h.update(json.dumps([raw.name, raw.values, grid.names, grid.values, grid.zipped, keep, rows, driver.__version__]
-                        + ([shown] if shown is not None else []), sort_keys=True, default=str).encode())
-    h.update(code_digest(module))
-    return h.hexdigest()[:20]
+    """The batch record's signature: :func:`driver.sweep.store.signature` of what the rows depend on."""
+    return store.signature(["batch", raw.name, raw.values, grid.names, grid.values, grid.zipped, keep, rows]
+                           + ([shown] if shown is not None else []), module)
 
 
 def _swap(raw: RawGroup, values: dict[str, Any]) -> RawGroup:
@@ -160,11 +130,11 @@ def wanted_columns(module, keep: str, plotted: list[str], shown: list[str] | Non
     table = module.batch.passes if module.batch is not None else None
     if table is None:
         return None, None
-    def names(text: str) -> set[str]:   # summary columns an expression reads (not swept keys, not 'case')
+    def names(text: str) -> set[str]:   # summary columns a plotted expression reads (as the filter's)
         return {n for n in expr.parse(text).names if "." not in n and n != "case"} if text else set()
 
     order = lambda cols: [c for c in table if c in cols] + sorted(c for c in cols if c not in table)
-    filt = order(names(keep))
+    filt = order(keep_columns(keep))
     if shown is None:
         return filt, None
     return filt, order(set(filt).union(*(names(t) for t in plotted)) | set(shown))
@@ -284,10 +254,7 @@ def chunk_rows(p: BatchPlan, start: int, stop: int, folder: str = "") -> ChunkRe
         first = _summaries(module, base, cols, every, p.filter_columns, None)
         data = {"case": np.arange(start + 1, stop + 1, dtype=np.int64), **cols,
                 **{c: first[c].to_numpy() for c in first.columns}}
-        try:
-            mask = np.asarray(expr.parse(p.keep).mask(data), dtype=bool)
-        except expr.ExprError:
-            mask = np.zeros(n, dtype=bool)
+        mask = keep_mask(p.keep, data)
         shown = np.flatnonzero(mask)
         out = _frame(start, stop, cols, bad, err, _summaries(module, base, cols, shown, p.shown_columns, None), shown)
         out["kept"] = True
@@ -302,10 +269,7 @@ def chunk_rows(p: BatchPlan, start: int, stop: int, folder: str = "") -> ChunkRe
     frame = _frame(start, stop, cols, bad, err, first)
     mask = ~bad
     if p.keep:
-        try:
-            mask &= np.asarray(expr.parse(p.keep).mask(frame), dtype=bool)
-        except expr.ExprError:
-            mask[:] = False
+        mask &= keep_mask(p.keep, frame)
     frame["kept"] = mask
     res = ChunkResult(start, stop, frame, int((~bad).sum()), int(mask.sum()), int(bad.sum()))
     if p.rows == "kept":
@@ -343,20 +307,6 @@ def _frame(start: int, stop: int, cols: dict[str, np.ndarray], bad: np.ndarray, 
     frame = pd.concat([frame, summ], axis=1)
     frame["error"] = pick(err)
     return frame
-
-
-def _watch_parent(ppid: int) -> None:
-    while True:
-        if os.getppid() != ppid:
-            os._exit(1)
-        time.sleep(0.5)
-
-
-def worker_init() -> None:
-    """Process-pool initializer: ignore Ctrl-C (the driver handles it) and exit with the driver."""
-    import signal
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    threading.Thread(target=_watch_parent, args=(os.getppid(),), daemon=True).start()
 
 
 # ----------------------------------------------------------------------------- dataset (resume record)
@@ -474,56 +424,6 @@ def execute(p: BatchPlan, todo: list[tuple[int, int]], jobs: int, scheduler: Any
              in_flight or 2 * jobs, "chunks")
 
 
-def run_pool(source: Callable[[], Any], submit: Callable[[cf.ProcessPoolExecutor, Any], cf.Future],
-             alone: Callable[[Any], Any], on_result: Callable[[Any, Any, int], None], jobs: int, limit: int,
-             what: str, order: Callable[[Any], Any] = lambda t: t) -> None:
-    """The local worker pool of both sweep engines, with a bounded number of tasks in flight.
-
-    ``source()`` gives the next task (None: none now; with nothing in flight, the end);
-    ``submit(pool, task)`` sends it; ``on_result(task, result, n_in_flight)`` takes each result as it
-    comes.  When a worker dies every task in flight is suspect: each is retried once, alone, by
-    ``alone(task)`` (in ``order``), and a fresh pool takes over.  Workers exit with the driver
-    (:func:`worker_init`)."""
-    pool = cf.ProcessPoolExecutor(max_workers=jobs, initializer=worker_init)
-    pending: dict[cf.Future, Any] = {}
-    try:
-        while True:
-            suspects: list[Any] = []
-            while len(pending) < limit and not suspects:
-                task = source()
-                if task is None:
-                    break
-                try:
-                    pending[submit(pool, task)] = task
-                except cf.process.BrokenProcessPool:   # a worker died since the last wait
-                    suspects.append(task)
-            if not pending and not suspects:   # every task sent and returned
-                break
-            if not suspects:
-                done, _ = cf.wait(pending, return_when=cf.FIRST_COMPLETED)
-                for fut in done:
-                    task = pending.pop(fut)
-                    try:
-                        res = fut.result()
-                    except cf.process.BrokenProcessPool:
-                        suspects.append(task)
-                        continue
-                    on_result(task, res, len(pending))
-            if suspects:   # every task in flight is suspect: each is retried once, alone
-                suspects += list(pending.values())
-                pending.clear()
-                pool.shutdown(wait=False, cancel_futures=True)
-                for task in sorted(suspects, key=order):
-                    on_result(task, alone(task), 0)
-                pool = cf.ProcessPoolExecutor(max_workers=jobs, initializer=worker_init)
-    except KeyboardInterrupt:
-        print(f"interrupt: cancelling queued {what}, finishing the running ones", file=sys.stderr)
-        pool.shutdown(wait=True, cancel_futures=True)
-        raise
-    finally:
-        pool.shutdown(wait=True)
-
-
 def _execute_dask(p: BatchPlan, todo: list[tuple[int, int]], scheduler: Any, on_result, in_flight: int,
                   folder: str = "") -> None:
     from dask.distributed import Client, as_completed
@@ -531,7 +431,6 @@ def _execute_dask(p: BatchPlan, todo: list[tuple[int, int]], scheduler: Any, on_
     client = scheduler if not isinstance(scheduler, str) else Client(scheduler)
     try:
         if folder:   # workers write their parts only where this machine reads them back
-            from driver.sweep.engine import check_shared_folder
             try:
                 check_shared_folder(client, Path(folder))
             except OSError:
@@ -577,8 +476,9 @@ class StreamedRows:
 def run(p: BatchPlan, folder: Path, jobs: int, scheduler: Any, resume: bool, progress: bool,
         chunk: int = 0, announce=None, stream_rows: int = 0
         ) -> tuple[pd.DataFrame | StreamedRows, dict[str, int], int]:
-    """Run the whole batch sweep; returns (rows, counts, chunk size).  ``announce(resumed)``
-    is called with the number of cases found complete before anything runs.
+    """Run the whole batch sweep; returns (rows, counts, chunk size).  ``announce(resumed, damaged)``
+    is called before anything runs with the number of cases found complete in the record and the
+    case counts of its parts that failed their checksum (dropped: their cases run again).
 
     ``stream_rows``: above this many returned rows (kept and failed ones with ``rows = 'kept'``)
     the driver stops holding them and returns a :class:`StreamedRows` (the record's parts, read
@@ -594,9 +494,6 @@ def run(p: BatchPlan, folder: Path, jobs: int, scheduler: Any, resume: bool, pro
     for s in set(done) - complete:
         Path(done[s]["path"]).unlink(missing_ok=True)
     paths = {s: Path(done[s]["path"]) for s in complete}
-    if damaged:
-        print(f"warning: resume: {sum(damaged)} cases redone: {len(damaged)} record part(s) failed their "
-              "checksum (the record is verified, never believed)", file=sys.stderr)
     counts = {"ok": 0, "kept": 0, "failed": 0}
     n_rows = 0   # rows of the resumed chunks and those returned
     for s in complete:
@@ -606,7 +503,7 @@ def run(p: BatchPlan, folder: Path, jobs: int, scheduler: Any, resume: bool, pro
     resumed = sum(min(s + size, n) - s for s in complete)
     todo = [r for r in ranges if r[0] not in complete]
     if announce:
-        announce(resumed)
+        announce(resumed, damaged)
     own_folder(folder, folder.parent)
     bar = _progress(n, resumed, progress)
 
