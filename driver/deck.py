@@ -307,9 +307,7 @@ def _known_keys(group: str) -> frozenset[str] | None:
     no module declares it (the runner then refuses the group itself)."""
     if group not in _KNOWN:
         import importlib
-        from types import ModuleType
         keys = None
-        module: ModuleType | None
         try:
             if group in ("sweep", "optimize", "synthesis"):
                 spec = importlib.import_module(f"driver.{group}").SPEC

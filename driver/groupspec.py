@@ -49,4 +49,4 @@ class GroupSpec:
     name: str
     keys: dict[str, Key]
     doc: str = ""
-    check: Callable[["Params"], None] | None = None
+    check: Callable[[Params], None] | None = None

@@ -593,9 +593,9 @@ def page_for_sweep(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> st
                 f"{esc(k)} = {summary.loc[best, k]:.6g}" for k in numeric_keys) + ".</p>")
             anim = mechanism_animation(params, "anim-best", "The marked design over one crank turn.")
             body += anim or ""
-            figs, failed = _figures_html(result)
+            figs_html, failed = _figures_html(result)
             notes += failed
-            body += figs + _kv_table(result.summary)
+            body += figs_html + _kv_table(result.summary)
             sections.append(Section("best", "the marked design", body))
         except Exception as exc:
             notes.append(f"the marked design could not be run again: {exc.__class__.__name__}: {exc}")

@@ -45,7 +45,12 @@ def _compare(name: str, printed: list[float] | None, computed: np.ndarray,
         return [], []
     lines, flags = [], []
     for i, (a, c) in enumerate(zip(printed, computed)):
-        exp = -decimals if decimals is not None else Decimal(repr(float(a))).as_tuple().exponent
+        if decimals is not None:
+            exp = -decimals
+        else:
+            exponent = Decimal(repr(float(a))).as_tuple().exponent
+            assert isinstance(exponent, int)   # a printed number is finite ('n'/'N'/'F': NaN, inf)
+            exp = exponent
         unit = 10.0 ** exp
         ok = abs(a - c) <= 0.5 * unit + 1e-12
         # one unit off in the last printed digit: a rounding slip, not a wrong method
@@ -132,9 +137,9 @@ def run(params: Params, progress: bool = False) -> Result:
                 if _g(r[key][i]) != _g(e[key][i]):
                     L.append(f"  {key}[b{i}]  report {_g(r[key][i]):>11}  exact {_g(e[key][i]):>11}  {why}")
         for key in ("eq29", "eq213"):
-            a, c = (f"{v:.3f}" if v is not None else "none" for v in (r[key], e[key]))
-            if a != c:
-                L.append(f"  {key}  report {a}  exact {c}  follows from the fit")
+            as_report, as_exact = (f"{v:.3f}" if v is not None else "none" for v in (r[key], e[key]))
+            if as_report != as_exact:
+                L.append(f"  {key}  report {as_report}  exact {as_exact}  follows from the fit")
         L.append("")
     recs = []
     for key in ("eq27", "eq28", "eq211", "eq212"):

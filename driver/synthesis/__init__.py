@@ -506,7 +506,7 @@ def synthesise(deck: Deck | str | Path) -> Synthesis:
     if syn.linkage is not None:
         fp = validate(RawGroup("fourbar", dict(syn.linkage, title=p.title or f"{Path(deck.path).stem} ({p.task} synthesis)"),
                                {}, p.line), fourbar.SPEC, deck.path)
-        syn.study_result = compute(fourbar, fp)
+        syn.study_result = compute(fourbar.STUDY, fp)
         syn.linkage = {k: v for k, v in fp.items() if v is not None and v != [] and v != ""}
     return syn
 

@@ -19,7 +19,7 @@ from driver.study import Figure, Result
 from driver.ujoint.spec import SPEC
 from driver.export import with_units
 from driver.ujoint.kernel import UJOINT_MODELS
-from driver.table import Column, fortran_f, render_table
+from driver.table import Cell, Column, fortran_f, render_table
 from driver.ujoint.analysis import (TIE_RTOL, Chain, Design, StartRun, _chain, _free_index, _starts, evaluate,
                                     objective_scale, optimise, output_speed, phases_for, pick_best, yoke_shifts)
 from driver.ujoint.spec import BAND_TOL, CONVENTIONS, DEG, OPTIONS, _geometry, _per, _phases
@@ -236,7 +236,7 @@ def _render_compare(params: Params, chain: Chain, designs: list[Design]) -> list
            "in rpm, p-p ratio)"]
     cols = [Column("design", "s", 14), Column("model", "s", 25), Column("w_min rpm", "f", 10, 4),
             Column("w_max rpm", "f", 10, 4), Column("p-p ratio", "f", 10, 6), Column("objective", "s", 12)]
-    rows = []
+    rows: list[list[Cell]] = []
     for d in designs:
         for label, code in models:
             m = UJOINT_MODELS[code]
