@@ -31,7 +31,10 @@ def _pair(x, n: int) -> np.ndarray:
     return farray(np.broadcast_to(np.asarray(x, dtype=np.float64), (n, 2)), 2)
 
 
-def _arm_inputs(l1, l2, th1, th2, qd, qdd, m1, m2, mass_per_length: float) -> tuple:
+_Arrays8 = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+
+def _arm_inputs(l1, l2, th1, th2, qd, qdd, m1, m2, mass_per_length: float) -> _Arrays8:
     """Kernel arguments of the 2R routines: every input broadcast to n rows, masses defaulted
     to ``mass_per_length`` times the link length."""
     n = max(np.size(l1), np.size(l2), np.size(th1), np.size(th2))
@@ -59,7 +62,8 @@ def manipulator_arm_states(l1, l2, th1, th2, qd=(1.0, 1.0), qdd=(1.0, 1.0), m1=N
     n = args[0].shape[0]
     shapes = ((n, 4), (n,), (n,), (n, 2))
     if out is None:
-        out = tuple(np.empty(shp, dtype=np.float64, order="F") for shp in shapes)
+        out = (np.empty(shapes[0], dtype=np.float64, order="F"), np.empty(shapes[1], dtype=np.float64, order="F"),
+               np.empty(shapes[2], dtype=np.float64, order="F"), np.empty(shapes[3], dtype=np.float64, order="F"))
     elif len(out) != 4 or not all(isinstance(a, np.ndarray) and a.flags.f_contiguous and a.dtype == np.float64
                                   and a.shape == shp for a, shp in zip(out, shapes)):
         raise ValueError(f"out must be four Fortran-ordered float64 arrays of shapes {shapes}; "

@@ -8,6 +8,8 @@ back.  Each kernel's physics and units are documented in its Fortran source.
 """
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from driver.kernels import _kernels, farray
@@ -63,7 +65,7 @@ def slidercrank_simulate(n_elements: int, crank_radius: float, rod_length: float
         int(bool(dynamic)), int(bool(geometric_stiffness)), int(bool(fast)), int(lag), q0, qd0)
     names = ("eps_ax", "eps_of", "n_avg", "mid", "slider", "elong", "prof", "q_end", "qd_end", "status",
              "fail_step")
-    res = dict(zip(names, out))
+    res: dict[str, Any] = dict(zip(names, out))   # arrays and the integer status words
     res["status"], res["fail_step"] = int(res["status"]), int(res["fail_step"])
     prof = res.pop("prof")
     for k, name in enumerate(SLIDERCRANK_PROFILE):
@@ -156,7 +158,7 @@ def slidercrank_nl_simulate(n_elements: int, crank_radius: float, rod_length: fl
         {"rest": 0, "quasistatic": 1}[start], tol, int(max_iterations), int(max_cuts), int(bool(energy)))
     names = ("eps_ax", "eps_of", "lat_max", "mid", "elong", "slider", "energy", "rev_lat", "rev_eps", "shapes",
              "shape_step", "stats", "status", "fail_step", "fail_iter")
-    res = dict(zip(names, out))
+    res: dict[str, Any] = dict(zip(names, out))   # arrays and the integer status words
     for key in ("status", "fail_step", "fail_iter"):
         res[key] = int(res[key])
     return res
