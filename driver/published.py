@@ -17,8 +17,9 @@ from __future__ import annotations
 
 import math
 import re
-from decimal import Decimal, InvalidOperation
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from decimal import Decimal, InvalidOperation
 from pathlib import Path
 from typing import Any
 
@@ -101,7 +102,8 @@ def matches(match: dict[str, str], values: dict[str, object], rel: float = 1e-12
         if key not in values:
             return False
         want = text.split(",")
-        got = values[key] if isinstance(values[key], (list, tuple)) else [values[key]]
+        value = values[key]
+        got: Sequence[object] = value if isinstance(value, (list, tuple)) else [value]
         if len(want) != len(got):
             return False
         for t, v in zip(want, got):
@@ -205,14 +207,14 @@ def agrees_printed(computed: float, printed: str) -> bool:
         exp = Decimal(printed.strip()).as_tuple().exponent
     except InvalidOperation:
         return False
-    half = 0.5 * 10.0 ** int(exp)  # type: ignore[arg-type]
+    half = 0.5 * 10.0 ** int(exp)
     return math.isfinite(computed) and abs(float(computed) - float(printed)) <= half + 1e-9
 
 
 def decimals(printed: str) -> int:
     """The number of decimals ``printed`` shows."""
     exp = Decimal(printed.strip()).as_tuple().exponent
-    return max(0, -int(exp))  # type: ignore[arg-type]
+    return max(0, -int(exp))
 
 
 def cell(table: str, row: Any, column: str, printed: str, computed: str, status: str, reason: str = "") -> dict:
