@@ -20,9 +20,9 @@ import traceback
 from pathlib import Path
 
 from driver import __version__, limits
+from driver._study import study_names
 from driver.export import FORMATS
 from driver.extras import MissingExtra, require
-from driver._study import study_names
 from driver.outcome import ExitCode, Outcome, RunOutcome, SweepOutcome
 from driver.study import PLOT_FORMATS
 

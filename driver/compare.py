@@ -27,8 +27,9 @@ as ``python -m driver --compare DECK...`` prints them.  Each study compares its 
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import pandas as pd
 
@@ -163,6 +164,7 @@ def compare_decks(decks: list[Path], out=None) -> int:
     """Compare every deck, print the report (``out``: a text stream, default stdout); exit status
     0 when every reproducible cell agrees, 1 when a cell differs or a run failed, 2 for bad input."""
     import sys
+
     from driver.deck import DeckError
     out = sys.stdout if out is None else out
     if not published.PUBLISHED_DIR.is_dir():

@@ -17,15 +17,16 @@ import functools
 import math
 import re
 import warnings
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
-from typing import Any, Callable, Iterator, Sequence, TypeVar
+from typing import Any, TypeVar
 
 from driver.extras import require
 
 require("plot")   # a clear message naming the [plot] extra when matplotlib is missing
 import matplotlib  # noqa: E402
-import matplotlib.ticker
 import matplotlib.colors
+import matplotlib.ticker
 import numpy as np
 from matplotlib.figure import Figure
 

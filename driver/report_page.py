@@ -24,10 +24,10 @@ import json
 import math
 import platform
 import re
-import sys
-from dataclasses import dataclass, field
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Iterable, Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -96,7 +96,7 @@ def run_metadata() -> dict[str, str]:
         meta["kernels"] = "not found"
     meta["build"] = (f"Python {platform.python_version()}, numpy {np.__version__}, "
                      f"{platform.system()} {platform.machine()}")
-    meta["date"] = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC")
+    meta["date"] = _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M:%S UTC")
     return meta
 
 
@@ -125,7 +125,7 @@ def _figure_block(fig: Any, caption: str) -> str:
     return f'<figure class="plot">{figure_svg(fig, caption)}<figcaption>{esc(caption)}</figcaption></figure>'
 
 
-def _figures_html(result: "Result", skip: Iterable[str] = ()) -> tuple[str, list[str]]:
+def _figures_html(result: Result, skip: Iterable[str] = ()) -> tuple[str, list[str]]:
     """Every figure of ``result`` drawn as inline SVG; and the figures that could not be drawn."""
     blocks, failed = [], []
     for f in result.figures:
@@ -192,8 +192,8 @@ _ANIM_JS = r"""
 """
 
 
-def mechanism_animation(params: "Params", anim_id: str = "anim", caption: str = "",
-                        result: "Result | None" = None) -> str | None:
+def mechanism_animation(params: Params, anim_id: str = "anim", caption: str = "",
+                        result: Result | None = None) -> str | None:
     """The animation of a deck's mechanism over one crank turn (inline SVG, JSON positions from the
     study's ``Study.animation``, and a few lines of JavaScript), or None for a study without one.
     The positions' ``kind`` says what the crank drives: a coupler and a ``'rocker'`` (four-bar) or a
@@ -322,7 +322,7 @@ def _fmt(v: Any) -> str:
     return str(v)
 
 
-def _frame_table(frame: "pd.DataFrame", limit: int = MAX_TIDY_ROWS, cls: str = "data") -> str:
+def _frame_table(frame: pd.DataFrame, limit: int = MAX_TIDY_ROWS, cls: str = "data") -> str:
     shown = frame.head(limit)
     head = "".join(f"<th>{esc(c)}</th>" for c in shown.columns)
     rows = "".join("<tr>" + "".join(f"<td>{esc(_fmt(v))}</td>" for v in r) + "</tr>"
@@ -338,7 +338,7 @@ def _warnings_html(warnings: Sequence[str]) -> str:
     return '<ul class="warn">' + "".join(f"<li>{esc(w)}</li>" for w in warnings) + "</ul>"
 
 
-def _comparison_html(frame: "pd.DataFrame | None", note: str = "") -> str:
+def _comparison_html(frame: pd.DataFrame | None, note: str = "") -> str:
     if frame is None or not len(frame):
         return f'<p class="note">{esc(note or "No published table belongs to this deck.")}</p>'
     counts = frame.groupby(["table", "status"]).size().unstack(fill_value=0)
@@ -423,7 +423,7 @@ def build_page(title: str, subtitle: str, sections: Sequence[Section], meta: dic
 """
 
 
-def _deck_text(deck: "Deck | None", params: "Params | None" = None) -> str:
+def _deck_text(deck: Deck | None, params: Params | None = None) -> str:
     """The deck as its file says it (or, for a deck given in Python, its groups as namelists)."""
     if deck is not None:
         path = Path(deck.path)
@@ -443,7 +443,7 @@ def _deck_text(deck: "Deck | None", params: "Params | None" = None) -> str:
     return ""
 
 
-def _result_sections(result: "Result", params: "Params | None", comparison: "pd.DataFrame | None",
+def _result_sections(result: Result, params: Params | None, comparison: pd.DataFrame | None,
                      comparison_note: str = "", anim_caption: str = "") -> tuple[list[Section], list[str]]:
     sections = []
     notes: list[str] = []
@@ -470,7 +470,7 @@ def _result_sections(result: "Result", params: "Params | None", comparison: "pd.
     return sections, notes
 
 
-def page_for_result(result: "Result", deck: "Deck | None" = None, params: "Params | None" = None,
+def page_for_result(result: Result, deck: Deck | None = None, params: Params | None = None,
                     compare: bool = True) -> str:
     """The page of one single-case run: ``result`` as the runner returned it, the ``deck`` it
     ran (for the echo) and its validated ``params`` (for the animation and the comparison)."""
@@ -492,7 +492,7 @@ def page_for_result(result: "Result", deck: "Deck | None" = None, params: "Param
     return build_page(title, sub, sections, run_metadata())
 
 
-def _subtitle(study: str, params: "Params | None") -> str:
+def _subtitle(study: str, params: Params | None) -> str:
     from driver._study import load_study
     module = load_study(study) if study else None
     doc = module.spec.doc if module is not None else ""
@@ -507,7 +507,7 @@ def _labels(module: Any, names: Iterable[str]) -> dict[str, str]:
     return {n: column_label(module, n) for n in names}
 
 
-def _case_result(deck_path: Path, text: str) -> tuple["Result", "Params"]:
+def _case_result(deck_path: Path, text: str) -> tuple[Result, Params]:
     """Run a deck text in memory (an optimum, a best case): its Result and Params."""
     from driver.deck import read_deck
     from driver.runner import compute, study_of
@@ -532,7 +532,7 @@ def _namelist(group: str, values: dict[str, Any]) -> str:
     return f"&{group}\n" + "".join(f"  {k} = {lit(v)}\n" for k, v in values.items() if v is not None) + "/\n"
 
 
-def page_for_sweep(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> str:
+def page_for_sweep(deck: Deck, outdir: Path, stem: str, status: int = 0) -> str:
     """The page of a sweep deck, from the files the sweep wrote: the design-space maps of the
     plotted summary columns (kept designs outlined; the best kept design by the first plotted
     column marked where the study says which way is better, its ``sweep_best``, else the first
@@ -613,7 +613,7 @@ def page_for_sweep(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> st
     return build_page(f"{stem}: sweep", sub, sections, run_metadata())
 
 
-def _objective(deck: "Deck") -> tuple[str, str]:
+def _objective(deck: Deck) -> tuple[str, str]:
     """The optimisation's objective text and sense from the deck's &optimize group."""
     values = deck.groups["optimize"].values
     for sense in ("minimize", "maximize", "minimise", "maximise"):
@@ -622,7 +622,7 @@ def _objective(deck: "Deck") -> tuple[str, str]:
     return "objective", "minimize"
 
 
-def page_for_optimize(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> str:
+def page_for_optimize(deck: Deck, outdir: Path, stem: str, status: int = 0) -> str:
     """The page of an optimisation deck, from the files it wrote: the convergence plot, the map
     of the designs evaluated over the first two design variables (coloured by the objective,
     infeasible designs grey, the optimum marked), the optimum's drawing and animation, the
@@ -684,7 +684,7 @@ def page_for_optimize(deck: "Deck", outdir: Path, stem: str, status: int = 0) ->
     return build_page(f"{stem}: optimisation", sub, sections, run_metadata())
 
 
-def _evaluated_map(frame: "pd.DataFrame", design: Sequence[str], objective: str, opt: Any,
+def _evaluated_map(frame: pd.DataFrame, design: Sequence[str], objective: str, opt: Any,
                    labels: dict[str, str], title: str) -> Any:
     """The designs an optimiser evaluated: feasible ones coloured by the objective, infeasible
     grey, the optimum starred (a scatter: an optimiser's designs are not on a grid)."""
@@ -710,7 +710,7 @@ def _evaluated_map(frame: "pd.DataFrame", design: Sequence[str], objective: str,
     return fig
 
 
-def page_for_synthesis(deck: "Deck", outdir: Path, stem: str, status: int = 0) -> str:
+def page_for_synthesis(deck: Deck, outdir: Path, stem: str, status: int = 0) -> str:
     """The page of a synthesis deck, from the files it wrote: the synthesised linkage's
     animation and figures (run again from ``<stem>.linkage.dat``), the report and the deck."""
     outdir = Path(outdir)

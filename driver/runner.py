@@ -10,16 +10,15 @@ import functools
 import os
 import re
 from collections.abc import Callable, Iterable
-from typing import Any
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from driver import blas, limits
 from driver._study import REGISTRY, Study, load_study, registered, study_names
 from driver.atomic import NAME_MAX, inside, output_set, remove_stale_temporaries, write_text
-from driver.deck import Deck, DeckError, Params
-from driver.deck import validate
+from driver.deck import Deck, DeckError, Params, validate
 from driver.export import FORMATS, summary_json_text, write_tidy
 from driver.outcome import RunOutcome
 from driver.pydeck import deck_of

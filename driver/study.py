@@ -9,10 +9,11 @@ summary columns from a study's ``labels``; the decorator that gives ``run`` its 
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
-from typing import TYPE_CHECKING, Any, Callable
+from typing import TYPE_CHECKING, Any
 
 from driver._study import Study
 
@@ -102,7 +103,7 @@ class Result:
         """Names of the figures this result can draw (``<stem>_<name>.png`` with --plot)."""
         return [f.name for f in self.figures]
 
-    def figure(self, name: str | None = None) -> "matplotlib.figure.Figure":
+    def figure(self, name: str | None = None) -> matplotlib.figure.Figure:
         """Draw one figure (the first when ``name`` is None) as a new matplotlib Figure.
 
         It is drawn in the house style inside an ``rc_context``; the matplotlib backend and
@@ -174,7 +175,7 @@ def column_label(study: Study | None, name: str) -> str:
     spec_key = study.spec.keys.get(key) if study is not None else None
     if entry is None:
         words, units = key, ""
-        from driver.export import SUFFIX_UNITS   # the one suffix table (tidy units and labels)
+        from driver.export import SUFFIX_UNITS  # the one suffix table (tidy units and labels)
 
         for suffix, u in SUFFIX_UNITS:
             if key.endswith(suffix) and len(key) > len(suffix):

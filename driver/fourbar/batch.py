@@ -3,7 +3,8 @@ summary of one deck (the same kernel row)."""
 from __future__ import annotations
 
 import math
-from typing import Any, Callable, Collection, Mapping
+from collections.abc import Callable, Collection, Mapping
+from typing import Any
 
 import numpy as np
 import pandas as pd

@@ -7,7 +7,7 @@ Drawn in the house style (:mod:`driver.plotting`); this module imports matplotli
 from __future__ import annotations
 
 import math
-from typing import Sequence
+from collections.abc import Sequence
 
 import matplotlib
 import matplotlib.colors

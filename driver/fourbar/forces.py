@@ -20,8 +20,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from driver.fourbar import kernel
 from driver.deck import Key, Params, non_negative
+from driver.fourbar import kernel
 from driver.study import Figure
 from driver.table import Column, fortran_f, render_table
 

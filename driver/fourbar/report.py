@@ -13,14 +13,28 @@ from driver._signatures import keyword_signature
 from driver.deck import Params
 from driver.export import with_units
 from driver.fourbar import forces
-from driver.fourbar.analysis import (ST, TIDY_UNITS, Extremes, Grashof, coupler_point, crank_angles, deg360,
-                                     assembly_intervals, exact_columns, exact_grid, extremes, grashof, limit_angles,
-                                     listing_grid, rocking_motions, tidy_frame)
+from driver.fourbar.analysis import (
+    ST,
+    TIDY_UNITS,
+    Extremes,
+    Grashof,
+    assembly_intervals,
+    coupler_point,
+    crank_angles,
+    deg360,
+    exact_columns,
+    exact_grid,
+    extremes,
+    grashof,
+    limit_angles,
+    listing_grid,
+    rocking_motions,
+    tidy_frame,
+)
 from driver.fourbar.batch import summary_of, summary_rows
-from driver.fourbar.spec import band_of
+from driver.fourbar.spec import SPEC, band_of
 from driver.runner import keyword_run
 from driver.study import Figure, Result
-from driver.fourbar.spec import SPEC
 from driver.table import Column, fortran_f, render_table
 
 __all__ = ["run", "listing_text", "exact_table", "summary_lines", "audit", "deck_figures", "output_name", "animation_frames"]
@@ -235,7 +249,7 @@ def output_name(p: Params) -> str:
 def deck_figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> list[Figure]:
     """The figures of a run (drawn on demand): the curves and the linkage at its limit positions."""
     def curves():
-        from driver.fourbar import figures   # matplotlib is the optional [plot] extra: imported when drawn
+        from driver.fourbar import figures  # matplotlib is the optional [plot] extra: imported when drawn
         theta = np.linspace(p.start_deg, p.stop_deg, 721)
         out, st = exact_grid(p, theta)
         exact = tidy_frame("exact", theta, exact_columns(out, st), st)

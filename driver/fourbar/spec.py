@@ -6,7 +6,8 @@ accelerations in rad/s^2."""
 from __future__ import annotations
 
 import math
-from typing import Any, Mapping
+from collections.abc import Mapping
+from typing import Any
 
 from driver.deck import GroupSpec, Key, Params, positive
 from driver.fourbar import forces

@@ -14,8 +14,8 @@ from typing import Any
 import numpy as np
 from scipy.optimize import minimize
 
-from driver.manipulator import kernel
 from driver.deck import Params
+from driver.manipulator import kernel
 
 __all__ = ["STATUS", "SIGNIFICANT", "DESIGN_STATUS", "round_half_up", "Workspace", "Conv", "optima", "tolerance_box",
            "design_status"]

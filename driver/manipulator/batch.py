@@ -24,8 +24,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from driver.manipulator import kernel
 from driver.deck import Params
+from driver.manipulator import kernel
 from driver.manipulator.analysis import STATUS, Conv, Workspace, _design_list, design_status, round_half_up
 from driver.manipulator.report import design_torque_columns, sweep_columns, workspace_columns
 from driver.manipulator.tables import _t48

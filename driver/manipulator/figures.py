@@ -7,7 +7,7 @@ Drawn in the house style (:mod:`driver.plotting`); this module imports matplotli
 from __future__ import annotations
 
 import math
-from typing import Sequence
+from collections.abc import Sequence
 
 import matplotlib
 import matplotlib.colors
@@ -15,10 +15,10 @@ import matplotlib.ticker
 import numpy as np
 from matplotlib.figure import Figure
 
-from driver.plotting import new_figure, plain_text, styled
 from driver.deck import Params
 from driver.manipulator import kernel
 from driver.manipulator.analysis import Conv, Workspace, optima
+from driver.plotting import new_figure, plain_text, styled
 
 
 def _ellipse_levels(levels: Sequence[float], n: int) -> list[float]:

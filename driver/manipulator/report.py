@@ -11,14 +11,14 @@ import pandas as pd
 
 from driver import _keywords
 from driver._signatures import keyword_signature
-from driver.manipulator import kernel
 from driver.deck import Params
 from driver.export import with_units
+from driver.manipulator import kernel
 from driver.manipulator.analysis import SIGNIFICANT, Conv, Workspace, _design_list, _target, design_status, optima, round_half_up
+from driver.manipulator.spec import SPEC
 from driver.manipulator.tables import TIDY_NAMES, Table, _differences, _tables, _tolerance
 from driver.runner import keyword_run
 from driver.study import Figure, Result
-from driver.manipulator.spec import SPEC
 from driver.table import fortran_f
 
 __all__ = ["run", "TIDY_UNITS", "table_frame"]

@@ -8,8 +8,8 @@ from typing import Any
 
 import numpy as np
 
-from driver.manipulator import kernel
 from driver.deck import Params
+from driver.manipulator import kernel
 from driver.manipulator.analysis import (
     STATUS,
     Conv,

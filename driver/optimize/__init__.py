@@ -33,17 +33,17 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from driver.atomic import output_set, write_text
 from driver import blas
+from driver.atomic import output_set, write_text
 from driver.deck import Deck, read_deck
 from driver.export import write_tidy
 from driver.extras import require
-from driver.outcome import ExitCode, Outcome
+from driver.optimize import journal as journal_file
+from driver.optimize import report
 from driver.optimize.evaluate import Evaluator, Record, design_params
 from driver.optimize.methods import HistoryRow, MethodResult, run_method
 from driver.optimize.problem import SPEC, Problem, problem_of
-from driver.optimize import journal as journal_file
-from driver.optimize import report
+from driver.outcome import ExitCode, Outcome
 from driver.runner import compute, output_stem, write_outputs
 
 __all__ = ["SPEC", "OptimizeOutcome", "optimize", "run_optimize_deck", "problem_of"]

@@ -11,8 +11,8 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
-from driver.plotting import new_figure, plain_text, styled
 from driver.deck import Params
+from driver.plotting import new_figure, plain_text, styled
 
 
 @styled

@@ -14,9 +14,9 @@ from driver.deck import Params
 from driver.export import with_units
 from driver.robust_example.analysis import analyse, tmin
 from driver.robust_example.published import MODE_REASONS
+from driver.robust_example.spec import SPEC
 from driver.runner import keyword_run
 from driver.study import Figure, Result
-from driver.robust_example.spec import SPEC
 from driver.table import Column, render_table
 
 __all__ = ["run", "TIDY_UNITS"]

@@ -11,8 +11,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.linalg import LinAlgError, cholesky_banded
 
-from driver.slidercrank import kernel
 from driver.deck import Params
+from driver.slidercrank import kernel
 from driver.slidercrank.spec import SIMEON1996, Model
 
 

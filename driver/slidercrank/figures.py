@@ -7,13 +7,14 @@ Drawn in the house style (:mod:`driver.plotting`); this module imports matplotli
 """
 from __future__ import annotations
 
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 from matplotlib.figure import Figure
 
-from driver.plotting import new_figure, plain_text, styled
 from driver.deck import Params
+from driver.plotting import new_figure, plain_text, styled
 from driver.slidercrank.analysis import Case, history
 from driver.slidercrank.spec import Model
 

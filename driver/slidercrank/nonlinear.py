@@ -21,8 +21,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from driver.slidercrank import kernel
 from driver.deck import Params
+from driver.slidercrank import kernel
 from driver.slidercrank.analysis import no_record
 from driver.slidercrank.spec import Model
 

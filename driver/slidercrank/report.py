@@ -15,8 +15,17 @@ from driver.deck import Params
 from driver.export import with_units
 from driver.slidercrank import kernel
 from driver.slidercrank.analysis import Case, _run_case, static_onset
-from driver.slidercrank.spec import (EULER_WARN, MIN_STEPS_PER_BENDING_PERIOD, MIN_STEPS_PER_REV, SIMEON1996, STATUS_TEXT,
-                                     Model, _model, _shape, rayleigh)
+from driver.slidercrank.spec import (
+    EULER_WARN,
+    MIN_STEPS_PER_BENDING_PERIOD,
+    MIN_STEPS_PER_REV,
+    SIMEON1996,
+    STATUS_TEXT,
+    Model,
+    _model,
+    _shape,
+    rayleigh,
+)
 from driver.study import Figure, Result
 from driver.table import Cell, Column, render_table
 

@@ -17,13 +17,12 @@ from driver import _keywords
 from driver._signatures import keyword_signature
 from driver.deck import Params
 from driver.export import with_units
+from driver.runner import keyword_run
 from driver.slidercrank.analysis import Case, _run_case, static_onset
 from driver.slidercrank.nonlinear import IRREGULAR, NLCase, onset_search, run_nl_case
 from driver.slidercrank.report import Derived, _figures, _header, _status_text, run_linear
-from driver.slidercrank.spec import _model, rayleigh
-from driver.runner import keyword_run
+from driver.slidercrank.spec import SPEC, _model, rayleigh
 from driver.study import Figure, Result
-from driver.slidercrank.spec import SPEC
 from driver.table import Cell, Column, render_table
 
 NL_STATUS_TEXT = {
@@ -105,7 +104,7 @@ def _newton_table(cases: list[NLCase], params: Params) -> list[str]:
                      c.deepest_cut])
         trailers.append("" if c.ok else nl_status_text(c))
     return ["Table 7  Newton iterations and step control of the nonlinear runs",
-            f"         solves = Newton solves in all; max = most in one step; cuts = time steps halved",
+            "         solves = Newton solves in all; max = most in one step; cuts = time steps halved",
             f"         (deepest = most halvings of one step, of {params.max_step_cuts} allowed); tolerance "
             f"{params.newton_tolerance:g} (relative residual)", ""] + render_table(cols, rows, trailers)
 

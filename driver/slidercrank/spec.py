@@ -9,9 +9,9 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, TypedDict
 
-from driver.slidercrank import kernel
-from driver.limits import Estimate
 from driver.deck import GroupSpec, Key, Params, non_negative, positive
+from driver.limits import Estimate
+from driver.slidercrank import kernel
 
 #: Table 1a of the paper (columns re-ordered, docs/slidercrank.md); the depth is the
 #: in-plane section depth used for the outer-fibre strain (weak axis in plane).

@@ -57,12 +57,23 @@ from driver.outcome import ExitCode, SweepOutcome
 from driver.runner import compute, output_stem, study_of
 from driver.sweep import batch as batch_path
 from driver.sweep import engine, store, stream
-from driver.sweep.keep import check_keep, keep_columns
 from driver.sweep.engine import Task, auto_chunk, run_task
+from driver.sweep.keep import check_keep, keep_columns
 from driver.sweep.report import Warnings, summary_frame, summary_settings, sweep_text, write_sweep_files
-from driver.sweep.spec import (FULL_VALIDATION, MAX_CASES, MAX_KEYS, SPEC, Case,
-                               CaseResult, _axes, _configured_scheduler, build_cases, case_count, grid_of,
-                               validate_sweep)
+from driver.sweep.spec import (
+    FULL_VALIDATION,
+    MAX_CASES,
+    MAX_KEYS,
+    SPEC,
+    Case,
+    CaseResult,
+    _axes,
+    _configured_scheduler,
+    build_cases,
+    case_count,
+    grid_of,
+    validate_sweep,
+)
 
 __all__ = ["SPEC", "Case", "build_cases", "run_sweep_deck", "run_task", "auto_chunk", "MAX_KEYS", "MAX_CASES",
            "summary_frame", "case_count", "CASES_TABLE_MAX", "SweepOutcome"]
@@ -180,6 +191,7 @@ class _CasesTable:
 
     def add(self, indices: list[int]) -> None:
         import pyarrow.parquet as pq
+
         from driver.export import csv_bytes
         for k in indices:
             if self.full:
@@ -204,6 +216,7 @@ class _CasesTable:
         if self.full:
             return None
         import pyarrow as pa
+
         from driver.export import csv_bytes
         parts = [self.pieces[k] for k in written]
         first = parts[0][0].schema

@@ -28,9 +28,10 @@ import socket
 import sys
 import time
 from collections import deque
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Iterable
+from typing import Any
 
 import pandas as pd
 
@@ -65,7 +66,7 @@ class Task:
     plot: bool | str            # the cases' own figures (only with --plot and case_plots)
     base_hash: str
 
-    def part(self, indices: list[int]) -> "Task":
+    def part(self, indices: list[int]) -> Task:
         return Task(self.deck_path, self.raw, self.grid, indices, self.layout, self.keep, self.case_outputs,
                     self.formats, self.plot, self.base_hash)
 

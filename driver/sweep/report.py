@@ -205,7 +205,7 @@ def head_lines(deck: Deck, sw: Params, base: Params, axes: list[tuple[str, list]
         shown = (", ".join(map(fmt, vals[:8])) if len(vals) <= 8 else
                  f"{fmt(vals[0])}, {fmt(vals[1])}, ..., {fmt(vals[-1])} ({len(vals)} values)")
         lines.append(f"    {name:<28} {shown}")
-    from driver._study import load_study   # settings of the base deck the summary columns depend on
+    from driver._study import load_study  # settings of the base deck the summary columns depend on
     swept = {name.partition(".")[2] for name, _ in axes}
     for key, v in summary_settings(load_study(base.group), base, swept).items():
         lines.append(f"    {key:<28} " + (", ".join(f"{x:g}" for x in v) if isinstance(v, (list, tuple)) else f"{v}")

@@ -23,15 +23,13 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
 from driver.atomic import atomic_open, output_set
 from driver.deck import Deck, Params
-from driver.sweep.report import (FAILED_LISTED, failed_lines, head_lines, not_listed_line, table_columns,
-                                 table_values)
+from driver.sweep.report import FAILED_LISTED, failed_lines, head_lines, not_listed_line, table_columns, table_values
 from driver.table import Column
 
 __all__ = ["STREAM_ROWS", "write_streamed", "Streamed"]

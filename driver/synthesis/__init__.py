@@ -31,10 +31,10 @@ import numpy as np
 import pandas as pd
 
 from driver import blas, expr, fourbar
-from driver.fourbar import kernel as fourbar_kernel
 from driver.atomic import output_set, write_text
 from driver.deck import Deck, DeckError, GroupSpec, Key, Params, RawGroup, positive, read_deck, validate
 from driver.export import write_tidy
+from driver.fourbar import kernel as fourbar_kernel
 from driver.outcome import FilesOutcome
 from driver.runner import compute, output_stem, write_outputs
 from driver.synthesis import crank_rocker as cr

@@ -6,16 +6,22 @@ from __future__ import annotations
 
 import math
 import re
-from typing import Any, Collection, Mapping
+from collections.abc import Collection, Mapping
+from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from driver.deck import Params
-from driver.ujoint.kernel import (UJOINT_MODELS, UJOINT_OBJECTIVES, UJOINT_PASSES, UJOINT_SUMMARY_COLUMNS, ujoint_geometry,
-                            ujoint_summaries)
+from driver.ujoint.kernel import (
+    UJOINT_MODELS,
+    UJOINT_OBJECTIVES,
+    UJOINT_PASSES,
+    UJOINT_SUMMARY_COLUMNS,
+    ujoint_geometry,
+    ujoint_summaries,
+)
 from driver.ujoint.spec import _KEYS, DEG
-
 
 #: deck keys a batch may vary (one value per design); list keys as one value per design (a
 #: single-element list, as a sweep sets them), a (designs, k) array of whole lists, or element

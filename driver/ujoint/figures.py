@@ -6,7 +6,7 @@ Drawn in the house style (:mod:`driver.plotting`); this module imports matplotli
 """
 from __future__ import annotations
 
-from typing import Sequence
+from collections.abc import Sequence
 
 import matplotlib
 import matplotlib.colors
@@ -16,7 +16,6 @@ from matplotlib.figure import Figure
 
 from driver.plotting import new_figure, plain_text, styled
 from driver.ujoint.analysis import Chain, Design, output_speed
-
 
 #: line styles of the Hooke-joint designs, by the label driver.ujoint gives them
 _UJOINT_STYLES = {"trial": dict(color="C1", lw=1.4), "design": dict(color="C1", lw=1.4),

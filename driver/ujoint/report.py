@@ -14,15 +14,28 @@ import pandas as pd
 from driver import _keywords
 from driver._signatures import keyword_signature
 from driver.deck import Params
+from driver.export import with_units
 from driver.runner import keyword_run
 from driver.study import Figure, Result
-from driver.ujoint.spec import SPEC
-from driver.export import with_units
-from driver.ujoint.kernel import UJOINT_MODELS
 from driver.table import Cell, Column, fortran_f, render_table
-from driver.ujoint.analysis import (TIE_RTOL, Chain, Design, StartRun, _chain, _free_index, _starts, evaluate,
-                                    objective_scale, optimise, output_speed, phases_for, pick_best, yoke_shifts)
-from driver.ujoint.spec import BAND_TOL, CONVENTIONS, DEG, OPTIONS, _geometry, _per, _phases
+from driver.ujoint.analysis import (
+    TIE_RTOL,
+    Chain,
+    Design,
+    StartRun,
+    _chain,
+    _free_index,
+    _starts,
+    evaluate,
+    objective_scale,
+    optimise,
+    output_speed,
+    phases_for,
+    pick_best,
+    yoke_shifts,
+)
+from driver.ujoint.kernel import UJOINT_MODELS
+from driver.ujoint.spec import BAND_TOL, CONVENTIONS, DEG, OPTIONS, SPEC, _geometry, _per, _phases
 
 
 def _model_text(params: Params) -> str:
