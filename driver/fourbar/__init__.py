@@ -18,24 +18,11 @@ from __future__ import annotations
 
 from driver._study import BatchSummary, Study
 from driver.fourbar import forces, kernel, published
-from driver.fourbar.analysis import (
-                                     ST,
-                                     Extremes,
-                                     Grashof,
-                                     Motion,
-                                     assembly_intervals,
-                                     blame,
-                                     coupler_point,
-                                     crank_angles,
-                                     exact_grid,
-                                     extremes,
-                                     grashof,
-                                     limit_angles,
-                                     listing_grid,
-                                     rocking_motions,
-                                     tidy_frame,
-)
-from driver.fourbar.batch import BATCH_IGNORED, BATCH_INDEPENDENT, BATCH_KEYS, BATCH_PASSES, PASS_BITS, summarise, summarise_batch
+from driver.fourbar.analysis import (ST, Extremes, Grashof, Motion, assembly_intervals, blame, coupler_point,
+                                     crank_angles, exact_grid, extremes, grashof, limit_angles, listing_grid,
+                                     rocking_motions, tidy_frame)
+from driver.fourbar.batch import (BATCH_IGNORED, BATCH_INDEPENDENT, BATCH_KEYS, BATCH_PASSES, PASS_BITS, summarise,
+                                  summarise_batch)
 from driver.fourbar.published import LISTING_DEFECT, LISTING_PRECISION, exact_as_listed
 from driver.fourbar.report import animation_frames, run
 from driver.fourbar.spec import LABELS, SPEC, SUMMARY_SETTINGS, SWEEP_BEST, SWEEP_PLOT, estimate

@@ -24,19 +24,8 @@ from driver.slidercrank import kernel, published
 from driver.slidercrank.analysis import Case, simeon_initial_state, static_onset
 from driver.slidercrank.report import animation_frames
 from driver.slidercrank.report_nl import run
-from driver.slidercrank.spec import (
-                                     LABELS,
-                                     MATERIALS,
-                                     PAPER_SPEEDS,
-                                     SIMEON1996,
-                                     SPEC,
-                                     STATUS_TEXT,
-                                     SWEEP_PLOT,
-                                     Model,
-                                     estimate,
-                                     min_steps_per_rev,
-                                     rayleigh,
-)
+from driver.slidercrank.spec import (LABELS, MATERIALS, PAPER_SPEEDS, SIMEON1996, SPEC, STATUS_TEXT, SWEEP_PLOT, Model,
+                                     estimate, min_steps_per_rev, rayleigh)
 
 __all__ = ["SPEC", "STUDY", "run", "estimate", "MATERIALS", "PAPER_SPEEDS", "SIMEON1996", "simeon_initial_state",
            "min_steps_per_rev", "rayleigh", "static_onset", "STATUS_TEXT", "Model", "Case", "LABELS", "SWEEP_PLOT",
