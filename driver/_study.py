@@ -30,9 +30,9 @@ from typing import TYPE_CHECKING, Any
 from driver.groupspec import GroupSpec
 
 if TYPE_CHECKING:
-    from driver.deck import Params
+    from driver.groupspec import Params
     from driver.limits import Estimate
-    from driver.study import Result
+    from driver.result import Result
 
 __all__ = ["Study", "BatchSummary", "REGISTRY", "load_study", "study_names", "registered"]
 

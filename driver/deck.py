@@ -23,36 +23,19 @@ import re
 import stat
 import unicodedata
 import warnings
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import f90nml
 
-from driver.groupspec import GroupSpec, Key
+from driver.groupspec import DeckError, GroupSpec, Key, Params
 
 __all__ = ["DeckError", "Key", "GroupSpec", "Params", "RawGroup", "Deck", "read_deck", "validate"]
 
 #: magnitudes no deck value of any study needs; larger ones only overflow the kernels
 MAX_FLOAT, MAX_INT = 1e15, 10**9
-
-
-class DeckError(ValueError):
-    """Bad input: names the deck, the line and the key (exit status 2).
-
-    Attributes ``path``, ``line`` (None when unknown) and ``key`` (None for the whole group)
-    locate the problem; ``message`` says what it is.
-    """
-
-    def __init__(self, path: str | Path, line: int | None, key: str | None, message: str):
-        self.path, self.line, self.key, self.message = str(path), line, key, message
-        super().__init__(str(self))
-
-    def __str__(self) -> str:
-        where = f"{self.path}:{self.line}" if self.line else self.path
-        what = f"key '{self.key}': " if self.key else ""
-        return f"{where}: {what}{self.message}"
 
 
 @dataclass
@@ -72,39 +55,6 @@ class Deck:
     path: Path
     groups: dict[str, RawGroup]
     legacy: bool = False
-
-
-class Params(Mapping):
-    """Validated values of one group (defaults filled in), with their deck lines."""
-
-    def __init__(self, group: str, path: Path, values: dict[str, Any], lines: dict[str, int],
-                 line: int, given: set[str] | None = None):
-        self.group, self.path, self.line = group, Path(path), line
-        self._values, self._lines = dict(values), dict(lines)
-        self.given = set(given if given is not None else values)
-
-    def __getitem__(self, key: str) -> Any:
-        return self._values[key]
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(self._values)
-
-    def __len__(self) -> int:
-        return len(self._values)
-
-    def __getattr__(self, key: str) -> Any:
-        try:
-            return self.__dict__["_values"][key]
-        except KeyError:
-            raise AttributeError(key) from None
-
-    def line_of(self, key: str) -> int:
-        """Line of ``key`` in the deck, or the group's line when it was defaulted."""
-        return self._lines.get(key, self.line)
-
-    def error(self, key: str | None, message: str) -> DeckError:
-        """A DeckError located at ``key`` (for cross-key checks in studies)."""
-        return DeckError(self.path, self.line_of(key) if key else self.line, key, message)
 
 
 # --------------------------------------------------------------------------- reading the file

@@ -19,14 +19,12 @@ from __future__ import annotations
 import math
 import os
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import Protocol
 
-from driver.deck import Params
-
-if TYPE_CHECKING:
-    from driver._study import Study
+from driver.groupspec import Params
 
 __all__ = ["Estimate", "Budget", "budget", "configure", "restore", "check", "parse_size", "parse_seconds",
            "DEFAULT_WORK", "ENV_MEMORY", "ENV_WORK"]
@@ -161,7 +159,15 @@ def _time(s: float) -> str:
     return f"{s:.3g} s"
 
 
-def check(study: Study, params: Params, what: str = "", lim: Budget | None = None) -> Estimate:
+class Estimating(Protocol):
+    """What :func:`check` needs of a study: its ``estimate`` (every
+    :class:`driver._study.Study` has one; the contract lives above this module, which it uses)."""
+
+    @property
+    def estimate(self) -> Callable[[Params], Estimate]: ...
+
+
+def check(study: Estimating, params: Params, what: str = "", lim: Budget | None = None) -> Estimate:
     """Raise DeckError when the study's estimate for ``params`` exceeds the budget.
 
     ``lim``: the budget to apply (default :func:`budget`, this process's); a caller that sends
