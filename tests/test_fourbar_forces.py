@@ -344,8 +344,9 @@ def test_berkof_lowen_makes_the_centre_of_mass_stationary(case, k1, k3):
     assert cw[4] == pytest.approx(cw[0] / radii[0]) and cw[5] == pytest.approx(cw[2] / radii[1])
     fb, _, _ = tool_forces(theta, p, q, r, s, w, al, branch, pb)
     unb = np.hypot(f[good, 9], f[good, 10]).max()
-    if unb > 0:
-        assert np.hypot(fb[good, 9], fb[good, 10]).max() <= 1e-9 * unb
+    if unb > 0:   # + the smallest normal float: at a crank speed of ~1e-159 rad/s the forces are subnormal,
+        # where no relative bound holds (hypothesis found w = 6.1e-159: 5e-324 N against 2.3e-317 N)
+        assert np.hypot(fb[good, 9], fb[good, 10]).max() <= 1e-9 * unb + np.finfo(float).tiny
     # the balanced linkage still satisfies Newton-Euler (the oracle with the balanced props)
     ref = oracle_forces(theta[good], p, q, r, s, w, al, branch, pb)
     assert np.max(np.abs(fb[good] - ref) / (np.max(np.abs(ref), axis=1, keepdims=True) + 1e-300)) < 1e-9
