@@ -23,7 +23,7 @@ from driver import __version__, limits
 from driver._study import study_names
 from driver.export import FORMATS
 from driver.extras import MissingExtra, require
-from driver.outcome import ExitCode, Outcome, RunOutcome, SweepOutcome
+from driver.outcome import CompareOutcome, ExitCode, Outcome, RunOutcome, SweepOutcome
 from driver.study import PLOT_FORMATS
 
 __all__ = ["main", "run_deck", "say", "ExitCode"]
@@ -114,8 +114,13 @@ def say(outcome: Outcome, quiet: bool = False) -> None:
 
 def _stdout_lines(outcome: Outcome) -> list[str]:
     """What a deck's run says on stdout: for a sweep its notes, its summary line and the files
-    written (its own tables in one line); otherwise the files written, then the notes (an
-    optimisation's result and the designs it computed)."""
+    written (its own tables in one line); for a comparison each deck's agreement lines, then the
+    totals; otherwise the files written, then the notes (an optimisation's result and the designs
+    it computed)."""
+    if isinstance(outcome, CompareOutcome):
+        from driver.compare import compare_text
+        return [line for c in outcome.comparisons for line in compare_text(c)] + \
+            (["Total", *outcome.totals] if outcome.totals else [])
     if isinstance(outcome, SweepOutcome):
         oc, out = outcome, outcome.outdir or Path(".")
         own = [out / f"{oc.name}.out", out / f"{oc.name}_summary.csv", out / f"{oc.name}_summary.parquet"]
@@ -284,7 +289,10 @@ def _main(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
     if args.compare:
         from driver.compare import compare_decks
         try:
-            return compare_decks(args.decks)
+            compared = compare_decks(args.decks, on_deck=say)   # each deck's lines as soon as it is compared
+            if compared.totals:
+                say(CompareOutcome(totals=compared.totals))
+            return compared.exit_code
         except BrokenPipeError:
             sys.stderr.close()
             return ExitCode.OK

@@ -21,7 +21,8 @@ reason    why a cell is not ``identical``/``agrees``, or why a reproduced printe
 ========  ===========================================================================
 
 :func:`compare_text` renders the per-table agreement lines and every cell that does not agree,
-as ``python -m driver --compare DECK...`` prints them.  Each study compares its own tables (its
+as ``python -m driver --compare DECK...`` prints them; :func:`compare_decks` compares several decks
+and returns a :class:`~driver.outcome.CompareOutcome` (the command line prints it).  Each study compares its own tables (its
 ``published.py``, declared as ``Study.published``; the cell primitives are in
 :mod:`driver.published`); this module runs the deck and reports.
 """
@@ -36,6 +37,7 @@ import pandas as pd
 from driver import published
 from driver._study import load_study
 from driver.deck import Params, read_deck
+from driver.outcome import CompareOutcome
 from driver.published import agrees_printed
 from driver.runner import study_of
 from driver.study import Result
@@ -160,41 +162,46 @@ def totals_text(comparisons: list[Comparison]) -> list[str]:
     return lines
 
 
-def compare_decks(decks: list[Path], out=None) -> int:
-    """Compare every deck, print the report (``out``: a text stream, default stdout); exit status
-    0 when every reproducible cell agrees, 1 when a cell differs or a run failed, 2 for bad input."""
-    import sys
+def compare_decks(decks: list[Path], on_deck: Callable[[CompareOutcome], None] | None = None) -> CompareOutcome:
+    """Compare every deck with the published record; nothing is printed or written.
 
+    Returns a :class:`~driver.outcome.CompareOutcome`: the comparisons, the totals over the decks,
+    an error message per deck that had bad input (exit status 2) or whose run failed (1), and exit
+    status 1 when a reproducible cell differs.  ``on_deck`` (e.g. the command line's printer) gets
+    each part as soon as it is known: each deck's own outcome, or the error that the published
+    tables are missing; the totals are the returned outcome's alone."""
     from driver.deck import DeckError
-    out = sys.stdout if out is None else out
+    whole = CompareOutcome()
     if not published.PUBLISHED_DIR.is_dir():
-        print(f"error: the published tables are not installed ({published.PUBLISHED_DIR} is missing); "
-              "the install is incomplete: reinstall it (pip install --force-reinstall PATH-TO-THE-SOURCE-OR-WHEEL; "
-              "in a clone: bash .ci/setup)", file=sys.stderr)
-        return 1
-    status, done = 0, []
+        whole.error(f"the published tables are not installed ({published.PUBLISHED_DIR} is missing); "
+                    "the install is incomplete: reinstall it (pip install --force-reinstall PATH-TO-THE-SOURCE-OR-WHEEL; "
+                    "in a clone: bash .ci/setup)")
+        whole.failed = True
+        if on_deck is not None:
+            on_deck(whole)
+        return whole
     for deck in decks:
+        part = CompareOutcome()
         try:
-            c = run_comparison(deck)
+            part.comparisons.append(run_comparison(deck))
         except DeckError as exc:
-            print(f"error: {exc}", file=sys.stderr)
-            status = max(status, 2)
-            continue
+            part.error(str(exc))
+            part.bad_input = True
         except Exception as exc:  # a run failure: say so plainly
-            print(f"error: {deck}: run failed: {exc.__class__.__name__}: {exc}", file=sys.stderr)
-            status = max(status, 1)
-            continue
-        done.append(c)
-        print("\n".join(compare_text(c)), file=out)
-        if not c.ok:
-            status = max(status, 1)
+            part.error(f"{deck}: run failed: {exc.__class__.__name__}: {exc}")
+            part.failed = True
+        if on_deck is not None:
+            on_deck(part)
+        whole.comparisons += part.comparisons
+        whole.messages += part.messages
+        whole.bad_input |= part.bad_input
+        whole.failed |= part.failed
+    done = whole.comparisons
     if len(done) > 1:
-        totals = totals_text(done)
-        print("Total", file=out)
-        print("\n".join(totals) if totals else
-              f"  no published cells among these {len(done)} decks (sweep, optimisation and synthesis decks "
-              "have none: compare the single-case decks a sweep writes instead)", file=out)
-    return status
+        whole.totals = totals_text(done) or [
+            f"  no published cells among these {len(done)} decks (sweep, optimisation and synthesis decks "
+            "have none: compare the single-case decks a sweep writes instead)"]
+    return whole
 
 
 def _table_line(table: str, t: pd.DataFrame) -> str:

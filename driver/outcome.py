@@ -19,9 +19,10 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:   # annotations only
     import pandas as pd
 
+    from driver.compare import Comparison
     from driver.study import Result
 
-__all__ = ["ExitCode", "Message", "Outcome", "RunOutcome", "FilesOutcome", "SweepOutcome"]
+__all__ = ["ExitCode", "Message", "Outcome", "RunOutcome", "FilesOutcome", "SweepOutcome", "CompareOutcome"]
 
 
 class ExitCode(enum.IntEnum):
@@ -180,3 +181,28 @@ class SweepOutcome(Outcome):
     def __repr__(self) -> str:
         return (f"<SweepResult {self.name!r}: {self.n_cases} cases, {self.n_ok} ok, {self.n_kept} kept; "
                 f"status {self.status}" + (f"; files in {self.outdir}" if self.outdir else "") + ">")
+
+
+@dataclass(kw_only=True)
+class CompareOutcome(Outcome):
+    """A comparison of decks with the published record (:func:`driver.compare.compare_decks`).
+
+    comparisons  the decks compared, in order (:class:`~driver.compare.Comparison`: one row per
+                 published cell, ``ok`` when no reproducible cell differs)
+    totals       one line per study (and mode or method) over the decks compared, as the command
+                 line prints them under "Total"; empty when fewer than two decks were compared
+    bad_input    a deck had bad input (its error is in ``messages``)
+    failed       a run failed or the published tables are missing (the error is in ``messages``)
+    """
+
+    comparisons: list[Comparison] = field(default_factory=list)
+    totals: list[str] = field(default_factory=list)
+    bad_input: bool = False
+    failed: bool = False
+
+    @property
+    def exit_code(self) -> ExitCode:
+        """0 every reproducible cell agrees, 1 a cell differs or a run failed, 2 a deck had bad input."""
+        differs = self.failed or not all(c.ok for c in self.comparisons)
+        worst = ExitCode.BAD_INPUT if self.bad_input else ExitCode.FAILED if differs else ExitCode.OK
+        return max(super().exit_code, worst)
