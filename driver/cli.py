@@ -68,7 +68,7 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool | str, pro
         given = [opt for opt, key in (("-j/--jobs", "jobs"), ("--scheduler", "scheduler"), ("--resume", "resume"))
                  if (sweep_options or {}).get(key) and not ({"sweep", "optimize"} & set(deck.groups))]
         outcome = run_by_engine(deck, outdir, formats, plot, progress, summary_json=summary_json, report=report,
-                                **(sweep_options or {}))
+                                notify=_notify, **(sweep_options or {}))
     except DeckError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return ExitCode.BAD_INPUT
@@ -99,6 +99,11 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool | str, pro
               f"(a &sweep or &optimize group) only; ignored for this deck", file=sys.stderr)
     say(outcome, quiet)
     return outcome.exit_code
+
+
+def _notify(line: str) -> None:
+    """What an engine says at once, before its outcome (a sweep's Ctrl-C notice): a line on stderr."""
+    print(line, file=sys.stderr, flush=True)
 
 
 def say(outcome: Outcome, quiet: bool = False) -> None:

@@ -9,6 +9,7 @@ returns an :class:`~driver.outcome.Outcome`.
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -32,11 +33,12 @@ def engine_of(deck: Deck) -> str:
 
 def run_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, progress: bool = False, *,
              jobs: int | None = None, scheduler: Any = None, resume: bool = False, summary_json: bool = False,
-             report: bool = False) -> Outcome:
+             report: bool = False, notify: Callable[[str], None] | None = None) -> Outcome:
     """Run ``deck`` by its engine and write its outputs to ``outdir``; ``summary_json`` also its
     ``<stem>.json``, ``report`` its report page ``<stem>.html`` (:mod:`driver.report_page`,
     once the run has written its outputs).  ``jobs``, ``scheduler`` and ``resume`` apply to
-    sweeps and optimisations.  Returns the engine's outcome; raises DeckError for bad input
+    sweeps and optimisations; ``notify(line)`` hears what cannot wait for the outcome (a sweep's
+    Ctrl-C: the queued cases are cancelled).  Returns the engine's outcome; raises DeckError for bad input
     (nothing written) and :class:`~driver.extras.MissingExtra` for a missing optional package."""
     kind = engine_of(deck)
     if report:   # the page's name is known now: refused before the run, not after it
@@ -53,7 +55,7 @@ def run_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, pro
         require("parquet")   # sweeps keep their cases in Parquet: say so before importing them
         from driver import sweep
         outcome = sweep.run_sweep_deck(deck, outdir, formats, plot, progress, jobs=jobs, scheduler=scheduler,
-                                       resume=resume)
+                                       resume=resume, notify=notify)
         if summary_json:
             from driver.sweep.record import write_sweep_json
             outcome.written.append(write_sweep_json(deck, outdir, int(outcome.exit_code)))

@@ -42,6 +42,7 @@ import hashlib
 import json
 import os
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -95,10 +96,13 @@ def _base_hash(raw: RawGroup) -> str:
 
 
 def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool = False,
-                   jobs: int | None = None, scheduler: Any = None, resume: bool = False) -> SweepOutcome:
+                   jobs: int | None = None, scheduler: Any = None, resume: bool = False,
+                   notify: Callable[[str], None] | None = None) -> SweepOutcome:
     """Run a deck with a &sweep group; returns what it did (:class:`~driver.outcome.SweepOutcome`:
     counts, failed cases, warnings as data, files written, the driver's CPU per phase).  Prints
-    nothing (a progress bar on stderr with ``progress``).
+    nothing (a progress bar on stderr with ``progress``).  ``notify(line)`` hears what cannot wait
+    for the outcome: on Ctrl-C, that the queued cases are cancelled while the running ones finish
+    (the command line prints it on stderr at once; default: nothing is said).
 
     Raises DeckError for bad input before any case runs, and
     :class:`~driver.extras.MissingExtra` before running anything when pyarrow (case files and
@@ -165,6 +169,7 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
 
     run = _Run(deck, sw, base_params, module, grid, outdir, stem_path.name, layout, task_of, plot, progress,
                jobs, scheduler, resume, start_cpu)
+    run.notify = notify
     run.shown_columns = shown_columns
     sig = store.case_signature(raw, names, str(deck.path), sw.keep, sw.case_outputs, formats, case_plot, module)
     if batchable:
@@ -237,6 +242,7 @@ class _Run:
         self.plot, self.progress, self.jobs, self.scheduler, self.resume = plot, progress, jobs, scheduler, resume
         self.axes = list(zip(grid.names, grid.values))
         self.shown_columns: list[str] | None = None   # summary_columns given: the columns the tables show
+        self.notify: Callable[[str], None] | None = None   # told at once of a Ctrl-C (run_sweep_deck)
         self.start_cpu = start_cpu
         self.outcome = SweepOutcome(deck=str(deck.path), name=stem, outdir=outdir, n_cases=grid.n,
                                     workers=self._where())
@@ -296,7 +302,8 @@ class _Run:
         t_start, c_start = time.perf_counter(), time.process_time()
         oc.phases["prepare_cpu"] = c_start - self.start_cpu
         try:
-            chunk = engine.execute(order, n - n_done, self.task_of, self.jobs, self.scheduler, sw.chunk, on_result)
+            chunk = engine.execute(order, n - n_done, self.task_of, self.jobs, self.scheduler, sw.chunk, on_result,
+                                   notify=self.notify)
         finally:
             bar.close()
         elapsed = time.perf_counter() - t_start
@@ -418,7 +425,8 @@ class _Run:
         # case_outputs = 'kept', whose kept cases' failures rewrite their rows
         rows, counts, chunk = batch_path.run(bplan, self.outdir / f"{self.stem}.sweep", self.jobs, self.scheduler,
                                              self.resume, self.progress, sw.chunk, announce,
-                                             stream_rows=stream.STREAM_ROWS if sw.case_outputs == "none" else 0)
+                                             stream_rows=stream.STREAM_ROWS if sw.case_outputs == "none" else 0,
+                                             notify=self.notify)
         c_run = time.process_time()
         # the driver's CPU per phase (bench/bench_search.py): merging the chunks, then the tables
         oc.phases.update(run_cpu=c_run - c_start, chunk=chunk, chunks=-(-n // chunk), rows=len(rows))
@@ -446,7 +454,7 @@ class _Run:
                                 f"{len(todo)} to write")
             self._check_workers_see(bool(todo))
             engine.execute(todo, len(todo), self.task_of, self.jobs, self.scheduler, 0,
-                           lambda res: record.append(res, self.layout))
+                           lambda res: record.append(res, self.layout), notify=self.notify)
             wanted = set(kept)
             results = sorted((r for r in record.results() if r.index in wanted), key=lambda r: r.index)
             written = [r.index for r in results if r.files]

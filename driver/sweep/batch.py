@@ -33,7 +33,7 @@ import itertools
 import json
 import re
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -393,13 +393,15 @@ def _alone(p: BatchPlan, start: int, stop: int, folder: str = "") -> ChunkResult
 
 
 def execute(p: BatchPlan, todo: list[tuple[int, int]], jobs: int, scheduler: Any,
-            on_result, in_flight: int = 0, folder: str = "", adaptive: bool = False) -> None:
+            on_result, in_flight: int = 0, folder: str = "", adaptive: bool = False,
+            notify: Callable[[str], None] | None = None) -> None:
     """Run chunks ``todo`` [(start, stop)]; ``on_result(ChunkResult)`` as each completes.
     ``folder``: the record's folder, where the workers write their chunks' parts (on Dask only
     when every worker sees it; otherwise the result comes back unwritten).  ``adaptive`` (the
     deck sets no chunk size): a sweep of at most :data:`SMALL_SWEEP` cases runs its first chunk
     in this process and the rest too when, at that chunk's CPU time, they would take less than
-    :data:`POOL_MIN_SECONDS` (the worker pool is started only when it pays)."""
+    :data:`POOL_MIN_SECONDS` (the worker pool is started only when it pays).  ``notify(line)`` is
+    told at once when Ctrl-C cancels the queued chunks of workers (:func:`~driver.sweep.pool.run_pool`)."""
     if not todo:
         return
     if scheduler:
@@ -422,7 +424,7 @@ def execute(p: BatchPlan, todo: list[tuple[int, int]], jobs: int, scheduler: Any
     queue: Iterator[tuple[int, int]] = iter(todo)
     run_pool(lambda: next(queue, None), lambda pool, rng: pool.submit(chunk_rows, p, *rng, folder),
              lambda rng: _alone(p, *rng, folder), lambda rng, res, pending: on_result(res), jobs,
-             in_flight or 2 * jobs, "chunks")
+             in_flight or 2 * jobs, "chunks", notify=notify)
 
 
 def _execute_dask(p: BatchPlan, todo: list[tuple[int, int]], scheduler: Any, on_result, in_flight: int,
@@ -475,7 +477,7 @@ class StreamedRows:
 
 
 def run(p: BatchPlan, folder: Path, jobs: int, scheduler: Any, resume: bool, progress: bool,
-        chunk: int = 0, announce=None, stream_rows: int = 0
+        chunk: int = 0, announce=None, stream_rows: int = 0, notify: Callable[[str], None] | None = None
         ) -> tuple[pd.DataFrame | StreamedRows, dict[str, int], int]:
     """Run the whole batch sweep; returns (rows, counts, chunk size).  ``announce(resumed, damaged)``
     is called before anything runs with the number of cases found complete in the record and the
@@ -528,7 +530,7 @@ def run(p: BatchPlan, folder: Path, jobs: int, scheduler: Any, resume: bool, pro
             bar.update(res.stop - res.start)
 
     try:
-        execute(p, todo, jobs, scheduler, on_result, folder=str(folder), adaptive=not chunk)
+        execute(p, todo, jobs, scheduler, on_result, folder=str(folder), adaptive=not chunk, notify=notify)
     finally:
         if bar is not None:
             bar.close()

@@ -25,7 +25,6 @@ import math
 import os
 import secrets
 import socket
-import sys
 import time
 from collections import deque
 from collections.abc import Callable, Iterable
@@ -250,9 +249,11 @@ def _alone(task: Task) -> list[CaseResult]:
 
 
 def execute(order: Iterable[int], n_todo: int, task_of: Callable[[list[int]], Task], jobs: int, scheduler: Any,
-            chunk: int, on_result: Callable[[list[CaseResult]], None], in_flight: int = 0) -> int:
+            chunk: int, on_result: Callable[[list[CaseResult]], None], in_flight: int = 0,
+            notify: Callable[[str], None] | None = None) -> int:
     """Run the cases ``order`` (case numbers, started in that order) in chunks; ``on_result``
-    gets each chunk's results as it completes.  Returns the chunk size used."""
+    gets each chunk's results as it completes.  Returns the chunk size used.  ``notify(line)`` is
+    told at once when Ctrl-C cancels the queued cases of workers (:func:`~driver.sweep.pool.run_pool`)."""
     it = iter(order)
     if not scheduler and (jobs <= 1 or n_todo <= 1):
         if not chunk:   # time two cases (the second is warm), then chunks of ~0.1 s
@@ -268,8 +269,8 @@ def execute(order: Iterable[int], n_todo: int, task_of: Callable[[list[int]], Ta
                 return chunk
             on_result(run_task(task_of(cs)))
     if scheduler:
-        return _execute_dask(it, n_todo, task_of, scheduler, chunk, on_result, in_flight)
-    return _execute_pool(it, n_todo, task_of, jobs, chunk, on_result, in_flight)
+        return _execute_dask(it, n_todo, task_of, scheduler, chunk, on_result, in_flight, notify)
+    return _execute_pool(it, n_todo, task_of, jobs, chunk, on_result, in_flight, notify)
 
 
 class _Feed:
@@ -300,7 +301,8 @@ class _Feed:
             self.chunk = auto_chunk(min(self.times or [1.0]), max(self.n_todo - self.n_probes, 0), self.workers)
 
 
-def _execute_pool(it, n_todo: int, task_of, jobs: int, chunk: int, on_result, in_flight: int) -> int:
+def _execute_pool(it, n_todo: int, task_of, jobs: int, chunk: int, on_result, in_flight: int,
+                  notify: Callable[[str], None] | None = None) -> int:
     feed = _Feed(it, n_todo, jobs, chunk)
 
     def source() -> Task | None:
@@ -312,11 +314,12 @@ def _execute_pool(it, n_todo: int, task_of, jobs: int, chunk: int, on_result, in
         feed.returned(task, res, in_flight)
 
     run_pool(source, lambda pool, task: pool.submit(run_task, task), _alone, took, jobs,
-             in_flight or 2 * jobs, "cases", order=lambda t: t.indices[0])
+             in_flight or 2 * jobs, "cases", order=lambda t: t.indices[0], notify=notify)
     return feed.chunk or 1
 
 
-def _execute_dask(it, n_todo: int, task_of, scheduler: Any, chunk: int, on_result, in_flight: int) -> int:
+def _execute_dask(it, n_todo: int, task_of, scheduler: Any, chunk: int, on_result, in_flight: int,
+                  notify: Callable[[str], None] | None = None) -> int:
     from dask.distributed import Client, as_completed
     from distributed.scheduler import KilledWorker
     client = scheduler if not isinstance(scheduler, str) else Client(scheduler)
@@ -349,7 +352,8 @@ def _execute_dask(it, n_todo: int, task_of, scheduler: Any, chunk: int, on_resul
             feed.returned(task, res, len(pending))
             fill()
     except KeyboardInterrupt:
-        print("interrupt: cancelling queued cases, finishing the running ones", file=sys.stderr)
+        if notify is not None:
+            notify("interrupt: cancelling queued cases, finishing the running ones")
         client.cancel(list(pending))
         raise
     finally:

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import os
-import sys
 import threading
 import time
 from collections.abc import Callable
@@ -30,14 +29,16 @@ def worker_init() -> None:
 
 def run_pool(source: Callable[[], Any], submit: Callable[[cf.ProcessPoolExecutor, Any], cf.Future],
              alone: Callable[[Any], Any], on_result: Callable[[Any, Any, int], None], jobs: int, limit: int,
-             what: str, order: Callable[[Any], Any] = lambda t: t) -> None:
+             what: str, order: Callable[[Any], Any] = lambda t: t, notify: Callable[[str], None] | None = None) -> None:
     """The local worker pool of both sweep engines, with a bounded number of tasks in flight.
 
     ``source()`` gives the next task (None: none now; with nothing in flight, the end);
     ``submit(pool, task)`` sends it; ``on_result(task, result, n_in_flight)`` takes each result as it
     comes.  When a worker dies every task in flight is suspect: each is retried once, alone, by
     ``alone(task)`` (in ``order``), and a fresh pool takes over.  Workers exit with the driver
-    (:func:`worker_init`)."""
+    (:func:`worker_init`).  On Ctrl-C the queued tasks are cancelled and the running ones finish
+    before the interrupt goes on; ``notify(line)`` (the command line's: a line on stderr) is told
+    so at once, before that wait (default: nothing is said, the KeyboardInterrupt is the news)."""
     pool = cf.ProcessPoolExecutor(max_workers=jobs, initializer=worker_init)
     pending: dict[cf.Future, Any] = {}
     try:
@@ -71,7 +72,8 @@ def run_pool(source: Callable[[], Any], submit: Callable[[cf.ProcessPoolExecutor
                     on_result(task, alone(task), 0)
                 pool = cf.ProcessPoolExecutor(max_workers=jobs, initializer=worker_init)
     except KeyboardInterrupt:
-        print(f"interrupt: cancelling queued {what}, finishing the running ones", file=sys.stderr)
+        if notify is not None:
+            notify(f"interrupt: cancelling queued {what}, finishing the running ones")
         pool.shutdown(wait=True, cancel_futures=True)
         raise
     finally:
