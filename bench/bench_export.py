@@ -25,7 +25,7 @@ import pyarrow.csv as pacsv
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from driver.export import _write_csv_arrow  # noqa: E402
+from driver.export import write_csv_arrow  # noqa: E402
 
 
 def frame(rows: int) -> pd.DataFrame:
@@ -46,7 +46,7 @@ def main() -> None:
     table = pa.Table.from_pandas(df, preserve_index=False)
 
     def ours():
-        _write_csv_arrow(pa.Table.from_pandas(df, preserve_index=False), io.BytesIO())
+        write_csv_arrow(pa.Table.from_pandas(df, preserve_index=False), io.BytesIO())
 
     def arrow():
         pacsv.write_csv(table, io.BytesIO(), pacsv.WriteOptions(quoting_style="needed"))
@@ -65,7 +65,7 @@ def main() -> None:
             times[name].append(time.process_time() - t0)
     med = {k: statistics.median(v) for k, v in times.items()}
     buf = io.BytesIO()
-    _write_csv_arrow(table, buf)
+    write_csv_arrow(table, buf)
     back = pd.read_csv(io.BytesIO(buf.getvalue()))
     assert back["theta_deg"].dtype == np.float64 and np.array_equal(back["q3_rad_s"], df["q3_rad_s"])
     print(f"CSV of {args.rows} x {df.shape[1]} (median CPU time of {args.repeat}, interleaved)")

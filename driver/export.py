@@ -89,7 +89,7 @@ def _cells(col: pa.Array | pa.ChunkedArray) -> pa.Array | pa.ChunkedArray:
     raise TypeError(f"no CSV form for {t}")
 
 
-def _write_csv_arrow(table: pa.Table, fh: Any, batch_rows: int = 1 << 16, header: bool = True) -> None:
+def write_csv_arrow(table: pa.Table, fh: Any, batch_rows: int = 1 << 16, header: bool = True) -> None:
     """CSV rows built column-wise by Arrow compute and written from its buffers, a batch of
     rows at a time (no Python per row; memory bounded by the batch)."""
     import pyarrow.compute as pc
@@ -130,7 +130,7 @@ def write_tidy(frame: pd.DataFrame, path_stem: str | Path, fmt: str) -> Path:
                 table = None   # a column mixing types: let pandas stringify it
         if table is not None:
             with atomic_open(path, "wb") as fh:
-                _write_csv_arrow(table, fh)
+                write_csv_arrow(table, fh)
         else:
             with atomic_open(path, "w") as fh:
                 frame.to_csv(fh, index=False, lineterminator="\n")
@@ -146,7 +146,7 @@ def csv_bytes(table: pa.Table, header: bool = True) -> bytes:
     ``_cases`` table).  TypeError for a column type without a CSV form here."""
     import io
     buf = io.BytesIO()
-    _write_csv_arrow(table, buf, header=header)
+    write_csv_arrow(table, buf, header=header)
     return buf.getvalue()
 
 

@@ -28,7 +28,7 @@ except ImportError as _exc:
     raise ImportError(f"the Fortran kernels (driver._kernels) cannot be loaded: {_exc}; reinstall "
                       f"mechanism-driver (see docs/install.md)") from _exc
 
-__all__ = ["farray", "release_spares"]
+__all__ = ["farray", "release_spares", "spare_buffer"]
 
 
 def farray(x, ndim: int | None = None) -> np.ndarray:
@@ -62,7 +62,7 @@ def _refs(store: dict[str, np.ndarray], name: str) -> int:
 _FREE_REFS = _refs({"probe": np.empty(1)}, "probe")
 
 
-def _spare(name: str, shape: tuple[int, ...], dtype: type) -> np.ndarray:
+def spare_buffer(name: str, shape: tuple[int, ...], dtype: type) -> np.ndarray:
     """A fresh-to-the-caller output array of ``shape`` (Fortran order) for kernel output ``name``.
 
     A large output array (``SPARE_MIN_BYTES`` or more) is remembered; the next call of the

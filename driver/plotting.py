@@ -107,7 +107,7 @@ _METADATA = {"png": {"Software": None},
              "svg": {"Date": None, "Creator": None},
              "pdf": {"Creator": None, "Producer": None, "CreationDate": None}}
 #: fixed seed for the ids matplotlib writes into SVG files (otherwise random per run)
-_SVG_SALT = "driver-figures"
+SVG_SALT = "driver-figures"
 
 
 def save_figure(fig: Figure, path: str | Path, fmt: bool | str | None = None) -> Path:
@@ -123,7 +123,7 @@ def save_figure(fig: Figure, path: str | Path, fmt: bool | str | None = None) ->
         fmt = path.suffix.lstrip(".").lower() if path.suffix.lstrip(".").lower() in PLOT_FORMATS else "png"
     fmt = plot_format(fmt)
     path = path.with_suffix(f".{fmt}")
-    with style(**{"svg.hashsalt": _SVG_SALT}), atomic_open(path, "wb") as fh:
+    with style(**{"svg.hashsalt": SVG_SALT}), atomic_open(path, "wb") as fh:
         fig.savefig(fh, format=fmt, metadata=_METADATA[fmt])
     return path
 
@@ -262,7 +262,7 @@ def _edges(v: np.ndarray) -> np.ndarray:
     return np.concatenate([[2 * v[0] - mid[0]], mid, [2 * v[-1] - mid[-1]]])
 
 
-def _plain_numbers(ax) -> None:
+def plain_numbers(ax) -> None:
     """No offset or scientific notation on either axis (a reader sees the numbers themselves)."""
     for axis in (ax.xaxis, ax.yaxis):
         fmt = axis.get_major_formatter()
@@ -313,7 +313,7 @@ def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, 
             ax.plot([brow[x]], [brow[metric]], "*", ms=14, color="C3", mec="k", label=best_text or "best")
         ax.set_xlabel(lab(x))
         ax.set_ylabel(lab(metric))
-        _plain_numbers(ax)
+        plain_numbers(ax)
         ax.legend(loc="best")
         if title:
             ax.set_title(title)   # composed by the caller: deck parts through plain_text
@@ -364,7 +364,7 @@ def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, 
         a.set_ylim(_edges(ys_all)[[0, -1]])
         if zval is not None:
             a.set_title(f"{lab(kz).split(' [')[0]} = {zval:.4g}", fontsize=9)
-        _plain_numbers(a)
+        plain_numbers(a)
     for a in axes[:n]:
         if a.get_subplotspec() is None or a.get_subplotspec().is_last_row() or n == 1:
             a.set_xlabel(lab(kx))
@@ -374,7 +374,7 @@ def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, 
         fig.supxlabel("\u2605 " + wrap(best_text, 110), fontsize=8.5, color="0.15")
     cb = fig.colorbar(image, ax=list(axes[:n]), shrink=0.9, pad=0.02)
     cb.set_label(lab(metric))
-    _plain_numbers(cb.ax)
+    plain_numbers(cb.ax)
     note = ("kept designs outlined in black" if not kept.all() else
             "only kept designs tabulated (blank: not kept)" if only_kept else "every design kept")
     if title:
@@ -459,8 +459,8 @@ def convergence_plot(history, evals, objective: str, sense: str = "minimize", ti
     a3.set_title("constraint violation")
     for a in axes:
         a.set_xlabel("designs evaluated")
-    _plain_numbers(a1)
-    _plain_numbers(a3) if a3.get_yscale() == "linear" else None
+    plain_numbers(a1)
+    plain_numbers(a3) if a3.get_yscale() == "linear" else None
     if title:
         fig.suptitle(title)   # composed by the caller: deck parts through plain_text
     return fig

@@ -108,9 +108,9 @@ _SVG_HEAD = re.compile(r"^.*?(?=<svg\b)", re.S)
 def figure_svg(fig: Any, label: str = "") -> str:
     """A matplotlib figure as inline SVG markup: text kept as text (small, searchable, prints
     sharply), no XML prolog, scaled to the page width; ``label`` is its accessible name."""
-    from driver.plotting import _SVG_SALT, style
+    from driver.plotting import SVG_SALT, style
     buf = io.StringIO()
-    with style(**{"svg.hashsalt": _SVG_SALT, "svg.fonttype": "none"}):
+    with style(**{"svg.hashsalt": SVG_SALT, "svg.fonttype": "none"}):
         fig.savefig(buf, format="svg", metadata={"Date": None, "Creator": None})
     svg = _SVG_HEAD.sub("", buf.getvalue(), count=1)
     width_px = round(fig.get_figwidth() * 110)   # a figure's fonts read the same whatever its size
@@ -701,10 +701,10 @@ def _evaluated_map(frame: pd.DataFrame, design: Sequence[str], objective: str, o
         ax.plot([frame.loc[opt, x]], [frame.loc[opt, y]], "*", ms=16, color="C3", mec="k", label="optimum")
         cb = fig.colorbar(sc, ax=ax)
         cb.set_label(plotting.wrap(objective, 40))
-        plotting._plain_numbers(cb.ax)
+        plotting.plain_numbers(cb.ax)
         ax.set_xlabel(labels.get(x, x))
         ax.set_ylabel(labels.get(y, objective) if y != "objective" else objective)
-        plotting._plain_numbers(ax)
+        plotting.plain_numbers(ax)
         ax.legend(loc="best")
         ax.set_title(title)
     return fig

@@ -7,13 +7,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-from driver.manipulator import kernel as manipulator_kernel
-from driver.runner import study_of
 from driver.deck import read_deck
+from driver.manipulator import kernel as manipulator_kernel
 from driver.manipulator import table_frame, tolerance_box
-from driver.manipulator.analysis import _sensitivity_blocks
+from driver.manipulator.analysis import sensitivity_blocks
+from driver.runner import study_of
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -141,7 +142,7 @@ def test_design_indices_match_svd():
     ri, sumc2, reach = manipulator_kernel.manipulator_design_indices(x, y, l1, l2)
     for k in range(3):
         th1, th2, st_ = manipulator_kernel.manipulator_ik(l1[k], l2[k], x, y, 1)
-        Jx = _sensitivity_blocks(th1, th2).reshape(-1, 2)
+        Jx = sensitivity_blocks(th1, th2).reshape(-1, 2)
         s = np.linalg.svd(Jx, compute_uv=False)
         assert ri[k, 1] == pytest.approx(s[0], rel=1e-12)
         assert ri[k, 0] == pytest.approx(s[0] / s[1], rel=1e-10)
@@ -154,7 +155,7 @@ def test_tolerance_box_worst_corner_on_bound_and_monte_carlo(measure):
     x, y = np.array([1.0, 2, 3, 4]), np.array([5.0, 7, 7, 6])
     eps = 0.01
     th1, th2, _ = manipulator_kernel.manipulator_ik(5.61, 3.97, x, y, 1)
-    blocks = _sensitivity_blocks(th1, th2)
+    blocks = sensitivity_blocks(th1, th2)
     box = tolerance_box(blocks, eps, measure)
     dl = box["closed"]
     np.testing.assert_allclose(box["u"], dl, rtol=1e-6)          # SLSQP over all corners
@@ -199,7 +200,7 @@ def test_tolerance_box_property(points, l1, l2, measure):
         return
     th1, th2, status = manipulator_kernel.manipulator_ik(l1, l2, x, y, 1)
     assert (status == 0).all()
-    blocks = _sensitivity_blocks(th1, th2)
+    blocks = sensitivity_blocks(th1, th2)
     box = tolerance_box(blocks, 0.02, measure)
     assert box["converged"]
     np.testing.assert_allclose(box["u"], box["closed"], rtol=1e-5)

@@ -14,8 +14,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from driver.sweep import batch as sweep_batch
 from driver.cli import main
+from driver.sweep import batch as sweep_batch
 
 BASE = """&fourbar
   fixed_link = 12.0, crank = 3.0, coupler = 15.0, rocker = 9.0, omega = 5.0, step_deg = 10
@@ -93,7 +93,7 @@ def test_interior_bad_combination_of_a_large_grid_is_a_failed_case(tmp_path):
                            "       case_outputs = 'none' /\n")
     d = read_deck(path)
     sw = validate(d.groups["sweep"], sweep.SPEC, d.path)
-    axes = sweep._axes(sw, "fourbar", fourbar.SPEC)
+    axes = sweep.swept_axes(sw, "fourbar", fourbar.SPEC)
     grid = sweep_batch.Grid([a[0] for a in axes], [a[1] for a in axes], False)
     p = sweep_batch.plan(fourbar.STUDY, d.groups["fourbar"], str(path), grid, "", "all")
     res = sweep_batch.chunk_rows(p, 0, grid.n)
@@ -408,7 +408,7 @@ def test_plot_draws_the_summary_and_case_figures_only_when_asked(tmp_path):
 def test_dask_is_imported_only_when_configured(tmp_path):
     """Reading Dask's scheduler-address costs a 0.2 s import of Dask, serial before every sweep:
     it is done only when some Dask configuration exists (environment or configuration file)."""
-    code = ("import sys; from driver.sweep.spec import _configured_scheduler as c; "
+    code = ("import sys; from driver.sweep.spec import configured_scheduler as c; "
             "print(repr(c()), 'dask' in sys.modules)")
     env = {k: v for k, v in os.environ.items() if not k.startswith("DASK_")}
     env["HOME"] = str(tmp_path)

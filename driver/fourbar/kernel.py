@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from driver.kernels import _kernels, _spare, farray
+from driver.kernels import _kernels, farray, spare_buffer
 
 __all__ = ['FOURBAR_PASSES', 'fourbar_listing', 'fourbar_exact', 'fourbar_coupler_point', 'fourbar_summaries', 'fourbar_joint_forces', 'fourbar_berkof_lowen', 'fourbar_force_summaries', 'FOURBAR_FORCE_SUMMARY_COLUMNS', 'FOURBAR_SUMMARY_COLUMNS', 'FOURBAR_GRASHOF', 'FOURBAR_STATUS']
 
@@ -47,12 +47,12 @@ def fourbar_exact(theta: np.ndarray, p: float, q: float, r: float, s: float, ome
     theta = farray(np.atleast_1d(theta), 1)
     n = theta.shape[0]
     if out is None:
-        out = _spare("fourbar_exact.out", (n, 11), np.float64)
+        out = spare_buffer("fourbar_exact.out", (n, 11), np.float64)
     elif not (out.flags.f_contiguous and out.dtype == np.float64 and out.shape == (n, 11)):
         raise ValueError("out must be a Fortran-ordered float64 array of shape (n, 11); "
                          "f2py would otherwise work on a hidden copy")
     if status is None:
-        status = _spare("fourbar_exact.status", (n,), np.int32)
+        status = spare_buffer("fourbar_exact.status", (n,), np.int32)
     elif not (status.dtype == np.int32 and status.shape == (n,)):
         raise ValueError("status must be an int32 array of shape (n,)")
     return _kernels.fourbar.exact_states(theta, p, q, r, s, omega, alpha, int(branch), out, status)

@@ -88,7 +88,7 @@ class Conv:
         return round_half_up(self.radius ** 2, 2) if self.report else self.ws.mean_d2
 
 
-def _design_list(p: Params, conv: Conv) -> tuple[list[str], np.ndarray, np.ndarray]:
+def design_list(p: Params, conv: Conv) -> tuple[list[str], np.ndarray, np.ndarray]:
     """Names and lengths [m] of the designs: from the deck or the optima on C_rob."""
     if p.designs_l1 is not None:
         names = p.design_names or [f"Design {i + 1}" for i in range(len(p.designs_l1))]
@@ -174,21 +174,21 @@ def tolerance_box(blocks: np.ndarray, eps: float, measure: str = "global") -> di
             "message": str(res.message)}
 
 
-def _sensitivity_blocks(th1: np.ndarray, th2: np.ndarray) -> np.ndarray:
+def sensitivity_blocks(th1: np.ndarray, th2: np.ndarray) -> np.ndarray:
     """J_xi = [[c1, c12], [s1, s12]] per workspace point (eq. 2.23), shape (k, 2, 2)."""
     return np.stack([np.stack([np.cos(th1), np.cos(th1 + th2)], -1),
                      np.stack([np.sin(th1), np.sin(th1 + th2)], -1)], 1)
 
 
-def _target(p: Params, ws: Workspace) -> tuple[float, float]:
+def target_point(p: Params, ws: Workspace) -> tuple[float, float]:
     if p.target_x is not None:
         return float(p.target_x), float(p.target_y)
     return float(ws.x[0]), float(ws.y[0])
 
 
-def _design_angles(p: Params, conv: Conv, l1: np.ndarray, l2: np.ndarray) -> dict[str, np.ndarray]:
+def design_angles(p: Params, conv: Conv, l1: np.ndarray, l2: np.ndarray) -> dict[str, np.ndarray]:
     """Joint angles [deg] of the designs at the target: printed (Table 4.5) and used for torques."""
-    tx, ty = _target(p, conv.ws)
+    tx, ty = target_point(p, conv.ws)
     th1, th2, st = kernel.manipulator_ik(l1, l2, tx, ty, p.elbow)
     t1, t2 = np.degrees(th1), np.degrees(th2)
     if conv.report:
@@ -204,7 +204,7 @@ def _design_angles(p: Params, conv: Conv, l1: np.ndarray, l2: np.ndarray) -> dic
     return {"shown1": shown1, "shown2": shown2, "used1": used1, "used2": used2, "status": st}
 
 
-def _sweep_l1(p: Params, conv: Conv) -> np.ndarray:
+def sweep_l1_values(p: Params, conv: Conv) -> np.ndarray:
     if p.sweep_count > 0:
         return p.sweep_l1_start + p.sweep_l1_step * np.arange(p.sweep_count)
     top = math.sqrt(conv.c_sweep)

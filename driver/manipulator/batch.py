@@ -26,9 +26,9 @@ import pandas as pd
 
 from driver.deck import Params
 from driver.manipulator import kernel
-from driver.manipulator.analysis import STATUS, Conv, Workspace, _design_list, design_status, round_half_up
+from driver.manipulator.analysis import STATUS, Conv, Workspace, design_list, design_status, round_half_up
 from driver.manipulator.report import design_torque_columns, sweep_columns, workspace_columns
-from driver.manipulator.tables import _t48
+from driver.manipulator.tables import table_4_8
 
 __all__ = ["BATCH_KEYS", "BATCH_IGNORED", "BATCH_INDEPENDENT", "BATCH_PASSES", "BATCH_PASS_SUFFIXES", "summarise_batch",
            "summarise"]
@@ -113,7 +113,7 @@ def _lengths(base: Mapping[str, Any], columns: dict[str, Any], n: int, conv: Con
              ) -> tuple[list[str], np.ndarray, np.ndarray]:
     """Design names and lengths l1, l2 (n, k) [m]: swept, the base deck's, or the optima on C_rob."""
     if "designs_l1" not in columns and "designs_l2" not in columns:
-        names, l1, l2 = _design_list(_as_params(base), conv)
+        names, l1, l2 = design_list(_as_params(base), conv)
         return names, np.broadcast_to(l1, (n, l1.size)), np.broadcast_to(l2, (n, l2.size))
     out = []
     for key in ("designs_l1", "designs_l2"):
@@ -143,7 +143,7 @@ def _walk(p: Params, conv: Conv, tx: float, ty: float, mpl: float, g: float) -> 
     if key not in _WALKS:
         if len(_WALKS) > 4096:
             _WALKS.clear()
-        _, sweep = _t48(_with(p, target_x=tx, target_y=ty, mass_per_length=mpl, gravity=g), conv)
+        _, sweep = table_4_8(_with(p, target_x=tx, target_y=ty, mass_per_length=mpl, gravity=g), conv)
         _WALKS[key] = sweep_columns(sweep)
     return _WALKS[key]
 

@@ -14,9 +14,18 @@ from driver._signatures import keyword_signature
 from driver.deck import Params
 from driver.export import with_units
 from driver.manipulator import kernel
-from driver.manipulator.analysis import SIGNIFICANT, Conv, Workspace, _design_list, _target, design_status, optima, round_half_up
+from driver.manipulator.analysis import (
+    SIGNIFICANT,
+    Conv,
+    Workspace,
+    design_list,
+    design_status,
+    optima,
+    round_half_up,
+    target_point,
+)
 from driver.manipulator.spec import SPEC
-from driver.manipulator.tables import TIDY_NAMES, Table, _differences, _tables, _tolerance
+from driver.manipulator.tables import TIDY_NAMES, Table, mode_differences, report_tables, tolerance_table
 from driver.runner import keyword_run
 from driver.study import Figure, Result
 from driver.table import fortran_f
@@ -25,7 +34,7 @@ __all__ = ["run", "TIDY_UNITS", "table_frame"]
 
 
 def _header(p: Params, ws: Workspace, conv: Conv) -> list[str]:
-    tx, ty = _target(p, ws)
+    tx, ty = target_point(p, ws)
     pts = ", ".join(f"({x:g}, {y:g})" for x, y in zip(ws.x, ws.y))
     lines = ["2R manipulator robust design ([Ma'arif 2006], chapter 4)", "=" * 50]
     if p.title:
@@ -176,8 +185,8 @@ def run(params: Params, progress: bool = False) -> Result:
     ws = Workspace(np.array(p.points_x, float), np.array(p.points_y, float))
     conv = Conv(p.mode == "report", ws)
     _check_designs(p, ws, conv)
-    tables, used, sweep = _tables(p, conv)
-    tol_table, tol = _tolerance(p, ws, used["names"], used["l1"], used["l2"])
+    tables, used, sweep = report_tables(p, conv)
+    tol_table, tol = tolerance_table(p, ws, used["names"], used["l1"], used["l2"])
     if not conv.report:
         for t in tables + [tol_table]:
             t.significant(SIGNIFICANT)
@@ -195,8 +204,8 @@ def run(params: Params, progress: bool = False) -> Result:
     lines += tol_table.lines()
     lines += _claims(used, sweep)
     if conv.report:
-        exact_tables, _, _ = _tables(p, Conv(False, ws))
-        diff = _differences(tables, exact_tables)
+        exact_tables, _, _ = report_tables(p, Conv(False, ws))
+        diff = mode_differences(tables, exact_tables)
         lines += ["Cells where mode = 'report' and mode = 'exact' differ", "-" * 52]
         lines += diff or ["  none"]
         lines += [""]
@@ -214,7 +223,7 @@ def _check_designs(p: Params, ws: Workspace, conv: Conv) -> None:
     """Deck designs must satisfy the reach conditions (4.4): DeckError otherwise."""
     if p.designs_l1 is None:
         return
-    _, l1, l2 = _design_list(p, conv)
+    _, l1, l2 = design_list(p, conv)
     ri = kernel.manipulator_design_indices(ws.x, ws.y, l1, l2)
     for i in np.flatnonzero(ri[2] == 0):
         raise p.error("designs_l1", f"design {i + 1} (l1 = {l1[i]:g}, l2 = {l2[i]:g}) violates the reach "

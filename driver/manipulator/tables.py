@@ -14,13 +14,13 @@ from driver.manipulator.analysis import (
     STATUS,
     Conv,
     Workspace,
-    _design_angles,
-    _design_list,
-    _sensitivity_blocks,
-    _sweep_l1,
-    _target,
+    design_angles,
+    design_list,
     optima,
     round_half_up,
+    sensitivity_blocks,
+    sweep_l1_values,
+    target_point,
     tolerance_box,
 )
 from driver.table import Column, fortran_f, render_table
@@ -126,9 +126,9 @@ def _t44(p: Params, conv: Conv) -> Table:
 
 
 def _torque_tables(p: Params, conv: Conv) -> tuple[Table, Table, Table, dict[str, Any]]:
-    names, l1, l2 = _design_list(p, conv)
-    ang = _design_angles(p, conv, l1, l2)
-    tx, ty = _target(p, conv.ws)
+    names, l1, l2 = design_list(p, conv)
+    ang = design_angles(p, conv, l1, l2)
+    tx, ty = target_point(p, conv.ws)
     ok = ang["status"] == STATUS["ok"]
     if not ok.any():
         raise p.error("target_x", f"target point ({tx:g}, {ty:g}) is out of reach of every design "
@@ -180,9 +180,9 @@ def _torque_tables(p: Params, conv: Conv) -> tuple[Table, Table, Table, dict[str
 
 def _designs_table(p: Params, conv: Conv) -> Table:
     """Robustness indices of the designs and their manipulability/condition number at the target."""
-    names, l1, l2 = _design_list(p, conv)
+    names, l1, l2 = design_list(p, conv)
     ri, sumc2, reach = kernel.manipulator_design_indices(conv.ws.x, conv.ws.y, l1, l2)
-    tx, ty = _target(p, conv.ws)
+    tx, ty = target_point(p, conv.ws)
     th1, th2, st = kernel.manipulator_ik(l1, l2, tx, ty, p.elbow)
     _, w, kappa, _ = kernel.manipulator_arm_states(l1, l2, th1, th2)
     rows, trailers = [], []
@@ -204,11 +204,11 @@ def _designs_table(p: Params, conv: Conv) -> Table:
     return Table("designs", "Designs: robustness indices and dexterity measures", cols, rows, trailers, notes)
 
 
-def _t48(p: Params, conv: Conv) -> tuple[Table, dict[str, Any]]:
+def table_4_8(p: Params, conv: Conv) -> tuple[Table, dict[str, Any]]:
     c = conv.c_sweep
-    tx, ty = _target(p, conv.ws)
+    tx, ty = target_point(p, conv.ws)
     dt = math.hypot(tx, ty)
-    l1 = _sweep_l1(p, conv)
+    l1 = sweep_l1_values(p, conv)
     inside = l1 <= math.sqrt(c) + 1e-12
     l2 = np.sqrt(np.where(inside, c - np.minimum(l1, math.sqrt(c)) ** 2, 0.0))
     safe1, safe2 = np.where(l1 > 0, l1, 1.0), np.where(l2 > 0, l2, 1.0)
@@ -257,7 +257,7 @@ def _t48(p: Params, conv: Conv) -> tuple[Table, dict[str, Any]]:
     return Table("4.8", "Table 4.8  Torques for other arm lengths along C_rob", cols, rows, trailers, notes), data
 
 
-def _tolerance(p: Params, ws: Workspace, names: list[str], l1: np.ndarray, l2: np.ndarray) -> tuple[Table, list[dict]]:
+def tolerance_table(p: Params, ws: Workspace, names: list[str], l1: np.ndarray, l2: np.ndarray) -> tuple[Table, list[dict]]:
     eps = p.tolerance_bound
     rng = np.random.default_rng(p.mc_seed)
     unit = rng.uniform(-1.0, 1.0, size=(p.mc_samples, 2))
@@ -278,7 +278,7 @@ def _tolerance(p: Params, ws: Workspace, names: list[str], l1: np.ndarray, l2: n
             rows.append([name, float(l1[i]), float(l2[i])] + [None] * 8 + ["-"])
             trailers.append(why)
             continue
-        blocks = _sensitivity_blocks(th1, th2)
+        blocks = sensitivity_blocks(th1, th2)
         box = tolerance_box(blocks, eps, p.error_measure)
         dl = box["closed"] if box["closed"] is not None else box["u"]
         corners = np.array([[1, 1], [1, -1], [-1, 1], [-1, -1]], float) * dl
@@ -358,7 +358,7 @@ TIDY_NAMES = {"l1": "l1_m", "l2": "l2_m", "m1": "m1_kg", "m2": "m2_kg", "g": "g_
               "w": "manipulability_m2", "kappa": "condition_number"}
 
 
-def _differences(report: list[Table], exact: list[Table]) -> list[str]:
+def mode_differences(report: list[Table], exact: list[Table]) -> list[str]:
     """Every cell whose printed text differs between the two modes, with the reason."""
     lines = []
     for a, b in zip(report, exact):
@@ -376,8 +376,8 @@ def _differences(report: list[Table], exact: list[Table]) -> list[str]:
 
 # ----------------------------------------------------------------------------- run
 
-def _tables(p: Params, conv: Conv) -> tuple[list[Table], dict[str, Any], dict[str, Any]]:
+def report_tables(p: Params, conv: Conv) -> tuple[list[Table], dict[str, Any], dict[str, Any]]:
     t45, t46, t47, used = _torque_tables(p, conv)
-    t48, sweep = _t48(p, conv)
+    t48, sweep = table_4_8(p, conv)
     tables = [_t41(p, conv), _t42(p, conv), _t44(p, conv), _designs_table(p, conv), t45, t46, t47, t48]
     return tables, used, sweep

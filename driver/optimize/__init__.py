@@ -238,8 +238,8 @@ def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[
     njobs = jobs if jobs is not None else problem.opts.jobs
     history: list[HistoryRow] = []
     if scheduler is None:
-        from driver.sweep import _configured_scheduler
-        scheduler = _configured_scheduler() or None
+        from driver.sweep import configured_scheduler
+        scheduler = configured_scheduler() or None
     with Evaluator(problem, njobs, journal, found.rows, scheduler) as ev:
         ev.resume_note = found.note()
         mres = run_method(ev, history)

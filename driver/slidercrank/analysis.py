@@ -146,7 +146,7 @@ class Case:
         return float(self.outer_max.max())
 
 
-def _run_case(model: Model, params: Params, omega: float, n_el: int, alpha: float, beta: float,
+def run_case(model: Model, params: Params, omega: float, n_el: int, alpha: float, beta: float,
               p_euler: float) -> Case:
     spr = params.steps_per_rev
     dt = 2 * math.pi / (omega * spr)
@@ -216,7 +216,7 @@ def _settle(res: dict, spr: int) -> dict:
 def history(model: Model, params: Params, omega: float, n_el: int, alpha: float,
             beta: float) -> dict[str, np.ndarray]:
     """The whole time history of a benchmark run (``end_time`` > 0), for its figure: the same
-    kernel call as :func:`_run_case` recording every step instead of the end state only.
+    kernel call as :func:`run_case` recording every step instead of the end state only.
     Returns time [s], midpoint deflection from the chord [m], rod elongation [m], slider
     position [m]; empty arrays when the run stops early."""
     dt = 2 * math.pi / (omega * params.steps_per_rev)

@@ -14,7 +14,7 @@ from tqdm import tqdm
 from driver.deck import Params
 from driver.export import with_units
 from driver.slidercrank import kernel
-from driver.slidercrank.analysis import Case, _run_case, static_onset
+from driver.slidercrank.analysis import Case, run_case, static_onset
 from driver.slidercrank.spec import (
     EULER_WARN,
     MIN_STEPS_PER_BENDING_PERIOD,
@@ -22,9 +22,9 @@ from driver.slidercrank.spec import (
     SIMEON1996,
     STATUS_TEXT,
     Model,
-    _model,
-    _shape,
+    model_of,
     rayleigh,
+    section_shape,
 )
 from driver.study import Figure, Result
 from driver.table import Cell, Column, render_table
@@ -47,7 +47,7 @@ class Derived(TypedDict):
     onset: tuple[float, float] | None
 
 
-def _header(params: Params, model: Model, derived: Derived) -> list[str]:
+def header_lines(params: Params, model: Model, derived: Derived) -> list[str]:
     mat = params.material if params.material != "custom" else "custom (section from the deck)"
     src = model.sources
     rows = [
@@ -97,7 +97,7 @@ def _onset_line(onset: tuple[float, float] | None) -> str:
     return head + f"{onset[0]:10.2f} rad/s near theta2 = {onset[1]:.0f} deg"
 
 
-def _status_text(c: Case, why: bool = True) -> str:
+def status_text(c: Case, why: bool = True) -> str:
     if c.ok:
         return "ok"
     what, reason = STATUS_TEXT[c.status]
@@ -133,7 +133,7 @@ def _peak_table(cases: list[Case], tol: float) -> list[str]:
             trailers.append("; ".join(notes))
         else:
             rows.append([c.omega, "-", "-", "-", "-", "-", "-", "-", "-", c.euler_ratio, "-"])
-            trailers.append(_status_text(c, why=False))
+            trailers.append(status_text(c, why=False))
     return ["Table 1  Peak axial strain of the rod over the last revolution",
             "         omega [rad/s]; strains in microstrain; theta2 [deg] where the peak occurs; el = element",
             "         (1 = crank end); outer = peak outer-fibre strain |eps| + c|kappa|; middefl = peak |midpoint",
@@ -158,7 +158,7 @@ def _crank_end_table(cases: list[Case], every_deg: float = 10.0) -> list[str]:
     lines += render_table(cols, rows)
     bad = [c for c in cases if not c.ok]
     for c in bad:
-        lines.append(f"  w={c.omega:g}: {_status_text(c, why=False)}; no strains reported")
+        lines.append(f"  w={c.omega:g}: {status_text(c, why=False)}; no strains reported")
     return lines
 
 
@@ -183,7 +183,7 @@ def _convergence_table(conv: dict[float, list[Case]], length: float) -> list[str
             le = 1e3 * length / c.n_elements
             if not c.ok:
                 rows.append([c.n_elements, le] + ["-"] * 8)
-                trailers.append(_status_text(c, why=False))
+                trailers.append(status_text(c, why=False))
                 prev = None
                 continue
             vals = (c.peak(+1)[0] * 1e6, c.peak(-1)[0] * 1e6, c.crank_end_peak(+1) * 1e6, c.crank_end_peak(-1) * 1e6)
@@ -269,7 +269,7 @@ def _peak_notes(cases: list[Case]) -> list[str]:
 def _benchmark_lines(params: Params, case: Case) -> list[str]:
     lines = ["Table 4  End state at t = " + f"{params.end_time:g} s", ""]
     if not case.ok:
-        return lines + [f"  {_status_text(case)}"]
+        return lines + [f"  {status_text(case)}"]
     kin = kernel.slidercrank_rigid(np.array([case.omega * case.time[-1]]), case.omega,
                                     params.crank_radius, params.rod_length)[0]
     vals: list[tuple[str, str, float, Literal["q1", "q4", "x3", "phi2"]]] = [
@@ -294,7 +294,7 @@ def _benchmark_lines(params: Params, case: Case) -> list[str]:
     return lines
 
 
-def _figures():
+def figures_module():
     """The study's figure module, imported when a figure is drawn (matplotlib is the optional [plot] extra)."""
     from driver.slidercrank import figures
     return figures
@@ -303,7 +303,7 @@ def _figures():
 def run_linear(params: Params, progress: bool = False) -> Result:
     """Run every crank speed (and element count) of a linear-model deck (``model = 'linear'``):
     the paper's KED model; see the package docstring."""
-    model = _model(params)
+    model = model_of(params)
     w_bend, w_axial, p_euler = model.frequencies()
     alpha, beta = rayleigh(params.damping_ratio, w_bend, w_axial)
     counts = list(params.element_counts) if params.element_counts else [params.n_elements]
@@ -312,11 +312,11 @@ def run_linear(params: Params, progress: bool = False) -> Result:
     jobs = [(w, n) for w in params.speeds for n in counts]
     done: dict[tuple[float, int], Case] = {}
     for w, n in tqdm(jobs, desc="slidercrank", unit="case", disable=not progress):
-        done[(w, n)] = _run_case(model, params, w, n, alpha, beta, p_euler)
+        done[(w, n)] = run_case(model, params, w, n, alpha, beta, p_euler)
     main_n = counts[-1] if params.element_counts else params.n_elements
     cases = [done[(w, main_n)] for w in params.speeds]
 
-    text = _header(params, model, derived) + [""]
+    text = header_lines(params, model, derived) + [""]
     warnings: list[str] = []
     failure = None
     if params.end_time > 0:
@@ -344,9 +344,9 @@ def run_linear(params: Params, progress: bool = False) -> Result:
         if not c.ok:
             if params.geometric_stiffness and c.status in ("buckled", "diverged"):
                 warnings.append(f"crank speed {c.omega:g} rad/s, {c.n_elements} elements: "
-                                f"{_status_text(c)}")
+                                f"{status_text(c)}")
             else:
-                failure = f"crank speed {c.omega:g} rad/s, {c.n_elements} elements: {_status_text(c)}"
+                failure = f"crank speed {c.omega:g} rad/s, {c.n_elements} elements: {status_text(c)}"
                 warnings.append(failure)
     le = model.length / max(counts)
     notes = ["Notes"]
@@ -386,35 +386,36 @@ def run_linear(params: Params, progress: bool = False) -> Result:
     good = [c for c in cases if c.ok]
     if good and params.end_time <= 0:
         above = {f"{c.omega:g} rad/s": c.euler_ratio for c in good if c.euler_ratio > 1.0}
-        missing = [f"{c.omega:g} rad/s: {_status_text(c).split(' (')[0].lower()}, not drawn" for c in cases if not c.ok]
+        missing = [f"{c.omega:g} rad/s: {status_text(c).split(' (')[0].lower()}, not drawn" for c in cases if not c.ok]
         stiffness = "K + K_G" if params.geometric_stiffness else "linear model"
-        figures.append(Figure("strain", lambda: _figures().slidercrank_strain_figure(
+        figures.append(Figure("strain", lambda: figures_module().slidercrank_strain_figure(
             [(f"{c.omega:g} rad/s", c.angle_deg, c.eps_1 * 1e6) for c in good],
             f"{params.material}: crank-end element axial strain ({stiffness})", above=above, missing=missing)))
-        figures.append(Figure("deflection", lambda: _figures().slidercrank_strain_figure(
+        figures.append(Figure("deflection", lambda: figures_module().slidercrank_strain_figure(
             [(f"{c.omega:g} rad/s", c.angle_deg, c.mid * 1e3) for c in good],
             f"{params.material}: midpoint deflection ({stiffness})", ylabel="midpoint deflection [mm]",
             above=above, missing=missing)))
     if params.end_time > 0 and cases[0].ok:   # a benchmark run: its time history against the reference
         c0 = cases[0]
         ref = SIMEON1996 if params.benchmark == "simeon1996" else None
-        figures.append(Figure("history", lambda: _figures().history_figure(model, params, c0, alpha, beta, ref)))
+        figures.append(Figure("history", lambda: figures_module().history_figure(model, params, c0, alpha, beta, ref)))
     if conv:
         series = {f"{w:g} rad/s": ([c.n_elements for c in cs if c.ok], [c.peak(+1)[0] * 1e6 for c in cs if c.ok],
                                    [c.crank_end_peak(+1) * 1e6 for c in cs if c.ok])
                   for w, cs in conv.items()}
         speeds = ", ".join(series)
-        figures.append(Figure("convergence", lambda: _figures().slidercrank_convergence_figure(
+        figures.append(Figure("convergence", lambda: figures_module().slidercrank_convergence_figure(
             series, f"{params.material} rod at {speeds}: convergence of the peak tensile strain with the mesh")))
     return Result(text="\n".join(text) + "\n", tidy=_tidy(params.material, list(done.values())),
-                  summary=_summary(cases, model if _shape(params)[1] else None), warnings=warnings, failure=failure, figures=figures)
+                  summary=_summary(cases, model if section_shape(params)[1] else None), warnings=warnings, failure=failure,
+                  figures=figures)
 
 
 def animation_frames(params: Params, result: Result | None = None, n: int = 180) -> dict[str, Any] | None:
     """The mechanism's positions at ``n`` crank angles over one turn, for the report page's animation
     (:func:`driver.report_page.mechanism_animation`): crank pin A, slider B, and with ``result`` the
     elastic rod's midpoint deflection, magnified."""
-    model = _model(params)
+    model = model_of(params)
     r, length = float(model.r2), float(model.length)
     theta = np.linspace(0.0, 360.0, n, endpoint=False)
     states = kernel.slidercrank_rigid(np.radians(theta), 1.0, r, length)

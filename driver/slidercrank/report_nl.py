@@ -18,10 +18,10 @@ from driver._signatures import keyword_signature
 from driver.deck import Params
 from driver.export import with_units
 from driver.runner import keyword_run
-from driver.slidercrank.analysis import Case, _run_case, static_onset
+from driver.slidercrank.analysis import Case, run_case, static_onset
 from driver.slidercrank.nonlinear import IRREGULAR, NLCase, onset_search, run_nl_case
-from driver.slidercrank.report import Derived, _figures, _header, _status_text, run_linear
-from driver.slidercrank.spec import SPEC, _model, rayleigh
+from driver.slidercrank.report import Derived, figures_module, header_lines, run_linear, status_text
+from driver.slidercrank.spec import SPEC, model_of, rayleigh
 from driver.study import Figure, Result
 from driver.table import Cell, Column, render_table
 
@@ -195,7 +195,7 @@ def _summary(pairs: list[tuple[Case, NLCase]], tol: float, limit: float,
 def run_nonlinear(params: Params, progress: bool = False) -> Result:
     """Every crank speed of the deck in the linear and the nonlinear model; the onset search when
     the deck gives onset_speeds."""
-    model = _model(params)
+    model = model_of(params)
     w_bend, w_axial, p_euler = model.frequencies()
     alpha, beta = rayleigh(params.damping_ratio, w_bend, w_axial)
     n = params.n_elements
@@ -204,12 +204,12 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
     tol, limit = params.growth_tolerance, params.large_deflection * model.length
     pairs: list[tuple[Case, NLCase]] = []
     for w in tqdm(params.speeds, desc="slidercrank nonlinear", unit="speed", disable=not progress):
-        pairs.append((_run_case(model, params, w, n, alpha, beta, p_euler),
+        pairs.append((run_case(model, params, w, n, alpha, beta, p_euler),
                       run_nl_case(model, params, w, n, alpha, beta)))
     onset = onset_search(model, params, alpha, beta) if params.onset_speeds else None
     nls = [nl for _, nl in pairs]
 
-    text = _header(params, model, derived)
+    text = header_lines(params, model, derived)
     text += ["  nonlinear rod: co-rotational Euler-Bernoulli frame elements (same mesh, masses, damping and",
              "  inertia loading); Newmark average acceleration with Newton iterations on the consistent",
              "  tangent (the damping's included), a step halved when Newton fails; banded LU solves",
@@ -232,7 +232,7 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
         elif nl.collapsed:
             warnings.append(f"crank speed {nl.omega:g} rad/s: {nl_status_text(nl)}")
         if not lin.ok:
-            warnings.append(f"crank speed {lin.omega:g} rad/s, linear model: {_status_text(lin)}")
+            warnings.append(f"crank speed {lin.omega:g} rad/s, linear model: {status_text(lin)}")
         if nl.cuts:
             warnings.append(f"crank speed {nl.omega:g} rad/s: {nl.cuts} time step(s) halved for Newton convergence "
                             f"(deepest {nl.deepest_cut} halvings)")
@@ -254,15 +254,15 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
     figures = []
     good = [(lin, nl) for lin, nl in pairs if nl.ok and lin.ok]
     if good:
-        figures.append(Figure("strain_linear_nonlinear", lambda: _figures().slidercrank_nl_strain_figure(
+        figures.append(Figure("strain_linear_nonlinear", lambda: figures_module().slidercrank_nl_strain_figure(
             [(f"{nl.omega:g} rad/s", lin.angle_deg, lin.eps_1 * 1e6, nl.eps_ax[0] * 1e6) for lin, nl in good],
             f"{params.material}: crank-end axial strain, linear (dashed) and nonlinear (solid)")))
     okn = [nl for nl in nls if nl.ok]
     if okn:
-        figures.append(Figure("shapes", lambda: _figures().slidercrank_nl_shapes_figure(
+        figures.append(Figure("shapes", lambda: figures_module().slidercrank_nl_shapes_figure(
             [(f"{c.omega:g} rad/s", c.shape_deg, c.shapes) for c in okn], model.length,
             f"{params.material}: lateral deflection at the worst crank angles")))
-    figures.append(Figure("lateral_per_revolution", lambda: _figures().slidercrank_nl_revolutions_figure(
+    figures.append(Figure("lateral_per_revolution", lambda: figures_module().slidercrank_nl_revolutions_figure(
         [(f"{c.omega:g} rad/s", c.rev_lat[:max(c.steps_done - 1, 0) // c.steps_per_rev + 1] * 1e3)
          for c in nls if c.steps_done], f"{params.material}: peak lateral deflection per revolution")))
     return Result(text="\n".join(text) + "\n", tidy=_tidy(params.material, pairs),

@@ -220,7 +220,7 @@ class Model:
         return kernel.slidercrank_frequencies(self.rho_a, self.ea, self.ei, self.length, self.m_s)
 
 
-def _shape(params: Params) -> tuple[dict[str, float], str]:
+def section_shape(params: Params) -> tuple[dict[str, float], str]:
     """Section values from section_width (rectangle) or section_diameter (round bar), if given."""
     given = lambda k: k in params.given and params[k] is not None
     if given("section_diameter"):
@@ -241,10 +241,10 @@ def _shape(params: Params) -> tuple[dict[str, float], str]:
     return {}, ""
 
 
-def _model(params: Params) -> Model:
+def model_of(params: Params) -> Model:
     values, sources = {}, {}
     table = MATERIALS.get(params.material, {})
-    shape, shape_name = _shape(params)
+    shape, shape_name = section_shape(params)
     for key in SECTION_KEYS:
         if key in shape:
             values[key], sources[key] = shape[key], shape_name
@@ -276,7 +276,7 @@ def min_steps_per_rev(omega: float, w_bend: float) -> int:
 
 
 def _cross_check(params: Params) -> None:
-    model = _model(params)
+    model = model_of(params)
     if model.r2 >= model.length:
         raise params.error("crank_radius", f"crank radius {model.r2:g} m is not shorter than the rod "
                                            f"({model.length:g} m): the slider-crank cannot turn; "

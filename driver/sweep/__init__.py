@@ -68,11 +68,11 @@ from driver.sweep.spec import (
     SPEC,
     Case,
     CaseResult,
-    _axes,
-    _configured_scheduler,
     build_cases,
     case_count,
+    configured_scheduler,
     grid_of,
+    swept_axes,
     validate_sweep,
 )
 
@@ -158,7 +158,7 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
     # every name the sweep gives its files and folders, known before it runs (the longest counts)
     stem_path = output_stem(outdir, deck.path, (".out", ".sweep", "_summary.csv", "_summary.parquet", "_cases.csv",
                                                 "_cases.parquet", *(("_summary.png",) if plot else ())))
-    scheduler = scheduler or _configured_scheduler()
+    scheduler = scheduler or configured_scheduler()
     jobs = jobs or os.cpu_count() or 1
     layout = store.layout_for(stem_path, grid.n)
     case_plot = plot if sw.case_plots else False

@@ -42,7 +42,7 @@ from driver.outcome import ExitCode
 from driver.runner import compute, write_outputs
 from driver.sweep.keep import keep_mask
 from driver.sweep.pool import run_pool, worker_init
-from driver.sweep.spec import Case, CaseResult, Grid, _case_deck_text, _case_raw, iter_cases
+from driver.sweep.spec import Case, CaseResult, Grid, case_deck_text, case_raw, iter_cases
 from driver.sweep.store import Layout, json_default
 
 __all__ = ["Task", "run_task", "auto_chunk", "execute", "cluster_workers", "check_shared_folder", "DIED"]
@@ -87,7 +87,7 @@ def _compute(task: Task, case: Case, module) -> tuple[CaseResult, Any, Params | 
     res = CaseResult(case.index, case.values)
     result, params = None, None
     try:
-        params = validate(_case_raw(task.raw, case), module.spec, task.deck_path)
+        params = validate(case_raw(task.raw, case), module.spec, task.deck_path)
         full = task.case_outputs == "all" or (task.case_outputs == "kept" and not task.keep)
         if full or module.summarise is None:
             result = compute(module, params)
@@ -127,7 +127,7 @@ def _write_case(task: Task, case: Case, res: CaseResult, result, params: Params,
         own_folder(stem.parent, Path(task.layout.root).parent)   # the case folders: made here, never links
         with output_set(stem.parent):   # the case's files together, or none
             written = [write_text(stem.with_suffix(".dat"),
-                                  _case_deck_text(task.raw.name, params, case, Path(task.deck_path)))]
+                                  case_deck_text(task.raw.name, params, case, Path(task.deck_path)))]
             written += write_outputs(result, stem, [f for f in task.formats if f != "parquet"], task.plot, clean=False)
             written.append(write_tidy(tidy, stem, "parquet"))
             written.append(write_text(stem.with_suffix(".json"), json.dumps(record, default=json_default, indent=1)))

@@ -53,7 +53,7 @@ def _dask_configured() -> bool:
     return False
 
 
-def _configured_scheduler() -> str:
+def configured_scheduler() -> str:
     """The scheduler address from Dask's own configuration/environment, or ''.  Dask is imported
     (0.2 s) only when some Dask configuration exists."""
     if not _dask_configured():
@@ -159,7 +159,7 @@ class Case:
 
 
 
-def _axes(sw: Params, study_group: str, study_spec: GroupSpec) -> list[tuple[str, list]]:
+def swept_axes(sw: Params, study_group: str, study_spec: GroupSpec) -> list[tuple[str, list]]:
     """The swept axes [(‘group.key’, values)], checked against the study's keys."""
     axes = []
     for k in range(1, MAX_KEYS + 1):
@@ -245,7 +245,7 @@ def iter_cases(grid: Grid, indices: Iterable[int] | None = None) -> Iterator[Cas
 
 def grid_of(sw: Params, study_group: str, study_spec: GroupSpec) -> Grid:
     """The swept axes of the &sweep group as a :class:`Grid` (no case is built)."""
-    axes = _axes(sw, study_group, study_spec)
+    axes = swept_axes(sw, study_group, study_spec)
     _check_zip(sw, axes)
     return Grid([a[0] for a in axes], [a[1] for a in axes], bool(sw.zip))
 
@@ -255,7 +255,7 @@ def build_cases(sw: Params, study_group: str, study_spec: GroupSpec) -> list[Cas
 
     A sweep of more than :data:`MAX_CASES` cases is refused before a case is built.
     """
-    axes = _axes(sw, study_group, study_spec)
+    axes = swept_axes(sw, study_group, study_spec)
     names = [a[0] for a in axes]
     n_cases = case_count(sw, axes)
     if n_cases > MAX_CASES:
@@ -288,7 +288,7 @@ def validate_sweep(sw: Params, raw: RawGroup, module: Any, grid: Grid) -> dict[i
     and the study estimates its work (the engine runs the longest cases first), else {}."""
     def check(values: dict[str, Any], case_no: int | None) -> limits.Estimate | None:
         try:
-            return limits.check(module, validate(_case_raw(raw, Case(0, values)), module.spec, sw.path), "each case ")
+            return limits.check(module, validate(case_raw(raw, Case(0, values)), module.spec, sw.path), "each case ")
         except DeckError as exc:
             name = next((n for n in values if n.partition(".")[2] == exc.key), next(iter(values)))
             key, line = _axis_line(sw, name)
@@ -317,14 +317,14 @@ def validate_sweep(sw: Params, raw: RawGroup, module: Any, grid: Grid) -> dict[i
     return {}
 
 
-def _case_raw(raw: RawGroup, case: Case) -> RawGroup:
+def case_raw(raw: RawGroup, case: Case) -> RawGroup:
     values = dict(raw.values)
     for name, v in case.values.items():
         values[name.partition(".")[2]] = v
     return RawGroup(raw.name, values, raw.lines, raw.line)
 
 
-def _case_deck_text(study_group: str, params: Params, case: Case, deck_path: Path) -> str:
+def case_deck_text(study_group: str, params: Params, case: Case, deck_path: Path) -> str:
     """A complete deck for the case (the validated study group, swept values included)."""
     nml = f90nml.Namelist({study_group: {k: v for k, v in params.items() if v is not None and v != [] and v != ""}})
     head = (f"! case {case.index} of sweep deck {deck_path}: "

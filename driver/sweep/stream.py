@@ -91,7 +91,7 @@ def write_streamed(outdir: Path, stem: str, paths: list[Path], deck: Deck, sw: P
     (:func:`driver.sweep.report.summary_settings`) go into the Parquet metadata as pandas
     writes a frame's attrs.  Returns None, writing nothing, when the parts' columns differ in
     type (see the module)."""
-    from driver.export import _write_csv_arrow
+    from driver.export import write_csv_arrow
     schema = _uniform(paths)
     if schema is None:
         return None
@@ -115,7 +115,7 @@ def write_streamed(outdir: Path, stem: str, paths: list[Path], deck: Deck, sw: P
                     table = pq.read_table(path)
                     table = table.replace_schema_metadata(schema.metadata)
                     writer.write_table(table)
-                    _write_csv_arrow(table, csv, header=k == 0)
+                    write_csv_arrow(table, csv, header=k == 0)
                     frame = _frame(table, origins)
                     if k == 0:
                         cols, keys = table_columns(frame)

@@ -524,7 +524,7 @@ def _path_figure(syn: Synthesis, path: Path, title: str, fmt: bool | str = True)
     fig = fourbar_figures.fourbar_linkage(q["ground"], theta, out, st == ST["ok"], None, title, point=cp[:, :2])
     targets = np.column_stack([syn.params.target_x, syn.params.target_y]).astype(float)
     pp = pg.PathProblem(targets, None, 1, False, (0.0, 180.0), 1.0, 1.0)
-    tk = pg._to_kernel(pp, syn.design.x)
+    tk = pg.to_kernel_frame(pp, syn.design.x)
     ax = fig.axes[0]
     ax.plot(tk[:, 0], tk[:, 1], "s", mfc="none", mec="k", ms=7, label="target points")
     ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)   # beside the drawing

@@ -70,7 +70,7 @@ def bounds(pp: PathProblem) -> list[tuple[float, float]]:
     return b
 
 
-def _to_kernel(pp: PathProblem, x: np.ndarray) -> np.ndarray:
+def to_kernel_frame(pp: PathProblem, x: np.ndarray) -> np.ndarray:
     """Targets in the kernel frame of design x (O_A at the origin, O_B on +x)."""
     g = math.radians(x[2])
     c, s = math.cos(g), math.sin(g)
@@ -93,7 +93,7 @@ def evaluate(pp: PathProblem, x: np.ndarray) -> PathDesign:
     out, st = fourbar_kernel.fourbar_exact(np.radians(theta), d, a, b, c, 1.0, 0.0, pp.branch)
     cp = fourbar_kernel.fourbar_coupler_point(np.radians(theta), out, st, a, 1.0, 0.0, u, v)
     ok = st == ST_OK
-    tk = _to_kernel(pp, x)
+    tk = to_kernel_frame(pp, x)
     n = len(tk)
     if pp.full_rotation or pp.timing_deg is None:
         motion = np.ones(len(theta), bool)
@@ -137,7 +137,7 @@ def refine(pp: PathProblem, design: PathDesign) -> PathDesign:
     from scipy.optimize import minimize_scalar
     x = design.x
     d, a, b, c, u, v = x[3:9]
-    tk = _to_kernel(pp, x)
+    tk = to_kernel_frame(pp, x)
     step = 360.0 / pp.samples
     errs, ats = [], []
     for (tx, ty), t0, e0 in zip(tk, design.theta_at_targets_deg, design.errors):
@@ -185,7 +185,7 @@ def polish(pp: PathProblem, design: PathDesign) -> PathDesign:
         rad = np.radians(th)
         out, st = fourbar_kernel.fourbar_exact(rad, d, a, bb, c, 1.0, 0.0, pp.branch)
         cp = fourbar_kernel.fourbar_coupler_point(rad, out, st, a, 1.0, 0.0, u, v)[:, :2]
-        r = cp - _to_kernel(pp, np.concatenate([x, [0.0]]))
+        r = cp - to_kernel_frame(pp, np.concatenate([x, [0.0]]))
         r[st != ST_OK] = 10 * pp.length_max
         return r.ravel()
 

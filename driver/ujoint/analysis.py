@@ -135,7 +135,7 @@ def optimise(chain: Chain, option: int, beta0: np.ndarray, phi0: np.ndarray,
     [lb, lb + 180 deg): a bound there is no stopping point.
     """
     n = beta0.size
-    free = _free_index(option, n)
+    free = free_index(option, n)
 
     def full(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         z = np.concatenate([beta0, phi0])
@@ -165,7 +165,7 @@ def optimise(chain: Chain, option: int, beta0: np.ndarray, phi0: np.ndarray,
 
 def _periodic(option: int, n: int, lb: np.ndarray, ub: np.ndarray) -> np.ndarray:
     """Which free variables are phases whose bounds span a whole period (searched unbounded)."""
-    is_phase = _free_index(option, n) >= n
+    is_phase = free_index(option, n) >= n
     return is_phase & (ub - lb >= PHASE_PERIOD * DEG * (1.0 - 1e-12))
 
 
@@ -213,22 +213,22 @@ def _distance_deg(x: np.ndarray, y: np.ndarray, n_beta: int) -> float:
     return float(d.max(initial=0.0))
 
 
-def _free_index(option: int, n: int) -> np.ndarray:
+def free_index(option: int, n: int) -> np.ndarray:
     """Indices of the free variables in [beta_1..beta_n, phi_1..phi_(n-1)]."""
     return {1: np.arange(n, 2 * n - 1), 2: np.arange(n), 3: np.arange(2 * n - 1)}[option]
 
 
-def _chain(params: Params, rho_deg: np.ndarray | None, n: int, model: str | None = None) -> Chain:
+def chain_of(params: Params, rho_deg: np.ndarray | None, n: int, model: str | None = None) -> Chain:
     model = model or (params.model if params.model == "exact" else params.phasing)
     rho = np.zeros(n - 1) if rho_deg is None else np.asarray(rho_deg, float) * DEG
     return Chain(UJOINT_MODELS[model], UJOINT_OBJECTIVES[params.objective], rho, params.n_grid, params.rpm)
 
 
-def _starts(params: Params, option: int, beta: np.ndarray, phi: np.ndarray, lb: np.ndarray,
+def start_points(params: Params, option: int, beta: np.ndarray, phi: np.ndarray, lb: np.ndarray,
             ub: np.ndarray, chain: Chain) -> tuple[np.ndarray, list[str]]:
     """Start points [rad] (trial first, clipped into the bounds) and notes on what was done."""
     n = beta.size
-    free = _free_index(option, n)
+    free = free_index(option, n)
     x_trial = np.concatenate([beta, phi])[free] * DEG
     notes = []
     x0 = np.clip(x_trial, lb, ub)

@@ -21,7 +21,7 @@ from driver.ujoint.kernel import (
     ujoint_geometry,
     ujoint_summaries,
 )
-from driver.ujoint.spec import _KEYS, DEG
+from driver.ujoint.spec import DEG, KEYS
 
 #: deck keys a batch may vary (one value per design); list keys as one value per design (a
 #: single-element list, as a sweep sets them), a (designs, k) array of whole lists, or element
@@ -99,7 +99,7 @@ def _list_column(base: Mapping[str, Any], key: str, whole: Any, elements: dict[i
 
 def _choice_column(base: Mapping[str, Any], key: str, columns: dict[str, Any], nd: int) -> np.ndarray:
     v = np.broadcast_to(np.asarray(columns.get(key, base[key]), dtype=object), (nd,))
-    allowed = _KEYS[key].choices
+    allowed = KEYS[key].choices
     assert allowed is not None   # called for the choice keys only
     bad = ~np.isin(v, allowed)
     if bad.any():
@@ -180,7 +180,7 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     if axes and ({"beta", "rho"} & (set(cols) | set(elems))):
         raise _bad(base, "axes", "the base deck's 'axes' fix the joint and plane angles; a batch cannot vary "
                                  "'beta' or 'rho' then")
-    if axes:   # as _geometry (the base deck is valid): kernel radians -> degrees
+    if axes:   # as joint_geometry (the base deck is valid): kernel radians -> degrees
         b_rad, r_rad, _ = ujoint_geometry(np.asarray(base["axes"], dtype=np.float64).reshape(-1, 3))
         beta: np.ndarray = np.broadcast_to(b_rad / DEG, (nd, b_rad.size))
         rho: np.ndarray | None = np.broadcast_to(r_rad / DEG, (nd, r_rad.size))

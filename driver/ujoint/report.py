@@ -23,19 +23,19 @@ from driver.ujoint.analysis import (
     Chain,
     Design,
     StartRun,
-    _chain,
-    _free_index,
-    _starts,
+    chain_of,
     evaluate,
+    free_index,
     objective_scale,
     optimise,
     output_speed,
     phases_for,
     pick_best,
+    start_points,
     yoke_shifts,
 )
 from driver.ujoint.kernel import UJOINT_MODELS
-from driver.ujoint.spec import BAND_TOL, CONVENTIONS, DEG, OPTIONS, SPEC, _geometry, _per, _phases
+from driver.ujoint.spec import BAND_TOL, CONVENTIONS, DEG, OPTIONS, SPEC, joint_geometry, per_joint, phases_deg
 
 
 def _model_text(params: Params) -> str:
@@ -179,14 +179,14 @@ def _render(params: Params, chain: Chain, beta, rho, designs: list[Design], runs
 
 
 def _bounds_text(params: Params, base: str, count: int) -> str:
-    lo = _per(params, f"{base}_lower", count, "")
-    hi = _per(params, f"{base}_upper", count, "")
+    lo = per_joint(params, f"{base}_lower", count, "")
+    hi = per_joint(params, f"{base}_upper", count, "")
     return "  ".join(f"[{fortran_f(a, None, 4)}, {fortran_f(b, None, 4)}]" for a, b in zip(lo, hi)) + " deg"
 
 
 def _free_names(option: int, n: int) -> list[str]:
     names = [f"beta_{k + 1}" for k in range(n)] + [f"phi_{k + 1}" for k in range(n - 1)]
-    return [names[i] for i in _free_index(option, n)]
+    return [names[i] for i in free_index(option, n)]
 
 
 def _family(runs: list[StartRun], pick: StartRun, n_beta: int, resolution: float) -> tuple[int, np.ndarray]:
@@ -348,10 +348,10 @@ def _result_dat(params: Params, chain: Chain, designs: list[Design], best: Desig
 @keyword_run
 def run(params: Params, progress: bool = False) -> Result:
     """Analyse (option 0) or optimise (options 1-3) the chain of the deck."""
-    beta, rho = _geometry(params)
+    beta, rho = joint_geometry(params)
     n = beta.size
-    phi = _phases(params, n)
-    chain = _chain(params, rho, n)
+    phi = phases_deg(params, n)
+    chain = chain_of(params, rho, n)
     trial = evaluate(chain, "trial" if params.option else "design", beta, phi)
     designs = [trial]
     warnings: list[str] = []
@@ -361,11 +361,11 @@ def run(params: Params, progress: bool = False) -> Result:
     best = None
     option = params.option
     if option:
-        free = _free_index(option, n)
-        lo = np.concatenate([_per(params, "beta_lower", n, "joints"),
-                             _per(params, "phi_lower", n - 1, "phases") if n > 1 else []])
-        hi = np.concatenate([_per(params, "beta_upper", n, "joints"),
-                             _per(params, "phi_upper", n - 1, "phases") if n > 1 else []])
+        free = free_index(option, n)
+        lo = np.concatenate([per_joint(params, "beta_lower", n, "joints"),
+                             per_joint(params, "phi_lower", n - 1, "phases") if n > 1 else []])
+        hi = np.concatenate([per_joint(params, "beta_upper", n, "joints"),
+                             per_joint(params, "phi_upper", n - 1, "phases") if n > 1 else []])
         lb, ub = lo[free] * DEG, hi[free] * DEG
         beta_max = max(np.max(np.abs(beta)), np.max(np.abs(hi[:n])) if option in (2, 3) else 0.0)
         scale = objective_scale(chain, trial.objective, beta_max)
@@ -378,7 +378,7 @@ def run(params: Params, progress: bool = False) -> Result:
             notes.append("equal bounds fix every free variable: the fixed design is evaluated, "
                          "not optimised (no multi-start)")
         else:
-            starts, start_notes = _starts(params, option, beta, phi, lb, ub, chain)
+            starts, start_notes = start_points(params, option, beta, phi, lb, ub, chain)
             notes += start_notes
             runs = optimise(chain, option, beta * DEG, phi * DEG, lb, ub, starts, params.maxiter,
                             params.ftol, scale, progress)
@@ -397,7 +397,7 @@ def run(params: Params, progress: bool = False) -> Result:
     printed = None
     if params.paper_beta is not None or params.paper_phi is not None:
         pb = np.asarray(params.paper_beta if params.paper_beta is not None else beta, float)
-        pp = _phases(params, n, "paper_phi") if params.paper_phi is not None else phi
+        pp = phases_deg(params, n, "paper_phi") if params.paper_phi is not None else phi
         printed = evaluate(chain, "paper printed", pb, pp)
         designs.append(printed)
     text = _render(params, chain, beta, rho, designs, runs, notes, warnings, failure)

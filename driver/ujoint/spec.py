@@ -51,7 +51,7 @@ def _open_angles(v) -> str | None:
             if bad else None)
 
 
-_KEYS = dict(
+KEYS = dict(
     beta=Key("floats", check=lambda v: non_empty(v) or _open_angles(v), units="deg",
              doc="operating angle of each joint (any count >= 1); the trial/start design. "
              "Omit when 'axes' gives the geometry."),
@@ -110,7 +110,7 @@ _KEYS = dict(
 )
 
 
-def _per(params: Params, key: str, count: int, what: str) -> np.ndarray:
+def per_joint(params: Params, key: str, count: int, what: str) -> np.ndarray:
     """A bound key: one value for all, or exactly ``count`` values."""
     v = params[key]
     if len(v) == 1:
@@ -120,7 +120,7 @@ def _per(params: Params, key: str, count: int, what: str) -> np.ndarray:
     return np.asarray(v, float)
 
 
-def _geometry(params: Params) -> tuple[np.ndarray, np.ndarray | None]:
+def joint_geometry(params: Params) -> tuple[np.ndarray, np.ndarray | None]:
     """Joint angles [deg] and plane angles [deg or None] from beta/rho or axes."""
     if params.axes is not None:
         if params.beta is not None:
@@ -154,7 +154,7 @@ def _geometry(params: Params) -> tuple[np.ndarray, np.ndarray | None]:
     return beta, rho
 
 
-def _phases(params: Params, n: int, key: str | None = None) -> np.ndarray:
+def phases_deg(params: Params, n: int, key: str | None = None) -> np.ndarray:
     """The paper's phases phi [deg] (n-1,) from phi or delta (default: in phase)."""
     keys = [key] if key else ["phi", "delta"]
     given = [k for k in keys if params[k] is not None]
@@ -175,7 +175,7 @@ def _phases(params: Params, n: int, key: str | None = None) -> np.ndarray:
 
 def cross_check(params: Params) -> None:
     """Cross-key checks (DeckError naming the key)."""
-    beta, rho = _geometry(params)
+    beta, rho = joint_geometry(params)
     n = beta.size
     exact = params.model == "exact"
     if not exact:
@@ -185,9 +185,9 @@ def cross_check(params: Params) -> None:
     elif "phasing" in params.given:
         raise params.error("phasing", "applies only to model = 'paper' (the exact chain has no "
                                       "phasing choice)")
-    _phases(params, n)
-    blo = _per(params, "beta_lower", n, "joints")
-    bhi = _per(params, "beta_upper", n, "joints")
+    phases_deg(params, n)
+    blo = per_joint(params, "beta_lower", n, "joints")
+    bhi = per_joint(params, "beta_upper", n, "joints")
     for key, v in (("beta_lower", blo), ("beta_upper", bhi)):
         msg = _open_angles(v)
         if msg:
@@ -197,8 +197,8 @@ def cross_check(params: Params) -> None:
         raise params.error("beta_lower", f"lower bound {blo[j]} deg exceeds upper bound {bhi[j]} deg "
                                          f"for joint {j + 1}; need beta_lower <= beta_upper")
     if n > 1:
-        plo = _per(params, "phi_lower", n - 1, "phases")
-        phi_hi = _per(params, "phi_upper", n - 1, "phases")
+        plo = per_joint(params, "phi_lower", n - 1, "phases")
+        phi_hi = per_joint(params, "phi_upper", n - 1, "phases")
         if np.any(plo > phi_hi):
             j = int(np.argmax(plo > phi_hi))
             raise params.error("phi_lower", f"lower bound {plo[j]} deg exceeds upper bound {phi_hi[j]} "
@@ -216,7 +216,7 @@ def cross_check(params: Params) -> None:
         if msg:
             raise params.error("paper_beta", msg)
     if params.paper_phi is not None:
-        _phases(params, n, "paper_phi")
+        phases_deg(params, n, "paper_phi")
     if params.paper_band is not None and len(params.paper_band) != 2:
         raise params.error("paper_band", f"needs two values (min, max rpm); got {len(params.paper_band)}")
 
@@ -236,7 +236,7 @@ LABELS = {"rpm": ("input shaft speed", "rpm"), "objective": ("objective (optimum
 SWEEP_PLOT = ("omega_out_min_rpm", "omega_out_max_rpm", "pp_ratio", "beta_e_deg", "peak_accel_rad_s2", "objective")
 
 
-SPEC = GroupSpec("ujoint", _KEYS, check=cross_check,
+SPEC = GroupSpec("ujoint", KEYS, check=cross_check,
                  doc="Hooke-joint shaft chain: speed fluctuation, exact 3-D kinematics, SSO options 0-3. "
                  "Conventions: " + CONVENTIONS)
 
