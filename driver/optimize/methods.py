@@ -277,51 +277,62 @@ def lattice_polish(ev: Evaluator, x: np.ndarray, history: list[HistoryRow], labe
 
 # ----------------------------------------------------------------------------- local multi-start
 
-def _local_runs(ev: Evaluator, starts: np.ndarray, history: list[HistoryRow], method: str,
-                label: str = "start") -> tuple[list[dict], int, int]:
-    """SLSQP / trust-constr from each start (normalised coordinates), each end polished on the lattice.
+class _Local:
+    """The functions a local method (SLSQP, trust-constr) calls, for one problem, in normalised
+    coordinates u in [0, 1]^n: objective, constraints and their forward-difference Jacobians,
+    each point evaluated through the :class:`Evaluator`.
 
     Equalities go to the method as equalities; a max-min (min-max) objective as its epigraph:
     an extra unknown s, minimise s subject to s >= sense x term_j for every term (smooth where the
     terms are equal, which the min() form is not)."""
-    p, o = ev.problem, ev.problem.opts
-    lo, hi = p.lower, p.upper
-    span = hi - lo
-    n = len(p.variables)
-    h = 1e-6
-    epi = bool(p.terms)
 
-    def to_x(u: np.ndarray) -> np.ndarray:
-        return lo + np.clip(np.asarray(u)[..., :n], 0.0, 1.0) * span
+    #: forward-difference step in normalised coordinates
+    STEP = 1e-6
 
-    def stencil(u: np.ndarray):
+    def __init__(self, ev: Evaluator):
+        p = ev.problem
+        self.ev, self.p = ev, p
+        self.lo, self.span = p.lower, p.upper - p.lower
+        self.n = len(p.variables)
+        self.epi = bool(p.terms)
+        self.ineq = [k for k, c in enumerate(p.constraints) if not c.equality]
+        self.eq = [k for k, c in enumerate(p.constraints) if c.equality]
+        self.scale = 1.0   # objective scale of the current start: ftol is relative to |f(start)|
+
+    # ------------------------------------------------------------------ designs and their values
+    def to_x(self, u: np.ndarray) -> np.ndarray:
+        """Design values of normalised points (the epigraph unknown dropped, clipped into the box)."""
+        return self.lo + np.clip(np.asarray(u)[..., :self.n], 0.0, 1.0) * self.span
+
+    def one(self, u):
+        """The record of one point."""
+        return self.ev.evaluate(self.to_x(np.atleast_2d(np.asarray(u)[:self.n])))[0]
+
+    def stencil(self, u: np.ndarray):
         """Records at u and at the n forward (or backward, at the upper bound) points, in one batch."""
+        n, h = self.n, self.STEP
         u = np.clip(np.asarray(u[:n], dtype=np.float64), 0.0, 1.0)
         steps = np.where(u + h <= 1.0, h, -h)
         U = np.vstack([u] + [u + steps[i] * np.eye(n)[i] for i in range(n)])
-        return ev.evaluate(to_x(U)), steps
+        return self.ev.evaluate(self.to_x(U)), steps
 
-    def ok(r) -> bool:
-        return r.status == "ok" and math.isfinite(r.objective)
+    def fvals(self, recs) -> np.ndarray:
+        """sense x objective of each record, failed designs at FAILED_OBJECTIVE."""
+        return np.array([self.p.sense * r.objective if _computed(r) else FAILED_OBJECTIVE for r in recs])
 
-    def fvals(recs) -> np.ndarray:
-        return np.array([p.sense * r.objective if ok(r) else FAILED_OBJECTIVE for r in recs])
-
-    def tvals(recs) -> np.ndarray:
+    def tvals(self, recs) -> np.ndarray:
         """sense x term_j of each record (rows), failed designs at FAILED_OBJECTIVE."""
-        return np.array([[p.sense * t if (ok(r) and math.isfinite(t)) else FAILED_OBJECTIVE for t in r.terms]
+        p = self.p
+        return np.array([[p.sense * t if (_computed(r) and math.isfinite(t)) else FAILED_OBJECTIVE for t in r.terms]
                          if r.terms else [FAILED_OBJECTIVE] * len(p.terms) for r in recs])
 
-    ineq = [k for k, c in enumerate(p.constraints) if not c.equality]
-    eq = [k for k, c in enumerate(p.constraints) if c.equality]
-
-    def mvals(recs, which) -> np.ndarray:
+    def mvals(self, recs, which) -> np.ndarray:
         """Margins (inequalities) or signed residuals a - b (equalities) of the constraints ``which``."""
         rows = []
         for r in recs:
             row = []
             for k in which:
-                c = p.constraints[k]
+                c = self.p.constraints[k]
                 m = r.margins[k] if r.margins else -1e3
                 if c.equality:
                     m = r.signed[k] if r.signed else -1e3
@@ -329,105 +340,146 @@ def _local_runs(ev: Evaluator, starts: np.ndarray, history: list[HistoryRow], me
             rows.append(row)
         return np.array(rows, dtype=np.float64).reshape(len(recs), len(which))
 
-    scale = [1.0]   # objective scale of the current start: ftol is relative to |f(start)|
+    # ------------------------------------------------------------------ what the method calls
+    def fun(self, z) -> float:
+        if self.epi:
+            return float(z[self.n])
+        return float(self.fvals([self.one(z)])[0]) / self.scale
 
-    def one(u):
-        return ev.evaluate(to_x(np.atleast_2d(np.asarray(u)[:n])))[0]
+    def jac(self, z) -> np.ndarray:
+        if self.epi:
+            return np.concatenate([np.zeros(self.n), [1.0]])
+        recs, steps = self.stencil(z)
+        f = self.fvals(recs)
+        return (f[1:] - f[0]) / steps / self.scale
 
-    if epi:
-        fun = lambda z: float(z[n])
-        jac = lambda z: np.concatenate([np.zeros(n), [1.0]])
-    else:
-        fun = lambda u: float(fvals([one(u)])[0]) / scale[0]
-
-        def jac(u):
-            recs, steps = stencil(u)
-            f = fvals(recs)
-            return (f[1:] - f[0]) / steps / scale[0]
-
-    def gvals(z):
-        rec = one(z)
-        parts = [mvals([rec], ineq)[0]]
-        if epi:
-            parts.append(float(z[n]) - tvals([rec])[0] / scale[0])
+    def gvals(self, z) -> np.ndarray:
+        rec = self.one(z)
+        parts = [self.mvals([rec], self.ineq)[0]]
+        if self.epi:
+            parts.append(float(z[self.n]) - self.tvals([rec])[0] / self.scale)
         return np.concatenate(parts)
 
-    def gjac(z):
-        recs, steps = stencil(z)
-        m = mvals(recs, ineq)
+    def gjac(self, z) -> np.ndarray:
+        recs, steps = self.stencil(z)
+        m = self.mvals(recs, self.ineq)
         J = ((m[1:] - m[0]) / steps[:, None]).T
-        if epi:
-            t = tvals(recs) / scale[0]
+        if self.epi:
+            t = self.tvals(recs) / self.scale
             Jt = -((t[1:] - t[0]) / steps[:, None]).T
-            J = np.vstack([np.hstack([J, np.zeros((len(ineq), 1))]),
-                           np.hstack([Jt, np.ones((len(p.terms), 1))])])
+            J = np.vstack([np.hstack([J, np.zeros((len(self.ineq), 1))]),
+                           np.hstack([Jt, np.ones((len(self.p.terms), 1))])])
         return J
 
-    hvals = lambda z: mvals([one(z)], eq)[0]
+    def hvals(self, z) -> np.ndarray:
+        return self.mvals([self.one(z)], self.eq)[0]
 
-    def hjac(z):
-        recs, steps = stencil(z)
-        m = mvals(recs, eq)
+    def hjac(self, z) -> np.ndarray:
+        recs, steps = self.stencil(z)
+        m = self.mvals(recs, self.eq)
         J = ((m[1:] - m[0]) / steps[:, None]).T
-        return np.hstack([J, np.zeros((len(eq), 1))]) if epi else J
+        return np.hstack([J, np.zeros((len(self.eq), 1))]) if self.epi else J
 
-    runs, nit, nfev = [], 0, 0
-    for s, u0 in enumerate(starts, 1):
-        it = [0]
-        r0 = one(u0)
-        f0 = fvals([r0])[0]
-        scale[0] = abs(f0) if 0 < abs(f0) < FAILED_OBJECTIVE else 1.0
+    def constraints(self, method: str) -> list[dict[str, object] | NonlinearConstraint]:
+        """The constraints in the form ``method`` takes (SLSQP: dicts; trust-constr: objects)."""
+        cons: list[dict[str, object] | NonlinearConstraint] = []
+        has_ineq = bool(self.ineq) or self.epi
+        if method == "SLSQP":
+            if has_ineq:
+                cons.append({"type": "ineq", "fun": self.gvals, "jac": self.gjac})
+            if self.eq:
+                cons.append({"type": "eq", "fun": self.hvals, "jac": self.hjac})
+        else:
+            if has_ineq:
+                cons.append(NonlinearConstraint(self.gvals, 0.0, np.inf, jac=self.gjac))
+            if self.eq:
+                cons.append(NonlinearConstraint(self.hvals, 0.0, 0.0, jac=self.hjac))
+        return cons
+
+    def start(self, u0: np.ndarray) -> tuple[np.ndarray, Bounds]:
+        """Take ``u0`` as the start: the objective scale from its record; the method's start point
+        and bounds (the epigraph's s starts at the largest term)."""
+        n = self.n
+        r0 = self.one(u0)
+        f0 = self.fvals([r0])[0]
+        self.scale = abs(f0) if 0 < abs(f0) < FAILED_OBJECTIVE else 1.0
         z0 = np.asarray(u0, dtype=np.float64)
         lb, ub = np.zeros(n), np.ones(n)
-        if epi:
-            s0 = float(np.max(tvals([r0])[0])) / scale[0]
-            s0 = s0 if math.isfinite(s0) and abs(s0) < FAILED_OBJECTIVE / scale[0] else 0.0
+        if self.epi:
+            s0 = float(np.max(self.tvals([r0])[0])) / self.scale
+            s0 = s0 if math.isfinite(s0) and abs(s0) < FAILED_OBJECTIVE / self.scale else 0.0
             z0 = np.concatenate([z0, [s0]])
             lb, ub = np.concatenate([lb, [-np.inf]]), np.concatenate([ub, [np.inf]])
+        return z0, Bounds(lb, ub)
 
-        def callback(*args, **kw) -> None:   # called only by this start's minimize below
-            it[0] += 1  # noqa: B023
-            _snapshot(ev, f"{label} {s} iteration {it[0]}", history)  # noqa: B023
 
-        kw = {}
-        cons: list[dict[str, object] | NonlinearConstraint] = []
-        has_ineq = bool(ineq) or epi
-        if method == "SLSQP":
-            if has_ineq:
-                cons.append({"type": "ineq", "fun": gvals, "jac": gjac})
-            if eq:
-                cons.append({"type": "eq", "fun": hvals, "jac": hjac})
-        else:
-            if has_ineq:
-                cons.append(NonlinearConstraint(gvals, 0.0, np.inf, jac=gjac))
-            if eq:
-                cons.append(NonlinearConstraint(hvals, 0.0, 0.0, jac=hjac))
-        if cons:
-            kw["constraints"] = cons
-        options = {"maxiter": o.maxiter}
-        if method == "SLSQP":
-            options["ftol"] = max(o.tol * 1e-3, 1e-12)
-        else:
-            options.update({"gtol": max(o.tol * 1e-3, 1e-10), "xtol": 1e-10})
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            # method, constraints and options are chosen at run time: no single scipy-stubs overload
-            res = minimize(fun, z0, jac=jac, bounds=Bounds(lb, ub), method=method,  # type: ignore[call-overload]
-                           callback=callback, options=options, **kw)
-        end = one(res.x)
-        # the end and the best feasible design this start evaluated: the polish starts from the
-        # better one (an iterate can beat the method's last point), on the lattice
-        near = end.feasible or _near(p, end)
-        if near:    # feasible, or within a few tolerances of it: polished (restored first) on the lattice
-            rec, settled = lattice_polish(ev, np.array(end.x), history, f"{label} {s}")
-        else:       # far from feasible: not polished; its end follows the floating-point path
-            rec, settled = end, False
-        runs.append({"start": s, "x0": tuple(to_x(np.asarray(u0))), "x": rec.x, "objective": rec.objective,
-                     "feasible": rec.feasible, "settled": settled, "record": rec,
-                     "success": bool(res.success), "message": str(res.message),
-                     "method_x": end.x, "method_objective": end.objective,
-                     "iterations": int(getattr(res, "nit", it[0]))})
-        nit += int(getattr(res, "nit", it[0]))
+def _computed(r) -> bool:
+    """The design was computed and has a finite objective."""
+    return r.status == "ok" and math.isfinite(r.objective)
+
+
+def _method_options(o, method: str) -> dict[str, Any]:
+    """scipy's options of the local method: its iteration limit and stopping precision."""
+    options: dict[str, Any] = {"maxiter": o.maxiter}
+    if method == "SLSQP":
+        options["ftol"] = max(o.tol * 1e-3, 1e-12)
+    else:
+        options.update({"gtol": max(o.tol * 1e-3, 1e-10), "xtol": 1e-10})
+    return options
+
+
+def _minimise(loc: _Local, u0: np.ndarray, method: str, callback):
+    """One run of the local method from ``u0`` (scipy's OptimizeResult)."""
+    z0, bounds = loc.start(u0)
+    kw: dict[str, Any] = {}
+    cons = loc.constraints(method)
+    if cons:
+        kw["constraints"] = cons
+    options = _method_options(loc.p.opts, method)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        # method, constraints and options are chosen at run time: no single scipy-stubs overload
+        return minimize(loc.fun, z0, jac=loc.jac, bounds=bounds, method=method,  # type: ignore[call-overload]
+                        callback=callback, options=options, **kw)
+
+
+def _local_run(loc: _Local, s: int, u0: np.ndarray, history: list[HistoryRow], method: str, label: str):
+    """Start ``s`` from ``u0``: the method, then its end polished on the lattice when it is
+    feasible or near it.  Returns (the run's row, scipy's result)."""
+    ev = loc.ev
+    it = [0]
+
+    def callback(*args, **kw) -> None:
+        it[0] += 1
+        _snapshot(ev, f"{label} {s} iteration {it[0]}", history)
+
+    res = _minimise(loc, u0, method, callback)
+    end = loc.one(res.x)
+    # the end and the best feasible design this start evaluated: the polish starts from the
+    # better one (an iterate can beat the method's last point), on the lattice
+    if end.feasible or _near(loc.p, end):   # feasible, or within a few tolerances of it: polished (restored first)
+        rec, settled = lattice_polish(ev, np.array(end.x), history, f"{label} {s}")
+    else:       # far from feasible: not polished; its end follows the floating-point path
+        rec, settled = end, False
+    run = {"start": s, "x0": tuple(loc.to_x(np.asarray(u0))), "x": rec.x, "objective": rec.objective,
+           "feasible": rec.feasible, "settled": settled, "record": rec,
+           "success": bool(res.success), "message": str(res.message),
+           "method_x": end.x, "method_objective": end.objective,
+           "iterations": int(getattr(res, "nit", it[0]))}
+    return run, res
+
+
+def _local_runs(ev: Evaluator, starts: np.ndarray, history: list[HistoryRow], method: str,
+                label: str = "start") -> tuple[list[dict], int, int]:
+    """SLSQP / trust-constr from each start (normalised coordinates), each end polished on the
+    lattice (:class:`_Local` says how the problem is put to the method).  Returns (one row per
+    start, iterations, function evaluations of the method)."""
+    loc = _Local(ev)
+    runs, nit, nfev = [], 0, 0
+    for s, u0 in enumerate(starts, 1):
+        run, res = _local_run(loc, s, u0, history, method, label)
+        runs.append(run)
+        nit += run["iterations"]
         nfev += int(getattr(res, "nfev", 0))
         _snapshot(ev, f"{label} {s} end", history)
     return runs, nit, nfev
