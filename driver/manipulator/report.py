@@ -170,8 +170,20 @@ def _summary(p: Params, ws: Workspace, conv: Conv, used: dict, sweep: dict, tol:
 @keyword_signature(_keywords.manipulator, SPEC)
 @keyword_run
 def run(params: Params, progress: bool = False) -> Result:
-    """Run one &manipulator deck (see the package docstring): validated Params, or the deck's
-    keys as keyword arguments (``driver.manipulator.run(points_x=[...], points_y=[...])``)."""
+    """Synthesise a planar 2R arm robustly for a workspace of points (the report's chapter 4).
+
+    Reach conditions, the robust circle C_rob and the RI1/RI2/RI3 indices, the dexterity and
+    manipulability optima, joint angles and motor torques at a target point, and tolerance
+    synthesis checked by Monte Carlo (see :mod:`driver.manipulator`).  Lengths in m, angles in
+    degrees, joint rates in rad/s, torques in N m.
+
+    Examples
+    --------
+    >>> import driver
+    >>> r = driver.manipulator.run(points_x=[0.5, 1.0, 1.5], points_y=[1.0, 0.5, 1.0])
+    >>> round(r.summary["crob_radius_m"], 6), r.summary["design_status"]
+    (1.384437, 'ok')
+    """
     p = params
     ws = Workspace(np.array(p.points_x, float), np.array(p.points_y, float))
     conv = Conv(p.mode == "report", ws)
