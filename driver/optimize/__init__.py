@@ -71,18 +71,38 @@ class DesignVector(dict):
 
 @dataclass
 class OptimizeOutcome(Outcome):
-    """Result of an optimisation, shaped like ``scipy.optimize.OptimizeResult`` (and an
-    :class:`~driver.outcome.Outcome`: files written, warnings and errors as messages, notes).
+    """Result of an optimisation, shaped like ``scipy.optimize.OptimizeResult``.
 
-    x            best feasible design: a :class:`DesignVector` ({'group.key': value}, and an
-                 array by ``np.asarray(x)`` with ``x.names``); None when none is feasible
-    fun          its objective value (the expression's value, not sign-flipped)
-    success      the method converged and x is feasible: x is an optimum
-    status       0 optimum, 1 not converged (x is the best feasible design found), 2 no feasible design
-    message      the method's words
-    nit          iterations (generations for differential evolution; all starts' for local methods)
-    nfev         designs evaluated (each distinct design once)
-    constraints  per constraint at x: text, kind, value, margin, tolerance, met (see :meth:`to_dict`)
+    Also an :class:`~driver.outcome.Outcome`: files written, warnings and errors as messages,
+    notes.  Values are in the units of the deck keys and summary columns they name.
+
+    Attributes
+    ----------
+    problem : Problem
+        The problem the ``&optimize`` group declared (variables, objective, constraints).
+    x : DesignVector or None
+        Best feasible design, ``{'group.key': value}`` in the variables' deck units (and an
+        array by ``np.asarray(x)``, names in ``x.names``); None when none is feasible.
+    fun : float or None
+        Its objective value, in the objective expression's units (not sign-flipped).
+    success : bool
+        The method converged and ``x`` is feasible: ``x`` is an optimum.
+    message : str
+        The method's words.
+    nfev : int
+        Designs evaluated (each distinct design once).
+    best : Record or None
+        The evaluation record of ``x``.
+    check : Record or None
+        The optimum re-run by the full study.
+    method : MethodResult
+        What the method returned (iterations, convergence, starts, polish).
+    history : list of HistoryRow
+        The designs in the order evaluated.
+    evaluator : Evaluator
+        The cache of evaluated designs.
+    study_result : Result or None
+        The study's full run at the optimum.
     """
 
     problem: Problem
@@ -100,6 +120,7 @@ class OptimizeOutcome(Outcome):
 
     @property
     def status(self) -> int:
+        """0 optimum, 1 not converged (``x`` the best feasible design found), 2 no feasible design."""
         return 0 if self.success else (2 if self.x is None else 1)
 
     @property
@@ -111,6 +132,7 @@ class OptimizeOutcome(Outcome):
 
     @property
     def nit(self) -> int:
+        """Iterations: generations for differential evolution, all starts' for local methods."""
         return int(self.method.iterations)
 
     @property
@@ -130,8 +152,14 @@ class OptimizeOutcome(Outcome):
         return out
 
     def to_dict(self) -> dict:
-        """The result as plain data (the ``--json`` record): scipy's fields, the constraints at x,
-        the starts of a local method and the polish of differential evolution."""
+        """Return the result as plain data: the ``--json`` record.
+
+        Returns
+        -------
+        dict
+            Scipy's fields, the constraints at ``x``, the starts of a local method and the
+            polish of differential evolution (JSON-safe; values in their deck units).
+        """
         p = self.problem
         rec = {"study": p.study.spec.name, "deck": str(p.deck.path), "objective": p.objective_text,
                "x": None if self.x is None else [float(v) for v in self.x.values()], "x_names": p.names,
