@@ -360,10 +360,24 @@ SPEC = GroupSpec("slidercrank", _KEYS,
 
 
 def estimate(params: Params) -> Estimate:
-    """Memory and work of a run from the keys alone (driver.limits): every (speed, element count)
+    """Estimate the memory and work of a run from the keys alone, before it allocates.
+
+    Every (speed, element count)
     integrates n_steps Newmark steps over 3 (n + 1) degrees of freedom (banded, about 0.2 us per
     dof and step) and records the last two revolutions of states (to judge settling); the static
-    buckling onset factors K + K_G some 2000 times (about 0.3 ms per dof in all)."""
+    buckling onset factors K + K_G some 2000 times (about 0.3 ms per dof in all).
+
+    Parameters
+    ----------
+    params : Params
+        Validated ``&slidercrank`` keys.
+
+    Returns
+    -------
+    Estimate
+        Bytes and seconds the run needs, each with the key that drives it
+        (``driver.limits`` refuses an absurd request with it).
+    """
     p = params
     counts = list(p.element_counts) if p.element_counts else [p.n_elements]
     work, mem, steps_max = 0.0, 0.0, 0.0
