@@ -96,8 +96,21 @@ def _tidy(tables: list[Table], tol: list[dict], sweep: dict, used: dict) -> pd.D
 
 
 def table_frame(tidy: pd.DataFrame, table: str) -> pd.DataFrame:
-    """One table of the long tidy frame in its printed shape: a row per printed row (row,
-    label, then a column per quantity in printed order; NaN where the printed cell is blank)."""
+    """Return one table of the long tidy frame in its printed, wide shape.
+
+    Parameters
+    ----------
+    tidy : pandas.DataFrame
+        A run's tidy table (``table, row, label, quantity, value, unit``).
+    table : str
+        The table's number, e.g. ``'4.8'``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        A row per printed row (row, label, then a column per quantity in printed order, in
+        the units of the tidy ``unit`` column); NaN where the printed cell is blank.
+    """
     part = tidy[tidy["table"] == table]
     if part.empty:
         known = ", ".join(dict.fromkeys(tidy["table"]))
