@@ -245,12 +245,38 @@ def base_value(problem: Problem, v) -> float:
 def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[str] | None = None,
              plot: bool = False, jobs: int | None = None, resume: bool = False,
              scheduler: Any = None) -> OptimizeOutcome:
-    """Run an optimisation deck; write its outputs to ``outdir`` (None: write nothing).
+    """Run an optimisation deck: a study group and an ``&optimize`` group.
 
-    ``scheduler``: a Dask scheduler address or Client (from the command line or Dask's
-    configuration, never from the deck): each batch of designs is spread over its workers.
+    Parameters
+    ----------
+    deck : Deck, str or path-like
+        The deck, or its file.
+    outdir : path-like, optional
+        Where to write the outputs (``<stem>.out``, the optimum's deck and run, the history);
+        None writes nothing.
+    formats : list of str, optional
+        Tidy table formats: ``'csv'``, ``'parquet'``.
+    plot : bool, default False
+        Write the figures.
+    jobs : int, optional
+        Worker processes for the design evaluations; default all cores.
+    resume : bool, default False
+        Reuse the evaluation journal in ``outdir`` (verified, never believed).
+    scheduler : str or dask.distributed.Client, optional
+        A Dask scheduler address or client (from the command line or Dask's configuration,
+        never from the deck): each batch of designs is spread over its workers.
 
-    Raises DeckError for bad input before anything is computed or written.
+    Returns
+    -------
+    OptimizeOutcome
+        ``x`` (the best feasible design in the variables' deck units), ``fun`` (the
+        objective, in its expression's units), ``success``, ``status``, ``nit``, ``nfev``,
+        the constraints at ``x`` and the files written.
+
+    Raises
+    ------
+    DeckError
+        Bad input, before anything is computed or written.
     """
     if not isinstance(deck, Deck):
         deck = read_deck(deck)
@@ -337,11 +363,43 @@ def _write(oc: OptimizeOutcome, stem: Path, params, formats: list[str], plot: bo
 def run_optimize_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool = False,
                       jobs: int | None = None, resume: bool = False,
                       scheduler: Any = None, summary_json: bool = False, **_: Any) -> OptimizeOutcome:
-    """Command-line entry: run and write (``summary_json``: also ``<stem>.json``); returns the
-    outcome with its warnings, errors and progress notes as data (DeckError propagates).
+    """Run an optimisation deck and write its outputs: the command line's entry.
 
-    Raises :class:`~driver.extras.MissingExtra` before running when pyarrow is missing (the
-    evaluation journal is Parquet) or, with a scheduler, Dask.
+    Parameters
+    ----------
+    deck : Deck
+        The read deck.
+    outdir : pathlib.Path
+        Where to write.
+    formats : list of str
+        Tidy table formats: ``'csv'``, ``'parquet'``.
+    plot : bool
+        Write the figures.
+    progress : bool, default False
+        Show a progress bar on the terminal.
+    jobs : int, optional
+        Worker processes; default all cores.
+    resume : bool, default False
+        Reuse the evaluation journal in ``outdir``.
+    scheduler : str or dask.distributed.Client, optional
+        A Dask scheduler address or client.
+    summary_json : bool, default False
+        Also write ``<stem>.json``.
+    **_ : dict
+        Options of other engines, ignored.
+
+    Returns
+    -------
+    OptimizeOutcome
+        The outcome, with its warnings, errors and progress notes as data.
+
+    Raises
+    ------
+    DeckError
+        Bad input.
+    MissingExtra
+        Before running, when pyarrow is missing (the evaluation journal is Parquet) or, with a
+        scheduler, Dask.
     """
     require("parquet")
     if scheduler:
