@@ -46,13 +46,6 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 
 PENDING_NAMES = (
-    "driver.fourbar.kernel.fourbar_berkof_lowen",
-    "driver.fourbar.kernel.fourbar_coupler_point",
-    "driver.fourbar.kernel.fourbar_exact",
-    "driver.fourbar.kernel.fourbar_force_summaries",
-    "driver.fourbar.kernel.fourbar_joint_forces",
-    "driver.fourbar.kernel.fourbar_listing",
-    "driver.fourbar.kernel.fourbar_summaries",
     "driver.manipulator.kernel.manipulator_arm_states",
     "driver.manipulator.kernel.manipulator_design_indices",
     "driver.manipulator.kernel.manipulator_design_summaries",
@@ -69,11 +62,6 @@ PENDING_NAMES = (
     "driver.slidercrank.kernel.slidercrank_simulate",
     "driver.sweep.auto_chunk",
     "driver.sweep.run_task",
-    "driver.ujoint.kernel.ujoint_equivalent",
-    "driver.ujoint.kernel.ujoint_geometry",
-    "driver.ujoint.kernel.ujoint_objective",
-    "driver.ujoint.kernel.ujoint_speed",
-    "driver.ujoint.kernel.ujoint_summaries",
 )
 
 #: the numpydoc checks enforced (see the module docstring for those left out and why)
