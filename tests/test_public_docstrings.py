@@ -46,20 +46,6 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 
 PENDING_NAMES = (
-    "driver.manipulator.kernel.manipulator_arm_states",
-    "driver.manipulator.kernel.manipulator_design_indices",
-    "driver.manipulator.kernel.manipulator_design_summaries",
-    "driver.manipulator.kernel.manipulator_ik",
-    "driver.manipulator.kernel.manipulator_position_errors",
-    "driver.manipulator.kernel.manipulator_torques",
-    "driver.slidercrank.kernel.slidercrank_axial_force",
-    "driver.slidercrank.kernel.slidercrank_column_static",
-    "driver.slidercrank.kernel.slidercrank_corot_element",
-    "driver.slidercrank.kernel.slidercrank_frequencies",
-    "driver.slidercrank.kernel.slidercrank_matrices",
-    "driver.slidercrank.kernel.slidercrank_nl_simulate",
-    "driver.slidercrank.kernel.slidercrank_rigid",
-    "driver.slidercrank.kernel.slidercrank_simulate",
     "driver.sweep.auto_chunk",
     "driver.sweep.run_task",
 )
