@@ -45,11 +45,6 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 
-PENDING_NAMES = (
-    "driver.sweep.auto_chunk",
-    "driver.sweep.run_task",
-)
-
 #: the numpydoc checks enforced (see the module docstring for those left out and why)
 CHECKS = frozenset({"GL02", "GL03", "GL05", "GL06", "GL07", "GL08", "GL09", "GL10",
                     "SS01", "SS02", "SS03", "SS04", "SS05", "SS06",
@@ -102,11 +97,6 @@ def public_names() -> dict[str, object]:
 
 PUBLIC = public_names()
 
-#: public names whose docstrings do not pass yet (a ratchet: the list only shrinks; a name
-#: here that passes fails the test, strict xfail, so it must be taken off)
-PENDING = frozenset(PENDING_NAMES)
-
-
 def _class_parameters_documented(name: str, cls: type) -> list[str]:
     """PR01/PR02 for a class: constructor parameters under Parameters or Attributes (its own or a base's)."""
     if issubclass(cls, enum.Enum):
@@ -149,12 +139,7 @@ def test_the_public_namespace_is_found():
     assert len(PUBLIC) > 100
 
 
-def test_pending_names_are_public():
-    assert not PENDING - set(PUBLIC), f"no longer public, take off PENDING: {sorted(PENDING - set(PUBLIC))}"
-
-
-@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.xfail(strict=True, reason="pending"))
-                                  if n in PENDING else n for n in sorted(PUBLIC)])
+@pytest.mark.parametrize("name", sorted(PUBLIC))
 def test_public_docstring_is_valid_numpydoc(name):
     found = problems(name)
     assert not found, f"{name}:\n  " + "\n  ".join(found)
