@@ -26,7 +26,8 @@ from driver.study import Figure
 from driver.table import Column, fortran_f, render_table
 
 __all__ = ["KEYS", "check", "active", "props", "ForceAnalysis", "analyse", "COLUMNS", "tidy_columns",
-           "table_lines", "summary_lines", "summary", "summarise_force_batch", "BATCH_KEYS", "figures"]
+           "table_lines", "summary_lines", "summary", "summarise_force_batch", "BATCH_KEYS", "figures",
+           "plot_torque", "plot_pin_polars", "plot_shaking"]
 
 ST_OK = kernel.FOURBAR_STATUS["ok"]
 LINKS = ("crank", "coupler", "rocker")
@@ -610,8 +611,27 @@ def figures(p: Params, title: str, theta_grid: Any) -> list[Figure]:
 
 
 def plot_torque(theta: np.ndarray, fa: ForceAnalysis, p: Mapping[str, Any], ax: Any) -> Any:
-    """Input torque against crank angle with its mean, and the energy fluctuation dE shaded between
-    the torque curve and the mean (axes ``ax``; the balanced linkage's torque dashed if any)."""
+    """Plot the input torque against crank angle, its mean, and the energy fluctuation dE.
+
+    dE is shaded between the torque curve and the mean; with balancing the torque of the
+    linkage without counterweights is dashed.
+
+    Parameters
+    ----------
+    theta : numpy.ndarray
+        Crank angles, deg.
+    fa : ForceAnalysis
+        The forces (:func:`analyse`).
+    p : mapping
+        The ``&fourbar`` keys.
+    ax : matplotlib.axes.Axes
+        The axes to draw into (crank angle in deg, torque in N m, dE in J in the legend).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        ``ax``.
+    """
     t = np.where(fa.ok, fa.forces[:, 0], np.nan)
     ax.plot(theta, t, color="C0", label="input torque")
     if fa.ok.all() and len(theta) > 1:
@@ -629,8 +649,23 @@ def plot_torque(theta: np.ndarray, fa: ForceAnalysis, p: Mapping[str, Any], ax: 
 
 
 def plot_pin_polars(fa: ForceAnalysis, axes: Any) -> Any:
-    """Polar plots of the force at each pin over the cycle (four polar axes: O2, A, B, O4):
-    angle = direction of the force, radius = its magnitude [N]."""
+    """Plot the force at each pin over the cycle on polar axes.
+
+    Angle = direction of the force, radius = its magnitude in N; with balancing, the
+    unbalanced linkage's dashed.
+
+    Parameters
+    ----------
+    fa : ForceAnalysis
+        The forces (:func:`analyse`).
+    axes : sequence of matplotlib.axes.Axes
+        Four polar axes: O2, A, B, O4.
+
+    Returns
+    -------
+    sequence of matplotlib.axes.Axes
+        ``axes``.
+    """
     names = ("O2 (ground on crank)", "A (crank on coupler)", "B (coupler on rocker)", "O4 (ground on rocker)")
     for j, ax in enumerate(np.ravel(axes)[:4]):
         fx = np.where(fa.ok, fa.forces[:, 1 + 2 * j], np.nan)
@@ -647,8 +682,24 @@ def plot_pin_polars(fa: ForceAnalysis, axes: Any) -> Any:
 
 
 def plot_shaking(theta: np.ndarray, fa: ForceAnalysis, ax: Any, polar_ax: Any | None = None) -> Any:
-    """Shaking force magnitude against crank angle (``ax``) and its locus F_y against F_x
-    (``polar_ax``, equal axes), before and after balancing."""
+    """Plot the shaking force magnitude against crank angle, and its locus, before and after balancing.
+
+    Parameters
+    ----------
+    theta : numpy.ndarray
+        Crank angles, deg.
+    fa : ForceAnalysis
+        The forces (:func:`analyse`).
+    ax : matplotlib.axes.Axes
+        Axes for |shaking force| (N) against crank angle (deg).
+    polar_ax : matplotlib.axes.Axes, optional
+        Axes for the locus F_y against F_x (N, equal scales).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        ``ax``.
+    """
     before = fa.unbalanced if fa.unbalanced is not None else fa.forces
     s = np.where(fa.ok[:, None], before[:, 9:11], np.nan)
     ax.plot(theta, np.hypot(*s.T), color="C0", label="unbalanced")
