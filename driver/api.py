@@ -124,13 +124,12 @@ def write(result: Result, outdir: str | os.PathLike, formats: Iterable[str] = ()
     Returns
     -------
     list of pathlib.Path
-        The files written, in order: ``<outdir>/<name>.out`` first, then extra files, tables,
-        figures, JSON and report page.
+        The files written, in order, ``<outdir>/<name>.out`` first.
 
     Raises
     ------
     ValueError
-        ``name`` is a path rather than a file stem, or a format is unknown.
+        ``name`` is a path rather than a file stem, or a table or figure format is unknown.
 
     Examples
     --------

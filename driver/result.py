@@ -122,7 +122,7 @@ class Result:
         Returns
         -------
         matplotlib.figure.Figure
-            The figure, axes labelled with their units.
+            The figure, drawn in the house style.
 
         Raises
         ------

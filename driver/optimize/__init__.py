@@ -98,9 +98,9 @@ class OptimizeOutcome(Outcome):
     method : MethodResult
         What the method returned (iterations, convergence, starts, polish).
     history : list of HistoryRow
-        The designs in the order evaluated.
+        The best feasible design after each generation, iteration or grid batch.
     evaluator : Evaluator
-        The cache of evaluated designs.
+        Every design evaluated (``evaluator.frame()``: feasibility, reason, margins, summary).
     study_result : Result or None
         The study's full run at the optimum.
     """

@@ -162,9 +162,10 @@ def slidercrank_matrices(n_elements: int, crank_radius: float, rod_length: float
     Returns
     -------
     mass : numpy.ndarray
-        (6, 3 n) banded mass, LAPACK lower band storage; kg (kg m^2 for rotations).
+        (6, 3 n) banded mass, LAPACK lower band storage: kg, kg m or kg m^2 as an entry
+        couples translations and rotations.
     stiffness : numpy.ndarray
-        (6, 3 n) banded stiffness, the same storage; N/m (N m for rotations).
+        (6, 3 n) banded stiffness, the same storage: N/m, N or N m likewise.
     """
     mb, kb = _kernels.slidercrank.assemble_matrices(
         int(n_elements), 3 * int(n_elements), crank_radius, rod_length, rho_a, ea, ei, slider_mass,
@@ -425,7 +426,7 @@ def slidercrank_corot_element(le: float, ea: float, ei: float, p: np.ndarray,
     force : numpy.ndarray
         (6,) nodal forces and moments, N and N m.
     tangent : numpy.ndarray
-        (6, 6) tangent stiffness, N/m (N, N m for the rotational entries).
+        (6, 6) tangent stiffness: N/m, N or N m as an entry couples translations and rotations.
     strain : float
         Axial strain, dimensionless.
     curvature : float

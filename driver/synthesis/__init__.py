@@ -174,8 +174,9 @@ class Synthesis:
     design : object
         The task's design object (function, family member or path design).
     checks : dict of str to float
-        The exact kernel's checks, units in the names (``swing_deg``, ``mu_min_deg``; the
-        errors in the length unit, ``time_ratio`` dimensionless).
+        The checks of the design, units in the names where they have one (``swing_deg``,
+        ``mu_min_deg``; ``time_ratio`` dimensionless; a path's ``rms`` and ``max_error`` in the
+        length unit of the targets, a function's ``max_error_y`` in the units of y).
     warnings : list of str
         A degenerate or poor design, in words.
     """

@@ -200,7 +200,7 @@ class StartRun:
     x0, x : numpy.ndarray
         Start and end point of the free variables, rad.
     f : float
-        Objective at ``x`` divided by the run's scale, dimensionless.
+        The objective at ``x`` (not scaled), dimensionless.
     nit, nfev, njev : int
         SLSQP iterations, objective and gradient evaluations.
     success : bool
