@@ -95,13 +95,17 @@ def unit_text(units: str) -> str:
 
 def _sentence(name: str, doc: str) -> str:
     """A key's description as a sentence starting with a capital letter (numpydoc PR08): the
-    SPEC's words, led by the key's name where they start with a quote, a bracket or a symbol."""
+    SPEC's words, led by the key's name where they start with a quote, a bracket or a symbol
+    (a symbol's case is its meaning: ``m_B`` is not ``M_B``, so it is never capitalised)."""
     words = name.replace("_", " ")
+    label = words[0].upper() + words[1:]
     text = doc.strip() or words
+    first = text.split()[0].rstrip(",:;")
+    symbol = first[:1].islower() and (any(c.isdigit() or c == "_" for c in first) or (len(first) == 1 and first != "a"))
     if text.startswith("("):
-        text = f"{words[0].upper()}{words[1:]} {text}"
-    elif not text[0].isalpha():
-        text = f"{words[0].upper()}{words[1:]}: {text}"
+        return f"{label} {text}"
+    if not text[0].isalpha() or symbol:
+        return f"{label}: {text}"
     return text[0].upper() + text[1:]
 
 
