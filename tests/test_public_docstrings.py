@@ -6,7 +6,8 @@ sweep, optimize, synthesis) and of :mod:`driver.outcome` (the outcome types the 
 recursing into the modules those ``__all__`` export (``driver.fourbar.forces``, the kernel
 wrappers).  Each function and class found there, and each public method and property a public
 class defines, is validated with :func:`numpydoc.validate.validate`.  A new public name without
-a docstring (GL08) fails here.
+a docstring (GL08) fails here.  Public data (``SPEC``, ``STUDY``, tables of constants) has no
+docstring of its own and is described by the ``#:`` comment above it; it is not validated.
 
 Checks enforced (:data:`CHECKS`):
 
@@ -97,6 +98,7 @@ def public_names() -> dict[str, object]:
 
 PUBLIC = public_names()
 
+
 def _class_parameters_documented(name: str, cls: type) -> list[str]:
     """PR01/PR02 for a class: constructor parameters under Parameters or Attributes (its own or a base's)."""
     if issubclass(cls, enum.Enum):
@@ -114,8 +116,8 @@ def _class_parameters_documented(name: str, cls: type) -> list[str]:
                        for n in entry.name.split(",")}
     errors = [f"PR01 class parameter {p!r} not documented (Parameters or Attributes)"
               for p in wanted if p not in documented]
-    errors += [f"PR02 unknown parameter {entry.name!r}" for entry in doc["Parameters"]
-               if entry.name.strip().lstrip("*") not in sig.parameters]
+    errors += [f"PR02 unknown parameter {n.strip()!r}" for entry in doc["Parameters"] for n in entry.name.split(",")
+               if n.strip().lstrip("*") not in sig.parameters]
     return errors
 
 
