@@ -24,7 +24,8 @@ from typing import Any, TypeVar
 
 from driver.deck import GroupSpec, Key
 
-__all__ = ["NOT_GIVEN", "key_type", "run_docstring", "run_signature", "keyword_signature", "render_module"]
+__all__ = ["NOT_GIVEN", "key_type", "unit_text", "run_docstring", "run_signature", "keyword_signature",
+           "render_module"]
 
 #: the Python type of each Key.kind, as annotation text (driver/_keywords.py imports these names)
 KIND_TYPES = {
@@ -81,6 +82,33 @@ def _default_text(key: Key) -> str:
     return _py(key.default)
 
 
+#: how a SPEC unit reads in a docstring: dimensionless marks become a word, the four-bar's
+#: free length unit says what it is; any other unit is printed as the SPEC gives it
+UNIT_WORDS = {"1": "dimensionless", "-": "dimensionless", "length": "length unit of the deck"}
+
+
+def unit_text(units: str) -> str:
+    """How a key's SPEC ``units`` read in its docstring entry: ``'[rad/s]'``, ``'[dimensionless]'``,
+    or ``''`` for a key without units (text, counts, switches)."""
+    return f"[{UNIT_WORDS.get(units, units)}]" if units else ""
+
+
+def _sentence(name: str, doc: str) -> str:
+    """A key's description as a sentence starting with a capital letter (numpydoc PR08): the
+    SPEC's words, led by the key's name where they start with a quote, a bracket or a symbol
+    (a symbol's case is its meaning: ``m_B`` is not ``M_B``, so it is never capitalised)."""
+    words = name.replace("_", " ")
+    label = words[0].upper() + words[1:]
+    text = doc.strip() or words
+    first = text.split()[0].rstrip(",:;")
+    symbol = first[:1].islower() and (any(c.isdigit() or c == "_" for c in first) or (len(first) == 1 and first != "a"))
+    if text.startswith("("):
+        return f"{label} {text}"
+    if not text[0].isalpha() or symbol:
+        return f"{label}: {text}"
+    return text[0].upper() + text[1:]
+
+
 def _entry(name: str, key: Key) -> list[str]:
     """The numpydoc entry of one key: ``name : type, default X`` and its description with units."""
     if key.choices:
@@ -91,11 +119,9 @@ def _entry(name: str, key: Key) -> list[str]:
         kind = KIND_WORDS[key.kind]
     head = f"{name} : {kind}" + (f", default {_default_text(key)}" if _has_default(key) else
                                   "" if key.required else ", optional")
-    text = key.doc or name.replace("_", " ")
-    if key.units and key.units != "1":
-        text += f" [{key.units}]"
-    elif key.units == "1":
-        text += " [-]"
+    text = _sentence(name, key.doc)
+    if key.units:
+        text += f" {unit_text(key.units)}"
     text += "." if not text.endswith(".") else ""
     if key.required:
         text += " Required."
@@ -104,12 +130,28 @@ def _entry(name: str, key: Key) -> list[str]:
 
 
 def run_docstring(spec: GroupSpec, summary: str = "") -> str:
-    """Numpydoc docstring of a study's ``run``: ``summary``, then every key of ``spec``."""
-    head = inspect.cleandoc(summary) or f"Run the &{spec.name} study: {spec.doc}."
-    lines = [head, "",
+    """Numpydoc docstring of a study's ``run``: ``summary``, then every key of ``spec``.
+
+    Parameters
+    ----------
+    spec : GroupSpec
+        The study's deck keys: each becomes a Parameters entry with its type, default (or
+        "Required."), allowed values and units in brackets (:func:`unit_text`).
+    summary : str, optional
+        The run's own docstring: a one-line summary and any paragraphs after it.  An
+        ``Examples`` section in it is moved to the end, after Returns and Raises.
+
+    Returns
+    -------
+    str
+        The docstring (numpydoc), ending with a newline.
+    """
+    text = inspect.cleandoc(summary) or f"Run the &{spec.name} study: {spec.doc}."
+    text, _, examples = text.partition("\nExamples\n--------\n")
+    lines = [text.rstrip(), "",
              f"Give either validated ``params`` (the runner's call) or the keys of a ``&{spec.name}``",
-             "deck group as keyword arguments: they are checked exactly like a deck (a bad value",
-             "raises :class:`driver.deck.DeckError` naming the key).", "",
+             "deck group as keyword arguments, in the deck's units: they are checked exactly like a deck.",
+             "Units are in brackets after each key's description.", "",
              "Parameters", "----------",
              "params : Params, optional",
              f"    Validated values of a ``&{spec.name}`` group (positional only; then no keys).",
@@ -119,7 +161,13 @@ def run_docstring(spec: GroupSpec, summary: str = "") -> str:
         lines += _entry(name, key)
     lines += ["", "Returns", "-------", "Result",
               "    The run's fixed-format text, tidy table, summary, figures and warnings",
-              "    (:class:`driver.study.Result`)."]
+              "    (:class:`driver.Result`); units in the tidy and summary column names.",
+              "", "Raises", "------", "DeckError",
+              "    A key is unknown, missing or has a bad value (the message names the key).",
+              "TypeError",
+              "    Both ``params`` and keys are given."]
+    if examples.strip():
+        lines += ["", "Examples", "--------", examples.strip("\n")]
     return "\n".join(lines) + "\n"
 
 

@@ -40,13 +40,51 @@ __all__ = ["run", "run_sweep", "write", "studies", "keys", "Result", "SweepResul
 # ----------------------------------------------------------------------------- single runs
 
 def run(source: DeckSource, *, name: str | None = None, progress: bool = False) -> Result:
-    """Run one study and return its :class:`~driver.study.Result` (nothing is written).
+    """Run one study deck and return its result (nothing is written).
 
-    ``source`` is a deck file (``"inputs/crank5.dat"``), a deck's text (``"&fourbar ... /"``)
-    or a dict ``{"fourbar": {"crank": 5, ...}}`` with the deck's keys and units.  ``name`` is
-    the output stem for :func:`write` (default: the deck's file stem, or the study
-    group for text and dicts).  Raises :class:`DeckError` for bad input, with the deck, line
-    and key; a deck with a ``&sweep`` group is run by :func:`run_sweep`.
+    The deck goes through the runner exactly as on the command line (``python -m driver
+    DECK``): the same validation, the same study code, the same tables.
+
+    Parameters
+    ----------
+    source : str, path-like or dict
+        A deck file (``"inputs/crank5.dat"``), a deck's text (``"&fourbar ... /"``) or a dict
+        of groups ``{"fourbar": {"crank": 5, ...}}``, with the deck's keys in the deck's units
+        (``driver.keys(group)`` lists them with their units).
+    name : str, optional
+        Output stem for :func:`write`; default the deck's file stem, or the study group for a
+        deck's text or a dict.
+    progress : bool, default False
+        Show a progress bar on the terminal.
+
+    Returns
+    -------
+    Result
+        The run's fixed-format text, tidy table, summary, figures and warnings; units are in
+        the tidy and summary column names (``omega3_rad_s``) or ``tidy.attrs["units"]``.
+
+    Raises
+    ------
+    DeckError
+        Bad input (names the deck, line and key), or a deck with a ``&sweep``, ``&optimize``
+        or ``&synthesis`` group (run those with :func:`run_sweep`, ``driver.optimize.optimize``
+        or ``driver.synthesis.synthesise``).
+
+    See Also
+    --------
+    run_sweep : Run a study over many cases.
+    write : Write a result's files as the command line does.
+
+    Examples
+    --------
+    >>> import driver
+    >>> r = driver.run({"fourbar": {"fixed_link": 12, "crank": 5, "coupler": 15, "rocker": 9,
+    ...                             "step_deg": 20}})
+    >>> r.study, r.name, r.ok
+    ('fourbar', 'fourbar', True)
+    >>> r = driver.run("inputs/crank5.dat")
+    >>> r.name, r.summary["grashof_class"]
+    ('crank5', 'crank-rocker')
     """
     deck = deck_of(source, name)
     engine = engine_of(deck)
@@ -62,12 +100,44 @@ def run(source: DeckSource, *, name: str | None = None, progress: bool = False) 
 
 def write(result: Result, outdir: str | os.PathLike, formats: Iterable[str] = (), plot: bool | str = False,
           json: bool = False, name: str | None = None, report: bool = False) -> list[Path]:
-    """Write the outputs the command line writes for a run's result: ``<outdir>/<name>.out`` and
-    extra files, tidy tables in ``formats`` ('csv', 'parquet'), figures with ``plot`` (True for
-    PNG, or 'svg', 'pdf'), the summary as ``<name>.json`` with ``json``, and the self-contained
-    report page ``<name>.html`` with ``report`` (as ``--report``).  ``name`` defaults to the
-    result's name (the deck's file stem).  Every file is written atomically; ``outdir`` is
-    created when missing.  Returns the paths written."""
+    """Write the files the command line writes for a run's result.
+
+    Every file is written atomically; ``outdir`` is created when missing.
+
+    Parameters
+    ----------
+    result : Result
+        What :func:`run` or ``driver.<study>.run`` returned.
+    outdir : str or path-like
+        Folder to write into.
+    formats : iterable of str, default ()
+        Tidy table formats: ``'csv'``, ``'parquet'`` (``<name>.csv``, ...).
+    plot : bool or str, default False
+        Write the figures: True for PNG, or ``'svg'``, ``'pdf'``.
+    json : bool, default False
+        Also write the summary as ``<name>.json`` (as ``--json``).
+    name : str, optional
+        Output stem, a plain file name; default the result's name (the deck's file stem).
+    report : bool, default False
+        Also write the self-contained report page ``<name>.html`` (as ``--report``).
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written, in order, ``<outdir>/<name>.out`` first.
+
+    Raises
+    ------
+    ValueError
+        ``name`` is a path rather than a file stem, or a table or figure format is unknown.
+
+    Examples
+    --------
+    >>> import driver
+    >>> r = driver.fourbar.run(fixed_link=12, crank=5, coupler=15, rocker=9, step_deg=20)
+    >>> [p.name for p in driver.write(r, tmp_path, formats=["csv"], json=True)]
+    ['fourbar.out', 'fourbar.csv', 'fourbar.json']
+    """
     stem = name or result.name or result.study or "result"
     if Path(stem).name != stem or stem in ("", ".", ".."):
         raise ValueError(f"output name {stem!r} must be a plain file stem, not a path")
@@ -80,13 +150,48 @@ def write(result: Result, outdir: str | os.PathLike, formats: Iterable[str] = ()
 
 
 def studies() -> dict[str, str]:
-    """The study groups this tool runs, with one line on each."""
+    """List the study groups this tool runs.
+
+    Returns
+    -------
+    dict of str to str
+        Namelist group (``'fourbar'``) -> one line on what the study does, in name order.
+
+    Examples
+    --------
+    >>> import driver
+    >>> sorted(driver.studies())
+    ['fourbar', 'manipulator', 'robust_example', 'slidercrank', 'ujoint']
+    """
     return {g: m.spec.doc for g, m in sorted(available_studies().items())}
 
 
 def keys(group: str) -> pd.DataFrame:
-    """The keys of a study group (the deck's and the keyword arguments'): kind, units, default,
-    whether required, allowed values and what each means; one row per key."""
+    """Tabulate the keys of a study group: the deck's keys and the keyword arguments of its ``run``.
+
+    Parameters
+    ----------
+    group : str
+        The study's namelist group, e.g. ``'fourbar'`` (a leading ``&`` and any case accepted).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per key, indexed by key: ``kind``, ``units`` (the SPEC's: ``'rad/s'``; ``'1'``
+        or ``'-'`` dimensionless; ``'length'`` the four-bar's free length unit; empty for
+        text, counts and switches), ``required``, ``default``, ``choices`` and ``doc``.
+
+    Raises
+    ------
+    KeyError
+        No study has that group.
+
+    Examples
+    --------
+    >>> import driver
+    >>> driver.keys("fourbar").loc["omega", ["units", "default"]].tolist()
+    ['rad/s', 1.0]
+    """
     from driver._study import load_study
     module = load_study(group.lstrip("&").lower())
     if module is None:
@@ -100,7 +205,8 @@ def keys(group: str) -> pd.DataFrame:
 
 # ----------------------------------------------------------------------------- sweeps
 
-#: what :func:`run_sweep` returns (the sweep engine's outcome, with its tables read back)
+#: what :func:`run_sweep` returns (the sweep engine's outcome, with its tables read back):
+#: :class:`driver.outcome.SweepOutcome`, documented there
 SweepResult = SweepOutcome
 
 
@@ -126,19 +232,76 @@ def run_sweep(source: DeckSource, grid: Mapping[str, Sequence[Any]] | None = Non
               outdir: str | os.PathLike | None = None, name: str | None = None,
               jobs: int | None = None, scheduler: Any = None, resume: bool = False,
               formats: Iterable[str] = (), plot: bool = False, progress: bool = False) -> SweepResult:
-    """Run a study over many cases and return the summary DataFrame (and more, :class:`SweepResult`).
+    """Run a study over many cases and return the sweep's summary and counts.
 
-    Either ``source`` is a deck with a ``&sweep`` group (file, text or dict with a "sweep"
-    entry), or ``grid`` gives the keys to vary in Python, ``{"crank": [2, 3, 4, 5]}``
-    (``"group.key"`` or the study's key alone; arrays welcome), with the &sweep options
-    ``zip``, ``keep`` (a filter on the summary columns), ``case_outputs``, ``summary_rows``
-    and ``chunk`` as keywords.  Execution options are the command line's: ``jobs`` worker
-    processes (default all cores; 1 runs in this process), ``scheduler`` a Dask scheduler
-    address or ``dask.distributed.Client``, ``resume``, ``formats``, ``plot``.
+    Either ``source`` is a deck with a ``&sweep`` group, or ``grid`` gives the keys to vary in
+    Python with the ``&sweep`` options as keywords.  Files are written to ``outdir`` exactly as
+    ``python -m driver DECK -o OUTDIR`` writes them; without ``outdir`` they go to a temporary
+    folder that is removed after the tables are read back.
 
-    Files are written to ``outdir`` exactly as ``python -m driver DECK -o OUTDIR`` writes
-    them; without ``outdir`` they go to a temporary folder that is removed after the tables
-    are read back.  Raises :class:`DeckError` for bad input before any case runs.
+    Parameters
+    ----------
+    source : str, path-like or dict
+        A deck file, a deck's text or a dict of groups (with a ``"sweep"`` entry unless
+        ``grid`` is given); keys in the deck's units.
+    grid : mapping of str to sequence, optional
+        The keys to vary and their values, ``{"crank": [2, 3, 4, 5]}`` (``"group.key"`` or the
+        study's key alone; arrays welcome), in the keys' deck units.
+    zip : bool, optional
+        Vary the keys together (case k takes value k of each) instead of over their product.
+    keep : str, optional
+        A filter on the summary columns in the deck expression language
+        (``"mu_min_deg > 15"``): the cases kept.
+    case_outputs : {'all', 'kept', 'none'}, optional
+        Which cases get their own ``.out``/``.parquet``/``.json`` files; default ``'all'``.
+    summary_rows : {'all', 'kept'}, optional
+        Which cases go into the ``_summary`` tables; default ``'all'``.
+    chunk : int, optional
+        Cases per task; default 0, chosen by the tool.
+    outdir : str or path-like, optional
+        Folder for the sweep's files; default a temporary folder, removed afterwards.
+    name : str, optional
+        Output stem; default the deck's file stem.
+    jobs : int, optional
+        Worker processes; default all cores, 1 runs in this process.
+    scheduler : str or dask.distributed.Client, optional
+        A Dask scheduler address or client to run the cases on.
+    resume : bool, default False
+        Reuse the cases a previous run into ``outdir`` completed (verified, never believed).
+    formats : iterable of str, default ()
+        Tidy table formats of the case files: ``'csv'``, ``'parquet'``.
+    plot : bool, default False
+        Write the sweep's figures (PNG).
+    progress : bool, default False
+        Show a progress bar on the terminal.
+
+    Returns
+    -------
+    SweepResult
+        ``summary`` (one row per case: the swept keys, status, kept, the study's headline
+        figures with units in their names), ``kept``, ``cases``, ``out``, ``status`` (the
+        command line's exit status) and the counts ``n_cases``, ``n_ok``, ``n_kept``,
+        ``n_failed``; ``seconds`` the cases' wall time in s.
+
+    Raises
+    ------
+    DeckError
+        Bad input (an unknown key, a filter that is not an expression on the summary
+        columns, no ``&sweep`` group and no ``grid``), before any case runs.
+    ValueError
+        ``jobs`` below 1 or an unknown table format.
+
+    See Also
+    --------
+    run : Run one case.
+
+    Examples
+    --------
+    >>> import driver
+    >>> s = driver.run_sweep({"fourbar": {"fixed_link": 12, "crank": 2, "coupler": 15, "rocker": 9,
+    ...                                   "step_deg": 20}}, grid={"crank": [2, 3, 4, 5]}, jobs=1)
+    >>> s.n_cases, s.status, s.summary["fourbar.crank"].tolist()
+    (4, 0, [2, 3, 4, 5])
     """
     deck = deck_of(source, name)
     options = {"zip": zip, "keep": keep, "case_outputs": case_outputs, "summary_rows": summary_rows,

@@ -19,8 +19,18 @@ KINDS = ("float", "int", "str", "bool", "floats", "ints", "strs", "list")
 class DeckError(ValueError):
     """Bad input: names the deck, the line and the key (exit status 2).
 
-    Attributes ``path``, ``line`` (None when unknown) and ``key`` (None for the whole group)
-    locate the problem; ``message`` says what it is.
+    A ``ValueError``; ``str()`` is ``'<path>:<line>: key '<key>': <message>'``.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The deck (or a label such as the study group for keyword arguments).
+    line : int or None
+        Line of the deck where the problem is; None when unknown.
+    key : str or None
+        The key at fault; None for the whole group.
+    message : str
+        What is wrong.
     """
 
     def __init__(self, path: str | Path, line: int | None, key: str | None, message: str):

@@ -37,8 +37,17 @@ class ExitCode(enum.IntEnum):
 
 @dataclass(frozen=True)
 class Message:
-    """A warning or an error an engine reports, as data: ``level`` ('warning' or 'error') and
-    ``text`` (which names the deck where it concerns one).  ``str()`` is the command line's line."""
+    """A warning or an error an engine reports, as data.
+
+    ``str()`` is the line the command line prints (``'warning: ...'``).
+
+    Parameters
+    ----------
+    level : {'warning', 'error'}
+        How bad it is.
+    text : str
+        What happened; names the deck where it concerns one.
+    """
 
     level: str
     text: str
@@ -49,11 +58,18 @@ class Message:
 
 @dataclass(kw_only=True)
 class Outcome:
-    """What an engine did.
+    """What an engine did: the base of every outcome.
 
-    written   the files written, in order
-    messages  warnings and errors (:class:`Message`), in the order they arose
-    notes     progress lines a terminal shows unless asked to be quiet ("resume: ...")
+    Parameters
+    ----------
+    written : list of pathlib.Path, optional
+        The files written, in order.
+    messages : list of Message, optional
+        Warnings and errors, in the order they arose.
+    notes : list of str, optional
+        Progress lines a terminal shows unless asked to be quiet (``"resume: ..."``).
+    late_failure : bool, default False
+        A failure after the engine's run (its report page could not be written): exit status 1.
     """
 
     written: list[Path] = field(default_factory=list)
@@ -73,35 +89,65 @@ class Outcome:
         return self.exit_code == ExitCode.OK
 
     def warn(self, text: str) -> None:
+        """Record a warning.
+
+        Parameters
+        ----------
+        text : str
+            The warning, naming the deck where it concerns one.
+        """
         self.messages.append(Message("warning", text))
 
     def error(self, text: str) -> None:
+        """Record an error.
+
+        Parameters
+        ----------
+        text : str
+            The error, naming the deck where it concerns one.
+        """
         self.messages.append(Message("error", text))
 
 
 @dataclass(kw_only=True)
 class RunOutcome(Outcome):
-    """One study run (:func:`driver.runner.run_study`): its :class:`~driver.study.Result` and the
-    files written.  The result's warnings and failure are the result's own (``result.warnings``,
-    ``result.failure``); the exit status is 1 when it failed."""
+    """One study run: its result and the files written.
+
+    The result's warnings and failure are the result's own (``result.warnings``,
+    ``result.failure``); the exit status is 1 when it failed.
+
+    Parameters
+    ----------
+    result : Result
+        What the study's run produced.
+    """
 
     result: Result
 
     @property
     def exit_code(self) -> ExitCode:
+        """The exit status: 1 when the run failed, else the outcome's (see :class:`ExitCode`)."""
         return ExitCode.FAILED if self.result.failure else super().exit_code
 
 
 @dataclass(kw_only=True)
 class FilesOutcome(Outcome):
-    """A deck whose engine writes a set of files and may fail after writing them (a synthesis):
-    ``failure`` (None: success) and the engine's own object as ``value``."""
+    """What an engine that writes a set of files and may fail after writing them did (a synthesis).
+
+    Parameters
+    ----------
+    failure : str or None, optional
+        Why the engine's result failed its check; None on success.
+    value : object, optional
+        The engine's own result (a :class:`driver.synthesis.Synthesis`).
+    """
 
     failure: str | None = None
     value: Any = None
 
     @property
     def exit_code(self) -> ExitCode:
+        """The exit status: 1 when the engine's result failed, else the outcome's."""
         return ExitCode.FAILED if self.failure else super().exit_code
 
 
@@ -109,26 +155,53 @@ class FilesOutcome(Outcome):
 class SweepOutcome(Outcome):
     """What a sweep did (:func:`driver.sweep.run_sweep_deck`, :func:`driver.run_sweep`).
 
-    deck       the sweep deck's path; ``name`` its stem (the outputs' names)
-    outdir     where the files are (None from :func:`driver.run_sweep` without ``outdir``: they
-               were written to a temporary folder, now gone)
-    n_cases    cases of the sweep; ``n_ok``, ``n_kept`` (by the deck's ``keep`` filter),
-               ``n_failed`` of them
-    n_resumed  cases found complete in the resume record (``--resume``) and not run again;
-               ``n_redone`` cases run again because their record or files failed a check
-    failed     the failed cases: (case, {swept key: value}, error); all of them, or the first
-               ones when the batch path streamed its tables (``n_failed`` counts them all);
-               ``bad_input``: some had bad values
-    batch      True when the study's batch path ran the sweep (else case by case)
-    workers    where the cases ran ("2 worker(s)", "dask ADDRESS"); ``chunk`` cases per task
-    seconds    wall time of the cases [s]
-    phases     the driver's CPU time per phase [s] (prepare_cpu, run_cpu, finish_cpu ...; the
-               benchmarks read it)
+    ``driver.SweepResult`` is this class.  ``summary``, ``cases`` and ``text`` are filled by
+    :func:`driver.run_sweep`, which reads the tables back.
 
-    From :func:`driver.run_sweep` also: ``summary`` (one row per case: case number, the swept
-    keys, status, kept, the study's headline figures, error), ``cases`` (the tidy rows of every
-    case that wrote its outputs, a column per swept key; None when no case did) and ``text``
-    (the fixed-format summary ``.out``).
+    Attributes
+    ----------
+    deck : str
+        The sweep deck's path.
+    name : str
+        Its stem (the outputs' names).
+    outdir : pathlib.Path or None
+        Where the files are; None from :func:`driver.run_sweep` without ``outdir`` (they were
+        written to a temporary folder, now gone).
+    n_cases : int
+        Cases of the sweep.
+    n_ok : int
+        Cases that succeeded.
+    n_kept : int
+        Cases the deck's ``keep`` filter kept.
+    n_resumed : int
+        Cases found complete in the resume record (``--resume``) and not run again.
+    n_redone : int
+        Cases run again because their record or files failed a check.
+    n_failed : int
+        Cases that failed.
+    failed : list of tuple
+        The failed cases as ``(case, {swept key: value}, error)``; all of them, or the first
+        ones when the batch path streamed its tables (``n_failed`` counts them all).
+    bad_input : bool
+        Some cases had bad values (exit status 2).
+    batch : bool
+        The study's batch path ran the sweep (else case by case).
+    workers : str
+        Where the cases ran (``"2 worker(s)"``, ``"dask ADDRESS"``).
+    chunk : int
+        Cases per task.
+    seconds : float
+        Wall time of the cases, s.
+    phases : dict of str to float
+        The driver's CPU time per phase (``prepare_cpu``, ``run_cpu``, ``finish_cpu`` ...), s.
+    summary : pandas.DataFrame or None
+        One row per case: case number, the swept keys, status, kept, the study's headline
+        figures (units in their names), error.
+    cases : pandas.DataFrame or None
+        The tidy rows of every case that wrote its outputs, a column per swept key; None
+        when no case did.
+    text : str
+        The fixed-format summary ``.out``.
     """
 
     deck: str = ""

@@ -43,19 +43,35 @@ class Figure:
 class Result:
     """Everything one deck run produced.
 
-    text      the fixed-format ``.out`` file content
-    tidy      tidy table (one row per output point) for CSV/Parquet
-    summary   headline figures of the case (flat dict of scalars; used by sweeps)
-    warnings  messages for the terminal (also written into ``text`` by the study)
-    failure   set when the run completed but did not succeed (e.g. an optimiser
-              did not converge): outputs are written, the exit status is 1
-    figures   figures for --plot (drawn only on demand: :meth:`figure`)
-    extra     further files: suffix -> text, written as ``<stem><suffix>``
-    name      output stem (the deck's file stem; set by the runner)
-    study     namelist group of the study (set by the runner)
+    What :func:`driver.run` and ``driver.<study>.run`` return.  Units are those of the study's
+    deck keys; tidy and summary columns carry them in their names (``theta_deg``,
+    ``omega3_rad_s``, ``tau1_Nm``) or in ``tidy.attrs["units"]``.
 
-    Units are those of the study's deck keys; tidy and summary columns carry
-    them in their names (``omega3_rad_s``) or in ``tidy.attrs["units"]``.
+    Attributes
+    ----------
+    text : str
+        The fixed-format ``.out`` file content (also :attr:`out`).
+    tidy : pandas.DataFrame
+        Tidy table, one row per output point, for CSV/Parquet; units in the column names or
+        in ``tidy.attrs["units"]`` (``'1'`` dimensionless).
+    summary : dict
+        Headline figures of the case, a flat dict of scalars (used by sweeps); units in the
+        names; None for a figure that does not exist.
+    warnings : list of str
+        Messages for the terminal (also written into ``text`` by the study).
+    failure : str or None
+        Set when the run completed but did not succeed (e.g. an optimiser did not converge):
+        outputs are written, the exit status is 1.
+    figures : list of Figure
+        Figures for ``--plot``, drawn only on demand (:meth:`figure`).
+    extra : dict of str to str
+        Further files: suffix -> text, written as ``<stem><suffix>``.
+    name : str
+        Output stem (the deck's file stem; set by the runner).
+    study : str
+        Namelist group of the study (set by the runner).
+    params : Params or None
+        The validated deck keys the run was made from (set by the runner).
     """
 
     text: str
@@ -93,10 +109,25 @@ class Result:
         return [f.name for f in self.figures]
 
     def figure(self, name: str | None = None) -> matplotlib.figure.Figure:
-        """Draw one figure (the first when ``name`` is None) as a new matplotlib Figure.
+        """Draw one figure of the run as a new matplotlib Figure.
 
         It is drawn in the house style inside an ``rc_context``; the matplotlib backend and
         the global rcParams are left as they were (figures show inline in Jupyter).
+
+        Parameters
+        ----------
+        name : str, optional
+            One of :attr:`figure_names`; default the first.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            The figure, drawn in the house style.
+
+        Raises
+        ------
+        LookupError
+            The result has no figures, or none called ``name``.
         """
         if not self.figures:
             raise LookupError(f"{self.name or 'this result'} has no figures")

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from driver._signatures import NOT_GIVEN
+from driver._signatures import NOT_GIVEN, unit_text
 from driver.deck import DeckError, GroupSpec
 from driver.runner import available_studies
 
@@ -96,8 +96,8 @@ def test_help_lists_keys_units_defaults_and_choices(group):
             assert head.endswith(f"default {key.default!r}".replace("'", '"')) or "default [" in head, (name, head)
         else:
             assert head.endswith("optional"), (name, head)
-        if key.units and key.units != "1":
-            assert f"[{key.units}]" in desc, (name, key.units, desc)
+        if key.units:   # "[rad/s]"; "1" and "-" read "[dimensionless]"
+            assert unit_text(key.units) in desc, (name, key.units, desc)
         for choice in key.choices or ():
             assert repr(choice).replace("'", '"') in head, (name, choice)
 

@@ -21,7 +21,19 @@ ST = kernel.FOURBAR_STATUS
 
 @dataclass
 class Grashof:
-    """Grashof classification of a four-bar (Norton's classes)."""
+    """Grashof classification of a four-bar (Norton's classes).
+
+    Attributes
+    ----------
+    name : str
+        The class: ``'crank-rocker'``, ``'double-crank (drag link)'``, ``'rocker-crank'``,
+        ``'Grashof double-rocker'``, ``'change-point (special Grashof)'`` or
+        ``'non-Grashof triple-rocker'``.
+    condition : str
+        The Grashof inequality with the lengths, ``'S + L = ... < P + Q = ...'``.
+    full_crank_rotation : bool
+        The crank turns fully.
+    """
 
     name: str
     condition: str
@@ -29,7 +41,24 @@ class Grashof:
 
 
 def grashof(p: float, q: float, r: float, s: float) -> Grashof:
-    """Class from link lengths (p ground, q crank, r coupler, s rocker)."""
+    """Classify a four-bar by Grashof's condition from its link lengths.
+
+    Parameters
+    ----------
+    p, q, r, s : float
+        Link lengths: ground (fixed link), crank, coupler, rocker, in one length unit.
+
+    Returns
+    -------
+    Grashof
+        The class, the condition with the lengths, and whether the crank turns fully.
+
+    Examples
+    --------
+    >>> from driver.fourbar import grashof
+    >>> grashof(12, 5, 15, 9).name
+    'crank-rocker'
+    """
     links = {"ground": p, "crank": q, "coupler": r, "rocker": s}
     srt = sorted(links.values())
     short, long_ = srt[0], srt[-1]
@@ -48,7 +77,18 @@ def grashof(p: float, q: float, r: float, s: float) -> Grashof:
 
 
 def limit_angles(p: float, q: float, r: float, s: float) -> list[float]:
-    """Crank angles [deg, 0..360) where |A O_B| = r + s or |r - s| (toggle / assembly limits)."""
+    """Find the crank angles of the limit (toggle) positions: |A O_B| = r + s or |r - s|.
+
+    Parameters
+    ----------
+    p, q, r, s : float
+        Link lengths: ground (fixed link), crank, coupler, rocker, in one length unit.
+
+    Returns
+    -------
+    list of float
+        The crank angles, deg in [0, 360), ascending; empty when the crank turns fully.
+    """
     out = []
     for d in (r + s, abs(r - s)):
         c = (p * p + q * q - d * d) / (2 * p * q)
@@ -59,12 +99,33 @@ def limit_angles(p: float, q: float, r: float, s: float) -> list[float]:
 
 
 def assembly_intervals(p: float, q: float, r: float, s: float) -> list[tuple[float, float]] | None:
-    """Crank-angle intervals [deg] over which the linkage assembles, from the closed form
-    (r - s)^2 <= |A O_B|^2 = p^2 + q^2 - 2 p q cos(theta) <= (r + s)^2; each ends at two limit
-    (toggle) positions.  None when the crank turns fully; [] when it cannot be assembled at all.
-    An interval through 0 deg is one interval (lo < 0 < hi), not two; a Grashof double-rocker
-    gives two, mirror images about the ground line (separate motions: one cannot reach the
-    other without taking the linkage apart)."""
+    """Find the crank-angle intervals over which the linkage assembles.
+
+    From the closed form (r - s)^2 <= |A O_B|^2 = p^2 + q^2 - 2 p q cos(theta) <= (r + s)^2;
+    each interval ends at two limit (toggle) positions.  An interval through 0 deg is one
+    interval (lo < 0 < hi), not two; a Grashof double-rocker gives two, mirror images about
+    the ground line (separate motions: one cannot reach the other without taking the linkage
+    apart).
+
+    Parameters
+    ----------
+    p, q, r, s : float
+        Link lengths: ground (fixed link), crank, coupler, rocker, in one length unit.
+
+    Returns
+    -------
+    list of tuple of float, or None
+        The intervals ``(lo, hi)`` of crank angle, deg; None when the crank turns fully,
+        ``[]`` when the linkage cannot be assembled at all.
+
+    Examples
+    --------
+    >>> from driver.fourbar import assembly_intervals
+    >>> assembly_intervals(12, 5, 15, 9) is None          # a crank-rocker: the crank turns
+    True
+    >>> [(round(lo, 4), round(hi, 4)) for lo, hi in assembly_intervals(10, 8, 3, 6)]  # a double-rocker
+    [(14.3615, 58.7516), (301.2484, 345.6385)]
+    """
     c_lo = (p * p + q * q - (r + s) ** 2) / (2 * p * q)   # cos(theta) at |A O_B| = r + s
     c_hi = (p * p + q * q - (r - s) ** 2) / (2 * p * q)   # cos(theta) at |A O_B| = |r - s|
     eps = 1e-12
@@ -83,13 +144,28 @@ def assembly_intervals(p: float, q: float, r: float, s: float) -> list[tuple[flo
 
 @dataclass
 class Motion:
-    """One motion of a linkage whose crank cannot turn: the crank swings from ``lo`` to ``hi``
-    on the deck's assembly branch, reverses at the limit position and swings back on the other
-    branch (at a limit the two branches meet: B lies on the line A-O_B).
+    """One motion of a linkage whose crank cannot turn fully.
 
-    ``theta`` [deg] the crank angles in the order they are passed, ``out``/``status`` the
-    kernel's states there, ``branch`` +1 (open) or -1 (crossed) per sample, ``stroke`` 0 for
-    the forward swing and 1 for the return."""
+    The crank swings from ``lo`` to ``hi`` on the deck's assembly branch, reverses at the limit
+    position and swings back on the other branch (at a limit the two branches meet: B lies on
+    the line A-O_B).
+
+    Attributes
+    ----------
+    lo, hi : float
+        The limit crank angles of the swing, deg.
+    theta : numpy.ndarray
+        The crank angles in the order they are passed, deg.
+    out : numpy.ndarray
+        The kernel's states there, (n, 11) (columns of ``driver.fourbar.kernel.fourbar_exact``:
+        angles in rad, positions in the deck's length unit, rad/s, rad/s^2).
+    status : numpy.ndarray
+        The kernel's status per sample (0 ok).
+    branch : numpy.ndarray
+        +1 (open) or -1 (crossed) per sample.
+    stroke : numpy.ndarray
+        0 for the forward swing, 1 for the return, per sample.
+    """
 
     lo: float
     hi: float
@@ -101,11 +177,25 @@ class Motion:
 
 
 def rocking_motions(p: Params, n_stroke: int = 181) -> list[Motion] | None:
-    """The motions of the deck's linkage when its crank cannot turn fully (None when it can):
-    per assembly interval (:func:`assembly_intervals`), ``n_stroke`` samples forward on the
+    """Trace the to-and-fro motions of a linkage whose crank cannot turn fully.
+
+    Per assembly interval (:func:`assembly_intervals`), ``n_stroke`` samples forward on the
     deck's branch and ``n_stroke`` back on the other, the ends a hair inside the limit angles
     (at the limit itself round-off may put A a ulp beyond reach).  Positions only: the
-    kernel's velocities assume the deck's constant crank speed (reversed on the return)."""
+    kernel's velocities assume the deck's constant crank speed (reversed on the return).
+
+    Parameters
+    ----------
+    p : Params
+        Validated ``&fourbar`` keys (lengths, ``branch``, ``omega`` in rad/s).
+    n_stroke : int, default 181
+        Samples per swing, cosine-spaced (dense at the limits).
+
+    Returns
+    -------
+    list of Motion, or None
+        One motion per assembly interval; None when the crank turns fully.
+    """
     spans = assembly_intervals(p.fixed_link, p.crank, p.coupler, p.rocker)
     if spans is None:
         return None
@@ -127,19 +217,63 @@ def rocking_motions(p: Params, n_stroke: int = 181) -> list[Motion] | None:
 
 
 def crank_angles(p: Params) -> np.ndarray:
-    """The requested crank angles [deg] (Fortran DO semantics: start, start+step, ... <= stop)."""
+    """Return the deck's crank angles (Fortran DO semantics: start, start + step, ... <= stop).
+
+    Parameters
+    ----------
+    p : Params
+        Validated ``&fourbar`` keys (``start_deg``, ``step_deg``, ``stop_deg``, deg).
+
+    Returns
+    -------
+    numpy.ndarray
+        The crank angles, deg.
+    """
     n = int(math.floor((p.stop_deg - p.start_deg) / p.step_deg + 1e-9)) + 1
     return p.start_deg + p.step_deg * np.arange(n)
 
 
 def exact_grid(p: Params, theta_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Closed-loop states at ``theta_deg`` (kernel columns, see kernel.fourbar_exact)."""
+    """Solve the closed loop at the given crank angles on the deck's branch.
+
+    Parameters
+    ----------
+    p : Params
+        Validated ``&fourbar`` keys (lengths, ``omega`` rad/s, ``alpha`` rad/s^2, ``branch``).
+    theta_deg : numpy.ndarray
+        Crank angles, deg.
+
+    Returns
+    -------
+    states : numpy.ndarray
+        (n, 11): coupler, rocker and transmission angle [rad]; xa, ya, xb, yb [length];
+        coupler and rocker angular velocity [rad/s] and acceleration [rad/s^2]
+        (``driver.fourbar.kernel.fourbar_exact``).
+    status : numpy.ndarray
+        (n,): 0 ok, 1 cannot be assembled, 2 toggle, 3 indeterminate.
+    """
     return kernel.fourbar_exact(np.radians(theta_deg), p.fixed_link, p.crank, p.coupler, p.rocker,
                                  p.omega, p.alpha, 1 if p.branch == "open" else -1)
 
 
 def coupler_point(p: Params, theta_deg: np.ndarray, out: np.ndarray, status: np.ndarray) -> np.ndarray | None:
-    """Position, velocity and acceleration of the deck's coupler point (None if it has none)."""
+    """Compute position, velocity and acceleration of the deck's coupler point.
+
+    Parameters
+    ----------
+    p : Params
+        Validated ``&fourbar`` keys (``coupler_point`` u, v in the length unit).
+    theta_deg : numpy.ndarray
+        Crank angles, deg.
+    out, status : numpy.ndarray
+        The states at ``theta_deg`` (:func:`exact_grid`).
+
+    Returns
+    -------
+    numpy.ndarray or None
+        (n, 6): x, y [length], vx, vy [length/s], ax, ay [length/s^2]; None when the deck
+        has no coupler point.
+    """
     if not p.coupler_point:
         return None
     u, v = p.coupler_point
@@ -147,7 +281,21 @@ def coupler_point(p: Params, theta_deg: np.ndarray, out: np.ndarray, status: np.
 
 
 def listing_grid(p: Params) -> tuple[np.ndarray, np.ndarray]:
-    """The published program's rows for the deck's crank angles."""
+    """Run the published program (Lampiran 1) for the deck's crank angles.
+
+    Parameters
+    ----------
+    p : Params
+        Validated ``&fourbar`` keys.
+
+    Returns
+    -------
+    table : numpy.ndarray
+        (n, 10), single precision as printed: crank angle, epsl, phi, beta [whole deg,
+        truncated]; xa, ya, xb, yb [length]; omr, oms [rad/s].
+    status : numpy.ndarray
+        (n,): 0 ok, 1 not assemblable, 2 velocities divide by zero.
+    """
     start, step = int(p.start_deg), int(p.step_deg)
     n = len(crank_angles(p))
     return kernel.fourbar_listing(p.fixed_link, p.crank, p.coupler, p.rocker, p.omega, start, step, n)
@@ -161,7 +309,31 @@ def deg360(rad: np.ndarray) -> np.ndarray:
 
 @dataclass
 class Extremes:
-    """Headline figures over the analysed crank range (exact solution), from the batch kernel."""
+    """Headline figures over the analysed crank range (exact solution), from the batch kernel.
+
+    Attributes
+    ----------
+    mu_min, mu_max : float
+        Smallest and largest transmission angle, deg.
+    mu_min_at, mu_max_at : float
+        Crank angles where they occur, deg.
+    rocker_min, rocker_max : float
+        Extreme rocker angles, deg.
+    rocker_min_at, rocker_max_at : float
+        Crank angles where they occur, deg.
+    w3_peak, w2_peak : float
+        Peak rocker and coupler angular velocity (signed), rad/s.
+    w3_peak_at, w2_peak_at : float
+        Crank angles where they occur, deg.
+    assembled_fraction : float
+        Fraction of the range where the linkage assembles, dimensionless.
+    rocker_turns : bool
+        The rocker turns fully (a double crank).
+    toggles : tuple of float
+        Limit (toggle) crank angles inside the range, deg.
+    rocker_swing : float
+        Rocker swing angle, deg.
+    """
 
     mu_min: float
     mu_min_at: float
@@ -191,13 +363,25 @@ def toggles_in_range(p: float, q: float, r: float, s: float, lo: float, hi: floa
 
 
 def extremes(p: Params, row: np.ndarray | None = None) -> Extremes | None:
-    """Transmission-angle, rocker-position and speed extremes over the deck's crank range.
+    """Find the transmission-angle, rocker-position and speed extremes over the deck's crank range.
 
     One row of the batch kernel (fortran/fourbar_summary.f90, see :func:`summarise_batch`),
     so a single run and a sweep report the same figures: transmission-angle and rocker
     extremes in closed form, peak speeds from a 1 deg scan refined to 1e-12 rad.
-    None when the linkage cannot be assembled anywhere in the range.  ``row``: the deck's row
-    of the summary kernel when the caller has it (:func:`driver.fourbar.batch.summary_rows`).
+
+    Parameters
+    ----------
+    p : Params
+        Validated ``&fourbar`` keys.
+    row : numpy.ndarray, optional
+        The deck's row of the summary kernel when the caller has it
+        (``driver.fourbar.batch.summary_rows``); computed otherwise.
+
+    Returns
+    -------
+    Extremes or None
+        The extremes (deg, rad/s); None when the linkage cannot be assembled anywhere in
+        the range.
     """
     lo, hi = sorted((p.start_deg, p.stop_deg))
     if row is None:
@@ -216,8 +400,27 @@ TIDY_UNITS = {"xa": "length", "ya": "length", "xb": "length", "yb": "length", "x
 
 def tidy_frame(method: str, theta: np.ndarray, cols: dict[str, np.ndarray], status: np.ndarray,
                not_closed: np.ndarray | None = None) -> pd.DataFrame:
-    """One row per crank angle; status in words ('loop_not_closed' where ``not_closed``: a
-    listing row whose |AB| is not the coupler length); unassemblable cells left empty (NaN)."""
+    """Build the tidy table of a run: one row per crank angle.
+
+    Parameters
+    ----------
+    method : str
+        ``'exact'`` or ``'listing'`` (the ``method`` column).
+    theta : numpy.ndarray
+        Crank angles, deg (the ``theta_deg`` column).
+    cols : dict of str to numpy.ndarray
+        Further columns, units in their names or in ``TIDY_UNITS`` (positions: length).
+    status : numpy.ndarray
+        Kernel status per row (0 ok, 1 cannot assemble, 2 toggle, 3 indeterminate).
+    not_closed : numpy.ndarray, optional
+        True for a listing row whose |AB| is not the coupler length (``loop_not_closed``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        The table, status in words; unassemblable cells left empty (NaN); units in
+        ``attrs["units"]``.
+    """
     words = np.array(["ok", "cannot_assemble", "toggle", "indeterminate", "loop_not_closed"])[
         np.where(not_closed, 4, status) if not_closed is not None else status]
     frame = pd.DataFrame({"method": method, "theta_deg": theta, **cols, "status": words})

@@ -102,7 +102,7 @@ def param_matrix(base: Mapping[str, Any], columns: Mapping[str, Any], n: int) ->
 
 def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None = None,
                     detail: bool = False, wanted: Collection[str] | None = None) -> pd.DataFrame:
-    """Summaries of many four-bar designs in one Fortran call: one row per design.
+    """Summarise many four-bar designs in one Fortran call: one row per design.
 
     ``base``: a validated ``&fourbar`` Params (or any mapping with the BATCH_KEYS).
     ``columns``: {key: array of n values} for keys in BATCH_KEYS (``'fourbar.crank'`` is
@@ -121,6 +121,31 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     A bad value raises DeckError (``base`` a deck's Params: deck, line and key of the base
     deck, the design's index in the message) or ValueError.  About 3 microseconds per design
     on one core with every column, 0.7 without the peak speeds (bench/bench_sweep.py).
+
+    Parameters
+    ----------
+    base : mapping
+        A validated ``&fourbar`` Params (or any mapping with the ``BATCH_KEYS``).
+    columns : mapping of str to array, optional
+        {key: n values} for keys in ``BATCH_KEYS``, in the deck's units (length unit, rad/s,
+        deg); scalars broadcast.
+    detail : bool, default False
+        Also the crank angles of the extremes, rocker extreme positions (deg) and toggle counts.
+    wanted : collection of str, optional
+        Only these columns; None: all.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per design, the columns above (units in their names: ``_deg``, ``_rad_s``).
+
+    Raises
+    ------
+    DeckError
+        A bad value, when ``base`` is a deck's Params (deck, line and key of the base deck,
+        the design's index in the message).
+    ValueError
+        A bad value otherwise.
     """
     columns = {k.partition(".")[2] if k.startswith("fourbar.") else k: v for k, v in (columns or {}).items()}
     unknown = [k for k in columns if k not in BATCH_KEYS and k not in BATCH_IGNORED]
@@ -197,7 +222,21 @@ def summary_frame(res: np.ndarray, detail: bool = False, band: tuple[float, floa
 
 
 def summarise(params: Params) -> dict:
-    """Headline figures only (what a sweep needs when it writes no per-case files)."""
+    """Summarise one deck: the headline figures only, without the tables.
+
+    What a sweep needs when it writes no per-case files.
+
+    Parameters
+    ----------
+    params : Params
+        Validated ``&fourbar`` keys.
+
+    Returns
+    -------
+    dict
+        The run's summary (``run(params).summary``): units in the names (``mu_min_deg``,
+        ``omega3_peak_rad_s``), None for a figure that does not exist.
+    """
     return summary_of(params)
 
 

@@ -26,7 +26,8 @@ from driver.study import Figure
 from driver.table import Column, fortran_f, render_table
 
 __all__ = ["KEYS", "check", "active", "props", "ForceAnalysis", "analyse", "COLUMNS", "tidy_columns",
-           "table_lines", "summary_lines", "summary", "summarise_force_batch", "BATCH_KEYS", "figures"]
+           "table_lines", "summary_lines", "summary", "summarise_force_batch", "BATCH_KEYS", "figures",
+           "plot_torque", "plot_pin_polars", "plot_shaking"]
 
 ST_OK = kernel.FOURBAR_STATUS["ok"]
 LINKS = ("crank", "coupler", "rocker")
@@ -97,7 +98,18 @@ def value(p: Mapping[str, Any], key: str) -> Any:
 
 
 def active(p: Mapping[str, Any]) -> bool:
-    """True when the deck asks for the force analysis (``mass`` given)."""
+    """Tell whether the deck asks for the force analysis (``mass`` given).
+
+    Parameters
+    ----------
+    p : mapping
+        ``&fourbar`` keys (validated Params or a plain mapping).
+
+    Returns
+    -------
+    bool
+        True when ``mass`` is given.
+    """
     return p.get("mass") is not None
 
 
@@ -106,7 +118,19 @@ def _lengths(p: Mapping[str, Any]) -> tuple[float, float, float]:
 
 
 def check(p: Params) -> None:
-    """Cross-key checks of the force keys (called by the four-bar SPEC's check)."""
+    """Check the force keys against each other and the linkage (the four-bar SPEC's check calls it).
+
+    Parameters
+    ----------
+    p : Params
+        Validated ``&fourbar`` keys (lengths in m with ``mass``).
+
+    Raises
+    ------
+    DeckError
+        A force key without ``mass``, a load force without ``coupler_point``, ``method =
+        'listing'`` with masses, or a detectable unit mismatch (a link over 100 m, ...).
+    """
     if not active(p):
         for key in sorted((k for k in DEPENDENT if k in p.given), key=p.line_of):
             if key in p.given:
@@ -150,7 +174,20 @@ def check(p: Params) -> None:
 
 
 def props(p: Mapping[str, Any]) -> np.ndarray:
-    """The kernel's 18 link and load properties from the deck (defaults filled in)."""
+    """Pack the kernel's 18 link and load properties from the deck, defaults filled in.
+
+    Parameters
+    ----------
+    p : mapping
+        ``&fourbar`` keys with ``mass``.
+
+    Returns
+    -------
+    numpy.ndarray
+        (18,): masses [kg], inertias about the centres of mass [kg m^2], com distances [m]
+        and angles [rad] of crank, coupler, rocker; gravity [m/s^2]; load torque [N m]; load
+        force x, y [N]; the coupler point's u, v [m].
+    """
     lengths = np.array(_lengths(p))
     m = np.asarray(p["mass"], dtype=float)
     d = np.asarray(p["com_distance"], dtype=float) if p.get("com_distance") is not None else lengths / 2
@@ -198,9 +235,21 @@ UNITS = {c: ("N m" if c.endswith("_Nm") else "N") for c in COLUMNS}
 
 @dataclass
 class ForceAnalysis:
-    """Forces at the table's crank angles: ``forces`` (n, 12) in COLUMNS order (zero where not
-    defined), ``ok`` where defined.  With ``balance = 'force'`` the analysed linkage carries the
-    counterweights ``cw`` and ``unbalanced`` holds the forces of the linkage as given."""
+    """Forces at the table's crank angles.
+
+    Attributes
+    ----------
+    forces : numpy.ndarray
+        (n, 12) in ``COLUMNS`` order: input torque [N m]; F_O2, F_A, F_B, F_O4 (x, y) [N];
+        shaking force (x, y) [N]; shaking moment [N m]; zero where not defined.
+    ok : numpy.ndarray
+        (n,) bool: where the forces are defined (assembled, no toggle).
+    unbalanced : numpy.ndarray or None
+        With ``balance = 'force'``: the forces of the linkage as given (the analysed one
+        carries the counterweights).
+    cw : Counterweights or None
+        The Berkof-Lowen counterweights, with ``balance = 'force'``.
+    """
 
     forces: np.ndarray
     ok: np.ndarray
@@ -215,7 +264,20 @@ def forces_at(p: Mapping[str, Any], out: np.ndarray, status: np.ndarray, pr: np.
 
 
 def analyse(p: Params, out: np.ndarray, status: np.ndarray) -> ForceAnalysis:
-    """Force analysis at the deck's crank angles (``out``, ``status`` of its exact grid)."""
+    """Analyse the joint forces, input torque and shaking at the deck's crank angles.
+
+    Parameters
+    ----------
+    p : Params
+        Validated ``&fourbar`` keys (lengths in m with ``mass``).
+    out, status : numpy.ndarray
+        The deck's exact grid (``driver.fourbar.exact_grid``).
+
+    Returns
+    -------
+    ForceAnalysis
+        Forces in N, torques and moments in N m, per crank angle.
+    """
     given = forces_at(p, out, status, props(p))
     if value(p, "balance") != "force":
         return ForceAnalysis(given, status == ST_OK)
@@ -224,8 +286,20 @@ def analyse(p: Params, out: np.ndarray, status: np.ndarray) -> ForceAnalysis:
 
 
 def tidy_columns(fa: ForceAnalysis) -> dict[str, np.ndarray]:
-    """{tidy column: values} (NaN where the forces are not defined: no assembly or toggle); with
-    balancing, the linkage as given follows in columns prefixed ``unbalanced_``."""
+    """Return the force columns of the tidy table.
+
+    Parameters
+    ----------
+    fa : ForceAnalysis
+        The forces of a run.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        Tidy column (units in the name: ``input_torque_Nm``, ``F_O2_x_N``) -> values, NaN
+        where the forces are not defined (no assembly or toggle); with balancing, the
+        linkage as given follows in columns prefixed ``unbalanced_``.
+    """
     cols = {c: np.where(fa.ok, fa.forces[:, j], np.nan) for j, c in enumerate(COLUMNS)}
     if fa.unbalanced is not None:
         cols |= {"unbalanced_" + c: np.where(fa.ok, fa.unbalanced[:, j], np.nan) for j, c in enumerate(COLUMNS)}
@@ -235,7 +309,26 @@ def tidy_columns(fa: ForceAnalysis) -> dict[str, np.ndarray]:
 # ----------------------------------------------------------------------------- .out text
 
 def table_lines(theta: np.ndarray, f: np.ndarray, ok: np.ndarray, status_words: list[str], title: str) -> list[str]:
-    """The force table: one row per crank angle, forces [N] to 3 decimals, torques [N m] to 4."""
+    """Format the force table of the ``.out``: one row per crank angle.
+
+    Parameters
+    ----------
+    theta : numpy.ndarray
+        Crank angles, deg.
+    f : numpy.ndarray
+        (n, 12) forces in ``COLUMNS`` order (N, N m).
+    ok : numpy.ndarray
+        (n,) bool: where the forces are defined.
+    status_words : list of str
+        The status of each row in words (printed where not ok).
+    title : str
+        The table's heading.
+
+    Returns
+    -------
+    list of str
+        The lines: forces in N to 3 decimals, torques in N m to 4.
+    """
     whole = bool(np.all(np.isclose(theta, np.round(theta))))
     tcol = Column("theta", "i", 5, 0, 2) if whole else Column("theta", "f", 8, 3, 2)
     cols = [tcol, Column("T_in", "f", 10, 4)]
@@ -322,20 +415,43 @@ def frame_from_kernel(res: np.ndarray, prefix: str = "") -> pd.DataFrame:
 
 
 def summary(p: Params) -> dict[str, Any]:
-    """Force summary of one deck (one row of the batch kernel, of the balanced linkage with
-    ``balance = 'force'``; then also the figures of the linkage as given, prefixed ``unbalanced_``)."""
+    """Summarise the forces of one deck: one row of the batch kernel.
+
+    Parameters
+    ----------
+    p : Params
+        Validated ``&fourbar`` keys (lengths in m with ``mass``).
+
+    Returns
+    -------
+    dict of str to float or None
+        ``SUMMARY_DOC``'s figures, units in their names (``torque_peak_Nm``,
+        ``energy_fluctuation_J``, ``flywheel_inertia_kgm2``), None where one does not exist;
+        with ``balance = 'force'`` of the balanced linkage, and the linkage as given's
+        prefixed ``unbalanced_``.
+    """
     d = summarise_force_batch(p).iloc[0].to_dict()
     return {str(k): (None if isinstance(v, float) and math.isnan(v) else float(v)) for k, v in d.items()}
 
 
 def summarise_force_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None = None) -> pd.DataFrame:
-    """Force summaries of many designs in one Fortran call: one row per design.
+    """Summarise the forces of many designs in one Fortran call: one row per design.
 
-    ``base``: a validated ``&fourbar`` Params with ``mass`` given; ``columns``: {key: n values}
-    for scalar keys in BATCH_KEYS (``'fourbar.crank'`` accepted), or ``mass``/``inertia``/
-    ``com_distance``/``com_angle_deg`` as (n, 3) arrays; scalars broadcast.  Columns: SUMMARY_DOC.
-    With ``balance = 'force'`` the columns describe the balanced linkage and the same columns
-    prefixed ``unbalanced_`` the linkage as given.
+    Parameters
+    ----------
+    base : mapping
+        A validated ``&fourbar`` Params with ``mass`` given (lengths in m).
+    columns : mapping of str to array, optional
+        {key: n values} for scalar keys in ``BATCH_KEYS`` (``'fourbar.crank'`` accepted), or
+        ``mass``/``inertia``/``com_distance``/``com_angle_deg`` as (n, 3) arrays, in the
+        keys' deck units (kg, kg m^2, m, deg); scalars broadcast.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per design, the columns of ``SUMMARY_DOC`` (units in their names); with
+        ``balance = 'force'`` of the balanced linkage, and the same columns prefixed
+        ``unbalanced_`` for the linkage as given.
     """
     columns = {k.partition(".")[2] if k.startswith("fourbar.") else k: v for k, v in (columns or {}).items()}
     bad = [k for k in columns if k not in BATCH_KEYS]
@@ -367,7 +483,22 @@ def summarise_force_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | 
 
 
 def summary_lines(p: Params, s: dict[str, Any], fa: ForceAnalysis) -> list[str]:
-    """Words and numbers after the force table."""
+    """Format the words and numbers after the force table.
+
+    Parameters
+    ----------
+    p : Params
+        Validated ``&fourbar`` keys (lengths in m with ``mass``).
+    s : dict
+        The force summary (:func:`summary`).
+    fa : ForceAnalysis
+        The forces of the run.
+
+    Returns
+    -------
+    list of str
+        The lines (peaks in N and N m, energy fluctuation in J, flywheel inertia in kg m^2).
+    """
     def fmt(v: float | None, unit: str, spec: str = ".4f") -> str:
         if v is None:
             return "n/a"
@@ -427,7 +558,23 @@ def summary_lines(p: Params, s: dict[str, Any], fa: ForceAnalysis) -> list[str]:
 # ----------------------------------------------------------------------------- figures
 
 def figures(p: Params, title: str, theta_grid: Any) -> list[Figure]:
-    """Force figures of a run: input torque, pin-force polar plots, shaking force (before/after)."""
+    """List the force figures of a run: input torque, pin-force polar plots, shaking force.
+
+    Parameters
+    ----------
+    p : Params
+        Validated ``&fourbar`` keys (lengths in m with ``mass``).
+    title : str
+        The figures' title.
+    theta_grid : callable
+        ``theta_grid(p, theta_deg) -> (states, status)``, the exact grid
+        (``driver.fourbar.exact_grid``), called when a figure is drawn (721 crank angles).
+
+    Returns
+    -------
+    list of Figure
+        ``torque``, ``pin_forces`` and ``shaking`` (drawn lazily).
+    """
     def data() -> tuple[np.ndarray, ForceAnalysis]:
         theta = np.linspace(p.start_deg, p.stop_deg, 721)
         out, st = theta_grid(p, theta)
@@ -464,8 +611,27 @@ def figures(p: Params, title: str, theta_grid: Any) -> list[Figure]:
 
 
 def plot_torque(theta: np.ndarray, fa: ForceAnalysis, p: Mapping[str, Any], ax: Any) -> Any:
-    """Input torque against crank angle with its mean, and the energy fluctuation dE shaded between
-    the torque curve and the mean (axes ``ax``; the balanced linkage's torque dashed if any)."""
+    """Plot the input torque against crank angle, its mean, and the energy fluctuation dE.
+
+    dE is shaded between the torque curve and the mean; with balancing the torque of the
+    linkage without counterweights is dashed.
+
+    Parameters
+    ----------
+    theta : numpy.ndarray
+        Crank angles, deg.
+    fa : ForceAnalysis
+        The forces (:func:`analyse`).
+    p : mapping
+        The ``&fourbar`` keys.
+    ax : matplotlib.axes.Axes
+        The axes to draw into (crank angle in deg, torque in N m, dE in J in the legend).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        ``ax``.
+    """
     t = np.where(fa.ok, fa.forces[:, 0], np.nan)
     ax.plot(theta, t, color="C0", label="input torque")
     if fa.ok.all() and len(theta) > 1:
@@ -483,8 +649,23 @@ def plot_torque(theta: np.ndarray, fa: ForceAnalysis, p: Mapping[str, Any], ax: 
 
 
 def plot_pin_polars(fa: ForceAnalysis, axes: Any) -> Any:
-    """Polar plots of the force at each pin over the cycle (four polar axes: O2, A, B, O4):
-    angle = direction of the force, radius = its magnitude [N]."""
+    """Plot the force at each pin over the cycle on polar axes.
+
+    Angle = direction of the force, radius = its magnitude in N; with balancing, the
+    unbalanced linkage's dashed.
+
+    Parameters
+    ----------
+    fa : ForceAnalysis
+        The forces (:func:`analyse`).
+    axes : sequence of matplotlib.axes.Axes
+        Four polar axes: O2, A, B, O4.
+
+    Returns
+    -------
+    sequence of matplotlib.axes.Axes
+        ``axes``.
+    """
     names = ("O2 (ground on crank)", "A (crank on coupler)", "B (coupler on rocker)", "O4 (ground on rocker)")
     for j, ax in enumerate(np.ravel(axes)[:4]):
         fx = np.where(fa.ok, fa.forces[:, 1 + 2 * j], np.nan)
@@ -501,8 +682,24 @@ def plot_pin_polars(fa: ForceAnalysis, axes: Any) -> Any:
 
 
 def plot_shaking(theta: np.ndarray, fa: ForceAnalysis, ax: Any, polar_ax: Any | None = None) -> Any:
-    """Shaking force magnitude against crank angle (``ax``) and its locus F_y against F_x
-    (``polar_ax``, equal axes), before and after balancing."""
+    """Plot the shaking force magnitude against crank angle, and its locus, before and after balancing.
+
+    Parameters
+    ----------
+    theta : numpy.ndarray
+        Crank angles, deg.
+    fa : ForceAnalysis
+        The forces (:func:`analyse`).
+    ax : matplotlib.axes.Axes
+        Axes for |shaking force| (N) against crank angle (deg).
+    polar_ax : matplotlib.axes.Axes, optional
+        Axes for the locus F_y against F_x (N, equal scales).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        ``ax``.
+    """
     before = fa.unbalanced if fa.unbalanced is not None else fa.forces
     s = np.where(fa.ok[:, None], before[:, 9:11], np.nan)
     ax.plot(theta, np.hypot(*s.T), color="C0", label="unbalanced")

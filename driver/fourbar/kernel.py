@@ -23,10 +23,26 @@ FOURBAR_STATUS = {"ok": int(_kernels.fourbar.st_ok), "no_assembly": int(_kernels
 
 def fourbar_listing(p: float, q: float, r: float, s: float, omega: float,
                     start: int, step: int, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """The published listing's table (single precision, as printed): (n, 10) rows and status.
+    """Run the published listing's program (single precision, as printed).
 
-    Columns: crank angle i [deg], epsl, phi, beta [whole deg, truncated], xa, ya, xb, yb,
-    omr, oms [rad/s].  Status: 0 ok, 1 not assemblable, 2 velocities divide by zero.
+    Parameters
+    ----------
+    p, q, r, s : float
+        Ground, crank, coupler and rocker length, in one length unit.
+    omega : float
+        Crank speed, rad/s.
+    start, step : int
+        First crank angle and step, whole deg.
+    n : int
+        Rows.
+
+    Returns
+    -------
+    table : numpy.ndarray
+        (n, 10): crank angle i [deg], epsl, phi, beta [whole deg, truncated], xa, ya, xb, yb
+        [length], omr, oms [rad/s].
+    status : numpy.ndarray
+        (n,): 0 ok, 1 not assemblable, 2 velocities divide by zero.
     """
     table, status = _kernels.fourbar.listing_table(p, q, r, s, omega, int(start), int(step), int(n))
     return table, status
@@ -35,14 +51,39 @@ def fourbar_listing(p: float, q: float, r: float, s: float, omega: float,
 def fourbar_exact(theta: np.ndarray, p: float, q: float, r: float, s: float, omega: float,
                   alpha: float = 0.0, branch: int = 1, out: np.ndarray | None = None,
                   status: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Closed-loop states at crank angles ``theta`` [rad]: (n, 11) array and status (n,).
+    """Solve the closed loop at the given crank angles: positions, velocities, accelerations.
 
-    Columns: coupler angle, rocker angle, transmission angle [rad]; xa, ya, xb, yb [length];
-    coupler and rocker angular velocity [rad/s]; coupler and rocker angular acceleration
-    [rad/s^2].  ``branch`` +1 open, -1 crossed.  Status: 0 ok, 1 cannot be assembled,
-    2 toggle (velocities unbounded, returned as 0), 3 indeterminate (A on O_B).
-    ``out`` (Fortran-ordered float64, (n, 11)) and ``status`` (int32, (n,)) may be passed
-    to reuse buffers across calls; they are overwritten.
+    Parameters
+    ----------
+    theta : numpy.ndarray
+        Crank angles, rad.
+    p, q, r, s : float
+        Ground, crank, coupler and rocker length, in one length unit.
+    omega : float
+        Crank angular velocity, rad/s.
+    alpha : float, default 0.0
+        Crank angular acceleration, rad/s^2.
+    branch : int, default 1
+        +1 open, -1 crossed.
+    out : numpy.ndarray, optional
+        (n, 11) Fortran-ordered float64 buffer to reuse; overwritten.
+    status : numpy.ndarray, optional
+        (n,) int32 buffer to reuse; overwritten.
+
+    Returns
+    -------
+    out : numpy.ndarray
+        (n, 11): coupler angle, rocker angle, transmission angle [rad]; xa, ya, xb, yb
+        [length]; coupler and rocker angular velocity [rad/s]; coupler and rocker angular
+        acceleration [rad/s^2].
+    status : numpy.ndarray
+        (n,): 0 ok, 1 cannot be assembled, 2 toggle (velocities unbounded, returned as 0),
+        3 indeterminate (A on O_B).
+
+    Raises
+    ------
+    ValueError
+        A buffer of the wrong shape, type or order (f2py would work on a hidden copy).
     """
     theta = farray(np.atleast_1d(theta), 1)
     n = theta.shape[0]
@@ -77,14 +118,28 @@ FOURBAR_PASSES = {k: int(getattr(_kernels.fourbar_summary, f"pass_{k}")) for k i
 
 
 def fourbar_summaries(params: np.ndarray, passes: int = 7) -> np.ndarray:
-    """Headline figures of many four-bars in one kernel call: (n, 19) array.
+    """Compute the headline figures of many four-bars in one kernel call.
 
-    ``params`` (n, 8): fixed link p, crank q, coupler r, rocker s [length], crank speed
-    [rad/s], first and last crank angle of the range [deg], branch (+1 open, -1 crossed).
-    Columns: FOURBAR_SUMMARY_COLUMNS (angles in degrees, speeds in rad/s; flags 0/1;
-    figures that do not exist are 0 -- mask them with 'assemblable' and 'toggles_in_range').
-    ``passes``: sum of FOURBAR_PASSES bits; the columns of a pass not asked for are 0 (not
-    computed), the others have the same bits whichever passes run (default: all three).
+    Parameters
+    ----------
+    params : numpy.ndarray
+        (n, 8): fixed link p, crank q, coupler r, rocker s [length], crank speed [rad/s],
+        first and last crank angle of the range [deg], branch (+1 open, -1 crossed).
+    passes : int, default 7
+        Sum of ``FOURBAR_PASSES`` bits; the columns of a pass not asked for are 0 (not
+        computed), the others have the same bits whichever passes run (default: all three).
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, 19), columns ``FOURBAR_SUMMARY_COLUMNS`` (angles in deg, speeds in rad/s, flags
+        0/1; figures that do not exist are 0 -- mask them with 'assemblable' and
+        'toggles_in_range').
+
+    Raises
+    ------
+    ValueError
+        ``params`` does not have 8 columns.
     """
     params = farray(params, 2)
     if params.shape[1] != 8:
@@ -94,9 +149,29 @@ def fourbar_summaries(params: np.ndarray, passes: int = 7) -> np.ndarray:
 
 def fourbar_coupler_point(theta: np.ndarray, states: np.ndarray, status: np.ndarray, q: float,
                           omega: float, alpha: float, u: float, v: float) -> np.ndarray:
-    """A point fixed to the coupler, u along A->B and v to its left [length], from the
-    ``fourbar_exact`` results at crank angles ``theta`` [rad]: (n, 6) position, velocity
-    [length/s] and acceleration [length/s^2] (zero where the linkage is not placed)."""
+    """Compute position, velocity and acceleration of a point fixed to the coupler.
+
+    Parameters
+    ----------
+    theta : numpy.ndarray
+        Crank angles, rad.
+    states, status : numpy.ndarray
+        The ``fourbar_exact`` results at ``theta``.
+    q : float
+        Crank length [length].
+    omega : float
+        Crank angular velocity, rad/s.
+    alpha : float
+        Crank angular acceleration, rad/s^2.
+    u, v : float
+        The point: u along A->B and v to its left [length].
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, 6): x, y [length], vx, vy [length/s], ax, ay [length/s^2]; zero where the
+        linkage is not placed.
+    """
     theta = farray(np.atleast_1d(theta), 1)
     return _kernels.fourbar.coupler_point(theta, q, omega, alpha, u, v, farray(states, 2),
                                           np.asarray(status, dtype=np.int32))
@@ -104,13 +179,34 @@ def fourbar_coupler_point(theta: np.ndarray, states: np.ndarray, status: np.ndar
 
 def fourbar_joint_forces(states: np.ndarray, status: np.ndarray, p: float, q: float, r: float, s: float,
                          omega: float, alpha: float, props: np.ndarray) -> np.ndarray:
-    """Joint forces from ``fourbar_exact`` results (same omega [rad/s], alpha [rad/s^2]): (n, 12).
+    """Compute joint forces, input torque and shaking from ``fourbar_exact`` results.
 
-    ``props`` (18,): masses [kg], inertias about the centres of mass [kg m^2], com distances [m]
-    and angles [rad] of crank, coupler, rocker; gravity [m/s^2] (along -y); load torque on the
-    rocker [N m]; load force at the coupler point [N]; the point's u, v [m].  Columns: input
-    torque [N m]; F_O2, F_A, F_B, F_O4 (x, y) [N]; shaking force (x, y) [N]; shaking moment
-    about O2 [N m] (fortran/fourbar_forces.f90).  Zero where status is not ok.
+    Parameters
+    ----------
+    states, status : numpy.ndarray
+        The ``fourbar_exact`` results (same omega and alpha).
+    p, q, r, s : float
+        Ground, crank, coupler and rocker length, m.
+    omega : float
+        Crank angular velocity, rad/s.
+    alpha : float
+        Crank angular acceleration, rad/s^2.
+    props : numpy.ndarray
+        (18,): masses [kg], inertias about the centres of mass [kg m^2], com distances [m]
+        and angles [rad] of crank, coupler, rocker; gravity [m/s^2] (along -y); load torque
+        on the rocker [N m]; load force at the coupler point [N]; the point's u, v [m].
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, 12): input torque [N m]; F_O2, F_A, F_B, F_O4 (x, y) [N]; shaking force (x, y)
+        [N]; shaking moment about O2 [N m] (fortran/fourbar_forces.f90).  Zero where status
+        is not ok.
+
+    Raises
+    ------
+    ValueError
+        ``props`` does not have 18 values.
     """
     props = np.ascontiguousarray(props, dtype=np.float64)
     if props.shape != (18,):
@@ -121,9 +217,25 @@ def fourbar_joint_forces(states: np.ndarray, status: np.ndarray, p: float, q: fl
 
 def fourbar_berkof_lowen(q: float, r: float, s: float, props: np.ndarray,
                          radii: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
-    """Berkof-Lowen counterweights on crank and rocker at ``radii`` [m]: (props of the balanced
-    linkage (18,), cw (6,) = crank mass x radius [kg m] and angle [rad], rocker the same, the two
-    counterweight masses [kg])."""
+    """Compute the Berkof-Lowen counterweights on crank and rocker that cancel the shaking force.
+
+    Parameters
+    ----------
+    q, r, s : float
+        Crank, coupler and rocker length, m.
+    props : numpy.ndarray
+        (18,) link and load properties, as for ``fourbar_joint_forces``.
+    radii : tuple of float
+        Counterweight radii on crank and rocker, m.
+
+    Returns
+    -------
+    props : numpy.ndarray
+        (18,) properties of the balanced linkage.
+    cw : numpy.ndarray
+        (6,): crank counterweight mass x radius [kg m] and angle [rad], rocker the same, the
+        two counterweight masses [kg].
+    """
     return _kernels.fourbar_forces.berkof_lowen(q, r, s, np.asarray(props, dtype=np.float64),
                                                 np.asarray(radii, dtype=np.float64))
 
@@ -136,11 +248,26 @@ FOURBAR_FORCE_SUMMARY_COLUMNS = ("defined_fraction", "torque_peak_Nm", "torque_p
 
 
 def fourbar_force_summaries(params: np.ndarray) -> np.ndarray:
-    """Force summaries of many four-bars in one kernel call: (n, 13), FOURBAR_FORCE_SUMMARY_COLUMNS.
+    """Compute the force summaries of many four-bars in one kernel call.
 
-    ``params`` (n, 31): p, q, r, s [m], omega [rad/s], alpha [rad/s^2], first and last crank
-    angle [deg], branch (+1/-1), the 18 props of ``fourbar_joint_forces``, speed fluctuation,
-    balance flag (1 = Berkof-Lowen counterweights first), counterweight radii [m].
+    Parameters
+    ----------
+    params : numpy.ndarray
+        (n, 31): p, q, r, s [m], omega [rad/s], alpha [rad/s^2], first and last crank angle
+        [deg], branch (+1/-1), the 18 props of ``fourbar_joint_forces``, speed fluctuation
+        [dimensionless], balance flag (1 = Berkof-Lowen counterweights first), counterweight
+        radii [m].
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, 13), columns ``FOURBAR_FORCE_SUMMARY_COLUMNS`` (units in their names: N, N m, J,
+        kg m^2, deg).
+
+    Raises
+    ------
+    ValueError
+        ``params`` does not have 31 columns.
     """
     params = farray(params, 2)
     if params.shape[1] != 31:

@@ -27,10 +27,24 @@ LISTING_PRECISION = ("the listing works in single precision with pi/180 = 0.0174
 
 
 def exact_as_listed(p: Params, theta_deg: np.ndarray) -> dict[tuple[int, str], str]:
-    """The closed-loop solution at whole crank angles ``theta_deg`` printed the way the listing prints
-    (FORMAT 25: angles truncated to whole degrees, legacy F5.1 / F7.4), keyed by (angle, column of
-    the listing table): what the published table shows where it is right.  Blank where the linkage
-    cannot be placed."""
+    """Print the closed-loop solution the way the published listing prints it.
+
+    FORMAT 25: angles truncated to whole degrees, legacy F5.1 / F7.4: what the published table
+    shows where it is right.
+
+    Parameters
+    ----------
+    p : Params
+        Validated ``&fourbar`` keys.
+    theta_deg : numpy.ndarray
+        Whole crank angles, deg.
+
+    Returns
+    -------
+    dict of tuple to str
+        (angle, column of the listing table) -> the printed cell (deg, length unit, rad/s);
+        blank where the linkage cannot be placed.
+    """
     out, status = exact_grid(p, theta_deg)
     cols = exact_columns(out, status)
     names = {"epsl": "coupler_deg", "phi": "rocker_deg", "beta": "transmission_deg", "xa": "xa", "ya": "ya",

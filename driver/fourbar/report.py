@@ -183,7 +183,24 @@ def audit(p: Params, theta: np.ndarray, table: np.ndarray, lst_status: np.ndarra
 @keyword_signature(_keywords.fourbar, SPEC)
 @keyword_run
 def run(params: Params, progress: bool = False) -> Result:
-    """Analyse one four-bar deck (see module docstring)."""
+    """Analyse a planar four-bar linkage driven by its crank over a range of crank angles.
+
+    ``method = 'exact'`` solves the loop on the requested branch: angles, angular velocities and
+    accelerations of coupler and rocker, the Grashof class, limit and toggle positions, the
+    transmission angle and a summary; ``method = 'listing'`` runs the published program cell for
+    cell and audits it.  With ``mass`` the force analysis is added (joint forces, input torque,
+    shaking force and moment).  Link lengths are in any one consistent unit (metres when
+    ``mass`` is given); angles in degrees, crank speed in rad/s.
+
+    Examples
+    --------
+    >>> import driver
+    >>> r = driver.fourbar.run(fixed_link=12, crank=5, coupler=15, rocker=9, step_deg=20)
+    >>> r.summary["grashof_class"], round(r.summary["mu_min_deg"], 3)
+    ('crank-rocker', 17.852)
+    >>> r.tidy.shape
+    (19, 15)
+    """
     p = params
     theta = crank_angles(p)
     g = grashof(p.fixed_link, p.crank, p.coupler, p.rocker)

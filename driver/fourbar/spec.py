@@ -121,9 +121,23 @@ SPEC = GroupSpec(
 
 
 def estimate(params: Params) -> Estimate:
-    """Memory and work of a run from the keys alone (driver.limits): per crank angle a table row
+    """Estimate the memory and work of a run from the keys alone, before it allocates.
+
+    Per crank angle a table row
     (text, two tidy frames, kernel columns; about 2 KB and 50 us of Python formatting), and the
-    summary kernel's 1 deg scan of at most one turn (the motion is periodic; about 30 us)."""
+    summary kernel's 1 deg scan of at most one turn (the motion is periodic; about 30 us).
+
+    Parameters
+    ----------
+    params : Params
+        Validated ``&fourbar`` keys.
+
+    Returns
+    -------
+    Estimate
+        Bytes and seconds the run needs, each with the key that drives it
+        (``driver.limits`` refuses an absurd request with it).
+    """
     p = params
     try:
         n = float(math.floor((p.stop_deg - p.start_deg) / p.step_deg + 1e-9) + 1)

@@ -27,20 +27,46 @@ SIGNIFICANT = 6
 
 
 def round_half_up(x: float, d: int) -> float:
-    """``x`` rounded to ``d`` decimals, half away from zero (as the report's printed values)."""
+    """Round half away from zero, as the report's printed values are.
+
+    Parameters
+    ----------
+    x : float
+        The value.
+    d : int
+        Decimals to keep.
+
+    Returns
+    -------
+    float
+        ``x`` rounded to ``d`` decimals, a half rounded away from zero.
+
+    Examples
+    --------
+    >>> from driver.manipulator import round_half_up
+    >>> round_half_up(0.125, 2), round_half_up(-0.125, 2), round(0.125, 2)   # Python's round: half to even
+    (0.13, -0.13, 0.12)
+    """
     q = Decimal(1).scaleb(-d)
     return float(Decimal(float(x)).quantize(q, rounding=ROUND_HALF_UP))
 
 
 @dataclass
 class Workspace:
-    """Workspace points and the quantities derived from them (lengths in m)."""
+    """Workspace points and the quantities derived from them (lengths in m).
+
+    Attributes
+    ----------
+    x, y : numpy.ndarray
+        Coordinates of the points P_i, base A at the origin, m.
+    """
 
     x: np.ndarray
     y: np.ndarray
 
     @property
     def n(self) -> int:
+        """Number of workspace points."""
         return int(self.x.size)
 
     @property
@@ -50,17 +76,17 @@ class Workspace:
 
     @property
     def r(self) -> float:
-        """min d(A, P_i) [m]."""
+        """Smallest distance min d(A, P_i) from the base to a point [m]."""
         return float(np.sqrt(self.d2.min()))
 
     @property
     def R(self) -> float:
-        """max d(A, P_i) [m]."""
+        """Largest distance max d(A, P_i) from the base to a point [m]."""
         return float(np.sqrt(self.d2.max()))
 
     @property
     def mean_d2(self) -> float:
-        """mean d^2 = l1^2 + l2^2 on C_rob [m^2] (eq. 4.12)."""
+        """Mean squared distance, mean d^2 = l1^2 + l2^2 on C_rob [m^2] (eq. 4.12)."""
         return float(self.d2.mean())
 
 
@@ -116,7 +142,24 @@ def design_status(reach: bool, target_ok: bool, ri1: float) -> str:
 
 
 def optima(c: float) -> dict[str, tuple[float, float]]:
-    """Optimum designs on l1^2 + l2^2 = c [m^2]: dexterity l2 = l1 sqrt(2)/2, manipulability l1 = l2."""
+    """Find the dexterity and manipulability optima on the robust circle l1^2 + l2^2 = c.
+
+    Parameters
+    ----------
+    c : float
+        The circle's l1^2 + l2^2, m^2.
+
+    Returns
+    -------
+    dict of str to tuple of float
+        ``'dexterity'`` (l2 = l1 sqrt(2)/2) and ``'manipulability'`` (l1 = l2) -> (l1, l2), m.
+
+    Examples
+    --------
+    >>> from driver.manipulator import optima
+    >>> {k: tuple(round(v, 6) for v in lengths) for k, lengths in optima(3.0).items()}
+    {'dexterity': (1.414214, 1.0), 'manipulability': (1.224745, 1.224745)}
+    """
     return {"dexterity": (math.sqrt(2 * c / 3), math.sqrt(c / 3)),
             "manipulability": (math.sqrt(c / 2), math.sqrt(c / 2))}
 
@@ -129,13 +172,28 @@ def _corner_patterns(l: int) -> np.ndarray:
 
 
 def tolerance_box(blocks: np.ndarray, eps: float, measure: str = "global") -> dict[str, Any]:
-    """Largest tolerance box (Caro 2005, eq. 2.45) for sensitivity blocks ``blocks`` (k, 2, l).
+    """Find the largest tolerance box on the link lengths (Caro 2005, eq. 2.45).
 
     Feasible region: ||J_x du||_2 <= eps (``global``, J_x = blocks stacked) or
     max_i ||J_xi du||_2 <= eps (``per_point``), for every corner du = s * u of the box.
     Maximises prod u_i with SLSQP over all 2^(l-1) corner patterns; for l = 2 the closed form
     u_i = eps / sqrt(2 S_ii (1 + |rho|)) of the binding corner is returned alongside.
-    Returns dict(u=SLSQP half-widths, closed=closed form or None, converged, message).
+
+    Parameters
+    ----------
+    blocks : numpy.ndarray
+        (k, 2, l) sensitivity blocks J_xi: the position of point i per unit change of each
+        of the l link lengths, dimensionless.
+    eps : float
+        Largest allowed positioning error, m.
+    measure : {'global', 'per_point'}, default 'global'
+        The error measure: all points stacked, or the worst point.
+
+    Returns
+    -------
+    dict
+        ``u`` the SLSQP half-widths of the box (m), ``closed`` the closed form for l = 2 (m;
+        else None), ``converged`` and ``message``.
     """
     k, _, l = blocks.shape
     pats = _corner_patterns(l)

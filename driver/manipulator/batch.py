@@ -150,7 +150,7 @@ def _walk(p: Params, conv: Conv, tx: float, ty: float, mpl: float, g: float) -> 
 
 def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None = None,
                     wanted: Collection[str] | None = None) -> pd.DataFrame:
-    """Summaries of many &manipulator design decks in one Fortran call: one row per deck.
+    """Summarise many &manipulator design decks in one Fortran call: one row per deck.
 
     ``base``: a validated ``&manipulator`` Params.  ``columns``: {key: n values} for keys in
     BATCH_KEYS (``'manipulator.gravity'`` is accepted for ``'gravity'``); scalars broadcast;
@@ -164,6 +164,29 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     (bench/bench_manipulator.py), a tenth of it in the kernel.  ``wanted``: only these
     columns, computed by only the passes they need (:data:`BATCH_PASSES`; the same values as
     in a full summary); None: all.
+
+    Parameters
+    ----------
+    base : mapping
+        A validated ``&manipulator`` Params.
+    columns : mapping of str to array, optional
+        {key: n values} for keys in ``BATCH_KEYS``, in the deck's units (m, kg/m, m/s^2).
+    wanted : collection of str, optional
+        Only these columns; None: all.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per deck: the single run's summary columns (units in their names: ``_m``,
+        ``_Nm``), missing figures as NaN, and ``design_status``.
+
+    Raises
+    ------
+    DeckError
+        A bad value, when ``base`` is a deck's Params (deck, line and key of the base deck,
+        the design's index in the message).
+    ValueError
+        A bad value otherwise.
     """
     out = _arrays(base, columns, wanted)
     if wanted is not None:
@@ -316,10 +339,22 @@ def _report_torques(p: Params, prm: np.ndarray, r: dict[str, np.ndarray], n: int
 
 
 def summarise(params: Params) -> dict[str, Any]:
-    """The design summary of one deck (one row of :func:`summarise_batch`; missing -> None):
-    what a sweep or an optimiser needs when it writes no per-case files.  Equals
+    """Summarise the design of one deck: one row of :func:`summarise_batch`.
+
+    What a sweep or an optimiser needs when it writes no per-case files.  Equals
     ``run(params).summary`` wherever a run succeeds, and also answers for a design the run
-    refuses (one that cannot reach the workspace or the target), with its ``design_status``."""
+    refuses (one that cannot reach the workspace or the target), with its ``design_status``.
+
+    Parameters
+    ----------
+    params : Params
+        Validated ``&manipulator`` keys.
+
+    Returns
+    -------
+    dict
+        The summary, units in the names (``_m``, ``_Nm``); None for a missing figure.
+    """
     out = {}
     for key, col in _arrays(params, None).items():
         v = col[0]

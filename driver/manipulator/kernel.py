@@ -47,16 +47,46 @@ def _arm_inputs(l1, l2, th1, th2, qd, qdd, m1, m2, mass_per_length: float) -> _A
 def manipulator_arm_states(l1, l2, th1, th2, qd=(1.0, 1.0), qdd=(1.0, 1.0), m1=None, m2=None,
                            g: float = 9.8, mass_per_length: float = 10.0,
                            out: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None):
-    """Jacobian, manipulability, condition number and torques of 2R configurations.
+    """Compute Jacobian, manipulability, condition number and torques of 2R configurations.
 
-    Inputs broadcast to n rows: lengths l1, l2 [m], joint angles th1, th2 [rad] (th2 relative),
-    joint rates ``qd`` [rad/s] and accelerations ``qdd`` [rad/s^2] as pairs or (n, 2), link
-    masses m1, m2 [kg] (default ``mass_per_length`` [kg/m] times the length), g [m/s^2] along -y.
-    Returns (jac (n, 4) = J11, J12, J21, J22 [m] of eq. 4.18, w = |det J| [m^2],
-    kappa = sigma_max/sigma_min (0 where J is singular), tau (n, 2) [N m]).
-    ``out`` = (jac, w, kappa, tau) Fortran-ordered float64 arrays of those shapes may be
-    passed to reuse buffers across calls (large fresh arrays cost page faults that can
-    exceed the kernel's own time); they are overwritten and returned.
+    Inputs broadcast to n rows.
+
+    Parameters
+    ----------
+    l1, l2 : float or array_like
+        Link lengths, m.
+    th1, th2 : float or array_like
+        Joint angles, rad (th2 relative to link 1).
+    qd : array_like, default (1.0, 1.0)
+        Joint rates (th1', th2'), rad/s, a pair or (n, 2).
+    qdd : array_like, default (1.0, 1.0)
+        Joint accelerations (th1'', th2''), rad/s^2, a pair or (n, 2).
+    m1, m2 : float or array_like, optional
+        Link masses, kg; default ``mass_per_length`` times the length.
+    g : float, default 9.8
+        Gravitational acceleration along -y, m/s^2.
+    mass_per_length : float, default 10.0
+        Link mass per unit length for the default masses, kg/m.
+    out : tuple of numpy.ndarray, optional
+        (jac, w, kappa, tau) Fortran-ordered float64 buffers of the shapes returned, reused
+        across calls (large fresh arrays cost page faults that can exceed the kernel's own
+        time); overwritten and returned.
+
+    Returns
+    -------
+    jac : numpy.ndarray
+        (n, 4): J11, J12, J21, J22 of eq. 4.18, m.
+    w : numpy.ndarray
+        (n,) manipulability |det J|, m^2.
+    kappa : numpy.ndarray
+        (n,) condition number sigma_max/sigma_min, dimensionless (0 where J is singular).
+    tau : numpy.ndarray
+        (n, 2) joint torques, N m.
+
+    Raises
+    ------
+    ValueError
+        ``out`` of the wrong shapes, type or order (f2py would work on hidden copies).
     """
     args = _arm_inputs(l1, l2, th1, th2, qd, qdd, m1, m2, mass_per_length)
     n = args[0].shape[0]
@@ -73,19 +103,52 @@ def manipulator_arm_states(l1, l2, th1, th2, qd=(1.0, 1.0), qdd=(1.0, 1.0), m1=N
 
 def manipulator_torques(l1, l2, th1, th2, qd=(1.0, 1.0), qdd=(1.0, 1.0), m1=None, m2=None,
                         g: float = 9.8, mass_per_length: float = 10.0) -> np.ndarray:
-    """Joint torques (n, 2) [N m] of Craig's point-mass 2R arm (report eqs 2.52/2.53).
+    """Compute the joint torques of Craig's point-mass 2R arm (report eqs 2.52/2.53).
 
-    Same inputs and units as :func:`manipulator_arm_states`.
+    Parameters
+    ----------
+    l1, l2 : float or array_like
+        Link lengths, m.
+    th1, th2 : float or array_like
+        Joint angles, rad (th2 relative to link 1).
+    qd : array_like, default (1.0, 1.0)
+        Joint rates (th1', th2'), rad/s, a pair or (n, 2).
+    qdd : array_like, default (1.0, 1.0)
+        Joint accelerations (th1'', th2''), rad/s^2, a pair or (n, 2).
+    m1, m2 : float or array_like, optional
+        Link masses, kg; default ``mass_per_length`` times the length.
+    g : float, default 9.8
+        Gravitational acceleration along -y, m/s^2.
+    mass_per_length : float, default 10.0
+        Link mass per unit length for the default masses, kg/m.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, 2) joint torques, N m.
     """
     return _kernels.manipulator.craig_torques(*_arm_inputs(l1, l2, th1, th2, qd, qdd, m1, m2, mass_per_length),
                                               float(g))
 
 
 def manipulator_ik(l1, l2, x, y, branch: int = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Inverse kinematics of targets (x, y) [m] for arms (l1, l2) [m] on elbow ``branch``.
+    """Solve the inverse kinematics of 2R arms for target points on one elbow branch.
 
-    +1 gives th2 >= 0, -1 gives th2 <= 0.  Returns th1, th2 [rad] and status per row
-    (0 ok, 1 out of reach, 2 degenerate: zero link or target at the base; angles 0 there).
+    Parameters
+    ----------
+    l1, l2 : float or array_like
+        Link lengths, m.
+    x, y : float or array_like
+        Target points, m (base at the origin).
+    branch : int, default 1
+        Elbow branch: +1 gives th2 >= 0, -1 gives th2 <= 0.
+
+    Returns
+    -------
+    th1, th2 : numpy.ndarray
+        Joint angles, rad (0 where the status is not ok).
+    status : numpy.ndarray
+        Per row: 0 ok, 1 out of reach, 2 degenerate (zero link or target at the base).
     """
     n = max(np.size(l1), np.size(l2), np.size(x), np.size(y))
     return _kernels.manipulator.inverse_kin(_col(l1, n), _col(l2, n), _col(x, n), _col(y, n),
@@ -93,11 +156,25 @@ def manipulator_ik(l1, l2, x, y, branch: int = 1) -> tuple[np.ndarray, np.ndarra
 
 
 def manipulator_design_indices(x, y, l1, l2) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Robustness indices of designs (l1, l2) [m] for workspace points (x, y) [m].
+    """Compute the robustness indices of designs for the workspace points.
 
-    Returns ri (nd, 3) = RI1 (sigma_max/sigma_min, 0 when sigma_min = 0), RI2 = sigma_max
-    (eq. 2.25), RI3 = sigma_max + ||J_x||_F (dimensionless); sum of cos(th2_i); and reach
-    (1 when the design reaches every point).
+    Parameters
+    ----------
+    x, y : array_like
+        Workspace points, m.
+    l1, l2 : float or array_like
+        Link lengths of the nd designs, m.
+
+    Returns
+    -------
+    ri : numpy.ndarray
+        (nd, 3): RI1 = sigma_max/sigma_min (0 when sigma_min = 0), RI2 = sigma_max
+        (eq. 2.25), RI3 = sigma_max + ||J_x||_F, all dimensionless (J_x the sensitivity of
+        the positions to the link lengths).
+    sum_c2 : numpy.ndarray
+        (nd,) sum of cos(th2_i) over the points, dimensionless.
+    reach : numpy.ndarray
+        (nd,) 1 when the design reaches every point, else 0.
     """
     x, y = farray(np.atleast_1d(x), 1), farray(np.atleast_1d(y), 1)
     nd = max(np.size(l1), np.size(l2))
@@ -105,11 +182,20 @@ def manipulator_design_indices(x, y, l1, l2) -> tuple[np.ndarray, np.ndarray, np
 
 
 def manipulator_position_errors(th1, th2, dl) -> np.ndarray:
-    """Positioning errors [m] of an arm held at joint angles (th1, th2) [rad] of the workspace
-    points, for link-length errors ``dl`` (ns, 2) [m].
+    """Compute the positioning errors of an arm for link-length errors.
 
-    Returns (ns, 2): column 0 the global norm over all points stacked (Caro), column 1 the
-    largest error at a single point.
+    Parameters
+    ----------
+    th1, th2 : array_like
+        Joint angles at the workspace points, rad.
+    dl : array_like
+        (ns, 2) link-length errors, m.
+
+    Returns
+    -------
+    numpy.ndarray
+        (ns, 2), m: column 0 the global norm over all points stacked (Caro), column 1 the
+        largest error at a single point.
     """
     th1, th2 = farray(np.atleast_1d(th1), 1), farray(np.atleast_1d(th2), 1)
     return _kernels.manipulator.position_errors(th1, th2, farray(dl, 2))
@@ -129,13 +215,8 @@ MANIPULATOR_PASSES = {k: int(getattr(_kernels.manipulator_summary, f"ds_{k}")) f
 
 def manipulator_design_summaries(x, y, params, branch: int = 1, rates=(1.0, 1.0, 1.0, 1.0),
                                  measure: str = "global", unit=None, passes: int = 7) -> np.ndarray:
-    """Design summaries of nd 2R arms for workspace points (x, y) [m] in one call: (nd, 14).
+    """Summarise nd 2R arm designs for the workspace points in one kernel call.
 
-    ``params`` (nd, 7): columns MANIPULATOR_SUMMARY_PARAMS -- l1, l2 [m] (positive), the
-    target point x, y [m], mass per length [kg/m], g [m/s^2] along -y, tolerance bound [m].
-    ``branch`` the IK elbow branch (+1/-1), ``rates`` = (th1', th2' [rad/s], th1'', th2''
-    [rad/s^2]), ``measure`` 'global' or 'per_point', ``unit`` (ns, 2) Monte Carlo samples in
-    [-1, 1]^2 (the box is unit * dl; default one sample at (1, 1)).
     Result columns MANIPULATOR_SUMMARY_COLUMNS: RI1 (0 where sigma_min = 0), RI2, RI3, sum c2,
     reach (1/0, conditions 4.4), IK status at the target (MANIPULATOR_STATUS), theta1, theta2
     there [deg], tau1, tau2 [N m] (0 unless the status is ok), reaches_points (1 when the IK
@@ -143,6 +224,36 @@ def manipulator_design_summaries(x, y, params, branch: int = 1, rates=(1.0, 1.0,
     maximum error [m] (the last three 0 unless reaches_points).  ``passes``: sum of
     MANIPULATOR_PASSES bits (indices: columns 0-4, target: 5-9, tolerance: 10-13); the
     columns of a pass not asked for are 0 (not computed).
+
+    Parameters
+    ----------
+    x, y : array_like
+        Workspace points, m.
+    params : numpy.ndarray
+        (nd, 7), columns ``MANIPULATOR_SUMMARY_PARAMS``: l1, l2 [m] (positive), the target
+        point x, y [m], mass per length [kg/m], g [m/s^2] along -y, tolerance bound [m].
+    branch : int, default 1
+        The IK elbow branch (+1/-1).
+    rates : array_like, default (1.0, 1.0, 1.0, 1.0)
+        (th1', th2' [rad/s], th1'', th2'' [rad/s^2]).
+    measure : {'global', 'per_point'}, default 'global'
+        The positioning-error measure.
+    unit : numpy.ndarray, optional
+        (ns, 2) Monte Carlo samples in [-1, 1]^2 (the box is unit * dl); default one sample
+        at (1, 1).
+    passes : int, default 7
+        Sum of ``MANIPULATOR_PASSES`` bits.
+
+    Returns
+    -------
+    numpy.ndarray
+        (nd, 14), columns ``MANIPULATOR_SUMMARY_COLUMNS`` (indices dimensionless, angles deg,
+        torques N m, half-widths and errors m).
+
+    Raises
+    ------
+    ValueError
+        ``params`` without 7 columns or ``unit`` not (ns >= 1, 2).
     """
     x, y = farray(np.atleast_1d(x), 1), farray(np.atleast_1d(y), 1)
     params = farray(params, 2)

@@ -105,8 +105,21 @@ def _tidy(tables: list[Table], tol: list[dict], sweep: dict, used: dict) -> pd.D
 
 
 def table_frame(tidy: pd.DataFrame, table: str) -> pd.DataFrame:
-    """One table of the long tidy frame in its printed shape: a row per printed row (row,
-    label, then a column per quantity in printed order; NaN where the printed cell is blank)."""
+    """Return one table of the long tidy frame in its printed, wide shape.
+
+    Parameters
+    ----------
+    tidy : pandas.DataFrame
+        A run's tidy table (``table, row, label, quantity, value, unit``).
+    table : str
+        The table's number, e.g. ``'4.8'``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        A row per printed row (row, label, then a column per quantity in printed order, in
+        the units of the tidy ``unit`` column); NaN where the printed cell is blank.
+    """
     part = tidy[tidy["table"] == table]
     if part.empty:
         known = ", ".join(dict.fromkeys(tidy["table"]))
@@ -179,8 +192,20 @@ def _summary(p: Params, ws: Workspace, conv: Conv, used: dict, sweep: dict, tol:
 @keyword_signature(_keywords.manipulator, SPEC)
 @keyword_run
 def run(params: Params, progress: bool = False) -> Result:
-    """Run one &manipulator deck (see the package docstring): validated Params, or the deck's
-    keys as keyword arguments (``driver.manipulator.run(points_x=[...], points_y=[...])``)."""
+    """Synthesise a planar 2R arm robustly for a workspace of points (the report's chapter 4).
+
+    Reach conditions, the robust circle C_rob and the RI1/RI2/RI3 indices, the dexterity and
+    manipulability optima, joint angles and motor torques at a target point, and tolerance
+    synthesis checked by Monte Carlo (see :mod:`driver.manipulator`).  Lengths in m, angles in
+    degrees, joint rates in rad/s, torques in N m.
+
+    Examples
+    --------
+    >>> import driver
+    >>> r = driver.manipulator.run(points_x=[0.5, 1.0, 1.5], points_y=[1.0, 0.5, 1.0])
+    >>> round(r.summary["crob_radius_m"], 6), r.summary["design_status"]
+    (1.384437, 'ok')
+    """
     p = params
     ws = Workspace(np.array(p.points_x, float), np.array(p.points_y, float))
     conv = Conv(p.mode == "report", ws)

@@ -154,9 +154,23 @@ SPEC = GroupSpec(
 
 
 def estimate(params: Params) -> Estimate:
-    """Memory and work of a run from the keys alone (driver.limits): the Monte Carlo check holds
+    """Estimate the memory and work of a run from the keys alone, before it allocates.
+
+    The Monte Carlo check holds
     mc_samples x points errors (about 64 bytes and 50 ns each), every row of the C_rob sweep is a
-    small design evaluation (about 2 ms), the designs tables a few us per design and point."""
+    small design evaluation (about 2 ms), the designs tables a few us per design and point.
+
+    Parameters
+    ----------
+    params : Params
+        Validated ``&manipulator`` keys.
+
+    Returns
+    -------
+    Estimate
+        Bytes and seconds the run needs, each with the key that drives it
+        (``driver.limits`` refuses an absurd request with it).
+    """
     p = params
     pts = max(len(p.points_x), len(p.points_y))
     designs = len(p.designs_l1 or []) + len(p.crob_l1 or []) + 10

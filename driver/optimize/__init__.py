@@ -71,18 +71,38 @@ class DesignVector(dict):
 
 @dataclass
 class OptimizeOutcome(Outcome):
-    """Result of an optimisation, shaped like ``scipy.optimize.OptimizeResult`` (and an
-    :class:`~driver.outcome.Outcome`: files written, warnings and errors as messages, notes).
+    """Result of an optimisation, shaped like ``scipy.optimize.OptimizeResult``.
 
-    x            best feasible design: a :class:`DesignVector` ({'group.key': value}, and an
-                 array by ``np.asarray(x)`` with ``x.names``); None when none is feasible
-    fun          its objective value (the expression's value, not sign-flipped)
-    success      the method converged and x is feasible: x is an optimum
-    status       0 optimum, 1 not converged (x is the best feasible design found), 2 no feasible design
-    message      the method's words
-    nit          iterations (generations for differential evolution; all starts' for local methods)
-    nfev         designs evaluated (each distinct design once)
-    constraints  per constraint at x: text, kind, value, margin, tolerance, met (see :meth:`to_dict`)
+    Also an :class:`~driver.outcome.Outcome`: files written, warnings and errors as messages,
+    notes.  Values are in the units of the deck keys and summary columns they name.
+
+    Attributes
+    ----------
+    problem : Problem
+        The problem the ``&optimize`` group declared (variables, objective, constraints).
+    x : DesignVector or None
+        Best feasible design, ``{'group.key': value}`` in the variables' deck units (and an
+        array by ``np.asarray(x)``, names in ``x.names``); None when none is feasible.
+    fun : float or None
+        Its objective value, in the objective expression's units (not sign-flipped).
+    success : bool
+        The method converged and ``x`` is feasible: ``x`` is an optimum.
+    message : str
+        The method's words.
+    nfev : int
+        Designs evaluated (each distinct design once).
+    best : Record or None
+        The evaluation record of ``x``.
+    check : Record or None
+        The optimum re-run by the full study.
+    method : MethodResult
+        What the method returned (iterations, convergence, starts, polish).
+    history : list of HistoryRow
+        The best feasible design after each generation, iteration or grid batch.
+    evaluator : Evaluator
+        Every design evaluated (``evaluator.frame()``: feasibility, reason, margins, summary).
+    study_result : Result or None
+        The study's full run at the optimum.
     """
 
     problem: Problem
@@ -100,6 +120,7 @@ class OptimizeOutcome(Outcome):
 
     @property
     def status(self) -> int:
+        """0 optimum, 1 not converged (``x`` the best feasible design found), 2 no feasible design."""
         return 0 if self.success else (2 if self.x is None else 1)
 
     @property
@@ -111,6 +132,7 @@ class OptimizeOutcome(Outcome):
 
     @property
     def nit(self) -> int:
+        """Iterations: generations for differential evolution, all starts' for local methods."""
         return int(self.method.iterations)
 
     @property
@@ -130,8 +152,14 @@ class OptimizeOutcome(Outcome):
         return out
 
     def to_dict(self) -> dict:
-        """The result as plain data (the ``--json`` record): scipy's fields, the constraints at x,
-        the starts of a local method and the polish of differential evolution."""
+        """Return the result as plain data: the ``--json`` record.
+
+        Returns
+        -------
+        dict
+            Scipy's fields, the constraints at ``x``, the starts of a local method and the
+            polish of differential evolution (JSON-safe; values in their deck units).
+        """
         p = self.problem
         rec = {"study": p.study.spec.name, "deck": str(p.deck.path), "objective": p.objective_text,
                "x": None if self.x is None else [float(v) for v in self.x.values()], "x_names": p.names,
@@ -217,12 +245,38 @@ def base_value(problem: Problem, v) -> float:
 def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[str] | None = None,
              plot: bool = False, jobs: int | None = None, resume: bool = False,
              scheduler: Any = None) -> OptimizeOutcome:
-    """Run an optimisation deck; write its outputs to ``outdir`` (None: write nothing).
+    """Run an optimisation deck: a study group and an ``&optimize`` group.
 
-    ``scheduler``: a Dask scheduler address or Client (from the command line or Dask's
-    configuration, never from the deck): each batch of designs is spread over its workers.
+    Parameters
+    ----------
+    deck : Deck, str or path-like
+        The deck, or its file.
+    outdir : path-like, optional
+        Where to write the outputs (``<stem>.out``, the optimum's deck and run, the history);
+        None writes nothing.
+    formats : list of str, optional
+        Tidy table formats: ``'csv'``, ``'parquet'``.
+    plot : bool, default False
+        Write the figures.
+    jobs : int, optional
+        Worker processes for the design evaluations; default all cores.
+    resume : bool, default False
+        Reuse the evaluation journal in ``outdir`` (verified, never believed).
+    scheduler : str or dask.distributed.Client, optional
+        A Dask scheduler address or client (from the command line or Dask's configuration,
+        never from the deck): each batch of designs is spread over its workers.
 
-    Raises DeckError for bad input before anything is computed or written.
+    Returns
+    -------
+    OptimizeOutcome
+        ``x`` (the best feasible design in the variables' deck units), ``fun`` (the
+        objective, in its expression's units), ``success``, ``status``, ``nit``, ``nfev``,
+        the constraints at ``x`` and the files written.
+
+    Raises
+    ------
+    DeckError
+        Bad input, before anything is computed or written.
     """
     if not isinstance(deck, Deck):
         deck = read_deck(deck)
@@ -309,11 +363,43 @@ def _write(oc: OptimizeOutcome, stem: Path, params, formats: list[str], plot: bo
 def run_optimize_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool = False,
                       jobs: int | None = None, resume: bool = False,
                       scheduler: Any = None, summary_json: bool = False, **_: Any) -> OptimizeOutcome:
-    """Command-line entry: run and write (``summary_json``: also ``<stem>.json``); returns the
-    outcome with its warnings, errors and progress notes as data (DeckError propagates).
+    """Run an optimisation deck and write its outputs: the command line's entry.
 
-    Raises :class:`~driver.extras.MissingExtra` before running when pyarrow is missing (the
-    evaluation journal is Parquet) or, with a scheduler, Dask.
+    Parameters
+    ----------
+    deck : Deck
+        The read deck.
+    outdir : pathlib.Path
+        Where to write.
+    formats : list of str
+        Tidy table formats: ``'csv'``, ``'parquet'``.
+    plot : bool
+        Write the figures.
+    progress : bool, default False
+        Show a progress bar on the terminal.
+    jobs : int, optional
+        Worker processes; default all cores.
+    resume : bool, default False
+        Reuse the evaluation journal in ``outdir``.
+    scheduler : str or dask.distributed.Client, optional
+        A Dask scheduler address or client.
+    summary_json : bool, default False
+        Also write ``<stem>.json``.
+    **_ : dict
+        Options of other engines, ignored.
+
+    Returns
+    -------
+    OptimizeOutcome
+        The outcome, with its warnings, errors and progress notes as data.
+
+    Raises
+    ------
+    DeckError
+        Bad input.
+    MissingExtra
+        Before running, when pyarrow is missing (the evaluation journal is Parquet) or, with a
+        scheduler, Dask.
     """
     require("parquet")
     if scheduler:

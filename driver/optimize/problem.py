@@ -246,7 +246,24 @@ def _parse_expr(opts: Params, key: str) -> expr.Expr:
 
 
 def problem_of(deck: Deck) -> Problem:
-    """Validate the deck's study group and its &optimize group into a :class:`Problem`."""
+    """Validate the deck's study group and its &optimize group into a problem.
+
+    Parameters
+    ----------
+    deck : Deck
+        A read deck with one study group and an ``&optimize`` group.
+
+    Returns
+    -------
+    Problem
+        The variables (deck keys, in their units, with bounds), the objective and the
+        constraints, checked against the study's summary columns.
+
+    Raises
+    ------
+    DeckError
+        Bad input, naming the deck, line and key.
+    """
     from driver.runner import study_of
     study, base = study_of(deck)
     opts = validate(deck.groups["optimize"], SPEC, deck.path)

@@ -23,10 +23,34 @@ class FitError(ValueError):
 
 
 def quadratic_fit(t: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Least-squares quadratic b0 + b1 t + b2 t^2 through (t, y): B = (X'X)^-1 X'Y (eq. 2.4).
+    """Fit a least-squares quadratic b0 + b1 t + b2 t^2 through (t, y): B = (X'X)^-1 X'Y (eq. 2.4).
 
-    Raises FitError when X'X is singular or its condition number exceeds MAX_COND (targets
-    too few or too close together for the digits of a double)."""
+    Parameters
+    ----------
+    t : numpy.ndarray
+        Abscissae (targets of X), in the units of the data.
+    y : numpy.ndarray
+        Ordinates (means, or ln of standard deviations).
+
+    Returns
+    -------
+    numpy.ndarray
+        (b0, b1, b2).
+
+    Raises
+    ------
+    FitError
+        X'X is singular or its condition number exceeds MAX_COND (targets too few or too
+        close together for the digits of a double).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from driver.robust_example import quadratic_fit
+    >>> b = quadratic_fit(np.array([0.0, 1.0, 2.0, 3.0]), np.array([1.0, 2.0, 5.0, 10.0]))  # y = 1 + t^2
+    >>> [round(float(v), 9) + 0.0 for v in b]
+    [1.0, 0.0, 1.0]
+    """
     X = np.vander(np.asarray(t, float), 3, increasing=True)
     A = X.T @ X
     cond = np.linalg.cond(A)
@@ -74,7 +98,28 @@ def _r(x: np.ndarray, d: int) -> np.ndarray:
 
 
 def analyse(p: Params, report: bool) -> dict[str, Any]:
-    """All section-2.3 results for one mode (see the module docstring)."""
+    """Compute every section-2.3 result for one mode (see the module docstring).
+
+    Parameters
+    ----------
+    p : Params
+        Validated ``&robust_example`` keys.
+    report : bool
+        Fit the printed (rounded) statistics, as the report does (``mode = 'report'``).
+
+    Returns
+    -------
+    dict
+        The tables (``mean22``, ``std22``, ``t24``, ``mean25``, ``std25``), the fitted
+        coefficients (``eq27``, ``eq28``, ``eq211``, ``eq212``), the estimates of t_min
+        (``eq22_tmin``, ``eq29``, ``eq213``, ``eq215``, in the units of X, each with a
+        ``_why`` when there is none) and ``sigma_at``, the std of Y at a target.
+
+    Raises
+    ------
+    DeckError
+        The data admit no fit (equal observations, targets too close), naming the key.
+    """
     b = np.array(p.true_coeffs, float)
     sx = p.sigma_x
     out: dict[str, Any] = {"eq22_slope": (b[1], 2 * b[2]), "eq22_quartic": 2 * b[2] ** 2, "eq22_tmin": tmin(b)}

@@ -76,7 +76,12 @@ TIDY_UNITS = {"index": "1", "value": "unit of item"}
 @keyword_signature(_keywords.robust_example, SPEC)
 @keyword_run
 def run(params: Params, progress: bool = False) -> Result:
-    """Run one &robust_example deck."""
+    """Estimate the robust target of Taylor's (1996) example three ways ([Ma'arif 2006], 2.3).
+
+    Exact tolerance analysis of the known quadratic, dual response and the Taguchi inner/outer
+    array, each giving the target t_x that minimises the spread of Y.  X and Y carry the units
+    of the deck's data (the example gives none).
+    """
     p = params
     report = p.mode == "report"
     r = analyse(p, report)

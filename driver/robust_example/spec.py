@@ -70,7 +70,21 @@ SPEC = GroupSpec(
 
 
 def estimate(params: Params) -> Estimate:
-    """Memory and work from the keys alone (driver.limits): least-squares fits of a few dozen
-    numbers; the lists are bounded by the deck reader (10 000 values per key)."""
+    """Estimate the memory and work of a run from the keys alone, before it allocates.
+
+    Least-squares fits of a few dozen
+    numbers; the lists are bounded by the deck reader (10 000 values per key).
+
+    Parameters
+    ----------
+    params : Params
+        Validated ``&robust_example`` keys.
+
+    Returns
+    -------
+    Estimate
+        Bytes and seconds the run needs, each with the key that drives it
+        (``driver.limits`` refuses an absurd request with it).
+    """
     n = len(params.dual_y) + len(params.taguchi_y) + len(params.taguchi_targets) * len(params.taguchi_offsets)
     return Estimate(1e6 + 1e3 * n, 0.05 + 1e-5 * n, "taguchi_y", "taguchi_y", f"{n} observations")

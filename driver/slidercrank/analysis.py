@@ -17,10 +17,24 @@ from driver.slidercrank.spec import SIMEON1996, Model
 
 
 def simeon_initial_state(n_elements: int, length: float) -> tuple[np.ndarray, np.ndarray]:
-    """Simeon's published initial modal values mapped onto the FE nodes (kernel q ordering).
+    """Map Simeon's published initial modal values onto the finite-element nodes.
 
     Lateral v(x) = q1 sin(pi x/L) + q2 sin(2 pi x/L) with rotations v'(x); axial u(x) the
     quadratic through (0, 0), (L/2, q3), (L, q4); the slider's U_X = q4 (theta3 = 0 at t = 0).
+
+    Parameters
+    ----------
+    n_elements : int
+        Rod elements.
+    length : float
+        Rod length L, m.
+
+    Returns
+    -------
+    q : numpy.ndarray
+        Nodal displacements and rotations in the kernel's q ordering (3 n_elements), m and rad.
+    qd : numpy.ndarray
+        Their rates, m/s and rad/s.
     """
     x = np.linspace(0.0, 1.0, n_elements + 1)
 
@@ -39,9 +53,10 @@ def simeon_initial_state(n_elements: int, length: float) -> tuple[np.ndarray, np
 
 
 def static_onset(model: Model, n_elements: int, step_deg: float = 10.0) -> tuple[float, float] | None:
-    """Lowest constant crank speed [rad/s] at which the static tangent K + K_G of the rigid-body
-    axial force loses definiteness at some crank angle, and that angle [deg] to the ``step_deg``
-    scan; None if never (below 1e6 rad/s).
+    """Find the lowest constant crank speed at which the rod buckles statically.
+
+    The speed at which the static tangent K + K_G of the rigid-body axial force loses
+    definiteness at some crank angle, and that angle to the ``step_deg`` scan.
 
     The rigid-body axial force, hence K_G, scales with omega^2 at constant crank speed, so at
     each crank angle the onset is the largest t = omega^2 keeping K + t K_G(omega = 1) positive
@@ -49,6 +64,21 @@ def static_onset(model: Model, n_elements: int, step_deg: float = 10.0) -> tuple
     ``step_deg`` scan finds the critical angle and a 1-deg scan around it the speed.  Near the
     critical angle the speed varies by ~1e-4 only and the Cholesky test is that noisy on fine
     meshes, so the speed is good to about 0.01 rad/s and the angle only to the coarse scan.
+
+    Parameters
+    ----------
+    model : Model
+        The rod and mechanism (SI units).
+    n_elements : int
+        Rod elements.
+    step_deg : float, default 10.0
+        Crank-angle step of the coarse scan, deg.
+
+    Returns
+    -------
+    tuple of float, or None
+        (crank speed in rad/s, crank angle in deg); None if the rod never buckles below
+        1e6 rad/s.
     """
     args = (n_elements, model.r2, model.length, model.rho_a, model.ea, model.ei, model.m_s)
 
@@ -90,8 +120,53 @@ def no_record() -> np.ndarray:
 
 @dataclass
 class Case:
-    """One run: crank speed, element count and its last-revolution (or end-state) results
-    (the records are empty unless the run is ``ok``)."""
+    """One run: crank speed, element count and its last-revolution (or end-state) results.
+
+    The records (arrays, one value per recorded time step) are empty unless the run is ``ok``.
+    Strains are dimensionless (the report prints microstrain).
+
+    Attributes
+    ----------
+    omega : float
+        Crank speed, rad/s.
+    n_elements : int
+        Rod elements.
+    status : str
+        ``'ok'``, ``'buckled'``, ``'diverged'``, ``'not_spd'`` ...
+    dt : float
+        Time step, s.
+    fail_angle_deg : float or None
+        Crank angle where a failed run stopped, deg.
+    fail_rev : int or None
+        Revolution where a failed run stopped.
+    angle_deg : numpy.ndarray
+        Crank angle of each recorded step, deg.
+    time : numpy.ndarray
+        Time of each recorded step, s.
+    eps_1, eps_2 : numpy.ndarray
+        Axial strain of elements 1 and 2 (at the crank end).
+    eps_max, eps_min : numpy.ndarray
+        Largest and smallest axial strain over the rod.
+    eps_max_el, eps_min_el : numpy.ndarray
+        Their (0-based) elements.
+    outer_max : numpy.ndarray
+        Largest outer-fibre strain.
+    n_avg_1 : numpy.ndarray
+        Element 1's rigid-body axial force, N.
+    mid : numpy.ndarray
+        Midpoint deflection of the rod from its chord, m.
+    slider : numpy.ndarray
+        Slider position, m.
+    elong : numpy.ndarray
+        Rod elongation, m.
+    euler_ratio : float
+        Peak rigid-body rod compression over the Euler load, dimensionless.
+    peak_compression : float
+        Peak rigid-body rod compression, N.
+    settle_strain, settle_mid : float or None
+        Change of the strain field and of the midpoint deflection between the last two
+        revolutions, relative to their peak, dimensionless; None when not measured.
+    """
 
     omega: float
     n_elements: int
@@ -123,26 +198,62 @@ class Case:
 
     @property
     def ok(self) -> bool:
+        """True when the run completed (``status == 'ok'``)."""
         return self.status == "ok"
 
     def crank_end_peak(self, sign: int) -> float:
-        """Peak strain [-] at the crank pin itself (s = 0), recovered by linear extrapolation
-        of the first two element strains (midpoints L/2n, 3L/2n); exact for a strain field
-        linear in s.  Element averages converge as 1/n where N(s) varies; this converges fast."""
+        """Find the peak axial strain at the crank pin itself (s = 0).
+
+        Recovered by linear extrapolation of the first two element strains (midpoints L/2n,
+        3L/2n); exact for a strain field linear in s.  Element averages converge as 1/n where
+        N(s) varies; this converges fast.
+
+        Parameters
+        ----------
+        sign : int
+            +1 the peak tension, -1 the peak compression.
+
+        Returns
+        -------
+        float
+            The peak strain, dimensionless (signed).
+        """
         e = self.eps_1 if self.n_elements < 2 else 1.5 * self.eps_1 - 0.5 * self.eps_2
         return float(np.max(sign * e) * sign)
 
     def peak(self, sign: int) -> tuple[float, float, int]:
-        """Peak tensile (sign=+1) or compressive (-1) axial strain [-], crank angle [deg], element.
+        """Find the peak axial strain over the rod and where it occurs.
+
         Where several elements and steps reach it: the lowest element, then its first step (the
-        order of numpy's argmax over the (element, step) field)."""
+        order of numpy's argmax over the (element, step) field).
+
+        Parameters
+        ----------
+        sign : int
+            +1 the peak tension, -1 the peak compression.
+
+        Returns
+        -------
+        strain : float
+            The peak strain, dimensionless (signed).
+        angle_deg : float
+            Crank angle where it occurs, deg in [0, 360).
+        element : int
+            The element (1-based, from the crank end).
+        """
         vals, els = (self.eps_max, self.eps_max_el) if sign > 0 else (self.eps_min, self.eps_min_el)
         hit = np.flatnonzero(vals == (vals.max() if sign > 0 else vals.min()))
         j = int(hit[np.argmin(els[hit])])
         return float(vals[j]), float(self.angle_deg[j] % 360.0), int(els[j]) + 1
 
     def outer_peak(self) -> float:
-        """The largest outer-fibre strain [-] over the recorded steps."""
+        """Find the largest outer-fibre strain over the recorded steps.
+
+        Returns
+        -------
+        float
+            The strain, dimensionless.
+        """
         return float(self.outer_max.max())
 
 

@@ -37,15 +37,64 @@ def slidercrank_simulate(n_elements: int, crank_radius: float, rod_length: float
                          geometric_stiffness: bool = False, fast: bool = True,
                          q_init: np.ndarray | None = None, qd_init: np.ndarray | None = None,
                          fields: bool = True, lag: int = 0) -> dict:
-    """Elastic connecting rod of a slider-crank, whole time loop in Fortran.
+    """Simulate the elastic connecting rod of a slider-crank: the whole time loop in Fortran.
 
-    SI units: lengths [m], rho_a mass per length [kg/m], ea [N], ei [N m^2], masses [kg],
-    omega crank speed [rad/s] (theta2 = omega t from 0), dt [s].  alpha [1/s] and beta [s]
-    are the Rayleigh coefficients (C = alpha M + beta K).  start: 'rest', 'quasistatic' or
-    'given' (q_init, qd_init in the kernel's q ordering, 3*n_elements values [m, rad]).
-    Records steps rec_start .. rec_start + n_rec - 1 (step 0 is the start).
+    SI units throughout.  Records steps rec_start .. rec_start + n_rec - 1 (step 0 is the
+    start).
 
-    Returns a dict: eps_ax, eps_of (n_elements, n_rec) axial and outer-fibre strain [-];
+    Parameters
+    ----------
+    n_elements : int
+        Rod elements.
+    crank_radius : float
+        Crank radius, m.
+    rod_length : float
+        Rod length, m.
+    rho_a : float
+        Rod mass per unit length, kg/m.
+    ea : float
+        Axial stiffness E A, N.
+    ei : float
+        Bending stiffness E I, N m^2.
+    half_depth : float
+        Half the in-plane section depth (the outer fibre), m.
+    slider_mass : float
+        Mass on the guide, kg.
+    omega : float
+        Crank speed, rad/s (theta2 = omega t from 0).
+    dt : float
+        Time step, s.
+    n_steps : int
+        Time steps.
+    rec_start, n_rec : int
+        First recorded step and the number recorded.
+    alpha : float, default 0.0
+        Mass-proportional Rayleigh coefficient, 1/s (C = alpha M + beta K).
+    beta : float, default 0.0
+        Stiffness-proportional Rayleigh coefficient, s.
+    start : {'quasistatic', 'rest', 'given'}, default 'quasistatic'
+        Initial state; 'given' takes ``q_init`` and ``qd_init``.
+    dynamic : bool, default True
+        Newmark integration; False solves K u = Q quasi-statically at every step.
+    geometric_stiffness : bool, default False
+        Add K_G of the rigid-body axial force.
+    fast : bool, default True
+        Use the constant-leading-block Schur path when there is no geometric stiffness.
+    q_init, qd_init : numpy.ndarray, optional
+        Initial state in the kernel's q ordering, 3 n_elements values, m and rad (and per s).
+    fields : bool, default True
+        Record the whole strain and force fields (else only the per-step profile).
+    lag : int, default 0
+        With lag > 0 also ``lag_change`` (see Returns).
+
+    Returns
+    -------
+    dict
+        The records, as listed below.
+
+    Notes
+    -----
+    The dict holds: eps_ax, eps_of (n_elements, n_rec) axial and outer-fibre strain [-];
     n_avg (n_elements, n_rec) element-averaged rigid-body axial force [N] -- these three only
     with ``fields`` (else None: a study that prints the profile below need not record 3 x 8
     bytes per element and step); mid midpoint deflection from the chord [m]; slider position
@@ -82,10 +131,41 @@ def slidercrank_simulate(n_elements: int, crank_radius: float, rod_length: float
 def slidercrank_matrices(n_elements: int, crank_radius: float, rod_length: float, rho_a: float,
                          ea: float, ei: float, slider_mass: float, theta2: float, omega: float = 0.0,
                          geometric_stiffness: bool = False) -> tuple[np.ndarray, np.ndarray]:
-    """Banded mass and stiffness (LAPACK lower storage, shape (6, 3 n)) at crank angle theta2 [rad].
+    """Assemble the banded mass and stiffness matrices at one crank angle.
 
     The mass includes the slider mass on U_X; with geometric_stiffness the stiffness includes
-    K_G of the rigid-body axial force at crank speed omega [rad/s].
+    K_G of the rigid-body axial force at crank speed omega.
+
+    Parameters
+    ----------
+    n_elements : int
+        Rod elements.
+    crank_radius : float
+        Crank radius, m.
+    rod_length : float
+        Rod length, m.
+    rho_a : float
+        Rod mass per unit length, kg/m.
+    ea : float
+        Axial stiffness E A, N.
+    ei : float
+        Bending stiffness E I, N m^2.
+    slider_mass : float
+        Mass on the guide, kg.
+    theta2 : float
+        Crank angle, rad.
+    omega : float, default 0.0
+        Crank speed, rad/s.
+    geometric_stiffness : bool, default False
+        Include K_G.
+
+    Returns
+    -------
+    mass : numpy.ndarray
+        (6, 3 n) banded mass, LAPACK lower band storage: kg, kg m or kg m^2 as an entry
+        couples translations and rotations.
+    stiffness : numpy.ndarray
+        (6, 3 n) banded stiffness, the same storage: N/m, N or N m likewise.
     """
     mb, kb = _kernels.slidercrank.assemble_matrices(
         int(n_elements), 3 * int(n_elements), crank_radius, rod_length, rho_a, ea, ei, slider_mass,
@@ -94,10 +174,25 @@ def slidercrank_matrices(n_elements: int, crank_radius: float, rod_length: float
 
 
 def slidercrank_rigid(theta2: np.ndarray, omega: float, crank_radius: float, rod_length: float) -> np.ndarray:
-    """Rigid kinematics at crank angles theta2 [rad], constant crank speed omega [rad/s]: (n, 7).
+    """Compute the rigid-body kinematics at constant crank speed.
 
-    Columns: theta3 [rad], theta3' [rad/s], theta3'' [rad/s^2], slider position x4 [m],
-    slider acceleration A_h [m/s^2], crank-pin acceleration along and across the rod [m/s^2].
+    Parameters
+    ----------
+    theta2 : numpy.ndarray
+        Crank angles, rad.
+    omega : float
+        Crank speed, rad/s.
+    crank_radius : float
+        Crank radius, m.
+    rod_length : float
+        Rod length, m.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, 7): theta3 [rad], theta3' [rad/s], theta3'' [rad/s^2], slider position x4 [m],
+        slider acceleration A_h [m/s^2], crank-pin acceleration along and across the rod
+        [m/s^2].
     """
     theta2 = farray(np.atleast_1d(theta2), 1)
     return _kernels.slidercrank.rigid_states(theta2, omega, crank_radius, rod_length)
@@ -105,7 +200,30 @@ def slidercrank_rigid(theta2: np.ndarray, omega: float, crank_radius: float, rod
 
 def slidercrank_axial_force(theta2: np.ndarray, s: np.ndarray, omega: float, crank_radius: float,
                             rod_length: float, rho_a: float, slider_mass: float) -> np.ndarray:
-    """Rigid-body axial force N [N] (tension positive) at stations s [m]: shape (len(s), len(theta2))."""
+    """Compute the rigid-body axial force along the rod.
+
+    Parameters
+    ----------
+    theta2 : numpy.ndarray
+        Crank angles, rad.
+    s : numpy.ndarray
+        Stations along the rod from the crank pin, m.
+    omega : float
+        Crank speed, rad/s.
+    crank_radius : float
+        Crank radius, m.
+    rod_length : float
+        Rod length, m.
+    rho_a : float
+        Rod mass per unit length, kg/m.
+    slider_mass : float
+        Mass on the guide, kg.
+
+    Returns
+    -------
+    numpy.ndarray
+        (len(s), len(theta2)) axial force N, newtons, tension positive.
+    """
     theta2 = farray(np.atleast_1d(theta2), 1)
     s = farray(np.atleast_1d(s), 1)
     return _kernels.slidercrank.axial_force_at(theta2, s, omega, crank_radius, rod_length, rho_a, slider_mass)
@@ -113,8 +231,30 @@ def slidercrank_axial_force(theta2: np.ndarray, s: np.ndarray, omega: float, cra
 
 def slidercrank_frequencies(rho_a: float, ea: float, ei: float, rod_length: float,
                             slider_mass: float) -> tuple[float, float, float]:
-    """Closed forms: first bending (pinned-pinned) and first axial (fixed / slider mass) natural
-    frequencies [rad/s], and the pinned-pinned Euler load pi^2 EI / L^2 [N]."""
+    """Compute the rod's first natural frequencies and Euler load in closed form.
+
+    Parameters
+    ----------
+    rho_a : float
+        Rod mass per unit length, kg/m.
+    ea : float
+        Axial stiffness E A, N.
+    ei : float
+        Bending stiffness E I, N m^2.
+    rod_length : float
+        Rod length, m.
+    slider_mass : float
+        Mass on the guide, kg.
+
+    Returns
+    -------
+    w_bend : float
+        First bending (pinned-pinned) natural frequency, rad/s.
+    w_axial : float
+        First axial (fixed / slider mass) natural frequency, rad/s.
+    p_euler : float
+        Pinned-pinned Euler load pi^2 EI / L^2, N.
+    """
     wb, wa, pe = _kernels.slidercrank.analytic_frequencies(rho_a, ea, ei, rod_length, slider_mass)
     return float(wb), float(wa), float(pe)
 
@@ -134,14 +274,62 @@ def slidercrank_nl_simulate(n_elements: int, crank_radius: float, rod_length: fl
                             alpha: float = 0.0, beta: float = 0.0, hht: float = 0.0, start: str = "quasistatic",
                             tol: float = 1e-8, max_iterations: int = 25, max_cuts: int = 6,
                             energy: bool = False) -> dict:
-    """Geometrically nonlinear (co-rotational) connecting rod, whole time loop in Fortran.
+    """Simulate the geometrically nonlinear (co-rotational) connecting rod: the whole time loop in Fortran.
 
-    Arguments as :func:`slidercrank_simulate` (SI units); steps_per_rev groups the steps into
-    revolutions for the per-revolution peaks; hht the HHT-alpha parameter in [-1/3, 0] (0: Newmark
-    average acceleration, no numerical damping); tol is the Newton tolerance on the relative
-    residual, max_iterations the Newton solves allowed per step, max_cuts the step halvings.
+    Parameters
+    ----------
+    n_elements : int
+        Rod elements.
+    crank_radius : float
+        Crank radius, m.
+    rod_length : float
+        Rod length, m.
+    rho_a : float
+        Rod mass per unit length, kg/m.
+    ea : float
+        Axial stiffness E A, N.
+    ei : float
+        Bending stiffness E I, N m^2.
+    half_depth : float
+        Half the in-plane section depth (the outer fibre), m.
+    slider_mass : float
+        Mass on the guide, kg.
+    omega : float
+        Crank speed, rad/s (theta2 = omega t from 0).
+    dt : float
+        Time step, s.
+    n_steps : int
+        Time steps.
+    steps_per_rev : int
+        Steps per revolution (groups the steps for the per-revolution peaks).
+    rec_start, n_rec : int
+        First recorded step and the number recorded.
+    alpha : float, default 0.0
+        Mass-proportional Rayleigh coefficient, 1/s.
+    beta : float, default 0.0
+        Stiffness-proportional Rayleigh coefficient, s.
+    hht : float, default 0.0
+        HHT-alpha parameter in [-1/3, 0], dimensionless (0: Newmark average acceleration, no
+        numerical damping).
+    start : {'quasistatic', 'rest'}, default 'quasistatic'
+        Initial state.
+    tol : float, default 1e-8
+        Newton tolerance on the relative residual, dimensionless.
+    max_iterations : int, default 25
+        Newton solves allowed per step.
+    max_cuts : int, default 6
+        Step halvings allowed.
+    energy : bool, default False
+        Record the energy balance.
 
-    Returns a dict: eps_ax, eps_of (n_elements, n_rec) axial and outer-fibre strain [-];
+    Returns
+    -------
+    dict
+        The records, as listed below.
+
+    Notes
+    -----
+    The dict holds: eps_ax, eps_of (n_elements, n_rec) axial and outer-fibre strain [-];
     lat_max largest |lateral deflection from the chord| [m], mid the midspan node's lateral
     deflection [m], elong rod elongation [m], slider position [m], energy (4, n_rec):
     kinetic, strain energy, work of the loads, damping dissipation since the start [J];
@@ -167,10 +355,37 @@ def slidercrank_nl_simulate(n_elements: int, crank_radius: float, rod_length: fl
 def slidercrank_column_static(n_elements: int, length: float, ea: float, ei: float, load: float,
                               imperfection: float, tol: float = 1e-10,
                               max_iterations: int = 500) -> tuple[float, float, int, int]:
-    """Static pinned-pinned column of co-rotational elements under an end load [N] (compression
-    positive), from a sine initial guess of amplitude ``imperfection`` [m].
+    """Solve a static pinned-pinned column of co-rotational elements under an end load.
 
-    Returns (midspan lateral deflection [m], end shortening [m], Newton solves, status).
+    Parameters
+    ----------
+    n_elements : int
+        Elements.
+    length : float
+        Column length, m.
+    ea : float
+        Axial stiffness E A, N.
+    ei : float
+        Bending stiffness E I, N m^2.
+    load : float
+        End load, N, compression positive.
+    imperfection : float
+        Amplitude of the sine initial guess, m.
+    tol : float, default 1e-10
+        Newton tolerance on the relative residual, dimensionless.
+    max_iterations : int, default 500
+        Newton solves allowed.
+
+    Returns
+    -------
+    mid : float
+        Midspan lateral deflection, m.
+    shortening : float
+        End shortening, m.
+    iterations : int
+        Newton solves used.
+    status : int
+        A ``SLIDERCRANK_NL_STATUS`` value.
     """
     n = int(n_elements)
     _q, mid, short, iters, status = _kernels.slidercrank_nl.column_static(
@@ -181,12 +396,44 @@ def slidercrank_column_static(n_elements: int, length: float, ea: float, ei: flo
 def slidercrank_corot_element(le: float, ea: float, ei: float, p: np.ndarray,
                               tangent: bool = True, rates: np.ndarray | None = None, damping: float = 0.0,
                               rate_weight: float = 0.0) -> tuple[np.ndarray, np.ndarray, float, float, float]:
-    """One co-rotational element: force (6,), tangent (6, 6) [N, N/m], axial strain, mean curvature
-    [1/m] and strain energy [J] for displacements p = (u, v, th) of its two nodes [m, rad].
+    """Evaluate one co-rotational element: nodal forces, tangent, strain, curvature and energy.
 
-    With ``damping`` bd [s] the force includes the damping of the deformation rates for the nodal
-    velocities ``rates`` [m/s, rad/s] and the tangent its derivative at fixed rates (not
-    symmetric) plus ``rate_weight`` cd times the rate derivative bd B^T K_l B / bd."""
+    With ``damping`` bd the force includes the damping of the deformation rates for the nodal
+    velocities ``rates`` and the tangent its derivative at fixed rates (not symmetric) plus
+    ``rate_weight`` cd times the rate derivative bd B^T K_l B / bd.
+
+    Parameters
+    ----------
+    le : float
+        Element length, m.
+    ea : float
+        Axial stiffness E A, N.
+    ei : float
+        Bending stiffness E I, N m^2.
+    p : numpy.ndarray
+        (6,) displacements (u, v, th) of its two nodes, m and rad.
+    tangent : bool, default True
+        Also compute the tangent.
+    rates : numpy.ndarray, optional
+        (6,) nodal velocities, m/s and rad/s (with ``damping``).
+    damping : float, default 0.0
+        Stiffness-proportional damping coefficient bd, s.
+    rate_weight : float, default 0.0
+        Weight cd of the rate derivative in the tangent, dimensionless.
+
+    Returns
+    -------
+    force : numpy.ndarray
+        (6,) nodal forces and moments, N and N m.
+    tangent : numpy.ndarray
+        (6, 6) tangent stiffness: N/m, N or N m as an entry couples translations and rotations.
+    strain : float
+        Axial strain, dimensionless.
+    curvature : float
+        Mean curvature, 1/m.
+    energy : float
+        Strain energy, J.
+    """
     if damping == 0.0 and rate_weight == 0.0:
         f, kt, eps, kap, en = _kernels.slidercrank_nl.element_corot(le, ea, ei, farray(p, 1), bool(tangent))
     else:

@@ -272,8 +272,14 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
 @keyword_signature(_keywords.slidercrank, SPEC)
 @keyword_run
 def run(params: Params, progress: bool = False) -> Result:
-    """Run one &slidercrank deck: the paper's linear KED model (:func:`run_linear`), or with
-    ``model = 'nonlinear'`` the co-rotational rod beside it (:func:`run_nonlinear`)."""
+    """Simulate a slider-crank with an elastic connecting rod at one or more crank speeds.
+
+    The paper's linear kineto-elastodynamic finite-element model integrated with Newmark's rule
+    (:func:`run_linear`), or with ``model = 'nonlinear'`` the co-rotational rod beside it
+    (:func:`run_nonlinear`): peak axial strain per crank speed, the crank-end strain against
+    crank angle, the Euler-load ratio and, with geometric stiffness, buckling.  SI units (m,
+    kg, Pa, rad/s, s); strains are reported in microstrain.
+    """
     if params.model == "nonlinear":
         return run_nonlinear(params, progress)
     return run_linear(params, progress)

@@ -184,7 +184,31 @@ _KEYS: dict[str, Key] = {
 
 @dataclass
 class Model:
-    """The rod and mechanism in SI units, with derived constants."""
+    """The rod and mechanism in SI units, with derived constants.
+
+    Attributes
+    ----------
+    r2 : float
+        Crank radius, m.
+    length : float
+        Rod length L3, m.
+    area : float
+        Rod section area, m^2.
+    inertia : float
+        In-plane second moment of area, m^4.
+    density : float
+        Rod density, kg/m^3.
+    modulus : float
+        Young's modulus, Pa.
+    depth : float
+        In-plane section depth (outer fibre at depth/2), m.
+    slider_mass : float
+        Slider mass M, kg.
+    bearing_crank, bearing_slider : float
+        Bearing masses at the crank pin and the slider, kg.
+    sources : dict of str to str
+        Where each value came from (the deck, a named material, a section shape).
+    """
 
     r2: float
     length: float
@@ -200,14 +224,17 @@ class Model:
 
     @property
     def rho_a(self) -> float:
+        """Mass per unit length of the rod, density x area [kg/m]."""
         return self.density * self.area
 
     @property
     def ea(self) -> float:
+        """Axial stiffness E A [N]."""
         return self.modulus * self.area
 
     @property
     def ei(self) -> float:
+        """Bending stiffness E I [N m^2]."""
         return self.modulus * self.inertia
 
     @property
@@ -216,7 +243,15 @@ class Model:
         return self.slider_mass + self.bearing_slider
 
     def frequencies(self) -> tuple[float, float, float]:
-        """First bending, first axial frequency [rad/s] and Euler load [N] (closed forms, kernel)."""
+        """Compute the first bending and axial frequencies and the Euler load (closed forms, kernel).
+
+        Returns
+        -------
+        w_bend, w_axial : float
+            First bending and first axial natural frequency, rad/s.
+        p_euler : float
+            Euler buckling load of the rod, N.
+        """
         return kernel.slidercrank_frequencies(self.rho_a, self.ea, self.ei, self.length, self.m_s)
 
 
@@ -261,16 +296,43 @@ def model_of(params: Params) -> Model:
 
 
 def rayleigh(zeta: float, w1: float, w2: float) -> tuple[float, float]:
-    """Rayleigh coefficients (alpha [1/s], beta [s]) giving ratio zeta at w1 and w2 [rad/s]."""
+    """Compute the Rayleigh damping coefficients that give one damping ratio at two frequencies.
+
+    Parameters
+    ----------
+    zeta : float
+        Damping ratio, dimensionless.
+    w1, w2 : float
+        The two frequencies (first bending and first axial), rad/s.
+
+    Returns
+    -------
+    alpha : float
+        Mass-proportional coefficient, 1/s (C = alpha M + beta K).
+    beta : float
+        Stiffness-proportional coefficient, s.
+    """
     return 2 * zeta * w1 * w2 / (w1 + w2), 2 * zeta / (w1 + w2)
 
 
 def min_steps_per_rev(omega: float, w_bend: float) -> int:
-    """Fewest steps per revolution at crank speed omega [rad/s] for the time-step criterion.
+    """Find the fewest time steps per crank revolution the time-step criterion allows.
 
     Newmark's average-acceleration rule is unconditionally stable but lengthens periods by
     about (w dt)^2 / 12: 20 steps per period of the first bending mode w_bend keep that error
     below 1 %.  Steps per bending period = steps_per_rev * omega / w_bend.
+
+    Parameters
+    ----------
+    omega : float
+        Crank speed, rad/s.
+    w_bend : float
+        First bending natural frequency of the rod, rad/s.
+
+    Returns
+    -------
+    int
+        Steps per revolution.
     """
     return max(MIN_STEPS_PER_REV, math.ceil(MIN_STEPS_PER_BENDING_PERIOD * w_bend / omega))
 
@@ -360,10 +422,24 @@ SPEC = GroupSpec("slidercrank", _KEYS,
 
 
 def estimate(params: Params) -> Estimate:
-    """Memory and work of a run from the keys alone (driver.limits): every (speed, element count)
+    """Estimate the memory and work of a run from the keys alone, before it allocates.
+
+    Every (speed, element count)
     integrates n_steps Newmark steps over 3 (n + 1) degrees of freedom (banded, about 0.2 us per
     dof and step) and records the last two revolutions of states (to judge settling); the static
-    buckling onset factors K + K_G some 2000 times (about 0.3 ms per dof in all)."""
+    buckling onset factors K + K_G some 2000 times (about 0.3 ms per dof in all).
+
+    Parameters
+    ----------
+    params : Params
+        Validated ``&slidercrank`` keys.
+
+    Returns
+    -------
+    Estimate
+        Bytes and seconds the run needs, each with the key that drives it
+        (``driver.limits`` refuses an absurd request with it).
+    """
     p = params
     counts = list(p.element_counts) if p.element_counts else [p.n_elements]
     work, mem, steps_max = 0.0, 0.0, 0.0

@@ -98,15 +98,44 @@ def _base_hash(raw: RawGroup) -> str:
 def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool = False,
                    jobs: int | None = None, scheduler: Any = None, resume: bool = False,
                    notify: Callable[[str], None] | None = None) -> SweepOutcome:
-    """Run a deck with a &sweep group; returns what it did (:class:`~driver.outcome.SweepOutcome`:
-    counts, failed cases, warnings as data, files written, the driver's CPU per phase).  Prints
-    nothing (a progress bar on stderr with ``progress``).  ``notify(line)`` hears what cannot wait
-    for the outcome: on Ctrl-C, that the queued cases are cancelled while the running ones finish
-    (the command line prints it on stderr at once; default: nothing is said).
+    """Run a deck with a &sweep group and write its files; print nothing.
 
-    Raises DeckError for bad input before any case runs, and
-    :class:`~driver.extras.MissingExtra` before running anything when pyarrow (case files and
-    summaries are Parquet) or, with a scheduler, Dask is not installed.
+    Parameters
+    ----------
+    deck : Deck
+        The read deck: one study group and a ``&sweep`` group.
+    outdir : pathlib.Path
+        Where to write.
+    formats : list of str
+        Tidy table formats of the case files: ``'csv'``, ``'parquet'``.
+    plot : bool
+        Write the sweep's figures.
+    progress : bool, default False
+        Show a progress bar on stderr.
+    jobs : int, optional
+        Worker processes; default all cores, 1 runs in this process.
+    scheduler : str or dask.distributed.Client, optional
+        A Dask scheduler address or client.
+    resume : bool, default False
+        Reuse the cases a previous run completed (verified, never believed).
+    notify : callable, optional
+        ``notify(line)`` hears what cannot wait for the outcome: on Ctrl-C, that the queued cases
+        are cancelled while the running ones finish (the command line prints it on stderr at
+        once). Default: nothing is said, the ``KeyboardInterrupt`` being the news.
+
+    Returns
+    -------
+    SweepOutcome
+        Counts, failed cases, warnings as data, files written, wall time (s) and the driver's
+        CPU time per phase (s).
+
+    Raises
+    ------
+    DeckError
+        Bad input, before any case runs.
+    MissingExtra
+        Before running anything, when pyarrow (case files and summaries are Parquet) or, with
+        a scheduler, Dask is not installed.
     """
     start_cpu = time.process_time()
     sw = validate(deck.groups["sweep"], SPEC, deck.path)

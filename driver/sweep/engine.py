@@ -140,7 +140,19 @@ def _write_case(task: Task, case: Case, res: CaseResult, result, params: Params,
 
 
 def run_task(task: Task) -> list[CaseResult]:
-    """Run a chunk of cases (the unit of work sent to a process or a Dask worker)."""
+    """Run a chunk of cases: the unit of work sent to a process or a Dask worker.
+
+    Parameters
+    ----------
+    task : Task
+        The cases (plain, picklable data: the deck's study group, the grid, the case numbers).
+
+    Returns
+    -------
+    list of CaseResult
+        One per case, in order: status, error, summary (units in the column names), kept,
+        the files written and the case's wall and CPU time (s).
+    """
     module = load_study(task.raw.name)
     writable = lambda res, result, params: params is not None and (result is not None or res.status == ExitCode.OK)
     cases = list(iter_cases(task.grid, task.indices))
@@ -221,7 +233,30 @@ def check_shared_folder(client: Any, folder: Path) -> None:
 # ----------------------------------------------------------------------------- execution
 
 def auto_chunk(seconds_per_case: float, n_cases: int, workers: int, target: float = 0.1) -> int:
-    """Cases per task: enough for ~``target`` s of work, but at least 4 tasks per worker."""
+    """Choose the cases per task: enough for about ``target`` of work, but at least 4 tasks per worker.
+
+    Parameters
+    ----------
+    seconds_per_case : float
+        Time of one warm case, s.
+    n_cases : int
+        Cases of the sweep.
+    workers : int
+        Worker processes (or a Dask cluster's threads).
+    target : float, default 0.1
+        Work per task, s.
+
+    Returns
+    -------
+    int
+        Cases per task, at least 1.
+
+    Examples
+    --------
+    >>> from driver.sweep import auto_chunk
+    >>> auto_chunk(0.001, 10_000, 2), auto_chunk(0.001, 100, 2), auto_chunk(1.0, 100, 2)
+    (100, 13, 1)
+    """
     by_time = math.ceil(target / max(seconds_per_case, 1e-6))
     by_balance = math.ceil(n_cases / (4 * max(workers, 1)))
     return max(1, min(by_time, by_balance))

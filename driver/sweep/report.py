@@ -48,7 +48,21 @@ def with_settings(frame: pd.DataFrame, settings: dict[str, Any]) -> pd.DataFrame
 
 
 def summary_frame(results: list[CaseResult], names: list[str]) -> pd.DataFrame:
-    """One row per case: case, swept keys, status, error, kept, headline figures."""
+    """Tabulate a sweep's cases: one row per case.
+
+    Parameters
+    ----------
+    results : list of CaseResult
+        What the workers returned.
+    names : list of str
+        The swept keys, ``'group.key'``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Case, swept keys, status, error, kept and the study's headline figures (units in
+        their names).
+    """
     rows = []
     for r in results:
         row = {"case": r.index, **{n: r.values[n] for n in names},

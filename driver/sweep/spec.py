@@ -152,7 +152,15 @@ class CaseResult:
 
 @dataclass
 class Case:
-    """One case of a sweep: its number (from 1) and the swept values {'group.key': value}."""
+    """One case of a sweep.
+
+    Attributes
+    ----------
+    index : int
+        The case's number, from 1.
+    values : dict
+        The swept values ``{'group.key': value}``, in the keys' deck units.
+    """
 
     index: int
     values: dict[str, Any]
@@ -207,7 +215,20 @@ def swept_axes(sw: Params, study_group: str, study_spec: GroupSpec) -> list[tupl
 
 
 def case_count(sw: Params, axes: list[tuple[str, list]]) -> int:
-    """Number of cases of the axes (full grid or zipped), computed before any case is built."""
+    """Count the cases of the axes (full grid or zipped) before any case is built.
+
+    Parameters
+    ----------
+    sw : Params
+        The validated ``&sweep`` group (``zip``).
+    axes : list of tuple
+        The swept axes ``('group.key', values)``.
+
+    Returns
+    -------
+    int
+        The number of cases.
+    """
     return len(axes[0][1]) if sw.zip else math.prod(len(v) for _, v in axes)
 
 
@@ -251,9 +272,27 @@ def grid_of(sw: Params, study_group: str, study_spec: GroupSpec) -> Grid:
 
 
 def build_cases(sw: Params, study_group: str, study_spec: GroupSpec) -> list[Case]:
-    """All cases of the sweep, numbered from 1: a full grid, or zipped axes.
+    """Build all cases of the sweep, numbered from 1: a full grid, or zipped axes.
 
-    A sweep of more than :data:`MAX_CASES` cases is refused before a case is built.
+    Parameters
+    ----------
+    sw : Params
+        The validated ``&sweep`` group.
+    study_group : str
+        The study's namelist group.
+    study_spec : GroupSpec
+        The study's keys (the swept keys are checked against them).
+
+    Returns
+    -------
+    list of Case
+        The cases, values in the keys' deck units.
+
+    Raises
+    ------
+    DeckError
+        An unknown key, unequal zipped lists, or more than :data:`MAX_CASES` cases (refused
+        before a case is built).
     """
     axes = swept_axes(sw, study_group, study_spec)
     names = [a[0] for a in axes]

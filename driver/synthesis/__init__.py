@@ -152,7 +152,34 @@ SPEC = GroupSpec(
 
 @dataclass
 class Synthesis:
-    """A synthesis result: the linkage deck, the study run of it, and the report."""
+    """A synthesis result: the linkage deck, the study run of it, and the report.
+
+    Attributes
+    ----------
+    params : Params
+        The validated ``&synthesis`` group.
+    linkage : dict or None
+        The linkage's ``&fourbar`` deck values (lengths in the deck's length unit, angles in
+        deg); None when no linkage was found.
+    text : str
+        The report (``<stem>.out``).
+    failure : str or None
+        Why the design failed its check by the exact kernel; None on success.
+    table : pandas.DataFrame
+        The task's table (structural error, family or targets).
+    table_name : str
+        Its file suffix (``'_error'``, ``'_family'``, ``'_targets'``).
+    study_result : Result or None
+        The four-bar study's run of the linkage.
+    design : object
+        The task's design object (function, family member or path design).
+    checks : dict of str to float
+        The checks of the design, units in the names where they have one (``swing_deg``,
+        ``mu_min_deg``; ``time_ratio`` dimensionless; a path's ``rms`` and ``max_error`` in the
+        length unit of the targets, a function's ``max_error_y`` in the units of y).
+    warnings : list of str
+        A degenerate or poor design, in words.
+    """
 
     params: Params
     linkage: dict[str, Any] | None   # the linkage deck's values; None when no linkage was found
@@ -493,7 +520,24 @@ def _path(p: Params) -> Synthesis:
 
 @blas.one_thread()
 def synthesise(deck: Deck | str | Path) -> Synthesis:
-    """Run a &synthesis deck: design the linkage, check it, and run its &fourbar deck."""
+    """Run a &synthesis deck: design the linkage, check it, and run its &fourbar deck.
+
+    Parameters
+    ----------
+    deck : Deck, str or path-like
+        The deck (a ``&synthesis`` group only), or its file.
+
+    Returns
+    -------
+    Synthesis
+        The linkage (lengths in the deck's length unit), the exact kernel's checks, the
+        report, and the four-bar study's run of the linkage; nothing is written.
+
+    Raises
+    ------
+    DeckError
+        Bad input, or another group beside ``&synthesis``.
+    """
     if not isinstance(deck, Deck):
         deck = read_deck(deck)
     others = [g for g in deck.groups if g != "synthesis"]
@@ -541,9 +585,36 @@ def synthesis_record(syn: Synthesis) -> dict[str, Any]:
 
 def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool = False,
                        summary_json: bool = False, **_: Any) -> FilesOutcome:
-    """Command-line entry: synthesise and write; returns the files written, the warnings and the
-    failure as data (:class:`~driver.outcome.FilesOutcome`, the :class:`Synthesis` as ``value``).
-    DeckError propagates."""
+    """Synthesise a linkage and write its files: the command line's entry.
+
+    Parameters
+    ----------
+    deck : Deck
+        The read deck.
+    outdir : pathlib.Path
+        Where to write.
+    formats : list of str
+        Tidy table formats of the linkage's run: ``'csv'``, ``'parquet'``.
+    plot : bool
+        Write the figures.
+    progress : bool, default False
+        Unused (a synthesis shows no progress bar); the engines' common signature.
+    summary_json : bool, default False
+        Also write ``<stem>.json``.
+    **_ : dict
+        Options of other engines, ignored.
+
+    Returns
+    -------
+    FilesOutcome
+        The files written, the warnings and the failure as data, the :class:`Synthesis` as
+        ``value``.
+
+    Raises
+    ------
+    DeckError
+        Bad input.
+    """
     syn = synthesise(deck)
     stem = output_stem(outdir, deck.path, (".out", ".linkage.dat", ".linkage.out", f"{syn.table_name}.csv",
                                            *(f".linkage.{fmt}" for fmt in formats),

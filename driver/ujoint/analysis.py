@@ -36,7 +36,21 @@ BOUND_TOL = 1e-7
 
 @dataclass
 class Chain:
-    """Fixed description of a run: model code, objective code, plane angles, grid."""
+    """Fixed description of a run: model code, objective code, plane angles, grid.
+
+    Attributes
+    ----------
+    model : int
+        Model code (``driver.ujoint.kernel.UJOINT_MODELS``: eq13, cumulative, exact).
+    kind : int
+        Objective code (``UJOINT_OBJECTIVES``: mean_square, rms, peak_to_peak).
+    rho : numpy.ndarray
+        (n-1,) angles between the planes of successive joints, rad.
+    m : int
+        Input angles per revolution of the grid.
+    rpm : float
+        Input shaft speed, rpm.
+    """
 
     model: int
     kind: int
@@ -52,7 +66,37 @@ class Chain:
 
 @dataclass
 class Design:
-    """One design evaluated: angles [deg] and its performance figures."""
+    """One design evaluated: its angles and performance figures.
+
+    R = omega_out / omega_in is the speed ratio of the chain over one input revolution.
+
+    Attributes
+    ----------
+    label : str
+        ``'trial'``, ``'optimum'``, ``'paper'``, ``'design'`` ...
+    beta : numpy.ndarray
+        Joint operating angles, deg.
+    phi : numpy.ndarray
+        Phases, deg (the paper's convention: 90 deg = yokes in phase).
+    objective : float
+        The run's objective of R (mean square, RMS or peak-to-peak of R - 1), dimensionless.
+    u_rpm2 : float
+        The paper's U: mean (R - 1)^2 times the input speed squared, rpm^2.
+    pp : float
+        Peak-to-peak ratio max R - min R, dimensionless.
+    w_min, w_max : float
+        Output speed band at the input speed, rpm.
+    beta_e : float
+        Closed-form equivalent angle of the chain, deg.
+    beta_res : float or None
+        Resultant angle, deg; None where undefined.
+    peak_acc : float
+        Peak output angular acceleration at constant input speed, rad/s^2.
+    mean_ratio : float
+        Mean of R over the revolution (1 for a closed chain), dimensionless.
+    extra : dict
+        Further figures of the design.
+    """
 
     label: str
     beta: np.ndarray         # deg
@@ -70,22 +114,68 @@ class Design:
 
 
 def yoke_shifts(model: int, phi_deg) -> np.ndarray:
-    """The phase shift between joints k and k+1 of a design's phases [deg], in the
-    cumulative/exact convention: phi itself, or phi_k - phi_(k-1) under eq. 13 as printed
-    (where phi_k is the absolute phase of joint k+1)."""
+    """Convert a design's phases to the phase shifts between successive joints.
+
+    In the cumulative/exact convention the shift is phi itself; under eq. 13 as printed it is
+    phi_k - phi_(k-1) (there phi_k is the absolute phase of joint k+1).
+
+    Parameters
+    ----------
+    model : int
+        Model code (``driver.ujoint.kernel.UJOINT_MODELS``).
+    phi_deg : array_like
+        The design's phases, deg.
+
+    Returns
+    -------
+    numpy.ndarray
+        The shifts between joints k and k+1, deg.
+    """
     phi = np.asarray(phi_deg, float)
     return np.diff(phi, prepend=0.0) if model == UJOINT_MODELS["eq13"] else phi
 
 
 def phases_for(model: int, shifts_deg) -> np.ndarray:
-    """The phases [deg] that give the shifts ``shifts_deg`` under ``model`` (inverse of
-    :func:`yoke_shifts`): the same physical assembly in another model's convention."""
+    """Convert phase shifts back to a model's phases (the inverse of :func:`yoke_shifts`).
+
+    Parameters
+    ----------
+    model : int
+        Model code (``driver.ujoint.kernel.UJOINT_MODELS``).
+    shifts_deg : array_like
+        Phase shifts between joints k and k+1, deg.
+
+    Returns
+    -------
+    numpy.ndarray
+        The phases, deg: the same physical assembly in ``model``'s convention.
+    """
     s = np.asarray(shifts_deg, float)
     return np.cumsum(s) if model == UJOINT_MODELS["eq13"] else s
 
 
 def evaluate(chain: Chain, label: str, beta_deg, phi_deg, model: int | None = None) -> Design:
-    """All headline figures of one design under ``chain`` (``model`` overrides its model)."""
+    """Evaluate one design: every headline figure under ``chain``.
+
+    Parameters
+    ----------
+    chain : Chain
+        The run's model, objective, plane angles, grid and input speed.
+    label : str
+        The design's name in the report (``'trial'``, ``'optimum'`` ...).
+    beta_deg : array_like
+        Joint operating angles, deg.
+    phi_deg : array_like
+        Phases (the paper's convention), deg.
+    model : int, optional
+        A model code overriding the chain's.
+
+    Returns
+    -------
+    Design
+        The figures: objective (dimensionless), speed band (rpm), equivalent angles (deg),
+        peak output acceleration (rad/s^2).
+    """
     model = chain.model if model is None else model
     b = np.asarray(beta_deg, float) * DEG
     ph = np.asarray(phi_deg, float) * DEG
@@ -103,7 +193,23 @@ def evaluate(chain: Chain, label: str, beta_deg, phi_deg, model: int | None = No
 
 @dataclass
 class StartRun:
-    """Outcome of one SLSQP start."""
+    """Outcome of one SLSQP start.
+
+    Attributes
+    ----------
+    x0, x : numpy.ndarray
+        Start and end point of the free variables, rad.
+    f : float
+        The objective at ``x`` (not scaled), dimensionless.
+    nit, nfev, njev : int
+        SLSQP iterations, objective and gradient evaluations.
+    success : bool
+        SLSQP converged.
+    message : str
+        SLSQP's words.
+    on_bound : numpy.ndarray
+        Indices of the free variables that end on a bound.
+    """
 
     x0: np.ndarray
     x: np.ndarray
@@ -127,12 +233,37 @@ def _symmetric(chain: Chain, phi_rad: np.ndarray) -> bool:
 def optimise(chain: Chain, option: int, beta0: np.ndarray, phi0: np.ndarray,
              lb: np.ndarray, ub: np.ndarray, starts: np.ndarray, maxiter: int,
              ftol: float, scale: float, progress: bool = False) -> list[StartRun]:
-    """SLSQP from every row of ``starts`` (free variables, rad) with the kernel gradient.
+    """Minimise the objective by SLSQP from every start, with the kernel's gradient.
 
-    beta0, phi0 [rad] hold the fixed variables; lb/ub the bounds of the free ones [rad].
     The objective is divided by ``scale`` (:func:`objective_scale`, never 0) so ``ftol`` is
     relative.  Phases whose bounds span a period are searched unbounded and wrapped into
     [lb, lb + 180 deg): a bound there is no stopping point.
+
+    Parameters
+    ----------
+    chain : Chain
+        The run's model, objective, plane angles, grid and input speed.
+    option : int
+        1 phases free, 2 angles free, 3 both.
+    beta0, phi0 : numpy.ndarray
+        Joint angles and phases holding the fixed variables, rad.
+    lb, ub : numpy.ndarray
+        Bounds of the free variables, rad.
+    starts : numpy.ndarray
+        (starts, free variables) start points, rad; row 0 the trial point.
+    maxiter : int
+        SLSQP iteration limit per start.
+    ftol : float
+        SLSQP tolerance on the scaled objective, dimensionless.
+    scale : float
+        The objective's scale (:func:`objective_scale`).
+    progress : bool, default False
+        Show a progress bar on the terminal.
+
+    Returns
+    -------
+    list of StartRun
+        One per start, in the order of ``starts``.
     """
     n = beta0.size
     free = free_index(option, n)
@@ -170,8 +301,23 @@ def _periodic(option: int, n: int, lb: np.ndarray, ub: np.ndarray) -> np.ndarray
 
 
 def objective_scale(chain: Chain, f_trial: float, beta_max_deg: float) -> float:
-    """The objective's scale, which cannot vanish: the larger of the trial's value and a
-    single joint's objective at the largest joint angle the run can reach (1 if that is 0)."""
+    """Choose the objective's scale, which cannot vanish.
+
+    Parameters
+    ----------
+    chain : Chain
+        The run's model, objective, plane angles, grid and input speed.
+    f_trial : float
+        The objective at the trial point, dimensionless.
+    beta_max_deg : float
+        The largest joint angle the run can reach, deg.
+
+    Returns
+    -------
+    float
+        The larger of ``f_trial`` and a single joint's objective at ``beta_max_deg`` (1 if
+        that is 0), dimensionless.
+    """
     b = np.array([abs(beta_max_deg) * DEG])
     ref = ujoint_objective(chain.model, chain.kind, b, None, None, chain.m, grad=False)[0]
     scale = max(f_trial, ref)
@@ -179,7 +325,7 @@ def objective_scale(chain: Chain, f_trial: float, beta_max_deg: float) -> float:
 
 
 def pick_best(runs: list[StartRun], n_beta: int) -> int:
-    """Index of the reported optimum among the starts (TIE RULE, deterministic).
+    """Pick the reported optimum among the starts by the (deterministic) tie rule.
 
     Converged starts within TIE_RTOL (relative) of the best objective tie (mirror optima
     agree to rounding; along a continuous family of optima the most converged start wins).
@@ -189,6 +335,18 @@ def pick_best(runs: list[StartRun], n_beta: int) -> int:
     CLUSTER_TOL of that end point are one optimum, and the one of them with the lowest
     objective is reported (then the start order).  With no converged start, the lowest
     objective (a last iterate, reported as such).
+
+    Parameters
+    ----------
+    runs : list of StartRun
+        The starts' outcomes (index 0 the trial start).
+    n_beta : int
+        Number of joint angles among the variables.
+
+    Returns
+    -------
+    int
+        Index into ``runs`` of the reported optimum.
     """
     ok = [k for k, r in enumerate(runs) if r.success]
     if not ok:

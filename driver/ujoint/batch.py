@@ -50,8 +50,18 @@ _ELEMENT = re.compile(r"([a-z_]+)\((\d+)\)")
 
 
 def batch_applies(base: Mapping[str, Any]) -> bool:
-    """Whether designs on ``base`` can take the batch path: option 0 only (options 1-3 run an
-    optimisation per case, which the batch does not)."""
+    """Tell whether designs on ``base`` can take the batch path.
+
+    Parameters
+    ----------
+    base : mapping
+        ``&ujoint`` keys (validated Params or a plain mapping).
+
+    Returns
+    -------
+    bool
+        True for option 0 (options 1-3 run an optimisation per case, which the batch does not).
+    """
     return int(base["option"]) == 0
 
 
@@ -133,7 +143,7 @@ def _number_column(base: Mapping[str, Any], key: str, columns: dict[str, Any], n
 
 def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None = None,
                     wanted: Collection[str] | None = None) -> pd.DataFrame:
-    """Summaries of many Hooke-joint designs, one Fortran call per chain layout: one row per design.
+    """Summarise many Hooke-joint designs, one Fortran call per chain layout: one row per design.
 
     What it computes: for each design the figures of an option-0 run (``run(...).summary``:
     the design evaluated as given, nothing optimised), with identical values -- objective and
@@ -159,6 +169,27 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     3-joint design at 360 angles on one core (bench/bench_ujoint.py).  ``wanted``: only these
     columns, computed by only the kernel passes they need (:data:`BATCH_PASSES`; the same bits
     as in a full summary); None: all.
+
+    Parameters
+    ----------
+    base : mapping
+        A validated ``&ujoint`` Params (or a mapping with its keys), option 0.
+    columns : mapping of str to array, optional
+        {key: values} for keys in ``BATCH_KEYS``, in the deck's units (deg, rpm).
+    wanted : collection of str, optional
+        Only these summary columns; None: all.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per design, the columns above (units in their names).
+
+    Raises
+    ------
+    DeckError
+        A bad value, when ``base`` is a deck's Params (deck, line and key of the base deck).
+    ValueError
+        A bad value otherwise.
     """
     if not batch_applies(base):
         raise _bad(base, "option", f"option {base['option']} optimises inside each case; the batch path "

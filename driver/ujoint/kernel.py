@@ -45,13 +45,30 @@ def _vector(x) -> np.ndarray:
 
 
 def ujoint_speed(model: int, beta, phi, rho, theta) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Chain speed ratio at input angles ``theta`` [rad]: (R, dR/dtheta, output angle).
+    """Compute the chain's speed ratio, its derivative and the output angle at input angles.
 
-    beta (n,) joint angles [rad]; phi (n-1,) the paper's phases [rad] (pi/2 = yokes in
-    phase); rho (n-1,) plane angles between successive joints [rad] or None (coplanar).
-    R = omega_out/omega_in [-]; dR/dtheta [1/rad] times omega_in**2 [rad/s]**2 is the
-    output angular acceleration [rad/s**2] at constant input speed; the output shaft angle
-    [rad] is given by the exact model only (zeros for the paper models).
+    Parameters
+    ----------
+    model : int
+        Model code (``UJOINT_MODELS``).
+    beta : array_like
+        (n,) joint angles, rad.
+    phi : array_like
+        (n-1,) the paper's phases, rad (pi/2 = yokes in phase).
+    rho : array_like or None
+        (n-1,) angles between the planes of successive joints, rad; None: coplanar.
+    theta : array_like
+        Input shaft angles, rad.
+
+    Returns
+    -------
+    ratio : numpy.ndarray
+        R = omega_out/omega_in, dimensionless.
+    dratio : numpy.ndarray
+        The derivative dR/dtheta, 1/rad; times omega_in**2 [(rad/s)**2] it is the output angular
+        acceleration [rad/s**2] at constant input speed.
+    angle : numpy.ndarray
+        Output shaft angle, rad (the exact model only; zeros for the paper models).
     """
     b, ph, rh = _ujoint_chain(beta, phi, rho)
     return _kernels.ujoint.chain_speed(int(model), b, ph, rh, farray(np.atleast_1d(theta), 1))
@@ -59,21 +76,59 @@ def ujoint_speed(model: int, beta, phi, rho, theta) -> tuple[np.ndarray, np.ndar
 
 def ujoint_objective(model: int, kind: int, beta, phi, rho, m: int,
                      grad: bool = True) -> tuple[float, np.ndarray]:
-    """Objective over ``m`` uniform input angles per revolution and its gradient.
+    """Evaluate the objective over ``m`` uniform input angles per revolution, and its gradient.
 
-    Returns (f, g): f dimensionless (mean (R-1)**2, its root, or max R - min R);
-    g (2n-1,) = df/d(beta_1..beta_n [rad], phi_1..phi_(n-1) [rad]); zeros when ``grad``
-    is False.
+    Parameters
+    ----------
+    model : int
+        Model code (``UJOINT_MODELS``).
+    kind : int
+        Objective code (``UJOINT_OBJECTIVES``).
+    beta : array_like
+        (n,) joint angles, rad.
+    phi : array_like
+        (n-1,) the paper's phases, rad.
+    rho : array_like or None
+        (n-1,) plane angles, rad; None: coplanar.
+    m : int
+        Input angles per revolution.
+    grad : bool, default True
+        Also compute the gradient.
+
+    Returns
+    -------
+    f : float
+        The objective, dimensionless (mean (R-1)**2, its root, or max R - min R).
+    g : numpy.ndarray
+        (2n-1,) df/d(beta_1..beta_n, phi_1..phi_(n-1)), 1/rad; zeros when ``grad`` is False.
     """
     b, ph, rh = _ujoint_chain(beta, phi, rho)
     return _kernels.ujoint.chain_objective(int(model), int(kind), b, ph, rh, int(m), int(bool(grad)))
 
 
 def ujoint_equivalent(model: int, beta, phi, rho, tol: float = 1e-7) -> tuple[float, float | None]:
-    """Closed-form equivalent angles [rad]: (beta_e, beta_res or None).
+    """Compute the closed-form equivalent angles of a chain.
 
-    beta_e from the first-order phasor sum of the model's phasing; beta_res of the exact
-    chain when every phi_k - rho_k is a multiple of pi/2 within ``tol`` [rad], else None.
+    Parameters
+    ----------
+    model : int
+        Model code (``UJOINT_MODELS``).
+    beta : array_like
+        (n,) joint angles, rad.
+    phi : array_like
+        (n-1,) the paper's phases, rad (pi/2 = yokes in phase).
+    rho : array_like or None
+        (n-1,) angles between the planes of successive joints, rad; None: coplanar.
+    tol : float, default 1e-7
+        Tolerance on phi_k - rho_k being a multiple of pi/2, rad.
+
+    Returns
+    -------
+    beta_e : float
+        Equivalent angle from the first-order phasor sum of the model's phasing, rad.
+    beta_res : float or None
+        Resultant angle of the exact chain, rad, when every phi_k - rho_k is a multiple of
+        pi/2 within ``tol``; else None.
     """
     b, ph, rh = _ujoint_chain(beta, phi, rho)
     be, br, st = _kernels.ujoint.chain_equivalent(int(model), b, ph, rh, float(tol))
@@ -90,11 +145,10 @@ UJOINT_PASSES = {k: int(getattr(_kernels.ujoint, f"sum_{k}")) for k in ("objecti
 
 
 def ujoint_summaries(model: int, kind: int, beta, phi, rho, m: int, tol: float = 1e-7, passes: int = 7) -> np.ndarray:
-    """Headline figures of many designs of one chain layout in one kernel call: (nd, 7) array.
+    """Compute the headline figures of many designs of one chain layout in one kernel call.
 
-    beta (nd, n) joint angles [rad]; phi (nd, n-1) the paper's phases [rad]; rho (nd, n-1)
-    plane angles [rad] or None (coplanar).  Every design shares ``model``, the objective
-    ``kind`` and the grid of ``m`` input angles per revolution.  Columns
+    Every design shares ``model``, the objective ``kind`` and the grid of ``m`` input angles
+    per revolution.  Columns
     (UJOINT_SUMMARY_COLUMNS): the objective (as :func:`ujoint_objective` without gradient),
     min and max of R = omega_out/omega_in and max |dR/dtheta| [1/rad] on the grid
     theta_j = 2 pi j/m (as :func:`ujoint_speed` there), beta_e and beta_res [rad] and the
@@ -102,6 +156,36 @@ def ujoint_summaries(model: int, kind: int, beta, phi, rho, m: int, tol: float =
     Each row has the same bits as those single-design calls.  ``passes``: sum of
     UJOINT_PASSES bits (objective: column 0, speed: 1-3, equivalent: 4-6); the columns of a
     pass not asked for are 0 (not computed).
+
+    Parameters
+    ----------
+    model : int
+        Model code (``UJOINT_MODELS``).
+    kind : int
+        Objective code (``UJOINT_OBJECTIVES``).
+    beta : array_like
+        (nd, n) joint angles, rad.
+    phi : array_like
+        (nd, n-1) the paper's phases, rad.
+    rho : array_like or None
+        (nd, n-1) plane angles, rad; None: coplanar.
+    m : int
+        Input angles per revolution.
+    tol : float, default 1e-7
+        Tolerance of beta_res's condition, rad.
+    passes : int, default 7
+        Sum of ``UJOINT_PASSES`` bits.
+
+    Returns
+    -------
+    numpy.ndarray
+        (nd, 7), columns ``UJOINT_SUMMARY_COLUMNS`` (objective and R dimensionless,
+        dR/dtheta 1/rad, angles rad).
+
+    Raises
+    ------
+    ValueError
+        ``beta`` is not a (designs, joints) array.
     """
     beta = np.asarray(beta, dtype=np.float64)
     if beta.ndim != 2 or beta.shape[1] < 1:
@@ -118,10 +202,21 @@ def ujoint_summaries(model: int, kind: int, beta, phi, rho, m: int, tol: float =
 
 
 def ujoint_geometry(axes) -> tuple[np.ndarray, np.ndarray, int]:
-    """Joint angles beta (n,) and plane angles rho (n-1,) [rad] of shaft directions ``axes``.
+    """Compute joint angles and plane angles of a 3-D chain from its shaft directions.
 
-    axes: (n+1, 3) direction vectors, input shaft first (any length unit, nonzero).
-    Status 0 ok, 2 an axis of zero length, 3 a joint angle of 90 deg or more.
+    Parameters
+    ----------
+    axes : array_like
+        (n+1, 3) shaft direction vectors, input shaft first (any length unit, nonzero).
+
+    Returns
+    -------
+    beta : numpy.ndarray
+        (n,) joint angles, rad.
+    rho : numpy.ndarray
+        (n-1,) angles between the planes of successive joints, rad.
+    status : int
+        0 ok, 2 an axis of zero length, 3 a joint angle of 90 deg or more.
     """
     a = farray(np.asarray(axes, dtype=np.float64).T, 2)
     beta, rho, status = _kernels.ujoint.chain_geometry(a)

@@ -347,7 +347,20 @@ def _result_dat(params: Params, chain: Chain, designs: list[Design], best: Desig
 @keyword_signature(_keywords.ujoint, SPEC)
 @keyword_run
 def run(params: Params, progress: bool = False) -> Result:
-    """Analyse (option 0) or optimise (options 1-3) the chain of the deck."""
+    """Analyse (option 0) or optimise (options 1-3) a chain of Hooke joints on a shaft line.
+
+    The output-speed fluctuation of the chain over one input revolution (objective, band,
+    peak-to-peak ratio, equivalent angles, peak output acceleration) for the given joint angles
+    ``beta`` and phases ``phi`` (or ``delta``); options 1-3 minimise the objective over the
+    phases, the angles or both with multi-start SLSQP.  Angles in degrees, speeds in rpm.
+
+    Examples
+    --------
+    >>> import driver
+    >>> r = driver.ujoint.run(beta=[10.0, 20.0], phi=[90.0], rpm=30.0)
+    >>> round(r.summary["omega_out_min_rpm"], 4), round(r.summary["omega_out_max_rpm"], 4)
+    (28.6257, 31.4403)
+    """
     beta, rho = joint_geometry(params)
     n = beta.size
     phi = phases_deg(params, n)

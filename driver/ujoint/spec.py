@@ -174,7 +174,19 @@ def phases_deg(params: Params, n: int, key: str | None = None) -> np.ndarray:
 
 
 def cross_check(params: Params) -> None:
-    """Cross-key checks (DeckError naming the key)."""
+    """Check the ``&ujoint`` keys against each other (the SPEC's cross-key check).
+
+    Parameters
+    ----------
+    params : Params
+        Validated ``&ujoint`` keys.
+
+    Raises
+    ------
+    DeckError
+        Keys that do not fit together (list lengths, a 3-D chain with a paper model, ...),
+        naming the key.
+    """
     beta, rho = joint_geometry(params)
     n = beta.size
     exact = params.model == "exact"
@@ -242,11 +254,22 @@ SPEC = GroupSpec("ujoint", KEYS, check=cross_check,
 
 
 def estimate(params: Params) -> Estimate:
-    """Memory and work of a run from the keys alone (driver.limits).
+    """Estimate the memory and work of a run from the keys alone, before it allocates.
 
     Per input angle of the grid and joint about 200 bytes of kernel arrays and 20 ns per
     objective evaluation; SLSQP evaluates objective and gradient about (variables + 1) times per
     iteration for every start; each speed-table row costs about 1 KB and 20 us to format.
+
+    Parameters
+    ----------
+    params : Params
+        Validated ``&ujoint`` keys.
+
+    Returns
+    -------
+    Estimate
+        Bytes and seconds the run needs, each with the key that drives it
+        (``driver.limits`` refuses an absurd request with it).
     """
     p = params
     joints = max(len(p.beta or []), len(p.phi or []) + 1, 2)
