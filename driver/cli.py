@@ -242,7 +242,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
                         help="sweeps and optimisations: run cases on this Dask distributed scheduler")
     parser.add_argument("--resume", action="store_true",
-                        help="sweeps: skip cases whose outputs are already complete; optimisations: replay the run's journal and compute only new designs")
+                        help="sweeps: skip cases whose outputs are already complete; "
+                             "optimisations: replay the run's journal and compute only new designs")
     parser.add_argument("--max-memory", metavar="SIZE", default=None,
                         help="refuse a deck (a sweep case) whose estimated memory is larger "
                              "(e.g. 8G, 512M; default: half of this machine's memory)")

@@ -1,7 +1,8 @@
 """The loader of the private Fortran extension ``driver._kernels``, shared by every study.
 
 It imports the extension once (with words on what to do when it is not built) and holds
-:func:`farray` and the spare output buffers of large kernel outputs (:func:`release_spares`).  Each study wraps its own modules of the extension in its ``kernel.py``
+:func:`farray` and the spare output buffers of large kernel outputs (:func:`release_spares`).
+Each study wraps its own modules of the extension in its ``kernel.py``
 (``driver.fourbar.kernel``, ``driver.ujoint.kernel``, ...; named in its ``Study.kernel``):
 wrappers convert inputs once to Fortran-ordered float64 (f2py would otherwise copy C-ordered
 2-D arrays silently), loop nothing in Python, and return numpy arrays.  Nothing else imports

@@ -5,8 +5,8 @@ convergence); each study draws its own figures in ``driver/<study>/figures.py`` 
 helpers (:func:`style`/:func:`styled`, :func:`new_figure`, :func:`plain_text`, :func:`save_figure`).
 Every builder returns a :class:`matplotlib.figure.Figure` drawn inside
 :func:`style` (an ``rc_context``), and :func:`save_figure` writes it atomically
-as PNG, SVG or PDF, byte for byte the same for the same inputs.  Nothing here selects a backend or changes the global ``rcParams``:
-importing this module or drawing a figure leaves a user's own matplotlib
+as PNG, SVG or PDF, byte for byte the same for the same inputs.  Nothing here selects a
+backend or changes the global ``rcParams``: importing this module or drawing a figure leaves a user's own matplotlib
 settings (e.g. Jupyter's inline backend) exactly as they were.  Studies wrap
 builders in :class:`driver.study.Figure` so nothing is drawn unless asked.
 """
@@ -21,17 +21,17 @@ from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any, TypeVar
 
-from driver.extras import require
-
-require("plot")   # a clear message naming the [plot] extra when matplotlib is missing
-import matplotlib  # noqa: E402
-import matplotlib.colors
-import matplotlib.ticker
 import numpy as np
-from matplotlib.figure import Figure
 
 from driver.atomic import atomic_open
+from driver.extras import require
 from driver.study import PLOT_FORMATS, plot_format
+
+require("plot")   # a clear message naming the [plot] extra when matplotlib is missing; then import it:
+import matplotlib  # noqa: E402 (after require above)
+import matplotlib.colors  # noqa: E402 (after require above)
+import matplotlib.ticker  # noqa: E402 (after require above)
+from matplotlib.figure import Figure  # noqa: E402 (after require above)
 
 __all__ = ["STYLE", "style", "styled", "new_figure", "save_figure", "line_panels", "plain_text"]
 

@@ -124,8 +124,9 @@ def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.nd
     ``theta``, ``out`` (kernel rows), ``stroke`` (0 forward, 1 back), ``branch`` (+1 open, -1
     crossed) and ``point`` (coupler point positions or None): then the linkage is drawn rocking
     between its limit positions, out on one assembly branch and back on the other, each
-    motion (a separate assembly interval) on its own.  ``output`` names the output link.  Coordinates in the deck's length ``units``, crank pivot at the origin, ground along
-    +x; the legend sits beside the drawing.
+    motion (a separate assembly interval) on its own.  ``output`` names the output link.
+    Coordinates in the deck's length ``units``, crank pivot at the origin, ground along +x;
+    the legend sits beside the drawing.
     """
     if ax is None:
         fig, (ax,) = new_figure(1, 1, figsize=(8.6, 5.2))

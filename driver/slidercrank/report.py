@@ -407,7 +407,8 @@ def run_linear(params: Params, progress: bool = False) -> Result:
         figures.append(Figure("convergence", lambda: _figures().slidercrank_convergence_figure(
             series, f"{params.material} rod at {speeds}: convergence of the peak tensile strain with the mesh")))
     return Result(text="\n".join(text) + "\n", tidy=_tidy(params.material, list(done.values())),
-                  summary=_summary(cases, model if _shape(params)[1] else None), warnings=warnings, failure=failure, figures=figures)
+                  summary=_summary(cases, model if _shape(params)[1] else None), warnings=warnings, failure=failure,
+                  figures=figures)
 
 
 def animation_frames(params: Params, result: Result | None = None, n: int = 180) -> dict[str, Any] | None:

@@ -49,7 +49,6 @@ import numpy as np
 import pandas as pd
 
 from driver import expr
-from driver._study import load_study
 from driver.atomic import refuse_link, remove_stale_temporaries
 from driver.deck import Deck, Params, RawGroup, validate
 from driver.extras import require
@@ -61,13 +60,11 @@ from driver.sweep.engine import Task, auto_chunk, run_task
 from driver.sweep.keep import check_keep, keep_columns
 from driver.sweep.report import Warnings, summary_frame, summary_settings, sweep_text, write_sweep_files
 from driver.sweep.spec import (
-    FULL_VALIDATION,
     MAX_CASES,
     MAX_KEYS,
     SPEC,
     Case,
     CaseResult,
-    _axes,
     _configured_scheduler,
     build_cases,
     case_count,
@@ -344,7 +341,8 @@ class _Run:
         oc.n_ok, oc.n_kept, oc.seconds, oc.chunk = n_ok, n_kept, elapsed, chunk
         self._failed([(r.index, r.values, r.error) for r in failed],
                      bad_input=any(r.status == ExitCode.BAD_INPUT for r in failed))
-        oc.written += [self.outdir / f"{self.stem}.out", *(self.outdir / f"{self.stem}_summary.{fmt}" for fmt in ("csv", "parquet"))]
+        oc.written += [self.outdir / f"{self.stem}.out",
+                       *(self.outdir / f"{self.stem}_summary.{fmt}" for fmt in ("csv", "parquet"))]
         return oc
 
     def _batch_streamed(self, rows: batch_path.StreamedRows, n: int, elapsed: float, chunk: int) -> bool:
@@ -360,7 +358,8 @@ class _Run:
             store.remove_stale_case_files(self.layout, np.zeros(n + 1, dtype=bool))
         oc.n_ok, oc.n_kept, oc.seconds, oc.chunk = n - res.n_failed, res.n_kept, elapsed, chunk
         self._failed(res.failed, n_failed=res.n_failed, bad_input=res.bad_input)
-        oc.written += [self.outdir / f"{self.stem}.out", *(self.outdir / f"{self.stem}_summary.{fmt}" for fmt in ("csv", "parquet"))]
+        oc.written += [self.outdir / f"{self.stem}.out",
+                       *(self.outdir / f"{self.stem}_summary.{fmt}" for fmt in ("csv", "parquet"))]
         return True
 
     def _settings(self) -> dict:
@@ -468,6 +467,7 @@ class _Run:
         oc.phases["finish_cpu"] = time.process_time() - c_run
         oc.n_ok, oc.n_kept, oc.seconds, oc.chunk = n - len(failed), int(rows["kept"].sum()), elapsed, chunk
         self._failed(failed, bad_input=bool((bad["status"] == "bad input").any()))
-        oc.written += [self.outdir / f"{self.stem}.out", *(self.outdir / f"{self.stem}_summary.{fmt}" for fmt in ("csv", "parquet"))]
+        oc.written += [self.outdir / f"{self.stem}.out",
+                       *(self.outdir / f"{self.stem}_summary.{fmt}" for fmt in ("csv", "parquet"))]
         return oc
 

@@ -312,7 +312,7 @@ def _frame(start: int, stop: int, cols: dict[str, np.ndarray], bad: np.ndarray, 
 
 # ----------------------------------------------------------------------------- dataset (resume record)
 
-_PART = re.compile(r"^part-(\d{12})-([0-9a-f]{%d})\.parquet$" % DIGEST_CHARS)
+_PART = re.compile(rf"^part-(\d{{12}})-([0-9a-f]{{{DIGEST_CHARS}}})\.parquet$")
 
 
 def _part_name(start: int, digest: str) -> str:

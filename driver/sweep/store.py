@@ -52,7 +52,7 @@ SHARD = 1000
 
 _CASE_FILE = re.compile(r"^case_(\d+)[._]")
 _SHARD_DIR = re.compile(r"^(\d+)-(\d+)$")
-_PART = re.compile(r"^part-r(\d+)-(\d+)-([0-9a-f]{%d})\.parquet$" % DIGEST_CHARS)
+_PART = re.compile(rf"^part-r(\d+)-(\d+)-([0-9a-f]{{{DIGEST_CHARS}}})\.parquet$")
 
 
 def json_default(o: Any) -> Any:
