@@ -19,14 +19,14 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from hypothesis import HealthCheck, assume, given, settings, strategies as st
+from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import strategies as st
 
 from driver import manipulator
-
-from driver.manipulator import kernel as manipulator_kernel
 from driver.cli import main
 from driver.deck import DeckError, Params
 from driver.manipulator import BATCH_KEYS, SPEC, summarise, summarise_batch
+from driver.manipulator import kernel as manipulator_kernel
 
 ROOT = Path(__file__).resolve().parents[1]
 #: what the bit-exact comparison covers (an optimiser's finite differences see these)

@@ -27,9 +27,8 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
-from headless import Browser, chromium_path  # noqa: E402
-
 from conftest import INPUTS, ROOT  # noqa: E402
+from headless import Browser, chromium_path  # noqa: E402
 
 pytest.importorskip("matplotlib")
 pytest.importorskip("pyarrow")
