@@ -539,7 +539,7 @@ def synthesis_record(syn: Synthesis) -> dict[str, Any]:
                       "linkage": syn.linkage, "checks": syn.checks})
 
 
-def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool = False,
+def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, progress: bool = False,
                        summary_json: bool = False, **_: Any) -> FilesOutcome:
     """Command-line entry: synthesise and write; returns the files written, the warnings and the
     failure as data (:class:`~driver.outcome.FilesOutcome`, the :class:`Synthesis` as ``value``).
