@@ -91,7 +91,7 @@ def _base_hash(raw: RawGroup) -> str:
     return hashlib.sha256(f"{raw.name}:{text}".encode()).hexdigest()[:16]
 
 
-def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool = False,
+def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, progress: bool = False,
                    jobs: int | None = None, scheduler: Any = None, resume: bool = False) -> SweepOutcome:
     """Run a deck with a &sweep group; returns what it did (:class:`~driver.outcome.SweepOutcome`:
     counts, failed cases, warnings as data, files written, the driver's CPU per phase).  Prints
@@ -217,9 +217,10 @@ class _CasesTable:
         from driver.export import csv_bytes
         parts = [self.pieces[k] for k in written]
         first = parts[0][0].schema
-        if all(t.schema.equals(first, check_metadata=False) and body is not None for t, body in parts):
+        bodies = [body for _, body in parts if body is not None]
+        if len(bodies) == len(parts) and all(t.schema.equals(first, check_metadata=False) for t, _ in parts):
             table = pa.concat_tables([t for t, _ in parts])
-            return table, csv_bytes(table.slice(0, 0)) + b"".join(body for _, body in parts)
+            return table, csv_bytes(table.slice(0, 0)) + b"".join(bodies)
         return pd.concat([t.to_pandas() for t, _ in parts], ignore_index=True)
 
 
@@ -454,7 +455,8 @@ class _Run:
             cases = _CasesTable(self.layout).table(written)
             for r in results:
                 if r.status != ExitCode.OK:
-                    rows.loc[rows["case"] == r.index, ["status", "kept", "error"]] = ["failed", False, r.error]
+                    cells: list[str | bool | None] = ["failed", False, r.error]
+                    rows.loc[rows["case"] == r.index, ["status", "kept", "error"]] = cells
         bad = rows[rows["status"] != "ok"]
         failed = [(int(r["case"]), {k: r[k] for k in names}, r["error"]) for _, r in bad.iterrows()]
         text = sweep_text(self.deck, sw, self.base, self.axes, n, rows, int(rows["kept"].sum()), failed,

@@ -138,7 +138,7 @@ class CaseResult:
 
     index: int
     values: dict[str, Any]
-    status: int = ExitCode.OK
+    status: ExitCode = ExitCode.OK
     error: str = ""
     summary: dict[str, Any] = field(default_factory=dict)
     kept: bool = True
