@@ -249,17 +249,17 @@ def _rocking_drawing(ax, ground: float, motions: Sequence[dict], title: str, uni
     ax.set_xlabel(f"x [{units}]")
     ax.set_ylabel(f"y [{units}]")
     ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
-    first = word[int(np.asarray(motions[0]["branch"])[0])]
-    other = word[-int(np.asarray(motions[0]["branch"])[0])]
+    out_word = word[int(np.asarray(motions[0]["branch"])[0])]
+    back_word = word[-int(np.asarray(motions[0]["branch"])[0])]
     what = "the crank rocks between its limit positions"
     if n_m == 1:
         m = motions[0]
-        what += (f"\n$\\theta_2$ = {_deg(m['lo'])}° to {_deg(m['hi'])}°: out on the {first} assembly, "
-                 f"back on the {other}")
+        what += (f"\n$\\theta_2$ = {_deg(m['lo'])}° to {_deg(m['hi'])}°: out on the {out_word} assembly, "
+                 f"back on the {back_word}")
     else:
         spans = " and ".join(f"{_deg(m['lo'])}-{_deg(m['hi'])}°" for m in motions)
         what += (f"\n{n_m} separate motions (mirror assemblies, $\\theta_2$ = {spans}),"
-                 f"\neach out on the {first} assembly, back on the {other}")
+                 f"\neach out on the {out_word} assembly, back on the {back_word}")
     ax.set_title(f"{plain_text(title)}: {what}" if title else what)
 
 
