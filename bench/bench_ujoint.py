@@ -27,10 +27,10 @@ from scipy.optimize import minimize
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from driver import ujoint  # noqa: E402
-from driver.deck import RawGroup, validate  # noqa: E402
-from driver.ujoint import Chain, optimise  # noqa: E402
-from driver.ujoint.kernel import UJOINT_MODELS, UJOINT_OBJECTIVES, ujoint_objective  # noqa: E402
+from driver import ujoint
+from driver.deck import RawGroup, validate
+from driver.ujoint import Chain, optimise
+from driver.ujoint.kernel import UJOINT_MODELS, UJOINT_OBJECTIVES, ujoint_objective
 
 D = math.pi / 180.0
 M = 360

@@ -29,19 +29,19 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-import bench_fourbar  # noqa: E402
-import bench_fourbar_forces  # noqa: E402
-import bench_manipulator  # noqa: E402
-import bench_slidercrank  # noqa: E402
-import bench_slidercrank_nl  # noqa: E402
-import bench_ujoint  # noqa: E402
-from driver import kernels  # noqa: E402
-from driver import ujoint as ujoint_study  # noqa: E402
-from driver.fourbar import kernel as fourbar_kernel  # noqa: E402
-from driver.manipulator import kernel as manipulator_kernel  # noqa: E402
-from driver.slidercrank import MATERIALS, rayleigh  # noqa: E402
-from driver.slidercrank import kernel as slidercrank_kernel  # noqa: E402
-from driver.ujoint import kernel as ujoint_kernel  # noqa: E402
+import bench_fourbar
+import bench_fourbar_forces
+import bench_manipulator
+import bench_slidercrank
+import bench_slidercrank_nl
+import bench_ujoint
+from driver import kernels
+from driver import ujoint as ujoint_study
+from driver.fourbar import kernel as fourbar_kernel
+from driver.manipulator import kernel as manipulator_kernel
+from driver.slidercrank import MATERIALS, rayleigh
+from driver.slidercrank import kernel as slidercrank_kernel
+from driver.ujoint import kernel as ujoint_kernel
 
 
 @dataclass

@@ -93,7 +93,7 @@ def styled(builder: _F) -> _F:
     def wrapper(*args: Any, **kwargs: Any) -> Any:
         with style():
             return builder(*args, **kwargs)
-    return wrapper  # type: ignore[return-value]
+    return wrapper  # type: ignore[return-value]  # functools.wraps keeps the call signature; its stub says _Wrapped
 
 
 def new_figure(nrows: int = 1, ncols: int = 1, **kw) -> tuple[Figure, np.ndarray]:
@@ -199,7 +199,7 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
                    and not pd.api.types.is_bool_dtype(frame[c]) and c not in keys]
         ordered = [c for c in preferred if c in numeric] + [c for c in numeric if c not in preferred]
         ys = []
-        unit = lambda c: labels.get(c, "").rpartition("[")[2].rstrip("]")  # noqa: E731
+        unit = lambda c: labels.get(c, "").rpartition("[")[2].rstrip("]")
         for c in ordered:
             if len(ys) < 6 and not _trivial(frame[c], frame[x], [frame[k] for k in [*ys, *keys]], unit(c)):
                 ys.append(c)

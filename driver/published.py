@@ -126,7 +126,7 @@ def matches(match: dict[str, str], values: Mapping[str, object], rel: float = 1e
             return False
         for t, v in zip(want, got):
             try:
-                a, b = float(t), float(v)  # type: ignore[arg-type]
+                a, b = float(t), float(v)  # type: ignore[arg-type]  # any deck value: a non-number raises, handled below
             except (TypeError, ValueError):
                 if str(v).strip().lower() != t.strip().lower():
                     return False
@@ -272,7 +272,8 @@ def one_digit_apart(a: str, b: str, column: str) -> bool:
     """Whether two printed values differ by at most one unit of the printed last digit
     (a whole degree for the truncated angle columns)."""
     try:
-        unit = 1.0 if column in ("epsl", "phi", "beta") else 10.0 ** Decimal(b).as_tuple().exponent  # type: ignore
+        # int() of the exponent: 'n'/'N'/'F' (a printed nan or inf) is a ValueError, not a number
+        unit = 1.0 if column in ("epsl", "phi", "beta") else 10.0 ** int(Decimal(b).as_tuple().exponent)
         return abs(float(a) - float(b)) <= unit * (1 + 1e-9)
     except (ValueError, InvalidOperation):
         return False

@@ -21,11 +21,11 @@ import pandas as pd
 import pytest
 
 pytest.importorskip("matplotlib")
-import matplotlib  # noqa: E402
-from matplotlib.testing.compare import compare_images  # noqa: E402
+import matplotlib
+from matplotlib.testing.compare import compare_images
 
-import driver  # noqa: E402
-from conftest import INPUTS, ROOT  # noqa: E402
+import driver
+from conftest import INPUTS, ROOT
 
 BASELINES = Path(__file__).parent / "baseline_figures"
 #: RMS tolerance on a 0-255 scale.  The same matplotlib draws the same pixels (RMS 0.0); a changed

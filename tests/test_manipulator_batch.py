@@ -235,7 +235,7 @@ def test_sweep_with_unreachable_designs(tmp_path):
     un = batch["design_status"] == "unreachable"
     truth = np.array([reaches(a, b, [1, 2, 3, 4], [5, 7, 7, 6]) for a, b in
                       zip(batch["manipulator.designs_l1"], batch["manipulator.designs_l2"])])
-    assert un.sum() > 10 and (un.to_numpy() == (truth == False)).all()   # noqa: E712
+    assert un.sum() > 10 and (un.to_numpy() == (truth == False)).all()   # noqa: E712 (elementwise on an array)
     assert not batch.loc[un, "kept"].any()
     # torques exist where the target (1, 5) is reached, whether or not the whole workspace is
     at_target = np.array([reaches(a, b, [1], [5]) for a, b in

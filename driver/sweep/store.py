@@ -228,7 +228,7 @@ class Record:
         import pyarrow.parquet as pq
         try:
             return [int(c) for c in pq.read_table(path, columns=["case"]).column("case").to_pylist()]
-        except Exception:   # noqa: BLE001 - unreadable: its cases are found missing instead
+        except Exception:   # unreadable: its cases are found missing instead
             return []
 
     @staticmethod
