@@ -18,8 +18,14 @@ import sysconfig
 from pathlib import Path
 
 import mesonpy
-from mesonpy import (build_editable, build_sdist, build_wheel, get_requires_for_build_editable,
-                     get_requires_for_build_sdist, get_requires_for_build_wheel)
+from mesonpy import (
+    build_editable,
+    build_sdist,
+    build_wheel,
+    get_requires_for_build_editable,
+    get_requires_for_build_sdist,
+    get_requires_for_build_wheel,
+)
 
 __all__ = ["build_editable", "build_sdist", "build_wheel", "get_requires_for_build_editable",
            "get_requires_for_build_sdist", "get_requires_for_build_wheel", "own_scripts_dir"]

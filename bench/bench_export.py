@@ -25,7 +25,7 @@ import pyarrow.csv as pacsv
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from driver.export import write_csv_arrow  # noqa: E402
+from driver.export import write_csv_arrow
 
 
 def frame(rows: int) -> pd.DataFrame:

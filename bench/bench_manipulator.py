@@ -77,7 +77,7 @@ def design_batch(n: int, n_case: int, repeat: int) -> tuple[float, float]:
 
     def per_case():
         for i in range(n_case):
-            manipulator.run(deck(i)).summary
+            manipulator.run(deck(i))
 
     tb, tc = [], []
     for _ in range(repeat):

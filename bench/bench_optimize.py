@@ -31,7 +31,6 @@ from pathlib import Path
 import pandas as pd
 
 from driver._study import registered
-
 from driver.deck import read_deck
 from driver.optimize import optimize
 
@@ -59,7 +58,7 @@ class KernelClock:
     def total(self) -> float:
         return sum(self.seconds.values())
 
-    def __enter__(self) -> "KernelClock":
+    def __enter__(self) -> KernelClock:
         for (mod, name), fn in self._orig.items():
             setattr(mod, name, self._timed(name, fn))
         return self

@@ -49,7 +49,7 @@ PEAK_KEEP = "meets_transmission_band and rocker_swing_deg >= 60 and abs(omega3_p
 
 
 def load() -> str:
-    return "load average %.1f %.1f %.1f" % os.getloadavg()
+    return "load average {:.1f} {:.1f} {:.1f}".format(*os.getloadavg())
 
 
 def deck_text(cranks: int, keep: str | None = None) -> str:

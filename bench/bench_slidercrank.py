@@ -21,9 +21,9 @@ import math
 import numpy as np
 from scipy.linalg import solveh_banded
 
-from driver.slidercrank import kernel as slidercrank_kernel
-from timing import median_time  # noqa: E402
 from driver.slidercrank import MATERIALS, rayleigh
+from driver.slidercrank import kernel as slidercrank_kernel
+from timing import median_time
 
 N_EL, SPR, OMEGA = 700, 1440, 29.32
 R2, LEN, M_S = 0.125, 0.505, 0.95

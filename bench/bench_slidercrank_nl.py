@@ -19,13 +19,13 @@ import os
 import statistics
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from driver.slidercrank import kernel as slidercrank_kernel  # noqa: E402
-from driver.slidercrank import MATERIALS, rayleigh  # noqa: E402
+from driver.slidercrank import MATERIALS, rayleigh
+from driver.slidercrank import kernel as slidercrank_kernel
 
 R2, LEN, M_S, OMEGA = 0.125, 0.505, 0.95, 29.32
 TARGET_RATIO = 25.0

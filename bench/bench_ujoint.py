@@ -27,10 +27,10 @@ from scipy.optimize import minimize
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from driver.ujoint.kernel import UJOINT_MODELS, UJOINT_OBJECTIVES, ujoint_objective  # noqa: E402
-from driver import ujoint  # noqa: E402
-from driver.deck import RawGroup, validate  # noqa: E402
-from driver.ujoint import Chain, optimise  # noqa: E402
+from driver import ujoint
+from driver.deck import RawGroup, validate
+from driver.ujoint import Chain, optimise
+from driver.ujoint.kernel import UJOINT_MODELS, UJOINT_OBJECTIVES, ujoint_objective
 
 D = math.pi / 180.0
 M = 360
@@ -132,7 +132,7 @@ def batch_rates(nd: int, n_run: int, repeat: int) -> dict[str, float]:
     def runs() -> None:
         for ph in phis[:n_run]:
             raw = RawGroup("ujoint", {"beta": base["beta"], "phi": list(ph), "rho": base["rho"]}, {}, 1)
-            ujoint.run(validate(raw, ujoint.SPEC, "bench.dat")).summary
+            ujoint.run(validate(raw, ujoint.SPEC, "bench.dat"))
     return {"batch": nd / cpu(lambda: ujoint.summarise_batch(base, {"phi": phis})),
             "evaluate": nd / cpu(lambda: [ujoint.evaluate(chain, "x", beta, ph) for ph in phis]),
             "run": n_run / cpu(runs)}
@@ -147,12 +147,12 @@ def main() -> None:
     for model in ("exact", "cumulative"):
         code = UJOINT_MODELS[model]
         rho = RHO if model == "exact" else np.zeros(2)
-        k_f = median_us(lambda: ujoint_objective(code, 0, BETA, PHI, rho, M, grad=False), rep, 2000)
-        k_g = median_us(lambda: ujoint_objective(code, 0, BETA, PHI, rho, M, grad=True), rep, 2000)
-        n_f = median_us(lambda: numpy_objective(model, BETA, PHI, rho), rep, 200)
+        k_f = median_us(lambda code=code, rho=rho: ujoint_objective(code, 0, BETA, PHI, rho, M, grad=False), rep, 2000)
+        k_g = median_us(lambda code=code, rho=rho: ujoint_objective(code, 0, BETA, PHI, rho, M, grad=True), rep, 2000)
+        n_f = median_us(lambda model=model, rho=rho: numpy_objective(model, BETA, PHI, rho), rep, 200)
         x = np.r_[BETA, PHI]
-        n_g = median_us(lambda: (numpy_objective(model, BETA, PHI, rho), numpy_fd_gradient(model, x, rho)),
-                        rep, 20)
+        n_g = median_us(lambda model=model, x=x, rho=rho: (numpy_objective(model, BETA, PHI, rho),
+                                                           numpy_fd_gradient(model, x, rho)), rep, 20)
         print(f"{model + ': objective [us]':<44}{k_f:12.2f}{n_f:12.2f}{n_f / k_f:9.1f}")
         print(f"{model + ': objective + gradient [us]':<44}{k_g:12.2f}{n_g:12.2f}{n_g / k_g:9.1f}")
         results[model] = k_f

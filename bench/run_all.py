@@ -20,28 +20,28 @@ import os
 import statistics
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-import bench_fourbar  # noqa: E402
-import bench_fourbar_forces  # noqa: E402
-import bench_manipulator  # noqa: E402
-import bench_slidercrank  # noqa: E402
-import bench_slidercrank_nl  # noqa: E402
-import bench_ujoint  # noqa: E402
-from driver import kernels  # noqa: E402
-from driver.fourbar import kernel as fourbar_kernel  # noqa: E402
-from driver.manipulator import kernel as manipulator_kernel  # noqa: E402
-from driver.slidercrank import kernel as slidercrank_kernel  # noqa: E402
-from driver.ujoint import kernel as ujoint_kernel  # noqa: E402
-from driver import ujoint as ujoint_study  # noqa: E402
-from driver.slidercrank import MATERIALS, rayleigh  # noqa: E402
+import bench_fourbar
+import bench_fourbar_forces
+import bench_manipulator
+import bench_slidercrank
+import bench_slidercrank_nl
+import bench_ujoint
+from driver import kernels
+from driver import ujoint as ujoint_study
+from driver.fourbar import kernel as fourbar_kernel
+from driver.manipulator import kernel as manipulator_kernel
+from driver.slidercrank import MATERIALS, rayleigh
+from driver.slidercrank import kernel as slidercrank_kernel
+from driver.ujoint import kernel as ujoint_kernel
 
 
 @dataclass
@@ -110,7 +110,8 @@ def fourbar(n: int, repeat: int) -> list[Row]:
                          lambda: bench_fourbar.numpy_baseline(theta, *link, 1), repeat)
     floor = write_floor(lambda: (out.fill(0.0), sts.fill(0)), repeat)
     rows = [Row("four-bar exact states (reused buffers)", "ns/position", tk / n, tb / n, 20e-9, 5.0,
-                "writes 92 B/position (11 float64 + int32 status); 1 sincos + 3 atan2 + 20 divisions (9 of them in the atan2) + 1 sqrt",
+                "writes 92 B/position (11 float64 + int32 status); "
+                "1 sincos + 3 atan2 + 20 divisions (9 of them in the atan2) + 1 sqrt",
                 floor / n)]
     # issue 27: the default path (no out=) gets the previous call's output memory back when the
     # caller dropped it; the baseline is the same call on fresh memory (first touch: page faults)

@@ -190,7 +190,7 @@ def keyword_signature(typed: F, spec: GroupSpec) -> Callable[[Callable[..., Any]
     ``typed``, its generated signature in ``driver/_keywords.py`` (for type checkers), and give it
     the signature and docstring of ``spec``'s keys at run time (for ``help()`` and IDEs)."""
     def apply(run: Callable[..., Any]) -> F:
-        run.__signature__ = run_signature(spec)  # type: ignore[attr-defined]
+        run.__signature__ = run_signature(spec)  # type: ignore[attr-defined]  # a function takes any attribute; inspect reads it
         run.__doc__ = run_docstring(spec, run.__doc__ or "")
         return run  # type: ignore[return-value]   # the same callable; ``typed`` is its static signature
     return apply

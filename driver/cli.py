@@ -18,6 +18,7 @@ import sys
 import threading
 import traceback
 from pathlib import Path
+from typing import Any
 
 from driver import __version__, limits
 from driver._study import study_names
@@ -252,7 +253,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
                         help="sweeps and optimisations: run cases on this Dask distributed scheduler")
     parser.add_argument("--resume", action="store_true",
-                        help="sweeps: skip cases whose outputs are already complete; optimisations: replay the run's journal and compute only new designs")
+                        help="sweeps: skip cases whose outputs are already complete; "
+                             "optimisations: replay the run's journal and compute only new designs")
     parser.add_argument("--max-memory", metavar="SIZE", default=None,
                         help="refuse a deck (a sweep case) whose estimated memory is larger "
                              "(e.g. 8G, 512M; default: half of this machine's memory)")
@@ -318,7 +320,7 @@ def _main(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
     progress = sys.stderr.isatty() and not args.quiet and not os.environ.get("CI")
     plot: bool | str = args.plot_format or args.plot
     sweep_options = {"jobs": args.jobs, "scheduler": args.scheduler, "resume": args.resume}
-    status = ExitCode.OK
+    status: int = ExitCode.OK   # the worst deck's status (run_deck returns a plain int)
     handlers = _install_signals()
     try:
         for deck in args.decks:
@@ -345,9 +347,9 @@ def _quiet_stdout() -> None:
         os.dup2(devnull, sys.stdout.fileno())
 
 
-def _install_signals() -> dict:
+def _install_signals() -> dict[signal.Signals, Any]:
     """SIGTERM like Ctrl-C; SIGXFSZ ignored so a file size limit is an EFBIG error, not a kill."""
-    old = {}
+    old: dict[signal.Signals, Any] = {}
     if threading.current_thread() is not threading.main_thread():
         return old
     for sig, handler in ((getattr(signal, "SIGTERM", None), _on_sigterm),
@@ -357,6 +359,6 @@ def _install_signals() -> dict:
     return old
 
 
-def _restore_signals(old: dict) -> None:
+def _restore_signals(old: dict[signal.Signals, Any]) -> None:
     for sig, handler in old.items():
         signal.signal(sig, handler)

@@ -54,7 +54,8 @@ class _LazyResult:
     """The deck's :class:`Result`, computed on first use (a comparison of inputs needs no run)."""
 
     def __init__(self, run: Callable[[], Result]):
-        self._run, self._result = run, None
+        self._run = run
+        self._result: Result | None = None
 
     def __getattr__(self, name: str) -> Any:
         if self._result is None:
@@ -135,11 +136,12 @@ def compare_text(cmp: Comparison) -> list[str]:
     if not odd.empty:
         w = max(len(s) for s in odd["table"])
         for (status, reason), g in odd.groupby(["status", "reason"], sort=False):
-            verb = {"departs": "depart", "differs": "differ"}.get(status, status) if len(g) > 1 else status
+            verb = {"departs": "depart", "differs": "differ"}.get(str(status), status) if len(g) > 1 else status
             lines.append(f"  {len(g)} cell{'s' if len(g) > 1 else ''} {verb}" + (f": {reason}" if reason else ""))
             lines.append(f"    {'table':<{w}}  {'row':>5}  {'column':<8} {'printed':>10} {'computed':>10}")
             for r in g.itertuples():
-                lines.append(f"    {r.table:<{w}}  {r.row:>5}  {r.column:<8} {r.printed:>10} {r.computed or '-':>10}")
+                # every cell is text (driver.published.cell); pandas cannot know it, hence !s
+                lines.append(f"    {r.table!s:<{w}}  {r.row!s:>5}  {r.column!s:<8} {r.printed!s:>10} {r.computed or '-'!s:>10}")
     errata = f[(f["status"].isin(["identical", "agrees"])) & f["reason"].str.startswith("erratum")]
     if not errata.empty:
         lines.append(f"  {len(errata)} of the reproduced printed cells are wrong (errata): a deck asking for the "

@@ -271,7 +271,7 @@ def _known_keys(group: str) -> frozenset[str] | None:
                 study = load_study(group)
                 spec = study.spec if study is not None else None
             keys = frozenset(spec.keys) if isinstance(spec, GroupSpec) else None
-        except Exception:   # noqa: BLE001 - a module that fails to import declares no keys here
+        except Exception:   # a module that fails to import declares no keys here
             keys = None
         _KNOWN[group] = keys
     return _KNOWN[group]

@@ -1,7 +1,8 @@
 """The loader of the private Fortran extension ``driver._kernels``, shared by every study.
 
 It imports the extension once (with words on what to do when it is not built) and holds
-:func:`farray` and the spare output buffers of large kernel outputs (:func:`release_spares`).  Each study wraps its own modules of the extension in its ``kernel.py``
+:func:`farray` and the spare output buffers of large kernel outputs (:func:`release_spares`).
+Each study wraps its own modules of the extension in its ``kernel.py``
 (``driver.fourbar.kernel``, ``driver.ujoint.kernel``, ...; named in its ``Study.kernel``):
 wrappers convert inputs once to Fortran-ordered float64 (f2py would otherwise copy C-ordered
 2-D arrays silently), loop nothing in Python, and return numpy arrays.  Nothing else imports
@@ -62,7 +63,7 @@ def _refs(store: dict[str, np.ndarray], name: str) -> int:
 _FREE_REFS = _refs({"probe": np.empty(1)}, "probe")
 
 
-def spare_buffer(name: str, shape: tuple[int, ...], dtype: type) -> np.ndarray:
+def spare_buffer(name: str, shape: tuple[int, ...], dtype: type[np.generic]) -> np.ndarray:
     """A fresh-to-the-caller output array of ``shape`` (Fortran order) for kernel output ``name``.
 
     A large output array (``SPARE_MIN_BYTES`` or more) is remembered; the next call of the
@@ -71,16 +72,16 @@ def spare_buffer(name: str, shape: tuple[int, ...], dtype: type) -> np.ndarray:
     hold their base) -- instead of new memory whose first touch costs a page fault per 4 KiB
     (at 10^6 four-bar positions, 88 MB: most of the call).  An array still held anywhere is
     never handed out again: the caller then gets new memory, which becomes the spare."""
-    dtype = np.dtype(dtype)
-    if int(np.prod(shape)) * dtype.itemsize < SPARE_MIN_BYTES:
-        return np.empty(shape, dtype=dtype, order="F")
+    dt = np.dtype(dtype)
+    if int(np.prod(shape)) * dt.itemsize < SPARE_MIN_BYTES:
+        return np.empty(shape, dtype=dt, order="F")
     with _spares_lock:
         # held only by the dict (counted as for the probe array at import): nobody else has it
         if name in _spares and _refs(_spares, name) == _FREE_REFS:
             a = _spares[name]
-            if a.shape == shape and a.dtype == dtype:
+            if a.shape == shape and a.dtype == dt:
                 return a
-        a = np.empty(shape, dtype=dtype, order="F")
+        a = np.empty(shape, dtype=dt, order="F")
         _spares[name] = a
         return a
 

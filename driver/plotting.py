@@ -5,8 +5,8 @@ convergence); each study draws its own figures in ``driver/<study>/figures.py`` 
 helpers (:func:`style`/:func:`styled`, :func:`new_figure`, :func:`plain_text`, :func:`save_figure`).
 Every builder returns a :class:`matplotlib.figure.Figure` drawn inside
 :func:`style` (an ``rc_context``), and :func:`save_figure` writes it atomically
-as PNG, SVG or PDF, byte for byte the same for the same inputs.  Nothing here selects a backend or changes the global ``rcParams``:
-importing this module or drawing a figure leaves a user's own matplotlib
+as PNG, SVG or PDF, byte for byte the same for the same inputs.  Nothing here selects a
+backend or changes the global ``rcParams``: importing this module or drawing a figure leaves a user's own matplotlib
 settings (e.g. Jupyter's inline backend) exactly as they were.  Studies wrap
 builders in :class:`driver.study.Figure` so nothing is drawn unless asked.
 """
@@ -17,21 +17,21 @@ import functools
 import math
 import re
 import warnings
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any, TypeVar
 
-from driver.extras import require
-
-require("plot")   # a clear message naming the [plot] extra when matplotlib is missing
-import matplotlib  # noqa: E402
-import matplotlib.colors
-import matplotlib.ticker
 import numpy as np
-from matplotlib.figure import Figure
 
 from driver.atomic import atomic_open
+from driver.extras import require
 from driver.study import PLOT_FORMATS, plot_format
+
+require("plot")   # a clear message naming the [plot] extra when matplotlib is missing; then import it:
+import matplotlib  # noqa: E402 (after require above)
+import matplotlib.colors  # noqa: E402 (after require above)
+import matplotlib.ticker  # noqa: E402 (after require above)
+from matplotlib.figure import Figure  # noqa: E402 (after require above)
 
 __all__ = ["STYLE", "style", "styled", "new_figure", "save_figure", "line_panels", "plain_text"]
 
@@ -80,7 +80,9 @@ def style(**overrides: Any) -> Iterator[None]:
 
     matplotlib's warnings (a glyph missing from the font, identical axis limits) are dropped
     here: they name package paths and say nothing a user of the tool can act on."""
-    with matplotlib.rc_context({**STYLE, **overrides}), warnings.catch_warnings():
+    # matplotlib checks the keys when they are set; its stub's Literal key type cannot describe **overrides
+    rc: dict[Any, Any] = {**STYLE, **overrides}
+    with matplotlib.rc_context(rc), warnings.catch_warnings():
         warnings.simplefilter("ignore")
         yield
 
@@ -91,7 +93,7 @@ def styled(builder: _F) -> _F:
     def wrapper(*args: Any, **kwargs: Any) -> Any:
         with style():
             return builder(*args, **kwargs)
-    return wrapper  # type: ignore[return-value]
+    return wrapper  # type: ignore[return-value]  # functools.wraps keeps the call signature; its stub says _Wrapped
 
 
 def new_figure(nrows: int = 1, ncols: int = 1, **kw) -> tuple[Figure, np.ndarray]:
@@ -121,10 +123,12 @@ def save_figure(fig: Figure, path: str | Path, fmt: bool | str | None = None) ->
     path = Path(path)
     if fmt is None or fmt is True:
         fmt = path.suffix.lstrip(".").lower() if path.suffix.lstrip(".").lower() in PLOT_FORMATS else "png"
-    fmt = plot_format(fmt)
-    path = path.with_suffix(f".{fmt}")
+    chosen = plot_format(fmt)
+    if chosen is None:   # fmt False or ''
+        raise ValueError(f"no figure format in {fmt!r}")
+    path = path.with_suffix(f".{chosen}")
     with style(**{"svg.hashsalt": SVG_SALT}), atomic_open(path, "wb") as fh:
-        fig.savefig(fh, format=fmt, metadata=_METADATA[fmt])
+        fig.savefig(fh, format=chosen, metadata=_METADATA[chosen])
     return path
 
 
@@ -183,8 +187,10 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
     import pandas as pd
     labels = labels or {}
     only_points = False
-    # a label that is the column's own name may be deck text (an expression): drawn literally
-    label = lambda c: wrap(labels.get(c, c) if labels.get(c, c) != c else plain_text(c), 28)  # noqa: E731
+
+    def label(c: str) -> str:   # a label that is the column's own name may be deck text (an expression): drawn literally
+        return wrap(labels.get(c, c) if labels.get(c, c) != c else plain_text(c), 28)
+
     x = x or next((k for k in keys if pd.api.types.is_numeric_dtype(frame[k])), "case")
     if ys:
         ys = list(ys)
@@ -193,7 +199,7 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
                    and not pd.api.types.is_bool_dtype(frame[c]) and c not in keys]
         ordered = [c for c in preferred if c in numeric] + [c for c in numeric if c not in preferred]
         ys = []
-        unit = lambda c: labels.get(c, "").rpartition("[")[2].rstrip("]")  # noqa: E731
+        unit = lambda c: labels.get(c, "").rpartition("[")[2].rstrip("]")
         for c in ordered:
             if len(ys) < 6 and not _trivial(frame[c], frame[x], [frame[k] for k in [*ys, *keys]], unit(c)):
                 ys.append(c)
@@ -289,7 +295,10 @@ def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, 
     """
     import pandas as pd
     labels = labels or {}
-    lab = lambda c: labels.get(c, c) if labels.get(c, c) != c else plain_text(c)  # noqa: E731  (deck text: literal)
+
+    def lab(c: str) -> str:   # a label that is the column's own name may be deck text (an expression): drawn literally
+        return labels.get(c, c) if labels.get(c, c) != c else plain_text(c)
+
     keys = [k for k in keys if k in frame.columns][:3]
     kept = frame["kept"].astype(bool) if "kept" in frame else pd.Series(True, index=frame.index)
     z_all = pd.to_numeric(frame[metric], errors="coerce").to_numpy(dtype=float)
@@ -338,8 +347,9 @@ def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, 
     else:
         ncols = min(3, n)
         nrows = int(math.ceil(n / ncols))
-        fig, axes = new_figure(nrows, ncols, sharex=True, sharey=True,
+        fig, grid = new_figure(nrows, ncols, sharex=True, sharey=True,
                                figsize=(6.4, 5.0) if n == 1 else (3.3 * ncols + 1.2, 2.9 * nrows + 1.0))
+        axes = list(grid)
         for extra in axes[n:]:
             extra.set_visible(False)
     xs_all, ys_all = _numeric_axis(frame[kx]), _numeric_axis(frame[ky])
@@ -372,6 +382,8 @@ def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, 
             a.set_ylabel(lab(ky))
     if brow is not None and best_text:   # the best design's values, under the panels
         fig.supxlabel("\u2605 " + wrap(best_text, 110), fontsize=8.5, color="0.15")
+    if image is None:   # no panel (an empty frame)
+        raise ValueError("design_space_map: no design to draw")
     cb = fig.colorbar(image, ax=list(axes[:n]), shrink=0.9, pad=0.02)
     cb.set_label(lab(metric))
     plain_numbers(cb.ax)
@@ -504,7 +516,7 @@ def _words_value(label: str, value: float, name: bool = True) -> str:
     return f"{words} {text}" if name else text
 
 
-def sweep_maps(frame, keys: Sequence[str], ys: Sequence[str], labels: dict[str, str], senses: dict[str, str],
+def sweep_maps(frame, keys: Sequence[str], ys: Sequence[str], labels: dict[str, str], senses: Mapping[str, str],
                title: str = "", only_kept: bool = False) -> list[Figure]:
     """Design-space maps of a 2-3-key grid sweep, one per plotted column ``ys``: the best kept
     design (by ``senses[y]``, 'min' or 'max', when the study knows which is better) starred and

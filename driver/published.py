@@ -17,17 +17,17 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from decimal import Decimal, InvalidOperation
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 import pandas as pd
 
-__all__ = ["PUBLISHED_DIR", "Published", "PublishedError", "match_line", "records", "read_listing",
-           "read_blocks", "matches", "listing_rows", "LISTING_COLUMNS", "agrees_printed", "cell", "numeric_cell",
+__all__ = ["PUBLISHED_DIR", "Published", "PrintedCell", "printed_cells", "PublishedError", "match_line", "records",
+           "read_listing", "read_blocks", "matches", "listing_rows", "LISTING_COLUMNS", "agrees_printed", "cell", "numeric_cell",
            "one_digit_apart", "decimals"]
 
 def _published_dir() -> Path:
@@ -68,6 +68,24 @@ class Published:
     cells: pd.DataFrame = field(repr=False)
 
 
+class PrintedCell(NamedTuple):
+    """One printed cell of a :class:`Published` table; every field is text, as printed."""
+
+    table: str
+    row: str
+    column: str
+    printed: str
+    note: str = ""
+
+
+def printed_cells(cells: pd.DataFrame) -> list[PrintedCell]:
+    """The rows of :attr:`Published.cells` (or of a selection of them) as :class:`PrintedCell`,
+    in order; ``note`` is empty where the table records none."""
+    notes = cells["note"] if "note" in cells.columns else [""] * len(cells)
+    return [PrintedCell(str(t), str(r), str(c), str(p), str(n))
+            for t, r, c, p, n in zip(cells["table"], cells["row"], cells["column"], cells["printed"], notes)]
+
+
 def match_line(path: Path) -> tuple[str, dict[str, str]]:
     """The study group and deck values of a published file's ``match:`` line."""
     for line in Path(path).read_text().splitlines():
@@ -95,7 +113,7 @@ def records(group: str, folder: Path | None = None) -> list[Path]:
     return found
 
 
-def matches(match: dict[str, str], values: dict[str, object], rel: float = 1e-12) -> bool:
+def matches(match: dict[str, str], values: Mapping[str, object], rel: float = 1e-12) -> bool:
     """Whether deck ``values`` equal a file's ``match`` values (numbers compared as numbers,
     comma-separated lists element by element)."""
     for key, text in match.items():
@@ -108,7 +126,7 @@ def matches(match: dict[str, str], values: dict[str, object], rel: float = 1e-12
             return False
         for t, v in zip(want, got):
             try:
-                a, b = float(t), float(v)  # type: ignore[arg-type]
+                a, b = float(t), float(v)  # type: ignore[arg-type]  # any deck value: a non-number raises, handled below
             except (TypeError, ValueError):
                 if str(v).strip().lower() != t.strip().lower():
                     return False
@@ -230,18 +248,18 @@ def numeric_cell(table: str, row: str, column: str, printed: str, value: float |
     ``flagged``: why the printed value is known not to be reproducible; ``departs``: why the
     deck's correct answer differs (None when the deck reproduces the published conventions).
     """
-    blank = value is None or not np.isfinite(value)
+    number = None if value is None or not np.isfinite(value) else value   # None: blank
     if printed == "":
-        comp = "" if blank else f"{value:g}"
-        return cell(table, row, column, "", comp, "identical" if blank else "differs",
-                    "" if blank else "the report leaves this cell blank (target out of reach)")
-    if blank:
+        comp = "" if number is None else f"{number:g}"
+        return cell(table, row, column, "", comp, "identical" if number is None else "differs",
+                    "" if number is None else "the report leaves this cell blank (target out of reach)")
+    if number is None:
         return cell(table, row, column, printed, "", "not reproducible" if flagged else
                     ("departs" if departs else "differs"), flagged or departs or "the run leaves this cell blank")
-    comp = f"{value:.{decimals(printed)}f}"
+    comp = f"{number:.{decimals(printed)}f}"
     if comp.startswith("-") and float(comp) == 0.0:
         comp = comp[1:]
-    if agrees_printed(value, printed):
+    if agrees_printed(number, printed):
         return cell(table, row, column, printed, comp, "identical" if comp == printed else "agrees")
     if flagged:
         return cell(table, row, column, printed, comp, "not reproducible", flagged)
@@ -254,7 +272,8 @@ def one_digit_apart(a: str, b: str, column: str) -> bool:
     """Whether two printed values differ by at most one unit of the printed last digit
     (a whole degree for the truncated angle columns)."""
     try:
-        unit = 1.0 if column in ("epsl", "phi", "beta") else 10.0 ** Decimal(b).as_tuple().exponent  # type: ignore
+        # int() of the exponent: 'n'/'N'/'F' (a printed nan or inf) is a ValueError, not a number
+        unit = 1.0 if column in ("epsl", "phi", "beta") else 10.0 ** int(Decimal(b).as_tuple().exponent)
         return abs(float(a) - float(b)) <= unit * (1 + 1e-9)
     except (ValueError, InvalidOperation):
         return False

@@ -11,7 +11,7 @@ from __future__ import annotations
 import os
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, Union
+from typing import Any, TypeAlias
 
 import numpy as np
 
@@ -20,7 +20,7 @@ from driver.deck import MAX_DECK_BYTES, MAX_VALUES, Deck, DeckError, RawGroup, r
 __all__ = ["DeckSource", "deck_of", "group_from_dict", "is_text", "plain_value"]
 
 #: what :func:`driver.run` and :func:`driver.run_sweep` accept: a deck file, a deck's text, or {group: {key: value}}
-DeckSource = Union[str, os.PathLike, Mapping[str, Mapping[str, Any]]]
+DeckSource: TypeAlias = str | os.PathLike | Mapping[str, Mapping[str, Any]]
 
 
 def plain_value(value: Any, where: str, key: str | None = None, depth: int = 0) -> Any:

@@ -185,7 +185,8 @@ _ANIM_JS = r"""
   play.addEventListener("click", function(){
     if (timer) { clearInterval(timer); timer = null; play.textContent = "play"; return; }
     play.textContent = "pause";
-    timer = setInterval(function(){ slider.value = (parseInt(slider.value, 10) + 1) %% n; show(parseInt(slider.value, 10)); }, 40);
+    timer = setInterval(function(){
+      slider.value = (parseInt(slider.value, 10) + 1) %% n; show(parseInt(slider.value, 10)); }, 40);
   });
   show(parseInt(slider.value, 10));
 })();
@@ -288,7 +289,7 @@ def mechanism_animation(params: Params, anim_id: str = "anim", caption: str = ""
   {out}{block}{pivots}
   <circle data-part="A" r="{rad:.4g}" fill="#fff" stroke="#000" stroke-width="{lw / 4:.4g}"/>
   <circle data-part="B" r="{rad:.4g}" fill="#fff" stroke="#000" stroke-width="{lw / 4:.4g}"/>
-  {'<circle data-part="P" r="%.4g" fill="#8e44ad"/>' % rad if F["P"] is not None else ''}
+  {f'<circle data-part="P" r="{rad:.4g}" fill="#8e44ad"/>' if F["P"] is not None else ''}
  </g>
  <text data-part="note" x="{x0 + 0.02 * w:.5g}" y="{y0 + 0.06 * h:.5g}" font-size="{0.04 * s:.4g}" fill="#c0392b"
   style="visibility:hidden">the linkage cannot be assembled at this crank angle</text>

@@ -201,7 +201,7 @@ def compute(study: Study, params: Params, progress: bool = False,
     return check_finite(result, params)
 
 
-def run_study(deck: Deck, outdir: Path | None, formats: list[str], plot: bool,
+def run_study(deck: Deck, outdir: Path | None, formats: list[str], plot: bool | str,
               progress: bool = False, summary_json: bool = False, name: str | None = None) -> RunOutcome:
     """Validate and run the deck's study; write its outputs to ``outdir`` (None: write nothing)
     as ``<name>.*`` (default: the deck's file stem).  Returns the result, the files written, and

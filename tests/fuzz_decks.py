@@ -8,8 +8,9 @@ wrong types and lengths, duplicated keys and groups, unicode, CRLF, BOM, binary 
 counts, '/' and subscripts, truncation; and a share (GRAMMAR_SHARE) from a grammar-aware generator
 (:func:`grammar_deck`): number spellings near and off the Fortran syntax, repeat counts, keep and
 plot_y expressions over the typed summary columns, titles with '$', braces and control characters,
-where a number Fortran does not read must be refused naming its key (oracle :func:`fortran_values`).  Every deck must end in exit 0, 1 or 2 with its
-messages naming the deck, never a traceback or an unexpected exception ("run failed"), no
+where a number Fortran does not read must be refused naming its key (oracle :func:`fortran_values`).
+Every deck must end in exit 0, 1 or 2 with its messages naming the deck, never a traceback or an
+unexpected exception ("run failed"), no
 NaN/inf/**** in a written table, and nothing written when the exit is 2 (the slowest deck is
 reported, not judged: no timing is a pass/fail rule).  Runs use a small work budget (``--max-work``) so that a mutated deck of a
 long study is refused by its estimate instead of running for seconds: the campaign exercises
@@ -169,7 +170,7 @@ def number_token(rng: random.Random) -> str:
     """A token near the Fortran number syntax (the grammar of tests/test_grammar_fuzz.py)."""
     if rng.random() < 0.06:
         return rng.choice(_SPECIAL)
-    digits = lambda: "".join(rng.choice("0123456789") for _ in range(rng.randrange(0, 4)))  # noqa: E731
+    digits = lambda: "".join(rng.choice("0123456789") for _ in range(rng.randrange(0, 4)))
     whole = digits() + (rng.choice(_ODD_DIGITS) if rng.random() < 0.05 else "")
     dot = rng.choice(["", ".", "."])
     body = rng.choice(["", "", "+", "-"]) + whole + dot + (digits() if dot else "")
@@ -253,9 +254,9 @@ _BAD = re.compile(r"(?<![A-Za-z_])(nan|[+-]?inf)(?![A-Za-z_])|\*\*\*\*", re.IGNO
 
 
 def campaign(count: int, seed: int, max_work: str, workdir: Path) -> dict:
+    from driver import sweep, synthesis
     from driver.cli import main
     from driver.runner import available_studies
-    from driver import sweep, synthesis
 
     specs = {name: m.spec for name, m in available_studies().items()}
     specs["sweep"] = sweep.SPEC
@@ -303,7 +304,7 @@ def campaign(count: int, seed: int, max_work: str, workdir: Path) -> dict:
                         rc = 2
                 else:
                     rc = main(args)
-        except BaseException as exc:   # noqa: BLE001 - the campaign records what escaped
+        except BaseException as exc:   # the campaign records what escaped
             rc = f"raised {exc.__class__.__name__}: {exc}"
         seconds = time.perf_counter() - t0
         slowest = max(slowest, (seconds, f"{deck} (deck {n})"))
@@ -348,6 +349,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     if args.memory:
         import resource
+
         from driver.limits import parse_size
         size = int(parse_size(args.memory))
         resource.setrlimit(resource.RLIMIT_AS, (size, size))

@@ -12,11 +12,8 @@ import json
 import numpy as np
 
 from driver.fourbar import kernel as fourbar_kernel
-
 from driver.manipulator import kernel as manipulator_kernel
-
 from driver.slidercrank import kernel as slidercrank_kernel
-
 from driver.ujoint import kernel as ujoint_kernel
 
 
@@ -44,7 +41,8 @@ def fingerprint() -> dict[str, str]:
     jac, w, kappa, tau = manipulator_kernel.manipulator_arm_states(l1, l2, th1, th2, (1.3, -0.4), (0.2, 2.0))
     out["manipulator_arm_states"] = _h(jac, w, kappa, tau, manipulator_kernel.manipulator_torques(l1, l2, th1, th2))
     x, y = rng.uniform(-1.5, 1.5, n), rng.uniform(-1.5, 1.5, n)
-    out["manipulator_ik"] = _h(*manipulator_kernel.manipulator_ik(l1, l2, x, y, 1), *manipulator_kernel.manipulator_ik(l1, l2, x, y, -1))
+    out["manipulator_ik"] = _h(*manipulator_kernel.manipulator_ik(l1, l2, x, y, 1),
+                               *manipulator_kernel.manipulator_ik(l1, l2, x, y, -1))
     px, py = rng.uniform(0.1, 0.6, 9), rng.uniform(0.1, 0.6, 9)
     out["manipulator_design_indices"] = _h(*manipulator_kernel.manipulator_design_indices(px, py, l1[:500] + 0.6, l2[:500] + 0.6))
     out["manipulator_position_errors"] = _h(manipulator_kernel.manipulator_position_errors(th1[:9], th2[:9],
@@ -102,7 +100,8 @@ def _batch_and_auxiliary_kernels(rng: np.random.Generator, theta: np.ndarray) ->
     kinds = ujoint_kernel.UJOINT_OBJECTIVES
     out["ujoint_summaries"] = _h(*(ujoint_kernel.ujoint_summaries(code, kinds[obj], beta, phi, rho, 360)
                                    for code in ujoint_kernel.UJOINT_MODELS.values() for obj in kinds))
-    eq = [ujoint_kernel.ujoint_equivalent(code, beta[i], phi[i], rho[i]) for code in ujoint_kernel.UJOINT_MODELS.values() for i in range(50)]
+    eq = [ujoint_kernel.ujoint_equivalent(code, beta[i], phi[i], rho[i])
+          for code in ujoint_kernel.UJOINT_MODELS.values() for i in range(50)]
     eq += [ujoint_kernel.ujoint_equivalent(ujoint_kernel.UJOINT_MODELS["exact"], beta[0], [np.pi / 2, 0.0], [0.0, 0.0])]
     out["ujoint_equivalent"] = _h([be for be, _ in eq], [np.nan if br is None else br for _, br in eq])
     axes = rng.normal(0, 1, (5, 3)) * 0.2 + np.array([1.0, 0.0, 0.0])
@@ -121,11 +120,11 @@ def _batch_and_auxiliary_kernels(rng: np.random.Generator, theta: np.ndarray) ->
     out["slidercrank_nl_simulate"] = _h(*(nl[key] for key in ("eps_ax", "eps_of", "lat_max", "mid", "elong",
                                                                "slider", "rev_lat", "rev_eps", "stats")),
                                         [nl["status"]])
-    out["slidercrank_column_static"] = _h(slidercrank_kernel.slidercrank_column_static(8, 1.0, 2e11 * 64e-6, 2e11 * 3.413333333e-10,
-                                                                      1.06 * np.pi ** 2 * 2e11 * 3.413333333e-10,
-                                                                      1e-3))
+    out["slidercrank_column_static"] = _h(slidercrank_kernel.slidercrank_column_static(
+        8, 1.0, 2e11 * 64e-6, 2e11 * 3.413333333e-10, 1.06 * np.pi ** 2 * 2e11 * 3.413333333e-10, 1e-3))
     pe = rng.normal(0, 1e-3, 6)
-    out["slidercrank_corot_element"] = _h(*slidercrank_kernel.slidercrank_corot_element(0.05, 2e11 * 64e-6, 2e11 * 3.413333333e-10, pe))
+    out["slidercrank_corot_element"] = _h(*slidercrank_kernel.slidercrank_corot_element(0.05, 2e11 * 64e-6,
+                                                                                        2e11 * 3.413333333e-10, pe))
     return out
 
 

@@ -8,9 +8,9 @@ import tracemalloc
 
 import pytest
 
+from conftest import INPUTS
 from driver import limits
 from driver.cli import main
-from conftest import INPUTS
 
 
 def _deck(tmp_path, base: str, edits: list[tuple[str, str]], add: str = "") -> str:

@@ -14,10 +14,9 @@ import pandas as pd
 import pytest
 
 import driver
+from conftest import INPUTS, ROOT
 from driver import cli
 from driver.deck import read_deck
-
-from conftest import INPUTS, ROOT
 
 CRANK5 = dict(fixed_link=12.0, crank=5.0, coupler=15.0, rocker=9.0, omega=5.0, step_deg=20)
 
@@ -60,9 +59,9 @@ def test_import_driver_is_cheap_and_exports_a_small_documented_surface():
     assert driver.fourbar.run.__doc__
     assert (Path(driver.__file__).parent / "py.typed").exists()
     with pytest.raises(AttributeError):
-        driver.no_such_thing
+        _ = driver.no_such_thing
     with pytest.raises(AttributeError):
-        driver._kernels_not_there
+        _ = driver._kernels_not_there
 
 
 def test_keys_lists_every_deck_key_with_units():

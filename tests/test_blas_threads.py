@@ -23,8 +23,9 @@ def _blas_threads() -> set[int]:
 
 
 def test_one_thread_is_a_scope():
-    from driver import blas
     import scipy.linalg  # noqa: F401  (scipy's own OpenBLAS loaded)
+
+    from driver import blas
     with threadpoolctl.threadpool_limits(limits=2, user_api="blas"):
         before = _blas_threads()
         with blas.one_thread():

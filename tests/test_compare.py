@@ -11,9 +11,9 @@ import shutil
 
 import pytest
 
+from conftest import INPUTS, ROOT
 from driver import compare, published
 from driver.cli import main
-from conftest import INPUTS, ROOT
 
 CRANKS = (2, 3, 4, 5)
 

@@ -5,10 +5,11 @@ from __future__ import annotations
 import re
 
 import pytest
-from hypothesis import HealthCheck, given, settings, strategies as st
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
-from driver.cli import main
 from conftest import INPUTS
+from driver.cli import main
 
 DECKS = ["crank5.dat", "crank5_exact.dat", "nongrashof.dat", "crank5_terminal.dat",
          "manipulator_case1_exact.dat", "manipulator_case2_report.dat", "robust_example.dat",

@@ -12,7 +12,6 @@ import doctest
 import re
 import shutil
 import traceback
-from pathlib import Path
 
 import pytest
 

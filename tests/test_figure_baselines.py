@@ -21,11 +21,11 @@ import pandas as pd
 import pytest
 
 pytest.importorskip("matplotlib")
-import matplotlib  # noqa: E402
-from matplotlib.testing.compare import compare_images  # noqa: E402
+import matplotlib
+from matplotlib.testing.compare import compare_images
 
-import driver  # noqa: E402
-from conftest import INPUTS, ROOT  # noqa: E402
+import driver
+from conftest import INPUTS, ROOT
 
 BASELINES = Path(__file__).parent / "baseline_figures"
 #: RMS tolerance on a 0-255 scale.  The same matplotlib draws the same pixels (RMS 0.0); a changed
@@ -65,7 +65,7 @@ def _convergence():
     from driver import plotting
     history = pd.read_csv(ROOT / "outputs" / "optimize_manipulator_torque_history.csv")
     evals = pd.read_parquet(ROOT / "outputs" / "optimize_manipulator_torque_evals.parquet")
-    from driver.study import expression_label   # the label the optimiser gives it (mathtext symbols)
+    from driver.study import expression_label  # the label the optimiser gives it (mathtext symbols)
     return plotting.convergence_plot(history, evals, expression_label(driver.manipulator.STUDY, "design_torque_demand_Nm"),
                                      "minimize", title="convergence")
 
@@ -141,7 +141,6 @@ KINDS = {
 
 @pytest.mark.parametrize("kind", sorted(KINDS))
 def test_figure_matches_its_baseline(kind, tmp_path):
-    from driver.plotting import save_figure
     with matplotlib.rc_context(TEST_RC):
         fig = KINDS[kind]()
         baseline = BASELINES / f"{kind}.png"

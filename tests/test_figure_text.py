@@ -9,8 +9,8 @@ import pytest
 
 pytest.importorskip("matplotlib")
 
-import driver  # noqa: E402
-from conftest import INPUTS  # noqa: E402
+import driver
+from conftest import INPUTS
 
 
 def _is_math(text_artist) -> bool:

@@ -6,11 +6,9 @@ and at the bytes of the files written (PNG, SVG, PDF).
 """
 from __future__ import annotations
 
-import re
-
 import subprocess
 import sys
-from functools import lru_cache
+from functools import cache
 
 import numpy as np
 import pandas as pd
@@ -20,15 +18,15 @@ from matplotlib.figure import Figure as MplFigure
 
 from conftest import INPUTS
 from driver import plotting
-from driver.fourbar import figures as fourbar_figures
-from driver.ujoint import figures as ujoint_figures
-from driver.deck import read_deck
-from driver.runner import compute, study_of
 from driver._study import load_study
+from driver.deck import read_deck
+from driver.fourbar import figures as fourbar_figures
+from driver.runner import compute, study_of
 from driver.study import column_label, plot_format
+from driver.ujoint import figures as ujoint_figures
 
 
-@lru_cache(maxsize=None)
+@cache
 def figures_of(deck: str) -> dict[str, MplFigure]:
     """Every figure a shipped deck draws with --plot, by name (drawn once per test session)."""
     module, params = study_of(read_deck(INPUTS / deck))
@@ -267,7 +265,8 @@ def test_slidercrank_buckled_speed_is_named_not_missing(write_deck):
         texts = _legend_texts(fig)
         drawn = [ln for ln in fig.axes[0].get_lines() if len(ln.get_xdata()) > 2]
         assert [ln.get_label() for ln in drawn] == ["11.52 rad/s"]          # 29.32 has no numbers to draw
-        assert any(t.startswith(("29.32 rad/s: static instability at theta2 = ", "29.32 rad/s: limit l/20 at theta2 = ")) and t.endswith("not drawn") for t in texts), texts
+        starts = ("29.32 rad/s: static instability at theta2 = ", "29.32 rad/s: limit l/20 at theta2 = ")
+        assert any(t.startswith(starts) and t.endswith("not drawn") for t in texts), texts
         assert _inside_figure(fig, fig.legends[0])
         assert_no_overlapping_text(fig)
 

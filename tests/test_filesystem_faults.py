@@ -11,10 +11,10 @@ import time
 
 import pytest
 
+from conftest import INPUTS, ROOT
 from driver import atomic
 from driver.atomic import output_set, remove_stale_temporaries, write_text
 from driver.cli import main
-from conftest import INPUTS, ROOT
 
 DECK = str(INPUTS / "crank5.dat")
 OTHER = str(INPUTS / "crank2.dat")

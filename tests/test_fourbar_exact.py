@@ -11,10 +11,11 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-from driver.fourbar import kernel as fourbar_kernel
 from driver.fourbar import grashof, limit_angles
+from driver.fourbar import kernel as fourbar_kernel
 
 OK = fourbar_kernel.FOURBAR_STATUS["ok"]
 length = st.floats(0.5, 10.0, allow_nan=False)

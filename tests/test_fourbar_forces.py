@@ -23,13 +23,14 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings, strategies as st
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
-from driver.fourbar import forces
-from driver.fourbar import kernel as fourbar_kernel
+from conftest import INPUTS
 from driver.api import run
 from driver.cli import main
-from conftest import INPUTS
+from driver.fourbar import forces
+from driver.fourbar import kernel as fourbar_kernel
 
 G = 9.81
 
@@ -89,7 +90,7 @@ def com_states(kin, p, pr):
              - (w ** 2)[:, None] * rel)
         out.append((G_, v, a))
     u, vv = pr[16], pr[17]
-    t2, w2, a2 = kin["t"][1], kin["w"][1], kin["a"][1]
+    t2, w2 = kin["t"][1], kin["w"][1]
     rel = np.stack([u * np.cos(t2) - vv * np.sin(t2), u * np.sin(t2) + vv * np.cos(t2)], axis=-1)
     P = A + rel
     vP = vA + w2[:, None] * np.stack([-rel[:, 1], rel[:, 0]], axis=-1)
@@ -353,7 +354,7 @@ def test_berkof_lowen_makes_the_centre_of_mass_stationary(case, k1, k3):
 
 
 def test_balanced_deck_reports_vanishing_shaking_force(tmp_path):
-    res = run((forces_deck := open(INPUTS / "fourbar_forces_balanced.dat").read()))
+    res = run(forces_deck := open(INPUTS / "fourbar_forces_balanced.dat").read())
     t = res.tidy
     shake = np.hypot(t["shaking_force_x_N"], t["shaking_force_y_N"])
     before = np.hypot(t["unbalanced_shaking_force_x_N"], t["unbalanced_shaking_force_y_N"])
@@ -415,8 +416,8 @@ def test_batch_summary_equals_single_runs():
 
 def _params(text: str):
     from driver import fourbar
-    from driver.pydeck import deck_of
     from driver.deck import validate
+    from driver.pydeck import deck_of
     deck = deck_of(text, None)
     return validate(deck.groups["fourbar"], fourbar.SPEC, str(deck.path))
 

@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import pytest
 
+from conftest import INPUTS
 from driver.cli import main
 from driver.published import PUBLISHED_DIR, listing_rows
-from conftest import INPUTS
 
 CRANKS = (2, 3, 4, 5)
 

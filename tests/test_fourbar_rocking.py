@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 
 import driver
+from conftest import INPUTS
 from driver import fourbar
 from driver.fourbar import kernel as fourbar_kernel
-from conftest import INPUTS
 
 OK = fourbar_kernel.FOURBAR_STATUS["ok"]
 NO = fourbar_kernel.FOURBAR_STATUS["no_assembly"]

@@ -16,11 +16,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-from driver.fourbar import kernel as fourbar_kernel
 from driver.deck import DeckError, Params
 from driver.fourbar import SPEC, grashof, limit_angles, summarise, summarise_batch
+from driver.fourbar import kernel as fourbar_kernel
 
 OK, TOG = fourbar_kernel.FOURBAR_STATUS["ok"], fourbar_kernel.FOURBAR_STATUS["toggle"]
 

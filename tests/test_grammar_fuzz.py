@@ -9,11 +9,9 @@ rule for the expression language.  Bounded: a few hundred examples, seconds in a
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
-import pytest
-from hypothesis import HealthCheck, given, settings, strategies as st
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from driver.deck import DeckError, RawGroup, read_deck, validate
 from driver.expr import ExprError, parse

@@ -7,6 +7,8 @@ the line and the key, and nothing is written.
 """
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 

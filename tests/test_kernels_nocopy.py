@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 
 from driver.fourbar import kernel as fourbar_kernel
-
 from driver.manipulator import kernel as manipulator_kernel
 
 

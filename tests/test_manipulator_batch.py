@@ -19,14 +19,14 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from hypothesis import HealthCheck, assume, given, settings, strategies as st
+from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import strategies as st
 
 from driver import manipulator
-
-from driver.manipulator import kernel as manipulator_kernel
 from driver.cli import main
 from driver.deck import DeckError, Params
 from driver.manipulator import BATCH_KEYS, SPEC, summarise, summarise_batch
+from driver.manipulator import kernel as manipulator_kernel
 
 ROOT = Path(__file__).resolve().parents[1]
 #: what the bit-exact comparison covers (an optimiser's finite differences see these)
@@ -235,7 +235,7 @@ def test_sweep_with_unreachable_designs(tmp_path):
     un = batch["design_status"] == "unreachable"
     truth = np.array([reaches(a, b, [1, 2, 3, 4], [5, 7, 7, 6]) for a, b in
                       zip(batch["manipulator.designs_l1"], batch["manipulator.designs_l2"])])
-    assert un.sum() > 10 and (un.to_numpy() == (truth == False)).all()   # noqa: E712
+    assert un.sum() > 10 and (un.to_numpy() == (truth == False)).all()   # noqa: E712 (elementwise on an array)
     assert not batch.loc[un, "kept"].any()
     # torques exist where the target (1, 5) is reached, whether or not the whole workspace is
     at_target = np.array([reaches(a, b, [1], [5]) for a, b in

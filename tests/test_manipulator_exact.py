@@ -56,7 +56,7 @@ def exact_runs():
 
 
 def test_exact_angles_reach_the_target(exact_runs):
-    for case, (res, p) in exact_runs.items():
+    for res, p in exact_runs.values():
         for key in ("4.5", "4.8"):
             t = table_frame(res.tidy, key).dropna(subset=["theta1_deg"])
             assert len(t) > 0
@@ -68,7 +68,7 @@ def test_exact_angles_reach_the_target(exact_runs):
 
 
 def test_exact_torques_match_newton_euler(exact_runs):
-    for case, (res, p) in exact_runs.items():
+    for res, p in exact_runs.values():
         for key in ("4.7", "4.8"):
             ang = table_frame(res.tidy, "4.5" if key == "4.7" else key)
             tq = table_frame(res.tidy, key)
@@ -178,7 +178,7 @@ def test_tolerance_box_worst_corner_on_bound_and_monte_carlo(measure):
 
 
 def test_study_tolerance_rows(exact_runs):
-    for case, (res, p) in exact_runs.items():
+    for res, p in exact_runs.values():
         t = table_frame(res.tidy, "tolerance")
         assert len(t) == 2
         np.testing.assert_allclose(t["worst_corner_m"], p.tolerance_bound, rtol=1e-12)

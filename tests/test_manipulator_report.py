@@ -7,20 +7,17 @@ never through a bare round().
 """
 from __future__ import annotations
 
-import math
 from decimal import Decimal
-from functools import lru_cache
+from functools import cache
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
-import pytest
 
-from driver.runner import study_of
 from driver.deck import read_deck
 from driver.manipulator import table_frame
-
 from driver.published import PUBLISHED_DIR, read_blocks
+from driver.runner import study_of
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -33,7 +30,7 @@ def assert_printed(computed: float, printed: str, what: str = "") -> None:
         f"{what}: computed {computed!r} vs printed {printed} (allowed +-{half:g})"
 
 
-@lru_cache(maxsize=None)
+@cache
 def run_deck(name: str):
     module, params = study_of(read_deck(ROOT / "inputs" / name))
     return module.run(params), params

@@ -189,6 +189,7 @@ def test_a_poor_best_transmission_angle_is_named(tmp_path, swing, q):
 
 def test_json_records_of_optimisation_synthesis_and_sweep(tmp_path):
     import json
+
     from driver.cli import main
     decks = [ROOT / "inputs" / n for n in ("optimize_manipulator_torque.dat", "synthesis_crank_rocker.dat",
                                            "fourbar_paper_sweep.dat")]

@@ -191,6 +191,7 @@ def test_ujoint_through_the_generic_group_finds_the_study_optimum(tmp_path):
 
 def test_manipulator_least_torque_robust_design_beats_the_walk_along_crob(tmp_path):
     from scipy.optimize import minimize_scalar
+
     from driver import manipulator
     oc = optimize(ROOT / "inputs" / "optimize_manipulator_torque.dat", tmp_path, jobs=1)
     assert oc.success
@@ -220,6 +221,7 @@ def test_manipulator_least_torque_robust_design_beats_the_walk_along_crob(tmp_pa
 def test_slidercrank_lightest_rod_is_bound_by_the_euler_constraint(tmp_path):
     """Width fixed: the lightest depth is where N_peak / P_E = 1/3; found again by bisection on the study."""
     from scipy.optimize import brentq
+
     from driver import slidercrank
     text = (ROOT / "inputs" / "optimize_slidercrank_section.dat").read_text()
     text = text.replace("  var2 = 'slidercrank.section_depth', lower2 = 2e-3, upper2 = 20e-3\n", "")
@@ -305,8 +307,9 @@ def test_differential_evolution_same_run_in_one_process_worker_processes_and_on_
     design, generation for generation, as in one process."""
     distributed = pytest.importorskip("distributed")
     import os
-    from driver.optimize import evaluate
+
     from driver import slidercrank
+    from driver.optimize import evaluate
     # a LocalCluster with worker processes sets OMP/MKL/OPENBLAS_NUM_THREADS=1 in this process's
     # environment; later tests' subprocesses must not inherit that (SLSQP results follow OpenBLAS's
     # thread count in the last bits, and the committed outputs are compared byte for byte)
@@ -388,7 +391,8 @@ def test_crank_rocker_through_optimize_agrees_with_the_closed_form_family(tmp_pa
     construction, must land on the closed-form family's best member.  Tolerances: swing and time
     ratio are held within 1e-6 by the deck's constraint pairs, which moves the optimum along the
     family by about 1e-5 (lengths) and its objective by < 1e-4 deg."""
-    from driver.synthesis import crank_rocker as cr, synthesise
+    from driver.synthesis import crank_rocker as cr
+    from driver.synthesis import synthesise
     oc = optimize(ROOT / "inputs" / "optimize_crank_rocker.dat", None, jobs=1)
     assert oc.success
     syn = synthesise(ROOT / "inputs" / "synthesis_crank_rocker.dat")

@@ -11,8 +11,8 @@ import tomllib
 import pytest
 
 import driver
-from driver import example_decks
 from conftest import INPUTS, ROOT
+from driver import example_decks
 
 PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text())
 
@@ -90,8 +90,8 @@ def test_example_command_line(tmp_path):
 
 
 def test_study_names_without_import_match_the_studies():
-    from driver.runner import available_studies
     from driver._study import study_names
+    from driver.runner import available_studies
     assert study_names() == sorted(available_studies())
 
 
@@ -122,6 +122,7 @@ def test_kernel_fingerprint_covers_every_kernel_wrapper():
     public wrapper of every study's kernel module (``Study.kernel``): a new kernel cannot escape the
     CPU-independence check."""
     import inspect
+
     from driver._study import registered
     wrappers = [f"{name}_kernel.{n}(" for name, s in registered().items() if s.kernel is not None
                 for n in s.kernel.__all__ if inspect.isfunction(getattr(s.kernel, n))]

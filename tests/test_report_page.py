@@ -27,9 +27,8 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
-from headless import Browser, chromium_path  # noqa: E402
-
-from conftest import INPUTS, ROOT  # noqa: E402
+from conftest import INPUTS, ROOT
+from headless import Browser, chromium_path
 
 pytest.importorskip("matplotlib")
 pytest.importorskip("pyarrow")
@@ -39,7 +38,7 @@ if chromium_path() is None:
         pytest.fail("CI must test the report page in Chromium: .ci/setup installs Debian's chromium", pytrace=False)
     pytest.skip("no chromium on PATH (bash .ci/setup installs it)", allow_module_level=True)
 
-from driver.report_page import MAX_PAGE_BYTES  # noqa: E402
+from driver.report_page import MAX_PAGE_BYTES
 
 #: a small slider-crank deck (the paper's aluminium rod, coarse mesh): seconds, not minutes
 SLIDERCRANK = """! aluminium rod of the paper, coarse mesh for a quick report

@@ -17,8 +17,8 @@ import pytest
 from driver.cli import main
 from driver.deck import RawGroup
 from driver.study import code_digest
-from driver.sweep import store
 from driver.sweep import batch as sweep_batch
+from driver.sweep import store
 
 
 @pytest.fixture

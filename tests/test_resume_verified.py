@@ -81,7 +81,7 @@ def test_a_damaged_case_file_is_redone(runs, capsys, suffix, damage):
     f = out / "sw" / f"case_0002{suffix}"
     f.write_bytes(damage(f.read_bytes()))
     said = _resume(deck, out, capsys)
-    assert f"1 cases redone" in said and f"case_0002{suffix} failed its checksum" in said
+    assert "1 cases redone" in said and f"case_0002{suffix} failed its checksum" in said
     assert "resume: 3 of 4 cases complete, 1 to run" in said
     _same(fresh, out)
 

@@ -10,10 +10,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from driver.runner import study_of
 from driver.deck import read_deck
-
 from driver.published import PUBLISHED_DIR, read_blocks
+from driver.runner import study_of
 
 ROOT = Path(__file__).resolve().parents[1]
 #: printed values that do not reproduce: the (2.12) coefficients, the last digit of two Table 2.5 std

@@ -14,14 +14,13 @@ from __future__ import annotations
 
 import json
 import os
-from pathlib import Path
 
 import pandas as pd
 import pyarrow.parquet as pq
 import pytest
 
-from driver.sweep import batch as sweep_batch
 from driver.cli import main
+from driver.sweep import batch as sweep_batch
 
 SWEEP = """&fourbar fixed_link = 12.0, crank = 3.0, coupler = 15.0, rocker = 9.0, omega = 5.0, step_deg = 10 /
 &sweep
@@ -112,7 +111,9 @@ def _decimal_half_up(value: float, decimals: int) -> str:
 def test_fast_fixed_point_text_equals_decimal_half_up():
     """The table writer's fast path (Python's correctly rounded 'f' text unless the double is an
     exact tie) gives Decimal's half-up text for every value: ties, negative zero, huge and tiny."""
-    from hypothesis import given, settings, strategies as st
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+
     from driver.table import _round_half_up
     for v in (0.5, 1.5, 2.5, -2.5, 0.125, -0.125, 2.675, 0.045, 0.0, -0.0, 1e-5, -1e-5, 1e20, 1e300, 5e-324):
         for d in range(0, 9):

@@ -20,14 +20,11 @@ import pandas as pd
 import pytest
 
 from driver import manipulator, ujoint
-
-from driver.fourbar import kernel as fourbar_kernel
-
-from driver.manipulator import kernel as manipulator_kernel
-
-from driver.ujoint import kernel as ujoint_kernel
 from driver.cli import main
 from driver.deck import Params
+from driver.fourbar import kernel as fourbar_kernel
+from driver.manipulator import kernel as manipulator_kernel
+from driver.ujoint import kernel as ujoint_kernel
 
 ROOT = Path(__file__).resolve().parents[1]
 P = fourbar_kernel.FOURBAR_PASSES

@@ -17,7 +17,7 @@ import pytest
 
 pytest.importorskip("matplotlib")
 
-import driver  # noqa: E402
+import driver
 
 DECK = ("&slidercrank\n material = 'aluminium'\n speeds = 29.32\n"
         " element_counts = 2, 4, 8, 16, 32, 64, 128\n steps_per_rev = 360, revolutions = 2\n/\n")

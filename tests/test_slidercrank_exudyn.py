@@ -39,8 +39,16 @@ REVS = 4
 def exudyn_run(omega: float, h: float = 2e-4) -> dict[str, float]:
     """Independent model in Exudyn (see the module docstring)."""
     from exudyn.beams import GenerateStraightLineANCFCable2D
-    from exudyn.itemInterface import (CoordinateConstraint, MarkerNodeCoordinate, MassPoint2D, NodePoint2D,
-                                      NodePointGround, ObjectANCFCable2D, SensorBody, SensorNode)
+    from exudyn.itemInterface import (
+        CoordinateConstraint,
+        MarkerNodeCoordinate,
+        MassPoint2D,
+        NodePoint2D,
+        NodePointGround,
+        ObjectANCFCable2D,
+        SensorBody,
+        SensorNode,
+    )
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
     ground = mbs.AddNode(NodePointGround(referenceCoordinates=[0, 0, 0]))

@@ -7,7 +7,6 @@ Every oracle here is written in the test (numpy/scipy) or transcribed from a pub
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,10 +14,9 @@ from scipy.integrate import quad
 from scipy.linalg import eigh
 from scipy.optimize import brentq
 
-from driver.slidercrank import kernel as slidercrank_kernel
-from driver.slidercrank import MATERIALS
-
 from driver.published import PUBLISHED_DIR, read_blocks
+from driver.slidercrank import MATERIALS
+from driver.slidercrank import kernel as slidercrank_kernel
 
 
 def _table1() -> tuple[dict[str, dict[str, float]], dict[str, float]]:
@@ -172,7 +170,7 @@ def test_quasistatic_limit_is_rigid_body_statics(name):
     for j in range(0, spr + 1, 6):
         th = w * dt * j
         for e in range(n):
-            nbar = quad(lambda x: axial_force_oracle(x, th, w, R2, L, rho_a, MS), e * le, (e + 1) * le,
+            nbar = quad(lambda x, th=th: axial_force_oracle(x, th, w, R2, L, rho_a, MS), e * le, (e + 1) * le,
                         epsabs=1e-13, epsrel=1e-13)[0] / le
             worst = max(worst, abs(res["eps_ax"][e, j] - nbar / ea))
             scale = max(scale, abs(nbar / ea))
@@ -189,7 +187,7 @@ def test_quasistatic_limit_of_a_very_stiff_rod():
     le = L / n
     for j in (0, 20, 40):
         th = w * dt * (spr - 40 + j)
-        nbar = quad(lambda x: axial_force_oracle(x, th, w, R2, L, rho_a, MS), 0, le)[0] / le
+        nbar = quad(lambda x, th=th: axial_force_oracle(x, th, w, R2, L, rho_a, MS), 0, le)[0] / le
         assert res["eps_ax"][0, j] == pytest.approx(nbar / (ea * stiff), rel=1e-5)
 
 
@@ -299,7 +297,8 @@ def test_convergence_monotone_and_below_half_percent_beyond_8(name):
     counts = [1, 2, 4, 8, 10, 16, 20, 32, 50, 64]
     tens, comp = [], []
     for n in counts:
-        r = slidercrank_kernel.slidercrank_simulate(n, R2, L, rho_a, ea, ei, 1e-3, MS, w, dt, 3 * spr, 2 * spr, spr + 1, alpha, beta)
+        r = slidercrank_kernel.slidercrank_simulate(n, R2, L, rho_a, ea, ei, 1e-3, MS, w, dt, 3 * spr, 2 * spr, spr + 1,
+                                                    alpha, beta)
         tens.append(r["eps_ax"].max())
         comp.append(r["eps_ax"].min())
     tens, comp = np.array(tens), np.array(comp)
@@ -319,8 +318,9 @@ def test_rest_start_overshoots_then_forgets():
     wb, wa, _ = slidercrank_kernel.slidercrank_frequencies(rho_a, ea, ei, L, MS)
     alpha, beta = 2 * zeta * wb * wa / (wb + wa), 2 * zeta / (wb + wa)
     dt = 2 * math.pi / (w * spr)
-    runs = {st: slidercrank_kernel.slidercrank_simulate(8, R2, L, rho_a, ea, ei, 1e-3, MS, w, dt, 4 * spr, 0, 4 * spr + 1, alpha, beta,
-                                       start=st)["eps_ax"][0] for st in ("quasistatic", "rest")}
+    runs = {st: slidercrank_kernel.slidercrank_simulate(8, R2, L, rho_a, ea, ei, 1e-3, MS, w, dt, 4 * spr, 0, 4 * spr + 1,
+                                                        alpha, beta, start=st)["eps_ax"][0]
+            for st in ("quasistatic", "rest")}
     qs, rest = runs["quasistatic"], runs["rest"]
     ratio = rest[:spr].max() / qs[:spr].max()
     assert 1.8 < ratio <= 1 + math.exp(-zeta * math.pi) + 1e-3
@@ -354,8 +354,8 @@ def test_crank_pin_strain_converges_for_every_rod(name, write_deck, tmp_path):
     monotonically and by < 0.5 % beyond 8 elements for all three rods (the element average does
     not for the low-carbon-steel rod, whose axial force falls 23 % along it), and at 8 elements it
     already equals the crank-end element strain of a 400-element mesh (le = 1.3 mm) within 0.1 %."""
-    from driver.deck import read_deck, validate
     from driver import slidercrank
+    from driver.deck import read_deck, validate
     deck = write_deck(f"&slidercrank material = '{name}', speeds = 29.32, steps_per_rev = 720, "
                       f"revolutions = 3, element_counts = 1, 2, 4, 8, 10, 16, 20, 32, 400 /\n")
     params = validate(read_deck(deck).groups["slidercrank"], slidercrank.SPEC, deck)

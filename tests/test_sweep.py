@@ -6,9 +6,9 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+from conftest import INPUTS
 from driver import sweep
 from driver.cli import main
-from conftest import INPUTS
 from test_fourbar_published import published, table_rows
 
 BASE = """&fourbar
@@ -47,8 +47,8 @@ def test_paper_study_in_one_run_reproduces_all_published_cells(tmp_path):
     ("&sweep key1 = 'fourbar.method', values1 = 'listing', 'exact' /\n", 2),
 ])
 def test_case_counts(tmp_path, text, n):
-    from driver.deck import read_deck, validate
     from driver import fourbar
+    from driver.deck import read_deck, validate
     d = read_deck(deck(tmp_path, text))
     sw = validate(d.groups["sweep"], sweep.SPEC, d.path)
     cases = sweep.build_cases(sw, "fourbar", fourbar.SPEC)
@@ -64,7 +64,8 @@ def test_case_counts(tmp_path, text, n):
     ("&sweep\n values1 = 2, 3 /\n", 6, "values1", "without key1"),
     ("&sweep\n key1 = 'fourbar.crank', start1 = 1, stop1 = 2 /\n", 5, "count1", "go together"),
     ("&sweep\n key1 = 'fourbar.crank', start1 = 1, stop1 = 2, count1 = 1e8 /\n", 6, "count1", "beyond the 10000000"),
-    ("&sweep\n key1 = 'fourbar.crank', values1 = 2\n keep = 'no_such_column > 1' /\n", 7, "keep", "unknown column 'no_such_column'"),
+    ("&sweep\n key1 = 'fourbar.crank', values1 = 2\n keep = 'no_such_column > 1' /\n", 7, "keep",
+     "unknown column 'no_such_column'"),
 ])
 def test_sweep_deck_errors(tmp_path, capsys, text, line, key, words):
     path = deck(tmp_path, text)

@@ -15,8 +15,8 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from driver.sweep import batch as sweep_batch
 from driver.cli import main
+from driver.sweep import batch as sweep_batch
 from driver.sweep import stream
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -101,10 +101,9 @@ def test_bad_input_rows(tmp_path, monkeypatch, order, streamed):
 
 
 def test_run_stops_holding_rows_above_the_threshold(tmp_path):
-    from driver.deck import read_deck
     from driver._study import load_study
+    from driver.deck import read_deck, validate
     from driver.sweep.spec import SPEC, grid_of
-    from driver.deck import validate
     deck = tmp_path / "s.dat"
     deck.write_text(SHIPPED.replace("count1 = 25", "count1 = 4"))
     d = read_deck(deck)

@@ -15,10 +15,9 @@ import numpy as np
 import pytest
 
 from driver import fourbar
-
-from driver.fourbar import kernel as fourbar_kernel
 from driver.cli import main
-from driver.deck import DeckError, RawGroup, validate
+from driver.deck import RawGroup, validate
+from driver.fourbar import kernel as fourbar_kernel
 from driver.synthesis import crank_rocker as cr
 from driver.synthesis import synthesise
 from driver.synthesis.function import chebyshev, freudenstein, links_from_k

@@ -7,10 +7,9 @@ import pandas as pd
 import pytest
 
 import driver
+from conftest import INPUTS
 from driver.export import unit_of, with_units, write_tidy
 from driver.manipulator import table_frame
-
-from conftest import INPUTS
 
 FAST = ["crank5", "crank5_coupler_point", "nongrashof", "ujoint_option1", "manipulator_case2_report",
         "robust_example", "slidercrank_simeon1996"]
@@ -60,7 +59,8 @@ def test_csv_and_parquet_read_back_with_the_same_dtypes(results, tmp_path):
         _assert_same(csv, pq)
     csv, _ = _read_both(results["crank5"].tidy, tmp_path)
     assert csv["theta_deg"].dtype == np.float64   # written 0.0, 20.0, ... not 0, 20
-    assert (tmp_path / "t.csv").read_text().splitlines()[1].split(",")[:3] == ["listing", "0.0", "23.0"]   # Lampiran 3: i = 0, epsl = 23
+    # Lampiran 3: i = 0, epsl = 23
+    assert (tmp_path / "t.csv").read_text().splitlines()[1].split(",")[:3] == ["listing", "0.0", "23.0"]
 
 
 def test_csv_writer_edge_cases(tmp_path):

@@ -13,9 +13,8 @@ import numpy as np
 import pytest
 
 import driver
-from driver.deck import DeckError
-
 from conftest import INPUTS
+from driver.deck import DeckError
 
 
 def _mu_extremes(d: float, a: float, b: float, c: float) -> tuple[float, float]:

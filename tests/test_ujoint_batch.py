@@ -15,14 +15,14 @@
 from __future__ import annotations
 
 import dataclasses
-
 import math
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from driver import ujoint
 from driver.cli import main

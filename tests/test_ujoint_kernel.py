@@ -13,8 +13,14 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from driver.ujoint.kernel import (UJOINT_MODELS, UJOINT_OBJECTIVES, ujoint_equivalent, ujoint_geometry,
-                            ujoint_objective, ujoint_speed)
+from driver.ujoint.kernel import (
+    UJOINT_MODELS,
+    UJOINT_OBJECTIVES,
+    ujoint_equivalent,
+    ujoint_geometry,
+    ujoint_objective,
+    ujoint_speed,
+)
 
 D = math.pi / 180.0
 EXACT, CUM, EQ13 = UJOINT_MODELS["exact"], UJOINT_MODELS["cumulative"], UJOINT_MODELS["eq13"]

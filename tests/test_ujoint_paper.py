@@ -9,11 +9,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from driver.runner import study_of
 from driver.deck import read_deck
-from driver.ujoint.kernel import UJOINT_MODELS, ujoint_speed
-
 from driver.published import PUBLISHED_DIR, read_blocks
+from driver.runner import study_of
+from driver.ujoint.kernel import UJOINT_MODELS, ujoint_speed
 
 
 def _paper() -> dict:

@@ -18,17 +18,31 @@ from __future__ import annotations
 
 from driver._study import BatchSummary, Study
 from driver.fourbar import forces, kernel, published
-from driver.fourbar.analysis import (ST, Extremes, Grashof, Motion, assembly_intervals, blame, coupler_point,
-                                     crank_angles, exact_grid, extremes, grashof, limit_angles, listing_grid,
-                                     rocking_motions, tidy_frame)
-from driver.fourbar.batch import (BATCH_IGNORED, BATCH_INDEPENDENT, BATCH_KEYS, BATCH_PASSES, PASS_BITS, summarise,
-                                  summarise_batch)
+from driver.fourbar.analysis import (
+    ST,
+    Extremes,
+    Grashof,
+    Motion,
+    assembly_intervals,
+    blame,
+    coupler_point,
+    crank_angles,
+    exact_grid,
+    extremes,
+    grashof,
+    limit_angles,
+    listing_grid,
+    rocking_motions,
+    tidy_frame,
+)
+from driver.fourbar.batch import BATCH_IGNORED, BATCH_INDEPENDENT, BATCH_KEYS, BATCH_PASSES, PASS_BITS, summarise, summarise_batch
 from driver.fourbar.published import LISTING_DEFECT, LISTING_PRECISION, exact_as_listed
 from driver.fourbar.report import animation_frames, run
 from driver.fourbar.spec import LABELS, SPEC, SUMMARY_SETTINGS, SWEEP_BEST, SWEEP_PLOT, estimate
 
 __all__ = ["SPEC", "STUDY", "run", "estimate", "summarise", "summarise_batch", "BATCH_KEYS", "BATCH_PASSES", "grashof",
-           "limit_angles", "assembly_intervals", "rocking_motions", "Motion", "crank_angles", "exact_grid", "coupler_point", "listing_grid", "extremes", "tidy_frame",
+           "limit_angles", "assembly_intervals", "rocking_motions", "Motion", "crank_angles", "exact_grid", "coupler_point",
+           "listing_grid", "extremes", "tidy_frame",
            "exact_as_listed", "Grashof", "Extremes", "ST", "LABELS", "SWEEP_BEST", "SWEEP_PLOT", "LISTING_DEFECT",
            "LISTING_PRECISION", "forces", "kernel"]
 

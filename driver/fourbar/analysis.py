@@ -13,7 +13,9 @@ from driver.export import with_units
 from driver.fourbar import kernel
 from driver.fourbar.batch import summary_rows
 
-__all__ = ['ST', 'Grashof', 'grashof', 'limit_angles', 'assembly_intervals', 'Motion', 'rocking_motions', 'crank_angles', 'exact_grid', 'coupler_point', 'listing_grid', 'deg360', 'Extremes', 'toggles_in_range', 'extremes', 'TIDY_UNITS', 'tidy_frame', 'exact_columns', 'blame']
+__all__ = ['ST', 'Grashof', 'grashof', 'limit_angles', 'assembly_intervals', 'Motion', 'rocking_motions',
+           'crank_angles', 'exact_grid', 'coupler_point', 'listing_grid', 'deg360', 'Extremes', 'toggles_in_range',
+           'extremes', 'TIDY_UNITS', 'tidy_frame', 'exact_columns', 'blame']
 
 
 ST = kernel.FOURBAR_STATUS
@@ -64,7 +66,8 @@ def grashof(p: float, q: float, r: float, s: float) -> Grashof:
     short, long_ = srt[0], srt[-1]
     lhs, rhs = short + long_, srt[1] + srt[2]
     tol = 1e-12 * rhs
-    cond = f"S + L = {short:g} + {long_:g} = {lhs:g} {'<' if lhs < rhs - tol else ('=' if abs(lhs - rhs) <= tol else '>')} P + Q = {rhs:g}"
+    rel = "<" if lhs < rhs - tol else ("=" if abs(lhs - rhs) <= tol else ">")
+    cond = f"S + L = {short:g} + {long_:g} = {lhs:g} {rel} P + Q = {rhs:g}"
     if lhs > rhs + tol:
         return Grashof("non-Grashof triple-rocker", cond, False)
     if abs(lhs - rhs) <= tol:

@@ -13,7 +13,8 @@ from driver.deck import Params
 from driver.fourbar import forces, kernel
 from driver.fourbar.spec import BAND, band_of
 
-__all__ = ['BATCH_KEYS', 'BATCH_IGNORED', 'BATCH_INDEPENDENT', 'BATCH_PASSES', 'PASS_BITS', 'DETAIL', 'param_matrix', 'summarise_batch', 'summary_rows', 'summary_frame', 'summarise', 'summary_of']
+__all__ = ['BATCH_KEYS', 'BATCH_IGNORED', 'BATCH_INDEPENDENT', 'BATCH_PASSES', 'PASS_BITS', 'DETAIL',
+           'param_matrix', 'summarise_batch', 'summary_rows', 'summary_frame', 'summarise', 'summary_of']
 
 
 #: deck keys a batch may vary (one value per design); every other key of &fourbar leaves the
@@ -110,7 +111,8 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     [rad/s], ``start_deg``/``stop_deg`` [deg], ``branch`` 'open'/'crossed' or +1/-1.
     Returns the columns of the single-case summary (``summarise``) with identical values
     (missing figures as NaN): grashof_class, full_crank_rotation, assemblable, mu_min_deg,
-    mu_max_deg, meets_transmission_band (mu within the base deck's ``transmission_band_deg``), rocker_turns_fully, rocker_swing_deg, toggle_in_range,
+    mu_max_deg, meets_transmission_band (mu within the base deck's ``transmission_band_deg``),
+    rocker_turns_fully, rocker_swing_deg, toggle_in_range,
     omega3_peak_rad_s, omega2_peak_rad_s, assembled_fraction, time_ratio (crank angle of the
     rocker's slower stroke over its quicker one, >= 1; missing unless the range holds a full
     turn, assembled throughout, without a toggle, with the rocker oscillating); with ``detail`` also the crank

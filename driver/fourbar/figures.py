@@ -124,8 +124,9 @@ def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.nd
     ``theta``, ``out`` (kernel rows), ``stroke`` (0 forward, 1 back), ``branch`` (+1 open, -1
     crossed) and ``point`` (coupler point positions or None): then the linkage is drawn rocking
     between its limit positions, out on one assembly branch and back on the other, each
-    motion (a separate assembly interval) on its own.  ``output`` names the output link.  Coordinates in the deck's length ``units``, crank pivot at the origin, ground along
-    +x; the legend sits beside the drawing.
+    motion (a separate assembly interval) on its own.  ``output`` names the output link.
+    Coordinates in the deck's length ``units``, crank pivot at the origin, ground along +x;
+    the legend sits beside the drawing.
     """
     if ax is None:
         fig, (ax,) = new_figure(1, 1, figsize=(8.6, 5.2))
@@ -248,17 +249,17 @@ def _rocking_drawing(ax, ground: float, motions: Sequence[dict], title: str, uni
     ax.set_xlabel(f"x [{units}]")
     ax.set_ylabel(f"y [{units}]")
     ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
-    first = word[int(np.asarray(motions[0]["branch"])[0])]
-    other = word[-int(np.asarray(motions[0]["branch"])[0])]
+    out_word = word[int(np.asarray(motions[0]["branch"])[0])]
+    back_word = word[-int(np.asarray(motions[0]["branch"])[0])]
     what = "the crank rocks between its limit positions"
     if n_m == 1:
         m = motions[0]
-        what += (f"\n$\\theta_2$ = {_deg(m['lo'])}° to {_deg(m['hi'])}°: out on the {first} assembly, "
-                 f"back on the {other}")
+        what += (f"\n$\\theta_2$ = {_deg(m['lo'])}° to {_deg(m['hi'])}°: out on the {out_word} assembly, "
+                 f"back on the {back_word}")
     else:
         spans = " and ".join(f"{_deg(m['lo'])}-{_deg(m['hi'])}°" for m in motions)
         what += (f"\n{n_m} separate motions (mirror assemblies, $\\theta_2$ = {spans}),"
-                 f"\neach out on the {first} assembly, back on the {other}")
+                 f"\neach out on the {out_word} assembly, back on the {back_word}")
     ax.set_title(f"{plain_text(title)}: {what}" if title else what)
 
 

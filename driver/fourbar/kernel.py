@@ -1,5 +1,6 @@
-"""The fourbar study's kernel wrappers: fourbar.f90 (closed-loop and listing kinematics, coupler point), fourbar_summary.f90 (the batch summary)
-and fourbar_forces.f90 (joint forces, Berkof-Lowen balancing, the force summary).
+"""The fourbar study's kernel wrappers: fourbar.f90 (closed-loop and listing kinematics, coupler
+point), fourbar_summary.f90 (the batch summary) and fourbar_forces.f90 (joint forces,
+Berkof-Lowen balancing, the force summary).
 
 Thin wrappers over the study's modules of the compiled extension (loaded once by
 :mod:`driver.kernels`): inputs are converted once to Fortran-ordered float64 (f2py would
@@ -12,7 +13,9 @@ import numpy as np
 
 from driver.kernels import _kernels, farray, spare_buffer
 
-__all__ = ['FOURBAR_PASSES', 'fourbar_listing', 'fourbar_exact', 'fourbar_coupler_point', 'fourbar_summaries', 'fourbar_joint_forces', 'fourbar_berkof_lowen', 'fourbar_force_summaries', 'FOURBAR_FORCE_SUMMARY_COLUMNS', 'FOURBAR_SUMMARY_COLUMNS', 'FOURBAR_GRASHOF', 'FOURBAR_STATUS']
+__all__ = ['FOURBAR_PASSES', 'fourbar_listing', 'fourbar_exact', 'fourbar_coupler_point', 'fourbar_summaries',
+           'fourbar_joint_forces', 'fourbar_berkof_lowen', 'fourbar_force_summaries',
+           'FOURBAR_FORCE_SUMMARY_COLUMNS', 'FOURBAR_SUMMARY_COLUMNS', 'FOURBAR_GRASHOF', 'FOURBAR_STATUS']
 
 
 #: status codes of the four-bar kernels (fortran/fourbar.f90)

@@ -77,7 +77,7 @@ def compare(params: Params, result: Result) -> list[dict]:
                         for c, v in zip(record.LISTING_COLUMNS, r)}
         else:
             computed = correct
-        for rec in pub.cells.itertuples():
+        for rec in record.printed_cells(pub.cells):
             key = (int(rec.row), rec.column)
             got = computed.get(key)
             wrong = correct.get(key) != rec.printed   # the published cell is not the correct answer

@@ -60,7 +60,8 @@ def listing_text(p: Params, table: np.ndarray, status: np.ndarray) -> tuple[list
             ""]
     # format 25: (2x,i3,2x,7(f5.1,2x),3x,2(f7.4,3x))
     cols = ([Column("i", "i", 3, 0, 2)] + [Column(h, "f", 5, 1, 2, "legacy") for h in ("epsl", "phi", "beta", "xa", "ya", "xb")]
-            + [Column("yb", "f", 5, 1, 2, "legacy"), Column("omr", "f", 7, 4, 5, "legacy"), Column("oms", "f", 7, 4, 3, "legacy")])
+            + [Column("yb", "f", 5, 1, 2, "legacy"), Column("omr", "f", 7, 4, 5, "legacy"),
+               Column("oms", "f", 7, 4, 3, "legacy")])
     rows, trailers = [], []
     for row, st in zip(table, status):
         if st == ST["no_assembly"]:

@@ -67,7 +67,8 @@ LABELS = {"crank": ("crank length", "length units"), "coupler": ("coupler length
           "rocker": ("rocker length", "length units"),
           "fixed_link": ("ground link length", "length units"), "omega": ("crank speed", ""),
           "mu_min_deg": ("minimum transmission angle", "deg"), "mu_max_deg": ("maximum transmission angle", "deg"),
-          "rocker_swing_deg": ("rocker swing", "deg"), "omega3_peak_rad_s": ("peak rocker speed (signed: the largest in size)", "rad/s"),
+          "rocker_swing_deg": ("rocker swing", "deg"),
+          "omega3_peak_rad_s": ("peak rocker speed (signed: the largest in size)", "rad/s"),
           "omega2_peak_rad_s": ("peak coupler speed (signed: the largest in size)", "rad/s"),
           "assembled_fraction": ("fraction of the turn assembled", "-"),
           "time_ratio": ("time ratio (slow / quick stroke)", "-"), **forces.LABELS}

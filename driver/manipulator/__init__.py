@@ -33,8 +33,16 @@ from __future__ import annotations
 from driver._study import BatchSummary, Study
 from driver.manipulator import kernel, published
 from driver.manipulator.analysis import DESIGN_STATUS, Workspace, optima, round_half_up, tolerance_box
-from driver.manipulator.batch import (BATCH_IGNORED, BATCH_INDEPENDENT, BATCH_KEYS, BATCH_PASS_SUFFIXES, BATCH_PASSES,
-                                      batch_refusal, summarise, summarise_batch)
+from driver.manipulator.batch import (
+    BATCH_IGNORED,
+    BATCH_INDEPENDENT,
+    BATCH_KEYS,
+    BATCH_PASS_SUFFIXES,
+    BATCH_PASSES,
+    batch_refusal,
+    summarise,
+    summarise_batch,
+)
 from driver.manipulator.report import TIDY_UNITS, run, table_frame
 from driver.manipulator.spec import LABELS, RENAMED, SPEC, SWEEP_BEST, SWEEP_PLOT, estimate
 from driver.manipulator.tables import NOT_REPRODUCIBLE, REASONS, TEXT_REASONS, TIDY_NAMES

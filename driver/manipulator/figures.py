@@ -113,7 +113,7 @@ def manipulator_torque_crob(l1: np.ndarray, tau1: np.ndarray, tau2: np.ndarray, 
             ax.plot(l1[bad], y[bad], "x", color="C3", ms=7, mew=1.5,
                     label="violates the workspace reach conditions" if k == 0 else None)
     ax.set_ylabel("motor torque [N m]")
-    ax.set_xlabel("l1 [m]  (l2 = sqrt(%g - l1^2) [m])" % c)
+    ax.set_xlabel(f"l1 [m]  (l2 = sqrt({c:g} - l1^2) [m])")
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     fig.suptitle(f"{plain_text(title)}: motor torques along C_rob" if title else "Motor torques along C_rob")
     return fig

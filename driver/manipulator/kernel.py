@@ -12,7 +12,9 @@ import numpy as np
 
 from driver.kernels import _kernels, farray
 
-__all__ = ['MANIPULATOR_PASSES', 'MANIPULATOR_STATUS', 'manipulator_arm_states', 'manipulator_torques', 'manipulator_ik', 'manipulator_design_indices', 'manipulator_position_errors', 'manipulator_design_summaries', 'MANIPULATOR_SUMMARY_PARAMS', 'MANIPULATOR_SUMMARY_COLUMNS']
+__all__ = ['MANIPULATOR_PASSES', 'MANIPULATOR_STATUS', 'manipulator_arm_states', 'manipulator_torques',
+           'manipulator_ik', 'manipulator_design_indices', 'manipulator_position_errors',
+           'manipulator_design_summaries', 'MANIPULATOR_SUMMARY_PARAMS', 'MANIPULATOR_SUMMARY_COLUMNS']
 
 
 #: status codes of the 2R manipulator kernels (fortran/manipulator.f90)

@@ -35,7 +35,7 @@ def compare(params: Params, result: Result) -> list[dict]:
         if not record.matches(pub.match, params):
             continue
         tidy, values = result.tidy, text_values()
-        for rec in pub.cells.itertuples():
+        for rec in record.printed_cells(pub.cells):
             table = str(rec.table)
             if table == "Text values":
                 value = values.get(str(rec.row))

@@ -243,7 +243,7 @@ def base_value(problem: Problem, v) -> float:
 
 @blas.one_thread()
 def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[str] | None = None,
-             plot: bool = False, jobs: int | None = None, resume: bool = False,
+             plot: bool | str = False, jobs: int | None = None, resume: bool = False,
              scheduler: Any = None) -> OptimizeOutcome:
     """Run an optimisation deck: a study group and an ``&optimize`` group.
 
@@ -322,14 +322,14 @@ def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[
     return outcome
 
 
-def _suffixes(formats: list[str], plot: bool) -> tuple[str, ...]:
+def _suffixes(formats: list[str], plot: bool | str) -> tuple[str, ...]:
     """What a run appends to the deck's stem, known before it runs (the optimum's figures are not)."""
     return (".out", ".optimum.dat", ".optimum.out", "_history.csv", "_evals.parquet", journal_file.SUFFIX,
             *(s for fmt in formats for s in (f"_evals.{fmt}", f"_history.{fmt}", f".optimum.{fmt}")),
             *(("_convergence.png",) if plot else ()))
 
 
-def _write(oc: OptimizeOutcome, stem: Path, params, formats: list[str], plot: bool, jobs: int) -> list[Path]:
+def _write(oc: OptimizeOutcome, stem: Path, params, formats: list[str], plot: bool | str, jobs: int) -> list[Path]:
     p, ev = oc.problem, oc.evaluator
     written: list[Path] = []
     files: list[str] = []
@@ -360,7 +360,7 @@ def _write(oc: OptimizeOutcome, stem: Path, params, formats: list[str], plot: bo
     return written
 
 
-def run_optimize_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool = False,
+def run_optimize_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, progress: bool = False,
                       jobs: int | None = None, resume: bool = False,
                       scheduler: Any = None, summary_json: bool = False, **_: Any) -> OptimizeOutcome:
     """Run an optimisation deck and write its outputs: the command line's entry.

@@ -68,7 +68,7 @@ def fits_figure(p: Params, r: dict[str, Any]):
     t = np.linspace(min(r["t22"].min(), r["t24_targets"].min()) - 1.0,
                     max(r["t22"].max(), r["t24_targets"].max()) + 1.0, 401)
     exact_sigma = np.sqrt((b[1] + 2 * b[2] * t) ** 2 * sx ** 2 + 2 * b[2] ** 2 * sx ** 4)
-    quad = lambda c: c[0] + c[1] * t + c[2] * t * t  # noqa: E731
+    quad = lambda c: c[0] + c[1] * t + c[2] * t * t
     means = {"known relation (2.1)": quad(b), "dual response fit (2.7)": quad(r["eq27"]),
              "Taguchi fit (2.11)": quad(r["eq211"])}
     spreads = {"tolerance analysis of (2.1), eq. (2.2)": exact_sigma,

@@ -33,12 +33,12 @@ NOT_REPRODUCIBLE = {
 def compare(params: Params, result: Result) -> list[dict]:
     """The run beside the printed results of section 2.3: one dict per printed value."""
     tidy = result.tidy
-    values = {(str(r.item), int(r.index)): float(r.value) for r in tidy.itertuples()}
+    values = {(str(i), int(k)): float(v) for i, k, v in zip(tidy["item"], tidy["index"], tidy["value"])}
     exact = params.mode == "exact"
     cells = []
     for path in record.records("robust_example"):
         pub = record.read_blocks(path)
-        for rec in pub.cells.itertuples():
+        for rec in record.printed_cells(pub.cells):
             item, index = str(rec.row).rstrip("]").split("[")
             key = (item, int(index))
             departs = MODE_REASONS.get(item, "follows from the unrounded fits") if exact else None

@@ -24,12 +24,24 @@ from driver.slidercrank import kernel, published
 from driver.slidercrank.analysis import Case, simeon_initial_state, static_onset
 from driver.slidercrank.report import animation_frames
 from driver.slidercrank.report_nl import run
-from driver.slidercrank.spec import (LABELS, MATERIALS, PAPER_SPEEDS, SIMEON1996, SPEC, STATUS_TEXT, SWEEP_PLOT, Model,
-                                     estimate, min_steps_per_rev, rayleigh)
+from driver.slidercrank.spec import (
+    LABELS,
+    MATERIALS,
+    PAPER_SPEEDS,
+    SIMEON1996,
+    SPEC,
+    STATUS_TEXT,
+    SWEEP_PLOT,
+    Model,
+    estimate,
+    min_steps_per_rev,
+    rayleigh,
+)
 
 __all__ = ["SPEC", "STUDY", "run", "estimate", "MATERIALS", "PAPER_SPEEDS", "SIMEON1996", "simeon_initial_state",
            "min_steps_per_rev", "rayleigh", "static_onset", "STATUS_TEXT", "Model", "Case", "LABELS", "SWEEP_PLOT",
            "kernel"]
 
 STUDY = Study(name="slidercrank", package=__name__, spec=SPEC, run=run, estimate=estimate, labels=LABELS,
-              sweep_plot=SWEEP_PLOT, published=published.compare, animation=animation_frames, figures=f"{__name__}.figures", kernel=kernel)
+              sweep_plot=SWEEP_PLOT, published=published.compare, animation=animation_frames, figures=f"{__name__}.figures",
+              kernel=kernel)

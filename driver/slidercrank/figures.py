@@ -205,7 +205,7 @@ def slidercrank_nl_shapes_figure(series: Sequence[tuple[str, tuple[float, float]
     largest crank-end compression (dotted), one colour per speed; true scale in mm (the axis
     is stretched, not the shape)."""
     fig, ax = _own_axes(ax, (7.4, 4.4))
-    for k, (label, (a1, a2), shapes) in enumerate(series):
+    for k, (label, (a1, _a2), shapes) in enumerate(series):   # the dotted line's angle is not labelled
         s = np.linspace(0.0, length, shapes.shape[0])
         ax.plot(s, shapes[:, 0] * 1e3, color=f"C{k % 10}", lw=1.2, label=f"{label}, theta2 = {a1:.0f} deg")
         ax.plot(s, shapes[:, 1] * 1e3, color=f"C{k % 10}", lw=0.8, ls=":")

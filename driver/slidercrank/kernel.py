@@ -14,7 +14,9 @@ import numpy as np
 
 from driver.kernels import _kernels, farray
 
-__all__ = ['SLIDERCRANK_STATUS', 'SLIDERCRANK_PROFILE', 'slidercrank_simulate', 'slidercrank_matrices', 'slidercrank_rigid', 'slidercrank_axial_force', 'slidercrank_frequencies', 'SLIDERCRANK_NL_STATUS', 'slidercrank_nl_simulate', 'slidercrank_column_static', 'slidercrank_corot_element']
+__all__ = ['SLIDERCRANK_STATUS', 'SLIDERCRANK_PROFILE', 'slidercrank_simulate', 'slidercrank_matrices',
+           'slidercrank_rigid', 'slidercrank_axial_force', 'slidercrank_frequencies', 'SLIDERCRANK_NL_STATUS',
+           'slidercrank_nl_simulate', 'slidercrank_column_static', 'slidercrank_corot_element']
 
 
 #: status codes of the slider-crank kernel (fortran/slidercrank.f90)

@@ -30,7 +30,7 @@ def compare(params: Params, result: Result) -> list[dict]:
                         printed_rows[sym] = float(line.split()[-3])
             ref = pub.cells[pub.cells["table"].str.startswith("Reference")]
             table = f"Simeon (1996) at t = {ref[ref['row'] == 't_s']['printed'].iloc[0]} s (within 0.5 %)"
-            for rec in ref[ref["row"] != "t_s"].itertuples():
+            for rec in record.printed_cells(ref[ref["row"] != "t_s"]):
                 sym = str(rec.row).split("_")[0]
                 value = printed_rows.get(sym)
                 if value is None:
@@ -51,7 +51,7 @@ def compare(params: Params, result: Result) -> list[dict]:
                 "slider_mass_kg": params.slider_mass,
                 "bearing_masses_kg": params.bearing_mass_crank + params.bearing_mass_slider,
                 "crank_radius_m": params.crank_radius}
-        for rec in pub.cells.itertuples():
+        for rec in record.printed_cells(pub.cells):
             if rec.table == "Table 1a" and rec.row != material:
                 continue
             key = rec.column if rec.table == "Table 1a" else str(rec.row)

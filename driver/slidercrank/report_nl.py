@@ -71,14 +71,15 @@ def _side_by_side(pairs: list[tuple[Case, NLCase]], tol: float, limit: float) ->
         row += [lin.euler_ratio, 100 * nl.growth if nl.ok else "-", 100 * nl.scatter if nl.ok else "-"]
         rows.append(row)
         trailers.append(verdict(nl, tol, limit))
-    return ["Table 5  Linear (the paper's KED model) and geometrically nonlinear rod, last revolution",
+    head = ["Table 5  Linear (the paper's KED model) and geometrically nonlinear rod, last revolution",
             "         omega [rad/s]; tens/comp = peak tensile/compressive axial strain, outer = peak outer-fibre",
             "         strain |eps| + c|kappa| (microstrain); lat = peak lateral deflection [mm] (linear: midpoint",
             "         from the chord; nonlinear: largest over the rod); N/P_E = peak rigid-body compression / Euler",
             "         load; growth% = mean growth per revolution of the per-revolution peak lateral deflection",
             f"         (Table 6; medians of the last revolutions against those before; GROWS above {100 * tol:g} %);",
             "         spread% = max/min - 1 of those peaks (irregular above "
-            f"{100 * IRREGULAR:g} %); BUCKLED = lateral deflection above {1e3 * limit:.1f} mm", ""] + render_table(cols, rows, trailers)
+            f"{100 * IRREGULAR:g} %); BUCKLED = lateral deflection above {1e3 * limit:.1f} mm", ""]
+    return head + render_table(cols, rows, trailers)
 
 
 def _per_revolution(cases: list[NLCase]) -> list[str]:

@@ -50,7 +50,6 @@ import numpy as np
 import pandas as pd
 
 from driver import expr
-from driver._study import load_study
 from driver.atomic import refuse_link, remove_stale_temporaries
 from driver.deck import Deck, Params, RawGroup, validate
 from driver.extras import require
@@ -62,7 +61,6 @@ from driver.sweep.engine import Task, auto_chunk, run_task
 from driver.sweep.keep import check_keep, keep_columns
 from driver.sweep.report import Warnings, summary_frame, summary_settings, sweep_text, write_sweep_files
 from driver.sweep.spec import (
-    FULL_VALIDATION,
     MAX_CASES,
     MAX_KEYS,
     SPEC,
@@ -95,7 +93,7 @@ def _base_hash(raw: RawGroup) -> str:
     return hashlib.sha256(f"{raw.name}:{text}".encode()).hexdigest()[:16]
 
 
-def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool = False,
+def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, progress: bool = False,
                    jobs: int | None = None, scheduler: Any = None, resume: bool = False,
                    notify: Callable[[str], None] | None = None) -> SweepOutcome:
     """Run a deck with a &sweep group and write its files; print nothing.
@@ -108,8 +106,8 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, pro
         Where to write.
     formats : list of str
         Tidy table formats of the case files: ``'csv'``, ``'parquet'``.
-    plot : bool
-        Write the sweep's figures.
+    plot : bool or str
+        Write the sweep's figures (``True`` or a figure format: ``'png'``, ``'svg'``, ``'pdf'``).
     progress : bool, default False
         Show a progress bar on stderr.
     jobs : int, optional
@@ -254,9 +252,10 @@ class _CasesTable:
         from driver.export import csv_bytes
         parts = [self.pieces[k] for k in written]
         first = parts[0][0].schema
-        if all(t.schema.equals(first, check_metadata=False) and body is not None for t, body in parts):
+        bodies = [body for _, body in parts if body is not None]
+        if len(bodies) == len(parts) and all(t.schema.equals(first, check_metadata=False) for t, _ in parts):
             table = pa.concat_tables([t for t, _ in parts])
-            return table, csv_bytes(table.slice(0, 0)) + b"".join(body for _, body in parts)
+            return table, csv_bytes(table.slice(0, 0)) + b"".join(bodies)
         return pd.concat([t.to_pandas() for t, _ in parts], ignore_index=True)
 
 
@@ -380,7 +379,8 @@ class _Run:
         oc.n_ok, oc.n_kept, oc.seconds, oc.chunk = n_ok, n_kept, elapsed, chunk
         self._failed([(r.index, r.values, r.error) for r in failed],
                      bad_input=any(r.status == ExitCode.BAD_INPUT for r in failed))
-        oc.written += [self.outdir / f"{self.stem}.out", *(self.outdir / f"{self.stem}_summary.{fmt}" for fmt in ("csv", "parquet"))]
+        oc.written += [self.outdir / f"{self.stem}.out",
+                       *(self.outdir / f"{self.stem}_summary.{fmt}" for fmt in ("csv", "parquet"))]
         return oc
 
     def _batch_streamed(self, rows: batch_path.StreamedRows, n: int, elapsed: float, chunk: int) -> bool:
@@ -396,7 +396,8 @@ class _Run:
             store.remove_stale_case_files(self.layout, np.zeros(n + 1, dtype=bool))
         oc.n_ok, oc.n_kept, oc.seconds, oc.chunk = n - res.n_failed, res.n_kept, elapsed, chunk
         self._failed(res.failed, n_failed=res.n_failed, bad_input=res.bad_input)
-        oc.written += [self.outdir / f"{self.stem}.out", *(self.outdir / f"{self.stem}_summary.{fmt}" for fmt in ("csv", "parquet"))]
+        oc.written += [self.outdir / f"{self.stem}.out",
+                       *(self.outdir / f"{self.stem}_summary.{fmt}" for fmt in ("csv", "parquet"))]
         return True
 
     def _settings(self) -> dict:
@@ -492,7 +493,8 @@ class _Run:
             cases = _CasesTable(self.layout).table(written)
             for r in results:
                 if r.status != ExitCode.OK:
-                    rows.loc[rows["case"] == r.index, ["status", "kept", "error"]] = ["failed", False, r.error]
+                    cells: list[str | bool | None] = ["failed", False, r.error]
+                    rows.loc[rows["case"] == r.index, ["status", "kept", "error"]] = cells
         bad = rows[rows["status"] != "ok"]
         failed = [(int(r["case"]), {k: r[k] for k in names}, r["error"]) for _, r in bad.iterrows()]
         text = sweep_text(self.deck, sw, self.base, self.axes, n, rows, int(rows["kept"].sum()), failed,
@@ -505,6 +507,7 @@ class _Run:
         oc.phases["finish_cpu"] = time.process_time() - c_run
         oc.n_ok, oc.n_kept, oc.seconds, oc.chunk = n - len(failed), int(rows["kept"].sum()), elapsed, chunk
         self._failed(failed, bad_input=bool((bad["status"] == "bad input").any()))
-        oc.written += [self.outdir / f"{self.stem}.out", *(self.outdir / f"{self.stem}_summary.{fmt}" for fmt in ("csv", "parquet"))]
+        oc.written += [self.outdir / f"{self.stem}.out",
+                       *(self.outdir / f"{self.stem}_summary.{fmt}" for fmt in ("csv", "parquet"))]
         return oc
 

@@ -171,9 +171,9 @@ def plan(module, raw: RawGroup, deck_path: str, grid: Grid, keep: str, rows: str
         if len(combos) > MAX_COMBOS:
             return None
         for combo in dict.fromkeys(combos):
-            vals = {grid.names[i]: grid.values[i][j] for i, j in zip(coupled, combo)}
+            combo_values = {grid.names[i]: grid.values[i][j] for i, j in zip(coupled, combo)}
             try:
-                validate(_swap(raw, vals), module.spec, deck_path)
+                validate(_swap(raw, combo_values), module.spec, deck_path)
             except DeckError as exc:
                 coupled_errors[combo] = str(exc)
     p = BatchPlan(deck_path, raw, grid, keep, rows, single, coupled, coupled_errors)
@@ -226,6 +226,8 @@ def chunk_rows(p: BatchPlan, start: int, stop: int, folder: str = "") -> ChunkRe
     the same values as a single summary of every column would give."""
     t0 = time.perf_counter()
     module = load_study(p.raw.name)
+    if module is None:   # a plan is only made for a registered study (plan() read its spec)
+        raise LookupError(f"no registered study &{p.raw.name}")
     n = stop - start
     cols = p.grid.columns(start, stop)
     idx = p.grid.indices(start, stop)
@@ -241,10 +243,10 @@ def chunk_rows(p: BatchPlan, start: int, stop: int, folder: str = "") -> ChunkRe
     if p.coupled_errors:
         keys = list(zip(*(idx[i] for i in p.coupled)))
         for k, key in enumerate(keys):
-            msg = p.coupled_errors.get(tuple(int(x) for x in key))
-            if msg and not bad[k]:
+            coupled_msg = p.coupled_errors.get(tuple(int(x) for x in key))
+            if coupled_msg and not bad[k]:
                 err = np.full(n, "", dtype=object) if err is None else err
-                err[k] = msg
+                err[k] = coupled_msg
                 bad[k] = True
     if err is None:
         err = np.full(n, "", dtype=object)
@@ -312,7 +314,7 @@ def _frame(start: int, stop: int, cols: dict[str, np.ndarray], bad: np.ndarray, 
 
 # ----------------------------------------------------------------------------- dataset (resume record)
 
-_PART = re.compile(r"^part-(\d{12})-([0-9a-f]{%d})\.parquet$" % DIGEST_CHARS)
+_PART = re.compile(rf"^part-(\d{{12}})-([0-9a-f]{{{DIGEST_CHARS}}})\.parquet$")
 
 
 def _part_name(start: int, digest: str) -> str:
@@ -341,7 +343,7 @@ def clean(folder: Path, signature: str, resume: bool, damaged: list[int] | None 
             with contextlib.suppress(Exception):
                 raw = pq.read_schema(f).metadata or {}
                 meta = json.loads(raw.get(b"sweep", b"{}"))
-        if meta and meta.get("signature") == signature and int(meta["start"]) == int(m.group(1)):
+        if m and meta and meta.get("signature") == signature and int(meta["start"]) == int(m.group(1)):
             if file_digest(f) == m.group(2):
                 done[int(meta["start"])] = {**meta, "path": str(f)}
                 continue
@@ -422,8 +424,8 @@ def execute(p: BatchPlan, todo: list[tuple[int, int]], jobs: int, scheduler: Any
                 on_result(chunk_rows(p, s, e, folder))
             return
     queue: Iterator[tuple[int, int]] = iter(todo)
-    run_pool(lambda: next(queue, None), lambda pool, rng: pool.submit(chunk_rows, p, *rng, folder),
-             lambda rng: _alone(p, *rng, folder), lambda rng, res, pending: on_result(res), jobs,
+    run_pool(lambda: next(queue, None), lambda pool, rng: pool.submit(chunk_rows, p, rng[0], rng[1], folder),
+             lambda rng: _alone(p, rng[0], rng[1], folder), lambda rng, res, pending: on_result(res), jobs,
              in_flight or 2 * jobs, "chunks", notify=notify)
 
 

@@ -154,7 +154,7 @@ def run_task(task: Task) -> list[CaseResult]:
         the files written and the case's wall and CPU time (s).
     """
     module = load_study(task.raw.name)
-    writable = lambda res, result, params: params is not None and (result is not None or res.status == ExitCode.OK)
+    writable = lambda res, result: result is not None or res.status == ExitCode.OK
     cases = list(iter_cases(task.grid, task.indices))
     if task.case_outputs == "all":
         # write each case as soon as it is computed: an interrupt loses at most one case
@@ -162,7 +162,7 @@ def run_task(task: Task) -> list[CaseResult]:
         for c in cases:
             res, result, params = _compute(task, c, module)
             res.kept = _kept_many(task.keep, [res])[0]
-            if writable(res, result, params):
+            if params is not None and writable(res, result):
                 _write_case(task, c, res, result, params, module)
             results.append(res)
         return results
@@ -172,7 +172,7 @@ def run_task(task: Task) -> list[CaseResult]:
         r.kept = k
     if task.case_outputs == "kept":
         for case, (res, result, params) in zip(cases, computed):
-            if res.kept and writable(res, result, params):
+            if res.kept and params is not None and writable(res, result):
                 _write_case(task, case, res, result, params, module)
     return results
 

@@ -18,8 +18,8 @@ from driver import limits
 from driver.deck import DeckError, GroupSpec, Key, Params, RawGroup, shown_value, validate
 from driver.outcome import ExitCode
 
-__all__ = ["SPEC", "Case", "CaseResult", "MAX_KEYS", "MAX_CASES", "FULL_VALIDATION", "build_cases", "grid_of", "case_at", "iter_cases",
-           "case_count", "validate_sweep"]
+__all__ = ["SPEC", "Case", "CaseResult", "MAX_KEYS", "MAX_CASES", "FULL_VALIDATION", "build_cases", "grid_of", "case_at",
+           "iter_cases", "case_count", "validate_sweep"]
 
 MAX_KEYS = 9
 #: most cases one per-case sweep deck may have (a batch sweep lists no case: driver.sweep.batch.MAX_CASES)
@@ -138,7 +138,7 @@ class CaseResult:
 
     index: int
     values: dict[str, Any]
-    status: int = ExitCode.OK
+    status: ExitCode = ExitCode.OK
     error: str = ""
     summary: dict[str, Any] = field(default_factory=dict)
     kept: bool = True

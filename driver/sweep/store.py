@@ -40,6 +40,7 @@ import numpy as np
 import driver
 from driver.atomic import DIGEST_CHARS, atomic_open, file_digest, own_folder, refuse_link, remove_stale_temporaries
 from driver.deck import RawGroup
+from driver.outcome import ExitCode
 from driver.sweep.spec import CaseResult, Grid, case_at
 
 __all__ = ["Layout", "layout_for", "Record", "signature", "case_signature", "json_default", "remove_stale_case_files",
@@ -52,7 +53,7 @@ SHARD = 1000
 
 _CASE_FILE = re.compile(r"^case_(\d+)[._]")
 _SHARD_DIR = re.compile(r"^(\d+)-(\d+)$")
-_PART = re.compile(r"^part-r(\d+)-(\d+)-([0-9a-f]{%d})\.parquet$" % DIGEST_CHARS)
+_PART = re.compile(rf"^part-r(\d+)-(\d+)-([0-9a-f]{{{DIGEST_CHARS}}})\.parquet$")
 
 
 def json_default(o: Any) -> Any:
@@ -211,7 +212,7 @@ class Record:
                     continue
                 m = _PART.match(f.name)
                 meta = self._meta(f) if (resume and m) else None
-                if meta and meta.get("signature") == self.signature:
+                if m and meta and meta.get("signature") == self.signature:
                     if file_digest(f) == m.group(3):
                         kept.append(((int(m.group(1)), int(m.group(2))), f))
                         continue
@@ -227,7 +228,7 @@ class Record:
         import pyarrow.parquet as pq
         try:
             return [int(c) for c in pq.read_table(path, columns=["case"]).column("case").to_pylist()]
-        except Exception:   # noqa: BLE001 - unreadable: its cases are found missing instead
+        except Exception:   # unreadable: its cases are found missing instead
             return []
 
     @staticmethod
@@ -337,7 +338,7 @@ class Record:
         """The newest row of every case (or of the cases ``wanted[case]``), as CaseResults,
         part by part (memory: one part at a time plus what the caller keeps)."""
         import pyarrow.parquet as pq
-        codes = {"ok": 0, "failed": 1, "bad input": 2}
+        codes = {"ok": ExitCode.OK, "failed": ExitCode.FAILED, "bad input": ExitCode.BAD_INPUT}
         for k, part in enumerate(self.parts):
             t = pq.read_table(part).to_pydict()
             for i, case in enumerate(t["case"]):

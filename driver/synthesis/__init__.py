@@ -583,7 +583,7 @@ def synthesis_record(syn: Synthesis) -> dict[str, Any]:
                       "linkage": syn.linkage, "checks": syn.checks})
 
 
-def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool, progress: bool = False,
+def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, progress: bool = False,
                        summary_json: bool = False, **_: Any) -> FilesOutcome:
     """Synthesise a linkage and write its files: the command line's entry.
 

@@ -28,14 +28,45 @@ from __future__ import annotations
 
 from driver._study import BatchSummary, Study
 from driver.ujoint import kernel, published
-from driver.ujoint.analysis import (BOUND_TOL, CLUSTER_TOL, PHASE_PERIOD, SADDLE_NUDGE, SYM_TOL, TIE_RTOL, Chain,
-                                    Design, StartRun, evaluate, objective_scale, optimise, phases_for, pick_best,
-                                    yoke_shifts)
-from driver.ujoint.batch import (BATCH_ELEMENTS, BATCH_IGNORED, BATCH_INDEPENDENT, BATCH_KEYS, BATCH_PASSES,
-                                 batch_applies, summarise_batch)
+from driver.ujoint.analysis import (
+    BOUND_TOL,
+    CLUSTER_TOL,
+    PHASE_PERIOD,
+    SADDLE_NUDGE,
+    SYM_TOL,
+    TIE_RTOL,
+    Chain,
+    Design,
+    StartRun,
+    evaluate,
+    objective_scale,
+    optimise,
+    phases_for,
+    pick_best,
+    yoke_shifts,
+)
+from driver.ujoint.batch import (
+    BATCH_ELEMENTS,
+    BATCH_IGNORED,
+    BATCH_INDEPENDENT,
+    BATCH_KEYS,
+    BATCH_PASSES,
+    batch_applies,
+    summarise_batch,
+)
 from driver.ujoint.report import run
-from driver.ujoint.spec import (BAND_TOL, CONVENTIONS, DEG, LABELS, NOT_REPRODUCIBLE, OPTIONS, SPEC, SWEEP_PLOT,
-                                cross_check, estimate)
+from driver.ujoint.spec import (
+    BAND_TOL,
+    CONVENTIONS,
+    DEG,
+    LABELS,
+    NOT_REPRODUCIBLE,
+    OPTIONS,
+    SPEC,
+    SWEEP_PLOT,
+    cross_check,
+    estimate,
+)
 
 __all__ = ["SPEC", "STUDY", "run", "estimate", "Chain", "Design", "StartRun", "evaluate", "optimise",
            "objective_scale", "pick_best", "yoke_shifts", "phases_for", "cross_check", "summarise_batch",

@@ -12,7 +12,8 @@ import numpy as np
 
 from driver.kernels import _kernels, farray
 
-__all__ = ['UJOINT_PASSES', 'UJOINT_MODELS', 'UJOINT_OBJECTIVES', 'ujoint_speed', 'ujoint_objective', 'ujoint_equivalent', 'ujoint_geometry', 'ujoint_summaries', 'UJOINT_SUMMARY_COLUMNS']
+__all__ = ['UJOINT_PASSES', 'UJOINT_MODELS', 'UJOINT_OBJECTIVES', 'ujoint_speed', 'ujoint_objective',
+           'ujoint_equivalent', 'ujoint_geometry', 'ujoint_summaries', 'UJOINT_SUMMARY_COLUMNS']
 
 
 #: model codes of fortran/ujoint.f90: the paper's eq. 13 as printed, the paper's text

@@ -21,7 +21,7 @@ def compare(params: Params, result: Result) -> list[dict]:
         trial = t[t["design"] == "trial"]
         printed_design = t[t["design"] == "paper printed"]
         option = pub.match.get("option", "?")
-        for rec in pub.cells.itertuples():
+        for rec in record.printed_cells(pub.cells):
             q, table = str(rec.row), f"SSO option {option}"
             if q.startswith("trial_band"):
                 value = float(trial["omega_out_rpm"].min() if q.endswith("min") else trial["omega_out_rpm"].max())

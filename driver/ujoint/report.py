@@ -127,8 +127,8 @@ def _render(params: Params, chain: Chain, beta, rho, designs: list[Design], runs
             Column("w_max rpm", "f", 10, 4), Column("beta_e", "f", 8, 4), Column("beta_res", "s", 9),
             Column("peak acc", "f", 11, 6)]
     ures = res * params.rpm ** 2 if res is not None and params.objective == "mean_square" else None
-    rows = [[d.label, _objective_text(d.objective, res), _objective_text(d.u_rpm2, ures), d.pp, d.w_min, d.w_max, d.beta_e, _fmt(d.beta_res),
-             d.peak_acc] for d in designs]
+    rows = [[d.label, _objective_text(d.objective, res), _objective_text(d.u_rpm2, ures), d.pp, d.w_min, d.w_max, d.beta_e,
+             _fmt(d.beta_res), d.peak_acc] for d in designs]
     out += render_table(cols, rows)
     out += ["   beta_e [deg]: first-order residual angle, beta_e^2 = |sum beta_k^2 exp(2i gamma_k)| "
             "(p-p ratio ~ beta_e^2 [rad^2])",

@@ -14,8 +14,8 @@ from __future__ import annotations
 from driver._study import BatchSummary, Study
 
 from . import kernel
-from .report import run, summarise
 from .batch import BATCH_KEYS, BATCH_PASSES, summarise_batch
+from .report import run, summarise
 from .spec import LABELS, SPEC, estimate
 
 __all__ = ["SPEC", "STUDY", "run", "estimate", "summarise", "summarise_batch"]
