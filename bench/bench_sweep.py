@@ -46,8 +46,8 @@ def design_columns(deck: Path) -> tuple[object, dict[str, np.ndarray]]:
     d = read_deck(deck)
     sw = validate(d.groups["sweep"], sweep.SPEC, d.path)
     base = validate(d.groups["fourbar"], fourbar.SPEC, d.path)
-    axes = sweep.swept_axes(sw, "fourbar", fourbar.SPEC)
-    from driver.sweep.spec import Grid
+    from driver.sweep.spec import Grid, swept_axes
+    axes = swept_axes(sw, "fourbar", fourbar.SPEC)
     g = Grid([a[0] for a in axes], [a[1] for a in axes], False)
     return base, {k.partition(".")[2]: v for k, v in g.columns(0, g.n).items()}
 

@@ -260,12 +260,18 @@ class SweepOutcome(Outcome):
 class CompareOutcome(Outcome):
     """A comparison of decks with the published record (:func:`driver.compare.compare_decks`).
 
-    comparisons  the decks compared, in order (:class:`~driver.compare.Comparison`: one row per
-                 published cell, ``ok`` when no reproducible cell differs)
-    totals       one line per study (and mode or method) over the decks compared, as the command
-                 line prints them under "Total"; empty when fewer than two decks were compared
-    bad_input    a deck had bad input (its error is in ``messages``)
-    failed       a run failed or the published tables are missing (the error is in ``messages``)
+    Attributes
+    ----------
+    comparisons : list of Comparison
+        The decks compared, in order (:class:`~driver.compare.Comparison`: one row per
+        published cell, ``ok`` when no reproducible cell differs).
+    totals : list of str
+        One line per study (and mode or method) over the decks compared, as the command line
+        prints them under "Total"; empty when fewer than two decks were compared.
+    bad_input : bool
+        A deck had bad input (its error is in ``messages``).
+    failed : bool
+        A run failed or the published tables are missing (the error is in ``messages``).
     """
 
     comparisons: list[Comparison] = field(default_factory=list)

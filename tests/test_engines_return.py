@@ -15,8 +15,8 @@ import subprocess
 from pathlib import Path
 
 import pytest
-from conftest import INPUTS, ROOT
 
+from conftest import INPUTS, ROOT
 from driver import compare, published
 from driver.cli import main
 from driver.outcome import CompareOutcome, ExitCode

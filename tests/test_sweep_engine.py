@@ -86,6 +86,7 @@ def test_interior_bad_combination_of_a_large_grid_is_a_failed_case(tmp_path):
     front; a bad combination inside the grid is found per chunk and reported as bad input."""
     from driver import fourbar, sweep
     from driver.deck import read_deck, validate
+    from driver.sweep.spec import swept_axes
     path = tmp_path / "inner.dat"
     path.write_text(BASE + "&sweep key1 = 'fourbar.start_deg', values1 = 0, 300, 0\n"
                            "       key2 = 'fourbar.stop_deg', values2 = 360, 200, 360\n"
@@ -93,7 +94,7 @@ def test_interior_bad_combination_of_a_large_grid_is_a_failed_case(tmp_path):
                            "       case_outputs = 'none' /\n")
     d = read_deck(path)
     sw = validate(d.groups["sweep"], sweep.SPEC, d.path)
-    axes = sweep.swept_axes(sw, "fourbar", fourbar.SPEC)
+    axes = swept_axes(sw, "fourbar", fourbar.SPEC)
     grid = sweep_batch.Grid([a[0] for a in axes], [a[1] for a in axes], False)
     p = sweep_batch.plan(fourbar.STUDY, d.groups["fourbar"], str(path), grid, "", "all")
     res = sweep_batch.chunk_rows(p, 0, grid.n)

@@ -70,7 +70,6 @@ from driver.sweep.spec import (
     case_count,
     configured_scheduler,
     grid_of,
-    swept_axes,
     validate_sweep,
 )
 
