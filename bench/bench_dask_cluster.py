@@ -82,7 +82,7 @@ def big_deck(tmp: Path, linkages: int) -> tuple[Path, int]:
 # the command line in a fresh process that reports its own peak memory (the driver's, not the workers')
 DRIVER = """
 import resource, sys
-from driver.cli import main
+from driver._cli import main
 rc = main(sys.argv[1:])
 me = resource.getrusage(resource.RUSAGE_SELF)
 print(f"maxrss_kib {me.ru_maxrss} cpu_s {me.ru_utime + me.ru_stime}", file=sys.stderr)

@@ -1,11 +1,11 @@
-"""CSV writer of the tidy exporter (driver.export) against pandas' to_csv and Arrow's own CSV
+"""CSV writer of the tidy exporter (driver._export) against pandas' to_csv and Arrow's own CSV
 writer, on a sweep-sized tidy table (200 000 rows x 15 columns: floats, whole-number floats,
 text, integers, logicals).
 
     .venv/bin/python bench/bench_export.py [--rows N]
 
 Arrow's writer is the fastest but writes the float 30.0 as '30' (read back as an integer) and
-quotes every string; driver.export builds round-trip-safe cells with Arrow compute (no Python
+quotes every string; driver._export builds round-trip-safe cells with Arrow compute (no Python
 per row).  Calls are interleaved and timed by process CPU time; medians and ratios are printed
 with the target: at least 2x faster than pandas.  Exit status 0 whether or not it is met.
 """
@@ -25,7 +25,7 @@ import pyarrow.csv as pacsv
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from driver.export import write_csv_arrow
+from driver._export import write_csv_arrow
 
 
 def frame(rows: int) -> pd.DataFrame:
@@ -54,7 +54,7 @@ def main() -> None:
     def pandas():
         df.to_csv(io.StringIO(), index=False, lineterminator="\n")
 
-    fns = {"driver.export": ours, "arrow write_csv": arrow, "pandas to_csv": pandas}
+    fns = {"driver._export": ours, "arrow write_csv": arrow, "pandas to_csv": pandas}
     times: dict[str, list[float]] = {k: [] for k in fns}
     for fn in fns.values():
         fn()   # warm-up
@@ -71,9 +71,9 @@ def main() -> None:
     print(f"CSV of {args.rows} x {df.shape[1]} (median CPU time of {args.repeat}, interleaved)")
     for name, t in med.items():
         print(f"  {name:<16} {t * 1e3:9.1f} ms   {args.rows / t / 1e6:6.2f} M rows/s")
-    ratio = med["pandas to_csv"] / med["driver.export"]
-    print(f"  driver.export vs pandas: {ratio:.1f}x faster (target >= 2x: {'met' if ratio >= 2 else 'NOT met'}); "
-          f"vs Arrow's writer (not round-trip safe): {med['driver.export'] / med['arrow write_csv']:.1f}x its time")
+    ratio = med["pandas to_csv"] / med["driver._export"]
+    print(f"  driver._export vs pandas: {ratio:.1f}x faster (target >= 2x: {'met' if ratio >= 2 else 'NOT met'}); "
+          f"vs Arrow's writer (not round-trip safe): {med['driver._export'] / med['arrow write_csv']:.1f}x its time")
 
 
 if __name__ == "__main__":

@@ -13,8 +13,8 @@ import os
 
 import numpy as np
 
-from driver.fourbar import kernel as fourbar_kernel
-from driver.kernels import release_spares
+from driver._fortran import release_spares
+from driver.fourbar import _kernel as fourbar_kernel
 from timing import median_time
 
 

@@ -16,7 +16,7 @@ import time
 
 import numpy as np
 
-from driver.fourbar import kernel as fourbar_kernel
+from driver.fourbar import _kernel as fourbar_kernel
 
 LINK = (0.30, 0.10, 0.35, 0.25, 20.0, 3.0)
 PROPS = np.array([0.5, 1.2, 0.9, 4e-4, 1.2e-2, 4.7e-3, 0.05, 0.175, 0.125, 0.1, 0.2, -0.3, 9.81, 5.0, 10.0, -20.0,

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from driver.manipulator import kernel as manipulator_kernel
+from driver.manipulator import _kernel as manipulator_kernel
 from timing import median_time as timeit
 
 DECK = Path(__file__).resolve().parents[1] / "inputs" / "optimize_manipulator_torque.dat"
@@ -60,7 +60,7 @@ def design_batch(n: int, n_case: int, repeat: int) -> tuple[float, float]:
     deck for n_case of them), medians of ``repeat`` interleaved rounds; the batch rows are
     checked against the runs first."""
     from driver import manipulator
-    from driver.deck import Params, read_deck, validate
+    from driver._deck import Params, read_deck, validate
     d = read_deck(DECK)
     base = validate(d.groups["manipulator"], manipulator.SPEC, d.path)
     rng = np.random.default_rng(3)

@@ -30,8 +30,8 @@ from pathlib import Path
 
 import pandas as pd
 
+from driver._deck import read_deck
 from driver._study import registered
-from driver.deck import read_deck
 from driver.optimize import optimize
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -84,7 +84,7 @@ class KernelClock:
 
 def grid_best(recompute: bool) -> float:
     if recompute:
-        from driver.cli import main
+        from driver._cli import main
         with tempfile.TemporaryDirectory() as d:
             main([str(ROOT / "inputs" / "fourbar_design_search.dat"), "-o", d, "-q"])
             frame = pd.read_csv(Path(d) / "fourbar_design_search_summary.csv")

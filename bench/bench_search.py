@@ -61,7 +61,7 @@ def deck_text(cranks: int, keep: str | None = None) -> str:
 
 def kernel_rates() -> dict[str, float]:
     """CPU seconds per linkage of the batch kernel over the shipped designs (median of 3)."""
-    from driver.fourbar import kernel as fourbar_kernel
+    from driver.fourbar import _kernel as fourbar_kernel
     c, k, r = np.meshgrid(np.linspace(1, 7, 25), np.linspace(6, 20, 64), np.linspace(4, 16, 64), indexing="ij")
     m = np.empty((c.size, 8), order="F")
     m[:, 0], m[:, 1], m[:, 2], m[:, 3], m[:, 4], m[:, 5], m[:, 6], m[:, 7] = 12, c.ravel(), k.ravel(), r.ravel(), 5, 0, 360, 1
@@ -85,7 +85,7 @@ import json, resource, sys, time
 from pathlib import Path
 from driver import sweep
 from driver.fourbar import kernel as fourbar_kernel
-from driver.deck import read_deck
+from driver._deck import read_deck
 if sys.argv[4] == "pool":    # the worker pool even for a small sweep (the measurement before the small-sweep rule)
     from driver.sweep import batch as sweep_batch
     sweep_batch.POOL_MIN_SECONDS = 0.0
@@ -125,7 +125,7 @@ def dask_estimate(tmp: Path, linkages: int) -> None:
     """The driver's CPU per phase on a loopback Dask cluster, and the 10^9 estimate."""
     sys.path.insert(0, str(ROOT / "bench"))
     import bench_dask_cluster as bdc
-    from driver.sweep import batch as sweep_batch
+    from driver.sweep import _batch as sweep_batch
     cranks = -(-linkages // PER_CRANK)
     n = cranks * PER_CRANK
     deck = tmp / "dask.dat"
@@ -134,7 +134,7 @@ def dask_estimate(tmp: Path, linkages: int) -> None:
     try:
         bdc.wait_workers(address, 2)
         code = ("import json, resource, sys, time\nfrom pathlib import Path\nfrom driver import sweep\n"
-                "from driver.deck import read_deck\nd = read_deck(Path(sys.argv[1]))\n"
+                "from driver._deck import read_deck\nd = read_deck(Path(sys.argv[1]))\n"
                 "t0, c0 = time.perf_counter(), time.process_time()\n"
                 "s = sweep.run_sweep_deck(d, Path(sys.argv[2]), [], False, False, scheduler=sys.argv[3])\n"
                 "print(json.dumps({'status': s.status, 'wall': time.perf_counter() - t0, 'cpu': time.process_time() - c0,"

@@ -22,7 +22,7 @@ import numpy as np
 from scipy.linalg import solveh_banded
 
 from driver.slidercrank import MATERIALS, rayleigh
-from driver.slidercrank import kernel as slidercrank_kernel
+from driver.slidercrank import _kernel as slidercrank_kernel
 from timing import median_time
 
 N_EL, SPR, OMEGA = 700, 1440, 29.32

@@ -25,7 +25,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from driver.slidercrank import MATERIALS, rayleigh
-from driver.slidercrank import kernel as slidercrank_kernel
+from driver.slidercrank import _kernel as slidercrank_kernel
 
 R2, LEN, M_S, OMEGA = 0.125, 0.505, 0.95, 29.32
 TARGET_RATIO = 25.0

@@ -36,7 +36,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from driver import fourbar, sweep  # noqa: E402
-from driver.deck import read_deck, validate  # noqa: E402
+from driver._deck import read_deck, validate  # noqa: E402
 
 DESIGN = ROOT / "inputs" / "fourbar_design_search.dat"
 
@@ -46,7 +46,7 @@ def design_columns(deck: Path) -> tuple[object, dict[str, np.ndarray]]:
     d = read_deck(deck)
     sw = validate(d.groups["sweep"], sweep.SPEC, d.path)
     base = validate(d.groups["fourbar"], fourbar.SPEC, d.path)
-    from driver.sweep.spec import Grid, swept_axes
+    from driver.sweep._spec import Grid, swept_axes
     axes = swept_axes(sw, "fourbar", fourbar.SPEC)
     g = Grid([a[0] for a in axes], [a[1] for a in axes], False)
     return base, {k.partition(".")[2]: v for k, v in g.columns(0, g.n).items()}
@@ -76,7 +76,7 @@ BIG = """
 import json, resource, sys, time
 from pathlib import Path
 from driver import sweep
-from driver.deck import read_deck
+from driver._deck import read_deck
 deck = read_deck(Path(sys.argv[1]))
 t0 = time.perf_counter()
 status = sweep.run_sweep_deck(deck, Path(sys.argv[2]), [], False, False, jobs=2).status
@@ -91,7 +91,7 @@ import json, resource, sys, time
 from pathlib import Path
 import pyarrow.parquet as pq
 from driver import sweep
-from driver.deck import read_deck
+from driver._deck import read_deck
 deck = read_deck(Path(sys.argv[1]))
 out, jobs = Path(sys.argv[2]), int(sys.argv[3])
 t0, c0 = time.perf_counter(), time.process_time()
@@ -178,7 +178,7 @@ def main() -> None:
               f"sweep / kernel CPU time {c1 / k:4.2f} (target <= 2)")
         print(f"  1 worker, wall time : {t1:7.2f} s  {n / t1:9.0f} linkages/s (best of 2)")
         print(f"  -j 2, wall time     : {t2:7.2f} s  {n / t2:9.0f} linkages/s (best of 2; a search this small runs "
-              "in the driver when the worker pool would not pay, see driver.sweep.batch.POOL_MIN_SECONDS)")
+              "in the driver when the worker pool would not pay, see driver.sweep._batch.POOL_MIN_SECONDS)")
         print(f"  targets: >= 100 000 linkages/s on 2 cores: wall {'met' if n / t2 >= 1e5 else 'NOT met'}, "
               f"from CPU time (2 idle cores) {'met' if 2 * n / c1 >= 1e5 else 'NOT met'}; "
               f"sweep within 2x of the kernel: {'met' if c1 <= 2 * k else 'NOT met'}")

@@ -28,9 +28,9 @@ from scipy.optimize import minimize
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from driver import ujoint
-from driver.deck import RawGroup, validate
+from driver._deck import RawGroup, validate
 from driver.ujoint import Chain, optimise
-from driver.ujoint.kernel import UJOINT_MODELS, UJOINT_OBJECTIVES, ujoint_objective
+from driver.ujoint._kernel import UJOINT_MODELS, UJOINT_OBJECTIVES, ujoint_objective
 
 D = math.pi / 180.0
 M = 360

@@ -35,13 +35,13 @@ import bench_manipulator
 import bench_slidercrank
 import bench_slidercrank_nl
 import bench_ujoint
-from driver import kernels
+from driver import _fortran as kernels
 from driver import ujoint as ujoint_study
-from driver.fourbar import kernel as fourbar_kernel
-from driver.manipulator import kernel as manipulator_kernel
+from driver.fourbar import _kernel as fourbar_kernel
+from driver.manipulator import _kernel as manipulator_kernel
 from driver.slidercrank import MATERIALS, rayleigh
-from driver.slidercrank import kernel as slidercrank_kernel
-from driver.ujoint import kernel as ujoint_kernel
+from driver.slidercrank import _kernel as slidercrank_kernel
+from driver.ujoint import _kernel as ujoint_kernel
 
 
 @dataclass

@@ -22,8 +22,8 @@ MARK = re.compile(r"(<!-- keys:(?P<group>[a-z_]+) begin -->\n)(?P<body>.*?)(<!--
 
 def spec_of(group: str):
     """The GroupSpec of a study or control group (sweep, optimize, synthesis)."""
+    from driver._runner import CONTROL_GROUPS
     from driver._study import load_study
-    from driver.runner import CONTROL_GROUPS
     if group in CONTROL_GROUPS:
         return importlib.import_module(f"driver.{group}").SPEC
     study = load_study(group)

@@ -1,6 +1,6 @@
 """``python -m driver DECK ...``"""
 import sys
 
-from driver.cli import main
+from driver._cli import main
 
 sys.exit(main())

@@ -8,8 +8,8 @@ from typing import Any, Literal, overload
 
 from numpy.typing import NDArray
 
-from driver.deck import Params
-from driver.study import Result
+from driver._deck import Params
+from driver._output import Result
 
 __all__ = ["fourbar", "manipulator", "robust_example", "slidercrank", "ujoint"]
 

@@ -1,8 +1,8 @@
 """Typed keyword signatures of the studies' ``run``, from each study's SPEC.
 
-A study's ``run`` takes validated :class:`~driver.deck.Params` (the runner's call) or the
-deck's keys as keyword arguments (:func:`driver.study.keyword_run`).  The keys are declared
-once, in the study's :class:`~driver.deck.GroupSpec`; this module turns that declaration into
+A study's ``run`` takes validated :class:`~driver._deck.Params` (the runner's call) or the
+deck's keys as keyword arguments (:func:`driver._output.keyword_run`).  The keys are declared
+once, in the study's :class:`~driver._deck.GroupSpec`; this module turns that declaration into
 
 - the run's runtime signature and numpydoc docstring (every key with its type, units,
   default or "required", and allowed values), so ``help(driver.fourbar.run)``, IDEs and
@@ -22,7 +22,7 @@ import textwrap
 from collections.abc import Callable, Sequence
 from typing import Any, TypeVar
 
-from driver.deck import GroupSpec, Key
+from driver._deck import GroupSpec, Key
 
 __all__ = ["NOT_GIVEN", "key_type", "unit_text", "run_docstring", "run_signature", "keyword_signature",
            "render_module"]
@@ -186,7 +186,7 @@ F = TypeVar("F", bound=Callable[..., Any])
 
 
 def keyword_signature(typed: F, spec: GroupSpec) -> Callable[[Callable[..., Any]], F]:
-    """Decorator for a study's ``run`` (outside :func:`driver.study.keyword_run`): type it as
+    """Decorator for a study's ``run`` (outside :func:`driver._output.keyword_run`): type it as
     ``typed``, its generated signature in ``driver/_keywords.py`` (for type checkers), and give it
     the signature and docstring of ``spec``'s keys at run time (for ``help()`` and IDEs)."""
     def apply(run: Callable[..., Any]) -> F:
@@ -209,8 +209,8 @@ def render_module(specs: Sequence[GroupSpec]) -> str:
            "",
            "from numpy.typing import NDArray",
            "",
-           "from driver.deck import Params",
-           "from driver.study import Result",
+           "from driver._deck import Params",
+           "from driver._output import Result",
            "",
            f"__all__ = [{', '.join(_py(s.name) for s in specs)}]"]
     for spec in specs:

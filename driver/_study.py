@@ -11,7 +11,7 @@ may use of it once, in a :class:`Study` bound to the name ``STUDY`` in its ``__i
 and is listed in :data:`REGISTRY`.  The engines reach a study only through its ``Study``
 (:func:`load_study`): they never probe a module for optional names.  What a study declares is
 checked when the package is imported (:meth:`Study.__post_init__`): a study without an
-``estimate`` cannot register (the absurd-request budget of :mod:`driver.limits` applies to every
+``estimate`` cannot register (the absurd-request budget of :mod:`driver._limits` applies to every
 study), a misspelt batch key or a pass table naming an unknown pass raises at import.
 
 Adding a study: the package (spec, analysis, report, figures, published, kernel; batch when it
@@ -27,12 +27,12 @@ from dataclasses import dataclass, field
 from types import MappingProxyType, ModuleType
 from typing import TYPE_CHECKING, Any
 
-from driver.groupspec import GroupSpec
+from driver._groupspec import GroupSpec
 
 if TYPE_CHECKING:
-    from driver.groupspec import Params
-    from driver.limits import Estimate
-    from driver.result import Result
+    from driver._groupspec import Params
+    from driver._limits import Estimate
+    from driver._result import Result
 
 __all__ = ["Study", "BatchSummary", "REGISTRY", "load_study", "study_names", "registered"]
 
@@ -138,9 +138,9 @@ class Study:
 
     name         namelist group (``&name`` in a deck); the key of :data:`REGISTRY`
     package      the study's package (``__name__``): its code digest signs resume records
-    spec         the deck keys (:class:`driver.deck.GroupSpec`, ``spec.name == name``)
+    spec         the deck keys (:class:`driver._deck.GroupSpec`, ``spec.name == name``)
     run          ``run(params, progress=False) -> Result``: the physics of one deck
-    estimate     ``estimate(params) -> driver.limits.Estimate``: memory [bytes] and work [s] of a
+    estimate     ``estimate(params) -> driver._limits.Estimate``: memory [bytes] and work [s] of a
                  run from the keys alone, for the absurd-request budget
 
     Optional:
@@ -158,11 +158,11 @@ class Study:
     blame        ``blame(params, exc) -> (key, message) | None``: the key a numerical failure
                  is due to
     published    ``published(params, result) -> list[dict]``: the run compared cell by cell
-                 with the published tables (:mod:`driver.compare`), or None
+                 with the published tables (:mod:`driver._compare`), or None
     animation    ``animation(params, result, n) -> dict | None``: the mechanism's positions at ``n``
                  crank angles over one turn for the report page's animation (crank pin ``A``,
                  driven pin ``B``, coupler point ``P``, ``ground``, ``kind`` 'rocker' or 'slider',
-                 ``box_points``; :func:`driver.report_page.mechanism_animation`), or None
+                 ``box_points``; :func:`driver._report_page.mechanism_animation`), or None
     figures      the dotted name of the study's figure module (drawn in the house style of
                  :mod:`driver.plotting`; imported only when a figure is drawn, matplotlib being
                  the optional [plot] extra), or None
@@ -191,7 +191,7 @@ class Study:
         if not (isinstance(self.name, str) and re.fullmatch(r"[a-z][a-z0-9_]*", self.name)):
             raise ValueError(f"Study.name {self.name!r} is not a namelist group name")
         if not isinstance(self.spec, GroupSpec):
-            raise TypeError(f"{self.name}: Study.spec must be a driver.deck.GroupSpec")
+            raise TypeError(f"{self.name}: Study.spec must be a driver._deck.GroupSpec")
         if self.spec.name != self.name:
             raise ValueError(f"{self.name}: Study.spec declares group &{self.spec.name}")
         for attr in ("run", "estimate"):

@@ -8,7 +8,7 @@ Every builder returns a :class:`matplotlib.figure.Figure` drawn inside
 as PNG, SVG or PDF, byte for byte the same for the same inputs.  Nothing here selects a
 backend or changes the global ``rcParams``: importing this module or drawing a figure leaves a user's own matplotlib
 settings (e.g. Jupyter's inline backend) exactly as they were.  Studies wrap
-builders in :class:`driver.study.Figure` so nothing is drawn unless asked.
+builders in :class:`driver._output.Figure` so nothing is drawn unless asked.
 """
 from __future__ import annotations
 
@@ -23,9 +23,9 @@ from typing import Any, TypeVar
 
 import numpy as np
 
-from driver.atomic import atomic_open
-from driver.extras import require
-from driver.study import PLOT_FORMATS, plot_format
+from driver._atomic import atomic_open
+from driver._extras import require
+from driver._output import PLOT_FORMATS, plot_format
 
 require("plot")   # a clear message naming the [plot] extra when matplotlib is missing; then import it:
 import matplotlib  # noqa: E402 (after require above)
@@ -116,7 +116,7 @@ def save_figure(fig: Figure, path: str | Path, fmt: bool | str | None = None) ->
     """Write ``fig`` to ``path`` atomically and reproducibly (no dates or versions inside), in the
     house style's resolution.
 
-    ``fmt`` is a format of :data:`driver.study.PLOT_FORMATS` (``True`` or None: PNG, or the
+    ``fmt`` is a format of :data:`driver._output.PLOT_FORMATS` (``True`` or None: PNG, or the
     format of ``path``'s suffix when that is one); ``path``'s suffix is replaced by it.
     Returns the path written.
     """
@@ -178,7 +178,7 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
                   labels: dict[str, str] | None = None, preferred: Sequence[str] = ()) -> Figure:
     """Summary of a sweep: chosen (or the study's headline) figures against a swept key.
 
-    ``labels`` maps column names to axis labels with units (driver.study.column_label);
+    ``labels`` maps column names to axis labels with units (driver._output.column_label);
     ``preferred`` are the study's headline columns, plotted when ``ys`` is empty.  Panels
     chosen automatically never repeat x, a constant or another panel.  With one numeric x
     the figures are drawn as lines over the cases, one line per value of the other keys;

@@ -255,8 +255,8 @@ _BAD = re.compile(r"(?<![A-Za-z_])(nan|[+-]?inf)(?![A-Za-z_])|\*\*\*\*", re.IGNO
 
 def campaign(count: int, seed: int, max_work: str, workdir: Path) -> dict:
     from driver import sweep, synthesis
-    from driver.cli import main
-    from driver.runner import available_studies
+    from driver._cli import main
+    from driver._runner import available_studies
 
     specs = {name: m.spec for name, m in available_studies().items()}
     specs["sweep"] = sweep.SPEC
@@ -295,7 +295,7 @@ def campaign(count: int, seed: int, max_work: str, workdir: Path) -> dict:
         try:
             with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
                 if name.startswith("read_only_"):
-                    from driver.deck import DeckError, read_deck
+                    from driver._deck import DeckError, read_deck
                     try:
                         read_deck(deck)
                         rc = 0
@@ -350,7 +350,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.memory:
         import resource
 
-        from driver.limits import parse_size
+        from driver._limits import parse_size
         size = int(parse_size(args.memory))
         resource.setrlimit(resource.RLIMIT_AS, (size, size))
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")

@@ -11,10 +11,10 @@ import json
 
 import numpy as np
 
-from driver.fourbar import kernel as fourbar_kernel
-from driver.manipulator import kernel as manipulator_kernel
-from driver.slidercrank import kernel as slidercrank_kernel
-from driver.ujoint import kernel as ujoint_kernel
+from driver.fourbar import _kernel as fourbar_kernel
+from driver.manipulator import _kernel as manipulator_kernel
+from driver.slidercrank import _kernel as slidercrank_kernel
+from driver.ujoint import _kernel as ujoint_kernel
 
 
 def _h(*arrays) -> str:
@@ -25,7 +25,7 @@ def _h(*arrays) -> str:
 
 
 def fingerprint() -> dict[str, str]:
-    """One hash per kernel wrapper of driver.kernels (every one: test_packaging checks it), inputs chosen
+    """One hash per kernel wrapper of driver._fortran (every one: test_packaging checks it), inputs chosen
     to exercise every code path (vector loops included)."""
     rng = np.random.default_rng(20261125)
     theta = np.concatenate([np.linspace(0, 2 * np.pi, 2001), rng.uniform(-50, 50, 4003)])
@@ -66,7 +66,7 @@ def fingerprint() -> dict[str, str]:
 
 
 def _batch_and_auxiliary_kernels(rng: np.random.Generator, theta: np.ndarray) -> dict[str, str]:
-    """The batch-summary, force, geometry and closed-form kernels (every other wrapper of driver.kernels)."""
+    """The batch-summary, force, geometry and closed-form kernels (every other wrapper of driver._fortran)."""
     out = {}
     nd = 2000
     links = rng.uniform(2.0, 15.0, (nd, 4))

@@ -1,5 +1,5 @@
 """Absurd requests are refused promptly (exit 2, the key named, nothing written), before any
-allocation: the budget of driver.limits, repeat counts and list lengths before expansion, sweep
+allocation: the budget of driver._limits, repeat counts and list lengths before expansion, sweep
 case counts; numerical failures reached from bad input are deck errors in words."""
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import tracemalloc
 import pytest
 
 from conftest import INPUTS
-from driver import limits
-from driver.cli import main
+from driver import _limits as limits
+from driver._cli import main
 
 
 def _deck(tmp_path, base: str, edits: list[tuple[str, str]], add: str = "") -> str:
@@ -112,8 +112,8 @@ def test_sizes_and_durations_parse():
 @pytest.mark.parametrize("deck", sorted(p.name for p in INPUTS.glob("*.dat")))
 def test_every_shipped_deck_is_within_the_default_budget(deck):
     """The estimates refuse nothing the tool ships (a sweep: its base deck)."""
-    from driver.deck import read_deck
-    from driver.runner import study_of
+    from driver._deck import read_deck
+    from driver._runner import study_of
     d = read_deck(INPUTS / deck)
     groups = {n: g for n, g in d.groups.items() if n not in ("sweep", "optimize", "synthesis")}
     if not groups:

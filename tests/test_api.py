@@ -15,8 +15,8 @@ import pytest
 
 import driver
 from conftest import INPUTS, ROOT
-from driver import cli
-from driver.deck import read_deck
+from driver import _cli as cli
+from driver._deck import read_deck
 
 CRANK5 = dict(fixed_link=12.0, crank=5.0, coupler=15.0, rocker=9.0, omega=5.0, step_deg=20)
 

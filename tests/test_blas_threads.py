@@ -1,4 +1,4 @@
-"""Results do not depend on the number of BLAS threads (driver/blas.py).
+"""Results do not depend on the number of BLAS threads (driver/_blas.py).
 
 scipy's SLSQP calls LAPACK; before the tool limited BLAS to one thread while it computes,
 ``OPENBLAS_NUM_THREADS=1`` and ``=2`` gave optima differing in the ninth digit
@@ -25,7 +25,7 @@ def _blas_threads() -> set[int]:
 def test_one_thread_is_a_scope():
     import scipy.linalg  # noqa: F401  (scipy's own OpenBLAS loaded)
 
-    from driver import blas
+    from driver import _blas as blas
     with threadpoolctl.threadpool_limits(limits=2, user_api="blas"):
         before = _blas_threads()
         with blas.one_thread():

@@ -73,9 +73,9 @@ def test_sweep_options_on_a_plain_deck_are_reported(tmp_path):
 
 
 def test_help_and_version_import_no_study(tmp_path):
-    code = ("import sys\nfrom driver.cli import main\n"
+    code = ("import sys\nfrom driver._cli import main\n"
             "try:\n    main(['--help'])\nexcept SystemExit:\n    pass\n"
-            "heavy = [m for m in ('pandas', 'scipy', 'driver.kernels', 'driver.fourbar', 'matplotlib') if m in sys.modules]\n"
+            "heavy = [m for m in ('pandas', 'scipy', 'driver._fortran', 'driver.fourbar', 'matplotlib') if m in sys.modules]\n"
             "print('HEAVY', heavy)")
     res = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True)
     assert "HEAVY []" in res.stdout, res.stdout[-300:] + res.stderr

@@ -1,4 +1,4 @@
-"""The published record (published/) and the comparison (driver.compare, ``--compare``).
+"""The published record (published/) and the comparison (driver._compare, ``--compare``).
 
 Expected values are the printed tables in published/ and independent facts about them (the
 paper's quadrant defect affects exactly the crank angles in (180, 360); the closed loop at
@@ -12,8 +12,9 @@ import shutil
 import pytest
 
 from conftest import INPUTS, ROOT
-from driver import compare, published
-from driver.cli import main
+from driver import _compare as compare
+from driver import _published as published
+from driver._cli import main
 
 CRANKS = (2, 3, 4, 5)
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 import pytest
 
 from conftest import GOOD_DECK as GOOD
-from driver.cli import main
+from driver._cli import main
 
 
 @pytest.mark.parametrize("change,line,key,words", [

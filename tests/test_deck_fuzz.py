@@ -9,7 +9,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from conftest import INPUTS
-from driver.cli import main
+from driver._cli import main
 
 DECKS = ["crank5.dat", "crank5_exact.dat", "nongrashof.dat", "crank5_terminal.dat",
          "manipulator_case1_exact.dat", "manipulator_case2_report.dat", "robust_example.dat",

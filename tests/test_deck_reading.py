@@ -8,8 +8,8 @@ import warnings
 import pytest
 
 from conftest import GOOD_DECK as GOOD
-from driver.cli import main
-from driver.deck import MAX_DECK_BYTES, MAX_VALUES, DeckError, read_deck
+from driver._cli import main
+from driver._deck import MAX_DECK_BYTES, MAX_VALUES, DeckError, read_deck
 
 
 def _raw(text, tmp_path, name="d.dat", mode="w"):

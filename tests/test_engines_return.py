@@ -1,8 +1,8 @@
 """Engines return, only the command line prints (issue 25).
 
-- No module of the driver other than the command line (driver/cli.py, driver/__main__.py) prints
+- No module of the driver other than the command line (driver/_cli.py, driver/__main__.py) prints
   or writes to sys.stdout/sys.stderr: an ast walk, with a self-check that it finds each form.
-- The comparison (driver.compare.compare_decks) returns a CompareOutcome; its fields are checked
+- The comparison (driver._compare.compare_decks) returns a CompareOutcome; its fields are checked
   against the published cells (crank2..5: 190 cells each, all identical, as printed in
   published/; crank5_exact: 50 cells depart, 48 of them the listing's quadrant defect).
 - A sweep's Ctrl-C notice reaches the callback the caller supplies, at once (while a running task
@@ -17,9 +17,10 @@ from pathlib import Path
 import pytest
 
 from conftest import INPUTS, ROOT
-from driver import compare, published
-from driver.cli import main
-from driver.outcome import CompareOutcome, ExitCode
+from driver import _compare as compare
+from driver import _published as published
+from driver._cli import main
+from driver._outcome import CompareOutcome, ExitCode
 
 DRIVER = ROOT / "driver"
 #: the command line prints (that is its job); nothing else may
@@ -67,7 +68,7 @@ def test_only_the_command_line_prints():
         if rel in PRINTERS or rel in ALLOWED:
             continue
         found += [f"driver/{rel}:{line}: {what}" for line, what in printing_sites(path.read_text())]
-    assert found == [], "engines return outcomes; only driver/cli.py prints:\n" + "\n".join(found)
+    assert found == [], "engines return outcomes; only driver/_cli.py prints:\n" + "\n".join(found)
     # the allow-list names real modules, each with a reason
     for rel, reason in {**PRINTERS, **ALLOWED}.items():
         assert (DRIVER / rel).is_file() and reason
@@ -151,7 +152,7 @@ def test_cli_prints_the_outcome_stdout_and_stderr_apart(write_deck, capsys):
 def test_interrupt_notice_reaches_the_callback_before_the_running_task_finishes(tmp_path, capsys):
     """run_pool: Ctrl-C while one task still runs (a 3 s shell sleep, then a marker file): the
     callback hears the notice before that task ends; run_pool waits for it, then re-raises."""
-    from driver.sweep.pool import run_pool
+    from driver.sweep._pool import run_pool
     marker = tmp_path / "done"
     queue = iter(["slow", "quick"])
     heard: list[tuple[str, bool]] = []
@@ -186,7 +187,7 @@ SWEEP = """&fourbar
 def interrupted_sweep(tmp_path, monkeypatch):
     """A 15-case per-case sweep whose 6th case raises KeyboardInterrupt in its worker (the workers
     are forked after the patch); the driver gets it from the case's future."""
-    from driver.sweep import engine
+    from driver.sweep import _engine as engine
     real = engine._compute
 
     def compute(task, case, module):
@@ -210,8 +211,8 @@ def test_cli_prints_the_interrupt_notice_then_exits_130(interrupted_sweep, tmp_p
 
 
 def test_the_engine_is_silent_without_a_callback_and_tells_one(interrupted_sweep, tmp_path, capsys):
-    from driver.deck import read_deck
-    from driver.dispatch import run_deck
+    from driver._deck import read_deck
+    from driver._dispatch import run_deck
     deck = read_deck(interrupted_sweep)
     with pytest.raises(KeyboardInterrupt):
         run_deck(deck, tmp_path / "a", [], False, jobs=2)

@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from driver.expr import ExprError, parse
+from driver._expr import ExprError, parse
 
 FRAME = pd.DataFrame({
     "fourbar.crank": [2.0, 3.0, 4.0, 5.0],

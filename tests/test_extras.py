@@ -16,7 +16,7 @@ class Block(importlib.abc.MetaPathFinder):
         if name.split('.')[0] in {blocked!r}:
             raise ModuleNotFoundError(f"No module named {{name!r}}", name=name)
 sys.meta_path.insert(0, Block())
-from driver.cli import main
+from driver._cli import main
 sys.exit(main({args!r}))
 """
 

@@ -44,7 +44,7 @@ def _fourbar(deck: str, name: str):
 
 def _design_map(keys: int):
     from driver import plotting
-    from driver.study import column_label
+    from driver._output import column_label
     grid = {"crank": np.linspace(2.0, 5.0, 7), "coupler": np.linspace(10.0, 16.0, 7),
             "rocker": np.linspace(7.0, 11.0, 4)}
     grid = dict(list(grid.items())[:keys])
@@ -65,7 +65,7 @@ def _convergence():
     from driver import plotting
     history = pd.read_csv(ROOT / "outputs" / "optimize_manipulator_torque_history.csv")
     evals = pd.read_parquet(ROOT / "outputs" / "optimize_manipulator_torque_evals.parquet")
-    from driver.study import expression_label  # the label the optimiser gives it (mathtext symbols)
+    from driver._output import expression_label  # the label the optimiser gives it (mathtext symbols)
     return plotting.convergence_plot(history, evals, expression_label(driver.manipulator.STUDY, "design_torque_demand_Nm"),
                                      "minimize", title="convergence")
 
@@ -73,7 +73,7 @@ def _convergence():
 def _manipulator_search():
     """The shipped manipulator design search's map (its labels carry mathtext symbols)."""
     from driver import plotting
-    from driver.study import column_label
+    from driver._output import column_label
     frame = pd.read_parquet(ROOT / "outputs" / "manipulator_design_search_summary.parquet")
     labels = {c: column_label(driver.manipulator.STUDY, c) for c in frame.columns}
     return plotting.sweep_maps(frame, ["manipulator.designs_l1", "manipulator.designs_l2"],

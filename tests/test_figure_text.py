@@ -46,7 +46,7 @@ def test_an_expression_label_is_drawn_literally():
     import pandas as pd
 
     from driver import plotting
-    from driver.study import column_label, expression_label
+    from driver._output import column_label, expression_label
     expr = 'mu_min_deg + 0*("$" == "$")'
     frame = pd.DataFrame({"case": [1, 2, 3], "fourbar.crank": [2.0, 3.0, 4.0], "kept": [True] * 3,
                           expr: [40.0, 33.0, 26.0]})
@@ -110,7 +110,7 @@ def test_simeon_benchmark_draws_its_history():
 def test_report_page_text_of_a_label():
     """The report page writes figure labels as text: mathtext symbols as Unicode, a deck's
     escaped dollar as a dollar."""
-    from driver.report_page import plain
+    from driver._report_page import plain
     assert plain(r"phase angle $\varphi_{12}$ [deg]") == "phase angle φ₁₂ [deg]"
     assert plain(r"crank angle $\theta_2$ [deg]") == "crank angle θ₂ [deg]"
     assert plain(r"cost \$x\$ per part") == "cost $x$ per part"
@@ -122,9 +122,9 @@ def test_figure_functions_draw_into_a_users_axes():
     from matplotlib.figure import Figure
 
     from driver import plotting
-    from driver.fourbar import figures as fourbar_figures
-    from driver.slidercrank import figures as slidercrank_figures
-    from driver.ujoint import figures as ujoint_figures
+    from driver.fourbar import _figures as fourbar_figures
+    from driver.slidercrank import _figures as slidercrank_figures
+    from driver.ujoint import _figures as ujoint_figures
     fig = Figure(layout="constrained")
     a, b = fig.subplots(1, 2)
     theta = np.linspace(0.0, 360.0, 73)
@@ -138,7 +138,7 @@ def test_figure_functions_draw_into_a_users_axes():
     fig3 = Figure()
     axes3 = fig3.subplots(3, 1)
     r = driver.fourbar.run(fixed_link=12.0, crank=5.0, coupler=15.0, rocker=9.0, step_deg=20)
-    from driver.fourbar.analysis import exact_columns, exact_grid, tidy_frame
+    from driver.fourbar._analysis import exact_columns, exact_grid, tidy_frame
     out, st = exact_grid(r.params, theta)
     assert fourbar_figures.fourbar_curves(tidy_frame("exact", theta, exact_columns(out, st), st), None, "",
                                    axes=axes3) is fig3
@@ -152,7 +152,7 @@ def test_manipulator_labels_set_their_symbols_in_mathtext():
 
     from conftest import ROOT
     from driver import plotting
-    from driver.study import column_label
+    from driver._output import column_label
     m = driver.manipulator.STUDY
     want = {"design_tau_sum_signed_Nm": r"$\tau_1 + \tau_2$", "design_torque_demand_Nm": r"$|\tau_1| + |\tau_2|$",
             "design_peak_torque_Nm": r"$\max(|\tau_1|, |\tau_2|)$", "sweep_min_tau_sum_signed_Nm": r"$\tau_1 + \tau_2$",
@@ -182,8 +182,8 @@ def test_manipulator_labels_set_their_symbols_in_mathtext():
 
 
 def test_report_page_writes_manipulator_symbols_as_unicode():
-    from driver.report_page import plain
-    from driver.study import column_label
+    from driver._output import column_label
+    from driver._report_page import plain
     m = driver.manipulator.STUDY
     assert plain(column_label(m, "design_torque_demand_Nm")) == \
         "design torque demand |\u03c4\u2081| + |\u03c4\u2082| at the target [N m]"
@@ -196,7 +196,7 @@ def test_a_wrapped_label_keeps_each_mathtext_span_on_one_line():
     """Long labels are wrapped onto lines; each line is parsed on its own, so a span
     ($|\\tau_1| + |\\tau_2|$) cut in two would be drawn as raw source."""
     from driver import plotting
-    label = driver.study.column_label(driver.manipulator.STUDY, "design_torque_demand_Nm")
+    label = driver._output.column_label(driver.manipulator.STUDY, "design_torque_demand_Nm")
     for width in (10, 20, 30, 40):
         lines = plotting.wrap(label, width).split("\n")
         assert len(lines) > 1

@@ -18,12 +18,12 @@ from matplotlib.figure import Figure as MplFigure
 
 from conftest import INPUTS
 from driver import plotting
+from driver._deck import read_deck
+from driver._output import column_label, plot_format
+from driver._runner import compute, study_of
 from driver._study import load_study
-from driver.deck import read_deck
-from driver.fourbar import figures as fourbar_figures
-from driver.runner import compute, study_of
-from driver.study import column_label, plot_format
-from driver.ujoint import figures as ujoint_figures
+from driver.fourbar import _figures as fourbar_figures
+from driver.ujoint import _figures as ujoint_figures
 
 
 @cache
@@ -338,7 +338,7 @@ def test_optimisation_convergence_figure_names_its_objective_with_units(tmp_path
     oc = optimize(deck, tmp_path / "out", plot="svg", jobs=1)
     svg = [p for p in oc.written if p.suffix == ".svg"]
     assert [p.name for p in svg] == ["opt.optimum_curves.svg", "opt.optimum_linkage.svg", "opt_convergence.svg"]
-    from driver.optimize import report
+    from driver.optimize import _report as report
     fig = report.convergence_figure(oc.problem, report.history_frame(oc.problem, oc.history),
                                     oc.evaluator.frame(), "opt")
     assert fig.axes[0].get_ylabel() == "rocker swing [deg]"

@@ -12,9 +12,9 @@ import time
 import pytest
 
 from conftest import INPUTS, ROOT
-from driver import atomic
-from driver.atomic import output_set, remove_stale_temporaries, write_text
-from driver.cli import main
+from driver import _atomic as atomic
+from driver._atomic import output_set, remove_stale_temporaries, write_text
+from driver._cli import main
 
 DECK = str(INPUTS / "crank5.dat")
 OTHER = str(INPUTS / "crank2.dat")
@@ -100,7 +100,7 @@ def test_full_disk_leaves_no_partial_file(code, words, tmp_path, capsys, monkeyp
 def test_file_size_limit_is_an_error_not_a_kill(tmp_path):
     out = tmp_path / "o"
     code = ("import resource, sys; resource.setrlimit(resource.RLIMIT_FSIZE, (2000, 2000)); "
-            "from driver.cli import main; sys.exit(main(sys.argv[1:]))")
+            "from driver._cli import main; sys.exit(main(sys.argv[1:]))")
     p = subprocess.run([sys.executable, "-c", code, DECK, OTHER, "-o", str(out), "-q"],
                        capture_output=True, text=True, cwd=ROOT, timeout=300)
     assert p.returncode == 1, p.stderr

@@ -14,8 +14,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from driver.fourbar import _kernel as fourbar_kernel
 from driver.fourbar import grashof, limit_angles
-from driver.fourbar import kernel as fourbar_kernel
 
 OK = fourbar_kernel.FOURBAR_STATUS["ok"]
 length = st.floats(0.5, 10.0, allow_nan=False)
@@ -86,7 +86,7 @@ def test_exact_agrees_with_listing_from_0_to_180(crank):
 @pytest.mark.parametrize("q", [2.0, 3.0, 4.0, 5.0])
 def test_transmission_and_rocker_extremes_in_closed_form(q, write_deck):
     """Crank-rocker: mu extremes at |A O_B| = p -/+ q; rocker extremes with crank and coupler collinear."""
-    from driver.deck import read_deck, validate
+    from driver._deck import read_deck, validate
     from driver.fourbar import SPEC, extremes
     p, r, s = 12.0, 15.0, 9.0
     deck = write_deck(f"&fourbar fixed_link={p}, crank={q}, coupler={r}, rocker={s}, step_deg=10 /\n")

@@ -27,10 +27,10 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from conftest import INPUTS
-from driver.api import run
-from driver.cli import main
-from driver.fourbar import forces
-from driver.fourbar import kernel as fourbar_kernel
+from driver._api import run
+from driver._cli import main
+from driver.fourbar import _forces as forces
+from driver.fourbar import _kernel as fourbar_kernel
 
 G = 9.81
 
@@ -416,8 +416,8 @@ def test_batch_summary_equals_single_runs():
 
 def _params(text: str):
     from driver import fourbar
-    from driver.deck import validate
-    from driver.pydeck import deck_of
+    from driver._deck import validate
+    from driver._pydeck import deck_of
     deck = deck_of(text, None)
     return validate(deck.groups["fourbar"], fourbar.SPEC, str(deck.path))
 
@@ -465,7 +465,7 @@ def test_bad_force_input_exits_2_naming_the_key(change, key, words, tmp_path, ca
 def test_sweeps_carry_the_force_columns():
     """A sweep over link lengths (batch path) and one over a force key (case by case) both report
     the force summary of each case, equal to single runs."""
-    from driver.api import run_sweep
+    from driver._api import run_sweep
     base = open(INPUTS / "fourbar_forces.dat").read()
     lengths = run_sweep(base, grid={"coupler": [0.33, 0.37]}, jobs=1)
     loads = run_sweep(base, grid={"load_torque": [0.0, 9.0]}, jobs=1)
@@ -506,7 +506,7 @@ def test_sweep_case_decks_of_a_force_deck_run_again(tmp_path):
     """The case decks a sweep writes carry the force keys the base deck gave and no others
     (a key defaulted to a value would be 'given' without mass in a deck that has none), and
     each runs again to the same force summary."""
-    from driver.api import run_sweep
+    from driver._api import run_sweep
     base = open(INPUTS / "fourbar_forces.dat").read()
     res = run_sweep(base, grid={"coupler": [0.33, 0.37]}, case_outputs="all", outdir=tmp_path, jobs=1, name="fs")
     cases = sorted(tmp_path.rglob("case_*.dat"))

@@ -19,7 +19,7 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from driver import fourbar
-from driver.fourbar import kernel as fourbar_kernel
+from driver.fourbar import _kernel as fourbar_kernel
 
 PASSES = fourbar_kernel.FOURBAR_PASSES
 ALL = PASSES["transmission"] | PASSES["rocker"] | PASSES["peaks"]

@@ -1,7 +1,7 @@
 """The listing method against the published tables (Lampiran 2-3 of the four-bar paper), cell for cell.
 
 The transcriptions are the files published/crank2.out ... crank5.out (read through
-driver.published, the same reader the comparison uses); the .out files are produced by the
+driver._published, the same reader the comparison uses); the .out files are produced by the
 CLI exactly as a user runs it.
 """
 from __future__ import annotations
@@ -9,8 +9,8 @@ from __future__ import annotations
 import pytest
 
 from conftest import INPUTS
-from driver.cli import main
-from driver.published import PUBLISHED_DIR, listing_rows
+from driver._cli import main
+from driver._published import PUBLISHED_DIR, listing_rows
 
 CRANKS = (2, 3, 4, 5)
 

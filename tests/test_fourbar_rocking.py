@@ -17,7 +17,7 @@ import pytest
 import driver
 from conftest import INPUTS
 from driver import fourbar
-from driver.fourbar import kernel as fourbar_kernel
+from driver.fourbar import _kernel as fourbar_kernel
 
 OK = fourbar_kernel.FOURBAR_STATUS["ok"]
 NO = fourbar_kernel.FOURBAR_STATUS["no_assembly"]

@@ -19,9 +19,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from driver.deck import DeckError, Params
+from driver._deck import DeckError, Params
 from driver.fourbar import SPEC, grashof, limit_angles, summarise, summarise_batch
-from driver.fourbar import kernel as fourbar_kernel
+from driver.fourbar import _kernel as fourbar_kernel
 
 OK, TOG = fourbar_kernel.FOURBAR_STATUS["ok"], fourbar_kernel.FOURBAR_STATUS["toggle"]
 
@@ -119,9 +119,9 @@ def test_batch_against_brute_force(lengths, branch):
 
 
 def test_time_ratio_of_the_closed_form_crank_rocker_family():
-    """Every crank-rocker of the textbook family (driver/synthesis/crank_rocker.py, built for a
+    """Every crank-rocker of the textbook family (driver/synthesis/_crank_rocker.py, built for a
     swing and a time ratio in closed form) has exactly that time ratio in the batch summary."""
-    from driver.synthesis import crank_rocker as cr
+    from driver.synthesis import _crank_rocker as cr
     for swing, q in ((60.0, 1.25), (45.0, 1.0), (80.0, 1.6)):
         members = [m for m in cr.family(swing, q, 25) if m.crank_rocker]
         assert len(members) > 10

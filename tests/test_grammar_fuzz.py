@@ -3,8 +3,8 @@
 Hypothesis builds number spellings, repeat counts, expressions over typed columns and
 titles from small grammars that mix what Fortran list-directed input reads with what it does
 not (kind suffixes, arithmetic, doubled repeat counts, non-ASCII digits, hex, bad exponents).
-Each property compares the tool with an oracle written here, apart from ``driver.deck`` and
-``driver.expr``: a character-by-character scanner of the Fortran number syntax, and a type
+Each property compares the tool with an oracle written here, apart from ``driver._deck`` and
+``driver._expr``: a character-by-character scanner of the Fortran number syntax, and a type
 rule for the expression language.  Bounded: a few hundred examples, seconds in all.
 """
 from __future__ import annotations
@@ -13,8 +13,8 @@ import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from driver.deck import DeckError, RawGroup, read_deck, validate
-from driver.expr import ExprError, parse
+from driver._deck import DeckError, RawGroup, read_deck, validate
+from driver._expr import ExprError, parse
 from fuzz_decks import fortran_values as _oracle_values
 
 SETTINGS = dict(deadline=None, derandomize=True, suppress_health_check=list(HealthCheck))

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import pytest
 
-from driver.cli import main
+from driver._cli import main
 
 BASE = """&fourbar
   fixed_link = 12.0, crank = 2.0, coupler = 15.0, rocker = 9.0

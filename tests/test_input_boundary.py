@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 import driver
-from driver.cli import main
-from driver.deck import DeckError, is_number, read_deck
-from driver.expr import ExprError, parse
+from driver._cli import main
+from driver._deck import DeckError, is_number, read_deck
+from driver._expr import ExprError, parse
 
 FOURBAR = """&fourbar
   fixed_link = 12.0, crank = 2.0, coupler = 15.0, rocker = 9.0
@@ -292,7 +292,7 @@ def test_a_symlinked_outdir_given_by_the_user_works(tmp_path, capsys):
 # ----------------------------------------------------------------------------- 5. the rest
 
 def test_concurrent_run_of_one_sweep_is_refused_with_one_line(tmp_path, capsys):
-    from driver.sweep import store
+    from driver.sweep import _store as store
     deck = tmp_path / "sw.dat"
     deck.write_text(SWEEP_DECK)
     out = tmp_path / "out"
@@ -434,7 +434,7 @@ def test_degenerate_syntheses_are_deck_errors(tmp_path, capsys, change, key):
 def test_unknown_keys_refused_before_the_namelist_reader(monkeypatch):
     """A group of 12 000 unknown keys: refused in the pre-scan, linear in the deck's size (the
     namelist library's work grows with the square of a group's keys: it is never reached)."""
-    import driver.deck as deck_module
+    import driver._deck as deck_module
 
     def never(text):
         raise AssertionError("f90nml reached")

@@ -74,7 +74,7 @@ def test_installed_examples_reproduce_committed_outputs(installed, tmp_path):
 
 def test_installed_package_ships_the_published_record_and_compares_from_another_folder(installed, tmp_path):
     py, _, _ = installed
-    where = subprocess.run([py, "-c", "from driver import published; print(published.PUBLISHED_DIR)"], cwd=tmp_path,
+    where = subprocess.run([py, "-c", "from driver import _published; print(_published.PUBLISHED_DIR)"], cwd=tmp_path,
                            check=True, capture_output=True, text=True).stdout.strip()
     assert where.endswith("driver/published_record") and "/env/" in where   # the installed copy, not the checkout
     shipped = {p.name: p.read_bytes() for p in Path(where).iterdir()}

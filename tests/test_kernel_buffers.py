@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from driver import kernels
-from driver.fourbar import kernel as fourbar_kernel
+from driver import _fortran as kernels
+from driver.fourbar import _kernel as fourbar_kernel
 
 LINK = (12.0, 5.0, 15.0, 9.0, 5.0, 0.0)
 

@@ -10,8 +10,8 @@ import tracemalloc
 import numpy as np
 import pytest
 
-from driver.fourbar import kernel as fourbar_kernel
-from driver.manipulator import kernel as manipulator_kernel
+from driver.fourbar import _kernel as fourbar_kernel
+from driver.manipulator import _kernel as manipulator_kernel
 
 
 def peak_alloc(fn) -> int:

@@ -17,9 +17,9 @@ from pathlib import Path
 
 import pytest
 
+from driver._deck import DeckError, GroupSpec
+from driver._runner import available_studies
 from driver._signatures import NOT_GIVEN, unit_text
-from driver.deck import DeckError, GroupSpec
-from driver.runner import available_studies
 
 ROOT = Path(__file__).resolve().parents[1]
 STUDIES = sorted(available_studies())

@@ -14,10 +14,10 @@ import pytest
 
 from conftest import INPUTS
 from driver import manipulator
-from driver.cli import main
-from driver.deck import read_deck
-from driver.runner import run_study
-from driver.table import significant
+from driver._cli import main
+from driver._deck import read_deck
+from driver._runner import run_study
+from driver._table import significant
 
 CASE1 = ("  points_x = 1, 2, 3, 4\n  points_y = 5, 7, 7, 6\n  target_x = 1, target_y = 5\n"
          "  mc_samples = 2000\n")

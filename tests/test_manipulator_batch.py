@@ -23,10 +23,10 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from driver import manipulator
-from driver.cli import main
-from driver.deck import DeckError, Params
+from driver._cli import main
+from driver._deck import DeckError, Params
 from driver.manipulator import BATCH_KEYS, SPEC, summarise, summarise_batch
-from driver.manipulator import kernel as manipulator_kernel
+from driver.manipulator import _kernel as manipulator_kernel
 
 ROOT = Path(__file__).resolve().parents[1]
 #: what the bit-exact comparison covers (an optimiser's finite differences see these)
@@ -253,7 +253,7 @@ def test_sweep_with_unreachable_designs(tmp_path):
 
 
 def test_optimiser_evaluates_populations_in_one_call(tmp_path, monkeypatch):
-    from driver.optimize import evaluate
+    from driver.optimize import _evaluate as evaluate
     calls = []
     real = manipulator_kernel.manipulator_design_summaries
 

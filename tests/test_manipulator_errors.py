@@ -6,7 +6,7 @@ import re
 
 import pytest
 
-from driver.cli import main
+from driver._cli import main
 
 BASE = {
     "points_x": "1, 2, 3, 4",

@@ -10,11 +10,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from driver.deck import read_deck
-from driver.manipulator import kernel as manipulator_kernel
+from driver._deck import read_deck
+from driver._runner import study_of
+from driver.manipulator import _kernel as manipulator_kernel
 from driver.manipulator import table_frame, tolerance_box
-from driver.manipulator.analysis import sensitivity_blocks
-from driver.runner import study_of
+from driver.manipulator._analysis import sensitivity_blocks
 
 ROOT = Path(__file__).resolve().parents[1]
 

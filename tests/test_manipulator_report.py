@@ -1,7 +1,7 @@
 """Report decks against the printed cells of [Ma'arif 2006], chapter 4 (the cells docs/manipulator.md lists as reproducible).
 
 Printed values are transcribed as text in published/manipulator_case1.txt and _case2.txt (the text
-keeps the printed number of decimals; read through driver.published, as the comparison reads
+keeps the printed number of decimals; read through driver._published, as the comparison reads
 them); a computed value matches when it is within half a unit of the last printed digit (+1e-9),
 never through a bare round().
 """
@@ -14,10 +14,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from driver.deck import read_deck
+from driver._deck import read_deck
+from driver._published import PUBLISHED_DIR, read_blocks
+from driver._runner import study_of
 from driver.manipulator import table_frame
-from driver.published import PUBLISHED_DIR, read_blocks
-from driver.runner import study_of
 
 ROOT = Path(__file__).resolve().parents[1]
 

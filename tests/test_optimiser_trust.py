@@ -41,7 +41,7 @@ REPRO_1 = """&manipulator
 
 def _manip_run(points, l1, l2, target):
     from driver import manipulator
-    from driver.deck import RawGroup, validate
+    from driver._deck import RawGroup, validate
     values = {"points_x": [p[0] for p in points], "points_y": [p[1] for p in points], "designs_l1": [l1],
               "designs_l2": [l2], "target_x": target[0], "target_y": target[1], "mc_samples": 200}
     return manipulator.run(validate(RawGroup("manipulator", values, {}, 1), manipulator.SPEC, "x.dat")).summary
@@ -84,7 +84,7 @@ def test_the_signed_torque_sum_is_not_a_demand():
 
 
 def test_an_old_column_name_is_answered_with_the_new_one(tmp_path):
-    from driver.deck import DeckError
+    from driver._deck import DeckError
     text = (ROOT / "inputs" / "optimize_manipulator_torque.dat").read_text()
     path = tmp_path / "old.dat"
     path.write_text(text.replace("minimize = 'design_torque_demand_Nm'", "minimize = 'design_total_torque_Nm'"))
@@ -190,7 +190,7 @@ def test_a_poor_best_transmission_angle_is_named(tmp_path, swing, q):
 def test_json_records_of_optimisation_synthesis_and_sweep(tmp_path):
     import json
 
-    from driver.cli import main
+    from driver._cli import main
     decks = [ROOT / "inputs" / n for n in ("optimize_manipulator_torque.dat", "synthesis_crank_rocker.dat",
                                            "fourbar_paper_sweep.dat")]
     assert main([*map(str, decks), "-o", str(tmp_path), "-q", "--json"]) == 0

@@ -17,8 +17,8 @@ import pandas as pd
 import pytest
 
 from driver import fourbar
-from driver.cli import main
-from driver.deck import DeckError, RawGroup, read_deck, validate
+from driver._cli import main
+from driver._deck import DeckError, RawGroup, read_deck, validate
 from driver.optimize import optimize
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -261,7 +261,7 @@ def test_grid_started_local_search_and_partial_journal_resume(tmp_path):
     evals = pd.read_parquet(out / "opt_evals.parquet")
     assert list(evals["fourbar.coupler"].iloc[:6]) == pytest.approx(list(np.linspace(10, 20, 6)))
     # an interrupted run: a journal holding the first half of the evaluations (as the run appends them)
-    from driver.optimize import journal
+    from driver.optimize import _journal as journal
     half = evals.iloc[: len(evals) // 2]
     lines = [journal.line(journal.record(oc.problem.fingerprint(), [float(v)], "ok", "",
                           {k[len("summary."):]: (None if isinstance(row[k], float) and math.isnan(row[k])
@@ -309,7 +309,7 @@ def test_differential_evolution_same_run_in_one_process_worker_processes_and_on_
     import os
 
     from driver import slidercrank
-    from driver.optimize import evaluate
+    from driver.optimize import _evaluate as evaluate
     # a LocalCluster with worker processes sets OMP/MKL/OPENBLAS_NUM_THREADS=1 in this process's
     # environment; later tests' subprocesses must not inherit that (SLSQP results follow OpenBLAS's
     # thread count in the last bits, and the committed outputs are compared byte for byte)
@@ -356,7 +356,8 @@ def test_a_deck_never_names_the_scheduler(tmp_path, capsys):
 def test_over_budget_and_non_finite_designs_are_infeasible_with_reasons(tmp_path, monkeypatch):
     """Per-design runs go through the runner: a design over the work budget is refused before it
     runs, counted by reason, and never ends the run (a Dask worker gets the budget with the cases)."""
-    from driver import limits, slidercrank
+    from driver import _limits as limits
+    from driver import slidercrank
     path = tmp_path / "sc.dat"
     path.write_text(SC_SMALL.replace("var2 = 'slidercrank.section_depth', lower2 = 2e-3, upper2 = 20e-3",
                              "var2 = 'slidercrank.section_depth', lower2 = 2e-3, upper2 = 20e-3\n"
@@ -391,7 +392,7 @@ def test_crank_rocker_through_optimize_agrees_with_the_closed_form_family(tmp_pa
     construction, must land on the closed-form family's best member.  Tolerances: swing and time
     ratio are held within 1e-6 by the deck's constraint pairs, which moves the optimum along the
     family by about 1e-5 (lengths) and its objective by < 1e-4 deg."""
-    from driver.synthesis import crank_rocker as cr
+    from driver.synthesis import _crank_rocker as cr
     from driver.synthesis import synthesise
     oc = optimize(ROOT / "inputs" / "optimize_crank_rocker.dat", None, jobs=1)
     assert oc.success

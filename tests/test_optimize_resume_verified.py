@@ -1,7 +1,7 @@
 """An ``&optimize`` resume record is verified, never believed (issue 23, section 2).
 
 Every journal line and every row of a finished run's ``_evals`` table carries a checksum of its
-content (driver/optimize/journal.py).  Real tampering -- a digit changed, a file cut, a byte
+content (driver/optimize/_journal.py).  Real tampering -- a digit changed, a file cut, a byte
 damaged -- makes ``--resume`` compute those designs again and say how many and why; the files
 it writes equal those of an uninterrupted run (the truth: a fresh run into another folder), and
 the number of designs computed again is exactly the number of records that failed.
@@ -15,7 +15,7 @@ import pyarrow.parquet as pq
 import pytest
 
 import driver.optimize as opt
-from driver.cli import main
+from driver._cli import main
 
 DECK = """&fourbar fixed_link = 12, crank = 3, coupler = 15, rocker = 9, omega = 5, step_deg = 10 /
 &optimize

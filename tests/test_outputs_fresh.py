@@ -38,7 +38,7 @@ PATH_RTOL = 1e-6
 
 def path_records(deck: str) -> bool:
     """The deck is an optimisation whose method has a BLAS-dependent step (its path records vary)."""
-    from driver.deck import read_deck
+    from driver._deck import read_deck
     d = read_deck(INPUTS / deck)
     if "optimize" not in d.groups:
         return False
@@ -64,7 +64,7 @@ def same_path_record(fresh: pd.DataFrame, committed: pd.DataFrame, sense: int) -
 
 
 def _sense(deck: str) -> int:
-    from driver.deck import read_deck
+    from driver._deck import read_deck
     vals = {k.lower(): v for k, v in read_deck(INPUTS / deck).groups["optimize"].values.items()}
     return 1 if vals.get("minimize") is not None else -1
 

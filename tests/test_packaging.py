@@ -12,7 +12,7 @@ import pytest
 
 import driver
 from conftest import INPUTS, ROOT
-from driver import example_decks
+from driver import _example_decks as example_decks
 
 PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text())
 
@@ -90,8 +90,8 @@ def test_example_command_line(tmp_path):
 
 
 def test_study_names_without_import_match_the_studies():
+    from driver._runner import available_studies
     from driver._study import study_names
-    from driver.runner import available_studies
     assert study_names() == sorted(available_studies())
 
 

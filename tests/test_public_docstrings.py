@@ -1,9 +1,9 @@
 """Every public name has a numpydoc docstring, and each study's ``run`` states every key's unit.
 
 The public namespace is derived, never listed: ``driver.__all__``, the ``__all__`` of every
-registered study (``driver.studies()``), of every engine package (``driver.dispatch.ENGINES``:
-sweep, optimize, synthesis) and of :mod:`driver.outcome` (the outcome types the API returns),
-recursing into the modules those ``__all__`` export (``driver.fourbar.forces``, the kernel
+registered study (``driver.studies()``), of every engine package (``driver._dispatch.ENGINES``:
+sweep, optimize, synthesis) and of :mod:`driver._outcome` (the outcome types the API returns),
+recursing into the modules those ``__all__`` export (``driver.fourbar._forces``, the kernel
 wrappers).  Each function and class found there, and each public method and property a public
 class defines, is validated with :func:`numpydoc.validate.validate`.  A new public name without
 a docstring (GL08) fails here.  Public data (``SPEC``, ``STUDY``, tables of constants) has no
@@ -56,8 +56,8 @@ CHECKS = frozenset({"GL02", "GL03", "GL05", "GL06", "GL07", "GL08", "GL09", "GL1
 def _roots() -> list[str]:
     """The public modules whose ``__all__`` make the public namespace (derived, not listed)."""
     import driver
-    from driver.dispatch import ENGINES
-    return ["driver", "driver.outcome", *(f"driver.{s}" for s in driver.studies()),
+    from driver._dispatch import ENGINES
+    return ["driver", "driver._outcome", *(f"driver.{s}" for s in driver.studies()),
             *(f"driver.{e}" for e in ENGINES)]
 
 
@@ -135,7 +135,7 @@ def problems(name: str) -> list[str]:
 def test_the_public_namespace_is_found():
     """The walk reaches what the API documents (a walk that finds nothing would pass anything)."""
     for name in ("driver.run", "driver.run_sweep", "driver.write", "driver.keys", "driver.Result",
-                 "driver.Result.figure", "driver.DeckError", "driver.outcome.ExitCode",
+                 "driver.Result.figure", "driver.DeckError", "driver._outcome.ExitCode",
                  "driver.fourbar.run", "driver.fourbar.assembly_intervals", "driver.optimize.optimize"):
         assert name in PUBLIC, name
     assert len(PUBLIC) > 100

@@ -38,7 +38,7 @@ if chromium_path() is None:
         pytest.fail("CI must test the report page in Chromium: .ci/setup installs Debian's chromium", pytrace=False)
     pytest.skip("no chromium on PATH (bash .ci/setup installs it)", allow_module_level=True)
 
-from driver.report_page import MAX_PAGE_BYTES
+from driver._report_page import MAX_PAGE_BYTES
 
 #: a small slider-crank deck (the paper's aluminium rod, coarse mesh): seconds, not minutes
 SLIDERCRANK = """! aluminium rod of the paper, coarse mesh for a quick report
@@ -238,7 +238,7 @@ def test_play_button_moves_the_mechanism(pages, browser):
 
 def test_published_comparison_on_the_page(pages, browser):
     """crank5 reproduces the paper's Lampiran 3: the page lists its cells and counts them."""
-    from driver.compare import compare
+    from driver._compare import compare
     expected = compare(INPUTS / "crank5.dat")
     browser.events.clear()
     browser.open(pages / "crank5.html")

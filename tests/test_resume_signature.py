@@ -2,10 +2,10 @@
 to *any* module of a study package, not only its ``__init__.py`` (an edit to a study's report
 module changes what the tables say, so a record made before it must be redone).
 
-Both kinds carry the one signature :func:`driver.sweep.store.signature`; checked on the
+Both kinds carry the one signature :func:`driver.sweep._store.signature`; checked on the
 functions (a synthetic study package edited on disk) and end to end (a Hooke-joint sweep run
 on the batch path and case by case, resumed before and after an edit of
-``driver/ujoint/report.py`` as the digest reads it)."""
+``driver/ujoint/_report.py`` as the digest reads it)."""
 from __future__ import annotations
 
 import importlib.util
@@ -14,11 +14,11 @@ from pathlib import Path
 
 import pytest
 
-from driver.cli import main
-from driver.deck import RawGroup
-from driver.study import code_digest
-from driver.sweep import batch as sweep_batch
-from driver.sweep import store
+from driver._cli import main
+from driver._deck import RawGroup
+from driver._output import code_digest
+from driver.sweep import _batch as sweep_batch
+from driver.sweep import _store as store
 
 
 @pytest.fixture
@@ -63,7 +63,7 @@ def test_editing_a_report_module_invalidates_both_record_kinds(fake_study):
 def test_code_digest_covers_every_module_of_a_real_study_package():
     import driver.ujoint as uj
     files = sorted(Path(uj.__file__).parent.rglob("*.py"))
-    assert any(f.name == "report.py" for f in files)
+    assert any(f.name == "_report.py" for f in files)
     assert len(code_digest(uj)) == 32
     assert code_digest(uj) != code_digest(None)
 
@@ -92,7 +92,7 @@ def _resumed(capsys, deck: Path, out: Path) -> str:
 
 @pytest.mark.parametrize("outputs, engine", [("none", "batch"), ("all", "case")])
 def test_an_edit_of_the_report_module_redoes_a_resumed_sweep(tmp_path, capsys, monkeypatch, outputs, engine):
-    import driver.ujoint.report as report
+    import driver.ujoint._report as report
     deck = tmp_path / "usw.dat"
     deck.write_text(DECK.format(outputs=outputs))
     out = tmp_path / "out"

@@ -12,7 +12,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
-from driver.cli import main
+from driver._cli import main
 
 DECK = """&fourbar
   fixed_link = 12.0, crank = 2.0, coupler = 15.0, rocker = 9.0

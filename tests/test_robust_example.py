@@ -1,5 +1,5 @@
 """Section 2.3 (Taylor's example) against the printed values of the report (published/robust_example.txt,
-read through driver.published); the printed results that do not reproduce (FLAGGED, docs/manipulator.md
+read through driver._published); the printed results that do not reproduce (FLAGGED, docs/manipulator.md
 section 4) must be flagged."""
 from __future__ import annotations
 
@@ -10,9 +10,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from driver.deck import read_deck
-from driver.published import PUBLISHED_DIR, read_blocks
-from driver.runner import study_of
+from driver._deck import read_deck
+from driver._published import PUBLISHED_DIR, read_blocks
+from driver._runner import study_of
 
 ROOT = Path(__file__).resolve().parents[1]
 #: printed values that do not reproduce: the (2.12) coefficients, the last digit of two Table 2.5 std

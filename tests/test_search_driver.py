@@ -19,8 +19,8 @@ import pandas as pd
 import pyarrow.parquet as pq
 import pytest
 
-from driver.cli import main
-from driver.sweep import batch as sweep_batch
+from driver._cli import main
+from driver.sweep import _batch as sweep_batch
 
 SWEEP = """&fourbar fixed_link = 12.0, crank = 3.0, coupler = 15.0, rocker = 9.0, omega = 5.0, step_deg = 10 /
 &sweep
@@ -114,7 +114,7 @@ def test_fast_fixed_point_text_equals_decimal_half_up():
     from hypothesis import given, settings
     from hypothesis import strategies as st
 
-    from driver.table import _round_half_up
+    from driver._table import _round_half_up
     for v in (0.5, 1.5, 2.5, -2.5, 0.125, -0.125, 2.675, 0.045, 0.0, -0.0, 1e-5, -1e-5, 1e20, 1e300, 5e-324):
         for d in range(0, 9):
             assert _round_half_up(v, d) == _decimal_half_up(v, d), (v, d)

@@ -20,11 +20,11 @@ import pandas as pd
 import pytest
 
 from driver import manipulator, ujoint
-from driver.cli import main
-from driver.deck import Params
-from driver.fourbar import kernel as fourbar_kernel
-from driver.manipulator import kernel as manipulator_kernel
-from driver.ujoint import kernel as ujoint_kernel
+from driver._cli import main
+from driver._deck import Params
+from driver.fourbar import _kernel as fourbar_kernel
+from driver.manipulator import _kernel as manipulator_kernel
+from driver.ujoint import _kernel as ujoint_kernel
 
 ROOT = Path(__file__).resolve().parents[1]
 P = fourbar_kernel.FOURBAR_PASSES
@@ -107,8 +107,8 @@ def test_ujoint_wanted_columns_have_the_full_bits_and_run_their_passes(monkeypat
     cols = {"ujoint.phi(1)": rng.uniform(0, 180, 300), "ujoint.phi(2)": rng.uniform(0, 180, 300)}
     full = ujoint.summarise_batch(b, cols)
     seen: list[int] = []
-    real = ujoint.batch.ujoint_summaries
-    monkeypatch.setattr(ujoint.batch, "ujoint_summaries", lambda *a, passes=7, **k: (seen.append(passes),
+    real = ujoint._batch.ujoint_summaries
+    monkeypatch.setattr(ujoint._batch, "ujoint_summaries", lambda *a, passes=7, **k: (seen.append(passes),
                                                                                    real(*a, passes=passes, **k))[1])
     for c in full.columns:
         seen.clear()
@@ -120,7 +120,7 @@ def test_ujoint_wanted_columns_have_the_full_bits_and_run_their_passes(monkeypat
 
 
 def test_manipulator_wanted_columns_have_the_full_bits_and_run_their_passes(monkeypatch):
-    from driver.deck import read_deck, validate
+    from driver._deck import read_deck, validate
     d = read_deck(ROOT / "inputs" / "manipulator_design_search.dat")
     base = validate(d.groups["manipulator"], manipulator.SPEC, d.path)
     rng = np.random.default_rng(4)
@@ -135,7 +135,7 @@ def test_manipulator_wanted_columns_have_the_full_bits_and_run_their_passes(monk
         part = manipulator.summarise_batch(base, cols, wanted=[c])
         assert list(part.columns) == [c]
         pd.testing.assert_series_equal(part[c], full[c])
-        need = manipulator.batch._passes([c]) - {"walk"}
+        need = manipulator._batch._passes([c]) - {"walk"}
         assert seen == [sum(manipulator_kernel.MANIPULATOR_PASSES[p] for p in need)], c
 
 

@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 from scipy.linalg import eigh
 
-from driver.cli import main
-from driver.deck import read_deck
-from driver.runner import run_study
+from driver._cli import main
+from driver._deck import read_deck
+from driver._runner import run_study
 from driver.slidercrank import MATERIALS, Model, static_onset
-from driver.slidercrank import kernel as slidercrank_kernel
+from driver.slidercrank import _kernel as slidercrank_kernel
 
 
 def _run(write_deck, body: str):

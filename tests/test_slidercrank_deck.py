@@ -8,8 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from driver.cli import main
-from driver.deck import read_deck, validate
+from driver._cli import main
+from driver._deck import read_deck, validate
 from driver.slidercrank import SPEC, run
 
 SMALL = """! small aluminium case

@@ -25,7 +25,7 @@ import math
 import numpy as np
 import pytest
 
-from driver.slidercrank import kernel as slidercrank_kernel
+from driver.slidercrank import _kernel as slidercrank_kernel
 
 exu = pytest.importorskip("exudyn")
 # Exudyn renames settings between releases; the old names still work and are what >= 1.9 has

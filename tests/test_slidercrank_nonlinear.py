@@ -14,8 +14,8 @@ import pytest
 from scipy.optimize import brentq
 from scipy.special import ellipk
 
-from driver.slidercrank import kernel as slidercrank_kernel
-from driver.slidercrank.spec import MATERIALS, rayleigh
+from driver.slidercrank import _kernel as slidercrank_kernel
+from driver.slidercrank._spec import MATERIALS, rayleigh
 
 ROOT = Path(__file__).resolve().parents[1]
 AL = MATERIALS["aluminium"]
@@ -241,7 +241,7 @@ def test_linear_only_options_are_refused(tmp_path, line, key):
 
 
 def test_growth_ratio_definition():
-    from driver.slidercrank.nonlinear import growth_ratio, scatter
+    from driver.slidercrank._nonlinear import growth_ratio, scatter
     assert growth_ratio(np.ones(8)) == 0.0
     assert growth_ratio(np.array([2.0, 1.0] * 6)) == 0.0                 # period 2: steady
     assert growth_ratio(1.1 ** np.arange(12)) == pytest.approx(0.1)      # 10 % a revolution
@@ -254,7 +254,7 @@ def test_nonlinear_figures_draw_the_given_curves_and_accept_axes():
     pytest.importorskip("matplotlib")
     from matplotlib.figure import Figure as MplFigure
 
-    from driver.slidercrank import figures as slidercrank_figures
+    from driver.slidercrank import _figures as slidercrank_figures
     x = np.linspace(0.0, 360.0, 7)
     lin, nl = np.sin(np.radians(x)), 2 * np.sin(np.radians(x))
     fig = slidercrank_figures.slidercrank_nl_strain_figure([("10 rad/s", x, lin, nl)], "strain")

@@ -14,9 +14,9 @@ from scipy.integrate import quad
 from scipy.linalg import eigh
 from scipy.optimize import brentq
 
-from driver.published import PUBLISHED_DIR, read_blocks
+from driver._published import PUBLISHED_DIR, read_blocks
 from driver.slidercrank import MATERIALS
-from driver.slidercrank import kernel as slidercrank_kernel
+from driver.slidercrank import _kernel as slidercrank_kernel
 
 
 def _table1() -> tuple[dict[str, dict[str, float]], dict[str, float]]:
@@ -355,7 +355,7 @@ def test_crank_pin_strain_converges_for_every_rod(name, write_deck, tmp_path):
     not for the low-carbon-steel rod, whose axial force falls 23 % along it), and at 8 elements it
     already equals the crank-end element strain of a 400-element mesh (le = 1.3 mm) within 0.1 %."""
     from driver import slidercrank
-    from driver.deck import read_deck, validate
+    from driver._deck import read_deck, validate
     deck = write_deck(f"&slidercrank material = '{name}', speeds = 29.32, steps_per_rev = 720, "
                       f"revolutions = 3, element_counts = 1, 2, 4, 8, 10, 16, 20, 32, 400 /\n")
     params = validate(read_deck(deck).groups["slidercrank"], slidercrank.SPEC, deck)

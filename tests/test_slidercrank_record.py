@@ -12,8 +12,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from driver.slidercrank import kernel as slidercrank_kernel
-from driver.slidercrank.analysis import PROFILE, Case, _settle
+from driver.slidercrank import _kernel as slidercrank_kernel
+from driver.slidercrank._analysis import PROFILE, Case, _settle
 
 STEEL = dict(crank_radius=0.15, rod_length=0.3, rho_a=7870 * 64e-6, ea=2e11 * 64e-6, ei=2e11 * 3.413333333e-10,
              half_depth=0.004, slider_mass=0.075552, omega=150.0, dt=2.5e-5)

@@ -24,13 +24,13 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import driver
-from driver import deck as deck_module
-from driver import limits
+from driver import _deck as deck_module
+from driver import _limits as limits
+from driver._deck import DeckError, GroupSpec, Key, read_deck
+from driver._limits import Estimate
+from driver._runner import CONTROL_GROUPS, compute, study_of
 from driver._study import REGISTRY, BatchSummary, Study, load_study, study_names
-from driver.deck import DeckError, GroupSpec, Key, read_deck
-from driver.limits import Estimate
-from driver.runner import CONTROL_GROUPS, compute, study_of
-from driver.sweep import batch as sweep_batch
+from driver.sweep import _batch as sweep_batch
 
 ROOT = Path(__file__).resolve().parents[1]
 INPUTS = ROOT / "inputs"
@@ -53,13 +53,13 @@ def _decks_of(group: str) -> list[Path]:
 
 def test_the_registry_is_an_explicit_list_and_names_every_study():
     assert study_names() == sorted(REGISTRY) == list(STUDIES)
-    for name in ("cli", "deck", "sweep", "optimize", "plotting", "kernels", "study", "_study", "fourbar.forces"):
+    for name in ("_cli", "_deck", "sweep", "optimize", "plotting", "_fortran", "_output", "_study", "fourbar._forces"):
         assert load_study(name) is None          # no module-name probing: what is not listed is no study
     assert set(driver.studies()) == set(STUDIES)
 
 
 def test_a_registered_package_without_a_study_is_an_error_not_skipped(monkeypatch):
-    monkeypatch.setitem(REGISTRY, "table", "driver.table")
+    monkeypatch.setitem(REGISTRY, "table", "driver._table")
     with pytest.raises(TypeError, match="binds no STUDY"):
         load_study("table")
 
@@ -100,8 +100,9 @@ def test_estimate_gives_sane_numbers_for_every_shipped_deck_of_the_study(name):
         assert limits.check(s, params) == est
 
 
-#: the files every study package has (plus kernel.py with a kernel, batch.py with a batch path)
-LAYOUT = {"__init__.py", "spec.py", "analysis.py", "report.py", "figures.py", "published.py"}
+#: the files every study package has (plus _kernel.py with a kernel, _batch.py with a batch path): private
+#: modules behind the package's public names
+LAYOUT = {"__init__.py", "_spec.py", "_analysis.py", "_report.py", "_figures.py", "_published.py"}
 
 
 @pytest.mark.parametrize("name", STUDIES)
@@ -109,12 +110,12 @@ def test_every_study_has_the_one_layout(name):
     s = load_study(name)
     folder = Path(s.module.__file__).parent
     files = {p.name for p in folder.glob("*.py")}
-    need = LAYOUT | ({"kernel.py"} if s.kernel is not None else set()) | ({"batch.py"} if s.batch is not None else set())
+    need = LAYOUT | ({"_kernel.py"} if s.kernel is not None else set()) | ({"_batch.py"} if s.batch is not None else set())
     assert need <= files, sorted(need - files)
-    assert s.figures == f"{s.package}.figures" and importlib.import_module(s.figures).__file__
-    assert s.published is not None and s.published.__module__ == f"{s.package}.published"
-    assert s.kernel is None or s.kernel.__name__ == f"{s.package}.kernel"
-    assert s.run.__module__.startswith(f"{s.package}.report") and s.estimate.__module__ == f"{s.package}.spec"
+    assert s.figures == f"{s.package}._figures" and importlib.import_module(s.figures).__file__
+    assert s.published is not None and s.published.__module__ == f"{s.package}._published"
+    assert s.kernel is None or s.kernel.__name__ == f"{s.package}._kernel"
+    assert s.run.__module__.startswith(f"{s.package}._report") and s.estimate.__module__ == f"{s.package}._spec"
     # public names and STUDY; a name alone on its line of a wrapped import (the one-per-line form
     # ruff's import sorting writes) is not counted: the cap bounds content, not formatting
     lines = [ln for ln in (folder / "__init__.py").read_text().splitlines() if not re.fullmatch(r"\s+\w+,", ln)]
@@ -124,7 +125,7 @@ def test_every_study_has_the_one_layout(name):
 def test_shared_modules_hold_no_per_study_code():
     """plotting keeps the house style and the shared figures, compare the comparison machinery,
     kernels the loader: no study group is named in their code (docstrings aside)."""
-    for module in ("plotting", "compare", "kernels", "published", "runner", "limits", "report_page"):
+    for module in ("plotting", "_compare", "_fortran", "_published", "_runner", "_limits", "_report_page"):
         tree = ast.parse((ROOT / "driver" / f"{module}.py").read_text())
         for node in ast.walk(tree):
             body = getattr(node, "body", None)
@@ -172,7 +173,7 @@ def _optional(s: Study, column: str) -> bool:
     """Columns of a pass table a deck may not produce: the four-bar's detail columns and its
     force columns (decks that give masses); the manipulator's C_rob walk minimum."""
     if s.name == "fourbar":
-        from driver.fourbar.batch import DETAIL
+        from driver.fourbar._batch import DETAIL
         return column in DETAIL or s.batch.passes[column] == ("forces",)
     return False
 
@@ -265,7 +266,7 @@ def _ode_period_and_swing(length: float, g: float, theta0: float, t: np.ndarray)
 def test_adding_a_study_is_one_folder_and_one_registry_line(pendulum):
     """The example lives in one folder of the house layout; no file of driver/ names it."""
     files = sorted(p.name for p in EXAMPLE.glob("*.py"))
-    assert files == ["__init__.py", "batch.py", "figures.py", "kernel.py", "report.py", "spec.py"]
+    assert files == ["__init__.py", "_batch.py", "_figures.py", "_kernel.py", "_report.py", "_spec.py"]
     for src in (ROOT / "driver").rglob("*.py"):
         assert "pendulum" not in src.read_text(), src
     assert isinstance(pendulum, Study) and pendulum.name in study_names()
@@ -289,7 +290,7 @@ def test_example_study_runs_through_the_driver_and_matches_the_equation_of_motio
 
 
 def test_example_study_deck_sweep_budget_and_figures(pendulum, tmp_path):
-    from driver.cli import main
+    from driver._cli import main
     deck = tmp_path / "swing.dat"
     deck.write_text("&pendulum length = 0.5, amplitude_deg = 60, title = 'example' /\n")
     assert main([str(deck), "-o", str(tmp_path / "out"), "-q", "--plot"]) == 0

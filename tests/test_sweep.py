@@ -8,7 +8,7 @@ import pytest
 
 from conftest import INPUTS
 from driver import sweep
-from driver.cli import main
+from driver._cli import main
 from test_fourbar_published import published, table_rows
 
 BASE = """&fourbar
@@ -48,7 +48,7 @@ def test_paper_study_in_one_run_reproduces_all_published_cells(tmp_path):
 ])
 def test_case_counts(tmp_path, text, n):
     from driver import fourbar
-    from driver.deck import read_deck, validate
+    from driver._deck import read_deck, validate
     d = read_deck(deck(tmp_path, text))
     sw = validate(d.groups["sweep"], sweep.SPEC, d.path)
     cases = sweep.build_cases(sw, "fourbar", fourbar.SPEC)
@@ -165,7 +165,7 @@ def test_resume_runs_only_missing_cases(tmp_path, capsys):
 def test_interrupt_keeps_finished_cases_and_leaves_no_partial_file(tmp_path, monkeypatch):
     path = deck(tmp_path, SWEEP_GRID)
     out = tmp_path / "o"
-    from driver.sweep import engine
+    from driver.sweep import _engine as engine
     real = engine._compute
 
     def interrupted(task, case, module):

@@ -1,4 +1,4 @@
-"""The streaming batch sweep engine (driver/sweep/batch.py): same tables as case by case, on one
+"""The streaming batch sweep engine (driver/sweep/_batch.py): same tables as case by case, on one
 process, two workers and Dask; exact resume after SIGKILL; a dying worker costs its chunk only;
 workers never outlive the driver; bad values found without validating every case."""
 from __future__ import annotations
@@ -14,8 +14,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from driver.cli import main
-from driver.sweep import batch as sweep_batch
+from driver._cli import main
+from driver.sweep import _batch as sweep_batch
 
 BASE = """&fourbar
   fixed_link = 12.0, crank = 3.0, coupler = 15.0, rocker = 9.0, omega = 5.0, step_deg = 10
@@ -85,8 +85,8 @@ def test_interior_bad_combination_of_a_large_grid_is_a_failed_case(tmp_path):
     """Above FULL_VALIDATION cases only each value and the grid's corners are validated up
     front; a bad combination inside the grid is found per chunk and reported as bad input."""
     from driver import fourbar, sweep
-    from driver.deck import read_deck, validate
-    from driver.sweep.spec import swept_axes
+    from driver._deck import read_deck, validate
+    from driver.sweep._spec import swept_axes
     path = tmp_path / "inner.dat"
     path.write_text(BASE + "&sweep key1 = 'fourbar.start_deg', values1 = 0, 300, 0\n"
                            "       key2 = 'fourbar.stop_deg', values2 = 360, 200, 360\n"
@@ -293,7 +293,7 @@ def test_shrunken_grid_removes_the_old_cases_files(tmp_path):
 
 
 def test_large_sweeps_shard_their_case_files(tmp_path, monkeypatch):
-    from driver.sweep import store
+    from driver.sweep import _store as store
     path = per_case_deck(tmp_path, a=3)                       # 9 cases
     flat = tmp_path / "flat"
     assert main([str(path), "-o", str(flat), "-q", "-j", "1"]) == 0
@@ -313,7 +313,7 @@ def test_large_sweeps_shard_their_case_files(tmp_path, monkeypatch):
 
 def _die_on_case(task, case, module, _real=None):
     """A case computation whose worker is SIGKILLed on case 7 (always, or once with DIE_ONCE)."""
-    from driver.sweep import engine
+    from driver.sweep import _engine as engine
     marker = os.environ.get("DIE_ONCE")
     if case.index == 7 and (not marker or not os.path.exists(marker)):
         if marker:
@@ -324,7 +324,7 @@ def _die_on_case(task, case, module, _real=None):
 
 @pytest.mark.parametrize("once", [True, False])
 def test_per_case_dying_worker_is_retried_then_isolated(tmp_path, monkeypatch, capsys, once):
-    from driver.sweep import engine
+    from driver.sweep import _engine as engine
     path = per_case_deck(tmp_path, a=4, extra=", chunk = 4")   # 12 cases; case 7 in chunk 5-8
     ref = tmp_path / "ref"
     assert main([str(path), "-o", str(ref), "-q", "-j", "1"]) == 0
@@ -352,7 +352,7 @@ def test_per_case_dying_worker_is_retried_then_isolated(tmp_path, monkeypatch, c
 
 def test_chunk_size_comes_from_a_warm_case(tmp_path, monkeypatch, capsys):
     """A worker's first case pays its cold imports: the chunk is sized from a later one."""
-    from driver.sweep import engine
+    from driver.sweep import _engine as engine
     real, calls = engine._compute, []
 
     def cold_first(task, case, module):
@@ -371,7 +371,7 @@ def test_chunk_size_comes_from_a_warm_case(tmp_path, monkeypatch, capsys):
 def test_dask_sizes_by_the_cluster_and_probes_its_file_system(tmp_path):
     """The first single-case batch is sized by the cluster's threads (not this machine's
     cores); workers that cannot see the output folder are found before anything runs."""
-    from driver.sweep import engine
+    from driver.sweep import _engine as engine
 
     class Client:   # the parts of a dask.distributed.Client the engine uses
         def __init__(self, root: Path | None = None):
@@ -409,7 +409,7 @@ def test_plot_draws_the_summary_and_case_figures_only_when_asked(tmp_path):
 def test_dask_is_imported_only_when_configured(tmp_path):
     """Reading Dask's scheduler-address costs a 0.2 s import of Dask, serial before every sweep:
     it is done only when some Dask configuration exists (environment or configuration file)."""
-    code = ("import sys; from driver.sweep.spec import configured_scheduler as c; "
+    code = ("import sys; from driver.sweep._spec import configured_scheduler as c; "
             "print(repr(c()), 'dask' in sys.modules)")
     env = {k: v for k, v in os.environ.items() if not k.startswith("DASK_")}
     env["HOME"] = str(tmp_path)

@@ -15,9 +15,9 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from driver.cli import main
-from driver.sweep import batch as sweep_batch
-from driver.sweep import stream
+from driver._cli import main
+from driver.sweep import _batch as sweep_batch
+from driver.sweep import _stream as stream
 
 ROOT = Path(__file__).resolve().parents[1]
 SHIPPED = (ROOT / "inputs" / "fourbar_design_search.dat").read_text()
@@ -101,9 +101,9 @@ def test_bad_input_rows(tmp_path, monkeypatch, order, streamed):
 
 
 def test_run_stops_holding_rows_above_the_threshold(tmp_path):
+    from driver._deck import read_deck, validate
     from driver._study import load_study
-    from driver.deck import read_deck, validate
-    from driver.sweep.spec import SPEC, grid_of
+    from driver.sweep._spec import SPEC, grid_of
     deck = tmp_path / "s.dat"
     deck.write_text(SHIPPED.replace("count1 = 25", "count1 = 4"))
     d = read_deck(deck)

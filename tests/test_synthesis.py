@@ -15,12 +15,12 @@ import numpy as np
 import pytest
 
 from driver import fourbar
-from driver.cli import main
-from driver.deck import RawGroup, validate
-from driver.fourbar import kernel as fourbar_kernel
-from driver.synthesis import crank_rocker as cr
+from driver._cli import main
+from driver._deck import RawGroup, validate
+from driver.fourbar import _kernel as fourbar_kernel
+from driver.synthesis import _crank_rocker as cr
 from driver.synthesis import synthesise
-from driver.synthesis.function import chebyshev, freudenstein, links_from_k
+from driver.synthesis._function import chebyshev, freudenstein, links_from_k
 
 D, A, B, C = 1.0, 0.45, 1.1, 0.9     # a crank-rocker (Grashof: 0.45 + 1.1 < 1.0 + 0.9)
 

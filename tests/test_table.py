@@ -3,7 +3,7 @@ import math
 
 import pytest
 
-from driver.table import Column, TableValueError, fortran_f, render_table
+from driver._table import Column, TableValueError, fortran_f, render_table
 
 
 @pytest.mark.parametrize("x,w,d,modern,legacy", [

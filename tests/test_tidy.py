@@ -8,7 +8,7 @@ import pytest
 
 import driver
 from conftest import INPUTS
-from driver.export import unit_of, with_units, write_tidy
+from driver._export import unit_of, with_units, write_tidy
 from driver.manipulator import table_frame
 
 FAST = ["crank5", "crank5_coupler_point", "nongrashof", "ujoint_option1", "manipulator_case2_report",

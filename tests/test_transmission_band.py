@@ -14,7 +14,7 @@ import pytest
 
 import driver
 from conftest import INPUTS
-from driver.deck import DeckError
+from driver._deck import DeckError
 
 
 def _mu_extremes(d: float, a: float, b: float, c: float) -> tuple[float, float]:
@@ -125,7 +125,7 @@ def test_the_summary_table_records_the_band_it_was_judged_by(tmp_path, case_outp
 
 def test_a_swept_band_is_a_column_not_table_metadata():
     from driver import fourbar
-    from driver.sweep.report import summary_settings
+    from driver.sweep._report import summary_settings
     base = {"crank": 3.0, "transmission_band_deg": [30, 150]}
     assert summary_settings(fourbar.STUDY, base) == {"transmission_band_deg": [30.0, 150.0]}
     assert summary_settings(fourbar.STUDY, base, {"transmission_band_deg"}) == {}

@@ -13,9 +13,9 @@ import re
 import numpy as np
 import pytest
 
-from driver.cli import main
-from driver.deck import read_deck
-from driver.runner import run_study
+from driver._cli import main
+from driver._deck import read_deck
+from driver._runner import run_study
 
 D = math.pi / 180.0
 

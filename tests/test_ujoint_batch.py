@@ -25,8 +25,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from driver import ujoint
-from driver.cli import main
-from driver.deck import DeckError, Params
+from driver._cli import main
+from driver._deck import DeckError, Params
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -187,7 +187,7 @@ def _sweep(tmp_path: Path, outputs: str, option: int = 0) -> Path:
 
 def _path_taken(out: Path, stem: str = "usw") -> str:
     """'batch' or 'case': the parts of the resume record <stem>.sweep/ say which engine ran
-    (driver.sweep.batch: part-<first case>.parquet; driver.sweep: part-r<run>-<seq>.parquet)."""
+    (driver.sweep._batch: part-<first case>.parquet; driver.sweep: part-r<run>-<seq>.parquet)."""
     parts = [p.name for p in (out / f"{stem}.sweep").glob("part-*.parquet")]
     assert parts
     return "case" if all(n.startswith("part-r") for n in parts) else "batch"

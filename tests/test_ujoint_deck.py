@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from driver.cli import main
+from driver._cli import main
 
 INPUTS = Path(__file__).resolve().parents[1] / "inputs"
 

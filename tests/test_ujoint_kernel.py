@@ -13,7 +13,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from driver.ujoint.kernel import (
+from driver.ujoint._kernel import (
     UJOINT_MODELS,
     UJOINT_OBJECTIVES,
     ujoint_equivalent,

@@ -9,10 +9,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from driver.deck import read_deck
-from driver.published import PUBLISHED_DIR, read_blocks
-from driver.runner import study_of
-from driver.ujoint.kernel import UJOINT_MODELS, ujoint_speed
+from driver._deck import read_deck
+from driver._published import PUBLISHED_DIR, read_blocks
+from driver._runner import study_of
+from driver.ujoint._kernel import UJOINT_MODELS, ujoint_speed
 
 
 def _paper() -> dict:

@@ -18,8 +18,8 @@ TARGET = Path(__file__).resolve().parents[1] / "driver" / "_keywords.py"
 def specs() -> list:
     """The SPEC of every study the runner knows, in name order (a study module's ``SPEC``, or
     the ``spec`` of its study contract)."""
-    from driver.deck import GroupSpec
-    from driver.runner import available_studies
+    from driver._deck import GroupSpec
+    from driver._runner import available_studies
     out = []
     for _, study in sorted(available_studies().items()):
         spec = getattr(study, "spec", None)   # a study package's 'spec' may be its spec module

@@ -17,28 +17,38 @@ call; the summary), ``report`` (the run: .out, tidy table, summary), ``figures``
 from __future__ import annotations
 
 from driver._study import BatchSummary, Study
-from driver.fourbar import forces, kernel, published
-from driver.fourbar.analysis import (
-    ST,
-    Extremes,
-    Grashof,
-    Motion,
-    assembly_intervals,
-    blame,
-    coupler_point,
-    crank_angles,
-    exact_grid,
-    extremes,
-    grashof,
-    limit_angles,
-    listing_grid,
-    rocking_motions,
-    tidy_frame,
+from driver.fourbar import _forces as forces
+from driver.fourbar import _kernel as kernel
+from driver.fourbar import _published as published
+from driver.fourbar._analysis import (
+           ST,
+           Extremes,
+           Grashof,
+           Motion,
+           assembly_intervals,
+           blame,
+           coupler_point,
+           crank_angles,
+           exact_grid,
+           extremes,
+           grashof,
+           limit_angles,
+           listing_grid,
+           rocking_motions,
+           tidy_frame,
 )
-from driver.fourbar.batch import BATCH_IGNORED, BATCH_INDEPENDENT, BATCH_KEYS, BATCH_PASSES, PASS_BITS, summarise, summarise_batch
-from driver.fourbar.published import LISTING_DEFECT, LISTING_PRECISION, exact_as_listed
-from driver.fourbar.report import animation_frames, run
-from driver.fourbar.spec import LABELS, SPEC, SUMMARY_SETTINGS, SWEEP_BEST, SWEEP_PLOT, estimate
+from driver.fourbar._batch import (
+           BATCH_IGNORED,
+           BATCH_INDEPENDENT,
+           BATCH_KEYS,
+           BATCH_PASSES,
+           PASS_BITS,
+           summarise,
+           summarise_batch,
+)
+from driver.fourbar._published import LISTING_DEFECT, LISTING_PRECISION, exact_as_listed
+from driver.fourbar._report import animation_frames, run
+from driver.fourbar._spec import LABELS, SPEC, SUMMARY_SETTINGS, SWEEP_BEST, SWEEP_PLOT, estimate
 
 __all__ = ["SPEC", "STUDY", "run", "estimate", "summarise", "summarise_batch", "BATCH_KEYS", "BATCH_PASSES", "grashof",
            "limit_angles", "assembly_intervals", "rocking_motions", "Motion", "crank_angles", "exact_grid", "coupler_point",
@@ -51,5 +61,5 @@ STUDY = Study(name="fourbar", package=__name__, spec=SPEC, run=run, estimate=est
                                  independent=BATCH_INDEPENDENT, passes=BATCH_PASSES,
                                  pass_names=(*PASS_BITS, "forces")),
               labels=LABELS, sweep_plot=SWEEP_PLOT, sweep_best=SWEEP_BEST, summary_settings=SUMMARY_SETTINGS,
-              blame=blame, published=published.compare, animation=animation_frames, figures=f"{__name__}.figures",
+              blame=blame, published=published.compare, animation=animation_frames, figures=f"{__name__}._figures",
               kernel=kernel)

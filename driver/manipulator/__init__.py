@@ -31,21 +31,22 @@ report/exact differences), :mod:`.report` (the run: text, tidy table, summary) a
 from __future__ import annotations
 
 from driver._study import BatchSummary, Study
-from driver.manipulator import kernel, published
-from driver.manipulator.analysis import DESIGN_STATUS, Workspace, optima, round_half_up, tolerance_box
-from driver.manipulator.batch import (
-    BATCH_IGNORED,
-    BATCH_INDEPENDENT,
-    BATCH_KEYS,
-    BATCH_PASS_SUFFIXES,
-    BATCH_PASSES,
-    batch_refusal,
-    summarise,
-    summarise_batch,
+from driver.manipulator import _kernel as kernel
+from driver.manipulator import _published as published
+from driver.manipulator._analysis import DESIGN_STATUS, Workspace, optima, round_half_up, tolerance_box
+from driver.manipulator._batch import (
+           BATCH_IGNORED,
+           BATCH_INDEPENDENT,
+           BATCH_KEYS,
+           BATCH_PASS_SUFFIXES,
+           BATCH_PASSES,
+           batch_refusal,
+           summarise,
+           summarise_batch,
 )
-from driver.manipulator.report import TIDY_UNITS, run, table_frame
-from driver.manipulator.spec import LABELS, RENAMED, SPEC, SWEEP_BEST, SWEEP_PLOT, estimate
-from driver.manipulator.tables import NOT_REPRODUCIBLE, REASONS, TEXT_REASONS, TIDY_NAMES
+from driver.manipulator._report import TIDY_UNITS, run, table_frame
+from driver.manipulator._spec import LABELS, RENAMED, SPEC, SWEEP_BEST, SWEEP_PLOT, estimate
+from driver.manipulator._tables import NOT_REPRODUCIBLE, REASONS, TEXT_REASONS, TIDY_NAMES
 
 __all__ = ["SPEC", "run", "Workspace", "tolerance_box", "round_half_up", "REASONS", "NOT_REPRODUCIBLE", "TEXT_REASONS",
            "TIDY_NAMES", "TIDY_UNITS", "table_frame", "LABELS", "SWEEP_PLOT", "SWEEP_BEST", "estimate", "optima",
@@ -57,4 +58,4 @@ STUDY = Study(name="manipulator", package=__name__, spec=SPEC, run=run, estimate
                                  independent=BATCH_INDEPENDENT, passes=BATCH_PASSES,
                                  pass_names=("indices", "target", "tolerance", "walk"), refusal=batch_refusal),
               labels=LABELS, sweep_plot=SWEEP_PLOT, sweep_best=SWEEP_BEST, renamed=RENAMED,
-              published=published.compare, figures=f"{__name__}.figures", kernel=kernel)
+              published=published.compare, figures=f"{__name__}._figures", kernel=kernel)

@@ -1,6 +1,6 @@
 """Optimisation of any study: an ``&optimize`` group beside the study group.
 
-See :mod:`driver.optimize.problem` for the deck keys.  Outputs for a deck ``<stem>.dat``:
+See :mod:`driver.optimize._problem` for the deck keys.  Outputs for a deck ``<stem>.dat``:
 
 * ``<stem>.out``: problem, method, result (converged or not -- a design is called an optimum
   only when the method converged), the optimum's constraint values and margins, the check of
@@ -16,7 +16,7 @@ While a run goes, each evaluation is appended to ``<stem>.journal.jsonl``; ``--r
 replays the (deterministic) run from the journal, or from a finished run's ``_evals``
 table, computing only designs not evaluated before.  Every journal line and table row carries
 a checksum of its content, verified on resume: what fails is computed again, and the command
-line says how many and why (:mod:`driver.optimize.journal`).  The journal is removed when the
+line says how many and why (:mod:`driver.optimize._journal`).  The journal is removed when the
 outputs are complete.
 
 Python API: :func:`optimize` returns an :class:`OptimizeOutcome` (``scipy.optimize``-like
@@ -33,18 +33,18 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from driver import blas
-from driver.atomic import output_set, write_text
-from driver.deck import Deck, read_deck
-from driver.export import write_tidy
-from driver.extras import require
-from driver.optimize import journal as journal_file
-from driver.optimize import report
-from driver.optimize.evaluate import Evaluator, Record, design_params
-from driver.optimize.methods import HistoryRow, MethodResult, run_method
-from driver.optimize.problem import SPEC, Problem, problem_of
-from driver.outcome import ExitCode, Outcome
-from driver.runner import compute, output_stem, write_outputs
+from driver import _blas as blas
+from driver._atomic import output_set, write_text
+from driver._deck import Deck, read_deck
+from driver._export import write_tidy
+from driver._extras import require
+from driver._outcome import ExitCode, Outcome
+from driver._runner import compute, output_stem, write_outputs
+from driver.optimize import _journal as journal_file
+from driver.optimize import _report as report
+from driver.optimize._evaluate import Evaluator, Record, design_params
+from driver.optimize._methods import HistoryRow, MethodResult, run_method
+from driver.optimize._problem import SPEC, Problem, problem_of
 
 __all__ = ["SPEC", "OptimizeOutcome", "optimize", "run_optimize_deck", "problem_of"]
 
@@ -73,7 +73,7 @@ class DesignVector(dict):
 class OptimizeOutcome(Outcome):
     """Result of an optimisation, shaped like ``scipy.optimize.OptimizeResult``.
 
-    Also an :class:`~driver.outcome.Outcome`: files written, warnings and errors as messages,
+    Also an :class:`~driver._outcome.Outcome`: files written, warnings and errors as messages,
     notes.  Values are in the units of the deck keys and summary columns they name.
 
     Attributes
@@ -204,7 +204,7 @@ def _probe(problem: Problem) -> None:
         return
     if not summary:
         return
-    from driver import expr
+    from driver import _expr as expr
     frame = pd.DataFrame([summary])
     o = problem.opts
     exprs = [("minimize" if problem.sense > 0 else "maximize", problem.objective)]

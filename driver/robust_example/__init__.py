@@ -25,13 +25,13 @@ The package, by job: ``spec`` (deck keys, the cross-check, the budget estimate),
 from __future__ import annotations
 
 from driver._study import Study
-from driver.robust_example import published
-from driver.robust_example.analysis import analyse, quadratic_fit
-from driver.robust_example.published import MODE_REASONS, NOT_REPRODUCIBLE
-from driver.robust_example.report import run
-from driver.robust_example.spec import SPEC, estimate
+from driver.robust_example import _published as published
+from driver.robust_example._analysis import analyse, quadratic_fit
+from driver.robust_example._published import MODE_REASONS, NOT_REPRODUCIBLE
+from driver.robust_example._report import run
+from driver.robust_example._spec import SPEC, estimate
 
 __all__ = ["SPEC", "STUDY", "run", "estimate", "quadratic_fit", "analyse", "MODE_REASONS", "NOT_REPRODUCIBLE"]
 
 STUDY = Study(name="robust_example", package=__name__, spec=SPEC, run=run, estimate=estimate,
-              published=published.compare, figures=f"{__name__}.figures")
+              published=published.compare, figures=f"{__name__}._figures")

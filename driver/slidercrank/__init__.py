@@ -20,22 +20,23 @@ study has no batch path: a sweep runs them one per task.
 from __future__ import annotations
 
 from driver._study import Study
-from driver.slidercrank import kernel, published
-from driver.slidercrank.analysis import Case, simeon_initial_state, static_onset
-from driver.slidercrank.report import animation_frames
-from driver.slidercrank.report_nl import run
-from driver.slidercrank.spec import (
-    LABELS,
-    MATERIALS,
-    PAPER_SPEEDS,
-    SIMEON1996,
-    SPEC,
-    STATUS_TEXT,
-    SWEEP_PLOT,
-    Model,
-    estimate,
-    min_steps_per_rev,
-    rayleigh,
+from driver.slidercrank import _kernel as kernel
+from driver.slidercrank import _published as published
+from driver.slidercrank._analysis import Case, simeon_initial_state, static_onset
+from driver.slidercrank._report import animation_frames
+from driver.slidercrank._report_nl import run
+from driver.slidercrank._spec import (
+           LABELS,
+           MATERIALS,
+           PAPER_SPEEDS,
+           SIMEON1996,
+           SPEC,
+           STATUS_TEXT,
+           SWEEP_PLOT,
+           Model,
+           estimate,
+           min_steps_per_rev,
+           rayleigh,
 )
 
 __all__ = ["SPEC", "STUDY", "run", "estimate", "MATERIALS", "PAPER_SPEEDS", "SIMEON1996", "simeon_initial_state",
@@ -43,5 +44,5 @@ __all__ = ["SPEC", "STUDY", "run", "estimate", "MATERIALS", "PAPER_SPEEDS", "SIM
            "kernel"]
 
 STUDY = Study(name="slidercrank", package=__name__, spec=SPEC, run=run, estimate=estimate, labels=LABELS,
-              sweep_plot=SWEEP_PLOT, published=published.compare, animation=animation_frames, figures=f"{__name__}.figures",
+              sweep_plot=SWEEP_PLOT, published=published.compare, animation=animation_frames, figures=f"{__name__}._figures",
               kernel=kernel)

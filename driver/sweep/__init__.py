@@ -20,21 +20,21 @@ and run exactly as a single run would be.  Outputs, for a deck ``<stem>.dat``:
 * ``<stem>_cases.{csv,parquet}``: the tidy tables of the written cases, with a
   column for every swept key (up to :data:`CASES_TABLE_MAX` written cases and
   :data:`CASES_TABLE_BYTES`);
-* ``<stem>.sweep/``: the resume record (:mod:`driver.sweep.store`).
+* ``<stem>.sweep/``: the resume record (:mod:`driver.sweep._store`).
 
 Cases run in worker processes (``--jobs``, default all cores) or on a Dask
 cluster (``--scheduler ADDRESS`` or Dask's ``scheduler-address`` configuration; never
 the deck: a deck naming a scheduler is refused), in chunks sized so that scheduling
-costs little (:mod:`driver.sweep.engine`); results are ordered by case whatever the
+costs little (:mod:`driver.sweep._engine`); results are ordered by case whatever the
 scheduling.  ``--resume`` skips cases whose row is in the resume record and whose files
 are all there.  A study with a batch path runs its summary-only sweeps on
-:mod:`driver.sweep.batch`.
+:mod:`driver.sweep._batch`.
 
-The package: :mod:`~driver.sweep.spec` (the &sweep keys, the grid, cases, validation),
-:mod:`~driver.sweep.keep` (the keep filter), :mod:`~driver.sweep.engine` (the per-case
-engine: workers and scheduling), :mod:`~driver.sweep.batch` (the batch engine),
-:mod:`~driver.sweep.pool` (the local worker pool of both), :mod:`~driver.sweep.store` (case
-files and the resume record), :mod:`~driver.sweep.report` (summary tables and text).
+The package: :mod:`~driver.sweep._spec` (the &sweep keys, the grid, cases, validation),
+:mod:`~driver.sweep._keep` (the keep filter), :mod:`~driver.sweep._engine` (the per-case
+engine: workers and scheduling), :mod:`~driver.sweep._batch` (the batch engine),
+:mod:`~driver.sweep._pool` (the local worker pool of both), :mod:`~driver.sweep._store` (case
+files and the resume record), :mod:`~driver.sweep._report` (summary tables and text).
 """
 from __future__ import annotations
 
@@ -49,18 +49,20 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from driver import expr
-from driver.atomic import refuse_link, remove_stale_temporaries
-from driver.deck import Deck, Params, RawGroup, validate
-from driver.extras import require
-from driver.outcome import ExitCode, SweepOutcome
-from driver.runner import compute, output_stem, study_of
-from driver.sweep import batch as batch_path
-from driver.sweep import engine, store, stream
-from driver.sweep.engine import Task, auto_chunk, run_task
-from driver.sweep.keep import check_keep, keep_columns
-from driver.sweep.report import Warnings, summary_frame, summary_settings, sweep_text, write_sweep_files
-from driver.sweep.spec import (
+from driver import _expr as expr
+from driver._atomic import refuse_link, remove_stale_temporaries
+from driver._deck import Deck, Params, RawGroup, validate
+from driver._extras import require
+from driver._outcome import ExitCode, SweepOutcome
+from driver._runner import compute, output_stem, study_of
+from driver.sweep import _batch as batch_path
+from driver.sweep import _engine as engine
+from driver.sweep import _store as store
+from driver.sweep import _stream as stream
+from driver.sweep._engine import Task, auto_chunk, run_task
+from driver.sweep._keep import check_keep, keep_columns
+from driver.sweep._report import Warnings, summary_frame, summary_settings, sweep_text, write_sweep_files
+from driver.sweep._spec import (
     MAX_CASES,
     MAX_KEYS,
     SPEC,
@@ -223,7 +225,7 @@ class _CasesTable:
     def add(self, indices: list[int]) -> None:
         import pyarrow.parquet as pq
 
-        from driver.export import csv_bytes
+        from driver._export import csv_bytes
         for k in indices:
             if self.full:
                 return
@@ -248,7 +250,7 @@ class _CasesTable:
             return None
         import pyarrow as pa
 
-        from driver.export import csv_bytes
+        from driver._export import csv_bytes
         parts = [self.pieces[k] for k in written]
         first = parts[0][0].schema
         bodies = [body for _, body in parts if body is not None]
@@ -383,7 +385,7 @@ class _Run:
         return oc
 
     def _batch_streamed(self, rows: batch_path.StreamedRows, n: int, elapsed: float, chunk: int) -> bool:
-        """The tables of a batch sweep written part by part from the record (:mod:`driver.sweep.stream`),
+        """The tables of a batch sweep written part by part from the record (:mod:`driver.sweep._stream`),
         on the outcome; False when the parts cannot be streamed (nothing written then)."""
         sw, names, oc = self.sw, self.grid.names, self.outcome
         remove_stale_temporaries(self.outdir, self.stem)
@@ -431,9 +433,9 @@ class _Run:
 
     # ------------------------------------------------------------------ batch path
     def batch(self, bplan, signature: str) -> SweepOutcome:
-        """A sweep on the study's batch path (driver.sweep.batch); same outputs as case by case.
+        """A sweep on the study's batch path (driver.sweep._batch); same outputs as case by case.
         With case_outputs = 'kept' the kept cases then run case by case for their files, with
-        their own resume record ``<stem>.sweep/cases/`` (:mod:`driver.sweep.store`)."""
+        their own resume record ``<stem>.sweep/cases/`` (:mod:`driver.sweep._store`)."""
         sw, names, n = self.sw, self.grid.names, bplan.grid.n
         oc = self.outcome
         oc.batch = True

@@ -30,15 +30,17 @@ import f90nml
 import numpy as np
 import pandas as pd
 
-from driver import blas, expr, fourbar
-from driver.atomic import output_set, write_text
-from driver.deck import Deck, DeckError, GroupSpec, Key, Params, RawGroup, positive, read_deck, validate
-from driver.export import write_tidy
-from driver.fourbar import kernel as fourbar_kernel
-from driver.outcome import FilesOutcome
-from driver.runner import compute, output_stem, write_outputs
-from driver.synthesis import crank_rocker as cr
-from driver.synthesis.function import FunctionDesign, chebyshev, freudenstein, links_from_k, wrap180
+from driver import _blas as blas
+from driver import _expr as expr
+from driver import fourbar
+from driver._atomic import output_set, write_text
+from driver._deck import Deck, DeckError, GroupSpec, Key, Params, RawGroup, positive, read_deck, validate
+from driver._export import write_tidy
+from driver._outcome import FilesOutcome
+from driver._runner import compute, output_stem, write_outputs
+from driver.fourbar import _kernel as fourbar_kernel
+from driver.synthesis import _crank_rocker as cr
+from driver.synthesis._function import FunctionDesign, chebyshev, freudenstein, links_from_k, wrap180
 
 __all__ = ["SPEC", "Synthesis", "synthesise", "run_synthesis_deck"]
 
@@ -452,7 +454,7 @@ def _at_family_end(members: list, m) -> bool:
 # ----------------------------------------------------------------------------- path generation
 
 def _path(p: Params) -> Synthesis:
-    from driver.synthesis import path as pg
+    from driver.synthesis import _path as pg
     targets = np.column_stack([p.target_x, p.target_y]).astype(float)
     ext = float(max(np.ptp(targets, axis=0))) or 1.0
     pp = pg.PathProblem(targets, None if p.timing_deg is None else np.array(p.timing_deg, float) - p.timing_deg[0],
@@ -558,8 +560,8 @@ def synthesise(deck: Deck | str | Path) -> Synthesis:
 def _path_figure(syn: Synthesis, path: Path, title: str, fmt: bool | str = True) -> Path:
     """The linkage, its coupler curve and the target points, in the linkage deck's frame."""
     from driver import plotting
-    from driver.fourbar import figures as fourbar_figures
-    from driver.synthesis import path as pg
+    from driver.fourbar import _figures as fourbar_figures
+    from driver.synthesis import _path as pg
     q = syn.design.parts
     theta = np.linspace(0.0, 360.0, 721)
     out, st = fourbar_kernel.fourbar_exact(np.radians(theta), q["ground"], q["crank"], q["coupler"], q["rocker"], 1.0, 0.0,
@@ -577,7 +579,7 @@ def _path_figure(syn: Synthesis, path: Path, title: str, fmt: bool | str = True)
 
 def synthesis_record(syn: Synthesis) -> dict[str, Any]:
     """The ``--json`` record of a synthesis: task, linkage, checks, failure and warnings."""
-    from driver.export import json_safe
+    from driver._export import json_safe
     return json_safe({"kind": "synthesis", "task": syn.params.task, "deck": str(syn.params.path),
                       "ok": syn.failure is None, "failure": syn.failure, "warnings": list(syn.warnings),
                       "linkage": syn.linkage, "checks": syn.checks})

@@ -27,45 +27,46 @@ wrappers).
 from __future__ import annotations
 
 from driver._study import BatchSummary, Study
-from driver.ujoint import kernel, published
-from driver.ujoint.analysis import (
-    BOUND_TOL,
-    CLUSTER_TOL,
-    PHASE_PERIOD,
-    SADDLE_NUDGE,
-    SYM_TOL,
-    TIE_RTOL,
-    Chain,
-    Design,
-    StartRun,
-    evaluate,
-    objective_scale,
-    optimise,
-    phases_for,
-    pick_best,
-    yoke_shifts,
+from driver.ujoint import _kernel as kernel
+from driver.ujoint import _published as published
+from driver.ujoint._analysis import (
+           BOUND_TOL,
+           CLUSTER_TOL,
+           PHASE_PERIOD,
+           SADDLE_NUDGE,
+           SYM_TOL,
+           TIE_RTOL,
+           Chain,
+           Design,
+           StartRun,
+           evaluate,
+           objective_scale,
+           optimise,
+           phases_for,
+           pick_best,
+           yoke_shifts,
 )
-from driver.ujoint.batch import (
-    BATCH_ELEMENTS,
-    BATCH_IGNORED,
-    BATCH_INDEPENDENT,
-    BATCH_KEYS,
-    BATCH_PASSES,
-    batch_applies,
-    summarise_batch,
+from driver.ujoint._batch import (
+           BATCH_ELEMENTS,
+           BATCH_IGNORED,
+           BATCH_INDEPENDENT,
+           BATCH_KEYS,
+           BATCH_PASSES,
+           batch_applies,
+           summarise_batch,
 )
-from driver.ujoint.report import run
-from driver.ujoint.spec import (
-    BAND_TOL,
-    CONVENTIONS,
-    DEG,
-    LABELS,
-    NOT_REPRODUCIBLE,
-    OPTIONS,
-    SPEC,
-    SWEEP_PLOT,
-    cross_check,
-    estimate,
+from driver.ujoint._report import run
+from driver.ujoint._spec import (
+           BAND_TOL,
+           CONVENTIONS,
+           DEG,
+           LABELS,
+           NOT_REPRODUCIBLE,
+           OPTIONS,
+           SPEC,
+           SWEEP_PLOT,
+           cross_check,
+           estimate,
 )
 
 __all__ = ["SPEC", "STUDY", "run", "estimate", "Chain", "Design", "StartRun", "evaluate", "optimise",
@@ -79,4 +80,4 @@ STUDY = Study(name="ujoint", package=__name__, spec=SPEC, run=run, estimate=esti
                                  independent=BATCH_INDEPENDENT, passes=BATCH_PASSES,
                                  pass_names=("objective", "speed", "equivalent"), applies=batch_applies,
                                  elements=BATCH_ELEMENTS),
-              labels=LABELS, sweep_plot=SWEEP_PLOT, published=published.compare, figures=f"{__name__}.figures", kernel=kernel)
+              labels=LABELS, sweep_plot=SWEEP_PLOT, published=published.compare, figures=f"{__name__}._figures", kernel=kernel)

@@ -13,10 +13,10 @@ from __future__ import annotations
 
 from driver._study import BatchSummary, Study
 
-from . import kernel
-from .batch import BATCH_KEYS, BATCH_PASSES, summarise_batch
-from .report import run, summarise
-from .spec import LABELS, SPEC, estimate
+from . import _kernel as kernel
+from ._batch import BATCH_KEYS, BATCH_PASSES, summarise_batch
+from ._report import run, summarise
+from ._spec import LABELS, SPEC, estimate
 
 __all__ = ["SPEC", "STUDY", "run", "estimate", "summarise", "summarise_batch"]
 
@@ -25,4 +25,4 @@ STUDY = Study(name="pendulum", package=__name__, spec=SPEC, run=run, estimate=es
                                  independent=("length", "gravity", "amplitude_deg", "title", "points"),
                                  passes=BATCH_PASSES, pass_names=("elliptic",)),
               labels=LABELS, sweep_plot=("period_s", "period_ratio"), sweep_best={"period_ratio": "min"},
-              figures=f"{__name__}.figures", kernel=kernel)
+              figures=f"{__name__}._figures", kernel=kernel)

@@ -1,0 +1,92 @@
+"""Which engine runs a deck, decided here and nowhere else, and the run of a deck by it.
+
+A deck with a ``&synthesis`` group is a synthesis (:mod:`driver.synthesis`), else one with an
+``&optimize`` group an optimisation (:mod:`driver.optimize`), else one with a ``&sweep`` group
+a sweep (:mod:`driver.sweep`), else one study run (:mod:`driver._runner`).  The command line
+(:func:`driver._cli.run_deck`) runs every deck through :func:`run_deck`; the Python API refuses
+a deck for the wrong entry point by :func:`engine_of`.  Nothing here prints: every engine
+returns an :class:`~driver._outcome.Outcome`.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from driver._deck import Deck
+from driver._extras import require
+from driver._outcome import ExitCode, Outcome, RunOutcome
+from driver._runner import output_stem, run_study, study_of
+
+__all__ = ["ENGINES", "engine_of", "run_deck"]
+
+#: the control groups that give a deck to an engine other than a single study run, in the
+#: order they decide, with the Python function that runs such a deck
+ENGINES = {"synthesis": "driver.synthesis.synthesise()", "optimize": "driver.optimize.optimize()",
+           "sweep": "driver.run_sweep()"}
+
+
+def engine_of(deck: Deck) -> str:
+    """'synthesis', 'optimize' or 'sweep' (the deck's control group, in that order), else 'study'."""
+    return next((g for g in ENGINES if g in deck.groups), "study")
+
+
+def run_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, progress: bool = False, *,
+             jobs: int | None = None, scheduler: Any = None, resume: bool = False, summary_json: bool = False,
+             report: bool = False, notify: Callable[[str], None] | None = None) -> Outcome:
+    """Run ``deck`` by its engine and write its outputs to ``outdir``; ``summary_json`` also its
+    ``<stem>.json``, ``report`` its report page ``<stem>.html`` (:mod:`driver._report_page`,
+    once the run has written its outputs).  ``jobs``, ``scheduler`` and ``resume`` apply to
+    sweeps and optimisations; ``notify(line)`` hears what cannot wait for the outcome (a sweep's
+    Ctrl-C: the queued cases are cancelled).  Returns the engine's outcome; raises DeckError for bad input
+    (nothing written) and :class:`~driver._extras.MissingExtra` for a missing optional package."""
+    kind = engine_of(deck)
+    if report:   # the page's name is known now: refused before the run, not after it
+        output_stem(outdir, deck.path, (".html",))
+    outcome: Outcome
+    if kind == "synthesis":
+        from driver import synthesis
+        outcome = synthesis.run_synthesis_deck(deck, outdir, formats, plot, progress, summary_json=summary_json)
+    elif kind == "optimize":
+        from driver import optimize
+        outcome = optimize.run_optimize_deck(deck, outdir, formats, plot, progress, summary_json=summary_json,
+                                             jobs=jobs, resume=resume, scheduler=scheduler)
+    elif kind == "sweep":
+        require("parquet")   # sweeps keep their cases in Parquet: say so before importing them
+        from driver import sweep
+        outcome = sweep.run_sweep_deck(deck, outdir, formats, plot, progress, jobs=jobs, scheduler=scheduler,
+                                       resume=resume, notify=notify)
+        if summary_json:
+            from driver.sweep._record import write_sweep_json
+            outcome.written.append(write_sweep_json(deck, outdir, int(outcome.exit_code)))
+    else:
+        outcome = run_study(deck, outdir, formats, plot, progress, summary_json=summary_json)
+    if report:
+        _report(deck, outdir, kind, outcome)
+    return outcome
+
+
+def _report(deck: Deck, outdir: Path, kind: str, outcome: Outcome) -> None:
+    """Write the deck's report page after its run (not after bad input: nothing is written then).
+    For a single run a failure to build it is a run failure (it propagates); for a sweep,
+    optimisation or synthesis it is an error message, and the deck's exit status becomes 1."""
+    from driver import _report_page as report_page
+    stem = output_stem(outdir, deck.path, (".html",))
+    path = stem.with_name(stem.name + ".html")
+    if isinstance(outcome, RunOutcome):
+        _, params = study_of(deck)
+        outcome.written.append(report_page.write_report(path, report_page.page_for_result(outcome.result, deck,
+                                                                                         params)))
+        return
+    status = outcome.exit_code
+    if status == ExitCode.BAD_INPUT:
+        return
+    build = {"sweep": report_page.page_for_sweep, "optimize": report_page.page_for_optimize,
+             "synthesis": report_page.page_for_synthesis}[kind]
+    try:
+        outcome.written.append(report_page.write_report(path, build(deck, outdir, stem.name, int(status))))
+    except (KeyboardInterrupt, BrokenPipeError):
+        raise
+    except Exception as exc:
+        outcome.error(f"{deck.path}: the report page could not be written: {exc.__class__.__name__}: {exc}")
+        outcome.late_failure = True

@@ -1,0 +1,287 @@
+"""What the engines return: outcome objects, and the exit codes of the command line (defined here,
+once).
+
+Every engine (one study run, :mod:`driver._runner`; a sweep, :mod:`driver.sweep`; an
+optimisation, :mod:`driver.optimize`; a synthesis, :mod:`driver.synthesis`) returns an
+:class:`Outcome`: what it wrote, its warnings and errors as data (:class:`Message`), the
+progress notes a terminal may show, and an :attr:`~Outcome.exit_code`.  Engines never print;
+the command line (:mod:`driver._cli`) is the one place that prints outcomes, and the Python API
+(:mod:`driver._api`) hands them back.  The shape follows ``scipy.optimize.OptimizeResult``: plain
+fields, ``success``/``status``/``message`` where they mean something.
+"""
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:   # annotations only
+    import pandas as pd
+
+    from driver._compare import Comparison
+    from driver._output import Result
+
+__all__ = ["ExitCode", "Message", "Outcome", "RunOutcome", "FilesOutcome", "SweepOutcome", "CompareOutcome"]
+
+
+class ExitCode(enum.IntEnum):
+    """The exit status of ``python -m driver`` (and of one deck, and of one sweep case)."""
+
+    OK = 0             #: every deck succeeded
+    FAILED = 1         #: a run failed (a case, an optimiser that did not converge, a file system fault)
+    BAD_INPUT = 2      #: a deck had bad input (nothing was written for it)
+    INTERRUPTED = 130  #: Ctrl-C (finished outputs are complete, no partial file is left)
+    TERMINATED = 143   #: SIGTERM, handled like Ctrl-C
+
+
+@dataclass(frozen=True)
+class Message:
+    """A warning or an error an engine reports, as data.
+
+    ``str()`` is the line the command line prints (``'warning: ...'``).
+
+    Parameters
+    ----------
+    level : {'warning', 'error'}
+        How bad it is.
+    text : str
+        What happened; names the deck where it concerns one.
+    """
+
+    level: str
+    text: str
+
+    def __str__(self) -> str:
+        return f"{self.level}: {self.text}"
+
+
+@dataclass(kw_only=True)
+class Outcome:
+    """What an engine did: the base of every outcome.
+
+    Parameters
+    ----------
+    written : list of pathlib.Path, optional
+        The files written, in order.
+    messages : list of Message, optional
+        Warnings and errors, in the order they arose.
+    notes : list of str, optional
+        Progress lines a terminal shows unless asked to be quiet (``"resume: ..."``).
+    late_failure : bool, default False
+        A failure after the engine's run (its report page could not be written): exit status 1.
+    """
+
+    written: list[Path] = field(default_factory=list)
+    messages: list[Message] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    #: a failure after the engine's run (its report page could not be written): exit status 1
+    late_failure: bool = False
+
+    @property
+    def exit_code(self) -> ExitCode:
+        """The exit status this outcome means (see :class:`ExitCode`)."""
+        return ExitCode.FAILED if self.late_failure else ExitCode.OK
+
+    @property
+    def ok(self) -> bool:
+        """True when the exit status is 0."""
+        return self.exit_code == ExitCode.OK
+
+    def warn(self, text: str) -> None:
+        """Record a warning.
+
+        Parameters
+        ----------
+        text : str
+            The warning, naming the deck where it concerns one.
+        """
+        self.messages.append(Message("warning", text))
+
+    def error(self, text: str) -> None:
+        """Record an error.
+
+        Parameters
+        ----------
+        text : str
+            The error, naming the deck where it concerns one.
+        """
+        self.messages.append(Message("error", text))
+
+
+@dataclass(kw_only=True)
+class RunOutcome(Outcome):
+    """One study run: its result and the files written.
+
+    The result's warnings and failure are the result's own (``result.warnings``,
+    ``result.failure``); the exit status is 1 when it failed.
+
+    Parameters
+    ----------
+    result : Result
+        What the study's run produced.
+    """
+
+    result: Result
+
+    @property
+    def exit_code(self) -> ExitCode:
+        """The exit status: 1 when the run failed, else the outcome's (see :class:`ExitCode`)."""
+        return ExitCode.FAILED if self.result.failure else super().exit_code
+
+
+@dataclass(kw_only=True)
+class FilesOutcome(Outcome):
+    """What an engine that writes a set of files and may fail after writing them did (a synthesis).
+
+    Parameters
+    ----------
+    failure : str or None, optional
+        Why the engine's result failed its check; None on success.
+    value : object, optional
+        The engine's own result (a :class:`driver.synthesis.Synthesis`).
+    """
+
+    failure: str | None = None
+    value: Any = None
+
+    @property
+    def exit_code(self) -> ExitCode:
+        """The exit status: 1 when the engine's result failed, else the outcome's."""
+        return ExitCode.FAILED if self.failure else super().exit_code
+
+
+@dataclass(kw_only=True)
+class SweepOutcome(Outcome):
+    """What a sweep did (:func:`driver.sweep.run_sweep_deck`, :func:`driver.run_sweep`).
+
+    ``driver.SweepResult`` is this class.  ``summary``, ``cases`` and ``text`` are filled by
+    :func:`driver.run_sweep`, which reads the tables back.
+
+    Attributes
+    ----------
+    deck : str
+        The sweep deck's path.
+    name : str
+        Its stem (the outputs' names).
+    outdir : pathlib.Path or None
+        Where the files are; None from :func:`driver.run_sweep` without ``outdir`` (they were
+        written to a temporary folder, now gone).
+    n_cases : int
+        Cases of the sweep.
+    n_ok : int
+        Cases that succeeded.
+    n_kept : int
+        Cases the deck's ``keep`` filter kept.
+    n_resumed : int
+        Cases found complete in the resume record (``--resume``) and not run again.
+    n_redone : int
+        Cases run again because their record or files failed a check.
+    n_failed : int
+        Cases that failed.
+    failed : list of tuple
+        The failed cases as ``(case, {swept key: value}, error)``; all of them, or the first
+        ones when the batch path streamed its tables (``n_failed`` counts them all).
+    bad_input : bool
+        Some cases had bad values (exit status 2).
+    batch : bool
+        The study's batch path ran the sweep (else case by case).
+    workers : str
+        Where the cases ran (``"2 worker(s)"``, ``"dask ADDRESS"``).
+    chunk : int
+        Cases per task.
+    seconds : float
+        Wall time of the cases, s.
+    phases : dict of str to float
+        The driver's CPU time per phase (``prepare_cpu``, ``run_cpu``, ``finish_cpu`` ...), s.
+    summary : pandas.DataFrame or None
+        One row per case: case number, the swept keys, status, kept, the study's headline
+        figures (units in their names), error.
+    cases : pandas.DataFrame or None
+        The tidy rows of every case that wrote its outputs, a column per swept key; None
+        when no case did.
+    text : str
+        The fixed-format summary ``.out``.
+    """
+
+    deck: str = ""
+    name: str = ""
+    outdir: Path | None = None
+    n_cases: int = 0
+    n_ok: int = 0
+    n_kept: int = 0
+    n_resumed: int = 0
+    n_redone: int = 0
+    n_failed: int = 0
+    failed: list[tuple[int, dict, str]] = field(default_factory=list)
+    bad_input: bool = False
+    batch: bool = False
+    workers: str = ""
+    chunk: int = 0
+    seconds: float = 0.0
+    phases: dict[str, float] = field(default_factory=dict)
+    summary: pd.DataFrame | None = None
+    cases: pd.DataFrame | None = None
+    text: str = ""
+
+    @property
+    def exit_code(self) -> ExitCode:
+        """0 every case ok, 2 a case had bad values, else 1 a case failed."""
+        worst = ExitCode.BAD_INPUT if self.bad_input else ExitCode.FAILED if self.n_failed else ExitCode.OK
+        return max(super().exit_code, worst)
+
+    @property
+    def warnings(self) -> list[str]:
+        """The sweep's warnings and errors, one line each as the command line prints them."""
+        return [str(m) for m in self.messages]
+
+    @property
+    def status(self) -> int:
+        """The exit status as a number (0, 1 or 2), as the command line returns it."""
+        return int(self.exit_code)
+
+    @property
+    def out(self) -> str:
+        """The fixed-format summary ``.out`` text."""
+        return self.text
+
+    @property
+    def kept(self) -> pd.DataFrame:
+        """The summary rows of the cases the deck's ``keep`` filter kept (all ok cases without one)."""
+        assert self.summary is not None, "the summary is read back by driver.run_sweep"
+        return self.summary[self.summary["kept"].astype(bool)]
+
+    def __repr__(self) -> str:
+        return (f"<SweepResult {self.name!r}: {self.n_cases} cases, {self.n_ok} ok, {self.n_kept} kept; "
+                f"status {self.status}" + (f"; files in {self.outdir}" if self.outdir else "") + ">")
+
+
+@dataclass(kw_only=True)
+class CompareOutcome(Outcome):
+    """A comparison of decks with the published record (:func:`driver._compare.compare_decks`).
+
+    Attributes
+    ----------
+    comparisons : list of Comparison
+        The decks compared, in order (:class:`~driver._compare.Comparison`: one row per
+        published cell, ``ok`` when no reproducible cell differs).
+    totals : list of str
+        One line per study (and mode or method) over the decks compared, as the command line
+        prints them under "Total"; empty when fewer than two decks were compared.
+    bad_input : bool
+        A deck had bad input (its error is in ``messages``).
+    failed : bool
+        A run failed or the published tables are missing (the error is in ``messages``).
+    """
+
+    comparisons: list[Comparison] = field(default_factory=list)
+    totals: list[str] = field(default_factory=list)
+    bad_input: bool = False
+    failed: bool = False
+
+    @property
+    def exit_code(self) -> ExitCode:
+        """0 every reproducible cell agrees, 1 a cell differs or a run failed, 2 a deck had bad input."""
+        differs = self.failed or not all(c.ok for c in self.comparisons)
+        worst = ExitCode.BAD_INPUT if self.bad_input else ExitCode.FAILED if differs else ExitCode.OK
+        return max(super().exit_code, worst)

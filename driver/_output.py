@@ -1,0 +1,107 @@
+"""What a study returns: :class:`Result` and its :class:`Figure` s; labels.
+
+What a study *is* (the :class:`~driver._study.Study` every study package declares as ``STUDY``)
+and the registry of studies are in :mod:`driver._study`.  This module holds what a study's run
+produces (:class:`Result`), the code digest that signs resume records, and the axis labels of
+summary columns from a study's ``labels``; the decorator that gives ``run`` its keyword form is
+:func:`driver._runner.keyword_run`.
+"""
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from types import ModuleType
+
+from driver._result import PLOT_FORMATS, Figure, Result, plot_format
+from driver._study import Study
+
+__all__ = ["Figure", "PLOT_FORMATS", "Result", "code_digest", "column_label", "expression_label", "plot_format"]
+
+
+def code_digest(module: Study | ModuleType | None, *others: ModuleType | None) -> bytes:
+    """SHA-256 of the source of study ``module`` (a :class:`~driver._study.Study` or its package)
+    -- every ``.py`` file of its package when it is one, so an edit to any module of the study
+    counts -- of the other modules ``others``,
+    and of the compiled kernels.  Both kinds of sweep resume record (batch and per-case) carry
+    it in their signature: a record made by other code is redone, never believed."""
+    import hashlib
+    import sys
+
+    def files(mod: ModuleType | None) -> list[Path]:
+        path = getattr(mod, "__file__", None)
+        if not path:
+            return []
+        p = Path(path)
+        if p.name == "__init__.py":
+            return sorted(p.parent.rglob("*.py"))
+        return [p]
+
+    if isinstance(module, Study):
+        module = module.module
+    h = hashlib.sha256()
+    kernels = sys.modules.get("driver._kernels")
+    for mod in (module, *others, kernels):
+        for f in files(mod):
+            h.update(str(f.name).encode())
+            try:
+                h.update(f.read_bytes())
+            except OSError:
+                h.update(b"<unreadable>")
+    return h.digest()
+
+
+def column_label(study: Study | None, name: str) -> str:
+    """The axis label of summary column or deck key ``name`` (``group.key`` or ``key``) of
+    ``study``: words and units from its ``labels``, else the key's ``SPEC`` units, else
+    units read off the name's suffix (``_deg``, ``_rad_s``, ...).  E.g. ``'crank speed [rad/s]'``."""
+    if not re.fullmatch(r"([a-z_][a-z0-9_]*\.)?[A-Za-z_][A-Za-z0-9_]*", name):
+        return name   # an expression of columns (driver._expr) is its own label
+    group, _, key = name.rpartition(".")
+    if study is not None and group and group != study.name:
+        study = None
+    labels = study.labels if study is not None else {}
+    entry = labels.get(key)
+    for pattern, value in labels.items() if entry is None else ():
+        m = re.fullmatch(re.escape(pattern).replace(r"\{i\}", "([0-9]+)"), key) if "{i}" in pattern else None
+        if m:
+            entry = (value[0].replace("{i}", m.group(1)), value[1])
+            break
+    spec_key = study.spec.keys.get(key) if study is not None else None
+    if entry is None:
+        words, units = key, ""
+        from driver._export import SUFFIX_UNITS  # the one suffix table (tidy units and labels)
+
+        for suffix, u in SUFFIX_UNITS:
+            if key.endswith(suffix) and len(key) > len(suffix):
+                words, units = key[: -len(suffix)], u
+                break
+        entry = (words.replace("_", " "), units)
+    words, units = entry
+    if not units and spec_key is not None:
+        units = spec_key.units
+    return f"{words} [{units}]" if units else words
+
+
+def expression_label(study: Study | None, text: str) -> str:
+    """The axis words of an objective: a summary column's words and unit, or for an expression
+    the expression in words with the unit its columns share (``min(mu_min_deg, ...) [deg]``)."""
+    from driver._export import SUFFIX_UNITS
+    if re.fullmatch(r"[A-Za-z_][A-Za-z0-9_.]*", text.strip()):
+        return column_label(study, text.strip())
+    names = set(re.findall(r"[A-Za-z_][A-Za-z0-9_]*", text)) - {"min", "max", "abs", "sqrt", "and", "or", "not"}
+    labels = study.labels if study is not None else {}
+    units = set()
+    for n in names:
+        for suffix, u in SUFFIX_UNITS:
+            if n.endswith(suffix):
+                units.add(u)
+                break
+        else:
+            if n in labels:
+                units.add(labels[n][1])
+    words = text.strip().replace("$", r"\$")   # the deck's text is never mathtext (driver.plotting.plain_text)
+    for n in sorted(names, key=len, reverse=True):
+        entry = labels.get(n)
+        if entry:
+            words = re.sub(rf"\b{re.escape(n)}\b", entry[0], words)
+    return f"{words} [{units.pop()}]" if len(units) == 1 and "" not in units else words

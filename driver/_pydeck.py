@@ -1,0 +1,92 @@
+"""Decks from Python: a deck file, a deck's text, or ``{group: {key: value}}`` with Python and numpy
+values, as the one deck type (:class:`~driver._deck.Deck`) the runner validates.
+
+Sizes are checked before anything is converted (a ``range(10**9)`` is refused, not
+materialised); a value is what a deck can hold: a number, a string, a logical or a flat
+list of them.  Used by the Python API (:mod:`driver._api`) and by the keyword face of every
+study's ``run`` (:func:`driver._runner.keyword_run`).
+"""
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any, TypeAlias
+
+import numpy as np
+
+from driver._deck import MAX_DECK_BYTES, MAX_VALUES, Deck, DeckError, RawGroup, read_deck, shown_value
+
+__all__ = ["DeckSource", "deck_of", "group_from_dict", "is_text", "plain_value"]
+
+#: what :func:`driver.run` and :func:`driver.run_sweep` accept: a deck file, a deck's text, or {group: {key: value}}
+DeckSource: TypeAlias = str | os.PathLike | Mapping[str, Mapping[str, Any]]
+
+
+def plain_value(value: Any, where: str, key: str | None = None, depth: int = 0) -> Any:
+    """A Python/numpy value as the deck reader's plain types (lists for sequences).
+
+    Sizes are checked from ``len()`` and ``shape`` before anything is converted (a
+    ``range(10**9)`` is refused, not materialised); a list of lists is one level deep at most
+    (a deck value is a number, a string, a logical or a list of them)."""
+    if isinstance(value, np.ndarray):
+        if value.ndim == 0:
+            return plain_value(value.item(), where, key, depth)
+        if value.size > MAX_VALUES or value.ndim > 1:
+            raise DeckError(where, None, key, f"array of shape {value.shape}: a deck value is at most a flat "
+                            f"list of {MAX_VALUES} values")
+        value = value.tolist()
+    if isinstance(value, (list, tuple, range)):
+        if len(value) > MAX_VALUES:
+            raise DeckError(where, None, key, f"{len(value)} values; at most {MAX_VALUES} are read per key "
+                            "(checked before anything is converted)")
+        if depth >= 1:
+            raise DeckError(where, None, key, "a list inside a list: a deck value is a number, a string, "
+                            "a logical or a flat list of them")
+        return [plain_value(v, where, key, depth + 1) for v in value]
+    if isinstance(value, np.generic):
+        return plain_value(value.item(), where, key, depth)
+    if isinstance(value, Path):
+        return str(value)
+    if isinstance(value, str) and len(value) > MAX_DECK_BYTES:
+        raise DeckError(where, None, key, f"a text of {len(value)} characters; a deck is at most {MAX_DECK_BYTES}")
+    if value is None or isinstance(value, (bool, int, float, str)):
+        return value
+    raise DeckError(where, None, key, f"value {shown_value(value)} of type {type(value).__name__} is not a deck value "
+                                       "(give numbers, strings, logicals or lists of them)")
+
+
+def group_from_dict(group: str, values: Mapping[str, Any], label: str) -> RawGroup:
+    if not isinstance(values, Mapping):
+        raise DeckError(label, None, None, f"group &{group} must be a dict of keys, got {type(values).__name__}")
+    plain = {}
+    for k, v in values.items():
+        if not isinstance(k, str):
+            raise DeckError(label, None, None, f"key {k!r} of &{group} is not a name")
+        plain[k.lower()] = plain_value(v, label, k.lower())
+    return RawGroup(group, plain, {}, 0)
+
+
+def is_text(source: str) -> bool:
+    return "\n" in source or source.lstrip().startswith(("&", "$", "!"))
+
+
+def deck_of(source: DeckSource | Deck, name: str | None) -> Deck:
+    """The deck for ``source``: a file path, a deck's text, a {group: {key: value}} dict."""
+    if isinstance(source, Deck):
+        return source
+    if isinstance(source, Mapping):
+        if not source:
+            raise DeckError(name or "<dict>", None, None, "deck has no study group")
+        named = [str(g).lower().lstrip("&") for g in source]
+        label = name or next((g for g in named if g != "sweep"), "sweep")
+        groups = {}
+        for g, values in source.items():
+            g = str(g).lower().lstrip("&")
+            groups[g] = group_from_dict(g, values, label)
+        return Deck(Path(label), groups)
+    if isinstance(source, str) and is_text(source):
+        return read_deck(Path(name or "deck"), text=source)
+    if isinstance(source, (str, os.PathLike)):
+        return read_deck(Path(source))
+    raise TypeError(f"a deck is a path, a deck's text or a dict of groups, not {type(source).__name__}")

@@ -1,0 +1,145 @@
+"""What one deck run produced: :class:`Result` with its :class:`Figure` s, and the figure
+formats of ``--plot``.  Plain data: it imports nothing of the driver, so that the study contract
+(:mod:`driver._study`), the runner and the studies can all name it (re-exported by
+:mod:`driver._output`)."""
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:   # annotations only: keeps `python -m driver --help` light
+    import matplotlib.figure
+    import pandas as pd
+
+__all__ = ["Figure", "PLOT_FORMATS", "Result", "plot_format"]
+
+
+#: file formats of ``--plot`` figures (``--plot-format``); the first is the default
+PLOT_FORMATS = ("png", "svg", "pdf")
+
+
+def plot_format(plot: bool | str | None) -> str | None:
+    """The figure format a ``plot`` argument asks for: None (no figures), or one of
+    :data:`PLOT_FORMATS` (``True`` means PNG).  Raises ValueError for any other format."""
+    if not plot:
+        return None
+    fmt = PLOT_FORMATS[0] if plot is True else str(plot).lower().lstrip(".")
+    if fmt not in PLOT_FORMATS:
+        raise ValueError(f"figure format {plot!r} is not one of {', '.join(PLOT_FORMATS)}")
+    return fmt
+
+
+@dataclass
+class Figure:
+    """A figure to write as ``<stem>_<name>.<format>``; ``draw`` builds it lazily (matplotlib Figure,
+    drawn in the house style by :mod:`driver.plotting`, never through pyplot)."""
+
+    name: str
+    draw: Callable[[], Any]
+
+
+@dataclass
+class Result:
+    """Everything one deck run produced.
+
+    What :func:`driver.run` and ``driver.<study>.run`` return.  Units are those of the study's
+    deck keys; tidy and summary columns carry them in their names (``theta_deg``,
+    ``omega3_rad_s``, ``tau1_Nm``) or in ``tidy.attrs["units"]``.
+
+    Attributes
+    ----------
+    text : str
+        The fixed-format ``.out`` file content (also :attr:`out`).
+    tidy : pandas.DataFrame
+        Tidy table, one row per output point, for CSV/Parquet; units in the column names or
+        in ``tidy.attrs["units"]`` (``'1'`` dimensionless).
+    summary : dict
+        Headline figures of the case, a flat dict of scalars (used by sweeps); units in the
+        names; None for a figure that does not exist.
+    warnings : list of str
+        Messages for the terminal (also written into ``text`` by the study).
+    failure : str or None
+        Set when the run completed but did not succeed (e.g. an optimiser did not converge):
+        outputs are written, the exit status is 1.
+    figures : list of Figure
+        Figures for ``--plot``, drawn only on demand (:meth:`figure`).
+    extra : dict of str to str
+        Further files: suffix -> text, written as ``<stem><suffix>``.
+    name : str
+        Output stem (the deck's file stem; set by the runner).
+    study : str
+        Namelist group of the study (set by the runner).
+    params : Params or None
+        The validated deck keys the run was made from (set by the runner).
+    """
+
+    text: str
+    tidy: pd.DataFrame
+    summary: dict[str, Any] = field(default_factory=dict)
+    warnings: list[str] = field(default_factory=list)
+    failure: str | None = None
+    figures: list[Figure] = field(default_factory=list)
+    extra: dict[str, str] = field(default_factory=dict)
+    name: str = ""
+    study: str = ""
+    #: the validated deck keys the run was made from (set by the runner; the report page's
+    #: animation and comparison use them)
+    params: Any = field(default=None, repr=False, compare=False)
+
+    @property
+    def out(self) -> str:
+        """The fixed-format ``.out`` text, exactly as the command line writes it."""
+        return self.text
+
+    @property
+    def ok(self) -> bool:
+        """True when the run succeeded (``failure`` is None)."""
+        return self.failure is None
+
+    @property
+    def summary_frame(self) -> pd.DataFrame:
+        """The summary as a one-row DataFrame (columns in summary order; None becomes missing)."""
+        import pandas as pd
+        return pd.DataFrame([self.summary])
+
+    @property
+    def figure_names(self) -> list[str]:
+        """Names of the figures this result can draw (``<stem>_<name>.png`` with --plot)."""
+        return [f.name for f in self.figures]
+
+    def figure(self, name: str | None = None) -> matplotlib.figure.Figure:
+        """Draw one figure of the run as a new matplotlib Figure.
+
+        It is drawn in the house style inside an ``rc_context``; the matplotlib backend and
+        the global rcParams are left as they were (figures show inline in Jupyter).
+
+        Parameters
+        ----------
+        name : str, optional
+            One of :attr:`figure_names`; default the first.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            The figure, drawn in the house style.
+
+        Raises
+        ------
+        LookupError
+            The result has no figures, or none called ``name``.
+        """
+        if not self.figures:
+            raise LookupError(f"{self.name or 'this result'} has no figures")
+        if name is None:
+            return self.figures[0].draw()
+        for f in self.figures:
+            if f.name == name:
+                return f.draw()
+        raise LookupError(f"no figure {name!r}; this result draws {', '.join(self.figure_names)}")
+
+    def __repr__(self) -> str:
+        state = "ok" if self.ok else f"failed: {self.failure}"
+        return (f"<Result {self.study or '?'} {self.name!r}: {state}; .out {len(self.text.splitlines())} lines, "
+                f"tidy {self.tidy.shape[0]}x{self.tidy.shape[1]}, summary {len(self.summary)} values, "
+                f"{len(self.warnings)} warning(s), figures {self.figure_names}>")

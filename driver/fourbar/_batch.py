@@ -1,0 +1,252 @@
+"""The four-bar batch summary: many designs in one kernel call (sweeps, &optimize), and the
+summary of one deck (the same kernel row)."""
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Collection, Mapping
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from driver._deck import Params
+from driver.fourbar import _forces as forces
+from driver.fourbar import _kernel as kernel
+from driver.fourbar._spec import BAND, band_of
+
+__all__ = ['BATCH_KEYS', 'BATCH_IGNORED', 'BATCH_INDEPENDENT', 'BATCH_PASSES', 'PASS_BITS', 'DETAIL',
+           'param_matrix', 'summarise_batch', 'summary_rows', 'summary_frame', 'summarise', 'summary_of']
+
+
+#: deck keys a batch may vary (one value per design); every other key of &fourbar leaves the
+#: summary unchanged (alpha, step_deg, method, title, coupler_point) and is accepted but ignored
+BATCH_KEYS = ("fixed_link", "crank", "coupler", "rocker", "omega", "start_deg", "stop_deg", "branch")
+
+
+BATCH_IGNORED = ("alpha", "step_deg", "method", "title", "coupler_point")
+
+
+#: keys whose deck checks do not involve other keys (a sweep validates each of their values once)
+BATCH_INDEPENDENT = ("fixed_link", "crank", "coupler", "rocker", "omega", "alpha", "title", "coupler_point")
+
+
+#: The column -> pass dependency table of the batch summary (the study's part of "compute only
+#: what the deck asks for"): for each column of :func:`summarise_batch` (``detail`` columns
+#: included), the kernel passes of fortran/fourbar_summary.f90 it needs.  Columns with no pass
+#: are closed form and always computed (Grashof class, assembly, toggles); 'transmission' is
+#: closed form too, 'rocker' evaluates the states at the rocker's candidate extremes, 'peaks'
+#: scans the range for the speed extremes (about 80 % of the kernel time when asked).
+BATCH_PASSES: dict[str, tuple[str, ...]] = {
+    "grashof_class": (), "full_crank_rotation": (), "assemblable": (),
+    "mu_min_deg": ("transmission",), "mu_max_deg": ("transmission",), "meets_transmission_band": ("transmission",),
+    "rocker_turns_fully": ("rocker",), "rocker_swing_deg": ("rocker",), "toggle_in_range": (),
+    "omega3_peak_rad_s": ("peaks",), "omega2_peak_rad_s": ("peaks",), "assembled_fraction": (),
+    "time_ratio": ("rocker",),
+    "mu_min_at_deg": ("transmission",), "mu_max_at_deg": ("transmission",), "rocker_min_deg": ("rocker",),
+    "rocker_min_at_deg": ("rocker",), "rocker_max_deg": ("rocker",), "rocker_max_at_deg": ("rocker",),
+    "omega3_peak_at_deg": ("peaks",), "omega2_peak_at_deg": ("peaks",), "toggles_in_range": (),
+    # decks that give masses: the force summary (driver/fourbar/_forces.py), a pass of its own
+    **{f"{pre}{c}": ("forces",) for pre in ("", "unbalanced_") for c in forces.SUMMARY_DOC},
+}
+
+
+#: the kernel's pass bits (fortran/fourbar_summary.f90 pass_*)
+PASS_BITS = {"transmission": kernel.FOURBAR_PASSES["transmission"], "rocker": kernel.FOURBAR_PASSES["rocker"],
+             "peaks": kernel.FOURBAR_PASSES["peaks"]}
+
+
+def _pass_mask(wanted: Collection[str] | None) -> int:
+    """The kernel's pass bits for summary columns ``wanted`` (None: every pass)."""
+    if wanted is None:
+        return sum(PASS_BITS.values())
+    return sum({PASS_BITS[p] for c in wanted for p in BATCH_PASSES.get(c, ()) if p in PASS_BITS})
+
+
+#: kernel Grashof codes -> (class name as grashof() prints it, full crank rotation)
+GRASHOF_NAMES = {"double_crank": ("double-crank (drag link)", True), "crank_rocker": ("crank-rocker", True),
+                 "rocker_crank": ("rocker-crank", False), "double_rocker": ("Grashof double-rocker", False),
+                 "change_point": ("change-point (special Grashof)", True),
+                 "triple_rocker": ("non-Grashof triple-rocker", False)}
+
+
+def _bad(base: Mapping[str, Any], key: str | None, message: str) -> Exception:
+    """A DeckError at the key's deck line when ``base`` is a deck's Params, else a ValueError."""
+    if isinstance(base, Params):
+        return base.error(key, message)
+    return ValueError(f"{key}: {message}" if key else message)
+
+
+def param_matrix(base: Mapping[str, Any], columns: Mapping[str, Any], n: int) -> np.ndarray:
+    """The kernel's (n, 8) parameter matrix: base values, overridden column by column."""
+    cols = {}
+    for key in BATCH_KEYS:
+        v = columns.get(key, base[key])
+        if key == "branch":
+            v = np.asarray(v)
+            if v.dtype.kind in "US":
+                bad = ~np.isin(v, ("open", "crossed"))
+                if bad.any():
+                    raise _bad(base, "branch", f"must be 'open' or 'crossed' (got {v[np.argmax(bad)]!r})")
+                v = np.where(v == "open", 1.0, -1.0)
+        v = np.broadcast_to(np.asarray(v, dtype=np.float64), (n,))
+        bad = ~np.isfinite(v)
+        if key in ("fixed_link", "crank", "coupler", "rocker"):
+            bad |= ~(v > 0)
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise _bad(base, key, f"design {i} has {float(v[i])!r} (lengths must be positive, all values finite)")
+        cols[key] = v
+    m = np.empty((n, 8), dtype=np.float64, order="F")
+    for j, key in enumerate(BATCH_KEYS):
+        m[:, j] = cols[key]
+    return m
+
+
+def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None = None,
+                    detail: bool = False, wanted: Collection[str] | None = None) -> pd.DataFrame:
+    """Summarise many four-bar designs in one Fortran call: one row per design.
+
+    ``base``: a validated ``&fourbar`` Params (or any mapping with the BATCH_KEYS).
+    ``columns``: {key: array of n values} for keys in BATCH_KEYS (``'fourbar.crank'`` is
+    accepted for ``'crank'``); scalars broadcast.  Lengths in the deck's unit, ``omega``
+    [rad/s], ``start_deg``/``stop_deg`` [deg], ``branch`` 'open'/'crossed' or +1/-1.
+    Returns the columns of the single-case summary (``summarise``) with identical values
+    (missing figures as NaN): grashof_class, full_crank_rotation, assemblable, mu_min_deg,
+    mu_max_deg, meets_transmission_band (mu within the base deck's ``transmission_band_deg``),
+    rocker_turns_fully, rocker_swing_deg, toggle_in_range,
+    omega3_peak_rad_s, omega2_peak_rad_s, assembled_fraction, time_ratio (crank angle of the
+    rocker's slower stroke over its quicker one, >= 1; missing unless the range holds a full
+    turn, assembled throughout, without a toggle, with the rocker oscillating); with ``detail`` also the crank
+    angles [deg] of those extremes, the rocker extreme positions [deg] and the number of
+    toggle positions in the range.  ``wanted``: only these columns (names of the columns
+    above; others are ignored), computed by only the kernel passes they need
+    (:data:`BATCH_PASSES`) -- each with the same bits as in a full summary; None: all.
+    A bad value raises DeckError (``base`` a deck's Params: deck, line and key of the base
+    deck, the design's index in the message) or ValueError.  About 3 microseconds per design
+    on one core with every column, 0.7 without the peak speeds (bench/bench_sweep.py).
+
+    Parameters
+    ----------
+    base : mapping
+        A validated ``&fourbar`` Params (or any mapping with the ``BATCH_KEYS``).
+    columns : mapping of str to array, optional
+        {key: n values} for keys in ``BATCH_KEYS``, in the deck's units (length unit, rad/s,
+        deg); scalars broadcast.
+    detail : bool, default False
+        Also the crank angles of the extremes, rocker extreme positions (deg) and toggle counts.
+    wanted : collection of str, optional
+        Only these columns; None: all.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per design, the columns above (units in their names: ``_deg``, ``_rad_s``).
+
+    Raises
+    ------
+    DeckError
+        A bad value, when ``base`` is a deck's Params (deck, line and key of the base deck,
+        the design's index in the message).
+    ValueError
+        A bad value otherwise.
+    """
+    columns = {k.partition(".")[2] if k.startswith("fourbar.") else k: v for k, v in (columns or {}).items()}
+    unknown = [k for k in columns if k not in BATCH_KEYS and k not in BATCH_IGNORED]
+    if unknown:
+        raise _bad(base, unknown[0], f"not a &fourbar key the summary depends on ({', '.join(BATCH_KEYS)})")
+    force_columns = {k: v for k, v in columns.items() if k in forces.BATCH_KEYS}
+    columns = {k: v for k, v in columns.items() if k in BATCH_KEYS}
+    sizes = {np.size(v) for v in columns.values() if np.ndim(v) > 0}
+    if len(sizes) > 1:
+        raise _bad(base, None, f"batch columns have different lengths {sorted(sizes)}")
+    n = sizes.pop() if sizes else 1
+    res = kernel.fourbar_summaries(param_matrix(base, columns, n), _pass_mask(wanted))
+    return _assemble(base, res, detail or (wanted is not None and any(c in DETAIL for c in wanted)), wanted,
+                     force_columns)
+
+
+def summary_rows(p: Params) -> np.ndarray:
+    """The summary kernel's row of one deck, every pass: (1, 19) (fortran/fourbar_summary.f90)."""
+    return kernel.fourbar_summaries(param_matrix(p, {}, 1), _pass_mask(None))
+
+
+def _assemble(base: Mapping[str, Any], res: np.ndarray, detail: bool, wanted: Collection[str] | None,
+              force_columns: Mapping[str, Any]) -> pd.DataFrame:
+    """The summary frame of kernel rows ``res`` (and the force columns when the deck gives masses)."""
+    frame = summary_frame(res, detail, band_of(base), wanted)
+    if forces.active(base) and (wanted is None or any(BATCH_PASSES.get(c) == ("forces",) for c in wanted)):
+        # force columns (driver/fourbar/_forces.py) when the deck gives masses, and someone reads one
+        more = forces.summarise_force_batch(base, force_columns)
+        if wanted is not None:
+            more = more[[c for c in more.columns if c in set(wanted)]]
+        frame = pd.concat([frame, more], axis=1)
+    return frame
+
+
+#: the columns of summarise_batch(detail=True) only
+DETAIL = ("mu_min_at_deg", "mu_max_at_deg", "rocker_min_deg", "rocker_min_at_deg", "rocker_max_deg",
+           "rocker_max_at_deg", "omega3_peak_at_deg", "omega2_peak_at_deg", "toggles_in_range")
+
+
+def summary_frame(res: np.ndarray, detail: bool = False, band: tuple[float, float] = BAND,
+           wanted: Collection[str] | None = None) -> pd.DataFrame:
+    """Kernel rows -> the summary columns (vectorised; the one place both paths go through);
+    with ``wanted``, only those columns are built."""
+    c = dict(zip(kernel.FOURBAR_SUMMARY_COLUMNS, res.T))
+    ok = c["assemblable"] > 0
+    lut = [GRASHOF_NAMES[kernel.FOURBAR_GRASHOF[k]] for k in range(len(GRASHOF_NAMES))]
+    tog = lambda: ok & (c["toggles_in_range"] > 0)
+    has = lambda v, m=None: np.where(ok if m is None else m, v, np.nan)
+    lo, hi = band
+    build: dict[str, Callable[[], Any]] = {
+        "grashof_class": lambda: np.array([n for n, _ in lut], dtype=object)[c["grashof"].astype(int)],
+        "full_crank_rotation": lambda: np.array([f for _, f in lut])[c["grashof"].astype(int)],
+        "assemblable": lambda: ok,
+        "mu_min_deg": lambda: has(c["mu_min_deg"]), "mu_max_deg": lambda: has(c["mu_max_deg"]),
+        "meets_transmission_band": lambda: ok & (c["mu_min_deg"] >= lo) & (c["mu_max_deg"] <= hi),
+        "rocker_turns_fully": lambda: ok & (c["rocker_turns"] > 0),
+        "rocker_swing_deg": lambda: has(c["rocker_swing_deg"]),
+        "toggle_in_range": tog,
+        "omega3_peak_rad_s": lambda: has(c["omega3_peak_rad_s"], ok & ~tog()),
+        "omega2_peak_rad_s": lambda: has(c["omega2_peak_rad_s"], ok & ~tog()),
+        "assembled_fraction": lambda: np.where(ok, c["assembled_fraction"], 0.0),
+        "time_ratio": lambda: np.where(ok & (c["time_ratio"] > 0), c["time_ratio"], np.nan)}
+    if detail:
+        build |= {"mu_min_at_deg": lambda: has(c["mu_min_at_deg"]), "mu_max_at_deg": lambda: has(c["mu_max_at_deg"]),
+                  "rocker_min_deg": lambda: has(c["rocker_min_deg"]),
+                  "rocker_min_at_deg": lambda: has(c["rocker_min_at_deg"]),
+                  "rocker_max_deg": lambda: has(c["rocker_max_deg"]),
+                  "rocker_max_at_deg": lambda: has(c["rocker_max_at_deg"]),
+                  "omega3_peak_at_deg": lambda: has(c["omega3_peak_at_deg"], ok & ~tog()),
+                  "omega2_peak_at_deg": lambda: has(c["omega2_peak_at_deg"], ok & ~tog()),
+                  "toggles_in_range": lambda: c["toggles_in_range"].astype(int)}
+    keys = build if wanted is None else [k for k in build if k in set(wanted)]
+    return pd.DataFrame({k: build[k]() for k in keys}, index=pd.RangeIndex(len(res)))
+
+
+def summarise(params: Params) -> dict:
+    """Summarise one deck: the headline figures only, without the tables.
+
+    What a sweep needs when it writes no per-case files.
+
+    Parameters
+    ----------
+    params : Params
+        Validated ``&fourbar`` keys.
+
+    Returns
+    -------
+    dict
+        The run's summary (``run(params).summary``): units in the names (``mu_min_deg``,
+        ``omega3_peak_rad_s``), None for a figure that does not exist.
+    """
+    return summary_of(params)
+
+
+def summary_of(p: Params, res: np.ndarray | None = None) -> dict:
+    """Headline figures for sweeps: one row of :func:`summarise_batch` as a dict (missing -> None).
+    ``res``: the deck's :func:`summary_rows` when the caller has them (the kernel then runs once)."""
+    row = _assemble(p, summary_rows(p) if res is None else res, False, None, {}).iloc[0].to_dict()
+    return {k: (None if isinstance(v, float) and math.isnan(v) else
+                bool(v) if isinstance(v, (bool, np.bool_)) else
+                float(v) if isinstance(v, np.floating) else v) for k, v in row.items()}

@@ -1,0 +1,278 @@
+"""The fourbar study's kernel wrappers: fourbar.f90 (closed-loop and listing kinematics, coupler
+point), fourbar_summary.f90 (the batch summary) and fourbar_forces.f90 (joint forces,
+Berkof-Lowen balancing, the force summary).
+
+Thin wrappers over the study's modules of the compiled extension (loaded once by
+:mod:`driver._fortran`): inputs are converted once to Fortran-ordered float64 (f2py would
+otherwise copy C-ordered 2-D arrays silently), nothing is looped in Python, numpy arrays come
+back.  Each kernel's physics and units are documented in its Fortran source.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from driver._fortran import _kernels, farray, spare_buffer
+
+__all__ = ['FOURBAR_PASSES', 'fourbar_listing', 'fourbar_exact', 'fourbar_coupler_point', 'fourbar_summaries',
+           'fourbar_joint_forces', 'fourbar_berkof_lowen', 'fourbar_force_summaries',
+           'FOURBAR_FORCE_SUMMARY_COLUMNS', 'FOURBAR_SUMMARY_COLUMNS', 'FOURBAR_GRASHOF', 'FOURBAR_STATUS']
+
+
+#: status codes of the four-bar kernels (fortran/fourbar.f90)
+FOURBAR_STATUS = {"ok": int(_kernels.fourbar.st_ok), "no_assembly": int(_kernels.fourbar.st_no_assembly),
+                  "toggle": int(_kernels.fourbar.st_toggle),
+                  "indeterminate": int(_kernels.fourbar.st_indeterminate)}
+
+
+def fourbar_listing(p: float, q: float, r: float, s: float, omega: float,
+                    start: int, step: int, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Run the published listing's program (single precision, as printed).
+
+    Parameters
+    ----------
+    p, q, r, s : float
+        Ground, crank, coupler and rocker length, in one length unit.
+    omega : float
+        Crank speed, rad/s.
+    start, step : int
+        First crank angle and step, whole deg.
+    n : int
+        Rows.
+
+    Returns
+    -------
+    table : numpy.ndarray
+        (n, 10): crank angle i [deg], epsl, phi, beta [whole deg, truncated], xa, ya, xb, yb
+        [length], omr, oms [rad/s].
+    status : numpy.ndarray
+        (n,): 0 ok, 1 not assemblable, 2 velocities divide by zero.
+    """
+    table, status = _kernels.fourbar.listing_table(p, q, r, s, omega, int(start), int(step), int(n))
+    return table, status
+
+
+def fourbar_exact(theta: np.ndarray, p: float, q: float, r: float, s: float, omega: float,
+                  alpha: float = 0.0, branch: int = 1, out: np.ndarray | None = None,
+                  status: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Solve the closed loop at the given crank angles: positions, velocities, accelerations.
+
+    Parameters
+    ----------
+    theta : numpy.ndarray
+        Crank angles, rad.
+    p, q, r, s : float
+        Ground, crank, coupler and rocker length, in one length unit.
+    omega : float
+        Crank angular velocity, rad/s.
+    alpha : float, default 0.0
+        Crank angular acceleration, rad/s^2.
+    branch : int, default 1
+        +1 open, -1 crossed.
+    out : numpy.ndarray, optional
+        (n, 11) Fortran-ordered float64 buffer to reuse; overwritten.
+    status : numpy.ndarray, optional
+        (n,) int32 buffer to reuse; overwritten.
+
+    Returns
+    -------
+    out : numpy.ndarray
+        (n, 11): coupler angle, rocker angle, transmission angle [rad]; xa, ya, xb, yb
+        [length]; coupler and rocker angular velocity [rad/s]; coupler and rocker angular
+        acceleration [rad/s^2].
+    status : numpy.ndarray
+        (n,): 0 ok, 1 cannot be assembled, 2 toggle (velocities unbounded, returned as 0),
+        3 indeterminate (A on O_B).
+
+    Raises
+    ------
+    ValueError
+        A buffer of the wrong shape, type or order (f2py would work on a hidden copy).
+    """
+    theta = farray(np.atleast_1d(theta), 1)
+    n = theta.shape[0]
+    if out is None:
+        out = spare_buffer("fourbar_exact.out", (n, 11), np.float64)
+    elif not (out.flags.f_contiguous and out.dtype == np.float64 and out.shape == (n, 11)):
+        raise ValueError("out must be a Fortran-ordered float64 array of shape (n, 11); "
+                         "f2py would otherwise work on a hidden copy")
+    if status is None:
+        status = spare_buffer("fourbar_exact.status", (n,), np.int32)
+    elif not (status.dtype == np.int32 and status.shape == (n,)):
+        raise ValueError("status must be an int32 array of shape (n,)")
+    return _kernels.fourbar.exact_states(theta, p, q, r, s, omega, alpha, int(branch), out, status)
+
+
+#: columns of fourbar_summaries (fortran/fourbar_summary.f90)
+FOURBAR_SUMMARY_COLUMNS = ("grashof", "assemblable", "assembled_fraction", "mu_min_deg", "mu_min_at_deg",
+                           "mu_max_deg", "mu_max_at_deg", "rocker_min_deg", "rocker_min_at_deg",
+                           "rocker_max_deg", "rocker_max_at_deg", "rocker_swing_deg", "rocker_turns",
+                           "toggles_in_range", "omega3_peak_rad_s", "omega3_peak_at_deg",
+                           "omega2_peak_rad_s", "omega2_peak_at_deg", "time_ratio")
+#: Grashof class codes of fourbar_summaries
+FOURBAR_GRASHOF = {int(getattr(_kernels.fourbar_summary, f"gr_{k}")): k for k in
+                   ("double_crank", "crank_rocker", "rocker_crank", "double_rocker", "change_point",
+                    "triple_rocker")}
+
+
+#: pass bits of fourbar_summaries (fortran/fourbar_summary.f90 pass_*); 'dense_scan' with
+#: 'peaks' is the previous peak search (every 1 deg grid point), the baseline of bench and tests
+FOURBAR_PASSES = {k: int(getattr(_kernels.fourbar_summary, f"pass_{k}")) for k in
+                  ("transmission", "rocker", "peaks", "dense_scan")}
+
+
+def fourbar_summaries(params: np.ndarray, passes: int = 7) -> np.ndarray:
+    """Compute the headline figures of many four-bars in one kernel call.
+
+    Parameters
+    ----------
+    params : numpy.ndarray
+        (n, 8): fixed link p, crank q, coupler r, rocker s [length], crank speed [rad/s],
+        first and last crank angle of the range [deg], branch (+1 open, -1 crossed).
+    passes : int, default 7
+        Sum of ``FOURBAR_PASSES`` bits; the columns of a pass not asked for are 0 (not
+        computed), the others have the same bits whichever passes run (default: all three).
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, 19), columns ``FOURBAR_SUMMARY_COLUMNS`` (angles in deg, speeds in rad/s, flags
+        0/1; figures that do not exist are 0 -- mask them with 'assemblable' and
+        'toggles_in_range').
+
+    Raises
+    ------
+    ValueError
+        ``params`` does not have 8 columns.
+    """
+    params = farray(params, 2)
+    if params.shape[1] != 8:
+        raise ValueError(f"params must have 8 columns, got {params.shape[1]}")
+    return _kernels.fourbar_summary.summaries(params, int(passes))
+
+
+def fourbar_coupler_point(theta: np.ndarray, states: np.ndarray, status: np.ndarray, q: float,
+                          omega: float, alpha: float, u: float, v: float) -> np.ndarray:
+    """Compute position, velocity and acceleration of a point fixed to the coupler.
+
+    Parameters
+    ----------
+    theta : numpy.ndarray
+        Crank angles, rad.
+    states, status : numpy.ndarray
+        The ``fourbar_exact`` results at ``theta``.
+    q : float
+        Crank length [length].
+    omega : float
+        Crank angular velocity, rad/s.
+    alpha : float
+        Crank angular acceleration, rad/s^2.
+    u, v : float
+        The point: u along A->B and v to its left [length].
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, 6): x, y [length], vx, vy [length/s], ax, ay [length/s^2]; zero where the
+        linkage is not placed.
+    """
+    theta = farray(np.atleast_1d(theta), 1)
+    return _kernels.fourbar.coupler_point(theta, q, omega, alpha, u, v, farray(states, 2),
+                                          np.asarray(status, dtype=np.int32))
+
+
+def fourbar_joint_forces(states: np.ndarray, status: np.ndarray, p: float, q: float, r: float, s: float,
+                         omega: float, alpha: float, props: np.ndarray) -> np.ndarray:
+    """Compute joint forces, input torque and shaking from ``fourbar_exact`` results.
+
+    Parameters
+    ----------
+    states, status : numpy.ndarray
+        The ``fourbar_exact`` results (same omega and alpha).
+    p, q, r, s : float
+        Ground, crank, coupler and rocker length, m.
+    omega : float
+        Crank angular velocity, rad/s.
+    alpha : float
+        Crank angular acceleration, rad/s^2.
+    props : numpy.ndarray
+        (18,): masses [kg], inertias about the centres of mass [kg m^2], com distances [m]
+        and angles [rad] of crank, coupler, rocker; gravity [m/s^2] (along -y); load torque
+        on the rocker [N m]; load force at the coupler point [N]; the point's u, v [m].
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, 12): input torque [N m]; F_O2, F_A, F_B, F_O4 (x, y) [N]; shaking force (x, y)
+        [N]; shaking moment about O2 [N m] (fortran/fourbar_forces.f90).  Zero where status
+        is not ok.
+
+    Raises
+    ------
+    ValueError
+        ``props`` does not have 18 values.
+    """
+    props = np.ascontiguousarray(props, dtype=np.float64)
+    if props.shape != (18,):
+        raise ValueError(f"props must have 18 values, got shape {props.shape}")
+    return _kernels.fourbar_forces.joint_forces(farray(states, 2), np.asarray(status, dtype=np.int32),
+                                                p, q, r, s, omega, alpha, props)
+
+
+def fourbar_berkof_lowen(q: float, r: float, s: float, props: np.ndarray,
+                         radii: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
+    """Compute the Berkof-Lowen counterweights on crank and rocker that cancel the shaking force.
+
+    Parameters
+    ----------
+    q, r, s : float
+        Crank, coupler and rocker length, m.
+    props : numpy.ndarray
+        (18,) link and load properties, as for ``fourbar_joint_forces``.
+    radii : tuple of float
+        Counterweight radii on crank and rocker, m.
+
+    Returns
+    -------
+    props : numpy.ndarray
+        (18,) properties of the balanced linkage.
+    cw : numpy.ndarray
+        (6,): crank counterweight mass x radius [kg m] and angle [rad], rocker the same, the
+        two counterweight masses [kg].
+    """
+    return _kernels.fourbar_forces.berkof_lowen(q, r, s, np.asarray(props, dtype=np.float64),
+                                                np.asarray(radii, dtype=np.float64))
+
+
+#: columns of fourbar_force_summaries (fortran/fourbar_forces.f90 force_summaries)
+FOURBAR_FORCE_SUMMARY_COLUMNS = ("defined_fraction", "torque_peak_Nm", "torque_peak_at_deg", "torque_mean_Nm",
+                                 "torque_rms_Nm", "F_O2_peak_N", "F_A_peak_N", "F_B_peak_N", "F_O4_peak_N",
+                                 "shaking_force_peak_N", "shaking_moment_peak_Nm", "energy_fluctuation_J",
+                                 "flywheel_inertia_kgm2")
+
+
+def fourbar_force_summaries(params: np.ndarray) -> np.ndarray:
+    """Compute the force summaries of many four-bars in one kernel call.
+
+    Parameters
+    ----------
+    params : numpy.ndarray
+        (n, 31): p, q, r, s [m], omega [rad/s], alpha [rad/s^2], first and last crank angle
+        [deg], branch (+1/-1), the 18 props of ``fourbar_joint_forces``, speed fluctuation
+        [dimensionless], balance flag (1 = Berkof-Lowen counterweights first), counterweight
+        radii [m].
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, 13), columns ``FOURBAR_FORCE_SUMMARY_COLUMNS`` (units in their names: N, N m, J,
+        kg m^2, deg).
+
+    Raises
+    ------
+    ValueError
+        ``params`` does not have 31 columns.
+    """
+    params = farray(params, 2)
+    if params.shape[1] != 31:
+        raise ValueError(f"params must have 31 columns, got {params.shape[1]}")
+    return _kernels.fourbar_forces.force_summaries(params)

@@ -1,0 +1,343 @@
+"""A four-bar deck run: the listing's output file (``method = 'listing'``) and its audit against
+the closed loop, or the closed-loop table with accelerations, coupler point and forces
+(``method = 'exact'``); the summary lines, tidy table, summary and figures."""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from driver import _keywords
+from driver._deck import Params
+from driver._export import with_units
+from driver._output import Figure, Result
+from driver._runner import keyword_run
+from driver._signatures import keyword_signature
+from driver._table import Column, fortran_f, render_table
+from driver.fourbar import _forces as forces
+from driver.fourbar._analysis import (
+    ST,
+    TIDY_UNITS,
+    Extremes,
+    Grashof,
+    assembly_intervals,
+    coupler_point,
+    crank_angles,
+    deg360,
+    exact_columns,
+    exact_grid,
+    extremes,
+    grashof,
+    limit_angles,
+    listing_grid,
+    rocking_motions,
+    tidy_frame,
+)
+from driver.fourbar._batch import summary_of, summary_rows
+from driver.fourbar._spec import SPEC, band_of
+
+__all__ = ["run", "listing_text", "exact_table", "summary_lines", "audit", "deck_figures", "output_name", "animation_frames"]
+
+
+def _echo(p: Params) -> list[str]:
+    """Deck inputs echoed in the English header of exact runs."""
+    rows = [("fixed link O_A-O_B", p.fixed_link, ""), ("crank (driver) O_A-A", p.crank, ""),
+            ("coupler A-B", p.coupler, ""), ("rocker (output) O_B-B", p.rocker, ""),
+            ("crank speed", p.omega, "rad/s"), ("crank acceleration", p.alpha, "rad/s^2")]
+    return [f"  {name:<24}{fortran_f(v, 12, 4)} {u}".rstrip() for name, v, u in rows]
+
+
+def listing_text(p: Params, table: np.ndarray, status: np.ndarray) -> tuple[list[str], list[Column]]:
+    """The listing's output file: its header (format 15), column line and rows (format 25);
+    and the table's columns."""
+    head = ["", "", "",
+            f"  panjang OA-OB (fixed link):  {fortran_f(p.fixed_link, 5, 2, 'legacy')}",
+            f"  panjang poros engkol (crank/driver):  {fortran_f(p.crank, 5, 2, 'legacy')}",
+            f"  panjang batang penghubung (coupler):  {fortran_f(p.coupler, 5, 2, 'legacy')}",
+            f"  panjang batang ayun (rocker/output link):  {fortran_f(p.rocker, 5, 2, 'legacy')}",
+            f"  kecepatan sudut poros engkol (rad/detik):  {fortran_f(p.omega, 5, 2, 'legacy')}",
+            ""]
+    # format 25: (2x,i3,2x,7(f5.1,2x),3x,2(f7.4,3x))
+    cols = ([Column("i", "i", 3, 0, 2)] + [Column(h, "f", 5, 1, 2, "legacy") for h in ("epsl", "phi", "beta", "xa", "ya", "xb")]
+            + [Column("yb", "f", 5, 1, 2, "legacy"), Column("omr", "f", 7, 4, 5, "legacy"),
+               Column("oms", "f", 7, 4, 3, "legacy")])
+    rows, trailers = [], []
+    for row, st in zip(table, status):
+        if st == ST["no_assembly"]:
+            rows.append([int(row[0])] + [None] * 9)
+            trailers.append("cannot be assembled: the listing's arccos argument leaves [-1, 1]")
+        elif st == ST["toggle"]:
+            rows.append([int(row[0])] + list(row[1:8]) + [None, None])
+            trailers.append("toggle: sin(phi - epsl) = 0, velocities unbounded")
+        else:
+            rows.append([int(row[0])] + list(row[1:]))
+            trailers.append("")
+    lines = render_table(cols, rows, trailers)
+    return head + [lines[0], ""] + lines[1:], cols
+
+
+def exact_table(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarray,
+                cp: np.ndarray | None = None) -> list[str]:
+    """Fixed-format exact table: the listing's ten columns (angles rounded) plus accelerations,
+    and the coupler point's position and speed when the deck defines one (``cp`` from
+    kernel.fourbar_coupler_point)."""
+    whole = np.all(np.isclose(theta, np.round(theta)))
+    tcol = Column("theta", "i", 5, 0, 2) if whole else Column("theta", "f", 8, 3, 2)
+    cols = [tcol, Column("coupler", "f", 7, 1), Column("rocker", "f", 7, 1), Column("transm", "f", 7, 1)]
+    cols += [Column(h, "f", 9, 4) for h in ("xa", "ya", "xb", "yb")]
+    cols += [Column(h, "f", 10, 4) for h in ("omega2", "omega3")] + [Column(h, "f", 11, 4) for h in ("alpha2", "alpha3")]
+    units = ["[deg]", "[deg]", "[deg]", "[deg]", "", "", "", "", "[rad/s]", "[rad/s]", "[rad/s2]", "[rad/s2]"]
+    if cp is not None:
+        cols += [Column("xp", "f", 9, 4), Column("yp", "f", 9, 4), Column("vp", "f", 10, 4)]
+        units += ["", "", "[len/s]"]
+        extra = np.column_stack([cp[:, 0], cp[:, 1], np.hypot(cp[:, 2], cp[:, 3])])
+    ang = np.column_stack([deg360(out[:, 0]), deg360(out[:, 1]), np.degrees(out[:, 2])])
+    rows, trailers = [], []
+    d = np.hypot(p.fixed_link - out[:, 3], out[:, 4])
+    for k in range(len(theta)):
+        t = int(round(theta[k])) if whole else theta[k]
+        if status[k] == ST["indeterminate"]:
+            rows.append([t, None, None, None, out[k, 3], out[k, 4]] + [None] * 6)
+            trailers.append("indeterminate: crank pin A on the rocker pivot O_B, B free on a circle")
+        elif status[k] == ST["no_assembly"]:
+            rows.append([t, None, None, None, out[k, 3], out[k, 4]] + [None] * 6)
+            trailers.append(f"cannot be assembled: |A O_B| = {d[k]:.4f} outside "
+                            f"[{abs(p.coupler - p.rocker):g}, {p.coupler + p.rocker:g}]")
+        elif status[k] == ST["toggle"]:
+            rows.append([t, *ang[k], *out[k, 3:7]] + [None] * 4)
+            trailers.append("toggle: coupler and rocker collinear, velocity unbounded")
+        else:
+            rows.append([t, *ang[k], *out[k, 3:11]])
+            trailers.append("")
+        if cp is not None:
+            placed = status[k] in (ST["ok"], ST["toggle"])
+            rows[-1] += [extra[k, 0] if placed else None, extra[k, 1] if placed else None,
+                         extra[k, 2] if status[k] == ST["ok"] else None]
+    lines = render_table(cols, rows, trailers)
+    unit_line = "".join(" " * c.sep + u.rjust(max(c.width, len(c.header))) for c, u in zip(cols, units)).rstrip()
+    return [lines[0], unit_line] + lines[1:]
+
+
+def summary_lines(p: Params, g: Grashof, ex: Extremes | None) -> list[str]:
+    """Words and numbers after an exact table."""
+    lim = limit_angles(p.fixed_link, p.crank, p.coupler, p.rocker)
+    out = ["", "  Summary (closed-loop solution, branch = " + p.branch + ")",
+           f"    Grashof class ........ {g.name}  ({g.condition})",
+           "    crank rotation ....... " + ("full turn" if not lim else
+                                           "limited: limit (toggle) crank angles " +
+                                           ", ".join(f"{a:.3f}" for a in lim) + " deg")]
+    if ex is None:
+        out.append("    the linkage cannot be assembled anywhere in the requested range")
+        return out
+    lo, hi = band_of(p)
+    meets = lo <= ex.mu_min and ex.mu_max <= hi
+    out += [f"    transmission angle ... min {ex.mu_min:.2f} deg at theta = {ex.mu_min_at:.2f}, "
+            f"max {ex.mu_max:.2f} deg at theta = {ex.mu_max_at:.2f}",
+            f"    {lo:g}-{hi:g} deg band ...... " + ("met" if meets else "NOT met"),
+            ("    rocker ............... turns fully (no extreme positions)" if ex.rocker_turns else
+             f"    rocker positions ..... {ex.rocker_min:.3f} deg (theta = {ex.rocker_min_at:.3f}) to "
+             f"{ex.rocker_max:.3f} deg (theta = {ex.rocker_max_at:.3f}); swing "
+             f"{ex.rocker_swing:.3f} deg")]
+    if ex.toggles:
+        out.append("    peak speeds .......... unbounded at the toggle positions (theta = "
+                   + ", ".join(f"{a:.3f}" for a in ex.toggles) + " deg)")
+    else:
+        out += [f"    peak rocker speed .... {ex.w3_peak:.4f} rad/s at theta = {ex.w3_peak_at:.2f} deg",
+                f"    peak coupler speed ... {ex.w2_peak:.4f} rad/s at theta = {ex.w2_peak_at:.2f} deg"]
+    if ex.assembled_fraction < 1.0:
+        out.append(f"    assemblable .......... about {100 * ex.assembled_fraction:.1f} % of the requested range")
+    return out
+
+
+def audit(p: Params, theta: np.ndarray, table: np.ndarray, lst_status: np.ndarray,
+          out: np.ndarray, status: np.ndarray) -> tuple[list[str], str | None, pd.DataFrame]:
+    """Rows of the listing that violate loop closure, compared with the exact solution."""
+    ab = np.hypot(table[:, 6] - table[:, 4], table[:, 7] - table[:, 5])
+    dev = ab - p.coupler
+    good = (lst_status == ST["ok"]) & (status == ST["ok"])
+    bad = good & (np.abs(dev) > 1e-4 * p.coupler)
+    lines = ["", "  Audit of the listing against the closed loop (method = 'exact', branch = 'open')"]
+    frame = pd.DataFrame({"theta_deg": theta, "ab_length": ab, "ab_deviation": dev, "loop_not_closed": bad})
+    if not bad.any():
+        lines.append(f"    every row closes the loop: |AB| = coupler within {np.max(np.abs(dev[good]), initial=0):.2e}")
+        return lines, None, frame
+    worst = int(np.argmax(np.where(bad, np.abs(dev), -1)))
+    cols = [Column("i", "i", 5, 0), Column("|AB|", "f", 9, 4), Column("dev", "f", 9, 4),
+            Column("xb lst", "f", 8, 3), Column("yb lst", "f", 8, 3), Column("xb", "f", 8, 3),
+            Column("yb", "f", 8, 3), Column("oms lst", "f", 9, 4), Column("omega3", "f", 9, 4)]
+    rows = [[int(theta[k]), ab[k], dev[k], table[k, 6], table[k, 7], out[k, 5], out[k, 6], table[k, 9], out[k, 8]]
+            for k in np.flatnonzero(bad)]
+    lines += [f"    {int(bad.sum())} of {len(theta)} rows have a coupler length |AB| different from "
+              f"the deck's {p.coupler:g}; largest deviation {dev[worst]:+.4f} at i = {int(theta[worst])}:"]
+    lines += ["  " + l for l in render_table(cols, rows)]
+    lines += ["    Why: for crank angles in (180, 360) deg the listing's quadrant test sends",
+              "    sigy > 0, sigx > 0 to 'sigma = 2 pi - |atan|' (meant: |atan|), so those rows",
+              "    repeat the positions of 360 - i (mirror image) and their velocities are",
+              "    wrong; the transmission angle column is still right (it depends on |A O_B| only).",
+              "    Use method = 'exact' for correct values (columns 'xb', 'yb', 'omega3' above)."]
+    warn = (f"listing rows violate loop closure at {int(bad.sum())} crank angles "
+            f"(largest |AB| deviation {dev[worst]:+.4f} at {int(theta[worst])} deg); see the audit in the .out")
+    return lines, warn, frame
+
+
+@keyword_signature(_keywords.fourbar, SPEC)
+@keyword_run
+def run(params: Params, progress: bool = False) -> Result:
+    """Analyse a planar four-bar linkage driven by its crank over a range of crank angles.
+
+    ``method = 'exact'`` solves the loop on the requested branch: angles, angular velocities and
+    accelerations of coupler and rocker, the Grashof class, limit and toggle positions, the
+    transmission angle and a summary; ``method = 'listing'`` runs the published program cell for
+    cell and audits it.  With ``mass`` the force analysis is added (joint forces, input torque,
+    shaking force and moment).  Link lengths are in any one consistent unit (metres when
+    ``mass`` is given); angles in degrees, crank speed in rad/s.
+
+    Examples
+    --------
+    >>> import driver
+    >>> r = driver.fourbar.run(fixed_link=12, crank=5, coupler=15, rocker=9, step_deg=20)
+    >>> r.summary["grashof_class"], round(r.summary["mu_min_deg"], 3)
+    ('crank-rocker', 17.852)
+    >>> r.tidy.shape
+    (19, 15)
+    """
+    p = params
+    theta = crank_angles(p)
+    g = grashof(p.fixed_link, p.crank, p.coupler, p.rocker)
+    out, status = exact_grid(p, theta)
+    cp = coupler_point(p, theta, out, status)
+    rows = summary_rows(p)   # the summary kernel, once: the .out's headline figures and the summary
+    ex = extremes(p, rows[0])
+    exact_frame = tidy_frame("exact", theta, exact_columns(out, status, cp, p.coupler), status)
+    warnings: list[str] = []
+    title = p.title or f"{p.path.stem}"
+    if p.method == "listing":
+        table, lst_status = listing_grid(p)
+        lines, _ = listing_text(p, table, lst_status)
+        alines, warn, closure = audit(p, theta, table, lst_status, out, status)
+        lines += alines + summary_lines(p, g, ex)
+        if warn:
+            warnings.append(warn)
+        lst_cols = dict(zip(["coupler_deg", "rocker_deg", "transmission_deg", "xa", "ya", "xb", "yb",
+                             "omega2_rad_s", "omega3_rad_s"], table[:, 1:].T))
+        lst_cols["ab_error"] = np.where(lst_status == ST["ok"], closure["ab_deviation"].to_numpy(), np.nan)
+        listing_frame = tidy_frame("listing", theta, lst_cols, lst_status, closure["loop_not_closed"].to_numpy())
+        tidy = with_units(pd.concat([listing_frame, exact_frame], ignore_index=True), TIDY_UNITS)
+    else:
+        listing_frame = None
+        lines = [f"  four-bar linkage: closed-loop analysis (method = exact, branch = {p.branch})",
+                 f"  deck: {p.path}" + (f" -- {p.title}" if p.title else ""), ""] + _echo(p) + [""]
+        lines += exact_table(p, theta, out, status, cp) + summary_lines(p, g, ex)
+        if cp is not None:
+            lines += [f"    coupler point P ...... u = {p.coupler_point[0]:g} along A->B, v = {p.coupler_point[1]:g} "
+                      "to its left; xp, yp its position, vp its speed [length/s]"]
+        if forces.active(p):
+            lines += _force_section(p, theta, out, status, exact_frame)
+        for k in np.flatnonzero(status == ST["no_assembly"])[:1]:
+            warnings.append(f"the linkage cannot be assembled at {int((status == ST['no_assembly']).sum())} "
+                            f"of {len(theta)} crank angles (first at {theta[k]:g} deg)")
+        tidy = exact_frame
+    summary = summary_of(p, rows)
+    figs = deck_figures(p, title, listing_frame) + (forces.figures(p, title, exact_grid) if forces.active(p) else [])
+    return Result(text="\n".join(lines) + "\n", tidy=tidy, summary=summary, warnings=warnings, figures=figs)
+
+
+def _force_section(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarray,
+                   frame: pd.DataFrame) -> list[str]:
+    """The force analysis's lines of the .out; its columns are added to ``frame`` (in place)."""
+    fa = forces.analyse(p, out, status)
+    for name, values in forces.tidy_columns(fa).items():
+        frame[name] = values
+    with_units(frame, TIDY_UNITS)
+    words = ["toggle: forces unbounded" if s == ST["toggle"] else "not placed" for s in status]
+    title = ("Force analysis (Newton-Euler, closed form; " +
+             ("with the Berkof-Lowen counterweights" if fa.cw is not None else "links as given") + ")")
+    return (forces.echo_lines(p) + forces.table_lines(theta, fa.forces, fa.ok, words, title)
+            + forces.summary_lines(p, forces.summary(p), fa))
+
+
+def output_name(p: Params) -> str:
+    """What the output link is called in figures: 'output crank' when it turns fully (a
+    double-crank, a drag link), 'rocker' otherwise."""
+    g = grashof(p.fixed_link, p.crank, p.coupler, p.rocker)
+    return "output crank" if g.name.startswith("double-crank") else "rocker"
+
+
+def deck_figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> list[Figure]:
+    """The figures of a run (drawn on demand): the curves and the linkage at its limit positions."""
+    def curves():
+        from driver.fourbar import _figures as figures  # matplotlib is the optional [plot] extra: imported when drawn
+        theta = np.linspace(p.start_deg, p.stop_deg, 721)
+        out, st = exact_grid(p, theta)
+        exact = tidy_frame("exact", theta, exact_columns(out, st), st)
+        return figures.fourbar_curves(exact, listing, stem_title, band=band_of(p), output=output_name(p))
+
+    def linkage():
+        from driver.fourbar import _figures as figures
+        lo, hi = sorted((p.start_deg, p.stop_deg))
+        # the deck's crank range when it is less than a turn (a function generator's design range)
+        theta = np.linspace(lo, hi, 721) if hi - lo < 360.0 else np.linspace(0.0, 360.0, 721)
+        out, st = exact_grid(p, theta)
+        cp = coupler_point(p, theta, out, st)
+        motions = rocking_motions(p) if hi - lo >= 360.0 else None
+        if motions:   # a crank that cannot turn: it rocks between its limit positions
+            drawn = []
+            for m in motions:
+                mp = coupler_point(p, m.theta, m.out, m.status)
+                drawn.append({"lo": m.lo, "hi": m.hi, "theta": m.theta, "out": m.out, "stroke": m.stroke,
+                              "branch": m.branch, "point": None if mp is None else mp[:, :2]})
+            return figures.fourbar_linkage(p.fixed_link, theta, out, st == ST["ok"], None, stem_title,
+                                           output=output_name(p), motions=drawn)
+        limits = []
+        for a in limit_angles(p.fixed_link, p.crank, p.coupler, p.rocker):
+            if theta[0] - 1e-9 <= a <= theta[-1] + 1e-9 or hi - lo >= 360.0:
+                row, rst = exact_grid(p, np.array([a]))
+                if rst[0] != ST["no_assembly"] and np.all(np.isfinite(row[0, 3:7])):
+                    limits.append((a, row[0]))
+        return figures.fourbar_linkage(p.fixed_link, theta, out, st == ST["ok"], listing, stem_title,
+                                       point=None if cp is None else cp[:, :2], output=output_name(p),
+                                       limits=limits)
+
+    return [Figure("curves", curves), Figure("linkage", linkage)]
+
+
+def animation_frames(params: Params, result: Result | None = None, n: int = 180) -> dict[str, Any] | None:
+    """The linkage's positions at ``n`` crank angles over one turn, for the report page's animation
+    (:func:`driver._report_page.mechanism_animation`): crank pin A, coupler pin B, coupler point P;
+    for a crank that cannot turn, its rocking motions (out on one assembly branch, back on the
+    other) with their phases, segments and limit positions."""
+    motions = rocking_motions(params, max(8, n // 2 // max(
+        1, len(assembly_intervals(params.fixed_link, params.crank, params.coupler, params.rocker) or [1]))))
+    extra: dict[str, Any] = {}
+    if motions:   # a crank that cannot turn: it rocks between its limit positions, out on one
+        # assembly branch and back on the other; each assembly interval a motion of its own
+        theta = np.concatenate([m.theta for m in motions])
+        out = np.vstack([m.out for m in motions])
+        status = np.concatenate([m.status for m in motions])
+        word = {1: "open", -1: "crossed"}
+        tag = (lambda i: "") if len(motions) == 1 else (lambda i: f", motion {i + 1} of {len(motions)}")
+        arrow = {0: "\u2192", 1: "\u2190"}   # forward stroke, return stroke
+        extra["phase"] = [f"{arrow[int(st)]} {word[int(b)]} assembly{tag(i)}"
+                          for i, m in enumerate(motions) for st, b in zip(m.stroke, m.branch)]
+        starts = np.cumsum([0] + [len(m.theta) for m in motions])
+        extra["segments"] = [[int(a), int(b)] for a, b in zip(starts[:-1], starts[1:])]
+        extra["limits"] = [[np.round(m.out[k, 3:7], 5).tolist() for k in (0, len(m.theta) // 2 - 1)] for m in motions]
+        extra["limit_angles"] = [[m.lo, m.hi] for m in motions]
+    else:
+        theta = np.linspace(0.0, 360.0, n, endpoint=False)
+        out, status = exact_grid(params, theta)
+    ok = (status != ST["no_assembly"]) & (status != ST["indeterminate"])
+    cp = coupler_point(params, theta, out, status)
+    g = params.fixed_link
+    frames = {"theta": theta.tolist(), "ok": ok.astype(int).tolist(),
+              "A": np.round(out[:, 3:5], 5).tolist(), "B": np.round(np.where(ok[:, None], out[:, 5:7], 0.0), 5).tolist(),
+              "P": None if cp is None else np.round(np.where(ok[:, None], cp[:, :2], 0.0), 5).tolist(),
+              "ground": [[0.0, 0.0], [g, 0.0]], "kind": "rocker",
+              "names": {"crank": "crank", "out": "rocker"}, **extra}
+    frames["theta"] = np.round(theta, 6).tolist()
+    pts = [out[:, 3:5], out[ok][:, 5:7], np.array([[0.0, 0.0], [g, 0.0]])]
+    if cp is not None:
+        pts.append(cp[ok][:, :2])
+    frames["box_points"] = np.vstack(pts)
+    return frames

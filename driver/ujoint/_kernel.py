@@ -1,0 +1,224 @@
+"""The ujoint study's kernel wrappers: ujoint.f90 (chain speed, objective and gradient, equivalent angle, batch summaries,
+3-D geometry).
+
+Thin wrappers over the study's modules of the compiled extension (loaded once by
+:mod:`driver._fortran`): inputs are converted once to Fortran-ordered float64 (f2py would
+otherwise copy C-ordered 2-D arrays silently), nothing is looped in Python, numpy arrays come
+back.  Each kernel's physics and units are documented in its Fortran source.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from driver._fortran import _kernels, farray
+
+__all__ = ['UJOINT_PASSES', 'UJOINT_MODELS', 'UJOINT_OBJECTIVES', 'ujoint_speed', 'ujoint_objective',
+           'ujoint_equivalent', 'ujoint_geometry', 'ujoint_summaries', 'UJOINT_SUMMARY_COLUMNS']
+
+
+#: model codes of fortran/ujoint.f90: the paper's eq. 13 as printed, the paper's text
+#: (cumulative phases), the exact chain
+UJOINT_MODELS = {"eq13": int(_kernels.ujoint.model_eq13), "cumulative": int(_kernels.ujoint.model_cumulative),
+                 "exact": int(_kernels.ujoint.model_exact)}
+#: objective codes of fortran/ujoint.f90
+UJOINT_OBJECTIVES = {"mean_square": int(_kernels.ujoint.obj_mean_square), "rms": int(_kernels.ujoint.obj_rms),
+                     "peak_to_peak": int(_kernels.ujoint.obj_peak_to_peak)}
+
+
+def _ujoint_chain(beta, phi, rho) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """beta (n,), phi and rho (n-1,) [rad; rho None = coplanar] as float64 arrays."""
+    beta = _vector(beta)
+    if beta.size == 1:   # f2py refuses a 0-length input for dimension(n-1); it takes a dummy of 1
+        return beta, _ONE_ZERO, _ONE_ZERO
+    ph = _vector(phi)
+    rh = np.zeros(ph.size) if rho is None else _vector(rho)
+    return beta, ph, rh
+
+
+_ONE_ZERO = np.zeros(1)
+
+
+def _vector(x) -> np.ndarray:
+    """``x`` (scalar or sequence) as a 1-D float64 array; no copy for one already."""
+    if type(x) is np.ndarray and x.ndim == 1:
+        return farray(x, 1)
+    return farray(np.atleast_1d(x), 1)
+
+
+def ujoint_speed(model: int, beta, phi, rho, theta) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Compute the chain's speed ratio, its derivative and the output angle at input angles.
+
+    Parameters
+    ----------
+    model : int
+        Model code (``UJOINT_MODELS``).
+    beta : array_like
+        (n,) joint angles, rad.
+    phi : array_like
+        (n-1,) the paper's phases, rad (pi/2 = yokes in phase).
+    rho : array_like or None
+        (n-1,) angles between the planes of successive joints, rad; None: coplanar.
+    theta : array_like
+        Input shaft angles, rad.
+
+    Returns
+    -------
+    ratio : numpy.ndarray
+        R = omega_out/omega_in, dimensionless.
+    dratio : numpy.ndarray
+        The derivative dR/dtheta, 1/rad; times omega_in**2 [(rad/s)**2] it is the output angular
+        acceleration [rad/s**2] at constant input speed.
+    angle : numpy.ndarray
+        Output shaft angle, rad (the exact model only; zeros for the paper models).
+    """
+    b, ph, rh = _ujoint_chain(beta, phi, rho)
+    return _kernels.ujoint.chain_speed(int(model), b, ph, rh, farray(np.atleast_1d(theta), 1))
+
+
+def ujoint_objective(model: int, kind: int, beta, phi, rho, m: int,
+                     grad: bool = True) -> tuple[float, np.ndarray]:
+    """Evaluate the objective over ``m`` uniform input angles per revolution, and its gradient.
+
+    Parameters
+    ----------
+    model : int
+        Model code (``UJOINT_MODELS``).
+    kind : int
+        Objective code (``UJOINT_OBJECTIVES``).
+    beta : array_like
+        (n,) joint angles, rad.
+    phi : array_like
+        (n-1,) the paper's phases, rad.
+    rho : array_like or None
+        (n-1,) plane angles, rad; None: coplanar.
+    m : int
+        Input angles per revolution.
+    grad : bool, default True
+        Also compute the gradient.
+
+    Returns
+    -------
+    f : float
+        The objective, dimensionless (mean (R-1)**2, its root, or max R - min R).
+    g : numpy.ndarray
+        (2n-1,) df/d(beta_1..beta_n, phi_1..phi_(n-1)), 1/rad; zeros when ``grad`` is False.
+    """
+    b, ph, rh = _ujoint_chain(beta, phi, rho)
+    return _kernels.ujoint.chain_objective(int(model), int(kind), b, ph, rh, int(m), int(bool(grad)))
+
+
+def ujoint_equivalent(model: int, beta, phi, rho, tol: float = 1e-7) -> tuple[float, float | None]:
+    """Compute the closed-form equivalent angles of a chain.
+
+    Parameters
+    ----------
+    model : int
+        Model code (``UJOINT_MODELS``).
+    beta : array_like
+        (n,) joint angles, rad.
+    phi : array_like
+        (n-1,) the paper's phases, rad (pi/2 = yokes in phase).
+    rho : array_like or None
+        (n-1,) angles between the planes of successive joints, rad; None: coplanar.
+    tol : float, default 1e-7
+        Tolerance on phi_k - rho_k being a multiple of pi/2, rad.
+
+    Returns
+    -------
+    beta_e : float
+        Equivalent angle from the first-order phasor sum of the model's phasing, rad.
+    beta_res : float or None
+        Resultant angle of the exact chain, rad, when every phi_k - rho_k is a multiple of
+        pi/2 within ``tol``; else None.
+    """
+    b, ph, rh = _ujoint_chain(beta, phi, rho)
+    be, br, st = _kernels.ujoint.chain_equivalent(int(model), b, ph, rh, float(tol))
+    return float(be), (float(br) if st == int(_kernels.ujoint.st_ok) else None)
+
+
+#: columns of ujoint_summaries (fortran/ujoint.f90 chain_summaries)
+UJOINT_SUMMARY_COLUMNS = ("objective", "ratio_min", "ratio_max", "dratio_abs_max", "beta_e", "beta_res",
+                          "beta_res_status")
+
+
+#: pass bits of ujoint_summaries (fortran/ujoint.f90 sum_*)
+UJOINT_PASSES = {k: int(getattr(_kernels.ujoint, f"sum_{k}")) for k in ("objective", "speed", "equivalent")}
+
+
+def ujoint_summaries(model: int, kind: int, beta, phi, rho, m: int, tol: float = 1e-7, passes: int = 7) -> np.ndarray:
+    """Compute the headline figures of many designs of one chain layout in one kernel call.
+
+    Every design shares ``model``, the objective ``kind`` and the grid of ``m`` input angles
+    per revolution.  Columns
+    (UJOINT_SUMMARY_COLUMNS): the objective (as :func:`ujoint_objective` without gradient),
+    min and max of R = omega_out/omega_in and max |dR/dtheta| [1/rad] on the grid
+    theta_j = 2 pi j/m (as :func:`ujoint_speed` there), beta_e and beta_res [rad] and the
+    status of beta_res (0: defined; as :func:`ujoint_equivalent` with ``tol`` [rad]).
+    Each row has the same bits as those single-design calls.  ``passes``: sum of
+    UJOINT_PASSES bits (objective: column 0, speed: 1-3, equivalent: 4-6); the columns of a
+    pass not asked for are 0 (not computed).
+
+    Parameters
+    ----------
+    model : int
+        Model code (``UJOINT_MODELS``).
+    kind : int
+        Objective code (``UJOINT_OBJECTIVES``).
+    beta : array_like
+        (nd, n) joint angles, rad.
+    phi : array_like
+        (nd, n-1) the paper's phases, rad.
+    rho : array_like or None
+        (nd, n-1) plane angles, rad; None: coplanar.
+    m : int
+        Input angles per revolution.
+    tol : float, default 1e-7
+        Tolerance of beta_res's condition, rad.
+    passes : int, default 7
+        Sum of ``UJOINT_PASSES`` bits.
+
+    Returns
+    -------
+    numpy.ndarray
+        (nd, 7), columns ``UJOINT_SUMMARY_COLUMNS`` (objective and R dimensionless,
+        dR/dtheta 1/rad, angles rad).
+
+    Raises
+    ------
+    ValueError
+        ``beta`` is not a (designs, joints) array.
+    """
+    beta = np.asarray(beta, dtype=np.float64)
+    if beta.ndim != 2 or beta.shape[1] < 1:
+        raise ValueError(f"beta must be (designs, joints), got shape {beta.shape}")
+    nd, n = beta.shape
+    if nd == 0:
+        return np.empty((0, len(UJOINT_SUMMARY_COLUMNS)))
+    x = np.empty((nd, 3 * n - 2), dtype=np.float64, order="F")
+    x[:, :n] = beta
+    x[:, n:2 * n - 1] = phi
+    x[:, 2 * n - 1:] = 0.0 if rho is None else rho
+    return _kernels.ujoint.chain_summaries(model=int(model), kind=int(kind), n=n, nd=nd, x=x, m=int(m),
+                                           tol=float(tol), passes=int(passes))
+
+
+def ujoint_geometry(axes) -> tuple[np.ndarray, np.ndarray, int]:
+    """Compute joint angles and plane angles of a 3-D chain from its shaft directions.
+
+    Parameters
+    ----------
+    axes : array_like
+        (n+1, 3) shaft direction vectors, input shaft first (any length unit, nonzero).
+
+    Returns
+    -------
+    beta : numpy.ndarray
+        (n,) joint angles, rad.
+    rho : numpy.ndarray
+        (n-1,) angles between the planes of successive joints, rad.
+    status : int
+        0 ok, 2 an axis of zero length, 3 a joint angle of 90 deg or more.
+    """
+    a = farray(np.asarray(axes, dtype=np.float64).T, 2)
+    beta, rho, status = _kernels.ujoint.chain_geometry(a)
+    return beta, rho, int(status)
