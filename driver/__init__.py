@@ -1,6 +1,6 @@
 """Mechanism-analysis studies driven by namelist decks: a batch program and a Python library.
 
-Batch: ``python -m driver inputs/crank5.dat`` (see :mod:`driver._cli`).  Python::
+Batch: ``python -m driver inputs/crank5.dat`` (``python -m driver --help``).  Python::
 
     import driver
     r = driver.run("inputs/crank5.dat")           # or deck text, or {"fourbar": {...}}
@@ -10,15 +10,17 @@ Batch: ``python -m driver inputs/crank5.dat`` (see :mod:`driver._cli`).  Python:
     s = driver.run_sweep("inputs/fourbar_paper_sweep.dat", jobs=1); s.summary
     driver.studies(), driver.keys("fourbar")
 
-Studies (one module each, named after their namelist group: ``driver.fourbar``,
-``driver.ujoint``, ``driver.slidercrank``, ``driver.manipulator``, ``driver.robust_example``)
-run Fortran 90 kernels through :mod:`driver._fortran`.  Names are imported on first use, so
-``import driver`` stays cheap.  The distribution is called ``mechanism-driver``.
+The public face, SciPy style: the names below (``driver.__all__``), the study packages
+(``driver.fourbar``, ``driver.ujoint``, ``driver.slidercrank``, ``driver.manipulator``,
+``driver.robust_example``: each runs its Fortran 90 kernels), the subpackages ``driver.sweep``,
+``driver.optimize`` and ``driver.synthesis``, and ``driver.plotting`` (the house figure style).
+Every other module is private (``driver._deck``, ``driver.fourbar._kernel``, ...): its names may
+change without notice.  Names are imported on first use, so ``import driver`` stays cheap.  The
+distribution is called ``mechanism-driver``.
 """
 from __future__ import annotations
 
 import importlib
-import importlib.util
 from typing import TYPE_CHECKING, Any
 
 try:
@@ -26,16 +28,26 @@ try:
 except ImportError:   # a source checkout that was never built (driver._fortran says what to do)
     __version__ = "unknown (unbuilt source checkout)"
 
-__all__ = ["run", "run_sweep", "write", "studies", "keys", "Result", "SweepResult", "DeckError"]
+__all__ = ["run", "run_sweep", "write", "compare", "read_deck", "studies", "keys", "Result", "Figure", "SweepResult",
+           "DeckError", "ExitCode", "Message", "RunOutcome", "FilesOutcome", "SweepOutcome"]
+
+#: the public subpackages and modules (every other module of the package is private)
+PUBLIC_MODULES = ("fourbar", "ujoint", "slidercrank", "manipulator", "robust_example", "sweep", "optimize", "synthesis",
+                  "plotting")
 
 _API = {"run": "driver._api", "run_sweep": "driver._api", "write": "driver._api", "studies": "driver._api",
-        "keys": "driver._api",
-        "Result": "driver._output", "SweepResult": "driver._api", "DeckError": "driver._deck"}
+        "keys": "driver._api", "compare": "driver._compare", "read_deck": "driver._deck",
+        "Result": "driver._result", "Figure": "driver._result", "SweepResult": "driver._api",
+        "DeckError": "driver._groupspec", "ExitCode": "driver._outcome", "Message": "driver._outcome",
+        "RunOutcome": "driver._outcome", "FilesOutcome": "driver._outcome", "SweepOutcome": "driver._outcome"}
 
 if TYPE_CHECKING:   # pragma: no cover - for type checkers and IDEs only
     from driver._api import SweepResult, keys, run, run_sweep, studies, write
-    from driver._deck import DeckError
-    from driver._output import Result
+    from driver._compare import compare
+    from driver._deck import read_deck
+    from driver._groupspec import DeckError
+    from driver._outcome import ExitCode, FilesOutcome, Message, RunOutcome, SweepOutcome
+    from driver._result import Figure, Result
 
 
 def __getattr__(name: str) -> Any:
@@ -44,10 +56,11 @@ def __getattr__(name: str) -> Any:
         value = getattr(importlib.import_module(_API[name]), name)
         globals()[name] = value
         return value
-    if name.isidentifier() and not name.startswith("_") and importlib.util.find_spec(f"driver.{name}"):
+    if name in PUBLIC_MODULES:
         return importlib.import_module(f"driver.{name}")   # a study (driver.fourbar) or a subpackage
     raise AttributeError(f"module 'driver' has no attribute {name!r}")
 
 
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+    """The public names only (the private modules a session has imported are not listed)."""
+    return sorted({*__all__, *PUBLIC_MODULES, "__version__"})

@@ -34,10 +34,6 @@ from driver._groupspec import DeckError, GroupSpec, Key, Params
 
 __all__ = ["DeckError", "Key", "GroupSpec", "Params", "RawGroup", "Deck", "read_deck", "validate"]
 
-# the public home of the deck's data types is this module (tracebacks and pickles name it);
-# they are defined in driver._groupspec, which imports nothing of the driver
-for _cls in (DeckError, GroupSpec, Key, Params):
-    _cls.__module__ = __name__
 
 #: magnitudes no deck value of any study needs; larger ones only overflow the kernels
 MAX_FLOAT, MAX_INT = 1e15, 10**9

@@ -37,6 +37,10 @@ class DeckError(ValueError):
         self.path, self.line, self.key, self.message = str(path), line, key, message
         super().__init__(str(self))
 
+    def __reduce__(self) -> tuple[type[DeckError], tuple[str, int | None, str | None, str]]:
+        """Pickle by the four fields (a worker process's error reaches the driver whole)."""
+        return (type(self), (self.path, self.line, self.key, self.message))
+
     def __str__(self) -> str:
         where = f"{self.path}:{self.line}" if self.line else self.path
         what = f"key '{self.key}': " if self.key else ""
@@ -110,3 +114,11 @@ class GroupSpec:
     keys: dict[str, Key]
     doc: str = ""
     check: Callable[[Params], None] | None = None
+
+
+# where tracebacks and pickles find these: DeckError in the public namespace (``driver.DeckError``),
+# the deck's data types in driver._deck (which re-exports them); defined here because this
+# module imports nothing of the driver
+DeckError.__module__ = "driver"
+for _cls in (GroupSpec, Key, Params):
+    _cls.__module__ = "driver._deck"

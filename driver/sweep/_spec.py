@@ -76,7 +76,7 @@ def _spec() -> GroupSpec:
         keys[f"count{k}"] = Key("int", doc="number of values from start to stop")
     keys.update({
         "zip": Key("bool", default=False, doc=".true.: vary the keys together instead of a full grid"),
-        "keep": Key("str", default="", doc="filter on the summary columns in the deck expression language (driver._expr): "
+        "keep": Key("str", default="", doc="filter on the summary columns in the deck expression language (docs/decks.md): "
                     "comparisons, and/or/not, arithmetic, abs/min/max/sqrt...; swept keys as group.key"),
         "case_outputs": Key("str", default="all", choices=("all", "kept", "none"),
                             doc="which cases get their own .out/.parquet/.json files"),
@@ -91,7 +91,7 @@ def _spec() -> GroupSpec:
         "case_plots": Key("bool", default=False,
                           doc="with --plot, also draw every written case's own figures (by default --plot "
                               "draws the sweep's summary only: per-case figures cost more than the sweep)"),
-        "plot_x": Key("str", default="", doc="summary column (or expression, driver._expr) on the x axis of the summary plot"),
+        "plot_x": Key("str", default="", doc="summary column (or expression in the deck language) on the x axis of the summary plot"),
         "plot_y": Key("strs", default=[], doc="summary columns (or expressions) plotted against plot_x"),
         "summary_columns": Key("strs", default=[],
                                doc="the summary columns the tables show (default: all); with keep and the "

@@ -1,0 +1,91 @@
+"""The public face, SciPy style: a small public namespace, every other module private.
+
+Public are the names of ``driver.__all__``, the study packages, ``driver.sweep``,
+``driver.optimize``, ``driver.synthesis`` and ``driver.plotting`` (``driver.PUBLIC_MODULES``);
+every other module's name starts with an underscore (``driver._deck``,
+``driver.fourbar._kernel``).  These tests read the files on disk, so a new module that is not
+underscored, a public name that does not resolve, or a user-facing text that reaches into a
+private module fails here.
+"""
+from __future__ import annotations
+
+import ast
+import importlib
+import pickle
+import re
+from pathlib import Path
+
+import pytest
+
+import driver
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGE = ROOT / "driver"
+
+
+def _dotted(path: Path) -> str:
+    parts = path.relative_to(ROOT).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def _public(dotted: str) -> bool:
+    return not any(p.startswith("_") for p in dotted.split(".")[1:])
+
+
+def test_every_module_is_private_but_the_declared_public_ones():
+    modules = {_dotted(p) for p in PACKAGE.rglob("*.py") if "__pycache__" not in p.parts and p.name != "__main__.py"}
+    public = {m for m in modules if _public(m)}
+    assert public == {"driver", *(f"driver.{m}" for m in driver.PUBLIC_MODULES)}, sorted(public)
+    assert len(modules) > 3 * len(public)   # the point: most of the code is behind the public names
+
+
+def test_the_public_names_resolve_and_nothing_else_is_offered():
+    for name in driver.__all__:
+        assert getattr(driver, name) is not None, name
+    for name in driver.PUBLIC_MODULES:
+        assert importlib.import_module(f"driver.{name}") is getattr(driver, name)
+    assert dir(driver) == sorted({*driver.__all__, *driver.PUBLIC_MODULES, "__version__"})
+    for private in ("deck", "runner", "cli", "kernels", "study"):
+        with pytest.raises(AttributeError):
+            getattr(driver, private)
+
+
+@pytest.mark.parametrize("name", driver.PUBLIC_MODULES)
+def test_each_public_package_exports_only_public_names_that_resolve(name):
+    module = importlib.import_module(f"driver.{name}")
+    exported = getattr(module, "__all__", None)
+    assert exported, f"driver.{name} declares no __all__"
+    for attr in exported:
+        assert not attr.startswith("_"), (name, attr)
+        assert hasattr(module, attr), (name, attr)
+
+
+def test_deck_error_is_the_public_one_in_tracebacks_and_pickles():
+    err = driver.DeckError("a.dat", 3, "crank", "must be positive (got -5.0)")
+    assert type(err).__module__ == "driver"
+    back = pickle.loads(pickle.dumps(err))
+    assert (back.path, back.line, back.key, back.message) == ("a.dat", 3, "crank", "must be positive (got -5.0)")
+    assert str(back) == str(err)
+    with pytest.raises(driver.DeckError, match="crank"):
+        driver.fourbar.run(fixed_link=12, crank=-5, coupler=15, rocker=9, step_deg=20)
+
+
+def _private_references(text: str) -> list[str]:
+    return re.findall(r"\bdriver(?:\.[a-z][a-z_]*)*\._(?!kernels\b)[a-z][a-z_]*", text)
+
+
+def test_examples_and_readme_use_the_public_api_only():
+    """What a user copies (examples/, README) names no private module; docs/ may, to explain
+    the inside, but not in their Python code blocks."""
+    for path in [*sorted((ROOT / "examples").glob("*.py")), ROOT / "README.md"]:
+        text = path.read_text()
+        if path.suffix == ".py":
+            tree = ast.parse(text)
+            names = [n.module or "" for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)]
+            names += [a.name for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names]
+            text = "\n".join(names)
+        assert not _private_references(text), (path.name, _private_references(text))
+    for path in sorted((ROOT / "docs").glob("*.md")):
+        blocks = re.findall(r"```python\n(.*?)```", path.read_text(), re.S)
+        found = [r for b in blocks for r in _private_references(b)]
+        assert not found, (path.name, found)
