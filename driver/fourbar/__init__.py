@@ -8,11 +8,11 @@ accelerations, Grashof class, limit and toggle positions and a summary.
 Lengths in any consistent unit; angles in degrees in decks and tables; crank
 speed in rad/s, accelerations in rad/s^2.
 
-The package, by job: ``spec`` (deck keys, checks, labels, the budget estimate), ``analysis``
-(Grashof class, states through the kernel, extremes), ``batch`` (many designs in one kernel
-call; the summary), ``report`` (the run: .out, tidy table, summary), ``figures``, ``published``
-(the published listing tables and their defects), ``kernel`` (the Fortran wrappers) and
-``forces`` (the force analysis).
+The package's private modules, by job: ``_spec`` (deck keys, checks, labels, the budget estimate), ``_analysis``
+(Grashof class, states through the kernel, extremes), ``_batch`` (many designs in one kernel
+call; the summary), ``_report`` (the run: .out, tidy table, summary), ``_figures``, ``_published``
+(the published listing tables and their defects), ``_kernel`` (the Fortran wrappers) and
+``_forces`` (the force analysis).
 """
 from __future__ import annotations
 

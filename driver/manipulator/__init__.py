@@ -22,11 +22,11 @@ report mode the .out lists every cell where the two modes differ, and why.
 
 Physics (IK, Jacobian, indices, torques, positioning errors) is in fortran/manipulator.f90.
 
-The package splits the study by job: :mod:`.spec` (deck keys, checks, the budget estimate), :mod:`.analysis`
-(conventions, optima, joint angles, tolerance synthesis), :mod:`.tables` (the tables and the
-report/exact differences), :mod:`.report` (the run: text, tidy table, summary) and
-:mod:`.batch` (the design summary of many designs in one kernel call), :mod:`.figures`,
-:mod:`.published` (the report's printed tables) and :mod:`.kernel` (the Fortran wrappers).
+The package's private modules split the study by job: :mod:`._spec` (deck keys, checks, the budget estimate), :mod:`._analysis`
+(conventions, optima, joint angles, tolerance synthesis), :mod:`._tables` (the tables and the
+report/exact differences), :mod:`._report` (the run: text, tidy table, summary) and
+:mod:`._batch` (the design summary of many designs in one kernel call), :mod:`._figures`,
+:mod:`._published` (the report's printed tables) and :mod:`._kernel` (the Fortran wrappers).
 """
 from __future__ import annotations
 

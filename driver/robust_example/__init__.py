@@ -18,9 +18,9 @@ values, are compared with the deck's ``printed_*`` values and flagged, not force
 
 This is statistics, not mechanism physics: it is plain numpy (no Fortran kernel).
 
-The package, by job: ``spec`` (deck keys, the cross-check, the budget estimate), ``analysis``
-(the fits and estimates), ``report`` (the run: .out, tidy table, summary), ``figures`` and
-``published`` (the printed results and what does not reproduce).
+The package's private modules, by job: ``_spec`` (deck keys, the cross-check, the budget estimate), ``_analysis``
+(the fits and estimates), ``_report`` (the run: .out, tidy table, summary), ``_figures`` and
+``_published`` (the printed results and what does not reproduce).
 """
 from __future__ import annotations
 

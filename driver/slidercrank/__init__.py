@@ -10,11 +10,11 @@ Euler-load ratio of every case and, with geometric stiffness, buckling.
 
 Units in decks: SI (m, kg, Pa, rad/s, s).  Strains are reported in microstrain.
 
-The package, by job: ``spec`` (deck keys, materials, the model a deck describes, checks, the budget
-estimate), ``analysis`` (one case through the kernel, settling, static buckling onset), ``report``
-(the linear run: .out sections, tidy table, summary), ``figures``, ``published`` (Table 1 and the
-Simeon 1996 reference), ``kernel`` (the Fortran wrappers), and the nonlinear rod (``nonlinear``,
-``report_nl``: the run of a deck, either model). Cases are heavy (a time integration each), so the
+The package's private modules, by job: ``_spec`` (deck keys, materials, the model a deck describes, checks, the budget
+estimate), ``_analysis`` (one case through the kernel, settling, static buckling onset), ``_report``
+(the linear run: .out sections, tidy table, summary), ``_figures``, ``_published`` (Table 1 and the
+Simeon 1996 reference), ``_kernel`` (the Fortran wrappers), and the nonlinear rod (``_nonlinear``,
+``_report_nl``: the run of a deck, either model). Cases are heavy (a time integration each), so the
 study has no batch path: a sweep runs them one per task.
 """
 from __future__ import annotations

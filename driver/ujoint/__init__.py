@@ -18,10 +18,10 @@ Angles in the deck are degrees; the kernel works in radians.  Phases: the paper'
 (90 deg = yokes on the intermediate shaft in phase) or the yoke phase delta = phi - 90 deg.
 See docs/ujoint.md for what reproduces and what does not.
 
-The package, by job: ``spec`` (deck keys, checks, conventions, labels, the budget estimate),
-``analysis`` (one design evaluated; the multi-start optimiser), ``report`` (the run: .out, tidy
-table, summary, result.dat), ``figures``, ``batch`` (many given designs in one kernel call:
-sweeps and &optimize), ``published`` (the paper's printed results) and ``kernel`` (the Fortran
+The package's private modules, by job: ``_spec`` (deck keys, checks, conventions, labels, the budget estimate),
+``_analysis`` (one design evaluated; the multi-start optimiser), ``_report`` (the run: .out, tidy
+table, summary, result.dat), ``_figures``, ``_batch`` (many given designs in one kernel call:
+sweeps and &optimize), ``_published`` (the paper's printed results) and ``_kernel`` (the Fortran
 wrappers).
 """
 from __future__ import annotations
