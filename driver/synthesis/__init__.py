@@ -243,7 +243,7 @@ def _distinct_angles(p: Params, th2: np.ndarray, th4: np.ndarray) -> None:
                       "rocker range is nil): no unique linkage through them")
 
 
-def _function(p: Params) -> Synthesis:
+def _synthesise_function(p: Params) -> Synthesis:
     d = p.fixed_link
     if p.x_values is not None:
         xs, ys = np.array(p.x_values, float), np.array(p.y_values, float)
@@ -360,7 +360,7 @@ def _function(p: Params) -> Synthesis:
 
 # ----------------------------------------------------------------------------- crank-rocker
 
-def _crank_rocker(p: Params) -> Synthesis:
+def _synthesise_crank_rocker(p: Params) -> Synthesis:
     members = cr.family(p.swing_deg, p.time_ratio, p.family_points)
     frac = p.min_link_fraction
     usable = lambda m: min(m.crank, m.coupler, m.rocker) >= frac * m.ground
@@ -453,7 +453,7 @@ def _at_family_end(members: list, m) -> bool:
 
 # ----------------------------------------------------------------------------- path generation
 
-def _path(p: Params) -> Synthesis:
+def _synthesise_path(p: Params) -> Synthesis:
     from driver.synthesis import _path as pg
     targets = np.column_stack([p.target_x, p.target_y]).astype(float)
     ext = float(max(np.ptp(targets, axis=0))) or 1.0
@@ -548,7 +548,7 @@ def synthesise(deck: Deck | str | Path) -> Synthesis:
         raise DeckError(deck.path, raw.line, None, f"a &synthesis deck has no other group (found &{others[0]}); "
                                                    "it writes the &fourbar deck of its linkage")
     p = validate(deck.groups["synthesis"], SPEC, deck.path)
-    syn = {"function": _function, "crank_rocker": _crank_rocker, "path": _path}[p.task](p)
+    syn = {"function": _synthesise_function, "crank_rocker": _synthesise_crank_rocker, "path": _synthesise_path}[p.task](p)
     if syn.linkage is not None:
         fp = validate(RawGroup("fourbar", dict(syn.linkage, title=p.title or f"{Path(deck.path).stem} ({p.task} synthesis)"),
                                {}, p.line), fourbar.SPEC, deck.path)
