@@ -115,8 +115,33 @@ def compare_result(deck: str | Path, params: Params, result: Result) -> pd.DataF
 
 
 def compare(deck: str | Path) -> pd.DataFrame:
-    """The comparison of ``deck`` with the published record: one row per published cell
-    (columns :data:`COLUMNS`; empty when no published table belongs to the deck)."""
+    """Compare a deck's run with the published record, cell by cell.
+
+    Parameters
+    ----------
+    deck : str or pathlib.Path
+        Path of the deck to run (one of the shipped decks whose case is in ``published/``, or any
+        deck: a deck no published table belongs to gives an empty frame).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per published cell, columns :data:`COLUMNS`: ``deck``, ``table``, ``row``,
+        ``column``, ``printed`` (the published text), ``computed`` (the run's value, in the
+        table's own unit), ``status`` (``identical``, ``agrees``, ``departs`` with a reason,
+        or ``differs``: a defect) and ``reason``.
+
+    Raises
+    ------
+    DeckError
+        The deck has bad input.
+
+    Examples
+    --------
+    >>> import driver
+    >>> frame = driver.compare("inputs/crank5.dat")   # doctest: +SKIP
+    >>> frame["status"].value_counts()                # doctest: +SKIP
+    """
     return run_comparison(deck).frame
 
 

@@ -475,11 +475,32 @@ def _locate(path: Path, items: list[_Item], exc: Exception | None) -> DeckError:
 
 
 def read_deck(path: str | Path, text: str | None = None) -> Deck:
-    """Parse a deck file (or ``text`` attributed to ``path``) into raw groups.
+    """Read a deck (Fortran namelist groups) into raw groups, before validation.
 
-    The text is pre-scanned (:func:`_prescan`) so that everything f90nml would silently
-    misread is a :class:`DeckError` with line and key, and repeat counts are capped before
-    f90nml expands them.
+    The text is pre-scanned so that everything f90nml would silently misread is a
+    :class:`DeckError` with line and key, and repeat counts are capped before f90nml expands
+    them.  Nothing in the deck is evaluated; a number is what Fortran list-directed input
+    means by one.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The deck file; with ``text``, the name the text is attributed to in messages.
+    text : str, optional
+        The deck's text (then ``path`` is not read).
+
+    Returns
+    -------
+    Deck
+        ``path`` and ``groups``: each namelist group by name (``'fourbar'``, ``'sweep'``, ...)
+        as raw key/value pairs with the line each key is on; values are validated (units,
+        ranges) only when a study runs them.
+
+    Raises
+    ------
+    DeckError
+        An unreadable or malformed deck (what f90nml would misread, a repeat count too large),
+        with file, line and key.
     """
     path = Path(path)
     if text is None:

@@ -32,8 +32,17 @@ def plot_format(plot: bool | str | None) -> str | None:
 
 @dataclass
 class Figure:
-    """A figure to write as ``<stem>_<name>.<format>``; ``draw`` builds it lazily (matplotlib Figure,
-    drawn in the house style by :mod:`driver.plotting`, never through pyplot)."""
+    """A figure of a run, drawn on demand.
+
+    Attributes
+    ----------
+    name : str
+        The figure's name: it is written as ``<stem>_<name>.<format>`` (``'linkage'``,
+        ``'curves'``, ...).
+    draw : callable
+        ``draw()`` builds and returns the matplotlib ``Figure``, drawn in the house style of
+        :mod:`driver.plotting` and never through pyplot; nothing is drawn until it is called.
+    """
 
     name: str
     draw: Callable[[], Any]

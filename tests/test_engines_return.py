@@ -24,7 +24,7 @@ from driver._outcome import CompareOutcome, ExitCode
 
 DRIVER = ROOT / "driver"
 #: the command line prints (that is its job); nothing else may
-PRINTERS = {"cli.py": "the command line: the one place that prints outcomes",
+PRINTERS = {"_cli.py": "the command line: the one place that prints outcomes",
             "__main__.py": "python -m driver: hands over to the command line"}
 #: module -> reason, for a module that must print anyway (none today)
 ALLOWED: dict[str, str] = {}

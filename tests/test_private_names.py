@@ -56,7 +56,7 @@ def private_imports(source: str, package: str = "driver") -> list[tuple[int, str
 def test_the_walk_finds_each_form():
     source = ("from driver.sweep._spec import Grid, _hidden\n"
               "from driver import _kernels, plotting\n"            # a private module: fine
-              "from driver.sweep import spec as sp\n"
+              "from driver.sweep import _spec as sp\n"
               "import driver.plotting as plt\n"
               "sp._secret(1); plt._wrap(2); plotting.wrap(3); _kernels.fourbar\n"
               "from driver._deck import __version__\n")             # dunder: not private

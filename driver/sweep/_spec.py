@@ -91,7 +91,8 @@ def _spec() -> GroupSpec:
         "case_plots": Key("bool", default=False,
                           doc="with --plot, also draw every written case's own figures (by default --plot "
                               "draws the sweep's summary only: per-case figures cost more than the sweep)"),
-        "plot_x": Key("str", default="", doc="summary column (or expression in the deck language) on the x axis of the summary plot"),
+        "plot_x": Key("str", default="",
+                      doc="summary column (or expression in the deck language) on the x axis of the summary plot"),
         "plot_y": Key("strs", default=[], doc="summary columns (or expressions) plotted against plot_x"),
         "summary_columns": Key("strs", default=[],
                                doc="the summary columns the tables show (default: all); with keep and the "
