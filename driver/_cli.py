@@ -24,7 +24,7 @@ from driver import __version__
 from driver import _limits as limits
 from driver._export import FORMATS
 from driver._extras import MissingExtra, require
-from driver._outcome import CompareOutcome, ExitCode, Outcome, RunOutcome, SweepOutcome
+from driver._outcome import ExitCode, Outcome, RunOutcome, SweepOutcome
 from driver._output import PLOT_FORMATS
 from driver._study import study_names
 
@@ -124,9 +124,9 @@ def _stdout_lines(outcome: Outcome) -> list[str]:
     written (its own tables in one line); for a comparison each deck's agreement lines, then the
     totals; otherwise the files written, then the notes (an optimisation's result and the designs
     it computed)."""
-    if isinstance(outcome, CompareOutcome):
-        from driver._compare import compare_text
-        return [line for c in outcome.comparisons for line in compare_text(c)] + \
+    compare = sys.modules.get("driver._compare")   # not imported (pandas!) unless --compare ran
+    if compare is not None and isinstance(outcome, compare.CompareOutcome):
+        return [line for c in outcome.comparisons for line in compare.compare_text(c)] + \
             (["Total", *outcome.totals] if outcome.totals else [])
     if isinstance(outcome, SweepOutcome):
         oc, out = outcome, outcome.outdir or Path(".")
@@ -295,7 +295,7 @@ def _main(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
     if not args.decks:
         parser.error("no deck given (python -m driver --examples lists the shipped example decks)")
     if args.compare:
-        from driver._compare import compare_decks
+        from driver._compare import CompareOutcome, compare_decks
         try:
             compared = compare_decks(args.decks, on_deck=say)   # each deck's lines as soon as it is compared
             if compared.totals:

@@ -22,13 +22,14 @@ reason    why a cell is not ``identical``/``agrees``, or why a reproduced printe
 
 :func:`compare_text` renders the per-table agreement lines and every cell that does not agree,
 as ``python -m driver --compare DECK...`` prints them; :func:`compare_decks` compares several decks
-and returns a :class:`~driver._outcome.CompareOutcome` (the command line prints it).  Each study compares its own tables (its
+and returns a :class:`CompareOutcome` (the command line prints it).  Each study compares its own tables (its
 ``published.py``, declared as ``Study.published``; the cell primitives are in
 :mod:`driver._published`); this module runs the deck and reports.
 """
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -36,14 +37,14 @@ import pandas as pd
 
 from driver import _published as published
 from driver._deck import Params, read_deck
-from driver._outcome import CompareOutcome
+from driver._outcome import ExitCode, Outcome
 from driver._output import Result
 from driver._published import agrees_printed
 from driver._runner import study_of
 from driver._study import load_study
 
-__all__ = ["COLUMNS", "OK", "Comparison", "agrees_printed", "compare", "compare_decks", "compare_result", "compare_text",
-           "run_comparison", "totals_text"]
+__all__ = ["COLUMNS", "OK", "Comparison", "CompareOutcome", "agrees_printed", "compare", "compare_decks",
+           "compare_result", "compare_text", "run_comparison", "totals_text"]
 
 COLUMNS = ["deck", "table", "row", "column", "printed", "computed", "status", "reason"]
 #: statuses that count as agreement (exit status 0)
@@ -189,10 +190,41 @@ def totals_text(comparisons: list[Comparison]) -> list[str]:
     return lines
 
 
+@dataclass(kw_only=True)
+class CompareOutcome(Outcome):
+    """A comparison of decks with the published record (:func:`compare_decks`).
+
+    Attributes
+    ----------
+    comparisons : list of Comparison
+        The decks compared, in order (:class:`Comparison`: one row per
+        published cell, ``ok`` when no reproducible cell differs).
+    totals : list of str
+        One line per study (and mode or method) over the decks compared, as the command line
+        prints them under "Total"; empty when fewer than two decks were compared.
+    bad_input : bool
+        A deck had bad input (its error is in ``messages``).
+    failed : bool
+        A run failed or the published tables are missing (the error is in ``messages``).
+    """
+
+    comparisons: list[Comparison] = field(default_factory=list)
+    totals: list[str] = field(default_factory=list)
+    bad_input: bool = False
+    failed: bool = False
+
+    @property
+    def exit_code(self) -> ExitCode:
+        """0 every reproducible cell agrees, 1 a cell differs or a run failed, 2 a deck had bad input."""
+        differs = self.failed or not all(c.ok for c in self.comparisons)
+        worst = ExitCode.BAD_INPUT if self.bad_input else ExitCode.FAILED if differs else ExitCode.OK
+        return max(super().exit_code, worst)
+
+
 def compare_decks(decks: list[Path], on_deck: Callable[[CompareOutcome], None] | None = None) -> CompareOutcome:
     """Compare every deck with the published record; nothing is printed or written.
 
-    Returns a :class:`~driver._outcome.CompareOutcome`: the comparisons, the totals over the decks,
+    Returns a :class:`CompareOutcome`: the comparisons, the totals over the decks,
     an error message per deck that had bad input (exit status 2) or whose run failed (1), and exit
     status 1 when a reproducible cell differs.  ``on_deck`` (e.g. the command line's printer) gets
     each part as soon as it is known: each deck's own outcome, or the error that the published

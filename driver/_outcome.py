@@ -19,10 +19,9 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:   # annotations only
     import pandas as pd
 
-    from driver._compare import Comparison
     from driver._output import Result
 
-__all__ = ["ExitCode", "Message", "Outcome", "RunOutcome", "FilesOutcome", "SweepOutcome", "CompareOutcome"]
+__all__ = ["ExitCode", "Message", "Outcome", "RunOutcome", "FilesOutcome", "SweepOutcome"]
 
 
 class ExitCode(enum.IntEnum):
@@ -254,34 +253,3 @@ class SweepOutcome(Outcome):
     def __repr__(self) -> str:
         return (f"<SweepResult {self.name!r}: {self.n_cases} cases, {self.n_ok} ok, {self.n_kept} kept; "
                 f"status {self.status}" + (f"; files in {self.outdir}" if self.outdir else "") + ">")
-
-
-@dataclass(kw_only=True)
-class CompareOutcome(Outcome):
-    """A comparison of decks with the published record (:func:`driver._compare.compare_decks`).
-
-    Attributes
-    ----------
-    comparisons : list of Comparison
-        The decks compared, in order (:class:`~driver._compare.Comparison`: one row per
-        published cell, ``ok`` when no reproducible cell differs).
-    totals : list of str
-        One line per study (and mode or method) over the decks compared, as the command line
-        prints them under "Total"; empty when fewer than two decks were compared.
-    bad_input : bool
-        A deck had bad input (its error is in ``messages``).
-    failed : bool
-        A run failed or the published tables are missing (the error is in ``messages``).
-    """
-
-    comparisons: list[Comparison] = field(default_factory=list)
-    totals: list[str] = field(default_factory=list)
-    bad_input: bool = False
-    failed: bool = False
-
-    @property
-    def exit_code(self) -> ExitCode:
-        """0 every reproducible cell agrees, 1 a cell differs or a run failed, 2 a deck had bad input."""
-        differs = self.failed or not all(c.ok for c in self.comparisons)
-        worst = ExitCode.BAD_INPUT if self.bad_input else ExitCode.FAILED if differs else ExitCode.OK
-        return max(super().exit_code, worst)

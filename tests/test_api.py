@@ -2,6 +2,7 @@
 command line and against closed forms."""
 from __future__ import annotations
 
+import ast
 import json
 import math
 import subprocess
@@ -51,7 +52,9 @@ def test_import_driver_is_cheap_and_exports_a_small_documented_surface():
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True)
     heavy, names = res.stdout.splitlines()
     assert heavy == "[]"
-    assert eval(names) == sorted(["run", "run_sweep", "write", "studies", "keys", "Result", "SweepResult", "DeckError"])
+    assert ast.literal_eval(names) == sorted(["run", "run_sweep", "write", "compare", "read_deck", "studies", "keys",
+                                              "Result", "Figure", "SweepResult", "DeckError", "ExitCode", "Message",
+                                              "RunOutcome", "FilesOutcome", "SweepOutcome"])
     for name in driver.__all__:
         obj = getattr(driver, name)
         assert obj.__doc__ and len(obj.__doc__) > 40, name

@@ -20,7 +20,8 @@ from conftest import INPUTS, ROOT
 from driver import _compare as compare
 from driver import _published as published
 from driver._cli import main
-from driver._outcome import CompareOutcome, ExitCode
+from driver._compare import CompareOutcome
+from driver._outcome import ExitCode
 
 DRIVER = ROOT / "driver"
 #: the command line prints (that is its job); nothing else may
