@@ -25,7 +25,7 @@ import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType, ModuleType
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from driver._groupspec import GroupSpec
 
@@ -59,6 +59,40 @@ def _names(what: str, values: Any, allowed: Mapping[str, Any] | None = None) -> 
         if allowed is not None and v not in allowed:
             raise ValueError(f"{what}: {v!r} is not a key of the study's group")
     return out
+
+
+#: the sections of the contract's hook docstrings, written once (SciPy's doccer, in small): a
+#: study's ``estimate`` or ``summarise`` keeps its own summary and notes in its docstring and ends
+#: it with ``%(estimate)s`` or ``%(summarise)s``, which :func:`contract_doc` fills
+_PARAMS_RETURNS = """Parameters
+    ----------
+    params : Params
+        Validated keys of the study's group.
+
+    Returns
+    -------
+"""
+HOOK_SECTIONS = {
+    "estimate": _PARAMS_RETURNS + """    Estimate
+        Bytes and seconds the run needs, each with the key that drives it
+        (``driver._limits`` refuses an absurd request with it).""",
+    "summarise": _PARAMS_RETURNS + """    dict
+        The run's headline figures (``run(params).summary`` wherever the run succeeds), units
+        in the names; None for a figure that does not exist.""",
+}
+
+_Hook = TypeVar("_Hook", bound=Callable[..., Any])
+
+
+def contract_doc(hook: _Hook) -> _Hook:
+    """Fill the ``%(estimate)s``/``%(summarise)s`` fields of a study hook's docstring with the
+    contract's sections (:data:`HOOK_SECTIONS`); a docstring without them is left alone."""
+    if hook.__doc__:
+        doc = hook.__doc__
+        for name, text in HOOK_SECTIONS.items():
+            doc = doc.replace(f"%({name})s", text)
+        hook.__doc__ = doc
+    return hook
 
 
 @dataclass(frozen=True)

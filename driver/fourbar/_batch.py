@@ -10,6 +10,7 @@ import numpy as np
 import pandas as pd
 
 from driver._deck import Params
+from driver._study import contract_doc
 from driver.fourbar import _forces as forces
 from driver.fourbar import _kernel as kernel
 from driver.fourbar._spec import BAND, band_of
@@ -224,21 +225,13 @@ def summary_frame(res: np.ndarray, detail: bool = False, band: tuple[float, floa
     return pd.DataFrame({k: build[k]() for k in keys}, index=pd.RangeIndex(len(res)))
 
 
+@contract_doc
 def summarise(params: Params) -> dict:
     """Summarise one deck: the headline figures only, without the tables.
 
     What a sweep needs when it writes no per-case files.
 
-    Parameters
-    ----------
-    params : Params
-        Validated ``&fourbar`` keys.
-
-    Returns
-    -------
-    dict
-        The run's summary (``run(params).summary``): units in the names (``mu_min_deg``,
-        ``omega3_peak_rad_s``), None for a figure that does not exist.
+    %(summarise)s
     """
     return summary_of(params)
 

@@ -11,6 +11,7 @@ from typing import Any
 
 from driver._deck import GroupSpec, Key, Params, positive
 from driver._limits import Estimate
+from driver._study import contract_doc
 from driver.fourbar import _forces as forces
 
 __all__ = ['SPEC', 'LABELS', 'SWEEP_BEST', 'SWEEP_PLOT', 'SUMMARY_SETTINGS', 'BAND', 'MAX_ANGLE', 'band_of', 'estimate']
@@ -121,6 +122,7 @@ SPEC = GroupSpec(
 )
 
 
+@contract_doc
 def estimate(params: Params) -> Estimate:
     """Estimate the memory and work of a run from the keys alone, before it allocates.
 
@@ -128,16 +130,7 @@ def estimate(params: Params) -> Estimate:
     (text, two tidy frames, kernel columns; about 2 KB and 50 us of Python formatting), and the
     summary kernel's 1 deg scan of at most one turn (the motion is periodic; about 30 us).
 
-    Parameters
-    ----------
-    params : Params
-        Validated ``&fourbar`` keys.
-
-    Returns
-    -------
-    Estimate
-        Bytes and seconds the run needs, each with the key that drives it
-        (``driver._limits`` refuses an absurd request with it).
+    %(estimate)s
     """
     p = params
     try:

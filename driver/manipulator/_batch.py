@@ -25,6 +25,7 @@ import numpy as np
 import pandas as pd
 
 from driver._deck import Params
+from driver._study import contract_doc
 from driver.manipulator import _kernel as kernel
 from driver.manipulator._analysis import STATUS, Conv, Workspace, design_list, design_status, round_half_up
 from driver.manipulator._report import design_torque_columns, sweep_columns, workspace_columns
@@ -338,6 +339,7 @@ def _report_torques(p: Params, prm: np.ndarray, r: dict[str, np.ndarray], n: int
     return tau[:, 0].reshape(n, k), tau[:, 1].reshape(n, k)
 
 
+@contract_doc
 def summarise(params: Params) -> dict[str, Any]:
     """Summarise the design of one deck: one row of :func:`summarise_batch`.
 
@@ -345,15 +347,7 @@ def summarise(params: Params) -> dict[str, Any]:
     ``run(params).summary`` wherever a run succeeds, and also answers for a design the run
     refuses (one that cannot reach the workspace or the target), with its ``design_status``.
 
-    Parameters
-    ----------
-    params : Params
-        Validated ``&manipulator`` keys.
-
-    Returns
-    -------
-    dict
-        The summary, units in the names (``_m``, ``_Nm``); None for a missing figure.
+    %(summarise)s
     """
     out = {}
     for key, col in _arrays(params, None).items():

@@ -7,6 +7,7 @@ from typing import Any
 
 from driver._deck import GroupSpec, Key, Params, non_empty, non_negative, positive
 from driver._limits import Estimate
+from driver._study import contract_doc
 
 __all__ = ["SPEC", "LABELS", "SWEEP_PLOT", "SWEEP_BEST", "estimate"]
 
@@ -153,6 +154,7 @@ SPEC = GroupSpec(
 )
 
 
+@contract_doc
 def estimate(params: Params) -> Estimate:
     """Estimate the memory and work of a run from the keys alone, before it allocates.
 
@@ -160,16 +162,7 @@ def estimate(params: Params) -> Estimate:
     mc_samples x points errors (about 64 bytes and 50 ns each), every row of the C_rob sweep is a
     small design evaluation (about 2 ms), the designs tables a few us per design and point.
 
-    Parameters
-    ----------
-    params : Params
-        Validated ``&manipulator`` keys.
-
-    Returns
-    -------
-    Estimate
-        Bytes and seconds the run needs, each with the key that drives it
-        (``driver._limits`` refuses an absurd request with it).
+    %(estimate)s
     """
     p = params
     pts = max(len(p.points_x), len(p.points_y))

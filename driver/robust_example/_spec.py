@@ -5,6 +5,7 @@ from typing import Any
 
 from driver._deck import GroupSpec, Key, Params, non_empty, positive
 from driver._limits import Estimate
+from driver._study import contract_doc
 
 __all__ = ["SPEC", "estimate"]
 
@@ -69,22 +70,14 @@ SPEC = GroupSpec(
 )
 
 
+@contract_doc
 def estimate(params: Params) -> Estimate:
     """Estimate the memory and work of a run from the keys alone, before it allocates.
 
     Least-squares fits of a few dozen
     numbers; the lists are bounded by the deck reader (10 000 values per key).
 
-    Parameters
-    ----------
-    params : Params
-        Validated ``&robust_example`` keys.
-
-    Returns
-    -------
-    Estimate
-        Bytes and seconds the run needs, each with the key that drives it
-        (``driver._limits`` refuses an absurd request with it).
+    %(estimate)s
     """
     n = len(params.dual_y) + len(params.taguchi_y) + len(params.taguchi_targets) * len(params.taguchi_offsets)
     return Estimate(1e6 + 1e3 * n, 0.05 + 1e-5 * n, "taguchi_y", "taguchi_y", f"{n} observations")

@@ -11,6 +11,7 @@ from typing import Any, TypedDict
 
 from driver._deck import GroupSpec, Key, Params, non_negative, positive
 from driver._limits import Estimate
+from driver._study import contract_doc
 from driver.slidercrank import _kernel as kernel
 
 #: Table 1a of the paper (columns re-ordered, docs/slidercrank.md); the depth is the
@@ -421,6 +422,7 @@ SPEC = GroupSpec("slidercrank", _KEYS,
                  check=_cross_check)
 
 
+@contract_doc
 def estimate(params: Params) -> Estimate:
     """Estimate the memory and work of a run from the keys alone, before it allocates.
 
@@ -429,16 +431,7 @@ def estimate(params: Params) -> Estimate:
     dof and step) and records the last two revolutions of states (to judge settling); the static
     buckling onset factors K + K_G some 2000 times (about 0.3 ms per dof in all).
 
-    Parameters
-    ----------
-    params : Params
-        Validated ``&slidercrank`` keys.
-
-    Returns
-    -------
-    Estimate
-        Bytes and seconds the run needs, each with the key that drives it
-        (``driver._limits`` refuses an absurd request with it).
+    %(estimate)s
     """
     p = params
     counts = list(p.element_counts) if p.element_counts else [p.n_elements]

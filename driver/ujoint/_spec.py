@@ -11,6 +11,7 @@ import numpy as np
 
 from driver._deck import GroupSpec, Key, Params, non_empty, positive
 from driver._limits import Estimate
+from driver._study import contract_doc
 from driver.ujoint._kernel import ujoint_geometry
 
 DEG = math.pi / 180.0
@@ -253,6 +254,7 @@ SPEC = GroupSpec("ujoint", KEYS, check=cross_check,
                  "Conventions: " + CONVENTIONS)
 
 
+@contract_doc
 def estimate(params: Params) -> Estimate:
     """Estimate the memory and work of a run from the keys alone, before it allocates.
 
@@ -260,16 +262,7 @@ def estimate(params: Params) -> Estimate:
     objective evaluation; SLSQP evaluates objective and gradient about (variables + 1) times per
     iteration for every start; each speed-table row costs about 1 KB and 20 us to format.
 
-    Parameters
-    ----------
-    params : Params
-        Validated ``&ujoint`` keys.
-
-    Returns
-    -------
-    Estimate
-        Bytes and seconds the run needs, each with the key that drives it
-        (``driver._limits`` refuses an absurd request with it).
+    %(estimate)s
     """
     p = params
     joints = max(len(p.beta or []), len(p.phi or []) + 1, 2)
