@@ -63,7 +63,8 @@ def _names(what: str, values: Any, allowed: Mapping[str, Any] | None = None) -> 
 
 #: the sections of the contract's hook docstrings, written once (SciPy's doccer, in small): a
 #: study's ``estimate`` or ``summarise`` keeps its own summary and notes in its docstring and ends
-#: it with ``%(estimate)s`` or ``%(summarise)s``, which :func:`contract_doc` fills
+#: it with ``%(estimate)s`` or ``%(summarise)s`` (a batch summary's Raises: ``%(batch_raises)s``),
+#: which :func:`contract_doc` fills
 _PARAMS_RETURNS = """Parameters
     ----------
     params : Params
@@ -79,6 +80,13 @@ HOOK_SECTIONS = {
     "summarise": _PARAMS_RETURNS + """    dict
         The run's headline figures (``run(params).summary`` wherever the run succeeds), units
         in the names; None for a figure that does not exist.""",
+    "batch_raises": """Raises
+    ------
+    DeckError
+        A bad value, when ``base`` is a deck's Params (deck, line and key of the base deck,
+        the design's index in the message).
+    ValueError
+        A bad value otherwise.""",
 }
 
 _Hook = TypeVar("_Hook", bound=Callable[..., Any])

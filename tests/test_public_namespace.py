@@ -89,3 +89,27 @@ def test_examples_and_readme_use_the_public_api_only():
         blocks = re.findall(r"```python\n(.*?)```", path.read_text(), re.S)
         found = [r for b in blocks for r in _private_references(b)]
         assert not found, (path.name, found)
+
+
+def test_shared_docstring_sections_are_filled_in_where_used():
+    """driver._docs.fill_doc (SciPy's doccer in small): a field is replaced by its section, an
+    unknown field stays visible (and fails the numpydoc check), no docstring is no error."""
+    from driver._docs import fill_doc
+    from driver._study import HOOK_SECTIONS
+
+    @fill_doc(rod="rod : float\n        Rod length, m.")
+    def f(rod: float) -> None:
+        """Do it.
+
+        Parameters
+        ----------
+        %(rod)s
+        %(other)s
+        """
+
+    assert "rod : float\n        Rod length, m." in (f.__doc__ or "") and "%(other)s" in (f.__doc__ or "")
+    g = fill_doc(rod="x")(lambda: None)
+    assert g.__doc__ is None
+    for study in ("fourbar", "manipulator", "robust_example", "slidercrank", "ujoint"):
+        doc = importlib.import_module(f"driver.{study}").estimate.__doc__
+        assert "%(" not in doc and HOOK_SECTIONS["estimate"] in doc, study

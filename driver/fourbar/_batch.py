@@ -103,6 +103,7 @@ def param_matrix(base: Mapping[str, Any], columns: Mapping[str, Any], n: int) ->
     return m
 
 
+@contract_doc
 def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None = None,
                     detail: bool = False, wanted: Collection[str] | None = None) -> pd.DataFrame:
     """Summarise many four-bar designs in one Fortran call: one row per design.
@@ -143,13 +144,7 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     pandas.DataFrame
         One row per design, the columns above (units in their names: ``_deg``, ``_rad_s``).
 
-    Raises
-    ------
-    DeckError
-        A bad value, when ``base`` is a deck's Params (deck, line and key of the base deck,
-        the design's index in the message).
-    ValueError
-        A bad value otherwise.
+    %(batch_raises)s
     """
     columns = {k.partition(".")[2] if k.startswith("fourbar.") else k: v for k, v in (columns or {}).items()}
     unknown = [k for k in columns if k not in BATCH_KEYS and k not in BATCH_IGNORED]

@@ -149,6 +149,7 @@ def _walk(p: Params, conv: Conv, tx: float, ty: float, mpl: float, g: float) -> 
     return _WALKS[key]
 
 
+@contract_doc
 def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None = None,
                     wanted: Collection[str] | None = None) -> pd.DataFrame:
     """Summarise many &manipulator design decks in one Fortran call: one row per deck.
@@ -181,13 +182,7 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
         One row per deck: the single run's summary columns (units in their names: ``_m``,
         ``_Nm``), missing figures as NaN, and ``design_status``.
 
-    Raises
-    ------
-    DeckError
-        A bad value, when ``base`` is a deck's Params (deck, line and key of the base deck,
-        the design's index in the message).
-    ValueError
-        A bad value otherwise.
+    %(batch_raises)s
     """
     out = _arrays(base, columns, wanted)
     if wanted is not None:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from driver._docs import fill_doc
 from driver._fortran import _kernels, farray
 
 __all__ = ['MANIPULATOR_PASSES', 'MANIPULATOR_STATUS', 'manipulator_arm_states', 'manipulator_torques',
@@ -21,6 +22,24 @@ __all__ = ['MANIPULATOR_PASSES', 'MANIPULATOR_STATUS', 'manipulator_arm_states',
 MANIPULATOR_STATUS = {"ok": int(_kernels.manipulator.st_ok),
                       "unreachable": int(_kernels.manipulator.st_unreachable),
                       "degenerate": int(_kernels.manipulator.st_degenerate)}
+
+
+_doc = fill_doc(
+    arm="""l1, l2 : float or array_like
+        Link lengths, m.
+    th1, th2 : float or array_like
+        Joint angles, rad (th2 relative to link 1).
+    qd : array_like, default (1.0, 1.0)
+        Joint rates (th1', th2'), rad/s, a pair or (n, 2).
+    qdd : array_like, default (1.0, 1.0)
+        Joint accelerations (th1'', th2''), rad/s^2, a pair or (n, 2).
+    m1, m2 : float or array_like, optional
+        Link masses, kg; default ``mass_per_length`` times the length.
+    g : float, default 9.8
+        Gravitational acceleration along -y, m/s^2.
+    mass_per_length : float, default 10.0
+        Link mass per unit length for the default masses, kg/m.""",
+)
 
 
 def _col(x, n: int) -> np.ndarray:
@@ -46,6 +65,7 @@ def _arm_inputs(l1, l2, th1, th2, qd, qdd, m1, m2, mass_per_length: float) -> _A
     return l1v, l2v, _col(th1, n), _col(th2, n), _pair(qd, n), _pair(qdd, n), m1v, m2v
 
 
+@_doc
 def manipulator_arm_states(l1, l2, th1, th2, qd=(1.0, 1.0), qdd=(1.0, 1.0), m1=None, m2=None,
                            g: float = 9.8, mass_per_length: float = 10.0,
                            out: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None):
@@ -55,20 +75,7 @@ def manipulator_arm_states(l1, l2, th1, th2, qd=(1.0, 1.0), qdd=(1.0, 1.0), m1=N
 
     Parameters
     ----------
-    l1, l2 : float or array_like
-        Link lengths, m.
-    th1, th2 : float or array_like
-        Joint angles, rad (th2 relative to link 1).
-    qd : array_like, default (1.0, 1.0)
-        Joint rates (th1', th2'), rad/s, a pair or (n, 2).
-    qdd : array_like, default (1.0, 1.0)
-        Joint accelerations (th1'', th2''), rad/s^2, a pair or (n, 2).
-    m1, m2 : float or array_like, optional
-        Link masses, kg; default ``mass_per_length`` times the length.
-    g : float, default 9.8
-        Gravitational acceleration along -y, m/s^2.
-    mass_per_length : float, default 10.0
-        Link mass per unit length for the default masses, kg/m.
+    %(arm)s
     out : tuple of numpy.ndarray, optional
         (jac, w, kappa, tau) Fortran-ordered float64 buffers of the shapes returned, reused
         across calls (large fresh arrays cost page faults that can exceed the kernel's own
@@ -103,26 +110,14 @@ def manipulator_arm_states(l1, l2, th1, th2, qd=(1.0, 1.0), qdd=(1.0, 1.0), m1=N
     return _kernels.manipulator.arm_states(*args, float(g), *out)
 
 
+@_doc
 def manipulator_torques(l1, l2, th1, th2, qd=(1.0, 1.0), qdd=(1.0, 1.0), m1=None, m2=None,
                         g: float = 9.8, mass_per_length: float = 10.0) -> np.ndarray:
     """Compute the joint torques of Craig's point-mass 2R arm (report eqs 2.52/2.53).
 
     Parameters
     ----------
-    l1, l2 : float or array_like
-        Link lengths, m.
-    th1, th2 : float or array_like
-        Joint angles, rad (th2 relative to link 1).
-    qd : array_like, default (1.0, 1.0)
-        Joint rates (th1', th2'), rad/s, a pair or (n, 2).
-    qdd : array_like, default (1.0, 1.0)
-        Joint accelerations (th1'', th2''), rad/s^2, a pair or (n, 2).
-    m1, m2 : float or array_like, optional
-        Link masses, kg; default ``mass_per_length`` times the length.
-    g : float, default 9.8
-        Gravitational acceleration along -y, m/s^2.
-    mass_per_length : float, default 10.0
-        Link mass per unit length for the default masses, kg/m.
+    %(arm)s
 
     Returns
     -------

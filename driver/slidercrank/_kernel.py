@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from driver._docs import fill_doc
 from driver._fortran import _kernels, farray
 
 __all__ = ['SLIDERCRANK_STATUS', 'SLIDERCRANK_PROFILE', 'slidercrank_simulate', 'slidercrank_matrices',
@@ -32,6 +33,33 @@ SLIDERCRANK_PROFILE = ("eps_1", "eps_2", "eps_max", "eps_max_el", "eps_min", "ep
                        "n_avg_1", "lag_change")
 
 
+_doc = fill_doc(
+    rod="""n_elements : int
+        Rod elements.
+    crank_radius : float
+        Crank radius, m.
+    rod_length : float
+        Rod length, m.
+    rho_a : float
+        Rod mass per unit length, kg/m.
+    ea : float
+        Axial stiffness E A, N.
+    ei : float
+        Bending stiffness E I, N m^2.""",
+    motion="""half_depth : float
+        Half the in-plane section depth (the outer fibre), m.
+    slider_mass : float
+        Mass on the guide, kg.
+    omega : float
+        Crank speed, rad/s (theta2 = omega t from 0).
+    dt : float
+        Time step, s.
+    n_steps : int
+        Time steps.""",
+)
+
+
+@_doc
 def slidercrank_simulate(n_elements: int, crank_radius: float, rod_length: float, rho_a: float,
                          ea: float, ei: float, half_depth: float, slider_mass: float, omega: float,
                          dt: float, n_steps: int, rec_start: int, n_rec: int, alpha: float = 0.0,
@@ -46,28 +74,8 @@ def slidercrank_simulate(n_elements: int, crank_radius: float, rod_length: float
 
     Parameters
     ----------
-    n_elements : int
-        Rod elements.
-    crank_radius : float
-        Crank radius, m.
-    rod_length : float
-        Rod length, m.
-    rho_a : float
-        Rod mass per unit length, kg/m.
-    ea : float
-        Axial stiffness E A, N.
-    ei : float
-        Bending stiffness E I, N m^2.
-    half_depth : float
-        Half the in-plane section depth (the outer fibre), m.
-    slider_mass : float
-        Mass on the guide, kg.
-    omega : float
-        Crank speed, rad/s (theta2 = omega t from 0).
-    dt : float
-        Time step, s.
-    n_steps : int
-        Time steps.
+    %(rod)s
+    %(motion)s
     rec_start, n_rec : int
         First recorded step and the number recorded.
     alpha : float, default 0.0
@@ -130,6 +138,7 @@ def slidercrank_simulate(n_elements: int, crank_radius: float, rod_length: float
     return res
 
 
+@_doc
 def slidercrank_matrices(n_elements: int, crank_radius: float, rod_length: float, rho_a: float,
                          ea: float, ei: float, slider_mass: float, theta2: float, omega: float = 0.0,
                          geometric_stiffness: bool = False) -> tuple[np.ndarray, np.ndarray]:
@@ -140,18 +149,7 @@ def slidercrank_matrices(n_elements: int, crank_radius: float, rod_length: float
 
     Parameters
     ----------
-    n_elements : int
-        Rod elements.
-    crank_radius : float
-        Crank radius, m.
-    rod_length : float
-        Rod length, m.
-    rho_a : float
-        Rod mass per unit length, kg/m.
-    ea : float
-        Axial stiffness E A, N.
-    ei : float
-        Bending stiffness E I, N m^2.
+    %(rod)s
     slider_mass : float
         Mass on the guide, kg.
     theta2 : float
@@ -270,6 +268,7 @@ SLIDERCRANK_NL_STATUS = {"ok": int(_kernels.slidercrank_nl.nl_ok), "limit": int(
                          "no_convergence": int(_kernels.slidercrank_nl.nl_no_convergence)}
 
 
+@_doc
 def slidercrank_nl_simulate(n_elements: int, crank_radius: float, rod_length: float, rho_a: float,
                             ea: float, ei: float, half_depth: float, slider_mass: float, omega: float,
                             dt: float, n_steps: int, steps_per_rev: int, rec_start: int, n_rec: int,
@@ -280,28 +279,8 @@ def slidercrank_nl_simulate(n_elements: int, crank_radius: float, rod_length: fl
 
     Parameters
     ----------
-    n_elements : int
-        Rod elements.
-    crank_radius : float
-        Crank radius, m.
-    rod_length : float
-        Rod length, m.
-    rho_a : float
-        Rod mass per unit length, kg/m.
-    ea : float
-        Axial stiffness E A, N.
-    ei : float
-        Bending stiffness E I, N m^2.
-    half_depth : float
-        Half the in-plane section depth (the outer fibre), m.
-    slider_mass : float
-        Mass on the guide, kg.
-    omega : float
-        Crank speed, rad/s (theta2 = omega t from 0).
-    dt : float
-        Time step, s.
-    n_steps : int
-        Time steps.
+    %(rod)s
+    %(motion)s
     steps_per_rev : int
         Steps per revolution (groups the steps for the per-revolution peaks).
     rec_start, n_rec : int

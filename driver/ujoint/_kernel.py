@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from driver._docs import fill_doc
 from driver._fortran import _kernels, farray
 
 __all__ = ['UJOINT_PASSES', 'UJOINT_MODELS', 'UJOINT_OBJECTIVES', 'ujoint_speed', 'ujoint_objective',
@@ -23,6 +24,16 @@ UJOINT_MODELS = {"eq13": int(_kernels.ujoint.model_eq13), "cumulative": int(_ker
 #: objective codes of fortran/ujoint.f90
 UJOINT_OBJECTIVES = {"mean_square": int(_kernels.ujoint.obj_mean_square), "rms": int(_kernels.ujoint.obj_rms),
                      "peak_to_peak": int(_kernels.ujoint.obj_peak_to_peak)}
+
+
+_doc = fill_doc(
+    chain="""beta : array_like
+        (n,) joint angles, rad.
+    phi : array_like
+        (n-1,) the paper's phases, rad (pi/2 = yokes in phase).
+    rho : array_like or None
+        (n-1,) angles between the planes of successive joints, rad; None: coplanar.""",
+)
 
 
 def _ujoint_chain(beta, phi, rho) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -45,6 +56,7 @@ def _vector(x) -> np.ndarray:
     return farray(np.atleast_1d(x), 1)
 
 
+@_doc
 def ujoint_speed(model: int, beta, phi, rho, theta) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Compute the chain's speed ratio, its derivative and the output angle at input angles.
 
@@ -52,12 +64,7 @@ def ujoint_speed(model: int, beta, phi, rho, theta) -> tuple[np.ndarray, np.ndar
     ----------
     model : int
         Model code (``UJOINT_MODELS``).
-    beta : array_like
-        (n,) joint angles, rad.
-    phi : array_like
-        (n-1,) the paper's phases, rad (pi/2 = yokes in phase).
-    rho : array_like or None
-        (n-1,) angles between the planes of successive joints, rad; None: coplanar.
+    %(chain)s
     theta : array_like
         Input shaft angles, rad.
 
@@ -107,6 +114,7 @@ def ujoint_objective(model: int, kind: int, beta, phi, rho, m: int,
     return _kernels.ujoint.chain_objective(int(model), int(kind), b, ph, rh, int(m), int(bool(grad)))
 
 
+@_doc
 def ujoint_equivalent(model: int, beta, phi, rho, tol: float = 1e-7) -> tuple[float, float | None]:
     """Compute the closed-form equivalent angles of a chain.
 
@@ -114,12 +122,7 @@ def ujoint_equivalent(model: int, beta, phi, rho, tol: float = 1e-7) -> tuple[fl
     ----------
     model : int
         Model code (``UJOINT_MODELS``).
-    beta : array_like
-        (n,) joint angles, rad.
-    phi : array_like
-        (n-1,) the paper's phases, rad (pi/2 = yokes in phase).
-    rho : array_like or None
-        (n-1,) angles between the planes of successive joints, rad; None: coplanar.
+    %(chain)s
     tol : float, default 1e-7
         Tolerance on phi_k - rho_k being a multiple of pi/2, rad.
 
