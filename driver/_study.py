@@ -25,8 +25,9 @@ import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType, ModuleType
-from typing import TYPE_CHECKING, Any, TypeVar
+from typing import TYPE_CHECKING, Any
 
+from driver._docs import fill_doc
 from driver._groupspec import GroupSpec
 
 if TYPE_CHECKING:
@@ -89,18 +90,9 @@ HOOK_SECTIONS = {
         A bad value otherwise.""",
 }
 
-_Hook = TypeVar("_Hook", bound=Callable[..., Any])
-
-
-def contract_doc(hook: _Hook) -> _Hook:
-    """Fill the ``%(estimate)s``/``%(summarise)s`` fields of a study hook's docstring with the
-    contract's sections (:data:`HOOK_SECTIONS`); a docstring without them is left alone."""
-    if hook.__doc__:
-        doc = hook.__doc__
-        for name, text in HOOK_SECTIONS.items():
-            doc = doc.replace(f"%({name})s", text)
-        hook.__doc__ = doc
-    return hook
+#: fills the ``%(estimate)s``/``%(summarise)s``/``%(batch_raises)s`` fields of a study hook's
+#: docstring with the contract's sections
+contract_doc = fill_doc(**HOOK_SECTIONS)
 
 
 @dataclass(frozen=True)
