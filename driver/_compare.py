@@ -99,6 +99,8 @@ def run_comparison(deck: str | Path) -> Comparison:
     group = study.name
     rows: list[dict] = []
     if study.published is not None:
+        # the run is made only if a published comparison reads it: _LazyResult stands in for the
+        # Result attribute by attribute, which Study.published's signature (a Result) cannot say
         rows = study.published(params, _LazyResult(lambda: study.run(params)))  # type: ignore[arg-type]
     frame = pd.DataFrame.from_records(rows, columns=COLUMNS[1:])
     frame.insert(0, "deck", str(path))
