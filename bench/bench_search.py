@@ -87,7 +87,7 @@ from driver import sweep
 from driver.fourbar import kernel as fourbar_kernel
 from driver._deck import read_deck
 if sys.argv[4] == "pool":    # the worker pool even for a small sweep (the measurement before the small-sweep rule)
-    from driver.sweep import batch as sweep_batch
+    from driver.sweep import _batch as sweep_batch
     sweep_batch.POOL_MIN_SECONDS = 0.0
 if sys.argv[4] == "dense":   # the previous peak search, in this process and in the forked workers
     real = fourbar_kernel.fourbar_summaries

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import ast
 import importlib
+import importlib.util
 import pickle
 import re
 from pathlib import Path
@@ -113,3 +114,31 @@ def test_shared_docstring_sections_are_filled_in_where_used():
     for study in ("fourbar", "manipulator", "robust_example", "slidercrank", "ujoint"):
         doc = importlib.import_module(f"driver.{study}").estimate.__doc__
         assert "%(" not in doc and HOOK_SECTIONS["estimate"] in doc, study
+
+
+#: files whose import lines in strings are made up on purpose (the self-checks of the import walks)
+FAKE_IMPORTS = {"test_private_names.py": "its walk's self-check imports names that do not exist",
+                "test_import_graph.py": "its docstring and self-check name a fake package"}
+
+
+def test_every_import_of_the_driver_resolves_also_in_code_held_in_strings():
+    """Code run through ``python -c`` (tests, bench/) is text to the import checks: every
+    ``from driver... import name`` written anywhere in the repository's Python must resolve (a
+    module renamed private would otherwise fail only when that script runs)."""
+    pattern = re.compile(r"from (driver(?:\.[A-Za-z_]+)*) import ([A-Za-z_][A-Za-z_0-9, ]*)")
+    missing = []
+    for path in sorted([*ROOT.glob("driver/**/*.py"), *ROOT.glob("tests/**/*.py"), *ROOT.glob("bench/*.py"),
+                        *ROOT.glob("tools/*.py"), *ROOT.glob("examples/*.py")]):
+        if path.name in FAKE_IMPORTS:
+            continue
+        for m in pattern.finditer(path.read_text()):
+            try:
+                module = importlib.import_module(m.group(1))
+            except ModuleNotFoundError:
+                missing.append(f"{path.relative_to(ROOT)}: from {m.group(1)} import ...")
+                continue
+            for name in (n.strip().split(" as ")[0] for n in m.group(2).split(",")):
+                if name and not hasattr(module, name) and not (
+                        hasattr(module, "__path__") and importlib.util.find_spec(f"{m.group(1)}.{name}")):
+                    missing.append(f"{path.relative_to(ROOT)}: from {m.group(1)} import {name}")
+    assert not missing, missing
