@@ -35,14 +35,14 @@ from driver.manipulator import _kernel as kernel
 from driver.manipulator import _published as published
 from driver.manipulator._analysis import DESIGN_STATUS, Workspace, optima, round_half_up, tolerance_box
 from driver.manipulator._batch import (
-           BATCH_IGNORED,
-           BATCH_INDEPENDENT,
-           BATCH_KEYS,
-           BATCH_PASS_SUFFIXES,
-           BATCH_PASSES,
-           batch_refusal,
-           summarise,
-           summarise_batch,
+    BATCH_IGNORED,
+    BATCH_INDEPENDENT,
+    BATCH_KEYS,
+    BATCH_PASS_SUFFIXES,
+    BATCH_PASSES,
+    batch_refusal,
+    summarise,
+    summarise_batch,
 )
 from driver.manipulator._report import TIDY_UNITS, run, table_frame
 from driver.manipulator._spec import LABELS, RENAMED, SPEC, SWEEP_BEST, SWEEP_PLOT, estimate

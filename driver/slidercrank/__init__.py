@@ -26,17 +26,17 @@ from driver.slidercrank._analysis import Case, simeon_initial_state, static_onse
 from driver.slidercrank._report import animation_frames
 from driver.slidercrank._report_nl import run
 from driver.slidercrank._spec import (
-           LABELS,
-           MATERIALS,
-           PAPER_SPEEDS,
-           SIMEON1996,
-           SPEC,
-           STATUS_TEXT,
-           SWEEP_PLOT,
-           Model,
-           estimate,
-           min_steps_per_rev,
-           rayleigh,
+    LABELS,
+    MATERIALS,
+    PAPER_SPEEDS,
+    SIMEON1996,
+    SPEC,
+    STATUS_TEXT,
+    SWEEP_PLOT,
+    Model,
+    estimate,
+    min_steps_per_rev,
+    rayleigh,
 )
 
 __all__ = ["SPEC", "STUDY", "run", "estimate", "MATERIALS", "PAPER_SPEEDS", "SIMEON1996", "simeon_initial_state",
