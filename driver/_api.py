@@ -29,8 +29,8 @@ import pandas as pd
 from driver._deck import Deck, DeckError, RawGroup
 from driver._dispatch import ENGINES, engine_of
 from driver._outcome import SweepOutcome
-from driver._output import Result
 from driver._pydeck import DeckSource, deck_of, is_text, plain_value
+from driver._result import Result
 from driver._runner import available_studies, run_study, write_outputs
 
 __all__ = ["run", "run_sweep", "write", "studies", "keys", "Result", "SweepResult", "DeckError", "DeckSource"]

@@ -25,7 +25,7 @@ from driver import _limits as limits
 from driver._export import FORMATS
 from driver._extras import MissingExtra, require
 from driver._outcome import ExitCode, Outcome, RunOutcome, SweepOutcome
-from driver._output import PLOT_FORMATS
+from driver._result import PLOT_FORMATS
 from driver._study import study_names
 
 __all__ = ["main", "run_deck", "say", "ExitCode"]

@@ -38,8 +38,8 @@ import pandas as pd
 from driver import _published as published
 from driver._deck import Params, read_deck
 from driver._outcome import ExitCode, Outcome
-from driver._output import Result
 from driver._published import agrees_printed
+from driver._result import Result
 from driver._runner import study_of
 from driver._study import load_study
 

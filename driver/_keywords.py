@@ -9,7 +9,7 @@ from typing import Any, Literal, overload
 from numpy.typing import NDArray
 
 from driver._deck import Params
-from driver._output import Result
+from driver._result import Result
 
 __all__ = ["fourbar", "manipulator", "robust_example", "slidercrank", "ujoint"]
 

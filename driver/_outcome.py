@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:   # annotations only
     import pandas as pd
 
-    from driver._output import Result
+    from driver._result import Result
 
 __all__ = ["ExitCode", "Message", "Outcome", "RunOutcome", "FilesOutcome", "SweepOutcome"]
 

@@ -1,10 +1,10 @@
-"""What a study returns: :class:`Result` and its :class:`Figure` s; labels.
+"""The code digest that signs resume records, and the axis labels of summary columns.
 
 What a study *is* (the :class:`~driver._study.Study` every study package declares as ``STUDY``)
-and the registry of studies are in :mod:`driver._study`.  This module holds what a study's run
-produces (:class:`Result`), the code digest that signs resume records, and the axis labels of
-summary columns from a study's ``labels``; the decorator that gives ``run`` its keyword form is
-:func:`driver._runner.keyword_run`.
+and the registry of studies are in :mod:`driver._study`; what a run returns (``Result`` and its
+``Figure`` s) in :mod:`driver._result`.  This module holds the code digest of a study (resume
+records carry it) and the axis labels of summary columns and objectives from a study's
+``labels``.
 """
 from __future__ import annotations
 
@@ -12,10 +12,9 @@ import re
 from pathlib import Path
 from types import ModuleType
 
-from driver._result import PLOT_FORMATS, Figure, Result, plot_format
 from driver._study import Study
 
-__all__ = ["Figure", "PLOT_FORMATS", "Result", "code_digest", "column_label", "expression_label", "plot_format"]
+__all__ = ["code_digest", "column_label", "expression_label"]
 
 
 def code_digest(module: Study | ModuleType | None, *others: ModuleType | None) -> bytes:

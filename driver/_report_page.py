@@ -35,7 +35,7 @@ if TYPE_CHECKING:
     import pandas as pd
 
     from driver._deck import Deck, Params
-    from driver._output import Result
+    from driver._result import Result
 
 __all__ = ["MAX_PAGE_BYTES", "Section", "build_page", "figure_svg", "mechanism_animation", "page_for_result",
            "page_for_sweep", "page_for_optimize", "page_for_synthesis", "write_report", "run_metadata"]

@@ -21,8 +21,8 @@ from driver._atomic import NAME_MAX, inside, output_set, remove_stale_temporarie
 from driver._deck import Deck, DeckError, Params, validate
 from driver._export import FORMATS, summary_json_text, write_tidy
 from driver._outcome import RunOutcome
-from driver._output import Result
 from driver._pydeck import deck_of
+from driver._result import Result
 from driver._study import REGISTRY, Study, load_study, registered, study_names
 from driver._table import TableValueError
 

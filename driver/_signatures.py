@@ -210,7 +210,7 @@ def render_module(specs: Sequence[GroupSpec]) -> str:
            "from numpy.typing import NDArray",
            "",
            "from driver._deck import Params",
-           "from driver._output import Result",
+           "from driver._result import Result",
            "",
            f"__all__ = [{', '.join(_py(s.name) for s in specs)}]"]
     for spec in specs:

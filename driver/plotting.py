@@ -25,7 +25,7 @@ import numpy as np
 
 from driver._atomic import atomic_open
 from driver._extras import require
-from driver._output import PLOT_FORMATS, plot_format
+from driver._result import PLOT_FORMATS, plot_format
 
 require("plot")   # a clear message naming the [plot] extra when matplotlib is missing; then import it:
 import matplotlib  # noqa: E402 (after require above)

@@ -19,7 +19,8 @@ from matplotlib.figure import Figure as MplFigure
 from conftest import INPUTS
 from driver import plotting
 from driver._deck import read_deck
-from driver._output import column_label, plot_format
+from driver._output import column_label
+from driver._result import plot_format
 from driver._runner import compute, study_of
 from driver._study import load_study
 from driver.fourbar import _figures as fourbar_figures

@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from driver._deck import Key, Params, non_negative
-from driver._output import Figure
+from driver._result import Figure
 from driver._table import Column, fortran_f, render_table
 from driver.fourbar import _kernel as kernel
 

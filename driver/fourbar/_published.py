@@ -8,8 +8,8 @@ import numpy as np
 
 from driver import _published as record
 from driver._deck import Params
-from driver._output import Result
 from driver._published import cell, one_digit_apart
+from driver._result import Result
 from driver._table import fortran_f
 from driver.fourbar._analysis import exact_columns, exact_grid
 

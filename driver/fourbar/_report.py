@@ -11,7 +11,7 @@ import pandas as pd
 from driver import _keywords
 from driver._deck import Params
 from driver._export import with_units
-from driver._output import Figure, Result
+from driver._result import Figure, Result
 from driver._runner import keyword_run
 from driver._signatures import keyword_signature
 from driver._table import Column, fortran_f, render_table

@@ -3,8 +3,8 @@ from __future__ import annotations
 
 from driver import _published as record
 from driver._deck import Params
-from driver._output import Result
 from driver._published import numeric_cell
+from driver._result import Result
 from driver.manipulator._report import table_frame
 from driver.manipulator._tables import NOT_REPRODUCIBLE, REASONS, TEXT_REASONS, TIDY_NAMES
 

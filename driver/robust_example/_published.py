@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from driver import _published as record
 from driver._deck import Params
-from driver._output import Result
 from driver._published import numeric_cell
+from driver._result import Result
 
 __all__ = ["MODE_REASONS", "NOT_REPRODUCIBLE", "compare"]
 

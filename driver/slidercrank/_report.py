@@ -13,7 +13,7 @@ from tqdm import tqdm
 
 from driver._deck import Params
 from driver._export import with_units
-from driver._output import Figure, Result
+from driver._result import Figure, Result
 from driver._table import Cell, Column, render_table
 from driver.slidercrank import _kernel as kernel
 from driver.slidercrank._analysis import Case, run_case, static_onset

@@ -3,8 +3,8 @@ from __future__ import annotations
 
 from driver import _published as record
 from driver._deck import Params
-from driver._output import Result
 from driver._published import cell
+from driver._result import Result
 from driver.ujoint._spec import BAND_TOL, NOT_REPRODUCIBLE
 
 __all__ = ["compare"]
