@@ -373,8 +373,8 @@ def run_optimize_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool |
         Where to write.
     formats : list of str
         Tidy table formats: ``'csv'``, ``'parquet'``.
-    plot : bool
-        Write the figures.
+    plot : bool or str
+        Write the figures (``True`` or a figure format: ``'png'``, ``'svg'``, ``'pdf'``).
     progress : bool, default False
         Show a progress bar on the terminal.
     jobs : int, optional

@@ -597,8 +597,8 @@ def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool 
         Where to write.
     formats : list of str
         Tidy table formats of the linkage's run: ``'csv'``, ``'parquet'``.
-    plot : bool
-        Write the figures.
+    plot : bool or str
+        Write the figures (``True`` or a figure format: ``'png'``, ``'svg'``, ``'pdf'``).
     progress : bool, default False
         Unused (a synthesis shows no progress bar); the engines' common signature.
     summary_json : bool, default False
