@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from conftest import INPUTS
@@ -318,8 +318,15 @@ def test_static_torque_from_virtual_work(case):
 
 # ----------------------------------------------------------------------------- balancing
 
+# found on a fresh clone: a coupler of 1.8e-19 kg beside a rocker of real inertia, every force rounding
+_NEAR_MASSLESS = np.array([0.0, 1.836645708724532e-19, 0.0, 0.0, 0.0, 3.125e-2, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+                           0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+
+
 @settings(max_examples=40, deadline=None)
 @given(cases(), st.floats(0.2, 2.0), st.floats(0.2, 2.0))
+@example((1.0, 1.0, 0.5, 1.0, 1.0, 0.0, 1, np.where(np.arange(18) == 7, 0.25, _NEAR_MASSLESS)), 1.0, 1.0)
+@example((1.0, 1.0, 1.0, 1.0, 1.0, 0.0, 1, _NEAR_MASSLESS), 1.0, 1.0)
 def test_berkof_lowen_makes_the_centre_of_mass_stationary(case, k1, k3):
     """The reported counterweights (m r and angle off the link line), put on the links as point
     masses by the oracle, leave the total centre of mass fixed; the kernel's balanced linkage has
@@ -344,13 +351,19 @@ def test_berkof_lowen_makes_the_centre_of_mass_stationary(case, k1, k3):
     assert np.ptp(total, axis=0).max() <= 1e-12 * (np.abs(total).max() + sum(pr[:3]) * max(p, q, r, s) + cw[0] + cw[2])
     assert cw[4] == pytest.approx(cw[0] / radii[0]) and cw[5] == pytest.approx(cw[2] / radii[1])
     fb, _, _ = tool_forces(theta, p, q, r, s, w, al, branch, pb)
+    # the linkage's own force scale (masses, counterweights included, at the crank pin's acceleration;
+    # inertias over the shortest link): where the forces themselves vanish (a near-massless linkage)
+    # what is left is rounding of that scale, which no bound relative to the forces can hold
+    acc = w ** 2 + abs(al)
+    own = np.sum(np.abs(pb[:3])) * q * acc + np.sum(np.abs(pb[3:6])) * acc / min(p, q, r, s)
     unb = np.hypot(f[good, 9], f[good, 10]).max()
     if unb > 0:   # + the smallest normal float: at a crank speed of ~1e-159 rad/s the forces are subnormal,
         # where no relative bound holds (hypothesis found w = 6.1e-159: 5e-324 N against 2.3e-317 N)
-        assert np.hypot(fb[good, 9], fb[good, 10]).max() <= 1e-9 * unb + np.finfo(float).tiny
+        assert np.hypot(fb[good, 9], fb[good, 10]).max() <= 1e-9 * unb + 1e-12 * own + np.finfo(float).tiny
     # the balanced linkage still satisfies Newton-Euler (the oracle with the balanced props)
     ref = oracle_forces(theta[good], p, q, r, s, w, al, branch, pb)
-    assert np.max(np.abs(fb[good] - ref) / (np.max(np.abs(ref), axis=1, keepdims=True) + 1e-300)) < 1e-9
+    scale = np.max(np.abs(ref), axis=1, keepdims=True) + own + 1e-300
+    assert np.max(np.abs(fb[good] - ref) / scale) < 1e-9
 
 
 def test_balanced_deck_reports_vanishing_shaking_force(tmp_path):
