@@ -27,7 +27,8 @@ from pathlib import Path
 from typing import IO
 
 __all__ = ["atomic_open", "write_text", "output_set", "OutputSet", "inside", "remove_stale_temporaries",
-           "file_digest", "DIGEST_CHARS", "own_folder", "refuse_link", "LinkRefused", "NAME_MAX", "NameTooLong"]
+           "file_digest", "DIGEST_CHARS", "own_folder", "refuse_link", "LinkRefused", "NAME_MAX", "NameTooLong",
+           "open_append", "read_own"]
 
 #: the longest file name the file systems we write to take [bytes]
 NAME_MAX = 255
@@ -268,3 +269,65 @@ def own_folder(path: str | Path, base: str | Path) -> Path:
         if not current.is_dir():
             raise NotADirectoryError(20, "exists and is not a folder", str(current))
     return path
+
+
+_NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
+_CLOEXEC = getattr(os, "O_CLOEXEC", 0)
+
+
+def open_append(path: str | Path) -> IO[str]:
+    """Open the tool's own log file ``path`` (an optimisation's journal) for appending, never
+    through a symbolic link: a link planted at its name is removed and a new file made in its
+    place (``O_NOFOLLOW``; ``O_EXCL`` for the new one), so nothing is written outside the folder
+    and the file a link points to is untouched.  Anything but a regular file there is refused."""
+    import errno
+    import stat as _stat
+    path = Path(path)
+    if len(os.fsencode(path.name)) > NAME_MAX:
+        raise NameTooLong(path)
+    flags = os.O_WRONLY | os.O_APPEND | _CLOEXEC
+    for _ in range(3):
+        try:
+            fd = os.open(path, flags | _NOFOLLOW)
+        except FileNotFoundError:
+            try:
+                fd = os.open(path, flags | os.O_CREAT | os.O_EXCL | _NOFOLLOW, 0o644)
+            except FileExistsError:   # made (or planted) meanwhile: look again
+                continue
+        except OSError as exc:
+            if exc.errno == errno.ELOOP or os.path.islink(path):   # a link in its place: replaced, not followed
+                with contextlib.suppress(FileNotFoundError):
+                    os.unlink(path)
+                continue
+            raise _fault(exc, path) from None
+        if not _stat.S_ISREG(os.fstat(fd).st_mode):
+            os.close(fd)
+            raise IsADirectoryError(errno.EISDIR, "exists and is not a regular file", str(path))
+        return os.fdopen(fd, "a", encoding="utf-8")
+    raise PermissionError(errno.EPERM, "a link keeps reappearing in place of the file", str(path))
+
+
+def read_own(path: str | Path, limit: int | None = None) -> bytes | None:
+    """The bytes of the tool's own file ``path`` (a resume record), or None when it is missing,
+    is a symbolic link (never followed: a record is not read from elsewhere), is not a regular
+    file, or has more than ``limit`` bytes."""
+    import stat as _stat
+    try:
+        fd = os.open(path, os.O_RDONLY | _NOFOLLOW | _CLOEXEC)
+    except OSError:
+        return None
+    try:
+        st = os.fstat(fd)
+        if not _stat.S_ISREG(st.st_mode) or (limit is not None and st.st_size > limit):
+            return None
+        chunks = []
+        while True:
+            block = os.read(fd, 1 << 20)
+            if not block:
+                break
+            chunks.append(block)
+        return b"".join(chunks)
+    except OSError:
+        return None
+    finally:
+        os.close(fd)

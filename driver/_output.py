@@ -14,7 +14,7 @@ from types import ModuleType
 
 from driver._study import Study
 
-__all__ = ["code_digest", "column_label", "expression_label"]
+__all__ = ["code_digest", "source_digest", "column_label", "expression_label"]
 
 
 def code_digest(module: Study | ModuleType | None, *others: ModuleType | None) -> bytes:
@@ -47,6 +47,45 @@ def code_digest(module: Study | ModuleType | None, *others: ModuleType | None) -
             except OSError:
                 h.update(b"<unreadable>")
     return h.digest()
+
+
+def source_digest(module: Study | ModuleType | None, *others: ModuleType | None) -> str:
+    """Hex SHA-256 of the Python source of study ``module`` (every ``.py`` of its package), of
+    the modules ``others`` and of the kernels' Fortran sources (``fortran/*.f90`` of a source
+    tree; an installed package's version instead).
+
+    Unlike :func:`code_digest` it does not read the compiled kernel, whose bytes differ between
+    machines and builds that compute the same numbers: a record that outputs/ keeps (an
+    optimisation's ``_evals`` table) carries it and stays the same on every machine, while an
+    edit to the code that computes the values changes it."""
+    import hashlib
+
+    import driver
+
+    def files(mod: ModuleType | None) -> list[Path]:
+        path = getattr(mod, "__file__", None)
+        if not path:
+            return []
+        p = Path(path)
+        return sorted(p.parent.rglob("*.py")) if p.name == "__init__.py" else [p]
+
+    if isinstance(module, Study):
+        module = module.module
+    h = hashlib.sha256()
+    for mod in (module, *others):
+        for f in files(mod):
+            h.update(f.name.encode())
+            try:
+                h.update(f.read_bytes())
+            except OSError:
+                h.update(b"<unreadable>")
+    fortran = Path(driver.__file__).resolve().parents[1] / "fortran"
+    sources = sorted(fortran.glob("*.f90")) if fortran.is_dir() else []
+    for f in sources:
+        h.update(f.name.encode() + f.read_bytes())
+    if not sources:
+        h.update(str(getattr(driver, "__version__", "")).encode())
+    return h.hexdigest()
 
 
 def column_label(study: Study | None, name: str) -> str:

@@ -263,7 +263,7 @@ def test_grid_started_local_search_and_partial_journal_resume(tmp_path):
     # an interrupted run: a journal holding the first half of the evaluations (as the run appends them)
     from driver.optimize import _journal as journal
     half = evals.iloc[: len(evals) // 2]
-    lines = [journal.line(journal.record(oc.problem.fingerprint(), [float(v)], "ok", "",
+    lines = [journal.line(journal.record(oc.problem.fingerprint(), oc.problem.code_digest(), [float(v)], "ok", "",
                           {k[len("summary."):]: (None if isinstance(row[k], float) and math.isnan(row[k])
                                                  else (row[k].item() if hasattr(row[k], "item") else row[k]))
                            for k in evals.columns if k.startswith("summary.")}))

@@ -42,7 +42,7 @@ from driver._outcome import ExitCode, Outcome
 from driver._runner import compute, output_stem, write_outputs
 from driver.optimize import _journal as journal_file
 from driver.optimize import _report as report
-from driver.optimize._evaluate import Evaluator, Record, design_params
+from driver.optimize._evaluate import Evaluator, Record, design_params, rerun_agrees
 from driver.optimize._methods import HistoryRow, MethodResult, run_method
 from driver.optimize._problem import SPEC, Problem, problem_of
 
@@ -124,10 +124,16 @@ class OptimizeOutcome(Outcome):
         return 0 if self.success else (2 if self.x is None else 1)
 
     @property
+    def check_agrees(self) -> bool:
+        """The full study's re-run of ``x`` agrees with its evaluation (True without a re-run)."""
+        return self.best is None or self.check is None or rerun_agrees(self.best, self.check)
+
+    @property
     def exit_code(self) -> ExitCode:
-        """1 when the method did not converge or the optimum's full run failed, else 0."""
-        failed = not self.success or (self.check is not None and self.study_result is not None
-                                      and bool(self.study_result.failure))
+        """1 when the method did not converge, the optimum's full run failed or differs from its
+        evaluation, else 0."""
+        failed = not self.success or not self.check_agrees or (
+            self.check is not None and self.study_result is not None and bool(self.study_result.failure))
         return ExitCode.FAILED if failed else super().exit_code
 
     @property
@@ -285,8 +291,7 @@ def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[
     formats = list(formats or [])
     stem = None if outdir is None else output_stem(outdir, deck.path, _suffixes(formats, plot))
     journal = None if stem is None else journal_file.journal_path(stem)
-    found = journal_file.read(problem.fingerprint(), problem.names, stem) if (resume and stem is not None) \
-        else journal_file.Resumed()
+    found = journal_file.read(problem, stem) if (resume and stem is not None) else journal_file.Resumed()
     if journal is not None and journal.exists() and not resume:
         journal.unlink()
     njobs = jobs if jobs is not None else problem.opts.jobs
@@ -341,7 +346,7 @@ def _write(oc: OptimizeOutcome, stem: Path, params, formats: list[str], plot: bo
         written += write_outputs(oc.study_result, opt_stem, formats, plot)
     evals = ev.frame()
     evals.insert(1, "base", p.fingerprint())
-    evals.attrs[journal_file.DIGEST_KEY] = journal_file.table_digests(evals, p.names)   # verified on --resume
+    journal_file.stamp(evals, p)   # bound to the problem and the code, verified on --resume
     if report.settings_of(p):   # the band behind summary.meets_transmission_band, with the table
         evals.attrs["summary_settings"] = report.settings_of(p)
     hist = report.history_frame(p, oc.history)
@@ -429,6 +434,11 @@ def run_optimize_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool |
         oc.error(f"{deck.path}: optimisation did not converge: {oc.message}")
     elif oc.check is not None and oc.study_result is not None and oc.study_result.failure:
         oc.error(f"{deck.path}: the optimum's full run failed: {oc.study_result.failure}")
+    if oc.best is not None and oc.check is not None and not oc.check_agrees:
+        shown = [f"{v:.6g}" if math.isfinite(v) else "undefined" for v in (oc.check.objective, oc.best.objective)]
+        oc.error(f"{deck.path}: the optimum re-run as a complete deck DIFFERS from its evaluation (objective "
+                 f"{shown[0]} against {shown[1]}, feasible {oc.check.feasible} against {oc.best.feasible}): the "
+                 "evaluation did not compute what the study computes, so no optimum is claimed")
     return oc
 
 

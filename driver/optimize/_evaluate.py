@@ -29,6 +29,7 @@ import pandas as pd
 from driver import _blas as blas
 from driver import _expr as expr
 from driver import _limits as limits
+from driver._atomic import open_append
 from driver._deck import DeckError, Params, RawGroup, validate
 from driver._runner import NUMERICAL, CaseFailure, compute, numerical_error
 from driver._study import load_study
@@ -38,7 +39,7 @@ from driver.optimize._problem import Problem
 if TYPE_CHECKING:   # pragma: no cover - dask is an optional dependency
     from dask.distributed import Client
 
-__all__ = ["Evaluator", "evaluate_cases", "FAILED_VIOLATION"]
+__all__ = ["Evaluator", "evaluate_cases", "FAILED_VIOLATION", "rerun_agrees"]
 
 #: constraint violation given to a design whose case failed (ranks below every evaluated design)
 FAILED_VIOLATION = 1e6
@@ -288,13 +289,13 @@ class Evaluator:
             self.cache[r.x] = r.index
             self.records.append(r)
         if self.journal is not None and any(journal):
-            if self._journal_fh is None:
+            if self._journal_fh is None:   # never through a link planted at its name
                 self.journal.parent.mkdir(parents=True, exist_ok=True)
-                self._journal_fh = open(self.journal, "a")
-            fp = self.problem.fingerprint()
+                self._journal_fh = open_append(self.journal)
+            fp, code = self.problem.fingerprint(), self.problem.code_digest()
             for r, j in zip(recs, journal):
                 if j:   # one checksummed line per computed design (driver.optimize._journal)
-                    self._journal_fh.write(journal_file.line(journal_file.record(fp, r.x, r.status, r.reason,
+                    self._journal_fh.write(journal_file.line(journal_file.record(fp, code, r.x, r.status, r.reason,
                                                                                  r.summary)))
             self._journal_fh.flush()
 
@@ -402,9 +403,12 @@ class Evaluator:
         return dict(sorted(out.items(), key=lambda kv: (-kv[1], kv[0])))
 
     def frame(self) -> pd.DataFrame:
-        """Every evaluation as a tidy table: variables, status, objective, margins, summary columns."""
+        """Every evaluation as a tidy table: variables, status, objective, margins, summary columns
+        (in name order: the same whether a design was computed or replayed from a resume record,
+        whose summary has sorted keys)."""
         p = self.problem
         rows = []
+        names = sorted({k for r in self.records for k in r.summary})
         for r in self.records:
             row: dict[str, Any] = {"eval": r.index + 1, **dict(zip(p.names, r.x)), "status": r.status,
                                    "feasible": r.feasible, "infeasible_reason": r.why,
@@ -413,9 +417,21 @@ class Evaluator:
             for k, m in enumerate(r.margins):
                 row[f"margin{_constraint_number(p, k)}"] = m if math.isfinite(m) else np.nan
             row["case_error"] = r.reason
-            row.update({f"summary.{k}": v for k, v in r.summary.items()})
+            row.update({f"summary.{k}": r.summary[k] for k in names if k in r.summary})
             rows.append(row)
         return pd.DataFrame(rows)
+
+
+def rerun_agrees(best: Record, check: Record) -> bool:
+    """Whether the full study's re-run of a design (``check``) agrees with its evaluation
+    (``best``): the same feasibility and the objective within 1e-9 x max(1, |f|).  A re-run that
+    differs means the evaluation did not compute what the study computes (a resume record of
+    another problem, a batch path out of step with the study): the run fails, never succeeds."""
+    if check.feasible != best.feasible:
+        return False
+    if check.objective == best.objective:
+        return True
+    return abs(check.objective - best.objective) <= 1e-9 * max(1.0, abs(best.objective))
 
 
 def _slots(problem: Problem) -> list[str]:
