@@ -14,6 +14,12 @@ checked to lie inside the set's output folder, and every name to fit NAME_MAX (2
 output's name); a process killed by SIGKILL cannot remove its
 own, so :func:`remove_stale_temporaries` removes those of processes no longer alive
 (the next run of the same deck calls it).
+
+Nothing is written through a symbolic link.  A temporary is created with ``O_EXCL``
+(``mkstemp``, which never follows a link) and renamed over the final name, so a link planted
+there is replaced, its target untouched; the folders the tool makes inside an output set are
+never links (:func:`own_folder`); the tool's own append-only and resume files are opened with
+``O_NOFOLLOW`` (:func:`open_append` replaces a link at the name, :func:`read_own` reads none).
 """
 from __future__ import annotations
 
