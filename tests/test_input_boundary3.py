@@ -99,3 +99,126 @@ def test_negative_zero_keeps_its_sign():
 def test_spellings_gfortran_reads_are_refused_in_words(value, words):
     with pytest.raises(DeckError, match=words):
         read_deck("d.dat", text=FOURBAR.replace("crank = 2.0", f"crank = {value}"))
+
+
+# ----------------------------------------------------------------------------- 4. budgets
+
+PATH = """&synthesis
+  task = 'path'
+  target_x = 2.539732, 2.961812, 0.467788, -1.640845, -1.699352
+  target_y = 4.978770, 7.379614, 7.194576, 4.811725, 2.397948
+  maxiter = 200, popsize = 10, seed = 1, tolerance = 1e-4, length_max = 12
+/
+"""
+
+
+@pytest.fixture
+def no_search(monkeypatch):
+    """A path search that starts is a failure of the test (the refusal must come before it)."""
+    from driver.synthesis import _path as pg
+
+    def started(*_a, **_k):
+        raise AssertionError("the search started")
+    monkeypatch.setattr(pg, "solve", started)
+    monkeypatch.setattr(pg, "evaluate", started)
+
+
+@pytest.mark.parametrize("change,options,key", [
+    (("", ""), ["--max-work", "1"], "target_x"),                       # the shipped deck's ~10 s
+    (("popsize = 10", "popsize = 10, samples = 100000"), ["--max-work", "1"], "samples"),   # the issue's: 100 000 samples
+    (("maxiter = 200", "maxiter = 100000, samples = 100000"), [], "samples"),   # beyond 2 min by default
+])
+def test_path_synthesis_is_refused_above_the_budget_before_it_starts(tmp_path, capsys, no_search, change, options,
+                                                                   key):
+    deck = tmp_path / "p.dat"
+    deck.write_text(PATH.replace(*change) if change[0] else PATH)
+    out = tmp_path / "out"
+    assert main([str(deck), "-o", str(out), "-q", *options]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"key '{key}'" in err[0] and "this synthesis is about" in err[0], err
+    assert "refused before starting" in err[0]
+    assert not out.exists() or not any(out.iterdir())
+
+
+@pytest.mark.parametrize("body,key", [
+    ("task = 'crank_rocker', swing_deg = 60, time_ratio = 1.2, family_points = 100000", "family_points"),
+    ("task = 'function', function = 'log10(x)', x_start = 1, x_stop = 2, crank_range_deg = 60, "
+     "rocker_range_deg = 90, error_points = 100000, points = 10000", "error_points"),
+])
+def test_every_synthesis_task_has_its_work_estimated(tmp_path, capsys, body, key):
+    deck = tmp_path / "s.dat"
+    deck.write_text(f"&synthesis\n  {body}\n/\n")
+    assert main([str(deck), "-o", str(tmp_path / "out"), "-q", "--max-work", "0.2"]) == 2
+    err = capsys.readouterr().err
+    assert f"key '{key}': this synthesis is about" in err and "refused before starting" in err, err
+
+
+@pytest.mark.parametrize("xs,ys,key,words", [
+    ("0, 1, 2, 3", "0, 1, 2, 3", "target_y", "lie on one straight line"),     # the issue's four collinear targets
+    ("0, 1, 1, 3", "0, 2, 2, 1", "target_x", "targets 2 and 3 are the same point"),
+    ("1, 1, 1", "2, 2, 2", "target_x", "every target is the same point"),
+])
+def test_degenerate_path_targets_are_refused_with_the_reason(tmp_path, capsys, no_search, xs, ys, key, words):
+    deck = tmp_path / "p.dat"
+    deck.write_text(f"&synthesis\n  task = 'path'\n  target_x = {xs}\n  target_y = {ys}\n  maxiter = 20\n/\n")
+    assert main([str(deck), "-o", str(tmp_path / "out"), "-q"]) == 2
+    err = capsys.readouterr().err
+    assert f"key '{key}'" in err and words in err, err
+
+
+def test_a_point_the_curve_passes_twice_at_other_crank_angles_is_no_degenerate_input():
+    import numpy as np
+
+    from driver.synthesis._budget import degenerate_targets
+    pts = np.array([[0.0, 0.0], [1.0, 2.0], [0.0, 0.0], [3.0, 1.0]])
+    assert degenerate_targets(pts, [0.0, 90.0, 180.0, 270.0]) is None
+    assert degenerate_targets(pts, [0.0, 90.0, 360.0, 270.0]) is not None
+    assert degenerate_targets(pts, None) is not None
+    assert degenerate_targets(np.array([[0.0, 0.0], [1.0, 1.0], [2.0, 2.0 + 1e-6]]), None) is None   # a curve, barely
+
+
+def test_the_estimate_grows_with_what_drives_the_work():
+    from driver._deck import read_deck, validate
+    from driver.synthesis import SPEC
+    from driver.synthesis._budget import estimate
+
+    def seconds(text):
+        return estimate(validate(read_deck("p.dat", text=text).groups["synthesis"], SPEC, "p.dat")).seconds
+    base = seconds(PATH)
+    assert 1.0 < base < 120.0           # the shipped deck runs in about 10 s
+    assert seconds(PATH.replace("maxiter = 200", "maxiter = 2000")) > 3 * base
+    assert seconds(PATH.replace("popsize = 10", "popsize = 10, samples = 3600")) > 2 * base
+
+
+def test_an_optimisation_whose_own_design_is_over_the_budget_is_refused_before_it_starts(tmp_path, capsys):
+    deck = tmp_path / "o.dat"
+    deck.write_text(FOURBAR.replace("step_deg = 60", "step_deg = 1e-3") +
+                    "&optimize\n  var1 = 'fourbar.crank', lower1 = 1, upper1 = 3\n  maximize = 'mu_min_deg'\n"
+                    "  method = 'grid', grid_count = 3\n/\n")
+    assert main([str(deck), "-o", str(tmp_path / "out"), "-q", "-j", "1", "--max-work", "10"]) == 2
+    err = capsys.readouterr().err
+    assert f"{deck}:3: key 'step_deg': each design of this optimisation (the deck's own design) is about" in err, err
+
+
+def test_a_library_warning_reaches_the_terminal_in_words(tmp_path, capfd, monkeypatch):
+    import warnings
+
+    import driver._runner as runner
+    real = runner.run_study
+
+    def noisy(*a, **k):
+        import numpy as np
+        with np.errstate(over="warn"):
+            np.exp(np.array([1000.0]))                 # numpy's own RuntimeWarning, from numpy
+        warnings.warn_explicit("the step is poorly scaled", UserWarning, "/x/site-packages/scipy/optimize/_y.py", 7)
+        return real(*a, **k)
+    monkeypatch.setattr("driver._dispatch.run_study", noisy)
+    deck = tmp_path / "d.dat"
+    deck.write_text(FOURBAR)
+    with warnings.catch_warnings():
+        warnings.simplefilter("default")
+        assert main([str(deck), "-o", str(tmp_path / "out"), "-q"]) == 0
+    err = capfd.readouterr().err.strip().splitlines()
+    assert any("warned while the deck ran (RuntimeWarning: overflow encountered in exp)" in e for e in err), err
+    assert any("scipy warned while the deck ran (UserWarning: the step is poorly scaled)" in e for e in err), err
+    assert all(e.startswith(f"warning: {deck}: ") for e in err), err

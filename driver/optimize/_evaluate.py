@@ -19,6 +19,7 @@ import math
 import os
 import re
 import time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any
@@ -89,35 +90,39 @@ def evaluate_cases(group: str, deck_path: str, raw: RawGroup, keys: list[str], k
     if module is None:   # the problem was built from this study's deck
         raise ValueError(f"no study reads namelist group &{group}")
     out: list[tuple[str, str, dict]] = []
-    for x in xs:
-        try:
-            params = validate(_design_raw(raw, keys, kinds, np.asarray(x)), module.spec, deck_path)
-        except DeckError as exc:
-            out.append(("bad_input", _deck_reason(exc), {}))
-            continue
-        try:
-            limits.check(module, params, lim=budget)
-        except DeckError as exc:
-            out.append(("refused", _deck_reason(exc), {}))
-            continue
-        try:
-            if module.summarise is not None:
-                try:
-                    with np.errstate(all="ignore"):
-                        summary = dict(module.summarise(params))
-                except NUMERICAL as exc:
-                    raise numerical_error(params, exc) from None
-                out.append(("ok", "", summary))
-            else:
-                result = compute(module, params, budget=budget)
-                out.append(("failed", str(result.failure), dict(result.summary)) if result.failure
-                           else ("ok", "", dict(result.summary)))
-        except CaseFailure as exc:   # a numerical failure, or a non-finite number bound for a table
-            out.append(("failed", _deck_reason(exc), {}))
-        except DeckError as exc:     # the study refuses the design (e.g. an arm that cannot reach)
-            out.append(("bad_input", _deck_reason(exc), {}))
-        except Exception as exc:   # a failing design is infeasible, never the end of the run
-            out.append(("failed", f"{exc.__class__.__name__}: {exc}", {}))
+    # a library's warning about one design is not printed from a worker: the design is judged by its
+    # own checks (numerical failures in words, finite numbers), the same on every route
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for x in xs:
+            try:
+                params = validate(_design_raw(raw, keys, kinds, np.asarray(x)), module.spec, deck_path)
+            except DeckError as exc:
+                out.append(("bad_input", _deck_reason(exc), {}))
+                continue
+            try:
+                limits.check(module, params, lim=budget)
+            except DeckError as exc:
+                out.append(("refused", _deck_reason(exc), {}))
+                continue
+            try:
+                if module.summarise is not None:
+                    try:
+                        with np.errstate(all="ignore"):
+                            summary = dict(module.summarise(params))
+                    except NUMERICAL as exc:
+                        raise numerical_error(params, exc) from None
+                    out.append(("ok", "", summary))
+                else:
+                    result = compute(module, params, budget=budget)
+                    out.append(("failed", str(result.failure), dict(result.summary)) if result.failure
+                               else ("ok", "", dict(result.summary)))
+            except CaseFailure as exc:   # a numerical failure, or a non-finite number bound for a table
+                out.append(("failed", _deck_reason(exc), {}))
+            except DeckError as exc:     # the study refuses the design (e.g. an arm that cannot reach)
+                out.append(("bad_input", _deck_reason(exc), {}))
+            except Exception as exc:   # a failing design is infeasible, never the end of the run
+                out.append(("failed", f"{exc.__class__.__name__}: {exc}", {}))
     return out
 
 

@@ -286,7 +286,8 @@ def problem_of(deck: Deck) -> Problem:
     Raises
     ------
     DeckError
-        Bad input, naming the deck, line and key.
+        Bad input, naming the deck, line and key; the deck's own design beyond the budget of one
+        run (``--max-work``, ``--max-memory``).
     """
     from driver._runner import study_of
     study, base = study_of(deck)
@@ -361,6 +362,11 @@ def problem_of(deck: Deck) -> Problem:
         raise opts.error(key, f"this run may need {worst:.3g} design evaluations, more than max_evals = "
                               f"{min(opts.max_evals, MAX_EVALS)}; reduce it or raise max_evals (at most {MAX_EVALS})")
     sense = 1 if okey == "minimize" else -1
+    # every design is one run of the study under the budget (--max-work, --max-memory): the deck's
+    # own design is checked before anything starts (a design the search reaches beyond it is
+    # refused on its own and counted as infeasible, driver.optimize._evaluate)
+    from driver import _limits as limits
+    limits.check(study, base, "each design of this optimisation (the deck's own design) ")
     return Problem(deck, study, raw, base, opts, variables, objective, sense, constraints, _terms(objective, sense))
 
 
