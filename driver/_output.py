@@ -49,9 +49,10 @@ def code_digest(module: Study | ModuleType | None, *others: ModuleType | None) -
     return h.digest()
 
 
-def source_digest(module: Study | ModuleType | None, *others: ModuleType | None) -> str:
+def source_digest(module: Study | ModuleType | None, *others: ModuleType | Path | None) -> str:
     """Hex SHA-256 of the Python source of study ``module`` (every ``.py`` of its package), of
-    the modules ``others`` and of the kernels' Fortran sources (``fortran/*.f90`` of a source
+    the modules ``others`` (a package's ``__init__.py`` path stands for the whole package, read
+    without importing it) and of the kernels' Fortran sources (``fortran/*.f90`` of a source
     tree; an installed package's version instead).
 
     Unlike :func:`code_digest` it does not read the compiled kernel, whose bytes differ between
@@ -62,8 +63,8 @@ def source_digest(module: Study | ModuleType | None, *others: ModuleType | None)
 
     import driver
 
-    def files(mod: ModuleType | None) -> list[Path]:
-        path = getattr(mod, "__file__", None)
+    def files(mod: ModuleType | Path | None) -> list[Path]:
+        path = mod if isinstance(mod, Path) else getattr(mod, "__file__", None)
         if not path:
             return []
         p = Path(path)

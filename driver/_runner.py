@@ -9,7 +9,7 @@ from __future__ import annotations
 import functools
 import os
 import re
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -21,7 +21,7 @@ from driver._atomic import NAME_MAX, inside, output_set, remove_stale_temporarie
 from driver._deck import Deck, DeckError, Params, validate
 from driver._export import FORMATS, summary_json_text, write_tidy
 from driver._outcome import RunOutcome
-from driver._pydeck import deck_of
+from driver._pydeck import deck_of, is_text
 from driver._result import Result
 from driver._study import REGISTRY, Study, load_study, registered, study_names
 from driver._table import TableValueError
@@ -228,8 +228,10 @@ def run_study(deck: Deck, outdir: Path | None, formats: list[str], plot: bool | 
 def keyword_run(run: Callable[..., Result]) -> Callable[..., Result]:
     """Decorator for a study's ``run``: accept validated Params (the runner's call) or the deck's
     keys as keyword arguments, e.g. ``driver.fourbar.run(fixed_link=12, crank=5, coupler=15,
-    rocker=9, step_deg=20)``.  Keywords are validated by the study's SPEC exactly like a deck
-    (errors are :class:`driver._deck.DeckError`); the result is the runner's, as for a deck
+    rocker=9, step_deg=20)``, or one positional dict of them or deck of the study (as
+    :func:`driver.run` takes one); anything else is a TypeError saying what to pass.  Keywords
+    are validated by the study's SPEC exactly like a deck (errors are
+    :class:`driver._deck.DeckError`); the result is the runner's, as for a deck
     (:func:`run_study`, the outputs named after the study group)."""
     @functools.wraps(run)
     def wrapper(params: Any = None, /, progress: bool = False, **keys: Any) -> Result:
@@ -237,10 +239,44 @@ def keyword_run(run: Callable[..., Result]) -> Callable[..., Result]:
         if params is not None:
             if keys:
                 raise TypeError(f"{group}.run() takes validated params or deck keys, not both")
-            return run(params, progress=progress)
+            if isinstance(params, Params):
+                return run(params, progress=progress)
+            return _positional_run(group, params, progress)
         return run_study(deck_of({group: keys}, None), None, [], False, progress=progress).result
 
     return wrapper
+
+
+def _positional_run(group: str, source: Any, progress: bool) -> Result:
+    """A study's ``run`` given one positional argument other than Params: a dict of its keys
+    (``{'crank': 5, ...}``), or a deck as :func:`driver.run` takes one (a dict of groups, a
+    deck's text, a deck file) whose study group is ``group``; anything else is a TypeError that
+    says what to pass."""
+    what = (f"{group}.run() takes the deck's keys as keyword arguments ({group}.run(crank=5, ...)), a dict of "
+            f"them, a &{group} deck (its text, its file, or {{'{group}': {{...}}}}), or validated Params")
+    if isinstance(source, Mapping):
+        nested = [isinstance(v, Mapping) for v in source.values()]
+        if source and not any(nested):          # the keys of this study
+            return run_study(deck_of({group: dict(source)}, None), None, [], False, progress=progress).result
+        if not all(nested):
+            raise TypeError(f"{what}; this dict mixes groups ({{'{group}': {{...}}}}) and keys")
+    elif not isinstance(source, (str, os.PathLike)):
+        raise TypeError(f"{what}, not {type(source).__name__}")
+    deck = deck_of(source, None)
+    control = [g for g in ("synthesis", "optimize", "sweep") if g in deck.groups]
+    if control:
+        raise DeckError(deck.path, deck.groups[control[0]].line or None, None,
+                        f"this deck has a &{control[0]} group: {group}.run() runs one &{group} deck (run the deck "
+                        "with driver.run_sweep(), driver.optimize.optimize() or driver.synthesis.synthesise())")
+    others = sorted(g for g in deck.groups if g != group)
+    if others:
+        raise DeckError(deck.path, deck.groups[others[0]].line or None, None,
+                        f"a &{others[0]} group in a deck given to {group}.run(), which runs a &{group} deck "
+                        f"(driver.run() runs a deck of any study)")
+    result = run_study(deck, None, [], False, progress=progress).result
+    if isinstance(source, str) and is_text(source):   # a deck's text has no file name: named after the study
+        result.name = group
+    return result
 
 
 def _group_of(module: str) -> str:

@@ -7,8 +7,10 @@ records tests/test_optimize_resume_verified.py.
 """
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
+import driver
 from driver._cli import main
 from driver._deck import DeckError, read_deck
 
@@ -167,8 +169,6 @@ def test_degenerate_path_targets_are_refused_with_the_reason(tmp_path, capsys, n
 
 
 def test_a_point_the_curve_passes_twice_at_other_crank_angles_is_no_degenerate_input():
-    import numpy as np
-
     from driver.synthesis._budget import degenerate_targets
     pts = np.array([[0.0, 0.0], [1.0, 2.0], [0.0, 0.0], [3.0, 1.0]])
     assert degenerate_targets(pts, [0.0, 90.0, 180.0, 270.0]) is None
@@ -222,3 +222,62 @@ def test_a_library_warning_reaches_the_terminal_in_words(tmp_path, capfd, monkey
     assert any("warned while the deck ran (RuntimeWarning: overflow encountered in exp)" in e for e in err), err
     assert any("scipy warned while the deck ran (UserWarning: the step is poorly scaled)" in e for e in err), err
     assert all(e.startswith(f"warning: {deck}: ") for e in err), err
+
+
+# ----------------------------------------------------------------------------- 6. the Python API
+
+API_BASE = dict(fixed_link=12.0, crank=5.0, coupler=15.0, rocker=9.0, omega=5.0, step_deg=20)
+
+
+def _self_holding() -> object:
+    a = np.empty(1, dtype=object)
+    a[0] = a
+    return a
+
+
+@pytest.mark.parametrize("key,value,expected", [
+    ("crank", lambda: np.longdouble(5.5), 5.5),                                    # was RecursionError
+    ("coupler_point", lambda: np.array([7.5, 3.0], dtype=np.longdouble), [7.5, 3.0]),
+    ("crank", lambda: np.array(np.longdouble(5.5)), 5.5),
+    ("coupler_point", lambda: np.array([np.longdouble(7.5), 3.0], dtype=object), [7.5, 3.0]),
+    ("crank", lambda: np.float16(5.5), 5.5),
+])
+def test_numpy_floats_of_every_precision_are_numbers(key, value, expected):
+    r = driver.run({"fourbar": dict(API_BASE, **{key: value()})})
+    assert r.ok and r.params[key] == expected
+
+
+@pytest.mark.parametrize("key,value,words", [
+    ("crank", lambda: np.clongdouble(5.0), "is a complex number"),                 # was RecursionError
+    ("coupler_point", lambda: np.array([1, 2], dtype=np.clongdouble), "is a complex number"),
+    ("crank", lambda: np.longdouble('1e4000'), "not a finite number"),             # beyond a double
+    ("coupler_point", lambda: _self_holding(), "a list inside a list"),            # an object array holding itself
+    ("coupler_point", lambda: np.array([[1.0], 2.0], dtype=object), "a list inside a list"),
+    ("title", lambda: np.bytes_(b'x'), "is bytes"),
+    ("crank", lambda: np.datetime64('2020-01-01'), "is a date"),
+])
+def test_numpy_values_that_are_no_deck_values_are_refused_naming_the_key(key, value, words):
+    with pytest.raises(DeckError, match=words) as info:
+        driver.run({"fourbar": dict(API_BASE, **{key: value()})})
+    assert info.value.key == key
+
+
+@pytest.mark.parametrize("source", [
+    {"fourbar": API_BASE},                                                    # was AttributeError: 'dict' ... 'stop_deg'
+    API_BASE,
+    "&fourbar fixed_link = 12, crank = 5, coupler = 15, rocker = 9, step_deg = 20 /",
+])
+def test_a_study_run_takes_a_deck_positionally_as_driver_run_does(source):
+    r = driver.fourbar.run(source)
+    want = driver.run({"fourbar": API_BASE})
+    assert r.ok and r.study == "fourbar" and r.name == "fourbar"
+    assert r.summary["mu_min_deg"] == want.summary["mu_min_deg"]
+
+
+def test_a_study_run_given_something_else_says_what_to_pass():
+    with pytest.raises(TypeError, match=r"fourbar.run\(\) takes the deck's keys as keyword arguments"):
+        driver.fourbar.run(5)
+    with pytest.raises(TypeError, match="mixes groups"):
+        driver.fourbar.run({"fourbar": API_BASE, "crank": 5})
+    with pytest.raises(DeckError, match=r"a &ujoint group in a deck given to fourbar.run\(\)"):
+        driver.fourbar.run({"ujoint": {"beta": [15.0]}})

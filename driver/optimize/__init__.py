@@ -130,8 +130,11 @@ class OptimizeOutcome(Outcome):
 
     @property
     def exit_code(self) -> ExitCode:
-        """1 when the method did not converge, the optimum's full run failed or differs from its
-        evaluation, else 0."""
+        """1 when the method failed or the optimum's re-run failed or differs, else 0.
+
+        Failed: the method did not converge, or the optimum's full run by the study failed or
+        differs from its evaluation (:attr:`check_agrees`).
+        """
         failed = not self.success or not self.check_agrees or (
             self.check is not None and self.study_result is not None and bool(self.study_result.failure))
         return ExitCode.FAILED if failed else super().exit_code

@@ -24,7 +24,6 @@ import hashlib
 import json
 import math
 import re
-import sys
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -217,13 +216,14 @@ class Problem:
         resume record computed by other code is not replayed.  The same on every machine
         (:func:`driver._output.source_digest`), so a committed ``_evals`` table carries it."""
         if self._code is None:
+            from pathlib import Path
+
             import driver._deck
             import driver._expr
             import driver._runner
-            import driver.optimize._evaluate
             from driver._output import source_digest
-            self._code = source_digest(self.study, driver.optimize._evaluate, driver._runner, sys.modules[__name__],
-                                       driver._deck, driver._expr)[:16]
+            engine = Path(__file__).with_name("__init__.py")   # the whole optimize package, not imported here
+            self._code = source_digest(self.study, engine, driver._runner, driver._deck, driver._expr)[:16]
         return self._code
 
 
