@@ -8,8 +8,9 @@ The files of one deck form a set (:func:`output_set`): every file is first writt
 to its temporary, and only when all are complete are they renamed into place; a
 failure or interrupt (Ctrl-C, SIGTERM, a full disk) removes all the temporaries, so a
 new ``.out`` never stands beside an old ``.csv``.  Every path written inside a set is
-checked to lie inside the set's output folder, and every name to fit NAME_MAX (255 bytes:
-:class:`NameTooLong` before the file is opened).  Temporaries are named
+checked to lie inside the set's output folder, every name to fit NAME_MAX (255 bytes:
+:class:`NameTooLong` before the file is opened), and no path to hold a control or bidi
+character (:class:`UnsafeName`, :mod:`driver._names`).  Temporaries are named
 ``.<first 40 characters of the file name>.<pid>.<random>.tmp`` (at most 62 bytes, whatever the
 output's name); a process killed by SIGKILL cannot remove its
 own, so :func:`remove_stale_temporaries` removes those of processes no longer alive
@@ -34,7 +35,7 @@ from typing import IO
 
 __all__ = ["atomic_open", "write_text", "output_set", "OutputSet", "inside", "remove_stale_temporaries",
            "file_digest", "DIGEST_CHARS", "own_folder", "refuse_link", "LinkRefused", "NAME_MAX", "NameTooLong",
-           "open_append", "read_own"]
+           "open_append", "read_own", "UnsafeName"]
 
 #: the longest file name the file systems we write to take [bytes]
 NAME_MAX = 255
@@ -49,6 +50,17 @@ class NameTooLong(OSError):
         n = len(os.fsencode(Path(path).name))
         super().__init__(errno.ENAMETOOLONG, f"the name has {n} bytes and a file name may have {NAME_MAX}",
                          str(path))
+
+
+class UnsafeName(OSError):
+    """An output's path holds a control or bidi character (:mod:`driver._names`): refused before its
+    file is opened, the path shown escaped."""
+
+    def __init__(self, path: str | Path, why: str):
+        import errno
+
+        from driver._names import shown
+        super().__init__(errno.EINVAL, why, shown(path))
 
 
 class OutputSet:
@@ -84,6 +96,7 @@ def atomic_open(path: str | Path, mode: str = "w") -> Iterator[IO]:
     path = Path(path)
     if len(os.fsencode(path.name)) > NAME_MAX:
         raise NameTooLong(path)
+    _check_name(path)
     current = _CURRENT.get()
     if current is not None and not inside(current.root, path):
         raise PermissionError(1, f"refusing to write outside the output folder {current.root}", str(path))
@@ -117,6 +130,14 @@ def atomic_open(path: str | Path, mode: str = "w") -> Iterator[IO]:
             with contextlib.suppress(FileNotFoundError):
                 os.unlink(tmp)
         raise
+
+
+def _check_name(path: Path) -> None:
+    """Refuse (:class:`UnsafeName`) a path holding a character that must not reach a terminal or a page."""
+    from driver._names import name_problem
+    why = name_problem(path, "the output's path")
+    if why:
+        raise UnsafeName(path, why)
 
 
 #: characters of the final name kept in a temporary's name (a 255-byte deck name still fits)
@@ -291,6 +312,7 @@ def open_append(path: str | Path) -> IO[str]:
     path = Path(path)
     if len(os.fsencode(path.name)) > NAME_MAX:
         raise NameTooLong(path)
+    _check_name(path)
     flags = os.O_WRONLY | os.O_APPEND | _CLOEXEC
     for _ in range(3):
         try:

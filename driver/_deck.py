@@ -36,6 +36,7 @@ from typing import Any
 import f90nml
 
 from driver._groupspec import DeckError, GroupSpec, Key, Params
+from driver._names import name_problem, shown
 
 __all__ = ["DeckError", "Key", "GroupSpec", "Params", "RawGroup", "Deck", "read_deck", "validate"]
 
@@ -646,9 +647,13 @@ def read_deck(path: str | Path, text: str | None = None) -> Deck:
     ------
     DeckError
         An unreadable or malformed deck (what f90nml would misread, a repeat count too large),
-        with file, line and key.
+        with file, line and key; a file name holding control or bidi characters
+        (:mod:`driver._names`).
     """
     path = Path(path)
+    why = name_problem(path, "the deck's file name")
+    if why:   # printed in every message and naming every output: refused, and shown escaped
+        raise DeckError(shown(path), None, None, why)
     if text is None:
         text = _read_text(path)
     text = _normalise(text)

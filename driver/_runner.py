@@ -20,6 +20,7 @@ from driver import _limits as limits
 from driver._atomic import NAME_MAX, inside, output_set, remove_stale_temporaries, write_text
 from driver._deck import Deck, DeckError, Params, validate
 from driver._export import FORMATS, summary_json_text, write_tidy
+from driver._names import name_problem, shown
 from driver._outcome import RunOutcome
 from driver._pydeck import deck_of, is_text
 from driver._result import Result
@@ -67,11 +68,15 @@ def output_stem(outdir: str | Path, deck_path: str | Path, suffixes: Iterable[st
     is opened (:class:`driver._atomic.NameTooLong`, before anything is renamed into place).
 
     A deck named ``..dat`` has the stem ``.``, ``...dat`` the stem ``..``: their outputs would
-    land beside or above OUTDIR.
+    land beside or above OUTDIR.  A name or folder holding control or bidi characters is refused
+    (:mod:`driver._names`).
     """
     name = Path(deck_path).name
     stem = name[: -len(Path(name).suffix)] if Path(name).suffix else name
     candidate = Path(outdir) / stem
+    why = name_problem(candidate, "the outputs' name (the output folder and the deck's stem)")
+    if why:   # every output's name is printed and written: control and bidi characters are refused
+        raise DeckError(shown(deck_path), None, None, why)
     if not stem or stem.strip(".") == "" or "/" in stem or "\\" in stem or not inside(outdir, candidate):
         raise DeckError(deck_path, None, None, f"outputs are named after the deck file, and {name!r} would name "
                         f"them outside the output folder {outdir}: rename the deck (e.g. case.dat)")

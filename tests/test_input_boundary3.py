@@ -281,3 +281,57 @@ def test_a_study_run_given_something_else_says_what_to_pass():
         driver.fourbar.run({"fourbar": API_BASE, "crank": 5})
     with pytest.raises(DeckError, match=r"a &ujoint group in a deck given to fourbar.run\(\)"):
         driver.fourbar.run({"ujoint": {"beta": [15.0]}})
+
+
+# ----------------------------------------------------------------------------- 5. names from anywhere
+
+NAMES = ["a\x1b]0;pwned\x07b", "x\u202egnp.exe", "\x1b[2J\x1b[31mred", "zw\u200bsp", "c1\x9bx", "ls\u2028ps"]
+
+
+@pytest.mark.parametrize("stem", NAMES)
+def test_a_deck_name_with_control_or_bidi_characters_is_refused_and_shown_escaped(tmp_path, capfd, stem):
+    """ESC/OSC sequences and right-to-left overrides in a deck's file name reached the terminal,
+    the .out and the report page raw (a bidi override spoofed the page title)."""
+    deck = tmp_path / f"{stem}.dat"
+    deck.write_text(FOURBAR)
+    out = tmp_path / "out"
+    assert main([str(deck), "-o", str(out), "--report", "--plot"]) == 2
+    cap = capfd.readouterr()
+    err = cap.err.strip().splitlines()
+    assert len(err) == 1 and "the deck's file name holds" in err[0] and "rename it" in err[0], err
+    from driver._names import unsafe
+    assert not unsafe((cap.out + cap.err).replace("\n", "")), "a raw control or bidi character reached the terminal"
+    assert not out.exists() or not any(out.iterdir())
+
+
+def test_an_output_folder_with_a_bidi_override_is_refused(tmp_path, capfd):
+    deck = tmp_path / "d.dat"
+    deck.write_text(FOURBAR)
+    out = tmp_path / "o\u202ex"
+    assert main([str(deck), "-o", str(out)]) == 2
+    cap = capfd.readouterr()
+    assert "\\u202e, RIGHT-TO-LEFT OVERRIDE" in cap.err and "\u202e" not in cap.err + cap.out
+    assert not out.exists() or not any(out.iterdir())
+
+
+def test_an_api_name_with_an_escape_writes_nothing(tmp_path):
+    from driver._atomic import UnsafeName
+    r = driver.run({"fourbar": API_BASE}, name="x\x1b[31m")
+    with pytest.raises(UnsafeName, match="holds a control character"):
+        driver.write(r, tmp_path / "o", formats=["csv"], json=True)
+    assert not (tmp_path / "o").exists() or not any((tmp_path / "o").iterdir())
+
+
+@pytest.mark.parametrize("char", ["\u202e", "\u2066", "\x1b", "\u200f"])
+def test_the_same_characters_are_refused_in_a_deck_title_too(tmp_path, capsys, char):
+    _refused(tmp_path, capsys, FOURBAR.replace("step_deg = 60", f"step_deg = 60, title = 'a{char}b'"), 3, "title",
+             "printable characters only")
+
+
+def test_shown_escapes_and_bounds_a_name():
+    from driver._names import shown
+    assert shown("a\x1b]0;x\x07b") == "a\\x1b]0;x\\x07b"
+    assert shown("r\u202el") == "r\\u202el"
+    assert shown("Ünïcødé ok") == "Ünïcødé ok"
+    long = shown("n" * 75_000)
+    assert len(long) <= 200 and "(74" in long and long.startswith("nnn") and long.endswith("nnn")
