@@ -159,7 +159,16 @@ def write_text(path: str | Path, text: str) -> Path:
 
 @contextlib.contextmanager
 def output_set(root: str | Path) -> Iterator[OutputSet]:
-    """Write a set of files inside folder ``root`` all or nothing (see the module docstring)."""
+    """Write a set of files inside folder ``root`` all or nothing (see the module docstring).
+
+    A set opened while another is being written, for a folder inside that one's (an engine's
+    outputs that include a study run's), joins it: its files are renamed into place with the
+    outer set's, or not at all.  Before anything is renamed every target is checked: a folder
+    where a file is to go fails the whole set, with nothing of it in place."""
+    outer = _CURRENT.get()
+    if outer is not None and (inside(outer.root, root) or os.path.abspath(root) == str(outer.root)):
+        yield outer
+        return
     s = OutputSet(Path(root))
     token = _CURRENT.set(s)
     current = True   # this set is the current one until reset
@@ -169,6 +178,10 @@ def output_set(root: str | Path) -> Iterator[OutputSet]:
         current = False
         done = 0
         try:
+            for _, path in s.pending:   # what would fail a rename fails the set before the first one
+                if os.path.isdir(path) and not os.path.islink(path):
+                    raise IsADirectoryError(21, "exists and is a folder; nothing of this run's outputs was put in "
+                                                "place", str(path))
             for tmp, path in s.pending:
                 try:
                     os.replace(tmp, path)

@@ -167,3 +167,26 @@ def test_an_example_deck_is_not_copied_through_a_link(tmp_path, capsys, dangling
     rc = main(["--example", "crank5.dat", "-o", str(out)])
     assert rc == 1 and "exists; not overwritten" in capsys.readouterr().err
     assert (not victim.exists()) if dangling else victim.read_bytes() == VICTIM
+
+
+# ----------------------------------------------------------------------------- an output set, whole or not at all
+
+@pytest.mark.parametrize("kind,text,options", [
+    ("study", FOURBAR, ["--csv", "--json", "--plot"]),
+    ("optimize", OPTIMIZE, ["--csv", "--json", "--plot"]),     # put .optimum.dat and .optimum.out in place
+    ("synthesis", SYNTHESIS, ["--csv", "--json", "--plot"]),
+])
+def test_an_output_set_is_written_whole_or_not_at_all(tmp_path, capsys, kind, text, options):
+    """Issue 36 item 7: an optimisation whose .out could not be written still put its optimum's
+    files in place.  A folder where the .out goes fails the run (exit 1, one line) with nothing
+    of its set in place, whatever the engine."""
+    deck = tmp_path / "d.dat"
+    deck.write_text(text)
+    out = tmp_path / "out"
+    (out / "d.out").mkdir(parents=True)
+    assert main([str(deck), "-o", str(out), "-q", "-j", "1", *options]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "d.out" in err[0] and "folder" in err[0], err
+    left = sorted(p.name for p in out.iterdir() if p.name not in ("d.out", "d.journal.jsonl"))
+    assert left == [], f"in place although the set failed: {left}"
+    assert not any(p.is_file() for p in (out / "d.out").iterdir())
