@@ -335,3 +335,44 @@ def test_shown_escapes_and_bounds_a_name():
     assert shown("Ünïcødé ok") == "Ünïcødé ok"
     long = shown("n" * 75_000)
     assert len(long) <= 200 and "(74" in long and long.startswith("nnn") and long.endswith("nnn")
+
+
+# ----------------------------------------------------------------------------- 7. the sweep's part (executor's files)
+
+SWEEP_OWNER = "issue 36 item 7 in driver/sweep/** (helper 'executor'): remove this mark when it passes"
+
+
+@pytest.mark.xfail(strict=True, reason=SWEEP_OWNER)
+def test_a_large_sweep_validates_every_case_before_any_runs(tmp_path, capsys):
+    """6 161 cases: every value of each axis is valid alone and every corner is valid, but one
+    inner case (start_deg 200, stop_deg 150) is not; it ran the others, wrote, and exited 2."""
+    start = [str(i) for i in range(100)]
+    start[50] = "200"
+    stop = [str(300 + i) for i in range(60)]
+    stop.insert(30, "150")
+    deck = tmp_path / "big.dat"
+    deck.write_text("&fourbar fixed_link = 12, crank = 5, coupler = 15, rocker = 9, omega = 5, step_deg = 90 /\n"
+                    f"&sweep\n  key1 = 'fourbar.start_deg', values1 = {', '.join(start)}\n"
+                    f"  key2 = 'fourbar.stop_deg', values2 = {', '.join(stop)}\n  case_outputs = 'none'\n/\n")
+    out = tmp_path / "out"
+    assert main([str(deck), "-o", str(out), "-q", "-j", "1"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "start_deg = 200" in err[0] and "stop_deg = 150" in err[0], err
+    assert not out.exists() or not any(out.iterdir())
+
+
+@pytest.mark.xfail(strict=True, reason=SWEEP_OWNER)
+def test_a_sweep_record_part_cut_in_half_is_redone_and_said(tmp_path, capsys):
+    """The optimiser's resume says how many records it did not believe and why; the sweep's
+    redid a part cut in half without a word ('resume: 3 of 4 cases complete, 1 to run')."""
+    deck = tmp_path / "sw.dat"
+    deck.write_text("&fourbar fixed_link = 12, crank = 5, coupler = 15, rocker = 9, omega = 5, step_deg = 90 /\n"
+                    "&sweep\n  key1 = 'fourbar.crank', values1 = 2, 3, 4, 5\n  chunk = 1\n/\n")
+    out = tmp_path / "out"
+    assert main([str(deck), "-o", str(out), "-q", "-j", "1"]) == 0
+    part = sorted((out / "sw.sweep").glob("part-*"))[0]
+    part.write_bytes(part.read_bytes()[: part.stat().st_size // 2])
+    capsys.readouterr()
+    assert main([str(deck), "-o", str(out), "-j", "1", "--resume"]) == 0
+    said = capsys.readouterr().err
+    assert any("1 " in line and "redone" in line and "because" in line for line in said.splitlines()), said
