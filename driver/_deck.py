@@ -211,7 +211,7 @@ _NULL_HELP = "a deck states every value (a null value would leave the key's defa
 
 
 def _null(path: Path, it: _Item, line: int, what: str) -> DeckError:
-    return DeckError(path, line, it.key, f"{what}: Fortran reads a null value (no value) there; {_NULL_HELP}")
+    return DeckError(path, line, it.key, f"{what}: Fortran reads a null value (an empty entry) there; {_NULL_HELP}")
 
 
 def _list_values(path: Path, it: _Item) -> list[_Value]:

@@ -18,7 +18,7 @@ import numpy as np
 from driver import _blas as blas
 from driver import _limits as limits
 from driver._atomic import NAME_MAX, inside, output_set, remove_stale_temporaries, write_text
-from driver._deck import Deck, DeckError, Params, validate
+from driver._deck import Deck, DeckError, Params, shown_value, validate
 from driver._export import FORMATS, summary_json_text, write_tidy
 from driver._names import name_problem, shown
 from driver._outcome import RunOutcome
@@ -163,7 +163,12 @@ def numerical_error(params: Params, exc: BaseException) -> CaseFailure:
     """
     study = load_study(params.group)
     blamed = study.blame(params, exc) if study is not None and study.blame is not None else None
-    if blamed:
+    if blamed and blamed[0] is not None and blamed[0] not in params.given:
+        # the deck does not have the key: the error is placed at the group, the default named
+        key, words = blamed
+        e = params.error(None, f"{words} (key '{key}' is not in the deck: its default, "
+                               f"{shown_value(params.get(key))}, applies)")
+    elif blamed:
         e = params.error(*blamed)
     else:
         words = next(w for cls, w in _WORDS if isinstance(exc, cls))
@@ -181,8 +186,10 @@ def check_finite(result: Result, params: Params) -> Result:
         m = _NON_FINITE.search(text)
         if m:
             line = text.count("\n", 0, m.start()) + 1
-            raise numerical_error(params, TableValueError(
-                f"'{m.group(0)}' would be written on line {line} of {what}"))
+            found = m.group(0)
+            kind = ("a field of asterisks (a number too wide for its column)" if found.startswith("*") else
+                    "a NaN (not a number)" if "nan" in found.lower() else "an infinity")
+            raise numerical_error(params, TableValueError(f"{kind} would be written on line {line} of {what}"))
     num = result.tidy.select_dtypes("number") if result.tidy is not None else None
     if num is not None and num.size and not np.isfinite(num.to_numpy(dtype=float, na_value=0.0)).all():
         bad = [c for c in num.columns if not np.isfinite(num[c].to_numpy(dtype=float, na_value=0.0)).all()]

@@ -376,3 +376,51 @@ def test_a_sweep_record_part_cut_in_half_is_redone_and_said(tmp_path, capsys):
     assert main([str(deck), "-o", str(out), "-j", "1", "--resume"]) == 0
     said = capsys.readouterr().err
     assert any("1 " in line and "redone" in line and "because" in line for line in said.splitlines()), said
+
+
+# ----------------------------------------------------------------------------- 7. messages in words
+
+def test_a_non_finite_table_value_is_said_in_words():
+    """The message printed the format 'FNone.3' and the float 'nan'."""
+    from driver._table import TableValueError, fortran_f
+    for value, words in ((float("nan"), "a NaN (not a number)"), (float("-inf"), "-infinity")):
+        with pytest.raises(TableValueError) as info:
+            fortran_f(value, None, 3)
+        assert str(info.value) == f"{words} cannot be written in a column of 3 decimals"
+        assert "None" not in str(info.value) and "nan" not in str(info.value)
+    with pytest.raises(TableValueError, match=r"cannot be written in an F10\.4 column"):
+        fortran_f(float("inf"), 10, 4)
+
+
+def test_a_nan_bound_for_a_table_is_said_in_words(monkeypatch):
+    import dataclasses
+
+    from driver import fourbar
+    from driver._runner import CaseFailure, compute, study_of
+    run = fourbar.STUDY.run
+
+    def with_nan(params, progress=False):
+        result = run(params, progress)
+        return dataclasses.replace(result, text=result.text + "   nan\n")
+    study = dataclasses.replace(fourbar.STUDY, run=with_nan)
+    _, params = study_of(read_deck("d.dat", text=FOURBAR))
+    with pytest.raises(CaseFailure) as info:
+        compute(study, params)
+    assert "a NaN (not a number) would be written on line" in info.value.message
+    assert "'nan'" not in info.value.message
+
+
+def test_a_numerical_failure_never_blames_a_key_the_deck_does_not_have(monkeypatch):
+    import dataclasses
+
+    from driver import _runner, fourbar
+    _, params = _runner.study_of(read_deck("d.dat", text=FOURBAR))
+    assert "method" not in params.given
+    study = dataclasses.replace(fourbar.STUDY, blame=lambda p, exc: ("method", "the listing divides 0 by 0"))
+    monkeypatch.setattr(_runner, "load_study", lambda group: study)
+    e = _runner.numerical_error(params, ZeroDivisionError("x"))
+    assert e.key is None and e.line == params.line
+    assert "key 'method' is not in the deck: its default, 'exact', applies" in e.message
+    given = dataclasses.replace(fourbar.STUDY, blame=lambda p, exc: ("crank", "too short"))
+    monkeypatch.setattr(_runner, "load_study", lambda group: given)
+    assert _runner.numerical_error(params, ZeroDivisionError("x")).key == "crank"
