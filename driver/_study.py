@@ -33,6 +33,7 @@ from driver._groupspec import GroupSpec
 if TYPE_CHECKING:
     from driver._groupspec import Params
     from driver._limits import Estimate
+    from driver._mechanism import MechanismFrames
     from driver._result import Result
 
 __all__ = ["Study", "BatchSummary", "REGISTRY", "load_study", "study_names", "registered"]
@@ -193,10 +194,11 @@ class Study:
                  is due to
     published    ``published(params, result) -> list[dict]``: the run compared cell by cell
                  with the published tables (:mod:`driver._compare`), or None
-    animation    ``animation(params, result, n) -> dict | None``: the mechanism's positions at ``n``
-                 crank angles over one turn for the report page's animation (crank pin ``A``,
-                 driven pin ``B``, coupler point ``P``, ``ground``, ``kind`` 'rocker' or 'slider',
-                 ``box_points``; :func:`driver._report_page.mechanism_animation`), or None
+    animation    ``animation(params, result, n) -> MechanismFrames``: the mechanism's motion for
+                 the report page's animation, about ``n`` frames (a crank turn), ``result`` the
+                 run of ``params`` when there is one (its deflections, its optimum): per frame the
+                 named points, once the links between them, fixed pivots, guides and traced paths
+                 (:class:`driver._mechanism.MechanismFrames`); or None
     figures      the dotted name of the study's figure module (drawn in the house style of
                  :mod:`driver.plotting`; imported only when a figure is drawn, matplotlib being
                  the optional [plot] extra), or None
@@ -217,7 +219,7 @@ class Study:
     renamed: Mapping[str, str] = field(default_factory=dict)
     blame: Callable[[Params, BaseException], tuple[str, str] | None] | None = None
     published: Callable[[Params, Result], list[dict]] | None = None
-    animation: Callable[[Params, Result | None, int], dict | None] | None = None
+    animation: Callable[[Params, Result | None, int], MechanismFrames] | None = None
     figures: str | None = None
     kernel: ModuleType | None = None
 

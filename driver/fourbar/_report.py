@@ -3,14 +3,13 @@ the closed loop, or the closed-loop table with accelerations, coupler point and 
 (``method = 'exact'``); the summary lines, tidy table, summary and figures."""
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 import pandas as pd
 
 from driver import _keywords
 from driver._deck import Params
 from driver._export import with_units
+from driver._mechanism import Guide, Link, MechanismFrames
 from driver._result import Figure, Result
 from driver._runner import keyword_run
 from driver._signatures import keyword_signature
@@ -302,14 +301,18 @@ def deck_figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> li
     return [Figure("curves", curves), Figure("linkage", linkage)]
 
 
-def animation_frames(params: Params, result: Result | None = None, n: int = 180) -> dict[str, Any] | None:
+def animation_frames(params: Params, result: Result | None = None, n: int = 180) -> MechanismFrames:
     """The linkage's positions at ``n`` crank angles over one turn, for the report page's animation
-    (:func:`driver._report_page.mechanism_animation`): crank pin A, coupler pin B, coupler point P;
-    for a crank that cannot turn, its rocking motions (out on one assembly branch, back on the
-    other) with their phases, segments and limit positions."""
+    (:class:`driver._mechanism.MechanismFrames`): the ground pivots O2 and O4, crank pin A, coupler
+    pin B and coupler point P, from the kernel's closed-loop states; for a crank that cannot turn,
+    its rocking motions (out on one assembly branch, back on the other) with their strokes in the
+    frame labels, each motion a segment, and the limit positions dashed."""
     motions = rocking_motions(params, max(8, n // 2 // max(
         1, len(assembly_intervals(params.fixed_link, params.crank, params.coupler, params.rocker) or [1]))))
-    extra: dict[str, Any] = {}
+    g = params.fixed_link
+    phase: list[str] = []
+    segments: list[tuple[int, int]] = []
+    guides = [Guide(np.array([[0.0, 0.0], [g, 0.0]]), "fixed link")]
     if motions:   # a crank that cannot turn: it rocks between its limit positions, out on one
         # assembly branch and back on the other; each assembly interval a motion of its own
         theta = np.concatenate([m.theta for m in motions])
@@ -318,26 +321,33 @@ def animation_frames(params: Params, result: Result | None = None, n: int = 180)
         word = {1: "open", -1: "crossed"}
         tag = (lambda i: "") if len(motions) == 1 else (lambda i: f", motion {i + 1} of {len(motions)}")
         arrow = {0: "\u2192", 1: "\u2190"}   # forward stroke, return stroke
-        extra["phase"] = [f"{arrow[int(st)]} {word[int(b)]} assembly{tag(i)}"
-                          for i, m in enumerate(motions) for st, b in zip(m.stroke, m.branch)]
+        phase = [f" {arrow[int(st)]} {word[int(b)]} assembly{tag(i)}"
+                 for i, m in enumerate(motions) for st, b in zip(m.stroke, m.branch)]
         starts = np.cumsum([0] + [len(m.theta) for m in motions])
-        extra["segments"] = [[int(a), int(b)] for a, b in zip(starts[:-1], starts[1:])]
-        extra["limits"] = [[np.round(m.out[k, 3:7], 5).tolist() for k in (0, len(m.theta) // 2 - 1)] for m in motions]
-        extra["limit_angles"] = [[m.lo, m.hi] for m in motions]
+        segments = [(int(a), int(b)) for a, b in zip(starts[:-1], starts[1:])]
+        for m in motions:   # the limit positions, where the crank reverses: O2-A-B-O4 dashed
+            for ang, k in ((m.lo, 0), (m.hi, len(m.theta) // 2 - 1)):
+                guides.append(Guide(np.vstack([[0.0, 0.0], m.out[k, 3:5], m.out[k, 5:7], [g, 0.0]]),
+                                    f"limit position: crank angle {ang:.1f}\u00b0 (the crank reverses)", dashed=True))
     else:
         theta = np.linspace(0.0, 360.0, n, endpoint=False)
         out, status = exact_grid(params, theta)
     ok = (status != ST["no_assembly"]) & (status != ST["indeterminate"])
     cp = coupler_point(params, theta, out, status)
-    g = params.fixed_link
-    frames = {"theta": theta.tolist(), "ok": ok.astype(int).tolist(),
-              "A": np.round(out[:, 3:5], 5).tolist(), "B": np.round(np.where(ok[:, None], out[:, 5:7], 0.0), 5).tolist(),
-              "P": None if cp is None else np.round(np.where(ok[:, None], cp[:, :2], 0.0), 5).tolist(),
-              "ground": [[0.0, 0.0], [g, 0.0]], "kind": "rocker",
-              "names": {"crank": "crank", "out": "rocker"}, **extra}
-    frames["theta"] = np.round(theta, 6).tolist()
-    pts = [out[:, 3:5], out[ok][:, 5:7], np.array([[0.0, 0.0], [g, 0.0]])]
+    names = ("O2", "A", "B", "O4") + (("P",) if cp is not None else ())
+    pts = np.full((len(theta), len(names), 2), np.nan)
+    pts[:, 0] = 0.0
+    pts[:, 3] = (g, 0.0)
+    pts[:, 1] = out[:, 3:5]
+    pts[ok, 2] = out[ok, 5:7]
     if cp is not None:
-        pts.append(cp[ok][:, :2])
-    frames["box_points"] = np.vstack(pts)
-    return frames
+        pts[ok, 4] = cp[ok, :2]
+    coupler = Link("coupler", (1, 2, 4), body=True) if cp is not None else Link("coupler", (1, 2))
+    return MechanismFrames(
+        names=names, points=pts, links=(Link("crank", (0, 1)), coupler, Link(output_name(params), (3, 2))),
+        labels=tuple(f"{t:.0f}\u00b0" + (phase[k] if phase else "") for k, t in enumerate(np.round(theta, 6))),
+        ground=(0, 3), joints=(1, 2), markers=(4,) if cp is not None else (), guides=tuple(guides),
+        paths=(1, 2, 4) if cp is not None else (1, 2), segments=tuple(segments),
+        caption="The linkage over " + ("its rocking motions between the limit positions (dashed)" if motions
+                                       else "one crank turn") + ", positions from the kernel's closed loop.",
+        invalid_note="the linkage cannot be assembled at this crank angle")

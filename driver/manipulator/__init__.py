@@ -44,7 +44,7 @@ from driver.manipulator._batch import (
     summarise,
     summarise_batch,
 )
-from driver.manipulator._report import TIDY_UNITS, run, table_frame
+from driver.manipulator._report import TIDY_UNITS, animation_frames, run, table_frame
 from driver.manipulator._spec import LABELS, RENAMED, SPEC, SWEEP_BEST, SWEEP_PLOT, estimate
 from driver.manipulator._tables import NOT_REPRODUCIBLE, REASONS, TEXT_REASONS, TIDY_NAMES
 
@@ -58,4 +58,5 @@ STUDY = Study(name="manipulator", package=__name__, spec=SPEC, run=run, estimate
                                  independent=BATCH_INDEPENDENT, passes=BATCH_PASSES,
                                  pass_names=("indices", "target", "tolerance", "walk"), refusal=batch_refusal),
               labels=LABELS, sweep_plot=SWEEP_PLOT, sweep_best=SWEEP_BEST, renamed=RENAMED,
-              published=published.compare, figures=f"{__name__}._figures", kernel=kernel)
+              published=published.compare, animation=animation_frames, figures=f"{__name__}._figures",
+              kernel=kernel)

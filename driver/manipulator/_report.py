@@ -12,6 +12,7 @@ import pandas as pd
 from driver import _keywords
 from driver._deck import Params
 from driver._export import with_units
+from driver._mechanism import Link, MechanismFrames
 from driver._result import Figure, Result
 from driver._runner import keyword_run
 from driver._signatures import keyword_signature
@@ -30,7 +31,7 @@ from driver.manipulator._analysis import (
 from driver.manipulator._spec import SPEC
 from driver.manipulator._tables import TIDY_NAMES, Table, mode_differences, report_tables, tolerance_table
 
-__all__ = ["run", "TIDY_UNITS", "table_frame"]
+__all__ = ["run", "TIDY_UNITS", "table_frame", "animation_frames"]
 
 
 def _header(p: Params, ws: Workspace, conv: Conv) -> list[str]:
@@ -310,3 +311,47 @@ def _figures():
     """The study's figure module, imported when a figure is drawn (matplotlib is the optional [plot] extra)."""
     from driver.manipulator import _figures as figures
     return figures
+
+
+def animation_frames(params: Params, result: Result | None = None, n: int = 180) -> MechanismFrames:
+    """The 2R arm of each design at the workspace points, for the report page's animation
+    (:class:`driver._mechanism.MechanismFrames`): the joint angles from the kernel's inverse
+    kinematics (:func:`~driver.manipulator.kernel.manipulator_ik`, the deck's elbow branch) at
+    each point, moving linearly in joint space from one point to the next; a design that cannot
+    reach a point is not drawn there.  The designs are the deck's, else the optima on C_rob."""
+    ws = Workspace(np.array(params.points_x, float), np.array(params.points_y, float))
+    names_d, l1s, l2s = design_list(params, Conv(params.mode == "report", ws))
+    m = ws.n
+    steps = max(4, n // max(1, len(l1s) * m))        # frames per move from one point to the next
+    px, py = np.append(ws.x, ws.x[0]), np.append(ws.y, ws.y[0])   # a tour of the points, back to the first
+    pts: list[list[np.ndarray]] = []
+    labels: list[str] = []
+    segments: list[tuple[int, int]] = []
+    for name, l1, l2 in zip(names_d, l1s, l2s):
+        th1, th2, st = kernel.manipulator_ik(l1, l2, px, py, params.elbow)
+        q = np.where((st == 0)[:, None], np.column_stack([th1, th2]), np.nan)
+        if np.isfinite(q).all():   # each move the short way round (the angles are modulo a turn)
+            q = np.unwrap(q, axis=0)
+        start = len(labels)
+        for i in range(m):
+            for j in range(steps):
+                t = j / steps
+                a, b = (1.0 - t) * q[i] + t * q[i + 1]
+                elbow = l1 * np.array([math.cos(a), math.sin(a)])
+                pts.append([elbow, elbow + l2 * np.array([math.cos(a + b), math.sin(a + b)])])
+                where = (f"at P{i + 1} ({ws.x[i]:g}, {ws.y[i]:g})" if j == 0 else
+                         f"P{i + 1} \u2192 P{(i + 1) % m + 1} (joint angles interpolated)")
+                labels.append(f"{name} (l\u2081 = {l1:g} m, l\u2082 = {l2:g} m) {where}")
+        segments.append((start, len(labels)))
+    arm = np.array(pts)
+    fixed = np.vstack([[0.0, 0.0], np.column_stack([ws.x, ws.y])])
+    names = ("A", "elbow", "tip", *(f"P{i + 1}" for i in range(m)))
+    points = np.concatenate([np.broadcast_to(fixed[:1], (len(arm), 1, 2)), arm,
+                             np.broadcast_to(fixed[1:], (len(arm), m, 2))], axis=1)
+    return MechanismFrames(
+        names=names, points=points, links=(Link("link 1", (0, 1)), Link("link 2", (1, 2))), labels=tuple(labels),
+        ground=(0,), joints=(1,), markers=(2, *range(3, 3 + m)), paths=(2,), segments=tuple(segments),
+        periodic=False, slider_label="pose", units="m",
+        caption=f"Each design's arm at the workspace points P1..P{m} (inverse kinematics from the kernel, elbow "
+                f"branch {params.elbow:+d}), moving linearly in joint space between them.",
+        invalid_note="the design cannot reach this point")

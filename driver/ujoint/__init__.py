@@ -55,7 +55,7 @@ from driver.ujoint._batch import (
     batch_applies,
     summarise_batch,
 )
-from driver.ujoint._report import run
+from driver.ujoint._report import animation_frames, run
 from driver.ujoint._spec import (
     BAND_TOL,
     CONVENTIONS,
@@ -80,4 +80,5 @@ STUDY = Study(name="ujoint", package=__name__, spec=SPEC, run=run, estimate=esti
                                  independent=BATCH_INDEPENDENT, passes=BATCH_PASSES,
                                  pass_names=("objective", "speed", "equivalent"), applies=batch_applies,
                                  elements=BATCH_ELEMENTS),
-              labels=LABELS, sweep_plot=SWEEP_PLOT, published=published.compare, figures=f"{__name__}._figures", kernel=kernel)
+              labels=LABELS, sweep_plot=SWEEP_PLOT, published=published.compare, animation=animation_frames,
+              figures=f"{__name__}._figures", kernel=kernel)
