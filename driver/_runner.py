@@ -19,7 +19,7 @@ from driver import _blas as blas
 from driver import _limits as limits
 from driver._atomic import NAME_MAX, inside, output_set, remove_stale_temporaries, write_text
 from driver._deck import Deck, DeckError, Params, validate
-from driver._export import FORMATS, summary_json_text, write_tidy
+from driver._export import FORMATS, write_tidy
 from driver._outcome import RunOutcome
 from driver._pydeck import deck_of
 from driver._result import Result
@@ -97,8 +97,9 @@ def study_suffixes(formats: list[str], summary_json: bool) -> tuple[str, ...]:
 
 def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool | str,
                   summary_json: bool = False, clean: bool = True) -> list[Path]:
-    """Write the .out file, extra files, tidy tables, the summary as ``<stem>.json`` (when
-    ``summary_json``) and figures (``plot``: True for PNG, or 'png', 'svg', 'pdf') for one case.
+    """Write the .out file, extra files, tidy tables, figures (``plot``: True for PNG, or 'png',
+    'svg', 'pdf') and the ``--json`` record as ``<stem>.json`` (when ``summary_json``;
+    :func:`driver._record.result_record`) for one case.
 
     ``plot`` is False (no figures), True (PNG) or a format of :data:`driver._output.PLOT_FORMATS`.
 
@@ -115,12 +116,14 @@ def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool | s
             written.append(write_text(stem.with_name(stem.name + suffix), text))
         for fmt in formats:
             written.append(write_tidy(result.tidy, stem, fmt))
-        if summary_json:
-            written.append(write_text(stem.with_name(stem.name + ".json"), summary_json_text(result)))
         if plot and result.figures:
             from driver.plotting import save_figure
             for fig in result.figures:
                 written.append(save_figure(fig.draw(), stem.with_name(f"{stem.name}_{fig.name}.png"), plot))
+        if summary_json:   # last: the record lists the files written with it
+            from driver._record import record_text, result_record
+            written.append(write_text(stem.with_name(stem.name + ".json"),
+                                      record_text(result_record(result, written, stem.parent))))
     # the set replaces an earlier run's: its tidy tables in formats not written now go
     for fmt in FORMATS:
         old = stem.with_name(f"{stem.name}.{fmt}")
