@@ -122,7 +122,7 @@ def compare_record(outcome: Any, deck: str | os.PathLike) -> dict[str, Any]:
         off = frame[~frame["status"].isin(["identical", "agrees"])]
         section = {"variant": c.variant, "note": c.note, "tables": tables,
                    "cells": off.drop(columns=["deck"]).to_dict("records")}
-        study = c.group
+        study = c.group if c.params is not None else None   # a control deck (&sweep ...) has no study of its own
     return _head("compare", study, Path(deck).stem, deck, outcome.ok, outcome.exit_code, _messages(outcome),
                  summary, [], section)
 
