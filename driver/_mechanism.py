@@ -111,8 +111,8 @@ class MechanismFrames:
         assembly interval); default one motion over every frame.
     periodic : bool, default True
         The frames cover one cycle: a path valid at every frame of a single motion is closed.
-    slider_label : str, default 'crank angle'
-        What the frame slider moves through.
+    frame_name : str, default 'frame'
+        What the frames step through, in words (``'crank angle'``), shown beside the page's range control.
     units : str, default ''
         The length unit of the positions (``'m'``; ``''`` when the deck's unit is free).
     caption : str, default ''
@@ -132,7 +132,7 @@ class MechanismFrames:
     paths: tuple[int, ...] = ()
     segments: tuple[tuple[int, int], ...] = ()
     periodic: bool = True
-    slider_label: str = "crank angle"
+    frame_name: str = "frame"
     units: str = ""
     caption: str = ""
     invalid_note: str = "the mechanism cannot be assembled at this position"

@@ -158,8 +158,10 @@ class FilesOutcome(Outcome):
 
 @dataclass(kw_only=True)
 class SynthesisOutcome(FilesOutcome):
-    """What a synthesis did (:func:`driver.synthesis.run_synthesis_deck`): the linkage, its tables
-    and its run, the files written, and the failure of its check as data.
+    """What a synthesis did (:func:`driver.synthesis.run_synthesis_deck`).
+
+    The linkage, its tables and its run, the files written, and the failure of its check as
+    data.
 
     Parameters
     ----------
@@ -188,8 +190,10 @@ class SynthesisOutcome(FilesOutcome):
 
     @property
     def linkage(self) -> dict[str, Any] | None:
-        """The linkage's ``&fourbar`` deck values (lengths in the deck's length unit, angles in
-        deg); None when no linkage was found."""
+        """The linkage's ``&fourbar`` deck values; None when no linkage was found.
+
+        Lengths are in the deck's length unit, angles in deg.
+        """
         return self.value.linkage
 
     @property

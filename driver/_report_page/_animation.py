@@ -53,7 +53,7 @@ class AnimationView:
     data: dict[str, Any]
     note: dict[str, Any]
     invalid_note: str
-    slider_label: str
+    frame_name: str
     caption: str
     n_frames: int
     first_label: str
@@ -99,7 +99,7 @@ def animation_view(frames: MechanismFrames, anim_id: str, caption: str = "") -> 
         line=line, pin=pin, links=links, joints=[(frames.names[i], i) for i in frames.joints],
         markers=[(frames.names[i], i) for i in frames.markers], ground=ground, guides=guides, paths=paths,
         data=data, note={"x": x0 + 0.02 * w, "y": y0 + 0.06 * h, "size": 0.04 * s},
-        invalid_note=frames.invalid_note, slider_label=frames.slider_label, caption=words,
+        invalid_note=frames.invalid_note, frame_name=frames.frame_name, caption=words,
         n_frames=frames.n_frames, first_label=frames.labels[0])
 
 

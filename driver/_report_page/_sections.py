@@ -224,7 +224,8 @@ def _synthesis_page(oc: SynthesisOutcome, deck: Deck | None) -> Page:
         sections.append(Section("task-table", f"{oc.name}{oc.table_name}.csv", [frame_table(oc.table)]))
     _close(sections, oc, deck, notes, "A synthesis has no published table of its own; compare the linkage "
                                       "deck it writes (--compare).")
-    return Page(f"{oc.name}: synthesis", f"four-bar synthesis ({oc.task})", sections, run_metadata())
+    linkage = f" of a &{oc.result.study} linkage" if oc.result is not None else ""
+    return Page(f"{oc.name}: synthesis", f"synthesis ({oc.task}){linkage}", sections, run_metadata())
 
 
 def page_of(outcome: Outcome, deck: Deck | None = None) -> Page:

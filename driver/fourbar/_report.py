@@ -347,7 +347,7 @@ def animation_frames(params: Params, result: Result | None = None, n: int = 180)
         names=names, points=pts, links=(Link("crank", (0, 1)), coupler, Link(output_name(params), (3, 2))),
         labels=tuple(f"{t:.0f}\u00b0" + (phase[k] if phase else "") for k, t in enumerate(np.round(theta, 6))),
         ground=(0, 3), joints=(1, 2), markers=(4,) if cp is not None else (), guides=tuple(guides),
-        paths=(1, 2, 4) if cp is not None else (1, 2), segments=tuple(segments),
+        paths=(1, 2, 4) if cp is not None else (1, 2), segments=tuple(segments), frame_name="crank angle",
         caption="The linkage over " + ("its rocking motions between the limit positions (dashed)" if motions
                                        else "one crank turn") + ", positions from the kernel's closed loop.",
         invalid_note="the linkage cannot be assembled at this crank angle")

@@ -351,7 +351,7 @@ def animation_frames(params: Params, result: Result | None = None, n: int = 180)
     return MechanismFrames(
         names=names, points=points, links=(Link("link 1", (0, 1)), Link("link 2", (1, 2))), labels=tuple(labels),
         ground=(0,), joints=(1,), markers=(2, *range(3, 3 + m)), paths=(2,), segments=tuple(segments),
-        periodic=False, slider_label="pose", units="m",
+        periodic=False, frame_name="pose", units="m",
         caption=f"Each design's arm at the workspace points P1..P{m} (inverse kinematics from the kernel, elbow "
                 f"branch {params.elbow:+d}), moving linearly in joint space between them.",
         invalid_note="the design cannot reach this point")

@@ -224,8 +224,9 @@ def _tables(oc: OptimizeOutcome, params: Params | None, files: list[str]) -> Non
         oc.optimum = Optimum(dict(oc.x), float(oc.best.objective), oc.constraints, oc.study_result, params,
                              report.optimum_deck(p, params, oc.best, oc.success), oc.success)
     title = Path(p.deck.path).stem
+    x = None if oc.x is None else dict(oc.x)
     oc.figures = [Figure("convergence", lambda: report.convergence_figure(p, hist, evals, title)),
-                  Figure("designs", lambda: report.designs_figure(p, evals, title))]
+                  Figure("designs", lambda: report.designs_figure(p, evals, title, x, oc.fun))]
 
 
 def _suffixes(formats: list[str], plot: bool | str) -> tuple[str, ...]:

@@ -242,31 +242,32 @@ def convergence_figure(p: Problem, history: pd.DataFrame, evals: pd.DataFrame, t
                                      title=plotting.plain_text(f"{title}: {p.objective_text}"))
 
 
-def designs_figure(p: Problem, evals: pd.DataFrame, title: str):
+def designs_figure(p: Problem, evals: pd.DataFrame, title: str, x: dict[str, float] | None = None,
+                   fun: float | None = None):
     """The designs evaluated, over the first two design variables (the objective against the one
     variable of a one-variable problem): feasible ones coloured by the objective, infeasible ones
-    grey crosses, the best feasible design starred (a scatter: an optimiser's designs are not on
-    a grid)."""
+    grey crosses, the reported design ``x`` (objective ``fun``) starred (a scatter: an optimiser's
+    designs are not on a grid)."""
     from driver import plotting
     from driver._output import column_label, expression_label
     objective = expression_label(p.study, p.objective.text)
-    x = p.names[0]
-    y = p.names[1] if len(p.names) > 1 else "objective"
+    vx = p.names[0]
+    vy = p.names[1] if len(p.names) > 1 else "objective"
     ok = evals["feasible"].astype(bool)
     feas, bad = evals[ok], evals[~ok]
     with plotting.style():
         fig, (ax,) = plotting.new_figure(1, 1, figsize=(6.4, 4.4))
-        ax.plot(bad[x], bad[y], "x", ms=3, color="0.6", label="infeasible designs", rasterized=len(bad) > 2000)
-        sc = ax.scatter(feas[x], feas[y], c=feas["objective"], s=10, cmap="viridis", label="feasible designs",
+        ax.plot(bad[vx], bad[vy], "x", ms=3, color="0.6", label="infeasible designs", rasterized=len(bad) > 2000)
+        sc = ax.scatter(feas[vx], feas[vy], c=feas["objective"], s=10, cmap="viridis", label="feasible designs",
                         rasterized=len(feas) > 2000)
         if len(feas):
-            best = feas.loc[[feas["objective"].idxmin() if p.sense > 0 else feas["objective"].idxmax()]]
-            ax.plot(best[x], best[y], "*", ms=16, color="C3", mec="k", label="optimum")
             cb = fig.colorbar(sc, ax=ax)
             cb.set_label(plotting.wrap(objective, 40))
             plotting.plain_numbers(cb.ax)
-        ax.set_xlabel(column_label(p.study, x))
-        ax.set_ylabel(column_label(p.study, y) if y != "objective" else objective)
+        if x is not None:
+            ax.plot([x[vx]], [x[vy] if vy != "objective" else fun], "*", ms=16, color="C3", mec="k", label="optimum")
+        ax.set_xlabel(column_label(p.study, vx))
+        ax.set_ylabel(column_label(p.study, vy) if vy != "objective" else objective)
         plotting.plain_numbers(ax)
         ax.legend(loc="best")
         ax.set_title(plotting.plain_text(f"{title}: designs evaluated"))

@@ -447,7 +447,7 @@ def animation_frames(params: Params, result: Result | None = None, n: int = 180)
     return MechanismFrames(
         names=tuple(names), points=np.stack(parts, axis=1),
         links=(Link("crank", (0, 1)), Link("connecting rod", rod), Link("slider", (3, 4, 5, 6), body=True)),
-        labels=tuple(f"{t:.0f}\u00b0" for t in theta), ground=(0,), joints=(1, 2), paths=(1,),
+        labels=tuple(f"{t:.0f}\u00b0" for t in theta), ground=(0,), joints=(1, 2), paths=(1,), frame_name="crank angle",
         guides=(Guide(np.array([[x0, -h / 2], [x1, -h / 2]]), "slider guide"),),
         units="m", caption=caption + ("; " + note if note else "") + ".")
 

@@ -597,8 +597,22 @@ def _error_figure(syn: Synthesis, title: str) -> Any:
 
 
 def synthesis_figures(syn: Synthesis, title: str) -> list[Figure]:
-    """The synthesis's own figures, drawn on demand: the structural error of a function
-    generation (``'error'``), the path through the targets of a path generation (``'path'``)."""
+    """List the synthesis's own figures, drawn on demand.
+
+    Parameters
+    ----------
+    syn : Synthesis
+        The synthesis (:func:`synthesise`).
+    title : str
+        The figures' title (the deck's stem).
+
+    Returns
+    -------
+    list of Figure
+        The structural error of a function generation (``'error'``), the linkage and its
+        coupler curve through the targets of a path generation (``'path'``); none for a
+        crank-rocker.
+    """
     if syn.design is None:
         return []
     if syn.params.task == "function" and len(syn.design.x):

@@ -517,6 +517,6 @@ def animation_frames(params: Params, result: Result | None = None, n: int = 180)
     return MechanismFrames(
         names=tuple(names), points=np.stack(parts, axis=1), links=tuple(links),
         labels=tuple(f"{t:.0f}\u00b0, output {d:+.2f}\u00b0 from uniform rotation" for t, d in zip(theta, dev)),
-        joints=tuple(range(1, nj + 1)), paths=(nj + 2, len(names) - 2), slider_label="input shaft angle",
+        joints=tuple(range(1, nj + 1)), paths=(nj + 2, len(names) - 2), frame_name="input shaft angle",
         caption=f"The shaft chain in an axonometric view (each shaft drawn one unit long, not to scale) at the {design} "
                 f"design, each yoke turned by its shaft's angle in the kernel's exact chain{model}.")

@@ -1,10 +1,10 @@
 (function () {
-  // moves the parts of one .anim block to the frame its slider selects; every part names the
+  // moves the parts of one .anim block to the frame its range control selects; every part names the
   // points it joins (data-points) or stands on (data-index), the frames' points come as JSON
   var root = document.currentScript.closest(".anim");
   var F = JSON.parse(root.querySelector("script[type='application/json']").textContent);
   var n = F.labels.length, timer = null;
-  var slider = root.querySelector("input[type=range]"), label = root.querySelector("output"),
+  var range = root.querySelector("input[type=range]"), label = root.querySelector("output"),
       play = root.querySelector("button"), note = root.querySelector("[data-role='note']");
   var links = Array.prototype.slice.call(root.querySelectorAll("[data-points]"));
   var dots = Array.prototype.slice.call(root.querySelectorAll("[data-index]"));
@@ -32,14 +32,14 @@
     note.style.visibility = F.points[k].indexOf(null) >= 0 ? "visible" : "hidden";
     label.textContent = F.labels[k];
   }
-  slider.addEventListener("input", function () { show(parseInt(slider.value, 10)); });
+  range.addEventListener("input", function () { show(parseInt(range.value, 10)); });
   play.addEventListener("click", function () {
     if (timer) { clearInterval(timer); timer = null; play.textContent = "play"; return; }
     play.textContent = "pause";
     timer = setInterval(function () {
-      slider.value = (parseInt(slider.value, 10) + 1) % n;
-      show(parseInt(slider.value, 10));
+      range.value = (parseInt(range.value, 10) + 1) % n;
+      show(parseInt(range.value, 10));
     }, 40);
   });
-  show(parseInt(slider.value, 10));
+  show(parseInt(range.value, 10));
 })();
