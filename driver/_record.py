@@ -48,14 +48,16 @@ def _head(engine: str, study: str | None, name: str | None, deck: Any, ok: bool,
                       engine: None if section is None else dict(section)})
 
 
-def result_record(result: Result, files: Iterable[Path] = (), folder: Path | None = None) -> dict[str, Any]:
+def result_record(result: Result, files: Iterable[Path] = (), folder: Path | None = None,
+                  name: str | None = None) -> dict[str, Any]:
     """The record of one study run: the result's summary, its warnings and failure as
-    messages, the files written with it (``files``, relative to ``folder``)."""
+    messages, the files written with it (``files``, relative to ``folder``); ``name`` the
+    outputs' stem when it is not the result's name."""
     params = result.params
     messages = [{"level": "warning", "text": w} for w in result.warnings if w != result.failure]
     if result.failure:
         messages.append({"level": "error", "text": result.failure})
-    return _head("run", result.study, result.name, getattr(params, "path", None), result.ok,
+    return _head("run", result.study, name or result.name, getattr(params, "path", None), result.ok,
                  0 if result.ok else 1, messages, result.summary, _files(files, folder),
                  {"failure": result.failure, "warnings": list(result.warnings), "figures": result.figure_names})
 

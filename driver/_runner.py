@@ -123,7 +123,7 @@ def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool | s
         if summary_json:   # last: the record lists the files written with it
             from driver._record import record_text, result_record
             written.append(write_text(stem.with_name(stem.name + ".json"),
-                                      record_text(result_record(result, written, stem.parent))))
+                                      record_text(result_record(result, written, stem.parent, stem.name))))
     # the set replaces an earlier run's: its tidy tables in formats not written now go
     for fmt in FORMATS:
         old = stem.with_name(f"{stem.name}.{fmt}")
