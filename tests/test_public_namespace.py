@@ -19,6 +19,7 @@ from pathlib import Path
 import pytest
 
 import driver
+from driver._study import study_names
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "driver"
@@ -111,7 +112,7 @@ def test_shared_docstring_sections_are_filled_in_where_used():
     assert "rod : float\n        Rod length, m." in (f.__doc__ or "") and "%(other)s" in (f.__doc__ or "")
     g = fill_doc(rod="x")(lambda: None)
     assert g.__doc__ is None
-    for study in ("fourbar", "manipulator", "robust_example", "slidercrank", "ujoint"):
+    for study in study_names():
         doc = importlib.import_module(f"driver.{study}").estimate.__doc__
         assert "%(" not in doc and HOOK_SECTIONS["estimate"] in doc, study
 
