@@ -117,10 +117,21 @@ def test_every_study_has_the_one_layout(name):
     assert s.published is not None and s.published.__module__ == f"{s.package}._published"
     assert s.kernel is None or s.kernel.__name__ == f"{s.package}._kernel"
     assert s.run.__module__.startswith(f"{s.package}._report") and s.estimate.__module__ == f"{s.package}._spec"
-    # the package's __init__ holds its public names and STUDY only: imports, __all__, assignments (no code)
+    # the package's __init__ holds its public names and STUDY only: imports, __all__, assignments (no
+    # code); run is its generated static signature to type checkers (``if TYPE_CHECKING:``)
     init = ast.parse((folder / "__init__.py").read_text())
-    kinds = {type(n) for n in init.body[1:]}
+    kinds = {type(n) for n in init.body[1:] if not _typed_run(n, s.package)}
     assert kinds <= {ast.ImportFrom, ast.Import, ast.Assign, ast.AnnAssign}, kinds
+    assert any(_typed_run(n, s.package) for n in init.body), "run is not typed by the study's _keywords.pyi"
+
+
+def _typed_run(node: ast.stmt, package: str) -> bool:
+    """``if TYPE_CHECKING: from <package>._keywords import run`` / ``else: from <package>._<module> import run``."""
+    return (isinstance(node, ast.If) and isinstance(node.test, ast.Name) and node.test.id == "TYPE_CHECKING"
+            and len(node.body) == len(node.orelse) == 1
+            and all(isinstance(b, ast.ImportFrom) and [a.name for a in b.names] == ["run"]
+                    for b in (*node.body, *node.orelse))
+            and node.body[0].module in (f"{package}._keywords", "._keywords"))
 
 
 def test_shared_modules_hold_no_per_study_code():

@@ -16,6 +16,8 @@ call; the summary), ``_report`` (the run: .out, tidy table, summary), ``_figures
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from driver._study import BatchSummary, Study
 from driver.fourbar import _forces as forces
 from driver.fourbar import _kernel as kernel
@@ -47,8 +49,13 @@ from driver.fourbar._batch import (
     summarise_batch,
 )
 from driver.fourbar._published import LISTING_DEFECT, LISTING_PRECISION, exact_as_listed
-from driver.fourbar._report import animation_frames, run
+from driver.fourbar._report import animation_frames
 from driver.fourbar._spec import LABELS, SPEC, SUMMARY_SETTINGS, SWEEP_BEST, SWEEP_PLOT, estimate
+
+if TYPE_CHECKING:   # run's keys as typed keywords: generated from SPEC (tools/gen_keyword_signatures.py)
+    from driver.fourbar._keywords import run
+else:
+    from driver.fourbar._report import run
 
 __all__ = ["SPEC", "STUDY", "run", "estimate", "summarise", "summarise_batch", "BATCH_KEYS", "BATCH_PASSES", "grashof",
            "limit_angles", "assembly_intervals", "rocking_motions", "Motion", "crank_angles", "exact_grid", "coupler_point",

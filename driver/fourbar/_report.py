@@ -8,12 +8,10 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from driver import _keywords
 from driver._deck import Params
 from driver._export import with_units
 from driver._result import Figure, Result
-from driver._runner import keyword_run
-from driver._signatures import keyword_signature
+from driver._runner import study_run
 from driver._table import Column, fortran_f, render_table
 from driver.fourbar import _forces as forces
 from driver.fourbar._analysis import (
@@ -181,8 +179,7 @@ def audit(p: Params, theta: np.ndarray, table: np.ndarray, lst_status: np.ndarra
     return lines, warn, frame
 
 
-@keyword_signature(_keywords.fourbar, SPEC)
-@keyword_run
+@study_run(SPEC)
 def run(params: Params, progress: bool = False) -> Result:
     """Analyse a planar four-bar linkage driven by its crank over a range of crank angles.
 

@@ -9,12 +9,10 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from driver import _keywords
 from driver._deck import Params
 from driver._export import with_units
 from driver._result import Figure, Result
-from driver._runner import keyword_run
-from driver._signatures import keyword_signature
+from driver._runner import study_run
 from driver._table import fortran_f
 from driver.manipulator import _kernel as kernel
 from driver.manipulator._analysis import (
@@ -189,8 +187,7 @@ def _summary(p: Params, ws: Workspace, conv: Conv, used: dict, sweep: dict, tol:
     return s
 
 
-@keyword_signature(_keywords.manipulator, SPEC)
-@keyword_run
+@study_run(SPEC)
 def run(params: Params, progress: bool = False) -> Result:
     """Synthesise a planar 2R arm robustly for a workspace of points (the report's chapter 4).
 

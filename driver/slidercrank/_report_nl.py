@@ -13,12 +13,10 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
-from driver import _keywords
 from driver._deck import Params
 from driver._export import with_units
 from driver._result import Figure, Result
-from driver._runner import keyword_run
-from driver._signatures import keyword_signature
+from driver._runner import study_run
 from driver._table import Cell, Column, render_table
 from driver.slidercrank._analysis import Case, run_case, static_onset
 from driver.slidercrank._nonlinear import IRREGULAR, NLCase, onset_search, run_nl_case
@@ -270,8 +268,7 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
                   summary=_summary(pairs, tol, limit, onset), warnings=warnings, failure=failure, figures=figures)
 
 
-@keyword_signature(_keywords.slidercrank, SPEC)
-@keyword_run
+@study_run(SPEC)
 def run(params: Params, progress: bool = False) -> Result:
     """Simulate a slider-crank with an elastic connecting rod at one or more crank speeds.
 

@@ -7,11 +7,12 @@ import pandas as pd
 from driver._deck import Params
 from driver._export import with_units
 from driver._result import Figure, Result
-from driver._runner import keyword_run
+from driver._runner import study_run
 from driver._table import Column, render_table
 
 from . import _kernel as kernel
 from ._batch import summarise_batch
+from ._spec import SPEC
 
 
 def summarise(params: Params) -> dict:
@@ -19,7 +20,7 @@ def summarise(params: Params) -> dict:
     return {k: float(v) for k, v in summarise_batch(params).iloc[0].items()}
 
 
-@keyword_run
+@study_run(SPEC)
 def run(params: Params, progress: bool = False) -> Result:
     """Period and half swing of the deck's rod."""
     p = params
