@@ -9,9 +9,16 @@ back.  Each kernel's physics and units are documented in its Fortran source.
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
-from driver._fortran import _kernels, farray, spare_buffer
+from driver._fortran import farray, spare_buffer
+
+if TYPE_CHECKING:   # the study's modules of the extension, typed (generated: tools/gen_kernel_stub.py)
+    from driver.fourbar import _kernels
+else:
+    from driver._fortran import _kernels
 
 __all__ = ['FOURBAR_PASSES', 'fourbar_listing', 'fourbar_exact', 'fourbar_coupler_point', 'fourbar_summaries',
            'fourbar_joint_forces', 'fourbar_berkof_lowen', 'fourbar_force_summaries',

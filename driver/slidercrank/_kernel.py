@@ -8,12 +8,17 @@ back.  Each kernel's physics and units are documented in its Fortran source.
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from driver._docs import fill_doc
-from driver._fortran import _kernels, farray
+from driver._fortran import farray
+
+if TYPE_CHECKING:   # the study's modules of the extension, typed (generated: tools/gen_kernel_stub.py)
+    from driver.slidercrank import _kernels
+else:
+    from driver._fortran import _kernels
 
 __all__ = ['SLIDERCRANK_STATUS', 'SLIDERCRANK_PROFILE', 'slidercrank_simulate', 'slidercrank_matrices',
            'slidercrank_rigid', 'slidercrank_axial_force', 'slidercrank_frequencies', 'SLIDERCRANK_NL_STATUS',

@@ -8,10 +8,17 @@ back.  Each kernel's physics and units are documented in its Fortran source.
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from driver._docs import fill_doc
-from driver._fortran import _kernels, farray
+from driver._fortran import farray
+
+if TYPE_CHECKING:   # the study's modules of the extension, typed (generated: tools/gen_kernel_stub.py)
+    from driver.ujoint import _kernels
+else:
+    from driver._fortran import _kernels
 
 __all__ = ['UJOINT_PASSES', 'UJOINT_MODELS', 'UJOINT_OBJECTIVES', 'ujoint_speed', 'ujoint_objective',
            'ujoint_equivalent', 'ujoint_geometry', 'ujoint_summaries', 'UJOINT_SUMMARY_COLUMNS']
