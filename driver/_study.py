@@ -14,9 +14,9 @@ checked when the package is imported (:meth:`Study.__post_init__`): a study with
 ``estimate`` cannot register (the absurd-request budget of :mod:`driver._limits` applies to every
 study), a misspelt batch key or a pass table naming an unknown pass raises at import.
 
-Adding a study: the package (spec, analysis, report, figures, published, kernel; batch when it
-has a batch summary), its Fortran kernel with a line in ``fortran/meson.build``, and one line
-in :data:`REGISTRY`.
+Adding a study: the package in the layers of :data:`LAYERS` (spec, analysis, figures, report,
+published; kernel with a kernel, batch with a batch summary), its Fortran kernel with its line in
+``fortran/meson.build``, and one line in :data:`REGISTRY`.
 """
 from __future__ import annotations
 
@@ -28,14 +28,14 @@ from types import MappingProxyType, ModuleType
 from typing import TYPE_CHECKING, Any
 
 from driver._docs import fill_doc
-from driver._groupspec import GroupSpec
+from driver._groupspec import GroupSpec, Params
 
 if TYPE_CHECKING:
-    from driver._groupspec import Params
     from driver._limits import Estimate
     from driver._result import Result
 
-__all__ = ["Study", "BatchSummary", "REGISTRY", "load_study", "study_names", "registered"]
+__all__ = ["Study", "BatchSummary", "REGISTRY", "LAYERS", "REQUIRED_LAYERS", "layer_of", "load_study", "study_names",
+           "registered", "batch_error"]
 
 #: the studies, by namelist group: group -> the package that binds ``STUDY``.  Imported only
 #: when a deck (or a caller) names the group, so ``python -m driver --help`` stays light.
@@ -46,6 +46,23 @@ REGISTRY: dict[str, str] = {
     "slidercrank": "driver.slidercrank",
     "ujoint": "driver.ujoint",
 }
+
+#: the layers of a study package, in dependency order (docs/layout.md): a module may import only
+#: modules of an earlier layer or of its own.  A module is its layer (``_report``) or an extra of
+#: it named after it (``_report_nl``, ``_analysis_forces``); ``__init__``, and any module that only
+#: hands names on (the four-bar's ``_forces``), is the package's face, above every layer.
+LAYERS = ("_kernel", "_spec", "_analysis", "_tables", "_batch", "_figures", "_report", "_published")
+#: the layers every study has (``_kernel`` too when it has a kernel, ``_batch`` a batch path)
+REQUIRED_LAYERS = ("_spec", "_analysis", "_figures", "_report", "_published")
+
+
+def layer_of(module: str) -> str | None:
+    """The layer (:data:`LAYERS`) of a study module by its name (``'_report_nl'`` -> ``'_report'``),
+    or None for a module of no layer (the package's face)."""
+    name = module.rpartition(".")[2]
+    mine = [layer for layer in LAYERS if name == layer or name.startswith(layer + "_")]
+    return max(mine, key=len) if mine else None
+
 
 _SENSES = ("max", "min")
 
@@ -93,6 +110,14 @@ HOOK_SECTIONS = {
 #: fills the ``%(estimate)s``/``%(summarise)s``/``%(batch_raises)s`` fields of a study hook's
 #: docstring with the contract's sections
 contract_doc = fill_doc(**HOOK_SECTIONS)
+
+
+def batch_error(base: Mapping[str, Any], key: str | None, message: str) -> Exception:
+    """The error a batch summary raises for a bad value (``%(batch_raises)s`` of the contract): a
+    DeckError at the key's deck line when ``base`` is a deck's Params, else a ValueError."""
+    if isinstance(base, Params):
+        return base.error(key, message)
+    return ValueError(f"{key}: {message}" if key else message)
 
 
 @dataclass(frozen=True)

@@ -29,7 +29,8 @@ from driver import _limits as limits
 from driver._deck import DeckError, GroupSpec, Key, read_deck
 from driver._limits import Estimate
 from driver._runner import CONTROL_GROUPS, compute, study_of
-from driver._study import REGISTRY, BatchSummary, Study, load_study, study_names
+from driver._signatures import render_stub
+from driver._study import REGISTRY, REQUIRED_LAYERS, BatchSummary, Study, load_study, study_names
 from driver.sweep import _batch as sweep_batch
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -102,13 +103,13 @@ def test_estimate_gives_sane_numbers_for_every_shipped_deck_of_the_study(name):
 
 
 #: the files every study package has (plus _kernel.py with a kernel, _batch.py with a batch path): private
-#: modules behind the package's public names
-LAYOUT = {"__init__.py", "_spec.py", "_analysis.py", "_report.py", "_figures.py", "_published.py"}
+#: modules behind the package's public names, one per layer of the contract (driver._study.LAYERS)
+LAYOUT = {"__init__.py", *(f"{layer}.py" for layer in REQUIRED_LAYERS)}
 
 
-@pytest.mark.parametrize("name", STUDIES)
-def test_every_study_has_the_one_layout(name):
-    s = load_study(name)
+def _check_layout(s: Study) -> None:
+    """The study's package has one file per required layer (and _kernel/_batch when it declares a
+    kernel/a batch path), each hook where its layer is, and a face without code."""
     folder = Path(s.module.__file__).parent
     files = {p.name for p in folder.glob("*.py")}
     need = LAYOUT | ({"_kernel.py"} if s.kernel is not None else set()) | ({"_batch.py"} if s.batch is not None else set())
@@ -123,6 +124,12 @@ def test_every_study_has_the_one_layout(name):
     kinds = {type(n) for n in init.body[1:] if not _typed_run(n, s.package)}
     assert kinds <= {ast.ImportFrom, ast.Import, ast.Assign, ast.AnnAssign}, kinds
     assert any(_typed_run(n, s.package) for n in init.body), "run is not typed by the study's _keywords.pyi"
+    assert (folder / "_keywords.pyi").is_file()
+
+
+@pytest.mark.parametrize("name", STUDIES)
+def test_every_study_has_the_one_layout(name):
+    _check_layout(load_study(name))
 
 
 def _typed_run(node: ast.stmt, package: str) -> bool:
@@ -131,7 +138,8 @@ def _typed_run(node: ast.stmt, package: str) -> bool:
             and len(node.body) == len(node.orelse) == 1
             and all(isinstance(b, ast.ImportFrom) and [a.name for a in b.names] == ["run"]
                     for b in (*node.body, *node.orelse))
-            and node.body[0].module in (f"{package}._keywords", "._keywords"))
+            and isinstance(node.body[0], ast.ImportFrom)
+            and (node.body[0].module == f"{package}._keywords" or (node.body[0].level, node.body[0].module) == (1, "_keywords")))
 
 
 def test_shared_modules_hold_no_per_study_code():
@@ -277,9 +285,14 @@ def _ode_period_and_swing(length: float, g: float, theta0: float, t: np.ndarray)
 
 
 def test_adding_a_study_is_one_folder_and_one_registry_line(pendulum):
-    """The example lives in one folder of the house layout; no file of driver/ names it."""
-    files = sorted(p.name for p in EXAMPLE.glob("*.py"))
-    assert files == ["__init__.py", "_batch.py", "_figures.py", "_kernel.py", "_report.py", "_spec.py"]
+    """The example lives in one folder in exactly the house layout (every layer it needs, its
+    generated stub fresh); no file of driver/ names it (tests/test_new_study.py runs it as a real
+    package of a scratch repository)."""
+    files = sorted(p.name for p in EXAMPLE.iterdir() if p.suffix in (".py", ".pyi"))
+    assert files == ["__init__.py", "_analysis.py", "_batch.py", "_figures.py", "_kernel.py", "_keywords.pyi",
+                     "_published.py", "_report.py", "_spec.py"]
+    _check_layout(pendulum)
+    assert (EXAMPLE / "_keywords.pyi").read_text() == render_stub(pendulum.spec)
     for src in (ROOT / "driver").rglob("*.py"):
         assert "pendulum" not in src.read_text(), src
     assert isinstance(pendulum, Study) and pendulum.name in study_names()
@@ -300,6 +313,10 @@ def test_example_study_runs_through_the_driver_and_matches_the_equation_of_motio
     assert res.tidy["theta_deg"].iloc[-1] == pytest.approx(-amplitude, abs=1e-6)   # half a period: the other side
     if amplitude == 90.0:
         assert res.summary["period_ratio"] == pytest.approx(1.1803406, abs=5e-8)   # 2 K(1/2) / pi, textbooks
+        cells = pendulum.published(res.params, res)   # K(45 deg) of the published table, to its 10 decimals
+        assert [(c["printed"], c["status"]) for c in cells] == [("1.8540746773", "identical")], cells
+    else:
+        assert pendulum.published(res.params, res) == []   # no row of the table for this amplitude
 
 
 def test_example_study_deck_sweep_budget_and_figures(pendulum, tmp_path):

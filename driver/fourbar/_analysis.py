@@ -3,19 +3,22 @@ through the kernel, the extremes over the crank range, and the tidy columns of t
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from driver._deck import Params
 from driver._export import with_units
+from driver._study import batch_error
 from driver.fourbar import _kernel as kernel
-from driver.fourbar._batch import summary_rows
 
 __all__ = ['ST', 'Grashof', 'grashof', 'limit_angles', 'assembly_intervals', 'Motion', 'rocking_motions',
            'crank_angles', 'exact_grid', 'coupler_point', 'listing_grid', 'deg360', 'Extremes', 'toggles_in_range',
-           'extremes', 'TIDY_UNITS', 'tidy_frame', 'exact_columns', 'blame']
+           'extremes', 'TIDY_UNITS', 'tidy_frame', 'exact_columns', 'blame', 'SUMMARY_KEYS', 'PASS_BITS', 'param_matrix',
+           'summary_rows']
 
 
 ST = kernel.FOURBAR_STATUS
@@ -310,6 +313,49 @@ def deg360(rad: np.ndarray) -> np.ndarray:
     return np.where(d >= 359.95, d - 360.0, d)
 
 
+# ----------------------------------------------------------------------------- the summary kernel
+
+#: the summary kernel's parameters, in its column order (fortran/fourbar_summary.f90): deck keys
+SUMMARY_KEYS = ("fixed_link", "crank", "coupler", "rocker", "omega", "start_deg", "stop_deg", "branch")
+
+
+#: the kernel's pass bits (fortran/fourbar_summary.f90 pass_*)
+PASS_BITS = {"transmission": kernel.FOURBAR_PASSES["transmission"], "rocker": kernel.FOURBAR_PASSES["rocker"],
+             "peaks": kernel.FOURBAR_PASSES["peaks"]}
+
+
+def param_matrix(base: Mapping[str, Any], columns: Mapping[str, Any], n: int) -> np.ndarray:
+    """The summary kernel's (n, 8) parameter matrix (:data:`SUMMARY_KEYS`): base values, overridden column by
+    column; a bad value raises DeckError at its deck line (``base`` a deck's Params) or ValueError."""
+    cols = {}
+    for key in SUMMARY_KEYS:
+        v = columns.get(key, base[key])
+        if key == "branch":
+            v = np.asarray(v)
+            if v.dtype.kind in "US":
+                bad = ~np.isin(v, ("open", "crossed"))
+                if bad.any():
+                    raise batch_error(base, "branch", f"must be 'open' or 'crossed' (got {v[np.argmax(bad)]!r})")
+                v = np.where(v == "open", 1.0, -1.0)
+        v = np.broadcast_to(np.asarray(v, dtype=np.float64), (n,))
+        bad = ~np.isfinite(v)
+        if key in ("fixed_link", "crank", "coupler", "rocker"):
+            bad |= ~(v > 0)
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise batch_error(base, key, f"design {i} has {float(v[i])!r} (lengths must be positive, all values finite)")
+        cols[key] = v
+    m = np.empty((n, 8), dtype=np.float64, order="F")
+    for j, key in enumerate(SUMMARY_KEYS):
+        m[:, j] = cols[key]
+    return m
+
+
+def summary_rows(p: Params) -> np.ndarray:
+    """The summary kernel's row of one deck, every pass: (1, 19) (fortran/fourbar_summary.f90)."""
+    return kernel.fourbar_summaries(param_matrix(p, {}, 1), sum(PASS_BITS.values()))
+
+
 @dataclass
 class Extremes:
     """Headline figures over the analysed crank range (exact solution), from the batch kernel.
@@ -378,7 +424,7 @@ def extremes(p: Params, row: np.ndarray | None = None) -> Extremes | None:
         Validated ``&fourbar`` keys.
     row : numpy.ndarray, optional
         The deck's row of the summary kernel when the caller has it
-        (``driver.fourbar._batch.summary_rows``); computed otherwise.
+        (:func:`summary_rows`); computed otherwise.
 
     Returns
     -------

@@ -1,5 +1,6 @@
-"""The four-bar figures: angle, speed and transmission-angle curves against the crank angle, and the
-linkage drawn over its turn at its limit positions.
+"""The four-bar figures: angle, speed and transmission-angle curves against the crank angle, the
+linkage drawn over its turn at its limit positions, and the force analysis's input torque, pin
+forces and shaking force (each drawn into axes the caller gives).
 
 Drawn in the house style (:mod:`driver.plotting`); this module imports matplotlib (the optional
 [plot] extra), so the study imports it only when a figure is drawn.
@@ -7,7 +8,8 @@ Drawn in the house style (:mod:`driver.plotting`); this module imports matplotli
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any
 
 import matplotlib
 import matplotlib.colors
@@ -16,6 +18,9 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from driver.plotting import new_figure, plain_text, styled
+
+if TYPE_CHECKING:
+    from driver.fourbar._analysis_forces import ForceAnalysis
 
 
 def break_wraps(x: np.ndarray, y: np.ndarray, period: float = 360.0) -> tuple[np.ndarray, np.ndarray]:
@@ -264,3 +269,115 @@ def _rocking_drawing(ax, ground: float, motions: Sequence[dict], title: str, uni
 
 
 # ----------------------------------------------------------------------------- figures of a run
+
+
+# ----------------------------------------------------------------------------- the force analysis
+
+def plot_torque(theta: np.ndarray, fa: ForceAnalysis, p: Mapping[str, Any], ax: Any) -> Any:
+    """Plot the input torque against crank angle, its mean, and the energy fluctuation dE.
+
+    dE is shaded between the torque curve and the mean; with balancing the torque of the
+    linkage without counterweights is dashed.
+
+    Parameters
+    ----------
+    theta : numpy.ndarray
+        Crank angles, deg.
+    fa : ForceAnalysis
+        The forces (``driver.fourbar.forces.analyse``).
+    p : mapping
+        The ``&fourbar`` keys.
+    ax : matplotlib.axes.Axes
+        The axes to draw into (crank angle in deg, torque in N m, dE in J in the legend).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        ``ax``.
+    """
+    t = np.where(fa.ok, fa.forces[:, 0], np.nan)
+    ax.plot(theta, t, color="C0", label="input torque")
+    if fa.ok.all() and len(theta) > 1:
+        mean = np.trapezoid(t, theta) / (theta[-1] - theta[0])
+        e = np.concatenate([[0.0], np.cumsum(0.5 * (t[1:] + t[:-1] - 2 * mean) * np.diff(np.radians(theta)))])
+        ax.axhline(mean, color="C1", lw=1, label=f"mean {mean:.3f} N m")
+        ax.fill_between(theta, t, mean, color="C0", alpha=0.15,
+                        label=f"dE = {e.max() - e.min():.4g} J (max - min of the area)")
+    if fa.unbalanced is not None:
+        ax.plot(theta, np.where(fa.ok, fa.unbalanced[:, 0], np.nan), "--", color="C3", label="without counterweights")
+    ax.set_xlabel("crank angle [deg]")
+    ax.set_ylabel("input torque [N m]")
+    ax.legend(fontsize=7, loc="best")
+    return ax
+
+
+def plot_pin_polars(fa: ForceAnalysis, axes: Any) -> Any:
+    """Plot the force at each pin over the cycle on polar axes.
+
+    Angle = direction of the force, radius = its magnitude in N; with balancing, the
+    unbalanced linkage's dashed.
+
+    Parameters
+    ----------
+    fa : ForceAnalysis
+        The forces (``driver.fourbar.forces.analyse``).
+    axes : sequence of matplotlib.axes.Axes
+        Four polar axes: O2, A, B, O4.
+
+    Returns
+    -------
+    sequence of matplotlib.axes.Axes
+        ``axes``.
+    """
+    names = ("O2 (ground on crank)", "A (crank on coupler)", "B (coupler on rocker)", "O4 (ground on rocker)")
+    for j, ax in enumerate(np.ravel(axes)[:4]):
+        fx = np.where(fa.ok, fa.forces[:, 1 + 2 * j], np.nan)
+        fy = np.where(fa.ok, fa.forces[:, 2 + 2 * j], np.nan)
+        ax.plot(np.arctan2(fy, fx), np.hypot(fx, fy), color="C0", lw=1,
+                label="balanced" if fa.unbalanced is not None else "as given")
+        if fa.unbalanced is not None:
+            bx = np.where(fa.ok, fa.unbalanced[:, 1 + 2 * j], np.nan)
+            by = np.where(fa.ok, fa.unbalanced[:, 2 + 2 * j], np.nan)
+            ax.plot(np.arctan2(by, bx), np.hypot(bx, by), color="C3", lw=1, ls="--", label="unbalanced")
+        ax.set_title(f"F at {names[j]} [N]", fontsize=8)
+    np.ravel(axes)[0].legend(fontsize=6, loc="lower left")
+    return axes
+
+
+def plot_shaking(theta: np.ndarray, fa: ForceAnalysis, ax: Any, polar_ax: Any | None = None) -> Any:
+    """Plot the shaking force magnitude against crank angle, and its locus, before and after balancing.
+
+    Parameters
+    ----------
+    theta : numpy.ndarray
+        Crank angles, deg.
+    fa : ForceAnalysis
+        The forces (``driver.fourbar.forces.analyse``).
+    ax : matplotlib.axes.Axes
+        Axes for |shaking force| (N) against crank angle (deg).
+    polar_ax : matplotlib.axes.Axes, optional
+        Axes for the locus F_y against F_x (N, equal scales).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        ``ax``.
+    """
+    before = fa.unbalanced if fa.unbalanced is not None else fa.forces
+    s = np.where(fa.ok[:, None], before[:, 9:11], np.nan)
+    ax.plot(theta, np.hypot(*s.T), color="C0", label="unbalanced")
+    if polar_ax is not None:
+        polar_ax.plot(s[:, 0], s[:, 1], color="C0", label="unbalanced")
+    if fa.unbalanced is not None:
+        b = np.where(fa.ok[:, None], fa.forces[:, 9:11], np.nan)
+        ax.plot(theta, np.hypot(*b.T), "--", color="C3", label="balanced (Berkof-Lowen)")
+        if polar_ax is not None:
+            polar_ax.plot(b[:, 0], b[:, 1], "o", ms=3, color="C3", label="balanced (Berkof-Lowen)")
+    ax.set_xlabel("crank angle [deg]")
+    ax.set_ylabel("|shaking force| [N]")
+    ax.legend(fontsize=7)
+    if polar_ax is not None:
+        polar_ax.set_xlabel("shaking force x [N]")
+        polar_ax.set_ylabel("shaking force y [N]")
+        polar_ax.set_aspect("equal", adjustable="datalim")
+    return ax

@@ -13,7 +13,6 @@ from driver._export import with_units
 from driver._result import Figure, Result
 from driver._runner import study_run
 from driver._table import Column, fortran_f, render_table
-from driver.fourbar import _forces as forces
 from driver.fourbar._analysis import (
     ST,
     TIDY_UNITS,
@@ -30,10 +29,13 @@ from driver.fourbar._analysis import (
     limit_angles,
     listing_grid,
     rocking_motions,
+    summary_rows,
     tidy_frame,
 )
-from driver.fourbar._batch import summary_of, summary_rows
-from driver.fourbar._spec import SPEC, band_of
+from driver.fourbar._batch import summary_of
+from driver.fourbar._report_forces import figures as force_figures
+from driver.fourbar._report_forces import force_section
+from driver.fourbar._spec import SPEC, band_of, forces_active
 
 __all__ = ["run", "listing_text", "exact_table", "summary_lines", "audit", "deck_figures", "output_name", "animation_frames"]
 
@@ -229,29 +231,15 @@ def run(params: Params, progress: bool = False) -> Result:
         if cp is not None:
             lines += [f"    coupler point P ...... u = {p.coupler_point[0]:g} along A->B, v = {p.coupler_point[1]:g} "
                       "to its left; xp, yp its position, vp its speed [length/s]"]
-        if forces.active(p):
-            lines += _force_section(p, theta, out, status, exact_frame)
+        if forces_active(p):
+            lines += force_section(p, theta, out, status, exact_frame)
         for k in np.flatnonzero(status == ST["no_assembly"])[:1]:
             warnings.append(f"the linkage cannot be assembled at {int((status == ST['no_assembly']).sum())} "
                             f"of {len(theta)} crank angles (first at {theta[k]:g} deg)")
         tidy = exact_frame
     summary = summary_of(p, rows)
-    figs = deck_figures(p, title, listing_frame) + (forces.figures(p, title, exact_grid) if forces.active(p) else [])
+    figs = deck_figures(p, title, listing_frame) + (force_figures(p, title, exact_grid) if forces_active(p) else [])
     return Result(text="\n".join(lines) + "\n", tidy=tidy, summary=summary, warnings=warnings, figures=figs)
-
-
-def _force_section(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarray,
-                   frame: pd.DataFrame) -> list[str]:
-    """The force analysis's lines of the .out; its columns are added to ``frame`` (in place)."""
-    fa = forces.analyse(p, out, status)
-    for name, values in forces.tidy_columns(fa).items():
-        frame[name] = values
-    with_units(frame, TIDY_UNITS)
-    words = ["toggle: forces unbounded" if s == ST["toggle"] else "not placed" for s in status]
-    title = ("Force analysis (Newton-Euler, closed form; " +
-             ("with the Berkof-Lowen counterweights" if fa.cw is not None else "links as given") + ")")
-    return (forces.echo_lines(p) + forces.table_lines(theta, fa.forces, fa.ok, words, title)
-            + forces.summary_lines(p, forces.summary(p), fa))
 
 
 def output_name(p: Params) -> str:

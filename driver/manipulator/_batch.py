@@ -25,10 +25,19 @@ import numpy as np
 import pandas as pd
 
 from driver._deck import Params
-from driver._study import contract_doc
+from driver._study import batch_error, contract_doc
 from driver.manipulator import _kernel as kernel
-from driver.manipulator._analysis import STATUS, Conv, Workspace, design_list, design_status, round_half_up
-from driver.manipulator._report import design_torque_columns, sweep_columns, workspace_columns
+from driver.manipulator._analysis import (
+    STATUS,
+    Conv,
+    Workspace,
+    design_list,
+    design_status,
+    design_torque_columns,
+    round_half_up,
+    sweep_columns,
+    workspace_columns,
+)
 from driver.manipulator._tables import table_4_8
 
 __all__ = ["BATCH_KEYS", "BATCH_IGNORED", "BATCH_INDEPENDENT", "BATCH_PASSES", "BATCH_PASS_SUFFIXES", "summarise_batch",
@@ -82,13 +91,6 @@ def _passes(wanted: Collection[str] | None) -> set[str]:
 _WALKS: dict[tuple, dict[str, Any]] = {}
 
 
-def _bad(base: Mapping[str, Any], key: str | None, message: str) -> Exception:
-    """A DeckError at the key's deck line when ``base`` is a deck's Params, else a ValueError."""
-    if isinstance(base, Params):
-        return base.error(key, message)
-    return ValueError(f"{key}: {message}" if key else message)
-
-
 def _as_params(base: Mapping[str, Any]) -> Params:
     if isinstance(base, Params):
         return base
@@ -106,7 +108,7 @@ def _column(base: Mapping[str, Any], key: str, v: Any, n: int, check) -> np.ndar
     bad = ~np.isfinite(a) | ~check(a)
     if bad.any():
         i = int(np.argmax(bad))
-        raise _bad(base, key, f"design {i} has {float(a[i])!r}")
+        raise batch_error(base, key, f"design {i} has {float(a[i])!r}")
     return a
 
 
@@ -120,21 +122,21 @@ def _lengths(base: Mapping[str, Any], columns: dict[str, Any], n: int, conv: Con
     for key in ("designs_l1", "designs_l2"):
         v = columns[key] if key in columns else base[key]
         if v is None:
-            raise _bad(base, key, "designs_l1 and designs_l2 must be given together")
+            raise batch_error(base, key, "designs_l1 and designs_l2 must be given together")
         a = np.asarray(v, dtype=np.float64)
         a = a.reshape(n, -1) if key in columns else np.broadcast_to(a.ravel(), (n, a.size))
         bad = ~np.isfinite(a) | ~(a > 0)
         if bad.any():
             i = int(np.argmax(bad.any(1)))
-            raise _bad(base, key, f"design {i} has {a[i].tolist()!r} (lengths must be positive and finite)")
+            raise batch_error(base, key, f"design {i} has {a[i].tolist()!r} (lengths must be positive and finite)")
         out.append(a)
     l1, l2 = out
     if l1.shape != l2.shape:
-        raise _bad(base, "designs_l2", f"gives {l2.shape[1]} lengths per design but designs_l1 gives {l1.shape[1]}")
+        raise batch_error(base, "designs_l2", f"gives {l2.shape[1]} lengths per design but designs_l1 gives {l1.shape[1]}")
     k = l1.shape[1]
     names = base["design_names"]
     if names is not None and len(names) != k:
-        raise _bad(base, "design_names", f"gives {len(names)} names for {k} designs")
+        raise batch_error(base, "design_names", f"gives {len(names)} names for {k} designs")
     return list(names or [f"Design {i + 1}" for i in range(k)]), l1, l2
 
 
@@ -200,11 +202,11 @@ def _arrays(base: Mapping[str, Any], columns: Mapping[str, Any] | None,
     columns = {k.partition(".")[2] if k.startswith("manipulator.") else k: v for k, v in (columns or {}).items()}
     unknown = [k for k in columns if k not in BATCH_KEYS and k not in BATCH_IGNORED]
     if unknown:
-        raise _bad(base, unknown[0], f"not a &manipulator key the summary takes per design ({', '.join(BATCH_KEYS)})")
+        raise batch_error(base, unknown[0], f"not a &manipulator key the summary takes per design ({', '.join(BATCH_KEYS)})")
     columns = {k: v for k, v in columns.items() if k in BATCH_KEYS}
     sizes = {np.shape(v)[0] for v in columns.values() if np.ndim(v) > 0}
     if len(sizes) > 1:
-        raise _bad(base, None, f"batch columns have different lengths {sorted(sizes)}")
+        raise batch_error(base, None, f"batch columns have different lengths {sorted(sizes)}")
     n = sizes.pop() if sizes else 1
     if n == 0:
         return {k: v[:0] for k, v in _arrays(base, None).items()}
@@ -214,15 +216,15 @@ def _arrays(base: Mapping[str, Any], columns: Mapping[str, Any] | None,
     k = l1.shape[1]
     if ("target_x" in columns or "target_y" in columns) and \
             (columns.get("target_x", p.target_x) is None or columns.get("target_y", p.target_y) is None):
-        raise _bad(base, "target_y" if "target_x" in columns else "target_x",
-                   "target_x and target_y must be given together")
+        raise batch_error(base, "target_y" if "target_x" in columns else "target_x",
+                         "target_x and target_y must be given together")
     tx0, ty0 = (p.target_x, p.target_y) if p.target_x is not None else (float(ws.x[0]), float(ws.y[0]))
     finite = lambda a: np.ones(a.shape, bool)
     tx = _column(base, "target_x", columns.get("target_x", tx0), n, finite)
     ty = _column(base, "target_y", columns.get("target_y", ty0), n, finite)
     if ((tx == 0.0) & (ty == 0.0)).any():
         i = int(np.argmax((tx == 0.0) & (ty == 0.0)))
-        raise _bad(base, "target_x", f"design {i}: the target point is the base (0, 0)")
+        raise batch_error(base, "target_x", f"design {i}: the target point is the base (0, 0)")
     mpl = _column(base, "mass_per_length", columns.get("mass_per_length", p.mass_per_length), n, lambda a: a > 0)
     g = _column(base, "gravity", columns.get("gravity", p.gravity), n, lambda a: a >= 0)
     eps = _column(base, "tolerance_bound", columns.get("tolerance_bound", p.tolerance_bound), n, lambda a: a >= 1e-9)

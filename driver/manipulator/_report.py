@@ -21,9 +21,12 @@ from driver.manipulator._analysis import (
     Workspace,
     design_list,
     design_status,
+    design_torque_columns,
     optima,
     round_half_up,
+    sweep_columns,
     target_point,
+    workspace_columns,
 )
 from driver.manipulator._spec import SPEC
 from driver.manipulator._tables import TIDY_NAMES, Table, mode_differences, report_tables, tolerance_table
@@ -127,40 +130,6 @@ def table_frame(tidy: pd.DataFrame, table: str) -> pd.DataFrame:
     wide.columns.name = None
     wide.attrs["units"] = {"row": "1", "label": "", **{q: TIDY_UNITS[q] for q in wide.columns[2:]}}
     return wide
-
-
-def workspace_columns(p: Params, ws: Workspace, conv: Conv) -> dict[str, Any]:
-    """Summary columns of the workspace and of C_rob (lengths [m], areas [m^2])."""
-    opt = optima(conv.c_pairs)
-    return {"mode": p.mode, "n_points": ws.n, "r_m": ws.r, "R_m": ws.R, "mean_d2_m2": ws.mean_d2,
-            "crob_radius_m": conv.radius, "crob_c_m2": conv.c_pairs, "ri2_min": math.sqrt(ws.n),
-            "dexterity_l1_m": opt["dexterity"][0], "dexterity_l2_m": opt["dexterity"][1],
-            "manipulability_l1_m": opt["manipulability"][0], "manipulability_l2_m": opt["manipulability"][1]}
-
-
-def sweep_columns(sweep: dict) -> dict[str, Any]:
-    """Summary columns of the least signed sum tau1 + tau2 along C_rob (Table 4.8's 'total
-    torque', as the report ranks it); none when no row reaches the target."""
-    tot = np.where(sweep["ok"], sweep["tau"].sum(1), np.inf)
-    if not np.isfinite(tot).any():
-        return {}
-    k = int(np.argmin(tot))
-    return {"sweep_min_tau_sum_signed_Nm": float(tot[k]), "sweep_min_l1_m": float(sweep["l1"][k]),
-            "sweep_min_l2_m": float(sweep["l2"][k]), "sweep_min_row": k + 1,
-            "sweep_min_reaches_workspace": bool(sweep["reach_all"][k])}
-
-
-def design_torque_columns(tau1: Any, tau2: Any, ok: Any) -> dict[str, Any]:
-    """The design's torques at the target [N m]: the signed sum tau1 + tau2 (the report's 'total
-    torque': a negative torque lowers it, so it is no measure of effort), the demand |tau1| + |tau2|
-    and the peak max(|tau1|, |tau2|) (the arm holds one pose: no trajectory, so no peak over time).
-    Scalars or arrays (the batch path); missing (None / NaN) where ``ok`` is false."""
-    t1, t2 = np.asarray(tau1, dtype=float), np.asarray(tau2, dtype=float)
-    cols = {"design_tau_sum_signed_Nm": t1 + t2, "design_torque_demand_Nm": np.abs(t1) + np.abs(t2),
-            "design_peak_torque_Nm": np.fmax(np.abs(t1), np.abs(t2))}
-    if np.ndim(t1) == 0:
-        return {k: (float(v) if ok else None) for k, v in cols.items()}
-    return {k: np.where(ok, v, np.nan) for k, v in cols.items()}
 
 
 def _summary(p: Params, ws: Workspace, conv: Conv, used: dict, sweep: dict, tol: list[dict]) -> dict[str, Any]:

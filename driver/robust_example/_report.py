@@ -14,8 +14,7 @@ from driver._result import Figure, Result
 from driver._runner import study_run
 from driver._table import Column, render_table
 from driver.robust_example._analysis import analyse, tmin
-from driver.robust_example._published import MODE_REASONS
-from driver.robust_example._spec import SPEC
+from driver.robust_example._spec import MODE_REASONS, SPEC
 
 __all__ = ["run", "TIDY_UNITS"]
 

@@ -13,7 +13,7 @@ Units in decks: SI (m, kg, Pa, rad/s, s).  Strains are reported in microstrain.
 The package's private modules, by job: ``_spec`` (deck keys, materials, the model a deck describes, checks, the budget
 estimate), ``_analysis`` (one case through the kernel, settling, static buckling onset), ``_report``
 (the linear run: .out sections, tidy table, summary), ``_figures``, ``_published`` (Table 1 and the
-Simeon 1996 reference), ``_kernel`` (the Fortran wrappers), and the nonlinear rod (``_nonlinear``,
+Simeon 1996 reference), ``_kernel`` (the Fortran wrappers), and the nonlinear rod (``_analysis_nl``,
 ``_report_nl``: the run of a deck, either model). Cases are heavy (a time integration each), so the
 study has no batch path: a sweep runs them one per task.
 """

@@ -19,7 +19,7 @@ from driver._result import Figure, Result
 from driver._runner import study_run
 from driver._table import Cell, Column, render_table
 from driver.slidercrank._analysis import Case, run_case, static_onset
-from driver.slidercrank._nonlinear import IRREGULAR, NLCase, onset_search, run_nl_case
+from driver.slidercrank._analysis_nl import IRREGULAR, NLCase, onset_search, run_nl_case
 from driver.slidercrank._report import Derived, figures_module, header_lines, run_linear, status_text
 from driver.slidercrank._spec import SPEC, model_of, rayleigh
 
