@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from driver._fortran import farray, spare_buffer
+from driver._fortran import farray
 
 if TYPE_CHECKING:   # the study's modules of the extension, typed (generated: tools/gen_kernel_stub.py)
     from driver.fourbar import _kernels
@@ -98,12 +98,12 @@ def fourbar_exact(theta: np.ndarray, p: float, q: float, r: float, s: float, ome
     theta = farray(np.atleast_1d(theta), 1)
     n = theta.shape[0]
     if out is None:
-        out = spare_buffer("fourbar_exact.out", (n, 11), np.float64)
+        out = np.empty((n, 11), order="F")
     elif not (out.flags.f_contiguous and out.dtype == np.float64 and out.shape == (n, 11)):
         raise ValueError("out must be a Fortran-ordered float64 array of shape (n, 11); "
                          "f2py would otherwise work on a hidden copy")
     if status is None:
-        status = spare_buffer("fourbar_exact.status", (n,), np.int32)
+        status = np.empty(n, dtype=np.int32)
     elif not (status.dtype == np.int32 and status.shape == (n,)):
         raise ValueError("status must be an int32 array of shape (n,)")
     return _kernels.fourbar.exact_states(theta, p, q, r, s, omega, alpha, int(branch), out, status)
