@@ -24,15 +24,15 @@ from driver._outcome import RunOutcome
 from driver._pydeck import deck_of
 from driver._result import Result
 from driver._signatures import sign
-from driver._study import Study, load_study, registered, study_names
+from driver._study import ENGINES, Study, load_study, registered, study_names
 from driver._table import TableValueError
 
 __all__ = ["CONTROL_GROUPS", "CaseFailure", "RunOutcome", "available_studies", "study_of", "run_study", "write_outputs",
            "study_run",
            "output_stem", "check_finite", "compute", "numerical_error"]
 
-#: groups handled by the driver itself rather than by a study module
-CONTROL_GROUPS = ("sweep", "optimize", "synthesis")
+#: groups handled by the driver's engines rather than by a study (driver._study.ENGINES)
+CONTROL_GROUPS = tuple(ENGINES)
 
 
 def available_studies() -> dict[str, Study]:

@@ -34,8 +34,8 @@ if TYPE_CHECKING:
     from driver._limits import Estimate
     from driver._result import Result
 
-__all__ = ["Study", "BatchSummary", "REGISTRY", "LAYERS", "REQUIRED_LAYERS", "layer_of", "load_study", "study_names",
-           "registered", "batch_error"]
+__all__ = ["Study", "BatchSummary", "REGISTRY", "ENGINES", "LAYERS", "REQUIRED_LAYERS", "layer_of", "load_study",
+           "study_names", "registered", "group_spec", "batch_error"]
 
 #: the studies, by namelist group: group -> the package that binds ``STUDY``.  Imported only
 #: when a deck (or a caller) names the group, so ``python -m driver --help`` stays light.
@@ -45,6 +45,15 @@ REGISTRY: dict[str, str] = {
     "robust_example": "driver.robust_example",
     "slidercrank": "driver.slidercrank",
     "ujoint": "driver.ujoint",
+}
+
+#: the engines' control groups, by group: the package whose ``SPEC`` declares the group's keys (a
+#: deck with one of them is run by that engine: driver._dispatch decides which).  Imported only
+#: when a deck (or a caller) names the group.
+ENGINES: dict[str, str] = {
+    "sweep": "driver.sweep",
+    "optimize": "driver.optimize",
+    "synthesis": "driver.synthesis",
 }
 
 #: the layers of a study package, in dependency order (docs/layout.md): a module may import only
@@ -312,6 +321,21 @@ def load_study(group: str) -> Study | None:
     if not isinstance(study, Study) or study.name != group:
         raise TypeError(f"{package} is registered as study &{group} but binds no STUDY = Study(name={group!r}, ...)")
     return study
+
+
+def group_spec(group: str) -> GroupSpec | None:
+    """The keys of namelist group ``group``: a registered study's spec or an engine's ``SPEC``; None
+    when no one declares the group (the runner refuses it, naming the known groups).
+
+    A registered package that fails to import, or binds no study, raises (a broken study is a bug
+    to see, never a group silently unknown)."""
+    if group in ENGINES:
+        spec = getattr(importlib.import_module(ENGINES[group]), "SPEC", None)
+        if not isinstance(spec, GroupSpec) or spec.name != group:
+            raise TypeError(f"{ENGINES[group]} is registered as engine &{group} but binds no SPEC of that group")
+        return spec
+    study = load_study(group)
+    return None if study is None else study.spec
 
 
 def study_names() -> list[str]:

@@ -66,6 +66,25 @@ def test_a_registered_package_without_a_study_is_an_error_not_skipped(monkeypatc
         load_study("table")
 
 
+def test_the_deck_reader_asks_the_registry_for_every_group(monkeypatch, tmp_path):
+    """Studies and engines alike (group_spec); an unknown group is None (the runner names the
+    known ones); a registered package that is broken is an error to see, not an unknown group."""
+    from driver import sweep
+    from driver._study import ENGINES, group_spec
+    assert group_spec("sweep") is sweep.SPEC and set(ENGINES) == set(CONTROL_GROUPS)
+    assert group_spec("fourbar") is load_study("fourbar").spec and group_spec("no_such_group") is None
+    deck = tmp_path / "d.dat"
+    deck.write_text("&broken x = 1 /\n")
+    monkeypatch.setitem(REGISTRY, "broken", "driver._no_such_module")
+    monkeypatch.delitem(deck_module._KNOWN, "broken", raising=False)
+    with pytest.raises(ModuleNotFoundError, match="driver._no_such_module"):
+        read_deck(deck)
+    deck_module._KNOWN.pop("broken", None)
+    deck.write_text("&unheard_of x = 1 /\n")
+    with pytest.raises(DeckError, match="unknown group &unheard_of"):
+        study_of(read_deck(deck))
+
+
 # ----------------------------------------------------------------------------- every registered study
 
 @pytest.mark.parametrize("name", STUDIES)
