@@ -31,7 +31,7 @@ except ImportError:   # a source checkout that was never built (driver._fortran 
     __version__ = "unknown (unbuilt source checkout)"
 
 __all__ = ["run", "run_sweep", "write", "compare", "read_deck", "studies", "keys", "Result", "Figure", "SweepResult",
-           "DeckError", "ExitCode", "Message", "RunOutcome", "FilesOutcome", "SweepOutcome"]
+           "DriverError", "DeckError", "ExitCode", "Message", "RunOutcome", "FilesOutcome", "SweepOutcome"]
 
 #: the public subpackages and modules: every study of the registry (``driver._study.REGISTRY``, each
 #: one folder ``driver/<group>/``), the engines and the house figure style; every other module of
@@ -42,13 +42,15 @@ PUBLIC_MODULES = (*sorted(group for group, package in REGISTRY.items() if packag
 _API = {"run": "driver._api", "run_sweep": "driver._api", "write": "driver._api", "studies": "driver._api",
         "keys": "driver._api", "compare": "driver._compare", "read_deck": "driver._deck",
         "Result": "driver._result", "Figure": "driver._result", "SweepResult": "driver._api",
-        "DeckError": "driver._groupspec", "ExitCode": "driver._outcome", "Message": "driver._outcome",
-        "RunOutcome": "driver._outcome", "FilesOutcome": "driver._outcome", "SweepOutcome": "driver._outcome"}
+        "DriverError": "driver._errors", "DeckError": "driver._groupspec", "ExitCode": "driver._outcome",
+        "Message": "driver._outcome", "RunOutcome": "driver._outcome", "FilesOutcome": "driver._outcome",
+        "SweepOutcome": "driver._outcome"}
 
 if TYPE_CHECKING:   # pragma: no cover - for type checkers and IDEs only
     from driver._api import SweepResult, keys, run, run_sweep, studies, write
     from driver._compare import compare
     from driver._deck import read_deck
+    from driver._errors import DriverError
     from driver._groupspec import DeckError
     from driver._outcome import ExitCode, FilesOutcome, Message, RunOutcome, SweepOutcome
     from driver._result import Figure, Result

@@ -28,6 +28,7 @@ from types import MappingProxyType, ModuleType
 from typing import TYPE_CHECKING, Any
 
 from driver._docs import fill_doc
+from driver._extras import missing_extra
 from driver._groupspec import GroupSpec, Params
 
 if TYPE_CHECKING:
@@ -328,9 +329,17 @@ def group_spec(group: str) -> GroupSpec | None:
     when no one declares the group (the runner refuses it, naming the known groups).
 
     A registered package that fails to import, or binds no study, raises (a broken study is a bug
-    to see, never a group silently unknown)."""
+    to see, never a group silently unknown); an engine whose optional package is not installed
+    raises :class:`~driver._extras.MissingExtra`, which names the extra that installs it."""
     if group in ENGINES:
-        spec = getattr(importlib.import_module(ENGINES[group]), "SPEC", None)
+        try:
+            engine = importlib.import_module(ENGINES[group])
+        except ImportError as exc:
+            extra = missing_extra(exc)
+            if extra is None:
+                raise
+            raise extra from exc
+        spec = getattr(engine, "SPEC", None)
         if not isinstance(spec, GroupSpec) or spec.name != group:
             raise TypeError(f"{ENGINES[group]} is registered as engine &{group} but binds no SPEC of that group")
         return spec

@@ -54,8 +54,8 @@ def test_import_driver_is_cheap_and_exports_a_small_documented_surface():
     heavy, names = res.stdout.splitlines()
     assert heavy == "[]"
     assert ast.literal_eval(names) == sorted(["run", "run_sweep", "write", "compare", "read_deck", "studies", "keys",
-                                              "Result", "Figure", "SweepResult", "DeckError", "ExitCode", "Message",
-                                              "RunOutcome", "FilesOutcome", "SweepOutcome"])
+                                              "Result", "Figure", "SweepResult", "DriverError", "DeckError", "ExitCode",
+                                              "Message", "RunOutcome", "FilesOutcome", "SweepOutcome"])
     for name in driver.__all__:
         obj = getattr(driver, name)
         assert obj.__doc__ and len(obj.__doc__) > 40, name

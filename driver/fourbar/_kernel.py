@@ -13,22 +13,32 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from driver._fortran import farray
+from driver._fortran import KernelStatus, farray
 
 if TYPE_CHECKING:   # the study's modules of the extension, typed (generated: tools/gen_kernel_stub.py)
     from driver.fourbar import _kernels
 else:
     from driver._fortran import _kernels
 
-__all__ = ['FOURBAR_PASSES', 'fourbar_listing', 'fourbar_exact', 'fourbar_coupler_point', 'fourbar_summaries',
+__all__ = ['FourbarStatus', 'FOURBAR_PASSES', 'fourbar_listing', 'fourbar_exact', 'fourbar_coupler_point', 'fourbar_summaries',
            'fourbar_joint_forces', 'fourbar_berkof_lowen', 'fourbar_force_summaries',
            'FOURBAR_FORCE_SUMMARY_COLUMNS', 'FOURBAR_SUMMARY_COLUMNS', 'FOURBAR_GRASHOF', 'FOURBAR_STATUS']
 
 
-#: status codes of the four-bar kernels (fortran/fourbar.f90)
-FOURBAR_STATUS = {"ok": int(_kernels.fourbar.st_ok), "no_assembly": int(_kernels.fourbar.st_no_assembly),
-                  "toggle": int(_kernels.fourbar.st_toggle),
-                  "indeterminate": int(_kernels.fourbar.st_indeterminate)}
+class FourbarStatus(KernelStatus):
+    """Status of each crank angle of the four-bar kernels (fortran/fourbar.f90 ``st_*``).
+
+    A result of the position, never an error of the call.
+    """
+
+    ok = int(_kernels.fourbar.st_ok), "ok"
+    no_assembly = int(_kernels.fourbar.st_no_assembly), "cannot assemble", "the loop does not close at this crank angle"
+    toggle = int(_kernels.fourbar.st_toggle), "toggle", "coupler and rocker in line: the velocities are unbounded"
+    indeterminate = int(_kernels.fourbar.st_indeterminate), "indeterminate", "the crank pin A lies on the rocker pivot O_B"
+
+
+#: the four-bar kernels' status codes by name (``FOURBAR_STATUS["no_assembly"]``): :class:`FourbarStatus`
+FOURBAR_STATUS: type[FourbarStatus] = FourbarStatus
 
 
 def fourbar_listing(p: float, q: float, r: float, s: float, omega: float,

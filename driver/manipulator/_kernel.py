@@ -13,22 +13,31 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from driver._docs import fill_doc
-from driver._fortran import farray
+from driver._fortran import KernelStatus, farray
 
 if TYPE_CHECKING:   # the study's modules of the extension, typed (generated: tools/gen_kernel_stub.py)
     from driver.manipulator import _kernels
 else:
     from driver._fortran import _kernels
 
-__all__ = ['MANIPULATOR_PASSES', 'MANIPULATOR_STATUS', 'manipulator_arm_states', 'manipulator_torques',
+__all__ = ['ManipulatorStatus', 'MANIPULATOR_PASSES', 'MANIPULATOR_STATUS', 'manipulator_arm_states', 'manipulator_torques',
            'manipulator_ik', 'manipulator_design_indices', 'manipulator_position_errors',
            'manipulator_design_summaries', 'MANIPULATOR_SUMMARY_PARAMS', 'MANIPULATOR_SUMMARY_COLUMNS']
 
 
-#: status codes of the 2R manipulator kernels (fortran/manipulator.f90)
-MANIPULATOR_STATUS = {"ok": int(_kernels.manipulator.st_ok),
-                      "unreachable": int(_kernels.manipulator.st_unreachable),
-                      "degenerate": int(_kernels.manipulator.st_degenerate)}
+class ManipulatorStatus(KernelStatus):
+    """Status of each point of the 2R arm's inverse kinematics (fortran/manipulator.f90 ``st_*``).
+
+    A result of the point, never an error of the call.
+    """
+
+    ok = int(_kernels.manipulator.st_ok), "ok"
+    unreachable = int(_kernels.manipulator.st_unreachable), "unreachable", "the point lies outside the arm's reach"
+    degenerate = int(_kernels.manipulator.st_degenerate), "degenerate", "a link of no length, or the point at the base"
+
+
+#: the 2R kernels' status codes by name (``MANIPULATOR_STATUS["ok"]``): :class:`ManipulatorStatus`
+MANIPULATOR_STATUS: type[ManipulatorStatus] = ManipulatorStatus
 
 
 _doc = fill_doc(
