@@ -16,6 +16,7 @@ import numpy as np
 
 from driver._deck import Params
 from driver.fourbar import _kernel as kernel
+from driver.fourbar._kernel import Counterweight
 from driver.fourbar._spec import force_value, moving_lengths
 
 __all__ = ["props", "cw_radii", "Counterweights", "counterweights", "COLUMNS", "ForceAnalysis", "forces_at",
@@ -72,10 +73,11 @@ def counterweights(p: Mapping[str, Any]) -> Counterweights:
     """The Berkof-Lowen counterweights of the deck's linkage (kernel berkof_lowen)."""
     radii = cw_radii(p)
     pb, cw = kernel.fourbar_berkof_lowen(p["crank"], p["coupler"], p["rocker"], props(p), radii)
-    ang = np.degrees([cw[1], cw[3]])
+    c = Counterweight
+    ang = np.degrees([cw[c.CRANK_ANGLE], cw[c.ROCKER_ANGLE]])
     ang = np.where(np.abs(ang) < 1e-9, 0.0, ang)
-    return Counterweights((float(cw[0]), float(cw[2])), (float(ang[0]), float(ang[1])), radii,
-                          (float(cw[4]), float(cw[5])), pb)
+    return Counterweights((float(cw[c.CRANK_MR]), float(cw[c.ROCKER_MR])), (float(ang[0]), float(ang[1])), radii,
+                          (float(cw[c.CRANK_MASS]), float(cw[c.ROCKER_MASS])), pb)
 
 
 #: tidy column names of the force kernel's twelve columns (issue 26 fixes them)

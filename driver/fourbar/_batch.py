@@ -16,6 +16,7 @@ from driver._study import batch_error, contract_doc
 from driver.fourbar import _kernel as kernel
 from driver.fourbar._analysis import PASS_BITS, SUMMARY_KEYS, param_matrix, summary_rows
 from driver.fourbar._analysis_forces import cw_radii, props
+from driver.fourbar._kernel import ForceParam
 from driver.fourbar._spec import BAND, FORCE_SUMMARY_DOC, band_of, force_value, forces_active
 
 __all__ = ['BATCH_KEYS', 'BATCH_IGNORED', 'BATCH_INDEPENDENT', 'BATCH_PASSES', 'DETAIL', 'summarise_batch',
@@ -283,7 +284,7 @@ def summarise_force_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | 
     if len(sizes) > 1:
         raise ValueError(f"batch columns have different lengths {sorted(sizes)}")
     n = sizes.pop() if sizes else 1
-    rows = np.empty((n, 31), order="F")
+    rows = np.empty((n, kernel.N_FORCE_PARAMS), order="F")
     for i in range(n):
         d = dict(base)
         for k, v in columns.items():
@@ -298,7 +299,7 @@ def summarise_force_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | 
     if not np.all(np.isfinite(rows)):
         raise ValueError("batch values must be finite")
     frame = force_frame(kernel.fourbar_force_summaries(rows))
-    if rows[:, 28].any():   # balanced designs: the figures without counterweights follow
-        rows[:, 28] = 0.0
+    if rows[:, ForceParam.BALANCE].any():   # balanced designs: the figures without counterweights follow
+        rows[:, ForceParam.BALANCE] = 0.0
         frame = pd.concat([frame, force_frame(kernel.fourbar_force_summaries(rows), "unbalanced_")], axis=1)
     return frame

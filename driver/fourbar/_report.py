@@ -33,6 +33,7 @@ from driver.fourbar._analysis import (
     tidy_frame,
 )
 from driver.fourbar._batch import summary_of
+from driver.fourbar._kernel import Listing, Point, State
 from driver.fourbar._report_forces import figures as force_figures
 from driver.fourbar._report_forces import force_section
 from driver.fourbar._spec import SPEC, band_of, forces_active
@@ -65,13 +66,13 @@ def listing_text(p: Params, table: np.ndarray, status: np.ndarray) -> tuple[list
     rows, trailers = [], []
     for row, st in zip(table, status):
         if st == ST["no_assembly"]:
-            rows.append([int(row[0])] + [None] * 9)
+            rows.append([int(row[Listing.THETA])] + [None] * 9)
             trailers.append("cannot be assembled: the listing's arccos argument leaves [-1, 1]")
         elif st == ST["toggle"]:
-            rows.append([int(row[0])] + list(row[1:8]) + [None, None])
+            rows.append([int(row[Listing.THETA])] + list(row[Listing.EPSL:Listing.YB + 1]) + [None, None])
             trailers.append("toggle: sin(phi - epsl) = 0, velocities unbounded")
         else:
-            rows.append([int(row[0])] + list(row[1:]))
+            rows.append([int(row[Listing.THETA])] + list(row[Listing.EPSL:]))
             trailers.append("")
     lines = render_table(cols, rows, trailers)
     return head + [lines[0], ""] + lines[1:], cols
@@ -91,24 +92,26 @@ def exact_table(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarra
     if cp is not None:
         cols += [Column("xp", "f", 9, 4), Column("yp", "f", 9, 4), Column("vp", "f", 10, 4)]
         units += ["", "", "[len/s]"]
-        extra = np.column_stack([cp[:, 0], cp[:, 1], np.hypot(cp[:, 2], cp[:, 3])])
-    ang = np.column_stack([deg360(out[:, 0]), deg360(out[:, 1]), np.degrees(out[:, 2])])
+        extra = np.column_stack([cp[:, Point.X], cp[:, Point.Y], np.hypot(cp[:, Point.VX], cp[:, Point.VY])])
+    ang = np.column_stack([deg360(out[:, State.COUPLER_ANGLE]), deg360(out[:, State.ROCKER_ANGLE]),
+                           np.degrees(out[:, State.TRANSMISSION_ANGLE])])
     rows, trailers = [], []
-    d = np.hypot(p.fixed_link - out[:, 3], out[:, 4])
+    d = np.hypot(p.fixed_link - out[:, State.XA], out[:, State.YA])
+    pins, rates = slice(State.XA, State.YB + 1), slice(State.XA, State.ALPHA3 + 1)
     for k in range(len(theta)):
         t = int(round(theta[k])) if whole else theta[k]
         if status[k] == ST["indeterminate"]:
-            rows.append([t, None, None, None, out[k, 3], out[k, 4]] + [None] * 6)
+            rows.append([t, None, None, None, out[k, State.XA], out[k, State.YA]] + [None] * 6)
             trailers.append("indeterminate: crank pin A on the rocker pivot O_B, B free on a circle")
         elif status[k] == ST["no_assembly"]:
-            rows.append([t, None, None, None, out[k, 3], out[k, 4]] + [None] * 6)
+            rows.append([t, None, None, None, out[k, State.XA], out[k, State.YA]] + [None] * 6)
             trailers.append(f"cannot be assembled: |A O_B| = {d[k]:.4f} outside "
                             f"[{abs(p.coupler - p.rocker):g}, {p.coupler + p.rocker:g}]")
         elif status[k] == ST["toggle"]:
-            rows.append([t, *ang[k], *out[k, 3:7]] + [None] * 4)
+            rows.append([t, *ang[k], *out[k, pins]] + [None] * 4)
             trailers.append("toggle: coupler and rocker collinear, velocity unbounded")
         else:
-            rows.append([t, *ang[k], *out[k, 3:11]])
+            rows.append([t, *ang[k], *out[k, rates]])
             trailers.append("")
         if cp is not None:
             placed = status[k] in (ST["ok"], ST["toggle"])
@@ -153,7 +156,7 @@ def summary_lines(p: Params, g: Grashof, ex: Extremes | None) -> list[str]:
 def audit(p: Params, theta: np.ndarray, table: np.ndarray, lst_status: np.ndarray,
           out: np.ndarray, status: np.ndarray) -> tuple[list[str], str | None, pd.DataFrame]:
     """Rows of the listing that violate loop closure, compared with the exact solution."""
-    ab = np.hypot(table[:, 6] - table[:, 4], table[:, 7] - table[:, 5])
+    ab = np.hypot(table[:, Listing.XB] - table[:, Listing.XA], table[:, Listing.YB] - table[:, Listing.YA])
     dev = ab - p.coupler
     good = (lst_status == ST["ok"]) & (status == ST["ok"])
     bad = good & (np.abs(dev) > 1e-4 * p.coupler)
@@ -166,8 +169,8 @@ def audit(p: Params, theta: np.ndarray, table: np.ndarray, lst_status: np.ndarra
     cols = [Column("i", "i", 5, 0), Column("|AB|", "f", 9, 4), Column("dev", "f", 9, 4),
             Column("xb lst", "f", 8, 3), Column("yb lst", "f", 8, 3), Column("xb", "f", 8, 3),
             Column("yb", "f", 8, 3), Column("oms lst", "f", 9, 4), Column("omega3", "f", 9, 4)]
-    rows = [[int(theta[k]), ab[k], dev[k], table[k, 6], table[k, 7], out[k, 5], out[k, 6], table[k, 9], out[k, 8]]
-            for k in np.flatnonzero(bad)]
+    rows = [[int(theta[k]), ab[k], dev[k], table[k, Listing.XB], table[k, Listing.YB], out[k, State.XB],
+             out[k, State.YB], table[k, Listing.OMS], out[k, State.OMEGA3]] for k in np.flatnonzero(bad)]
     lines += [f"    {int(bad.sum())} of {len(theta)} rows have a coupler length |AB| different from "
               f"the deck's {p.coupler:g}; largest deviation {dev[worst]:+.4f} at i = {int(theta[worst])}:"]
     lines += ["  " + l for l in render_table(cols, rows)]
@@ -219,7 +222,7 @@ def run(params: Params, progress: bool = False) -> Result:
         if warn:
             warnings.append(warn)
         lst_cols = dict(zip(["coupler_deg", "rocker_deg", "transmission_deg", "xa", "ya", "xb", "yb",
-                             "omega2_rad_s", "omega3_rad_s"], table[:, 1:].T))
+                             "omega2_rad_s", "omega3_rad_s"], table[:, Listing.EPSL:].T))
         lst_cols["ab_error"] = np.where(lst_status == ST["ok"], closure["ab_deviation"].to_numpy(), np.nan)
         listing_frame = tidy_frame("listing", theta, lst_cols, lst_status, closure["loop_not_closed"].to_numpy())
         tidy = with_units(pd.concat([listing_frame, exact_frame], ignore_index=True), TIDY_UNITS)
@@ -278,7 +281,7 @@ def deck_figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> li
         for a in limit_angles(p.fixed_link, p.crank, p.coupler, p.rocker):
             if theta[0] - 1e-9 <= a <= theta[-1] + 1e-9 or hi - lo >= 360.0:
                 row, rst = exact_grid(p, np.array([a]))
-                if rst[0] != ST["no_assembly"] and np.all(np.isfinite(row[0, 3:7])):
+                if rst[0] != ST["no_assembly"] and np.all(np.isfinite(row[0, State.XA:State.YB + 1])):
                     limits.append((a, row[0]))
         return figures.fourbar_linkage(p.fixed_link, theta, out, st == ST["ok"], listing, stem_title,
                                        point=None if cp is None else cp[:, :2], output=output_name(p),

@@ -18,6 +18,7 @@ from driver._table import Column, fortran_f, render_table
 from driver.fourbar._analysis import ST, TIDY_UNITS
 from driver.fourbar._analysis_forces import ForceAnalysis, analyse, props, tidy_columns
 from driver.fourbar._batch import force_summary
+from driver.fourbar._kernel import Force, Prop
 from driver.fourbar._spec import LINKS, force_value
 
 __all__ = ["force_section", "echo_lines", "table_lines", "summary_lines", "figures"]
@@ -84,9 +85,10 @@ def echo_lines(p: Params) -> list[str]:
     out = ["", "  Force analysis inputs (SI units; centre of mass from the first pin, angle off the link line)",
            "    link        mass [kg]   inertia [kg m2]   com distance [m]   com angle [deg]"]
     for i, name in enumerate(LINKS):
-        out.append(f"    {name:<10}{pr[i]:>10.4f}{pr[3 + i]:>17.6g}{pr[6 + i]:>19.4f}{math.degrees(pr[9 + i]):>18.2f}")
-    out.append(f"    gravity {pr[12]:g} m/s^2 along -y; load torque on the rocker {pr[13]:g} N m (ccw +); "
-               f"load force at P ({pr[14]:g}, {pr[15]:g}) N")
+        out.append(f"    {name:<10}{pr[Prop.MASS + i]:>10.4f}{pr[Prop.INERTIA + i]:>17.6g}"
+                   f"{pr[Prop.COM_DISTANCE + i]:>19.4f}{math.degrees(pr[Prop.COM_ANGLE + i]):>18.2f}")
+    out.append(f"    gravity {pr[Prop.GRAVITY]:g} m/s^2 along -y; load torque on the rocker {pr[Prop.LOAD_TORQUE]:g} N m "
+               f"(ccw +); load force at P ({pr[Prop.LOAD_FORCE_X]:g}, {pr[Prop.LOAD_FORCE_Y]:g}) N")
     return out
 
 
@@ -140,9 +142,11 @@ def summary_lines(p: Params, s: dict[str, Any], fa: ForceAnalysis) -> list[str]:
             out.append(f"    {name} counterweight .. m r = {cw.mr[i]:.6f} kg m at {cw.angle_deg[i]:.3f} deg off {pin}; "
                        f"{cw.mass[i]:.4f} kg at r = {cw.radius[i]:g} m")
         pb = cw.props
-        out.append(f"    balanced links ....... crank {pb[0]:.4f} kg, I = {pb[3]:.6g} kg m2, com {pb[6]:.4f} m at "
-                   f"{math.degrees(pb[9]):.2f} deg; rocker {pb[2]:.4f} kg, I = {pb[5]:.6g} kg m2, com {pb[8]:.4f} m at "
-                   f"{math.degrees(pb[11]):.2f} deg")
+        crank, rocker = 0, 2   # the links' offsets in each group of Prop
+        out.append(f"    balanced links ....... crank {pb[Prop.MASS + crank]:.4f} kg, I = {pb[Prop.INERTIA + crank]:.6g} "
+                   f"kg m2, com {pb[Prop.COM_DISTANCE + crank]:.4f} m at {math.degrees(pb[Prop.COM_ANGLE + crank]):.2f} "
+                   f"deg; rocker {pb[Prop.MASS + rocker]:.4f} kg, I = {pb[Prop.INERTIA + rocker]:.6g} kg m2, com "
+                   f"{pb[Prop.COM_DISTANCE + rocker]:.4f} m at {math.degrees(pb[Prop.COM_ANGLE + rocker]):.2f} deg")
         rows = [("peak |input torque| [N m]", "torque_peak_Nm", 4), ("RMS input torque [N m]", "torque_rms_Nm", 4),
                 ("peak |F_O2| [N]", "F_O2_peak_N", 3), ("peak |F_A| [N]", "F_A_peak_N", 3),
                 ("peak |F_B| [N]", "F_B_peak_N", 3), ("peak |F_O4| [N]", "F_O4_peak_N", 3),
@@ -156,8 +160,9 @@ def summary_lines(p: Params, s: dict[str, Any], fa: ForceAnalysis) -> list[str]:
                 continue
             out.append(f"    {label:<28}{fortran_f(a, 14, dec)}{fortran_f(b, 14, dec)}{fortran_f(b - a, 14, dec)}")
         if fa.ok.any():
-            mg = np.sum(pb[:3]) * pb[12]
-            inert = fa.forces[fa.ok, 9:11] - np.array([0.0, -mg]) - np.array([pb[14], pb[15]])
+            mg = np.sum(pb[Prop.MASS:Prop.MASS + 3]) * pb[Prop.GRAVITY]
+            inert = (fa.forces[fa.ok, Force.SHAKING_X:Force.SHAKING_Y + 1] - np.array([0.0, -mg])
+                     - np.array([pb[Prop.LOAD_FORCE_X], pb[Prop.LOAD_FORCE_Y]]))
             out.append(f"    balanced shaking force minus weight and load force: max {np.max(np.hypot(*inert.T)):.1e} N "
                        "over the table (zero but for round-off: the centre of mass does not move)")
     return out

@@ -38,6 +38,7 @@ from driver.manipulator._analysis import (
     sweep_columns,
     workspace_columns,
 )
+from driver.manipulator._kernel import SummaryParam, Torque
 from driver.manipulator._tables import table_4_8
 
 __all__ = ["BATCH_KEYS", "BATCH_IGNORED", "BATCH_INDEPENDENT", "BATCH_PASSES", "BATCH_PASS_SUFFIXES", "summarise_batch",
@@ -230,10 +231,12 @@ def _arrays(base: Mapping[str, Any], columns: Mapping[str, Any] | None,
     eps = _column(base, "tolerance_bound", columns.get("tolerance_bound", p.tolerance_bound), n, lambda a: a >= 1e-9)
 
     # every design of every deck in one kernel call (rows deck-major: deck i, design j -> i k + j)
-    prm = np.empty((n * k, 7), dtype=np.float64, order="F")
-    prm[:, 0], prm[:, 1] = l1.ravel(), l2.ravel()
-    for j, v in enumerate((tx, ty, mpl, g, eps), start=2):
-        prm[:, j] = np.repeat(v, k)
+    sp = SummaryParam
+    prm = np.empty((n * k, len(sp)), dtype=np.float64, order="F")
+    prm[:, sp.L1], prm[:, sp.L2] = l1.ravel(), l2.ravel()
+    for col, v in ((sp.TARGET_X, tx), (sp.TARGET_Y, ty), (sp.MASS_PER_LENGTH, mpl), (sp.GRAVITY, g),
+                   (sp.TOLERANCE_BOUND, eps)):
+        prm[:, col] = np.repeat(v, k)
     rates = [*p.joint_rates, *p.joint_accels]
     unit = _mc_samples(p.mc_seed, p.mc_samples)
     bits = sum(b for k, b in kernel.MANIPULATOR_PASSES.items() if k in passes)
@@ -327,13 +330,14 @@ def _report_torques(p: Params, prm: np.ndarray, r: dict[str, np.ndarray], n: int
     else:
         used = np.array([[round_half_up(a, 2), round_half_up(180.0 - abs(b), 2)] for a, b in zip(t1, t2)])
         used = used.reshape(-1, 2)
-    tau = np.empty((n * k, 2))
-    for gv in np.unique(prm[:, 5]):      # the torque kernel takes one g per call
-        m = prm[:, 5] == gv
-        tau[m] = kernel.manipulator_torques(prm[m, 0], prm[m, 1], np.radians(used[m, 0]), np.radians(used[m, 1]),
-                                             p.joint_rates, p.joint_accels, prm[m, 4] * prm[m, 0],
-                                             prm[m, 4] * prm[m, 1], float(gv))
-    return tau[:, 0].reshape(n, k), tau[:, 1].reshape(n, k)
+    sp = SummaryParam
+    tau = np.empty((n * k, len(Torque)))
+    for gv in np.unique(prm[:, sp.GRAVITY]):      # the torque kernel takes one g per call
+        m = prm[:, sp.GRAVITY] == gv
+        l1, l2, mpl = prm[m, sp.L1], prm[m, sp.L2], prm[m, sp.MASS_PER_LENGTH]
+        tau[m] = kernel.manipulator_torques(l1, l2, np.radians(used[m, 0]), np.radians(used[m, 1]),
+                                             p.joint_rates, p.joint_accels, mpl * l1, mpl * l2, float(gv))
+    return tau[:, Torque.TAU1].reshape(n, k), tau[:, Torque.TAU2].reshape(n, k)
 
 
 @contract_doc

@@ -8,6 +8,7 @@ back.  Each kernel's physics and units are documented in its Fortran source.
 """
 from __future__ import annotations
 
+from enum import IntEnum
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -20,9 +21,10 @@ if TYPE_CHECKING:   # the study's modules of the extension, typed (generated: to
 else:
     from driver._fortran import _kernels
 
-__all__ = ['ManipulatorStatus', 'MANIPULATOR_PASSES', 'MANIPULATOR_STATUS', 'manipulator_arm_states', 'manipulator_torques',
-           'manipulator_ik', 'manipulator_design_indices', 'manipulator_position_errors',
-           'manipulator_design_summaries', 'MANIPULATOR_SUMMARY_PARAMS', 'MANIPULATOR_SUMMARY_COLUMNS']
+__all__ = ['ManipulatorStatus', 'Torque', 'Index', 'SummaryParam', 'MANIPULATOR_PASSES', 'MANIPULATOR_STATUS',
+           'manipulator_arm_states', 'manipulator_torques', 'manipulator_ik', 'manipulator_design_indices',
+           'manipulator_position_errors', 'manipulator_design_summaries', 'MANIPULATOR_SUMMARY_PARAMS',
+           'MANIPULATOR_SUMMARY_COLUMNS']
 
 
 class ManipulatorStatus(KernelStatus):
@@ -38,6 +40,43 @@ class ManipulatorStatus(KernelStatus):
 
 #: the 2R kernels' status codes by name (``MANIPULATOR_STATUS["ok"]``): :class:`ManipulatorStatus`
 MANIPULATOR_STATUS: type[ManipulatorStatus] = ManipulatorStatus
+
+
+# ----------------------------------------------------------------------------- the kernels' column layouts
+
+class Torque(IntEnum):
+    """Columns of the joint torques [N m] (:func:`manipulator_torques`, :func:`manipulator_arm_states`).
+    """
+
+    TAU1 = 0
+    TAU2 = 1
+
+
+class Index(IntEnum):
+    """Columns of :func:`manipulator_design_indices`'s ``ri``.
+
+    The robustness indices RI1, RI2, RI3 (dimensionless).
+    """
+
+    RI1 = 0
+    RI2 = 1
+    RI3 = 2
+
+
+class SummaryParam(IntEnum):
+    """Columns of a :func:`manipulator_design_summaries` design.
+
+    Link lengths l1, l2 [m], the target point [m], mass per length [kg/m], gravity [m/s^2], the
+    tolerance bound [m].
+    """
+
+    L1 = 0
+    L2 = 1
+    TARGET_X = 2
+    TARGET_Y = 3
+    MASS_PER_LENGTH = 4
+    GRAVITY = 5
+    TOLERANCE_BOUND = 6
 
 
 _doc = fill_doc(
@@ -214,8 +253,8 @@ def manipulator_position_errors(th1, th2, dl) -> np.ndarray:
     return _kernels.manipulator.position_errors(th1, th2, farray(dl, 2))
 
 
-#: columns of the parameter matrix of :func:`manipulator_design_summaries`
-MANIPULATOR_SUMMARY_PARAMS = ("l1", "l2", "target_x", "target_y", "mass_per_length", "gravity", "tolerance_bound")
+#: columns of the parameter matrix of :func:`manipulator_design_summaries` by name: :class:`SummaryParam`
+MANIPULATOR_SUMMARY_PARAMS = tuple(c.name.lower() for c in SummaryParam)
 #: columns of its result (fortran/manipulator_summary.f90)
 MANIPULATOR_SUMMARY_COLUMNS = ("ri1", "ri2", "ri3", "sum_c2", "reach", "target_status", "theta1_deg", "theta2_deg",
                                "tau1", "tau2", "reaches_points", "dl1", "dl2", "mc_max")

@@ -28,6 +28,7 @@ from driver.manipulator._analysis import (
     target_point,
     workspace_columns,
 )
+from driver.manipulator._kernel import Torque
 from driver.manipulator._spec import SPEC
 from driver.manipulator._tables import TIDY_NAMES, Table, mode_differences, report_tables, tolerance_table
 
@@ -136,8 +137,8 @@ def _summary(p: Params, ws: Workspace, conv: Conv, used: dict, sweep: dict, tol:
     s = workspace_columns(p, ws, conv)
     for i, name in enumerate(used["names"]):
         key = name.lower().replace(" ", "_")
-        s[f"{key}_tau1_Nm"] = float(used["tau"][i, 0]) if used["ok"][i] else None
-        s[f"{key}_tau2_Nm"] = float(used["tau"][i, 1]) if used["ok"][i] else None
+        s[f"{key}_tau1_Nm"] = float(used["tau"][i, Torque.TAU1]) if used["ok"][i] else None
+        s[f"{key}_tau2_Nm"] = float(used["tau"][i, Torque.TAU2]) if used["ok"][i] else None
     for rec in tol:
         key = rec["name"].lower().replace(" ", "_")
         s[f"{key}_dl_m"] = rec["dl1"]

@@ -8,6 +8,7 @@ back.  Each kernel's physics and units are documented in its Fortran source.
 """
 from __future__ import annotations
 
+from enum import IntEnum
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -20,7 +21,7 @@ if TYPE_CHECKING:   # the study's modules of the extension, typed (generated: to
 else:
     from driver._fortran import _kernels
 
-__all__ = ['SimulateStatus', 'NonlinearStatus', 'SLIDERCRANK_STATUS', 'SLIDERCRANK_PROFILE', 'slidercrank_simulate',
+__all__ = ['SimulateStatus', 'NonlinearStatus', 'Shape', 'SLIDERCRANK_STATUS', 'SLIDERCRANK_PROFILE', 'slidercrank_simulate',
            'slidercrank_matrices', 'slidercrank_rigid', 'slidercrank_axial_force', 'slidercrank_frequencies',
            'SLIDERCRANK_NL_STATUS', 'slidercrank_nl_simulate', 'slidercrank_column_static',
            'slidercrank_corot_element']
@@ -296,6 +297,17 @@ class NonlinearStatus(KernelStatus):
 
 #: the nonlinear rod's status codes by name (``SLIDERCRANK_NL_STATUS["ok"]``): :class:`NonlinearStatus`
 SLIDERCRANK_NL_STATUS: type[NonlinearStatus] = NonlinearStatus
+
+
+class Shape(IntEnum):
+    """Columns of :func:`slidercrank_nl_simulate`'s ``shapes`` (and of its ``shape_step``).
+
+    The rod's lateral deflection [m] at the step of largest deflection and at the step of largest
+    crank-end compression.
+    """
+
+    LARGEST_DEFLECTION = 0
+    LARGEST_COMPRESSION = 1
 
 
 @_doc
