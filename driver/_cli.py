@@ -152,16 +152,10 @@ def _on_sigterm(signum: int, frame: object) -> None:
 
 def keys_help(group: str) -> str | None:
     """Every key of namelist group ``group`` with kind, units, default and doc; None if no such group."""
-    from driver._runner import CONTROL_GROUPS
-    if group in CONTROL_GROUPS:
-        import importlib
-        spec = importlib.import_module(f"driver.{group}").SPEC
-    else:
-        from driver._study import load_study
-        study = load_study(group)
-        if study is None:
-            return None
-        spec = study.spec
+    from driver._study import group_spec
+    spec = group_spec(group)
+    if spec is None:
+        return None
     lines = [f"&{spec.name}: {spec.doc}".rstrip(": "), ""]
     for name, key in spec.keys.items():
         req = "required" if key.required else f"default {key.default!r}"

@@ -312,7 +312,7 @@ def _synthesise_function(p: Params) -> Synthesis:
         crank_deg = fd.crank_start_deg + (x - x0) / (xf - x0) * p.crank_range_deg
         out, st = fourbar_kernel.fourbar_exact(np.radians(crank_deg), d, fd.crank, fd.coupler, fd.rocker, 1.0, 0.0, sgn)
         desired_psi = fd.rocker_start_deg + (curve(x) - y0) / (yf - y0) * p.rocker_range_deg
-        err = wrap180(np.degrees(out[:, 1]) - desired_psi)
+        err = wrap180(np.degrees(out[:, fourbar_kernel.State.ROCKER_ANGLE]) - desired_psi)
         err = np.where(st == ST["ok"], err, np.nan)
         y_gen = curve(x) + err / p.rocker_range_deg * (yf - y0)
         fd.x, fd.y_desired, fd.y_generated, fd.rocker_error_deg, fd.status = x, curve(x), y_gen, err, st
@@ -320,7 +320,8 @@ def _synthesise_function(p: Params) -> Synthesis:
         pr = fd.rocker_start_deg + (ys - y0) / (yf - y0) * p.rocker_range_deg
         for s, attr in ((sgn, "point_error_deg"), (-sgn, "other_branch_point_error_deg")):
             o2, s2 = fourbar_kernel.fourbar_exact(np.radians(pc), d, fd.crank, fd.coupler, fd.rocker, 1.0, 0.0, s)
-            setattr(fd, attr, np.where(s2 == ST["ok"], wrap180(np.degrees(o2[:, 1]) - pr), np.nan))
+            psi2 = np.degrees(o2[:, fourbar_kernel.State.ROCKER_ANGLE])
+            setattr(fd, attr, np.where(s2 == ST["ok"], wrap180(psi2 - pr), np.nan))
         worst = int(np.nanargmax(np.abs(err))) if np.isfinite(err).any() else 0
         tol_deg = 1e-6 if len(xs) == 3 else math.inf
         bad = np.flatnonzero(st != ST["ok"])
@@ -351,7 +352,7 @@ def _synthesise_function(p: Params) -> Synthesis:
                               "structural_error": y_gen - fd.y_desired, "rocker_error_deg": err,
                               "status": np.array(["ok", "cannot_assemble", "toggle", "indeterminate"])[st]})
         good = st == ST["ok"]
-        mu = np.degrees(out[good, 2]) if good.any() else np.array([])
+        mu = np.degrees(out[good, fourbar_kernel.State.TRANSMISSION_ANGLE]) if good.any() else np.array([])
         warnings = _quality_warnings(p, d, {"crank": fd.crank, "coupler": fd.coupler, "rocker": fd.rocker},
                                      float(mu.min()) if mu.size else None, float(mu.max()) if mu.size else None)
         lines += [f"  WARNING: {w} (over the x range)" if "transmission" in w else f"  WARNING: {w}" for w in warnings]

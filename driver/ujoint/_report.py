@@ -11,13 +11,11 @@ import textwrap
 import numpy as np
 import pandas as pd
 
-from driver import _keywords
 from driver._deck import Params
 from driver._export import with_units
 from driver._mechanism import Link, MechanismFrames
 from driver._result import Figure, Result
-from driver._runner import keyword_run
-from driver._signatures import keyword_signature
+from driver._runner import study_run
 from driver._table import Cell, Column, fortran_f, render_table
 from driver.ujoint._analysis import (
     TIE_RTOL,
@@ -345,8 +343,7 @@ def _result_dat(params: Params, chain: Chain, designs: list[Design], best: Desig
     return "\n".join(lines) + "\n"
 
 
-@keyword_signature(_keywords.ujoint, SPEC)
-@keyword_run
+@study_run(SPEC)
 def run(params: Params, progress: bool = False) -> Result:
     """Analyse (option 0) or optimise (options 1-3) a chain of Hooke joints on a shaft line.
 
