@@ -21,12 +21,14 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from decimal import Decimal, InvalidOperation
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
-import pandas as pd
 
 from driver._errors import DriverError
+
+if TYPE_CHECKING:   # annotations only: pandas is imported when a record is read
+    import pandas as pd
 
 __all__ = ["PUBLISHED_DIR", "Published", "PrintedCell", "printed_cells", "PublishedError", "match_line", "records",
            "read_listing", "read_blocks", "matches", "listing_rows", "LISTING_COLUMNS", "agrees_printed", "cell", "numeric_cell",
@@ -177,6 +179,7 @@ def read_listing(path: Path) -> Published:
             raise PublishedError(f"{path}: row {k + 1} has {len(row)} fields, expected {len(LISTING_COLUMNS)}")
         for col, value in zip(LISTING_COLUMNS, row):
             recs.append({"table": name, "row": row[0], "column": col, "printed": value})
+    import pandas as pd
     return Published(name, path, group, match, pd.DataFrame.from_records(recs))
 
 
@@ -216,6 +219,7 @@ def read_blocks(path: Path) -> Published:
         k += 1
     if not recs:
         raise PublishedError(f"{path}: no table found")
+    import pandas as pd
     return Published(path.stem, path, group, match, pd.DataFrame.from_records(recs))
 
 

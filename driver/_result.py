@@ -1,18 +1,119 @@
-"""What one deck run produced: :class:`Result` with its :class:`Figure` s, and the figure
-formats of ``--plot``.  Plain data: it imports nothing of the driver, so that the study contract
-(:mod:`driver._study`), the runner and the studies can all name it (re-exported by
-:mod:`driver._output`)."""
+"""What one deck run produced: :class:`Result` with its :class:`Figure` s, its :class:`Tidy`
+table, and the figure formats of ``--plot``.  Plain data: it imports nothing of the driver at
+module level, so that the study contract (:mod:`driver._study`), the runner and the studies can
+all name it (re-exported by :mod:`driver._output`); nor pandas: a run's tidy table is built into
+a DataFrame only when someone reads ``result.tidy`` (a CSV or Parquet file, the API, the report
+page), so a deck run that writes only its ``.out`` never imports pandas (docs/performance.md,
+*Start-up*)."""
 from __future__ import annotations
 
-from collections.abc import Callable
+import math
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
+
+import numpy as np
 
 if TYPE_CHECKING:   # annotations only: keeps `python -m driver --help` light
     import matplotlib.figure
     import pandas as pd
 
-__all__ = ["Figure", "PLOT_FORMATS", "Result", "plot_format"]
+__all__ = ["Figure", "PLOT_FORMATS", "Result", "Tidy", "plot_format"]
+
+
+class Tidy:
+    """A run's tidy table before it is a DataFrame: its columns as numpy arrays (or scalars that
+    broadcast), in one or more parts stacked row-wise, and the units the names do not say.
+
+    :meth:`frame` builds the pandas DataFrame exactly as ``with_units(pd.concat([pd.DataFrame(part)
+    for part in parts], ignore_index=True), units)`` (one part: without the concat) would, so a
+    study hands its columns over and pays for pandas only when the table is read.
+    :meth:`infinite_column` finds an infinite number without pandas (the runner's check that no
+    infinity reaches a table; NaN is a missing value, allowed as in a DataFrame's numeric columns).
+
+    Parameters
+    ----------
+    *parts : mapping of str to array or scalar
+        The columns of each part, in order; a scalar fills its part's rows.
+    units : mapping of str to str, optional
+        Units of the columns whose names do not say them (``'length'``, ``'1'``), as
+        :func:`driver._export.with_units` takes them.
+    records : sequence of mapping, optional
+        Instead of parts: the rows as records (``pd.DataFrame.from_records(records,
+        columns=columns)``).
+    columns : sequence of str, optional
+        The column order of ``records``.
+    """
+
+    def __init__(self, *parts: Mapping[str, Any], units: Mapping[str, str] | None = None,
+                 records: Sequence[Mapping[str, Any]] | None = None, columns: Sequence[str] | None = None) -> None:
+        if records is not None and parts:
+            raise TypeError("Tidy takes column parts or records, not both")
+        self.parts = [dict(p) for p in parts]
+        self.units = dict(units or {})
+        self.records = None if records is None else [dict(r) for r in records]
+        self.columns = None if columns is None else list(columns)
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """(rows, columns) of the table, without building it."""
+        if self.records is not None:
+            names = self.columns if self.columns is not None else list(dict.fromkeys(k for r in self.records for k in r))
+            return len(self.records), len(names)
+        rows = sum(max([np.size(v) for v in p.values() if np.ndim(v) > 0] or [1 if p else 0]) for p in self.parts)
+        return rows, len(dict.fromkeys(k for p in self.parts for k in p))
+
+    def _values(self) -> list[tuple[str, Any]]:
+        if self.records is not None:
+            return [(k, v) for r in self.records for k, v in r.items()]
+        return [(k, v) for p in self.parts for k, v in p.items()]
+
+    def infinite_column(self) -> str | None:
+        """The first column holding an infinite number (None: every number finite or NaN)."""
+        for name, value in self._values():
+            if isinstance(value, str) or value is None:
+                continue
+            a = np.asarray(value)
+            if a.dtype.kind in "fc":
+                if np.isinf(a).any():
+                    return name
+            elif a.dtype.kind == "O":
+                if any(isinstance(v, float | np.floating) and math.isinf(v) for v in a.ravel()):
+                    return name
+        return None
+
+    def frame(self) -> pd.DataFrame:
+        """The pandas DataFrame, units in ``attrs["units"]``."""
+        import pandas as pd
+
+        from driver._export import with_units
+        if self.records is not None:
+            frame = pd.DataFrame.from_records(self.records, columns=self.columns)
+        elif len(self.parts) == 1:
+            frame = pd.DataFrame(self.parts[0])
+        else:
+            frame = pd.concat([pd.DataFrame(p) for p in self.parts], ignore_index=True)
+        return with_units(frame, self.units)
+
+
+class _TidyField:
+    """The ``tidy`` field of :class:`Result`: set to a DataFrame or a :class:`Tidy`, read as a
+    DataFrame (a Tidy is built on first read and kept)."""
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.slot = "_" + name
+
+    def __get__(self, obj: Any, owner: type | None = None) -> pd.DataFrame:
+        if obj is None:
+            raise AttributeError("tidy")   # no class-level default: the field is required
+        value = obj.__dict__[self.slot]
+        if isinstance(value, Tidy):
+            value = obj.__dict__[self.slot] = value.frame()
+        return value
+
+    def __set__(self, obj: Any, value: pd.DataFrame | Tidy) -> None:
+        obj.__dict__[self.slot] = value
+
 
 
 #: file formats of ``--plot`` figures (``--plot-format``); the first is the default
@@ -84,7 +185,7 @@ class Result:
     """
 
     text: str
-    tidy: pd.DataFrame
+    tidy: _TidyField = _TidyField()
     summary: dict[str, Any] = field(default_factory=dict)
     warnings: list[str] = field(default_factory=list)
     failure: str | None = None
@@ -95,6 +196,12 @@ class Result:
     #: the validated deck keys the run was made from (set by the runner; the report page's
     #: animation and comparison use them)
     params: Any = field(default=None, repr=False, compare=False)
+
+    @property
+    def tidy_pending(self) -> Tidy | None:
+        """The :class:`Tidy` not yet built into a DataFrame (None once built, or when given as one)."""
+        value = self.__dict__.get("_tidy")
+        return value if isinstance(value, Tidy) else None
 
     @property
     def out(self) -> str:
@@ -149,6 +256,8 @@ class Result:
 
     def __repr__(self) -> str:
         state = "ok" if self.ok else f"failed: {self.failure}"
+        pending = self.tidy_pending
+        shape = pending.shape if pending is not None else self.tidy.shape
         return (f"<Result {self.study or '?'} {self.name!r}: {state}; .out {len(self.text.splitlines())} lines, "
-                f"tidy {self.tidy.shape[0]}x{self.tidy.shape[1]}, summary {len(self.summary)} values, "
+                f"tidy {shape[0]}x{shape[1]}, summary {len(self.summary)} values, "
                 f"{len(self.warnings)} warning(s), figures {self.figure_names}>")

@@ -194,9 +194,14 @@ def check_finite(result: Result, params: Params) -> Result:
             kind = ("a field of asterisks (a number too wide for its column)" if found.startswith("*") else
                     "a NaN (not a number)" if "nan" in found.lower() else "an infinity")
             raise numerical_error(params, TableValueError(f"{kind} would be written on line {line} of {what}"))
-    num = result.tidy.select_dtypes("number") if result.tidy is not None else None
-    if num is not None and num.size and not np.isfinite(num.to_numpy(dtype=float, na_value=0.0)).all():
-        bad = [c for c in num.columns if not np.isfinite(num[c].to_numpy(dtype=float, na_value=0.0)).all()]
+    pending = result.tidy_pending
+    if pending is not None:   # columns not yet a DataFrame (pandas not needed): checked as arrays
+        bad = [c for c in [pending.infinite_column()] if c is not None]
+    else:
+        num = result.tidy.select_dtypes("number") if result.tidy is not None else None
+        bad = [] if num is None or not num.size or np.isfinite(num.to_numpy(dtype=float, na_value=0.0)).all() else \
+            [c for c in num.columns if not np.isfinite(num[c].to_numpy(dtype=float, na_value=0.0)).all()]
+    if bad:
         raise numerical_error(params, TableValueError(f"non-finite values in column {bad[0]} of the tidy table"))
     return result
 

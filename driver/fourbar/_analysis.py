@@ -5,21 +5,23 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from driver._deck import Params
-from driver._export import with_units
+from driver._result import Tidy
 from driver._study import batch_error
 from driver.fourbar import _kernel as kernel
 from driver.fourbar._kernel import Point, State, Summary, SummaryParam
 
+if TYPE_CHECKING:   # annotations only: pandas is imported when a table is built
+    import pandas as pd
+
 __all__ = ['ST', 'Grashof', 'grashof', 'limit_angles', 'assembly_intervals', 'Motion', 'rocking_motions',
            'crank_angles', 'exact_grid', 'coupler_point', 'listing_grid', 'deg360', 'Extremes', 'toggles_in_range',
-           'extremes', 'TIDY_UNITS', 'tidy_frame', 'exact_columns', 'blame', 'SUMMARY_KEYS', 'PASS_BITS', 'param_matrix',
-           'summary_rows']
+           'extremes', 'TIDY_UNITS', 'tidy_frame', 'tidy_part', 'exact_columns', 'blame', 'SUMMARY_KEYS', 'PASS_BITS',
+           'param_matrix', 'summary_rows']
 
 
 ST = kernel.FOURBAR_STATUS
@@ -475,10 +477,16 @@ def tidy_frame(method: str, theta: np.ndarray, cols: dict[str, np.ndarray], stat
         The table, status in words; unassemblable cells left empty (NaN); units in
         ``attrs["units"]``.
     """
+    return Tidy(tidy_part(method, theta, cols, status, not_closed), units=TIDY_UNITS).frame()
+
+
+def tidy_part(method: str, theta: np.ndarray, cols: dict[str, np.ndarray], status: np.ndarray,
+              not_closed: np.ndarray | None = None) -> dict[str, Any]:
+    """The columns of :func:`tidy_frame` (numpy arrays, no pandas): a part of a run's
+    :class:`driver._result.Tidy`."""
     words = np.array(["ok", "cannot_assemble", "toggle", "indeterminate", "loop_not_closed"])[
         np.where(not_closed, 4, status) if not_closed is not None else status]
-    frame = pd.DataFrame({"method": method, "theta_deg": theta, **cols, "status": words})
-    return with_units(frame, TIDY_UNITS)
+    return {"method": method, "theta_deg": theta, **cols, "status": words}
 
 
 def exact_columns(out: np.ndarray, status: np.ndarray, cp: np.ndarray | None = None,

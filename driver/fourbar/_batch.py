@@ -6,10 +6,9 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Collection, Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from driver._deck import Params
 from driver._study import batch_error, contract_doc
@@ -18,6 +17,9 @@ from driver.fourbar._analysis import PASS_BITS, SUMMARY_KEYS, param_matrix, summ
 from driver.fourbar._analysis_forces import cw_radii, props
 from driver.fourbar._kernel import ForceParam
 from driver.fourbar._spec import BAND, FORCE_SUMMARY_DOC, band_of, force_value, forces_active
+
+if TYPE_CHECKING:   # annotations only: the frames are built with pandas imported where they are built
+    import pandas as pd
 
 __all__ = ['BATCH_KEYS', 'BATCH_IGNORED', 'BATCH_INDEPENDENT', 'BATCH_PASSES', 'DETAIL', 'summarise_batch',
            'summary_frame', 'summarise', 'summary_of',
@@ -132,14 +134,19 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
 def _assemble(base: Mapping[str, Any], res: np.ndarray, detail: bool, wanted: Collection[str] | None,
               force_columns: Mapping[str, Any]) -> pd.DataFrame:
     """The summary frame of kernel rows ``res`` (and the force columns when the deck gives masses)."""
-    frame = summary_frame(res, detail, band_of(base), wanted)
+    import pandas as pd
+    return pd.DataFrame(_assemble_columns(base, res, detail, wanted, force_columns), index=pd.RangeIndex(len(res)))
+
+
+def _assemble_columns(base: Mapping[str, Any], res: np.ndarray, detail: bool, wanted: Collection[str] | None,
+                      force_columns: Mapping[str, Any]) -> dict[str, np.ndarray]:
+    """The columns of :func:`_assemble` as numpy arrays (no pandas: a single run's summary)."""
+    cols = summary_columns(res, detail, band_of(base), wanted)
     if forces_active(base) and (wanted is None or any(BATCH_PASSES.get(c) == ("forces",) for c in wanted)):
         # force columns when the deck gives masses, and someone reads one
-        more = summarise_force_batch(base, force_columns)
-        if wanted is not None:
-            more = more[[c for c in more.columns if c in set(wanted)]]
-        frame = pd.concat([frame, more], axis=1)
-    return frame
+        more = _force_batch_columns(base, force_columns)
+        cols.update((c, v) for c, v in more.items() if wanted is None or c in set(wanted))
+    return cols
 
 
 #: the columns of summarise_batch(detail=True) only
@@ -151,6 +158,13 @@ def summary_frame(res: np.ndarray, detail: bool = False, band: tuple[float, floa
            wanted: Collection[str] | None = None) -> pd.DataFrame:
     """Kernel rows -> the summary columns (vectorised; the one place both paths go through);
     with ``wanted``, only those columns are built."""
+    import pandas as pd
+    return pd.DataFrame(summary_columns(res, detail, band, wanted), index=pd.RangeIndex(len(res)))
+
+
+def summary_columns(res: np.ndarray, detail: bool = False, band: tuple[float, float] = BAND,
+                    wanted: Collection[str] | None = None) -> dict[str, np.ndarray]:
+    """The columns of :func:`summary_frame` as numpy arrays, in its order."""
     c = dict(zip(kernel.FOURBAR_SUMMARY_COLUMNS, res.T))
     ok = c["assemblable"] > 0
     lut = [GRASHOF_NAMES[kernel.FOURBAR_GRASHOF[k]] for k in range(len(GRASHOF_NAMES))]
@@ -180,7 +194,7 @@ def summary_frame(res: np.ndarray, detail: bool = False, band: tuple[float, floa
                   "omega2_peak_at_deg": lambda: has(c["omega2_peak_at_deg"], ok & ~tog()),
                   "toggles_in_range": lambda: c["toggles_in_range"].astype(int)}
     keys = build if wanted is None else [k for k in build if k in set(wanted)]
-    return pd.DataFrame({k: build[k]() for k in keys}, index=pd.RangeIndex(len(res)))
+    return {k: np.asarray(build[k]()) for k in keys}
 
 
 @contract_doc
@@ -197,10 +211,20 @@ def summarise(params: Params) -> dict:
 def summary_of(p: Params, res: np.ndarray | None = None) -> dict:
     """Headline figures for sweeps: one row of :func:`summarise_batch` as a dict (missing -> None).
     ``res``: the deck's :func:`summary_rows` when the caller has them (the kernel then runs once)."""
-    row = _assemble(p, summary_rows(p) if res is None else res, False, None, {}).iloc[0].to_dict()
-    return {k: (None if isinstance(v, float) and math.isnan(v) else
-                bool(v) if isinstance(v, (bool, np.bool_)) else
-                float(v) if isinstance(v, np.floating) else v) for k, v in row.items()}
+    cols = _assemble_columns(p, summary_rows(p) if res is None else res, False, None, {})
+    return {k: _plain(v[0]) for k, v in cols.items()}
+
+
+def _plain(v: Any) -> Any:
+    """One summary cell as a plain Python value (NaN -> None), as a DataFrame row's to_dict() then
+    the summary's rules gave it: bool, float, int, str."""
+    if isinstance(v, (bool, np.bool_)):
+        return bool(v)
+    if isinstance(v, (float, np.floating)):
+        return None if math.isnan(v) else float(v)
+    if isinstance(v, np.integer):
+        return int(v)
+    return v
 
 
 # ----------------------------------------------------------------------------- the force summary (decks with mass)
@@ -223,6 +247,12 @@ def _force_row(p: Mapping[str, Any]) -> np.ndarray:
 
 def force_frame(res: np.ndarray, prefix: str = "") -> pd.DataFrame:
     """Force-summary kernel rows -> the force summary columns (NaN where a figure does not exist)."""
+    import pandas as pd
+    return pd.DataFrame(_force_columns(res, prefix))
+
+
+def _force_columns(res: np.ndarray, prefix: str = "") -> dict[str, np.ndarray]:
+    """The columns of :func:`force_frame` as numpy arrays."""
     c = dict(zip(kernel.FOURBAR_FORCE_SUMMARY_COLUMNS, res.T))
     anyok = c["defined_fraction"] > 0
     full = c["defined_fraction"] >= 1.0
@@ -234,7 +264,7 @@ def force_frame(res: np.ndarray, prefix: str = "") -> pd.DataFrame:
         if name == "flywheel_inertia_kgm2":
             mask = mask & (v > 0)
         out[prefix + name] = np.where(mask, v, np.nan)
-    return pd.DataFrame(out)
+    return out
 
 
 def force_summary(p: Params) -> dict[str, Any]:
@@ -253,8 +283,8 @@ def force_summary(p: Params) -> dict[str, Any]:
         with ``balance = 'force'`` of the balanced linkage, and the linkage as given's
         prefixed ``unbalanced_``.
     """
-    d = summarise_force_batch(p).iloc[0].to_dict()
-    return {str(k): (None if isinstance(v, float) and math.isnan(v) else float(v)) for k, v in d.items()}
+    d = _force_batch_columns(p, {})
+    return {str(k): (None if math.isnan(v[0]) else float(v[0])) for k, v in d.items()}
 
 
 def summarise_force_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None = None) -> pd.DataFrame:
@@ -276,6 +306,12 @@ def summarise_force_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | 
         ``balance = 'force'`` of the balanced linkage, and the same columns prefixed
         ``unbalanced_`` for the linkage as given.
     """
+    import pandas as pd
+    return pd.DataFrame(_force_batch_columns(base, columns))
+
+
+def _force_batch_columns(base: Mapping[str, Any], columns: Mapping[str, Any] | None = None) -> dict[str, np.ndarray]:
+    """The columns of :func:`summarise_force_batch` as numpy arrays (no pandas)."""
     columns = {k.partition(".")[2] if k.startswith("fourbar.") else k: v for k, v in (columns or {}).items()}
     bad = [k for k in columns if k not in FORCE_BATCH_KEYS]
     if bad:
@@ -298,8 +334,8 @@ def summarise_force_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | 
         rows[i] = _force_row(d)
     if not np.all(np.isfinite(rows)):
         raise ValueError("batch values must be finite")
-    frame = force_frame(kernel.fourbar_force_summaries(rows))
+    cols = _force_columns(kernel.fourbar_force_summaries(rows))
     if rows[:, ForceParam.BALANCE].any():   # balanced designs: the figures without counterweights follow
         rows[:, ForceParam.BALANCE] = 0.0
-        frame = pd.concat([frame, force_frame(kernel.fourbar_force_summaries(rows), "unbalanced_")], axis=1)
-    return frame
+        cols.update(_force_columns(kernel.fourbar_force_summaries(rows), "unbalanced_"))
+    return cols

@@ -3,13 +3,13 @@ the closed loop, or the closed-loop table with accelerations, coupler point and 
 (``method = 'exact'``); the summary lines, tidy table, summary and figures."""
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
-import pandas as pd
 
 from driver._deck import Params
-from driver._export import with_units
 from driver._mechanism import Guide, Link, MechanismFrames
-from driver._result import Figure, Result
+from driver._result import Figure, Result, Tidy
 from driver._runner import study_run
 from driver._table import Column, fortran_f, render_table
 from driver.fourbar._analysis import (
@@ -30,12 +30,16 @@ from driver.fourbar._analysis import (
     rocking_motions,
     summary_rows,
     tidy_frame,
+    tidy_part,
 )
 from driver.fourbar._batch import summary_of
 from driver.fourbar._kernel import Listing, Point, State
 from driver.fourbar._report_forces import figures as force_figures
 from driver.fourbar._report_forces import force_section
 from driver.fourbar._spec import SPEC, band_of, forces_active
+
+if TYPE_CHECKING:   # annotations only: pandas is imported when a table is built
+    import pandas as pd
 
 __all__ = ["run", "listing_text", "exact_table", "summary_lines", "audit", "deck_figures", "output_name", "animation_frames"]
 
@@ -153,14 +157,16 @@ def summary_lines(p: Params, g: Grashof, ex: Extremes | None) -> list[str]:
 
 
 def audit(p: Params, theta: np.ndarray, table: np.ndarray, lst_status: np.ndarray,
-          out: np.ndarray, status: np.ndarray) -> tuple[list[str], str | None, pd.DataFrame]:
-    """Rows of the listing that violate loop closure, compared with the exact solution."""
+          out: np.ndarray, status: np.ndarray) -> tuple[list[str], str | None, dict[str, np.ndarray]]:
+    """Rows of the listing that violate loop closure, compared with the exact solution; the
+    lines, the warning (None: every row closes) and the closure columns (``theta_deg``,
+    ``ab_length``, ``ab_deviation``, ``loop_not_closed``)."""
     ab = np.hypot(table[:, Listing.XB] - table[:, Listing.XA], table[:, Listing.YB] - table[:, Listing.YA])
     dev = ab - p.coupler
     good = (lst_status == ST["ok"]) & (status == ST["ok"])
     bad = good & (np.abs(dev) > 1e-4 * p.coupler)
     lines = ["", "  Audit of the listing against the closed loop (method = 'exact', branch = 'open')"]
-    frame = pd.DataFrame({"theta_deg": theta, "ab_length": ab, "ab_deviation": dev, "loop_not_closed": bad})
+    frame = {"theta_deg": theta, "ab_length": ab, "ab_deviation": dev, "loop_not_closed": bad}
     if not bad.any():
         lines.append(f"    every row closes the loop: |AB| = coupler within {np.max(np.abs(dev[good]), initial=0):.2e}")
         return lines, None, frame
@@ -210,7 +216,7 @@ def run(params: Params, progress: bool = False) -> Result:
     cp = coupler_point(p, theta, out, status)
     rows = summary_rows(p)   # the summary kernel, once: the .out's headline figures and the summary
     ex = extremes(p, rows[0])
-    exact_frame = tidy_frame("exact", theta, exact_columns(out, status, cp, p.coupler), status)
+    exact_part = tidy_part("exact", theta, exact_columns(out, status, cp, p.coupler), status)
     warnings: list[str] = []
     title = p.title or f"{p.path.stem}"
     if p.method == "listing":
@@ -222,11 +228,12 @@ def run(params: Params, progress: bool = False) -> Result:
             warnings.append(warn)
         lst_cols = dict(zip(["coupler_deg", "rocker_deg", "transmission_deg", "xa", "ya", "xb", "yb",
                              "omega2_rad_s", "omega3_rad_s"], table[:, Listing.EPSL:].T))
-        lst_cols["ab_error"] = np.where(lst_status == ST["ok"], closure["ab_deviation"].to_numpy(), np.nan)
-        listing_frame = tidy_frame("listing", theta, lst_cols, lst_status, closure["loop_not_closed"].to_numpy())
-        tidy = with_units(pd.concat([listing_frame, exact_frame], ignore_index=True), TIDY_UNITS)
+        lst_cols["ab_error"] = np.where(lst_status == ST["ok"], closure["ab_deviation"], np.nan)
+        listed = tidy_part("listing", theta, lst_cols, lst_status, closure["loop_not_closed"])
+        tidy = Tidy(listed, exact_part, units=TIDY_UNITS)
+        listing_part: dict[str, Any] | None = listed
     else:
-        listing_frame = None
+        listing_part = None
         lines = [f"  four-bar linkage: closed-loop analysis (method = exact, branch = {p.branch})",
                  f"  deck: {p.path}" + (f" -- {p.title}" if p.title else ""), ""] + _echo(p) + [""]
         lines += exact_table(p, theta, out, status, cp) + summary_lines(p, g, ex)
@@ -234,13 +241,13 @@ def run(params: Params, progress: bool = False) -> Result:
             lines += [f"    coupler point P ...... u = {p.coupler_point[0]:g} along A->B, v = {p.coupler_point[1]:g} "
                       "to its left; xp, yp its position, vp its speed [length/s]"]
         if forces_active(p):
-            lines += force_section(p, theta, out, status, exact_frame)
+            lines += force_section(p, theta, out, status, exact_part)
         for k in np.flatnonzero(status == ST["no_assembly"])[:1]:
             warnings.append(f"the linkage cannot be assembled at {int((status == ST['no_assembly']).sum())} "
                             f"of {len(theta)} crank angles (first at {theta[k]:g} deg)")
-        tidy = exact_frame
+        tidy = Tidy(exact_part, units=TIDY_UNITS)
     summary = summary_of(p, rows)
-    figs = deck_figures(p, title, listing_frame) + (force_figures(p, title, exact_grid) if forces_active(p) else [])
+    figs = deck_figures(p, title, listing_part) + (force_figures(p, title, exact_grid) if forces_active(p) else [])
     return Result(text="\n".join(lines) + "\n", tidy=tidy, summary=summary, warnings=warnings, figures=figs)
 
 
@@ -251,14 +258,20 @@ def output_name(p: Params) -> str:
     return "output crank" if g.name.startswith("double-crank") else "rocker"
 
 
-def deck_figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> list[Figure]:
-    """The figures of a run (drawn on demand): the curves and the linkage at its limit positions."""
+def deck_figures(p: Params, stem_title: str, listing_part: dict[str, Any] | pd.DataFrame | None) -> list[Figure]:
+    """The figures of a run (drawn on demand): the curves and the linkage at its limit positions.
+    ``listing_part``: the listing's tidy columns (:func:`tidy_part`) or frame, for a listing run."""
+    def listing_frame() -> pd.DataFrame | None:
+        if listing_part is None or not isinstance(listing_part, dict):
+            return listing_part
+        return Tidy(listing_part, units=TIDY_UNITS).frame()
+
     def curves():
         from driver.fourbar import _figures as figures  # matplotlib is the optional [plot] extra: imported when drawn
         theta = np.linspace(p.start_deg, p.stop_deg, 721)
         out, st = exact_grid(p, theta)
         exact = tidy_frame("exact", theta, exact_columns(out, st), st)
-        return figures.fourbar_curves(exact, listing, stem_title, band=band_of(p), output=output_name(p))
+        return figures.fourbar_curves(exact, listing_frame(), stem_title, band=band_of(p), output=output_name(p))
 
     def linkage():
         from driver.fourbar import _figures as figures
@@ -282,7 +295,7 @@ def deck_figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> li
                 row, rst = exact_grid(p, np.array([a]))
                 if rst[0] != ST["no_assembly"] and np.all(np.isfinite(row[0, State.XA:State.YB + 1])):
                     limits.append((a, row[0]))
-        return figures.fourbar_linkage(p.fixed_link, theta, out, st == ST["ok"], listing, stem_title,
+        return figures.fourbar_linkage(p.fixed_link, theta, out, st == ST["ok"], listing_frame(), stem_title,
                                        point=None if cp is None else cp[:, :2], output=output_name(p),
                                        limits=limits)
 

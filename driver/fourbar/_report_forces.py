@@ -9,13 +9,11 @@ import math
 from typing import Any
 
 import numpy as np
-import pandas as pd
 
 from driver._deck import Params
-from driver._export import with_units
 from driver._result import Figure
 from driver._table import Column, fortran_f, render_table
-from driver.fourbar._analysis import ST, TIDY_UNITS
+from driver.fourbar._analysis import ST
 from driver.fourbar._analysis_forces import ForceAnalysis, analyse, props, tidy_columns
 from driver.fourbar._batch import force_summary
 from driver.fourbar._kernel import Force, Prop
@@ -25,12 +23,11 @@ __all__ = ["force_section", "echo_lines", "table_lines", "summary_lines", "figur
 
 
 def force_section(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarray,
-                  frame: pd.DataFrame) -> list[str]:
-    """The force analysis's lines of the .out; its columns are added to ``frame`` (in place)."""
+                  part: dict[str, Any]) -> list[str]:
+    """The force analysis's lines of the .out; its tidy columns are added to ``part`` (the run's
+    tidy columns, :func:`driver.fourbar._analysis.tidy_part`; in place)."""
     fa = analyse(p, out, status)
-    for name, values in tidy_columns(fa).items():
-        frame[name] = values
-    with_units(frame, TIDY_UNITS)
+    part.update(tidy_columns(fa))
     words = ["toggle: forces unbounded" if s == ST["toggle"] else "not placed" for s in status]
     title = ("Force analysis (Newton-Euler, closed form; " +
              ("with the Berkof-Lowen counterweights" if fa.cw is not None else "links as given") + ")")
