@@ -38,7 +38,7 @@ class Tidy:
     units : mapping of str to str, optional
         Units of the columns whose names do not say them (``'length'``, ``'1'``), as
         :func:`driver._export.with_units` takes them.
-    records : sequence of mapping, optional
+    records : sequence of mapping or sequence, optional
         Instead of parts: the rows as records (``pd.DataFrame.from_records(records,
         columns=columns)``).
     columns : sequence of str, optional
@@ -46,26 +46,32 @@ class Tidy:
     """
 
     def __init__(self, *parts: Mapping[str, Any], units: Mapping[str, str] | None = None,
-                 records: Sequence[Mapping[str, Any]] | None = None, columns: Sequence[str] | None = None) -> None:
+                 records: Sequence[Sequence[Any] | Mapping[str, Any]] | None = None,
+                 columns: Sequence[str] | None = None) -> None:
         if records is not None and parts:
             raise TypeError("Tidy takes column parts or records, not both")
         self.parts = [dict(p) for p in parts]
         self.units = dict(units or {})
-        self.records = None if records is None else [dict(r) for r in records]
+        self.records = None if records is None else list(records)
         self.columns = None if columns is None else list(columns)
+
+    def _record_names(self) -> list[str]:
+        if self.columns is not None:
+            return self.columns
+        return list(dict.fromkeys(k for r in self.records or [] if isinstance(r, Mapping) for k in r))
 
     @property
     def shape(self) -> tuple[int, int]:
         """(rows, columns) of the table, without building it."""
         if self.records is not None:
-            names = self.columns if self.columns is not None else list(dict.fromkeys(k for r in self.records for k in r))
-            return len(self.records), len(names)
+            return len(self.records), len(self._record_names())
         rows = sum(max([np.size(v) for v in p.values() if np.ndim(v) > 0] or [1 if p else 0]) for p in self.parts)
         return rows, len(dict.fromkeys(k for p in self.parts for k in p))
 
     def _values(self) -> list[tuple[str, Any]]:
         if self.records is not None:
-            return [(k, v) for r in self.records for k, v in r.items()]
+            names = self._record_names()
+            return [kv for r in self.records for kv in (r.items() if isinstance(r, Mapping) else zip(names, r))]
         return [(k, v) for p in self.parts for k, v in p.items()]
 
     def infinite_column(self) -> str | None:
@@ -88,7 +94,8 @@ class Tidy:
 
         from driver._export import with_units
         if self.records is not None:
-            frame = pd.DataFrame.from_records(self.records, columns=self.columns)
+            records: Any = self.records   # records as pandas takes them: tuples or mappings
+            frame = pd.DataFrame.from_records(records, columns=self.columns)
         elif len(self.parts) == 1:
             frame = pd.DataFrame(self.parts[0])
         else:

@@ -19,10 +19,9 @@ from __future__ import annotations
 
 import math
 from collections.abc import Collection, Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from driver._deck import Params
 from driver._study import batch_error, contract_doc
@@ -40,6 +39,9 @@ from driver.manipulator._analysis import (
 )
 from driver.manipulator._kernel import SummaryParam, Torque
 from driver.manipulator._tables import table_4_8
+
+if TYPE_CHECKING:   # annotations only: pandas is imported when the frame is built
+    import pandas as pd
 
 __all__ = ["BATCH_KEYS", "BATCH_IGNORED", "BATCH_INDEPENDENT", "BATCH_PASSES", "BATCH_PASS_SUFFIXES", "summarise_batch",
            "summarise"]
@@ -191,6 +193,7 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     if wanted is not None:
         names = set(wanted)
         out = {k: v for k, v in out.items() if k in names}
+    import pandas as pd
     return pd.DataFrame(out)
 
 

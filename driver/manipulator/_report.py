@@ -4,15 +4,13 @@ from __future__ import annotations
 
 import math
 from decimal import Decimal
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from driver._deck import Params
-from driver._export import with_units
 from driver._mechanism import Link, MechanismFrames
-from driver._result import Figure, Result
+from driver._result import Figure, Result, Tidy
 from driver._runner import study_run
 from driver._table import fortran_f
 from driver.manipulator import _kernel as kernel
@@ -32,6 +30,9 @@ from driver.manipulator._analysis import (
 from driver.manipulator._kernel import Torque
 from driver.manipulator._spec import SPEC
 from driver.manipulator._tables import TIDY_NAMES, Table, mode_differences, report_tables, tolerance_table
+
+if TYPE_CHECKING:   # annotations only: pandas is imported when a table is built
+    import pandas as pd
 
 __all__ = ["run", "TIDY_UNITS", "table_frame", "animation_frames"]
 
@@ -74,7 +75,7 @@ TIDY_UNITS = {"l1_m": "m", "l2_m": "m", "m1_kg": "kg", "m2_kg": "kg", "g_m_s2": 
               "dl1_m": "m", "dl2_m": "m", "worst_corner_m": "m", "mc_max_m": "m", "mc_p99_m": "m"}
 
 
-def _tidy(tables: list[Table], tol: list[dict], sweep: dict, used: dict) -> pd.DataFrame:
+def _tidy(tables: list[Table], tol: list[dict], sweep: dict, used: dict) -> Tidy:
     """One long tidy frame for every table: table, row, label, quantity, value, unit.
 
     A blank printed cell (e.g. angles of a design that cannot reach the target) has no row,
@@ -103,8 +104,8 @@ def _tidy(tables: list[Table], tol: list[dict], sweep: dict, used: dict) -> pd.D
                       ("mc_max_m", "mc_max"), ("mc_p99_m", "mc_p99")]
         for name, key in pairs:
             add("tolerance", k, rec["name"], name, rec[key])
-    frame = pd.DataFrame.from_records(recs, columns=["table", "row", "label", "quantity", "value", "unit"])
-    return with_units(frame, {"row": "1", "value": "see unit column"})
+    return Tidy(records=recs, columns=["table", "row", "label", "quantity", "value", "unit"],
+                units={"row": "1", "value": "see unit column"})
 
 
 def table_frame(tidy: pd.DataFrame, table: str) -> pd.DataFrame:

@@ -6,11 +6,9 @@ import math
 from decimal import Decimal
 
 import numpy as np
-import pandas as pd
 
 from driver._deck import Params
-from driver._export import with_units
-from driver._result import Figure, Result
+from driver._result import Figure, Result, Tidy
 from driver._runner import study_run
 from driver._table import Column, render_table
 from driver.robust_example._analysis import analyse, tmin
@@ -162,7 +160,7 @@ def run(params: Params, progress: bool = False) -> Result:
     figures = [Figure("fits", lambda: _figures().fits_figure(p, r))]
     summary = {"mode": p.mode, "tmin_true": r["eq22_tmin"], "tmin_dual_response": r["eq29"],
                "tmin_taguchi": r["eq213"], "tmin_tolerance_analysis": r["eq215"], "flagged": len(flags)}
-    return Result(text="\n".join(L).rstrip() + "\n", tidy=with_units(pd.DataFrame.from_records(recs), TIDY_UNITS),
+    return Result(text="\n".join(L).rstrip() + "\n", tidy=Tidy(records=recs, units=TIDY_UNITS),
                   summary=summary, figures=figures,
                   warnings=[f"printed value differs in its last digit: {f}" if "the last digit only" in f
                             else f"printed value does not reproduce: {f}" for f in flags])

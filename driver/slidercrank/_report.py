@@ -8,13 +8,11 @@ from __future__ import annotations
 from typing import Any, Literal, TypedDict
 
 import numpy as np
-import pandas as pd
 from tqdm import tqdm
 
 from driver._deck import Params
-from driver._export import with_units
 from driver._mechanism import Guide, Link, MechanismFrames
-from driver._result import Figure, Result
+from driver._result import Figure, Result, Tidy
 from driver._table import Cell, Column, render_table
 from driver.slidercrank import _kernel as kernel
 from driver.slidercrank._analysis import Case, run_case, static_onset
@@ -200,12 +198,12 @@ def _convergence_table(conv: dict[float, list[Case]], length: float) -> list[str
     return lines
 
 
-def _tidy(model_name: str, cases: list[Case]) -> pd.DataFrame:
-    frames = []
+def _tidy(model_name: str, cases: list[Case]) -> Tidy:
+    frames: list[dict[str, Any]] = []
     for c in cases:
         if not c.ok:
             continue
-        frames.append(pd.DataFrame({
+        frames.append({
             "material": model_name, "omega_rad_s": c.omega, "n_elements": c.n_elements,
             "crank_angle_deg": c.angle_deg, "time_s": c.time,
             "eps_crank_end_microstrain": c.eps_1 * 1e6,
@@ -216,11 +214,11 @@ def _tidy(model_name: str, cases: list[Case]) -> pd.DataFrame:
             "midpoint_deflection_mm": c.mid * 1e3,
             "slider_position_m": c.slider,
             "rod_elongation_um": c.elong * 1e6,
-        }))
+        })
     if not frames:
-        return with_units(pd.DataFrame(columns=["material", "omega_rad_s", "n_elements", "crank_angle_deg"]),
-                          {"n_elements": "1"})
-    return with_units(pd.concat(frames, ignore_index=True), {"n_elements": "1"})
+        return Tidy(records=[], columns=["material", "omega_rad_s", "n_elements", "crank_angle_deg"],
+                    units={"n_elements": "1"})
+    return Tidy(*frames, units={"n_elements": "1"})
 
 
 def _summary(cases: list[Case], model: Model | None = None) -> dict[str, Any]:

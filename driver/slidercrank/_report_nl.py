@@ -10,12 +10,10 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-import pandas as pd
 from tqdm import tqdm
 
 from driver._deck import Params
-from driver._export import with_units
-from driver._result import Figure, Result
+from driver._result import Figure, Result, Tidy
 from driver._runner import study_run
 from driver._table import Cell, Column, render_table
 from driver.slidercrank._analysis import Case, run_case, static_onset
@@ -135,12 +133,12 @@ def _onset_lines(onset: dict[str, tuple[float, float] | None], params: Params, s
     return lines
 
 
-def _tidy(material: str, pairs: list[tuple[Case, NLCase]]) -> pd.DataFrame:
-    frames = []
+def _tidy(material: str, pairs: list[tuple[Case, NLCase]]) -> Tidy:
+    frames: list[dict[str, Any]] = []
     for lin, nl in pairs:
         if not nl.ok:
             continue
-        frame = pd.DataFrame({
+        frame: dict[str, Any] = {
             "material": material, "omega_rad_s": nl.omega, "n_elements": nl.n_elements,
             "crank_angle_deg": nl.angle_deg,
             "eps_crank_end_nonlinear_microstrain": nl.eps_ax[0] * 1e6,
@@ -148,15 +146,15 @@ def _tidy(material: str, pairs: list[tuple[Case, NLCase]]) -> pd.DataFrame:
             "eps_min_nonlinear_microstrain": nl.eps_ax.min(axis=0) * 1e6,
             "outer_fibre_max_nonlinear_microstrain": nl.eps_of.max(axis=0) * 1e6,
             "lateral_max_nonlinear_mm": nl.lat_max * 1e3,
-            "midspan_nonlinear_mm": nl.mid * 1e3})
+            "midspan_nonlinear_mm": nl.mid * 1e3}
         if lin.ok and len(lin.angle_deg) == len(nl.angle_deg):
             frame["eps_crank_end_linear_microstrain"] = lin.eps_1 * 1e6
             frame["midpoint_linear_mm"] = lin.mid * 1e3
         frames.append(frame)
     if not frames:
-        return with_units(pd.DataFrame(columns=["material", "omega_rad_s", "n_elements", "crank_angle_deg"]),
-                          {"n_elements": "1"})
-    return with_units(pd.concat(frames, ignore_index=True), {"n_elements": "1"})
+        return Tidy(records=[], columns=["material", "omega_rad_s", "n_elements", "crank_angle_deg"],
+                    units={"n_elements": "1"})
+    return Tidy(*frames, units={"n_elements": "1"})
 
 
 def _summary(pairs: list[tuple[Case, NLCase]], tol: float, limit: float,

@@ -9,9 +9,8 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import minimize
-from tqdm import tqdm
 
+from driver import _blas as blas
 from driver._deck import Params
 from driver.ujoint._kernel import UJOINT_MODELS, UJOINT_OBJECTIVES, ujoint_equivalent, ujoint_objective, ujoint_speed
 from driver.ujoint._spec import DEG
@@ -283,9 +282,14 @@ def optimise(chain: Chain, option: int, beta0: np.ndarray, phi0: np.ndarray,
     periodic = _periodic(option, n, lb, ub)
     bounds = [(None, None) if per else (a, b) for per, a, b in zip(periodic, lb, ub)]
     runs = []
-    for x0 in tqdm(starts, desc="multi-start", unit="start", disable=not progress):
-        res = minimize(fun, x0, jac=True, method="SLSQP", bounds=bounds,
-                       options={"maxiter": maxiter, "ftol": ftol})
+    # imported here, by the options that optimise (an option-0 run needs neither); then the BLAS
+    # library scipy brought is limited to one thread too (driver._blas)
+    from scipy.optimize import minimize
+    from tqdm import tqdm
+    with blas.one_thread():
+        results = [minimize(fun, x0, jac=True, method="SLSQP", bounds=bounds, options={"maxiter": maxiter, "ftol": ftol})
+                   for x0 in tqdm(starts, desc="multi-start", unit="start", disable=not progress)]
+    for x0, res in zip(starts, results):
         x = np.where(periodic, lb + np.mod(res.x - lb, PHASE_PERIOD * DEG), np.clip(res.x, lb, ub))
         f = ujoint_objective(chain.model, chain.kind, *full(x), chain.rho, chain.m, grad=False)[0]
         on_bound = ~periodic & (lb < ub) & ((x - lb < BOUND_TOL) | (ub - x < BOUND_TOL))

@@ -7,10 +7,9 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Collection, Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from driver._study import batch_error
 from driver.ujoint._kernel import (
@@ -22,6 +21,9 @@ from driver.ujoint._kernel import (
     ujoint_summaries,
 )
 from driver.ujoint._spec import DEG, KEYS
+
+if TYPE_CHECKING:   # annotations only: pandas is imported when the frame is built
+    import pandas as pd
 
 #: deck keys a batch may vary (one value per design); list keys as one value per design (a
 #: single-element list, as a sweep sets them), a (designs, k) array of whole lists, or element
@@ -283,4 +285,5 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     out.update({f"phi_{k + 1}_deg": phi[:, k] for k in range(n - 1)})
     if names is not None:
         out = {k: v for k, v in out.items() if k in names}
+    import pandas as pd
     return pd.DataFrame(out, index=pd.RangeIndex(nd))

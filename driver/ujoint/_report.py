@@ -9,12 +9,10 @@ import math
 import textwrap
 
 import numpy as np
-import pandas as pd
 
 from driver._deck import Params
-from driver._export import with_units
 from driver._mechanism import Link, MechanismFrames
-from driver._result import Figure, Result
+from driver._result import Figure, Result, Tidy
 from driver._runner import study_run
 from driver._table import Cell, Column, fortran_f, render_table
 from driver.ujoint._analysis import (
@@ -291,17 +289,17 @@ def _render_speed_table(params: Params, chain: Chain, designs: list[Design], exa
     return out
 
 
-def _tidy(chain: Chain, designs: list[Design]) -> pd.DataFrame:
+def _tidy(chain: Chain, designs: list[Design]) -> Tidy:
     theta = np.arange(chain.m) * (360.0 / chain.m)
-    frames = []
+    parts = []
     for d in designs:
         w, a, to = output_speed(chain, d, theta)
-        frame = pd.DataFrame({"design": d.label, "theta_in_deg": theta, "omega_in_rpm": chain.rpm,
-                              "omega_out_rpm": w, "ratio": w / chain.rpm, "alpha_out_rad_s2": a})
+        part = {"design": d.label, "theta_in_deg": theta, "omega_in_rpm": chain.rpm,
+                "omega_out_rpm": w, "ratio": w / chain.rpm, "alpha_out_rad_s2": a}
         if chain.model == UJOINT_MODELS["exact"]:
-            frame["theta_out_deg"] = to
-        frames.append(frame)
-    return with_units(pd.concat(frames, ignore_index=True), {"ratio": "1"})
+            part["theta_out_deg"] = to
+        parts.append(part)
+    return Tidy(*parts, units={"ratio": "1"})
 
 
 def _summary(trial: Design, best: Design | None, runs: list[StartRun], failure: str | None) -> dict:
