@@ -14,8 +14,6 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from driver._atomic import atomic_open
 from driver._extras import available, require
 
@@ -66,6 +64,7 @@ def _csv_name(name: str) -> str:
 
 def _cells(col: pa.Array | pa.ChunkedArray) -> pa.Array | pa.ChunkedArray:
     """One column as CSV cell text (nulls stay null, written as empty cells)."""
+    import numpy as np
     import pyarrow as pa
     import pyarrow.compute as pc
 
@@ -91,6 +90,7 @@ def _cells(col: pa.Array | pa.ChunkedArray) -> pa.Array | pa.ChunkedArray:
 def write_csv_arrow(table: pa.Table, fh: Any, batch_rows: int = 1 << 16, header: bool = True) -> None:
     """CSV rows built column-wise by Arrow compute and written from its buffers, a batch of
     rows at a time (no Python per row; memory bounded by the batch)."""
+    import numpy as np
     import pyarrow.compute as pc
 
     if header:
@@ -152,6 +152,7 @@ def csv_bytes(table: pa.Table, header: bool = True) -> bytes:
 def json_safe(value: Any) -> Any:
     """``value`` with numpy scalars and arrays made plain and non-finite floats made None
     (JSON has no NaN or Infinity; a missing figure is ``null``)."""
+    import numpy as np  # here, not at import: `python -m driver --help` needs no numpy
     if isinstance(value, dict):
         return {str(k): json_safe(v) for k, v in value.items()}
     if isinstance(value, (list, tuple, np.ndarray)):

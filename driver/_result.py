@@ -12,8 +12,6 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 if TYPE_CHECKING:   # annotations only: keeps `python -m driver --help` light
     import matplotlib.figure
     import pandas as pd
@@ -63,6 +61,7 @@ class Tidy:
     @property
     def shape(self) -> tuple[int, int]:
         """(rows, columns) of the table, without building it."""
+        import numpy as np  # here, not at import: `python -m driver --help` needs no numpy
         if self.records is not None:
             return len(self.records), len(self._record_names())
         rows = sum(max([np.size(v) for v in p.values() if np.ndim(v) > 0] or [1 if p else 0]) for p in self.parts)
@@ -76,6 +75,7 @@ class Tidy:
 
     def infinite_column(self) -> str | None:
         """The first column holding an infinite number (None: every number finite or NaN)."""
+        import numpy as np
         for name, value in self._values():
             if isinstance(value, str) or value is None:
                 continue

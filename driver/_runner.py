@@ -22,7 +22,6 @@ from driver._deck import Deck, DeckError, GroupSpec, Params, shown_value, valida
 from driver._export import FORMATS, write_tidy
 from driver._names import name_problem, shown
 from driver._outcome import RunOutcome
-from driver._pydeck import deck_of, is_text
 from driver._result import Result
 from driver._signatures import sign
 from driver._study import ENGINES, Study, load_study, registered, study_names
@@ -264,6 +263,7 @@ def study_run(spec: GroupSpec) -> Callable[[Callable[..., Result]], Callable[...
                 if isinstance(params, Params):
                     return run(params, progress=progress)
                 return _positional_run(spec.name, params, progress)
+            from driver._pydeck import deck_of  # decks from Python values: the API's calls only
             return run_study(deck_of({spec.name: keys}, None), None, [], False, progress=progress).result
 
         sign(wrapper, spec)
@@ -279,6 +279,7 @@ def _positional_run(group: str, source: Any, progress: bool) -> Result:
     says what to pass."""
     what = (f"{group}.run() takes the deck's keys as keyword arguments ({group}.run(crank=5, ...)), a dict of "
             f"them, a &{group} deck (its text, its file, or {{'{group}': {{...}}}}), or validated Params")
+    from driver._pydeck import deck_of, is_text
     if isinstance(source, Mapping):
         nested = [isinstance(v, Mapping) for v in source.values()]
         if source and not any(nested):          # the keys of this study

@@ -18,10 +18,9 @@ tables and their defects); ``_forces`` is the face of the force analysis (``driv
 """
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from driver._study import BatchSummary, Study
-from driver.fourbar import _forces as forces
 from driver.fourbar import _kernel as kernel
 from driver.fourbar import _published as published
 from driver.fourbar._analysis import (
@@ -55,6 +54,7 @@ from driver.fourbar._report import animation_frames
 from driver.fourbar._spec import LABELS, SPEC, SUMMARY_SETTINGS, SWEEP_BEST, SWEEP_PLOT, estimate
 
 if TYPE_CHECKING:   # run's keys as typed keywords: generated from SPEC (tools/gen_keyword_signatures.py)
+    from driver.fourbar import _forces as forces
     from driver.fourbar._keywords import run
 else:
     from driver.fourbar._report import run
@@ -72,3 +72,13 @@ STUDY = Study(name="fourbar", package=__name__, spec=SPEC, run=run, estimate=est
               labels=LABELS, sweep_plot=SWEEP_PLOT, sweep_best=SWEEP_BEST, summary_settings=SUMMARY_SETTINGS,
               blame=blame, published=published.compare, animation=animation_frames, figures=f"{__name__}._figures",
               kernel=kernel)
+
+
+def __getattr__(name: str) -> Any:
+    """PEP 562: ``forces`` (the force analysis's face) on first use, so that a run without masses
+    does not import its modules (docs/performance.md, *Start-up*)."""
+    if name == "forces":
+        from driver.fourbar import _forces
+        globals()["forces"] = _forces
+        return _forces
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

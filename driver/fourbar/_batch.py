@@ -14,7 +14,6 @@ from driver._deck import Params
 from driver._study import batch_error, contract_doc
 from driver.fourbar import _kernel as kernel
 from driver.fourbar._analysis import PASS_BITS, SUMMARY_KEYS, param_matrix, summary_rows
-from driver.fourbar._analysis_forces import cw_radii, props
 from driver.fourbar._kernel import ForceParam
 from driver.fourbar._spec import BAND, FORCE_SUMMARY_DOC, band_of, force_value, forces_active
 
@@ -237,6 +236,7 @@ FORCE_BATCH_KEYS = ("fixed_link", "crank", "coupler", "rocker", "omega", "alpha"
 
 def _force_row(p: Mapping[str, Any]) -> np.ndarray:
     """One row of the batch kernel's (31) parameters from a deck-like mapping."""
+    from driver.fourbar._analysis_forces import cw_radii, props  # decks that give masses only
     pr = props(p)
     bal = 1.0 if force_value(p, "balance") == "force" else 0.0
     return np.concatenate([[p["fixed_link"], p["crank"], p["coupler"], p["rocker"], p["omega"], p.get("alpha", 0.0),

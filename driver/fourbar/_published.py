@@ -3,15 +3,16 @@ what the listing gets wrong."""
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from driver import _published as record
 from driver._deck import Params
-from driver._published import cell, one_digit_apart
-from driver._result import Result
 from driver._table import fortran_f
 from driver.fourbar._analysis import exact_columns, exact_grid
+
+if TYPE_CHECKING:
+    from driver._result import Result
 
 __all__ = ['LISTING_DEFECT', 'LISTING_PRECISION', 'exact_as_listed', 'compare']
 
@@ -65,6 +66,8 @@ def exact_as_listed(p: Params, theta_deg: np.ndarray) -> dict[tuple[int, str], s
 
 def compare(params: Params, result: Result) -> list[dict]:
     """The run beside the published listing tables (Lampiran 2-5): one dict per printed cell."""
+    from driver import _published as record  # the comparison's reader: imported when a comparison runs
+    from driver._published import cell, one_digit_apart
     cells = []
     for path in record.records("fourbar"):
         pub = record.read_listing(path)

@@ -8,7 +8,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from driver._deck import Params
-from driver._mechanism import Guide, Link, MechanismFrames
 from driver._result import Figure, Result, Tidy
 from driver._runner import study_run
 from driver._table import Column, fortran_f, render_table
@@ -34,12 +33,12 @@ from driver.fourbar._analysis import (
 )
 from driver.fourbar._batch import summary_of
 from driver.fourbar._kernel import Listing, Point, State
-from driver.fourbar._report_forces import figures as force_figures
-from driver.fourbar._report_forces import force_section
 from driver.fourbar._spec import SPEC, band_of, forces_active
 
 if TYPE_CHECKING:   # annotations only: pandas is imported when a table is built
     import pandas as pd
+
+    from driver._mechanism import MechanismFrames
 
 __all__ = ["run", "listing_text", "exact_table", "summary_lines", "audit", "deck_figures", "output_name", "animation_frames"]
 
@@ -240,14 +239,18 @@ def run(params: Params, progress: bool = False) -> Result:
         if cp is not None:
             lines += [f"    coupler point P ...... u = {p.coupler_point[0]:g} along A->B, v = {p.coupler_point[1]:g} "
                       "to its left; xp, yp its position, vp its speed [length/s]"]
-        if forces_active(p):
+        if forces_active(p):   # the force analysis's modules: imported by the decks that give masses
+            from driver.fourbar._report_forces import force_section
             lines += force_section(p, theta, out, status, exact_part)
         for k in np.flatnonzero(status == ST["no_assembly"])[:1]:
             warnings.append(f"the linkage cannot be assembled at {int((status == ST['no_assembly']).sum())} "
                             f"of {len(theta)} crank angles (first at {theta[k]:g} deg)")
         tidy = Tidy(exact_part, units=TIDY_UNITS)
     summary = summary_of(p, rows)
-    figs = deck_figures(p, title, listing_part) + (force_figures(p, title, exact_grid) if forces_active(p) else [])
+    figs = deck_figures(p, title, listing_part)
+    if forces_active(p):
+        from driver.fourbar._report_forces import figures as force_figures
+        figs += force_figures(p, title, exact_grid)
     return Result(text="\n".join(lines) + "\n", tidy=tidy, summary=summary, warnings=warnings, figures=figs)
 
 
@@ -308,6 +311,7 @@ def animation_frames(params: Params, result: Result | None = None, n: int = 180)
     pin B and coupler point P, from the kernel's closed-loop states; for a crank that cannot turn,
     its rocking motions (out on one assembly branch, back on the other) with their strokes in the
     frame labels, each motion a segment, and the limit positions dashed."""
+    from driver._mechanism import Guide, Link, MechanismFrames  # the page's animation only
     motions = rocking_motions(params, max(8, n // 2 // max(
         1, len(assembly_intervals(params.fixed_link, params.crank, params.coupler, params.rocker) or [1]))))
     g = params.fixed_link

@@ -1,17 +1,21 @@
 """The Hooke-joint run beside the published SSO results of [Fajar]."""
 from __future__ import annotations
 
-from driver import _published as record
+from typing import TYPE_CHECKING
+
 from driver._deck import Params
-from driver._published import cell
-from driver._result import Result
 from driver.ujoint._spec import BAND_TOL, NOT_REPRODUCIBLE
+
+if TYPE_CHECKING:
+    from driver._result import Result
 
 __all__ = ["compare"]
 
 
 def compare(params: Params, result: Result) -> list[dict]:
     """The run beside the paper's SSO results (options 1-3): one dict per printed value."""
+    from driver import _published as record  # the comparison's reader: imported when a comparison runs
+    from driver._published import cell
     cells = []
     for path in record.records("ujoint"):
         pub = record.read_blocks(path)

@@ -7,11 +7,11 @@ from __future__ import annotations
 
 import math
 import textwrap
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from driver._deck import Params
-from driver._mechanism import Link, MechanismFrames
 from driver._result import Figure, Result, Tidy
 from driver._runner import study_run
 from driver._table import Cell, Column, fortran_f, render_table
@@ -33,6 +33,9 @@ from driver.ujoint._analysis import (
 )
 from driver.ujoint._kernel import UJOINT_MODELS, ujoint_speed
 from driver.ujoint._spec import BAND_TOL, CONVENTIONS, DEG, OPTIONS, SPEC, joint_geometry, per_joint, phases_deg
+
+if TYPE_CHECKING:
+    from driver._mechanism import MechanismFrames
 
 
 def _model_text(params: Params) -> str:
@@ -468,6 +471,7 @@ def animation_frames(params: Params, result: Result | None = None, n: int = 180)
     chain (:func:`~driver.ujoint.kernel.ujoint_speed`, the chain up to that shaft) at the run's
     design (the optimum of an optimising ``result``, else the deck's).  Each frame's label gives
     the output shaft's deviation from uniform rotation."""
+    from driver._mechanism import Link, MechanismFrames  # the page's animation only
     beta0, rho_given = joint_geometry(params)
     nj = beta0.size
     s = dict(getattr(result, "summary", None) or {})
