@@ -34,6 +34,7 @@ import bench_fourbar_forces
 import bench_manipulator
 import bench_slidercrank
 import bench_slidercrank_nl
+import bench_startup
 import bench_ujoint
 from driver import ujoint as ujoint_study
 from driver.fourbar import _kernel as fourbar_kernel
@@ -275,8 +276,24 @@ def slidercrank_nl(n_el: int, revs: int, repeat: int) -> list[Row]:
                 "band LU (a latency chain like the linear model's solves)")]
 
 
+def startup(repeat: int, both: bool = True) -> list[Row]:
+    """Issue 37: the command line's CPU per process against ``python -c "import numpy"`` in the same
+    rounds (bench/bench_startup.py: each a fresh process, interleaved, medians); the 'baseline' is
+    ``import numpy``, so the ratio is numpy's time over the run's and the target its inverse."""
+    rows = []
+    modes = (("editable checkout", False), ("bytecode cached", True)) if both else (("as configured", False),)
+    for label, cached in modes:
+        med = bench_startup.measure(repeat, cached)
+        base = med.pop("import numpy")
+        for name, t in med.items():
+            rows.append(Row(f"start-up, {label}: {name}", "ms/run", t, base, None, 1 / bench_startup.TARGETS[name],
+                            f"a fresh `python -m driver` process ({label}): {t / base:.2f}x the CPU of "
+                            f"`import numpy` (target <= {bench_startup.TARGETS[name]:g}x)"))
+    return rows
+
+
 SCALE = {"ns/position": 1e9, "ns/sample": 1e9, "us/config": 1e6, "us/objective": 1e6, "us/design": 1e6,
-         "ms/revolution": 1e3}
+         "ms/revolution": 1e3, "ms/run": 1e3}
 
 
 def print_table(rows: list[Row]) -> None:
@@ -289,7 +306,7 @@ def print_table(rows: list[Row]) -> None:
         if r.target_ratio is not None:
             tgt.append(f">= {r.target_ratio:g}x")
         verdict = ("met" if r.met() else "NOT met") if tgt else "-"
-        print(f"{r.name:<46}{r.unit:>14}{r.kernel_s * k:10.3f}{r.baseline_s * k:12.3f}{r.ratio:9.1f}x   "
+        print(f"{r.name:<46}{r.unit:>14}{r.kernel_s * k:10.3f}{r.baseline_s * k:12.3f}{r.ratio:9.2f}x   "
               f"{', '.join(tgt) or '-'} {verdict if tgt else ''}")
     print("\nlimits (floor: numpy writing the same output bytes in the same run):")
     for r in rows:
@@ -303,10 +320,10 @@ def main(argv: list[str] | None = None) -> list[Row]:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smaller sizes, fewer repeats")
     ap.add_argument("--smoke", action="store_true", help="tiny sizes (the test suite's check that this runs)")
-    ap.add_argument("--only", choices=["fourbar", "manipulator", "ujoint", "slidercrank", "slidercrank_nl"],
-                    action="append", help="run only these studies (repeatable)")
+    parts = ["fourbar", "manipulator", "ujoint", "slidercrank", "slidercrank_nl", "startup"]
+    ap.add_argument("--only", choices=parts, action="append", help="run only these parts (repeatable)")
     args = ap.parse_args(argv)
-    only = set(args.only or ["fourbar", "manipulator", "ujoint", "slidercrank", "slidercrank_nl"])
+    only = set(args.only or parts)
     if args.smoke:
         sizes = dict(n=2048, samples=4096, n_el=20, spr=72, base_steps=4, repeat=2, nl_el=20, nl_revs=1)
     elif args.quick:
@@ -327,6 +344,8 @@ def main(argv: list[str] | None = None) -> list[Row]:
         rows += slidercrank(sizes["n_el"], sizes["spr"], sizes["base_steps"], max(3, sizes["repeat"] // 3))
     if "slidercrank_nl" in only:
         rows += slidercrank_nl(sizes["nl_el"], sizes["nl_revs"], max(3, sizes["repeat"] // 3))
+    if "startup" in only:
+        rows += startup(1 if args.smoke else sizes["repeat"], both=not args.smoke)
     print_table(rows)
     return rows
 

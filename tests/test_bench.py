@@ -39,6 +39,10 @@ def test_run_all_smoke(run_all, capsys):
     # issue 27 (targets only above the sizes where fresh memory costs page faults: not at --smoke sizes)
     assert "four-bar exact, out= buffers vs fresh arrays" in names
     assert "slider-crank: study's record vs all fields" in names
+    # issue 37: start-up rows, each against `import numpy` measured in the same rounds
+    start = {r.name.split(": ", 1)[1]: r.target_ratio for r in rows if r.name.startswith("start-up")}
+    assert start == {"--help": pytest.approx(1 / 1.5), "--examples": pytest.approx(1 / 1.5), "crank5": 0.5,
+                     "manipulator case 1": 0.5, "U-joint option 0": 0.5}
     for r in rows:
         assert r.kernel_s > 0 and r.baseline_s > 0 and r.limit
         assert r.name in text

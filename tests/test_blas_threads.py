@@ -46,3 +46,29 @@ def test_optimum_independent_of_blas_threads(tmp_path):
         outs.append(out)
     for name in ("optimize_manipulator_torque.optimum.dat", "optimize_manipulator_torque.out"):
         assert (outs[0] / name).read_bytes() == (outs[1] / name).read_bytes(), name
+
+
+def test_one_thread_limits_a_library_loaded_before_a_nested_block():
+    """driver._blas no longer imports scipy to limit it (start-up, issue 37): a run that imports
+    scipy inside the runner's block opens a nested block after the import, which limits scipy's
+    BLAS too; the outer block's libraries are restored on exit.  In a fresh process, where scipy's
+    BLAS is not loaded yet."""
+    code = """
+import threadpoolctl
+from driver import _blas as blas
+def threads():
+    return sorted((i["internal_api"], i["filepath"], i["num_threads"])
+                  for i in threadpoolctl.threadpool_info() if i["user_api"] == "blas")
+with threadpoolctl.threadpool_limits(limits=2, user_api="blas"):
+    with blas.one_thread():
+        import scipy.linalg   # a new BLAS library, loaded inside the block
+        with blas.one_thread():
+            inner = threads()
+    after = threads()
+print(inner); print(after)
+"""
+    res = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert res.returncode == 0, res.stderr
+    inner, after = (eval(line) for line in res.stdout.strip().splitlines())
+    assert len(inner) >= 2 and {n for _, _, n in inner} == {1}, inner   # numpy's and scipy's BLAS
+    assert [n for _, path, n in after if "numpy" in path] == [2], after   # the outer limit, restored
