@@ -157,6 +157,17 @@ def fourbar(n: int, repeat: int) -> list[Row]:
     rows.append(Row("four-bar joint forces (baseline: exact states)", "ns/position", tk / n, tb / n, None, 0.5,
                     "reads 64 B, writes 96 B/position (fresh array); no transcendental function, 6 divisions",
                     floor / n))
+    # issue 37: out= as the kinematics kernel has it; both kernels on reused buffers, the force kernel
+    # at most 1.5x the kinematics per position and 1.6x its own store floor (numpy filling its buffer)
+    fout = np.empty((n, 12), order="F")
+    kout, ksts = np.empty((n, 11), order="F"), np.empty(n, dtype=np.int32)
+    np.testing.assert_array_equal(fourbar_kernel.fourbar_joint_forces(st_out, st_sts, *lk, pr, out=fout), f)
+    tk, tb = interleaved(lambda: fourbar_kernel.fourbar_joint_forces(st_out, st_sts, *lk, pr, out=fout),
+                         lambda: fourbar_kernel.fourbar_exact(theta, *lk, 1, out=kout, status=ksts), repeat)
+    floor = write_floor(lambda: fout.fill(0.0), repeat)
+    rows.append(Row("four-bar joint forces, out= (baseline: exact, out=)", "ns/position", tk / n, tb / n, None,
+                    1 / 1.5, f"reused buffers both; reads 64 B, writes 96 B/position; target <= 1.5x the kinematics "
+                    f"({tk / tb:.2f}x) and <= 1.6x its store floor ({tk / floor:.2f}x)", floor / n))
     return rows
 
 

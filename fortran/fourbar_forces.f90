@@ -49,13 +49,16 @@ contains
   !> fout(:, 1) input torque [N m]; fout(:, 2:9) F_O2, F_A, F_B, F_O4 (x, y) [N];
   !> fout(:, 10:11) shaking force [N]; fout(:, 12) shaking moment about O2 [N m].
   !> Rows whose status is not st_ok (no assembly, toggle, indeterminate) are zero.
+  !> fout is the caller's buffer (every element overwritten), as exact_states' out: a caller
+  !> that calls again and again reuses it instead of touching fresh memory each call.
   subroutine joint_forces(n, states, status, p, q, r, s, omega, alpha1, props, fout)
     !f2py threadsafe
     integer, intent(in) :: n
     real(dp), intent(in) :: states(n, 11)
     integer, intent(in) :: status(n)
     real(dp), intent(in) :: p, q, r, s, omega, alpha1, props(18)
-    real(dp), intent(out) :: fout(n, 12)
+    real(dp), intent(inout) :: fout(n, 12)
+    !f2py intent(in,out) :: fout
     integer :: k0, m
     ! blocks of nb rows, columns passed separately (see fourbar::exact_states)
     do k0 = 1, n, nb

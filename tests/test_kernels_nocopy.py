@@ -40,6 +40,26 @@ def test_fourbar_refuses_a_c_ordered_buffer_instead_of_copying_it():
         fourbar_kernel.fourbar_exact(np.zeros(n), 12, 5, 15, 9, 5, out=out, status=np.empty(n, dtype=np.int32))
 
 
+def test_fourbar_forces_reuse_the_callers_buffer():
+    """Issue 37: the force kernel takes out= as the kinematics kernel does: the same values as a
+    fresh array, written into the caller's buffer (no allocation of the output, no copy), and a
+    buffer f2py would copy is refused."""
+    n = 200_000
+    lk = (0.30, 0.10, 0.35, 0.25, 20.0, 3.0)
+    props = np.array([0.5, 1.2, 0.9, 4e-4, 1.2e-2, 4.7e-3, 0.05, 0.175, 0.125, 0.1, 0.2, -0.3, 9.81, 5.0, 10.0, -20.0,
+                      0.175, 0.05])
+    states, status = fourbar_kernel.fourbar_exact(np.linspace(0, 2 * np.pi, n), *lk)
+    fresh = fourbar_kernel.fourbar_joint_forces(states, status, *lk, props)
+    out = np.full((n, 12), np.nan, order="F")
+    got = fourbar_kernel.fourbar_joint_forces(states, status, *lk, props, out=out)
+    assert got is out
+    np.testing.assert_array_equal(out, fresh)
+    assert peak_alloc(lambda: fourbar_kernel.fourbar_joint_forces(states, status, *lk, props, out=out)) < out.nbytes // 20
+    for bad in (np.empty((n, 12)), np.empty((n, 11), order="F"), np.empty((n, 12), order="F", dtype=np.float32)):
+        with pytest.raises(ValueError):
+            fourbar_kernel.fourbar_joint_forces(states, status, *lk, props, out=bad)
+
+
 def test_manipulator_monte_carlo_samples_are_not_copied():
     ns = 400_000
     dl = np.asfortranarray(np.random.default_rng(0).uniform(-1e-3, 1e-3, (ns, 2)))

@@ -385,7 +385,7 @@ def fourbar_coupler_point(theta: np.ndarray, states: np.ndarray, status: np.ndar
 
 
 def fourbar_joint_forces(states: np.ndarray, status: np.ndarray, p: float, q: float, r: float, s: float,
-                         omega: float, alpha: float, props: np.ndarray) -> np.ndarray:
+                         omega: float, alpha: float, props: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
     """Compute joint forces, input torque and shaking from ``fourbar_exact`` results.
 
     Parameters
@@ -402,24 +402,35 @@ def fourbar_joint_forces(states: np.ndarray, status: np.ndarray, p: float, q: fl
         (18,): masses [kg], inertias about the centres of mass [kg m^2], com distances [m]
         and angles [rad] of crank, coupler, rocker; gravity [m/s^2] (along -y); load torque
         on the rocker [N m]; load force at the coupler point [N]; the point's u, v [m].
+    out : numpy.ndarray, optional
+        (n, 12) Fortran-ordered float64 buffer to reuse; overwritten (a caller that calls again
+        and again passes one, as for ``fourbar_exact``: fresh memory costs its first touch).
 
     Returns
     -------
     numpy.ndarray
         (n, 12): input torque [N m]; F_O2, F_A, F_B, F_O4 (x, y) [N]; shaking force (x, y)
         [N]; shaking moment about O2 [N m] (fortran/fourbar_forces.f90).  Zero where status
-        is not ok.
+        is not ok.  ``out`` itself when given.
 
     Raises
     ------
     ValueError
-        ``props`` does not have 18 values.
+        ``props`` does not have 18 values, or ``out`` is not an (n, 12) Fortran-ordered float64
+        array (f2py would work on a hidden copy).
     """
     props = np.ascontiguousarray(props, dtype=np.float64)
     if props.shape != (N_PROPS,):
         raise ValueError(f"props must have {N_PROPS} values, got shape {props.shape}")
-    return _kernels.fourbar_forces.joint_forces(farray(states, 2), np.asarray(status, dtype=np.int32),
-                                                p, q, r, s, omega, alpha, props)
+    states = farray(states, 2)
+    n = states.shape[0]
+    if out is None:
+        out = np.empty((n, len(Force)), order="F")
+    elif not (out.flags.f_contiguous and out.dtype == np.float64 and out.shape == (n, len(Force))):
+        raise ValueError(f"out must be a Fortran-ordered float64 array of shape (n, {len(Force)}); "
+                         "f2py would otherwise work on a hidden copy")
+    return _kernels.fourbar_forces.joint_forces(states, np.asarray(status, dtype=np.int32),
+                                                p, q, r, s, omega, alpha, props, out)
 
 
 def fourbar_berkof_lowen(q: float, r: float, s: float, props: np.ndarray,

@@ -82,9 +82,10 @@ class _fourbar_forces:
         omega: float,
         alpha1: float,
         props: NDArray[np.float64],
+        fout: NDArray[np.float64],
         n: int = ...,
     ) -> NDArray[np.float64]:
-        """``fout = joint_forces(states,status,p,q,r,s,omega,alpha1,props,[n])``; shapes fout(n,12)"""
+        """``fout = joint_forces(states,status,p,q,r,s,omega,alpha1,props,fout,[n])``; shapes fout(n,12)"""
         ...
     nbpar: NDArray[np.int32]
     nbres: NDArray[np.int32]
