@@ -17,6 +17,11 @@ module fourbar
   implicit none
   private
   public :: listing_table, exact_states, coupler_point
+  ! building blocks of the batched summaries (fortran/fourbar_summary.f90); not wrapped by f2py
+  public :: pose_block, rates_block, angles_block
+
+  !> positions per block of the batched loops (the size of their local arrays)
+  integer, parameter, public :: nb = 256
 
   !> status codes shared with driver/fourbar.py
   integer, parameter, public :: st_ok = 0, st_no_assembly = 1, st_toggle = 2, st_indeterminate = 3
@@ -131,18 +136,22 @@ contains
     !f2py intent(in,out) :: out
     integer, intent(inout) :: status(n)
     !f2py intent(in,out) :: status
-    integer, parameter :: nb = 256
-    real(dp) :: sgn, sblk(nb)
+    real(dp) :: pb(nb), qb(nb), rb(nb), sb(nb), gb(nb), sblk(nb)
     integer :: k0, m
 
-    sgn = merge(1.0_dp, -1.0_dp, branch >= 0)
+    ! one linkage: its lengths and branch sign as the blocks' per-position arrays
+    pb = p
+    qb = q
+    rb = r
+    sb = s
+    gb = merge(1.0_dp, -1.0_dp, branch >= 0)
     ! Blocks of nb positions: the block's transcendental functions are evaluated on whole
     ! arrays (vecmath) and its temporaries stay in cache.  Each output column is passed as
     ! its own dummy argument, so the compiler knows the columns do not overlap and
     ! vectorises the block's loops writing straight into out.
     do k0 = 1, n, nb
       m = min(nb, n - k0 + 1)
-      call exact_block(m, theta(k0:k0 + m - 1), p, q, r, s, omega, alpha1, sgn, &
+      call exact_block(m, theta(k0:k0 + m - 1), pb, qb, rb, sb, gb, omega, alpha1, &
                        out(k0:k0 + m - 1, 1), out(k0:k0 + m - 1, 2), out(k0:k0 + m - 1, 3), &
                        out(k0:k0 + m - 1, 4), out(k0:k0 + m - 1, 5), out(k0:k0 + m - 1, 6), &
                        out(k0:k0 + m - 1, 7), out(k0:k0 + m - 1, 8), out(k0:k0 + m - 1, 9), &
@@ -151,37 +160,54 @@ contains
     end do
   end subroutine exact_states
 
-  !> One block of exact_states (see there); m <= nb = 256 (the size of the caller's local arrays).
-  !> Every loop here is free of calls: the transcendental functions are evaluated on the
-  !> whole block by vecmath before and after the main loop, so the loops vectorise by
-  !> construction (not by the inliner's grace).
-  subroutine exact_block(m, theta, p, q, r, s, omega, alpha1, sgn, th2, th3, mu, xa, ya, xb, yb, &
+  !> One block of exact_states (see there), m <= nb positions, each position with its own linkage
+  !> (p, q, r, s and the branch sign sgn = +1/-1 per position: the batched summaries evaluate the
+  !> candidate crank angles of many linkages in one call).  The three stages -- positions
+  !> (pose_block), rates (rates_block) and angles (angles_block) -- are the one place the loop
+  !> closure lives; callers that need only some of them (the summaries' rocker angles, the peak
+  !> speeds) call those stages alone and get the same bits.
+  subroutine exact_block(m, theta, p, q, r, s, sgn, omega, alpha1, th2, th3, mu, xa, ya, xb, yb, &
                          w2o, w3o, a2o, a3o, status)
     integer, intent(in) :: m
-    real(dp), intent(in) :: theta(m), p, q, r, s, omega, alpha1, sgn
+    real(dp), intent(in) :: theta(m), p(m), q(m), r(m), s(m), sgn(m), omega, alpha1
     real(dp), intent(out) :: th2(m), th3(m), mu(m), xa(m), ya(m), xb(m), yb(m), w2o(m), w3o(m), &
                              a2o(m), a3o(m)   ! the eleven columns of exact_states' out
-    real(dp), intent(inout) :: status(256)   ! status code as a real: keeps the loop in one vector width
+    real(dp), intent(out) :: status(m)   ! status code as a real: keeps the loops in one vector width
+    real(dp) :: sn(nb), c(nb), e2x(nb), e2y(nb), e3x(nb), e3y(nb), s23(nb), c23(nb)
+    call pose_block(m, theta, p, q, r, s, sgn, sn, c, xa, ya, xb, yb, e2x, e2y, e3x, e3y, s23, c23, status)
+    call rates_block(m, q, r, s, omega, alpha1, sn, c, e2x, e2y, e3x, e3y, s23, c23, status, w2o, w3o, a2o, a3o)
+    call angles_block(m, e2x, e2y, e3x, e3y, s23, c23, status, th3, th2, mu)
+  end subroutine exact_block
+
+  !> Positions of m <= nb crank angles theta [rad], each of its own linkage p, q, r, s on branch
+  !> sgn (+1 open, -1 crossed): sin and cos of theta, the pins A = (xa, ya) and B = (xb, yb)
+  !> (B zeroed where not placed), the unit vectors e2 = A->B and e3 = O_B->B, sin and cos of
+  !> theta3 - theta2, and the status code (st_*, as a real).
+  !> Every loop here is free of calls: the transcendental functions are evaluated on the
+  !> whole block by vecmath before the main loop, so the loops vectorise by construction (not
+  !> by the inliner's grace).
+  subroutine pose_block(m, theta, p, q, r, s, sgn, sn, c, xa, ya, xb, yb, e2x, e2y, e3x, e3y, s23, c23, status)
+    integer, intent(in) :: m
+    real(dp), intent(in) :: theta(m), p(m), q(m), r(m), s(m), sgn(m)
+    real(dp), intent(out) :: sn(m), c(m), xa(m), ya(m), xb(m), yb(m), e2x(m), e2y(m), e3x(m), e3y(m), &
+                             s23(m), c23(m), status(m)
     real(dp), parameter :: tol = 1.0e-13_dp
-    real(dp) :: r2, s2, c, sn, ax, ay, dx, dy, d2, a, h2, h, bx, by
-    real(dp) :: e2x, e2y, e3x, e3y, s23, c23, w2, w3, den2, den3, sinv, ok, placed
-    real(dp) :: st, isno, istog, isdeg, degst, dmin2, ys(256, 3), xs(256, 3), sns(256), cs(256), keep(256)
+    real(dp) :: r2, s2, ax, ay, dx, dy, d2, a, h2, h, bx, by, placed
+    real(dp) :: st, isno, istog, isdeg, degst, dmin2
     ! st_ok = 0 is the value left when no flag is set
     real(dp), parameter :: none_ = st_no_assembly, tog_ = st_toggle, ind_ = st_indeterminate
     integer :: k
-    r2 = r*r
-    s2 = s*s
-    dmin2 = (tol*(p + q))**2
-    ! A on O_B: B free on a circle if r = s (indeterminate), else impossible
-    degst = merge(ind_, none_, abs(r - s) <= tol*(r + s))
-    call sincos_array(m, theta, sns, cs)
-    ! hot-loop: fourbar exact_block
+    call sincos_array(m, theta, sn, c)
+    ! hot-loop: fourbar pose_block
     do k = 1, m
-      sn = sns(k)
-      c = cs(k)
-      ax = q*c
-      ay = q*sn
-      dx = p - ax
+      r2 = r(k)*r(k)
+      s2 = s(k)*s(k)
+      dmin2 = (tol*(p(k) + q(k)))**2
+      ! A on O_B: B free on a circle if r = s (indeterminate), else impossible
+      degst = merge(ind_, none_, abs(r(k) - s(k)) <= tol*(r(k) + s(k)))
+      ax = q(k)*c(k)
+      ay = q(k)*sn(k)
+      dx = p(k) - ax
       dy = -ay
       d2 = max(dx*dx + dy*dy, tiny(1.0_dp))
       a = (d2 + r2 - s2)/(2*d2)
@@ -193,54 +219,89 @@ contains
       st = (1.0_dp - isdeg)*(none_*isno + tog_*istog) + isdeg*degst
       h2 = h2*(1.0_dp - isdeg)
       h = sqrt(max(h2, 0.0_dp))
-      bx = ax + a*dx - sgn*h*dy
-      by = ay + a*dy + sgn*h*dx
-      e2x = (bx - ax)/r
-      e2y = (by - ay)/r
-      e3x = (bx - p)/s
-      e3y = by/s
-      s23 = e2x*e3y - e2y*e3x            ! sin(theta3 - theta2)
-      c23 = e2x*e3x + e2y*e3y            ! cos(theta3 - theta2)
-      ok = (1.0_dp - isno)*(1.0_dp - istog)*(1.0_dp - isdeg)
-      sinv = ok/(ok*s23 + (1.0_dp - ok))
-      w2 = omega*q*(sn*e3x - c*e3y)/r*sinv
-      w3 = omega*q*(sn*e2x - c*e2y)/s*sinv
-      den2 = -r*s23
-      den3 = s*s23
+      bx = ax + a*dx - sgn(k)*h*dy
+      by = ay + a*dy + sgn(k)*h*dx
+      e2x(k) = (bx - ax)/r(k)
+      e2y(k) = (by - ay)/r(k)
+      e3x(k) = (bx - p(k))/s(k)
+      e3y(k) = by/s(k)
+      s23(k) = e2x(k)*e3y(k) - e2y(k)*e3x(k)            ! sin(theta3 - theta2)
+      c23(k) = e2x(k)*e3x(k) + e2y(k)*e3y(k)            ! cos(theta3 - theta2)
       placed = (1.0_dp - isno)*(1.0_dp - isdeg)
-      ys(k, 1) = e2y*placed
-      xs(k, 1) = e2x
-      ys(k, 2) = e3y*placed
-      xs(k, 2) = e3x
-      ys(k, 3) = abs(s23)*placed
-      xs(k, 3) = c23
       xa(k) = ax
       ya(k) = ay
       xb(k) = bx*placed
       yb(k) = by*placed
-      w2o(k) = w2
-      w3o(k) = w3
-      a2o(k) = ok*(-q*alpha1*(sn*e3x - c*e3y) - q*omega*omega*(c*e3x + sn*e3y) &
-                   - r*w2*w2*c23 + s*w3*w3)/(ok*den2 + (1.0_dp - ok))
-      a3o(k) = ok*(q*alpha1*(sn*e2x - c*e2y) + q*omega*omega*(c*e2x + sn*e2y) &
-                   + r*w2*w2 - s*w3*w3*c23)/(ok*den3 + (1.0_dp - ok))
       status(k) = st
     end do
-    ! angles: an unplaced row has y = 0 and x = 0 or a unit vector; its angle is then zeroed
-    ! hot-loop: fourbar angle mask
+  end subroutine pose_block
+
+  !> Angular velocities w2o, w3o [rad/s] and accelerations a2o, a3o [rad/s^2] of coupler and
+  !> rocker from pose_block's results (crank speed omega, acceleration alpha1; zero unless ok).
+  subroutine rates_block(m, q, r, s, omega, alpha1, sn, c, e2x, e2y, e3x, e3y, s23, c23, status, &
+                         w2o, w3o, a2o, a3o)
+    integer, intent(in) :: m
+    real(dp), intent(in) :: q(m), r(m), s(m), omega, alpha1, sn(m), c(m), e2x(m), e2y(m), e3x(m), e3y(m), &
+                            s23(m), c23(m), status(m)
+    real(dp), intent(out) :: w2o(m), w3o(m), a2o(m), a3o(m)
+    real(dp) :: w2, w3, den2, den3, sinv, ok
+    integer :: k
+    ! hot-loop: fourbar rates_block
     do k = 1, m
+      ok = merge(1.0_dp, 0.0_dp, status(k) == real(st_ok, dp))
+      sinv = ok/(ok*s23(k) + (1.0_dp - ok))
+      w2 = omega*q(k)*(sn(k)*e3x(k) - c(k)*e3y(k))/r(k)*sinv
+      w3 = omega*q(k)*(sn(k)*e2x(k) - c(k)*e2y(k))/s(k)*sinv
+      den2 = -r(k)*s23(k)
+      den3 = s(k)*s23(k)
+      w2o(k) = w2
+      w3o(k) = w3
+      a2o(k) = ok*(-q(k)*alpha1*(sn(k)*e3x(k) - c(k)*e3y(k)) - q(k)*omega*omega*(c(k)*e3x(k) + sn(k)*e3y(k)) &
+                   - r(k)*w2*w2*c23(k) + s(k)*w3*w3)/(ok*den2 + (1.0_dp - ok))
+      a3o(k) = ok*(q(k)*alpha1*(sn(k)*e2x(k) - c(k)*e2y(k)) + q(k)*omega*omega*(c(k)*e2x(k) + sn(k)*e2y(k)) &
+                   + r(k)*w2*w2 - s(k)*w3*w3*c23(k))/(ok*den3 + (1.0_dp - ok))
+    end do
+  end subroutine rates_block
+
+  !> Rocker angle th3 [rad] from pose_block's results, and with the optional th2, mu the coupler
+  !> angle and the transmission angle in [0, pi] (an unplaced row has y = 0 and x = 0 or a unit
+  !> vector; its angles are then zeroed).
+  subroutine angles_block(m, e2x, e2y, e3x, e3y, s23, c23, status, th3, th2, mu)
+    integer, intent(in) :: m
+    real(dp), intent(in) :: e2x(m), e2y(m), e3x(m), e3y(m), s23(m), c23(m), status(m)
+    real(dp), intent(out) :: th3(m)
+    real(dp), intent(out), optional :: th2(m), mu(m)
+    real(dp) :: ys(nb, 3), keep(nb), placed
+    real(dp), parameter :: none_ = st_no_assembly, ind_ = st_indeterminate, tog_ = st_toggle
+    integer :: k
+    ! hot-loop: fourbar angle inputs and mask
+    do k = 1, m
+      placed = merge(1.0_dp, 0.0_dp, status(k) == real(st_ok, dp) .or. status(k) == tog_)
+      ys(k, 1) = e2y(k)*placed
+      ys(k, 2) = e3y(k)*placed
+      ys(k, 3) = abs(s23(k))*placed
       keep(k) = merge(0.0_dp, 1.0_dp, status(k) == none_ .or. status(k) == ind_)
     end do
-    call atan2_array(m, ys(:, 1), xs(:, 1), th2)
-    call atan2_array(m, ys(:, 2), xs(:, 2), th3)
-    call atan2_array(m, ys(:, 3), xs(:, 3), mu)
-    ! hot-loop: fourbar angles zeroed where unplaced
+    call atan2_array(m, ys(:, 2), e3x, th3)
+    ! hot-loop: fourbar rocker angle zeroed where unplaced
     do k = 1, m
-      th2(k) = th2(k)*keep(k)
       th3(k) = th3(k)*keep(k)
-      mu(k) = mu(k)*keep(k)
     end do
-  end subroutine exact_block
+    if (present(th2)) then
+      call atan2_array(m, ys(:, 1), e2x, th2)
+      ! hot-loop: fourbar coupler angle zeroed where unplaced
+      do k = 1, m
+        th2(k) = th2(k)*keep(k)
+      end do
+    end if
+    if (present(mu)) then
+      call atan2_array(m, ys(:, 3), c23, mu)
+      ! hot-loop: fourbar transmission angle zeroed where unplaced
+      do k = 1, m
+        mu(k) = mu(k)*keep(k)
+      end do
+    end if
+  end subroutine angles_block
 
   !> A point P fixed to the coupler: P = A + u e2 + v n2, with e2 the unit vector A->B and
   !> n2 its left normal (u along the coupler, v to its left; length units of the linkage).
@@ -252,7 +313,6 @@ contains
     real(dp), intent(in) :: theta(n), q, omega, alpha1, u, v, states(n, 11)
     integer, intent(in) :: status(n)
     real(dp), intent(out) :: pout(n, 6)
-    integer, parameter :: nb = 256
     integer :: k0, m
     ! blocks of nb rows, columns passed separately (see exact_states)
     do k0 = 1, n, nb
@@ -273,7 +333,7 @@ contains
     integer, intent(in) :: status(m)
     real(dp), intent(in) :: theta(m), q, omega, alpha1, u, v, th2(m), xa(m), ya(m), w2(m), a2(m)
     real(dp), intent(out) :: px(m), py(m), vx(m), vy(m), ax(m), ay(m)
-    real(dp) :: s2(256), c2(256), sn(256), c(256), okb(256), placedb(256), rx, ry
+    real(dp) :: s2(nb), c2(nb), sn(nb), c(nb), okb(nb), placedb(nb), rx, ry
     integer :: k
     ! hot-loop: fourbar coupler masks
     do k = 1, m      ! row masks as reals: the main loop then works in one vector width

@@ -34,6 +34,21 @@
 !>
 !> Velocities are evaluated for a unit crank speed and scaled by omega (they are linear in it).
 !>
+!> Batched (issue 37): the linkages are taken lb at a time.  For each block the closed-form
+!> part runs linkage by linkage (class, limits, assembled intervals, candidates); the states
+!> the rocker figures need -- the rocker angle at every candidate of every linkage of the block,
+!> and the rocker speed's sign halfway between candidates -- are then evaluated in one batched
+!> call of fourbar's pose/angles/rates stages (each position with its own linkage), and the
+!> figures are finished linkage by linkage.  Bit for bit the figures of the linkage-by-linkage
+!> evaluation, with less work: the states' stages give the same bits alone as inside
+!> exact_states; |A O_B| is evaluated (libm cos) only at the candidates where an extreme or a
+!> tie of it can sit (interval ends, limits, 0/180 deg, and a crank/coupler collinear angle
+!> closer to one of those than a tie allows), and is exactly p -+ q at multiples of 180 deg;
+!> atan2 of the collinear angles once per pair (atan2 is odd in y); and for a Grashof
+!> crank-rocker without limits (its rocker swings less than half a turn, so the sign of the
+!> rocker speed between candidates is that of the step) no speeds halfway.  The peak speeds
+!> evaluate only the angular rates they need (no angles).
+!>
 !> Passes: the caller names the figures it needs (a bit mask, pass_*); the Grashof class, the
 !> toggle count and the assembled fraction (closed form) are always computed, the transmission
 !> angle (pass_transmission, closed form), the rocker extremes, swing and time ratio
@@ -42,7 +57,8 @@
 !> which other passes ran.
 module fourbar_summary
   use kinds, only: dp
-  use fourbar, only: exact_states, st_ok, st_no_assembly, st_toggle, st_indeterminate
+  use fourbar, only: exact_states, pose_block, rates_block, angles_block, nblk => nb, st_ok, st_no_assembly, st_toggle, &
+                     st_indeterminate
   implicit none
   private
   public :: summaries
@@ -68,6 +84,21 @@ module fourbar_summary
   real(dp), parameter :: scan_step = 1.0_dp   ! [deg] the fine grid
   integer, parameter :: coarse_every = 6      ! coarse scan: every 6th fine point (6 deg)
   integer, parameter :: max_depth = 10        ! bisections of a suspicious 1 deg interval
+  integer, parameter :: lb = 128              ! linkages per block of the batched evaluation
+  integer, parameter :: maxiv = 8             ! assembled intervals of one linkage (at most 5)
+  integer, parameter :: maxcl = 64            ! candidates of one linkage, all its intervals
+  ! candidate kinds: where |A O_B| can be extreme (evaluated) or not (a collinear angle, evaluated
+  ! only near one of the others)
+  integer, parameter :: ck_end = 1, ck_fixed = 2, ck_zero = 3
+
+  !> one linkage's plan between the closed-form part and the batched states
+  type :: plan
+    real(dp) :: p, q, r, s, lo, hie, sgn
+    integer :: branch, niv, nc(maxiv), q0, m0, nq, nm
+    logical :: states, fast
+    real(dp) :: cand(maxcl), ia(maxiv), ib(maxiv)
+    integer :: kind(maxcl), c0(maxiv)
+  end type plan
 
 contains
 
@@ -97,14 +128,441 @@ contains
     real(dp), intent(in) :: params(n, 8)      ! npar columns (literal for f2py)
     integer, intent(in) :: passes
     real(dp), intent(out) :: res(n, 19)        ! ncol columns
-    real(dp) :: row(ncol)
-    integer :: i
-    do i = 1, n
-      call one_linkage(params(i, 1), params(i, 2), params(i, 3), params(i, 4), params(i, 5), &
-                       params(i, 6), params(i, 7), params(i, 8), passes, row)
-      res(i, :) = row
+    type(plan), allocatable :: pl(:)
+    real(dp), allocatable :: rows(:, :), qc(:, :), qm(:, :)
+    real(dp) :: par(npar)
+    integer :: i0, m, l, nq, nm
+    ! per block: the plans, the rows, and the two queues of states (columns: crank angle [rad],
+    ! p, q, r, s, branch sign, then the result and the status): the rocker angle at the
+    ! candidates, the rocker speed halfway between them
+    allocate (pl(lb), rows(ncol, lb), qc(lb*maxcl, 8), qm(lb*maxcl + maxcl, 8))   ! qm: room for halfway
+    do i0 = 1, n, lb
+      m = min(lb, n - i0 + 1)
+      nq = 0
+      nm = 0
+      do l = 1, m
+        par = params(i0 + l - 1, :)
+        call prepare(par, passes, pl(l), rows(:, l), qc, nq, qm, nm)
+      end do
+      call batch_states(nq, qc, .false.)
+      call batch_states(nm, qm, .true.)
+      do l = 1, m
+        call finish(params(i0 + l - 1, 5), passes, pl(l), rows(:, l), qc, qm)
+        res(i0 + l - 1, :) = rows(:, l)
+      end do
     end do
   end subroutine summaries
+
+  !> States of the n positions queued in q (columns 1-6: crank angle [rad], p, q, r, s, branch
+  !> sign) at unit crank speed: column 7 the rocker angle [rad] (rates: the rocker speed
+  !> [rad/s]), column 8 the status code; in blocks of nb positions, each with its own linkage.
+  subroutine batch_states(n, q, rates)
+    integer, intent(in) :: n
+    real(dp), intent(inout), contiguous :: q(:, :)
+    logical, intent(in) :: rates
+    real(dp) :: sn(nblk), c(nblk), xa(nblk), ya(nblk), xb(nblk), yb(nblk), e2x(nblk), e2y(nblk), e3x(nblk), e3y(nblk), &
+                s23(nblk), c23(nblk), w2(nblk), a2(nblk), a3(nblk)
+    integer :: k0, m
+    do k0 = 1, n, nblk
+      m = min(nblk, n - k0 + 1)
+      call pose_block(m, q(k0:k0 + m - 1, 1), q(k0:k0 + m - 1, 2), q(k0:k0 + m - 1, 3), q(k0:k0 + m - 1, 4), &
+                      q(k0:k0 + m - 1, 5), q(k0:k0 + m - 1, 6), sn, c, xa, ya, xb, yb, e2x, e2y, e3x, e3y, &
+                      s23, c23, q(k0:k0 + m - 1, 8))
+      if (rates) then
+        call rates_block(m, q(k0:k0 + m - 1, 3), q(k0:k0 + m - 1, 4), q(k0:k0 + m - 1, 5), 1.0_dp, 0.0_dp, &
+                         sn, c, e2x, e2y, e3x, e3y, s23, c23, q(k0:k0 + m - 1, 8), w2, q(k0:k0 + m - 1, 7), a2, a3)
+      else
+        call angles_block(m, e2x, e2y, e3x, e3y, s23, c23, q(k0:k0 + m - 1, 8), q(k0:k0 + m - 1, 7))
+      end if
+    end do
+  end subroutine batch_states
+
+  !> The closed-form part of one linkage's summary (see summaries for the columns): class,
+  !> limits, toggles, assembled intervals and, for the transmission and rocker passes, the
+  !> candidate crank angles of each interval; the states the rocker figures need are queued
+  !> (qc: the candidates, qm: halfway between them) for the block's batched evaluation.
+  subroutine prepare(par, passes, pl, row, qc, nq, qm, nm)
+    real(dp), intent(in) :: par(npar)
+    integer, intent(in) :: passes
+    type(plan), intent(out) :: pl
+    real(dp), intent(out) :: row(ncol)
+    real(dp), intent(inout) :: qc(:, :), qm(:, :)
+    integer, intent(inout) :: nq, nm
+    real(dp) :: p, q, r, s, lo, hi, hie, lim(4), bp(maxc), zer(4), dd(2), x, y2, phi, t, d, total, tz
+    integer :: nlim, nbp, nz, nc, c0, i, j, k, ntog, kmin, kmax
+    logical :: okm, want_mu, want_rocker
+
+    p = par(1)
+    q = par(2)
+    r = par(3)
+    s = par(4)
+    row = 0.0_dp
+    want_mu = iand(passes, pass_transmission) /= 0
+    want_rocker = iand(passes, pass_rocker) /= 0
+    pl%p = p
+    pl%q = q
+    pl%r = r
+    pl%s = s
+    pl%branch = merge(1, -1, par(8) >= 0.0_dp)
+    pl%sgn = real(pl%branch, dp)
+    pl%niv = 0
+    pl%states = .false.
+    pl%fast = .false.
+    pl%nq = 0
+    pl%nm = 0
+    lo = min(par(6), par(7))
+    hi = max(par(6), par(7))
+    hie = min(hi, lo + 360.0_dp)
+    pl%lo = lo
+    pl%hie = hie
+    row(1) = real(grashof_code(p, q, r, s), dp)
+    call limit_angles(p, q, r, s, lim, nlim)
+    ntog = 0
+    do i = 1, nlim
+      kmin = ceiling((lo - lim(i))/360.0_dp)
+      kmax = floor((hi - lim(i))/360.0_dp)
+      ntog = ntog + max(0, kmax - kmin + 1)
+    end do
+    row(14) = real(ntog, dp)
+
+    if (hie <= lo) then                 ! a single crank angle
+      call single_angle(p, q, r, s, par(5), lo, pl%branch, passes, row)
+      return
+    end if
+
+    ! ---- assembled intervals: cut [lo, hie] at the limit angles, test each piece's midpoint
+    nbp = 1
+    bp(1) = lo
+    do i = 1, nlim
+      call add_periodic(lim(i), lo, hie, bp, nbp)
+    end do
+    nbp = nbp + 1
+    bp(nbp) = hie
+    call sort(bp, nbp)
+    do i = 1, nbp - 1
+      if (bp(i + 1) <= bp(i)) cycle
+      d = dist(p, q, 0.5_dp*(bp(i) + bp(i + 1)))
+      okm = d >= abs(r - s) .and. d <= r + s
+      if (.not. okm) cycle
+      if (pl%niv > 0) then
+        if (pl%ib(pl%niv) == bp(i)) then      ! touches the previous piece (toggle inside): merge
+          pl%ib(pl%niv) = bp(i + 1)
+          cycle
+        end if
+      end if
+      pl%niv = pl%niv + 1
+      pl%ia(pl%niv) = bp(i)
+      pl%ib(pl%niv) = bp(i + 1)
+    end do
+    if (pl%niv == 0) return             ! not assemblable anywhere in the range
+    row(2) = 1.0_dp
+    total = 0.0_dp
+    do i = 1, pl%niv
+      total = total + (pl%ib(i) - pl%ia(i))
+    end do
+    row(3) = min(1.0_dp, total/(hie - lo))
+    ! a full turn whose first and last intervals meet at lo = hie - 360 is one motion: join them
+    ! (crank angles below lo are reported one turn up)
+    if (pl%niv > 1 .and. hie - lo >= 360.0_dp .and. pl%ia(1) == lo .and. pl%ib(pl%niv) == hie) then
+      pl%ia(1) = pl%ia(pl%niv) - 360.0_dp
+      pl%niv = pl%niv - 1
+    end if
+    if (.not. (want_mu .or. want_rocker)) return
+
+    ! ---- crank angles where omega3 = 0 (crank and coupler collinear), any branch; atan2 once
+    ! per pair (it is odd in y)
+    nz = 0
+    dd = [q + r, abs(q - r)]
+    do k = 1, 2
+      if (dd(k) <= 0.0_dp) cycle
+      x = (dd(k)*dd(k) + p*p - s*s)/(2*p)
+      y2 = dd(k)*dd(k) - x*x
+      if (y2 < 0.0_dp) cycle
+      tz = atan2(sqrt(y2), x)
+      do j = -1, 1, 2
+        phi = (j*tz)/rad
+        if (k == 2 .and. r > q) phi = phi + 180.0_dp   ! folded with the coupler longer: B opposite A
+        nz = nz + 1
+        zer(nz) = modulo(phi, 360.0_dp)
+      end do
+    end do
+
+    ! ---- per interval: candidates (ends, 0/180 deg, omega3 zeros, inner breakpoints), sorted
+    c0 = 0
+    do i = 1, pl%niv
+      nc = 1
+      pl%cand(c0 + 1) = pl%ia(i)
+      pl%kind(c0 + 1) = ck_end
+      call add_kind(0.0_dp, ck_fixed)
+      call add_kind(180.0_dp, ck_fixed)
+      do k = 1, nz
+        call add_kind(zer(k), ck_zero)
+      end do
+      do k = 1, nlim
+        call add_kind(lim(k), ck_fixed)
+      end do
+      nc = nc + 1
+      pl%cand(c0 + nc) = pl%ib(i)
+      pl%kind(c0 + nc) = ck_end
+      call sort_kinds(pl%cand(c0 + 1:c0 + nc), pl%kind(c0 + 1:c0 + nc), nc)
+      pl%c0(i) = c0
+      pl%nc(i) = nc
+      c0 = c0 + nc
+    end do
+    if (.not. want_rocker) return
+
+    ! ---- the rocker's states: every candidate; halfway between them the sign of the rocker
+    ! speed, except for a Grashof crank-rocker that turns fully (it swings less than half a turn)
+    pl%states = .true.
+    pl%fast = nint(row(1)) == gr_crank_rocker .and. nlim == 0
+    pl%q0 = nq
+    pl%m0 = nm
+    do i = 1, pl%niv
+      do j = 1, pl%nc(i)
+        t = pl%cand(pl%c0(i) + j)
+        call push(qc, nq, t*rad)
+        if (j < pl%nc(i) .and. .not. pl%fast) &
+          call push(qm, nm, (0.5_dp*(t + pl%cand(pl%c0(i) + j + 1)))*rad)
+      end do
+    end do
+    pl%nq = nq - pl%q0
+    pl%nm = nm - pl%m0
+
+  contains
+
+    !> add_periodic for the current interval's candidates, with their kind
+    subroutine add_kind(base, kind)
+      real(dp), intent(in) :: base
+      integer, intent(in) :: kind
+      integer :: before, jj
+      before = nc
+      call add_periodic(base, pl%ia(i), pl%ib(i), pl%cand(c0 + 1:c0 + maxcl - c0 - 1), nc)
+      do jj = before + 1, nc
+        pl%kind(c0 + jj) = kind
+      end do
+    end subroutine add_kind
+
+    subroutine push(qq, nn, th)
+      real(dp), intent(inout) :: qq(:, :)
+      integer, intent(inout) :: nn
+      real(dp), intent(in) :: th
+      nn = nn + 1
+      qq(nn, 1) = th
+      qq(nn, 2) = p
+      qq(nn, 3) = q
+      qq(nn, 4) = r
+      qq(nn, 5) = s
+      qq(nn, 6) = pl%sgn
+    end subroutine push
+  end subroutine prepare
+
+  !> The rest of one linkage's summary from its plan and the batched states: the transmission
+  !> extremes, the rocker extremes (unwrapped along each interval), swing, full turn and time
+  !> ratio, and the peak speeds (their own scan, when asked).
+  subroutine finish(omega, passes, pl, row, qc, qm)
+    real(dp), intent(in) :: omega
+    integer, intent(in) :: passes
+    type(plan), intent(inout) :: pl
+    real(dp), intent(inout) :: row(ncol)
+    real(dp), intent(inout) :: qc(:, :), qm(:, :)
+    real(dp) :: dmin, dmax, dtol, d, tc, thr, umin, umax, tumin, tumax
+    integer :: i, j, jj, c0, nc
+    logical :: want_mu, want_rocker, near
+
+    if (pl%niv == 0) return
+    want_mu = iand(passes, pass_transmission) /= 0
+    want_rocker = iand(passes, pass_rocker) /= 0
+    if (want_mu .or. want_rocker) then
+      ! transmission angle: extremes of d among the candidates (ascending, first wins ties);
+      ! a collinear angle is evaluated only where a tie with an end, a limit or 0/180 deg is
+      ! possible (d is monotone between those, so elsewhere it is no extreme and ties none)
+      dmin = huge(1.0_dp)
+      dmax = -1.0_dp
+      dtol = 1.0e-12_dp*(pl%p + pl%q)
+      thr = 1.0e-3_dp*(pl%p + pl%q)/sqrt(pl%p*pl%q)/rad
+      do i = 1, pl%niv
+        c0 = pl%c0(i)
+        nc = pl%nc(i)
+        do j = 1, nc
+          if (pl%kind(c0 + j) == ck_zero) then
+            near = .false.
+            do jj = 1, nc
+              if (pl%kind(c0 + jj) /= ck_zero .and. abs(pl%cand(c0 + jj) - pl%cand(c0 + j)) <= thr) near = .true.
+            end do
+            if (.not. near) cycle
+          end if
+          d = dist(pl%p, pl%q, pl%cand(c0 + j))
+          tc = pl%cand(c0 + j)
+          if (tc < pl%lo) tc = tc + 360.0_dp
+          ! ties within rounding (e.g. the two crank angles of one limit) go to the smaller angle
+          if (d < dmin - dtol .or. (abs(d - dmin) <= dtol .and. tc < row(5))) then
+            dmin = min(d, dmin)
+            row(5) = tc
+          end if
+          if (d > dmax + dtol .or. (abs(d - dmax) <= dtol .and. tc < row(7))) then
+            dmax = max(d, dmax)
+            row(7) = tc
+          end if
+        end do
+      end do
+      if (want_mu) then
+        row(4) = mu_of(pl%r, pl%s, dmin)
+        row(6) = mu_of(pl%r, pl%s, dmax)
+      else
+        row(5) = 0.0_dp
+        row(7) = 0.0_dp
+      end if
+      if (want_rocker) then
+        call unwrap(pl, qc, qm, umin, umax, tumin, tumax)
+        if (pl%fast .and. umax - umin >= pi - 1.0e-3_dp) then
+          ! nearly half a turn: take the rocker speed's sign halfway after all
+          call halfway(pl, qm)
+          pl%fast = .false.
+          call unwrap(pl, qc, qm, umin, umax, tumin, tumax)
+        end if
+        call rocker_figures(row, pl, umin, umax, tumin, tumax)
+      end if
+    end if
+
+    ! ---- peak speeds: only without a toggle in the range (then the range is one interval)
+    if (iand(passes, pass_peaks) /= 0 .and. nint(row(14)) == 0 .and. pl%niv == 1) &
+      call peaks(pl%p, pl%q, pl%r, pl%s, omega, pl%lo, pl%hie, pl%branch, iand(passes, pass_dense_scan) /= 0, row)
+  end subroutine finish
+
+  !> The rocker's angle unwrapped along each assembled interval of a plan (monotonic between
+  !> candidates: the sign of the rocker speed halfway decides the direction, unless the plan is
+  !> fast), a later interval placed on the turn nearest to the first one's centre; its
+  !> extremes [rad] and their crank angles [deg].  A state the kernel finds just outside the
+  !> assemblable set (rounding at a limit angle) or indeterminate is re-evaluated 1e-12 rad
+  !> inside the interval.
+  subroutine unwrap(pl, qc, qm, umin, umax, tumin, tumax)
+    type(plan), intent(in) :: pl
+    real(dp), intent(inout) :: qc(:, :), qm(:, :)
+    real(dp), intent(out) :: umin, umax, tumin, tumax
+    real(dp) :: u(maxcl), ushift, c1, delta, sg, t, tc, a, b
+    integer :: i, j, c0, nc, kq, km
+    logical :: first
+    first = .true.
+    umin = 0
+    umax = 0
+    tumin = 0
+    tumax = 0
+    kq = pl%q0
+    km = pl%m0
+    do i = 1, pl%niv
+      c0 = pl%c0(i)
+      nc = pl%nc(i)
+      a = pl%ia(i)
+      b = pl%ib(i)
+      call retry(qc, kq + 1, kq + nc, 2)
+      if (.not. pl%fast) call retry(qm, km + 1, km + nc - 1, 9)
+      u(1) = qc(kq + 1, 7)
+      do j = 1, nc - 1
+        sg = 0.0_dp
+        if (.not. pl%fast) sg = qm(km + j, 7)            ! omega3 at the midpoint
+        delta = qc(kq + j + 1, 7) - qc(kq + j, 7)
+        delta = delta - twopi*anint(delta/twopi)          ! in [-pi, pi]
+        if (sg > 0.0_dp .and. delta < -1.0e-9_dp) delta = delta + twopi
+        if (sg < 0.0_dp .and. delta > 1.0e-9_dp) delta = delta - twopi
+        u(j + 1) = u(j) + delta
+      end do
+      ! a later interval is placed on the turn nearest to the first one's centre
+      if (first) then
+        ushift = 0.0_dp
+      else
+        c1 = 0.5_dp*(umin + umax)
+        ushift = twopi*anint((c1 - u(1))/twopi)
+      end if
+      do j = 1, nc
+        t = u(j) + ushift
+        tc = pl%cand(c0 + j)
+        if (tc < pl%lo) tc = tc + 360.0_dp
+        if (first .and. j == 1) then
+          umin = t; umax = t; tumin = tc; tumax = tc
+        else
+          if (t < umin .or. (t == umin .and. tc < tumin)) then
+            umin = t; tumin = tc
+          end if
+          if (t > umax .or. (t == umax .and. tc < tumax)) then
+            umax = t; tumax = tc
+          end if
+        end if
+      end do
+      first = .false.
+      kq = kq + nc
+      if (.not. pl%fast) km = km + nc - 1
+    end do
+
+  contains
+
+    !> queue rows k1..k2 whose state is not placed: again 1e-12 rad inside [a, b], the queue's
+    !> value taken from column col of exact_states' out (2 the rocker angle, 9 its speed)
+    subroutine retry(qq, k1, k2, col)
+      real(dp), intent(inout) :: qq(:, :)
+      integer, intent(in) :: k1, k2, col
+      real(dp) :: one(1), o1(1, 11)
+      integer :: s1(1), k
+      do k = k1, k2
+        if (nint(qq(k, 8)) == st_no_assembly .or. nint(qq(k, 8)) == st_indeterminate) then
+          one(1) = qq(k, 1) + merge(1.0e-12_dp, -1.0e-12_dp, qq(k, 1)/rad <= 0.5_dp*(a + b))
+          call exact_states(1, one, pl%p, pl%q, pl%r, pl%s, 1.0_dp, 0.0_dp, pl%branch, o1, s1)
+          qq(k, 7) = o1(1, col)
+          qq(k, 8) = real(s1(1), dp)
+        end if
+      end do
+    end subroutine retry
+  end subroutine unwrap
+
+  !> Queue-free evaluation of a plan's halfway states (a fast plan whose swing turned out near
+  !> half a turn): appended to qm after the block's, the plan pointing at them.
+  subroutine halfway(pl, qm)
+    type(plan), intent(inout) :: pl
+    real(dp), intent(inout) :: qm(:, :)
+    real(dp) :: th(maxcl)
+    real(dp), allocatable :: o(:, :)
+    integer, allocatable :: st(:)
+    integer :: i, j, n, c0
+    n = 0
+    do i = 1, pl%niv
+      c0 = pl%c0(i)
+      do j = 1, pl%nc(i) - 1
+        n = n + 1
+        th(n) = (0.5_dp*(pl%cand(c0 + j) + pl%cand(c0 + j + 1)))*rad
+      end do
+    end do
+    allocate (o(n, 11), st(n))
+    call exact_states(n, th(1:n), pl%p, pl%q, pl%r, pl%s, 1.0_dp, 0.0_dp, pl%branch, o, st)
+    pl%m0 = size(qm, 1) - n
+    qm(pl%m0 + 1:pl%m0 + n, 1) = th(1:n)
+    qm(pl%m0 + 1:pl%m0 + n, 7) = o(:, 9)
+    qm(pl%m0 + 1:pl%m0 + n, 8) = real(st, dp)
+    pl%nm = n
+  end subroutine halfway
+
+  !> Rocker extremes, swing, full turn and time ratio from the unwrapped extremes.
+  subroutine rocker_figures(row, pl, umin, umax, tumin, tumax)
+    real(dp), intent(inout) :: row(ncol)
+    type(plan), intent(in) :: pl
+    real(dp), intent(in) :: umin, umax, tumin, tumax
+    real(dp) :: t
+    row(8) = fold360(umin/rad)
+    row(9) = tumin
+    row(10) = fold360(umax/rad)
+    row(11) = tumax
+    if (row(3) >= 1.0_dp .and. pl%niv == 1 .and. (umax - umin) >= twopi - 1.0e-6_dp) then
+      row(13) = 1.0_dp
+      row(12) = 360.0_dp
+    else
+      row(12) = (umax - umin)/rad
+    end if
+
+    ! ---- time ratio: a full turn without toggles, the rocker oscillating
+    if (pl%hie - pl%lo >= 360.0_dp .and. row(3) >= 1.0_dp .and. pl%niv == 1 .and. nint(row(14)) == 0 .and. &
+        row(13) == 0.0_dp) then
+      t = modulo(tumax - tumin, 360.0_dp)
+      if (t > 0.0_dp .and. t < 360.0_dp) row(19) = max(t, 360.0_dp - t)/min(t, 360.0_dp - t)
+    end if
+  end subroutine rocker_figures
 
   !> Grashof class from the link lengths (same rule and tolerance as driver/fourbar.py grashof()).
   pure integer function grashof_code(p, q, r, s) result(code)
@@ -200,11 +658,47 @@ contains
     end do
   end subroutine sort
 
+  !> sort (the same insertion sort, so the same order) of x(1:m), carrying each value's kind along.
+  pure subroutine sort_kinds(x, kind, m)
+    real(dp), intent(inout) :: x(:)
+    integer, intent(inout) :: kind(:)
+    integer, intent(in) :: m
+    real(dp) :: t
+    integer :: i, j, kt
+    do i = 2, m
+      t = x(i)
+      kt = kind(i)
+      j = i - 1
+      do while (j >= 1)
+        if (x(j) <= t) exit
+        x(j + 1) = x(j)
+        kind(j + 1) = kind(j)
+        j = j - 1
+      end do
+      x(j + 1) = t
+      kind(j + 1) = kt
+    end do
+  end subroutine sort_kinds
+
   !> Distance |A O_B| at crank angle t [deg].
   pure real(dp) function dist(p, q, t)
     real(dp), intent(in) :: p, q, t
-    dist = sqrt(max(p*p + q*q - 2*p*q*cos(t*rad), 0.0_dp))
+    dist = sqrt(max(p*p + q*q - 2*p*q*cos_deg(t), 0.0_dp))
   end function dist
+
+  !> cos(t rad) for t [deg]: libm's, but at a whole multiple of 180 deg (|t| <= 1e6) its exact
+  !> value +-1, which libm returns there too (the argument's rounding moves cos by far less than
+  !> half an ulp) -- without the call.
+  pure real(dp) function cos_deg(t)
+    real(dp), intent(in) :: t
+    real(dp) :: k
+    k = anint(t/180.0_dp)
+    if (k*180.0_dp == t .and. abs(t) <= 1.0e6_dp) then
+      cos_deg = merge(1.0_dp, -1.0_dp, modulo(k, 2.0_dp) == 0.0_dp)
+    else
+      cos_deg = cos(t*rad)
+    end if
+  end function cos_deg
 
   !> Transmission angle [deg] for |A O_B| = d, d clamped to the assemblable range.
   pure real(dp) function mu_of(r, s, d)
@@ -214,218 +708,6 @@ contains
     mu_of = acos(min(1.0_dp, max(-1.0_dp, (r*r + s*s - dc*dc)/(2*r*s))))/rad
   end function mu_of
 
-  !> All figures of one linkage (see summaries for the columns).
-  subroutine one_linkage(p, q, r, s, omega, t0, t1, branch_r, passes, row)
-    real(dp), intent(in) :: p, q, r, s, omega, t0, t1, branch_r
-    integer, intent(in) :: passes
-    real(dp), intent(out) :: row(ncol)
-    real(dp) :: lo, hi, hie, lim(4), bp(maxc), ia(maxc), ib(maxc), zer(4), cand(maxc), tt(2*maxc)
-    real(dp) :: st(2*maxc, 11), u(maxc), dd(2), x, y2, phi, t, mid, total, d, dmin, dmax
-    real(dp) :: umin, umax, tumin, tumax, ushift, c1, delta, sg, tc, dtol
-    integer :: stat(2*maxc), nlim, nbp, niv, nz, nc, i, j, k, branch, ntog, nt, kmin, kmax
-    logical :: okm, first, want_mu, want_rocker
-
-    row = 0.0_dp
-    want_mu = iand(passes, pass_transmission) /= 0
-    want_rocker = iand(passes, pass_rocker) /= 0
-    branch = merge(1, -1, branch_r >= 0.0_dp)
-    lo = min(t0, t1)
-    hi = max(t0, t1)
-    hie = min(hi, lo + 360.0_dp)
-    row(1) = real(grashof_code(p, q, r, s), dp)
-    call limit_angles(p, q, r, s, lim, nlim)
-    ntog = 0
-    do i = 1, nlim
-      kmin = ceiling((lo - lim(i))/360.0_dp)
-      kmax = floor((hi - lim(i))/360.0_dp)
-      ntog = ntog + max(0, kmax - kmin + 1)
-    end do
-    row(14) = real(ntog, dp)
-
-    if (hie <= lo) then                 ! a single crank angle
-      call single_angle(p, q, r, s, omega, lo, branch, passes, row)
-      return
-    end if
-
-    ! ---- assembled intervals: cut [lo, hie] at the limit angles, test each piece's midpoint
-    nbp = 1
-    bp(1) = lo
-    do i = 1, nlim
-      call add_periodic(lim(i), lo, hie, bp, nbp)
-    end do
-    nbp = nbp + 1
-    bp(nbp) = hie
-    call sort(bp, nbp)
-    niv = 0
-    do i = 1, nbp - 1
-      if (bp(i + 1) <= bp(i)) cycle
-      d = dist(p, q, 0.5_dp*(bp(i) + bp(i + 1)))
-      okm = d >= abs(r - s) .and. d <= r + s
-      if (.not. okm) cycle
-      if (niv > 0) then
-        if (ib(niv) == bp(i)) then      ! touches the previous piece (toggle inside): merge
-          ib(niv) = bp(i + 1)
-          cycle
-        end if
-      end if
-      niv = niv + 1
-      ia(niv) = bp(i)
-      ib(niv) = bp(i + 1)
-    end do
-    if (niv == 0) return                ! not assemblable anywhere in the range
-    row(2) = 1.0_dp
-    total = 0.0_dp
-    do i = 1, niv
-      total = total + (ib(i) - ia(i))
-    end do
-    row(3) = min(1.0_dp, total/(hie - lo))
-    ! a full turn whose first and last intervals meet at lo = hie - 360 is one motion: join them
-    ! (crank angles below lo are reported one turn up)
-    if (niv > 1 .and. hie - lo >= 360.0_dp .and. ia(1) == lo .and. ib(niv) == hie) then
-      ia(1) = ia(niv) - 360.0_dp
-      niv = niv - 1
-    end if
-
-    if (want_mu .or. want_rocker) then
-      call motion()
-      if (want_mu) then
-        row(4) = mu_of(r, s, dmin)
-        row(6) = mu_of(r, s, dmax)
-      else
-        row(5) = 0.0_dp
-        row(7) = 0.0_dp
-      end if
-      if (want_rocker) call rocker_figures()
-    end if
-
-    ! ---- peak speeds: only without a toggle in the range (then the range is one interval)
-    if (iand(passes, pass_peaks) /= 0 .and. ntog == 0 .and. niv == 1) &
-      call peaks(p, q, r, s, omega, lo, hie, branch, iand(passes, pass_dense_scan) /= 0, row)
-
-  contains
-
-    !> Transmission-angle and rocker extremes over the assembled intervals (candidates in
-    !> closed form, states at the candidates only for the rocker).
-    subroutine motion()
-      ! ---- crank angles where omega3 = 0 (crank and coupler collinear), any branch
-      nz = 0
-      dd = [q + r, abs(q - r)]
-      do k = 1, 2
-        if (dd(k) <= 0.0_dp) cycle
-        x = (dd(k)*dd(k) + p*p - s*s)/(2*p)
-        y2 = dd(k)*dd(k) - x*x
-        if (y2 < 0.0_dp) cycle
-        do j = -1, 1, 2
-          phi = atan2(j*sqrt(y2), x)/rad
-          if (k == 2 .and. r > q) phi = phi + 180.0_dp   ! folded with the coupler longer: B opposite A
-          nz = nz + 1
-          zer(nz) = modulo(phi, 360.0_dp)
-        end do
-      end do
-
-      ! ---- per interval: candidates (ends, 0/180 deg, omega3 zeros, inner breakpoints) and midpoints
-      first = .true.
-      umin = 0; umax = 0; tumin = 0; tumax = 0
-      dmin = huge(1.0_dp); dmax = -1.0_dp
-      dtol = 1.0e-12_dp*(p + q)
-      do i = 1, niv
-        nc = 1
-        cand(1) = ia(i)
-        call add_periodic(0.0_dp, ia(i), ib(i), cand, nc)
-        call add_periodic(180.0_dp, ia(i), ib(i), cand, nc)
-        do k = 1, nz
-          call add_periodic(zer(k), ia(i), ib(i), cand, nc)
-        end do
-        do k = 1, nlim
-          call add_periodic(lim(k), ia(i), ib(i), cand, nc)
-        end do
-        nc = nc + 1
-        cand(nc) = ib(i)
-        call sort(cand, nc)
-        ! transmission angle: extremes of d among the candidates (ascending, first wins ties)
-        do j = 1, nc
-          d = dist(p, q, cand(j))
-          tc = cand(j)
-          if (tc < lo) tc = tc + 360.0_dp
-          ! ties within rounding (e.g. the two crank angles of one limit) go to the smaller angle
-          if (d < dmin - dtol .or. (abs(d - dmin) <= dtol .and. tc < row(5))) then
-            dmin = min(d, dmin)
-            row(5) = tc
-          end if
-          if (d > dmax + dtol .or. (abs(d - dmax) <= dtol .and. tc < row(7))) then
-            dmax = max(d, dmax)
-            row(7) = tc
-          end if
-        end do
-        if (.not. want_rocker) cycle
-        ! states at candidates and midpoints in one kernel call (unit crank speed)
-        nt = 0
-        do j = 1, nc
-          nt = nt + 1
-          tt(nt) = cand(j)
-          if (j < nc) then
-            nt = nt + 1
-            tt(nt) = 0.5_dp*(cand(j) + cand(j + 1))
-          end if
-        end do
-        call states_at(nt, tt, p, q, r, s, branch, ia(i), ib(i), st, stat)
-        ! unwrap the rocker angle along the interval: monotonic between candidates
-        u(1) = st(1, 2)
-        do j = 1, nc - 1
-          sg = st(2*j, 9)                 ! omega3 at the midpoint
-          delta = st(2*j + 1, 2) - st(2*j - 1, 2)
-          delta = delta - twopi*anint(delta/twopi)          ! in [-pi, pi]
-          if (sg > 0.0_dp .and. delta < -1.0e-9_dp) delta = delta + twopi
-          if (sg < 0.0_dp .and. delta > 1.0e-9_dp) delta = delta - twopi
-          u(j + 1) = u(j) + delta
-        end do
-        ! a later interval is placed on the turn nearest to the first one's centre
-        if (first) then
-          ushift = 0.0_dp
-        else
-          c1 = 0.5_dp*(umin + umax)
-          ushift = twopi*anint((c1 - u(1))/twopi)
-        end if
-        do j = 1, nc
-          t = u(j) + ushift
-          tc = cand(j)
-          if (tc < lo) tc = tc + 360.0_dp
-          if (first .and. j == 1) then
-            umin = t; umax = t; tumin = tc; tumax = tc
-          else
-            if (t < umin .or. (t == umin .and. tc < tumin)) then
-              umin = t; tumin = tc
-            end if
-            if (t > umax .or. (t == umax .and. tc < tumax)) then
-              umax = t; tumax = tc
-            end if
-          end if
-        end do
-        first = .false.
-      end do
-    end subroutine motion
-
-    !> Rocker extremes, swing, full turn and time ratio from the unwrapped extremes.
-    subroutine rocker_figures()
-      row(8) = fold360(umin/rad)
-      row(9) = tumin
-      row(10) = fold360(umax/rad)
-      row(11) = tumax
-      if (row(3) >= 1.0_dp .and. niv == 1 .and. (umax - umin) >= twopi - 1.0e-6_dp) then
-        row(13) = 1.0_dp
-        row(12) = 360.0_dp
-      else
-        row(12) = (umax - umin)/rad
-      end if
-
-      ! ---- time ratio: a full turn without toggles, the rocker oscillating
-      if (hie - lo >= 360.0_dp .and. row(3) >= 1.0_dp .and. niv == 1 .and. ntog == 0 .and. &
-          row(13) == 0.0_dp) then
-        t = modulo(tumax - tumin, 360.0_dp)
-        if (t > 0.0_dp .and. t < 360.0_dp) row(19) = max(t, 360.0_dp - t)/min(t, 360.0_dp - t)
-      end if
-    end subroutine rocker_figures
-  end subroutine one_linkage
 
   !> Rocker angle folded into [0, 360) [deg].
   pure real(dp) function fold360(a)
@@ -434,29 +716,6 @@ contains
     if (fold360 >= 360.0_dp - 1.0e-9_dp) fold360 = 0.0_dp
   end function fold360
 
-  !> exact_states at crank angles tt(1:m) [deg], unit crank speed and no crank acceleration.
-  !> A point the kernel finds just outside the assemblable set (rounding at a limit angle) or
-  !> indeterminate is re-evaluated 1e-12 rad inside the interval [a, b].
-  subroutine states_at(m, tt, p, q, r, s, branch, a, b, st, stat)
-    integer, intent(in) :: m, branch
-    real(dp), intent(in) :: tt(m), p, q, r, s, a, b
-    real(dp), intent(inout) :: st(:, :)
-    integer, intent(inout) :: stat(:)
-    real(dp) :: th(m), out(m, 11), one(1), o1(1, 11)
-    integer :: ist(m), s1(1), j
-    th = tt*rad
-    call exact_states(m, th, p, q, r, s, 1.0_dp, 0.0_dp, branch, out, ist)
-    do j = 1, m
-      if (ist(j) == st_no_assembly .or. ist(j) == st_indeterminate) then
-        one(1) = th(j) + merge(1.0e-12_dp, -1.0e-12_dp, tt(j) <= 0.5_dp*(a + b))
-        call exact_states(1, one, p, q, r, s, 1.0_dp, 0.0_dp, branch, o1, s1)
-        out(j, :) = o1(1, :)
-        ist(j) = s1(1)
-      end if
-    end do
-    st(1:m, :) = out
-    stat(1:m) = ist
-  end subroutine states_at
 
   !> The whole summary at one crank angle (a range of zero length): the passes asked for.
   subroutine single_angle(p, q, r, s, omega, t, branch, passes, row)
@@ -487,20 +746,30 @@ contains
     end if
   end subroutine single_angle
 
-  !> omega3, alpha3, omega2, alpha2 (unit crank speed) and status at crank angles t(1:np) [rad].
-  !> work: the caller's buffer of at least 11 np values (viewed here as exact_states' (np, 11)
-  !> output, so neither a copy-in/out temporary nor a heap-allocated automatic array is made).
-  subroutine speeds_at(np, t, p, q, r, s, branch, work, w3, a3, w2, a2, ist)
+  !> omega3, alpha3, omega2, alpha2 (unit crank speed) and status at crank angles t(1:np) [rad]:
+  !> fourbar's pose and rates stages only (the angles are not needed), the bits of exact_states'.
+  subroutine speeds_at(np, t, p, q, r, s, branch, w3, a3, w2, a2, ist)
     integer, intent(in) :: np, branch
     real(dp), intent(in) :: t(np), p, q, r, s
-    real(dp), intent(inout) :: work(np, 11)
     real(dp), intent(inout) :: w3(np), a3(np), w2(np), a2(np)
     integer, intent(inout) :: ist(np)
-    call exact_states(np, t, p, q, r, s, 1.0_dp, 0.0_dp, branch, work, ist)
-    w3 = work(:, 9)
-    a3 = work(:, 11)
-    w2 = work(:, 8)
-    a2 = work(:, 10)
+    real(dp) :: pb(nblk), qb(nblk), rb(nblk), sb(nblk), gb(nblk), sn(nblk), c(nblk), xa(nblk), ya(nblk), xb(nblk), yb(nblk), &
+                e2x(nblk), e2y(nblk), e3x(nblk), e3y(nblk), s23(nblk), c23(nblk), st(nblk)
+    integer :: k0, m
+    m = min(nblk, np)
+    pb(1:m) = p
+    qb(1:m) = q
+    rb(1:m) = r
+    sb(1:m) = s
+    gb(1:m) = merge(1.0_dp, -1.0_dp, branch >= 0)
+    do k0 = 1, np, nblk
+      m = min(nblk, np - k0 + 1)
+      call pose_block(m, t(k0:k0 + m - 1), pb, qb, rb, sb, gb, sn, c, xa, ya, xb, yb, e2x, e2y, e3x, e3y, &
+                      s23, c23, st)
+      call rates_block(m, qb, rb, sb, 1.0_dp, 0.0_dp, sn, c, e2x, e2y, e3x, e3y, s23, c23, st, &
+                       w2(k0:k0 + m - 1), w3(k0:k0 + m - 1), a2(k0:k0 + m - 1), a3(k0:k0 + m - 1))
+      ist(k0:k0 + m - 1) = nint(st(1:m))
+    end do
   end subroutine speeds_at
 
   !> Whether omega has no extremum in an interval of length h [rad] with end values fa, fb and
@@ -533,7 +802,7 @@ contains
     integer, intent(in) :: branch
     logical, intent(in) :: dense
     real(dp), intent(inout) :: row(ncol)
-    real(dp) :: th(maxscan), w(maxscan, 4), tg(maxscan), g(maxscan, 4), wk(11*maxscan), h
+    real(dp) :: th(maxscan), w(maxscan, 4), tg(maxscan), g(maxscan, 4), h
     real(dp) :: ba(maxbr), bb(maxbr), fa(maxbr), fb(maxbr), tx(maxbr), ox(maxbr, 4)
     real(dp) :: best(2), bestat(2), v
     integer :: ci(maxscan), gi(maxscan), ist(maxscan), isx(maxbr), bcol(maxbr), side(maxbr)
@@ -559,7 +828,7 @@ contains
     do j = 1, nco
       tg(j) = th(ci(j))
     end do
-    call speeds_at(nco, tg(1:nco), p, q, r, s, branch, wk, g(1:nco, 1), g(1:nco, 2), g(1:nco, 3), &
+    call speeds_at(nco, tg(1:nco), p, q, r, s, branch, g(1:nco, 1), g(1:nco, 2), g(1:nco, 3), &
                    g(1:nco, 4), ist(1:nco))
     do j = 1, nco
       w(ci(j), :) = g(j, :)
@@ -599,7 +868,7 @@ contains
       end do
     end do
     if (ng > 0) then
-      call speeds_at(ng, tg(1:ng), p, q, r, s, branch, wk, g(1:ng, 1), g(1:ng, 2), g(1:ng, 3), &
+      call speeds_at(ng, tg(1:ng), p, q, r, s, branch, g(1:ng, 1), g(1:ng, 2), g(1:ng, 3), &
                      g(1:ng, 4), ist(1:ng))
       do j = 1, ng
         w(gi(j), :) = g(j, :)
@@ -632,7 +901,7 @@ contains
         tx(j) = min(max(tx(j), ba(j)), bb(j))
       end do
       if (live == 0) exit
-      call speeds_at(nb, tx(1:nb), p, q, r, s, branch, wk, ox(1:nb, 1), ox(1:nb, 2), ox(1:nb, 3), &
+      call speeds_at(nb, tx(1:nb), p, q, r, s, branch, ox(1:nb, 1), ox(1:nb, 2), ox(1:nb, 3), &
                      ox(1:nb, 4), isx(1:nb))
       do j = 1, nb
         if (bb(j) - ba(j) <= 1.0e-12_dp) cycle
@@ -656,7 +925,7 @@ contains
     do j = 1, nb
       tx(j) = 0.5_dp*(ba(j) + bb(j))
     end do
-    if (nb > 0) call speeds_at(nb, tx(1:nb), p, q, r, s, branch, wk, ox(1:nb, 1), ox(1:nb, 2), ox(1:nb, 3), &
+    if (nb > 0) call speeds_at(nb, tx(1:nb), p, q, r, s, branch, ox(1:nb, 1), ox(1:nb, 2), ox(1:nb, 3), &
                                ox(1:nb, 4), isx(1:nb))
     ! pick the largest |omega| among the range ends and the refined roots (earliest on ties)
     do c = 1, 2
@@ -698,11 +967,11 @@ contains
     recursive subroutine hidden(a, b, ya, yb, da, db, col, depth)
       real(dp), intent(in) :: a, b, ya, yb, da, db
       integer, intent(in) :: col, depth
-      real(dp) :: tm(1), o(1, 4), o1(11), ym, dm
+      real(dp) :: tm(1), o(1, 4), ym, dm
       integer :: sm(1)
       if (depth > max_depth) return
       tm(1) = 0.5_dp*(a + b)
-      call speeds_at(1, tm, p, q, r, s, branch, o1, o(:, 1), o(:, 2), o(:, 3), o(:, 4), sm)
+      call speeds_at(1, tm, p, q, r, s, branch, o(:, 1), o(:, 2), o(:, 3), o(:, 4), sm)
       if (sm(1) /= st_ok) return
       ym = o(1, 2*col - 1)
       dm = o(1, 2*col)

@@ -49,6 +49,7 @@ class _fourbar:
     ) -> tuple[NDArray[np.float64], NDArray[np.int32]]:
         """``table,status = listing_table(p,q,r,s,omq,istart,incr,n)``; shapes table(n,10), status(n)"""
         ...
+    nb: NDArray[np.int32]
     st_indeterminate: NDArray[np.int32]
     st_no_assembly: NDArray[np.int32]
     st_ok: NDArray[np.int32]
