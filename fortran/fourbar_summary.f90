@@ -95,10 +95,20 @@ module fourbar_summary
   type :: plan
     real(dp) :: p, q, r, s, lo, hie, sgn
     integer :: branch, niv, nc(maxiv), q0, m0, nq, nm
-    logical :: states, fast
+    logical :: states, fast, peaks
+    real(dp) :: omega
     real(dp) :: cand(maxcl), ia(maxiv), ib(maxiv)
     integer :: kind(maxcl), c0(maxiv)
   end type plan
+
+  integer, parameter :: lbp = 32              ! linkages per batched peak search
+  !> one linkage's peak search (peaks_block): its grid, coarse and refined speeds, brackets
+  type :: peakplan
+    real(dp) :: p, q, r, s, sgn, omega, lo, hie, h
+    integer :: branch, row, m, nco, nref, nb
+    integer :: ci(maxscan), rj(maxscan), bcol(maxbr), side(maxbr)
+    real(dp) :: w(maxscan, 4), ba(maxbr), bb(maxbr), fa(maxbr), fb(maxbr), tx(maxbr)
+  end type peakplan
 
 contains
 
@@ -129,13 +139,14 @@ contains
     integer, intent(in) :: passes
     real(dp), intent(out) :: res(n, 19)        ! ncol columns
     type(plan), allocatable :: pl(:)
+    type(peakplan), allocatable :: pk(:)
     real(dp), allocatable :: rows(:, :), qc(:, :), qm(:, :)
     real(dp) :: par(npar)
-    integer :: i0, m, l, nq, nm
+    integer :: i0, m, l, nq, nm, npk
     ! per block: the plans, the rows, and the two queues of states (columns: crank angle [rad],
     ! p, q, r, s, branch sign, then the result and the status): the rocker angle at the
     ! candidates, the rocker speed halfway between them
-    allocate (pl(lb), rows(ncol, lb), qc(lb*maxcl, 8), qm(lb*maxcl + maxcl, 8))   ! qm: room for halfway
+    allocate (pl(lb), pk(lbp), rows(ncol, lb), qc(lb*maxcl, 8), qm(lb*maxcl + maxcl, 8))   ! qm: room for halfway
     do i0 = 1, n, lb
       m = min(lb, n - i0 + 1)
       nq = 0
@@ -146,10 +157,29 @@ contains
       end do
       call batch_states(nq, qc, .false.)
       call batch_states(nm, qm, .true.)
+      npk = 0
       do l = 1, m
         call finish(params(i0 + l - 1, 5), passes, pl(l), rows(:, l), qc, qm)
-        res(i0 + l - 1, :) = rows(:, l)
+        if (pl(l)%peaks) then
+          npk = npk + 1
+          pk(npk)%p = pl(l)%p
+          pk(npk)%q = pl(l)%q
+          pk(npk)%r = pl(l)%r
+          pk(npk)%s = pl(l)%s
+          pk(npk)%sgn = pl(l)%sgn
+          pk(npk)%omega = pl(l)%omega
+          pk(npk)%lo = pl(l)%lo
+          pk(npk)%hie = pl(l)%hie
+          pk(npk)%branch = pl(l)%branch
+          pk(npk)%row = l
+          if (npk == lbp) then
+            call peaks_block(npk, pk, iand(passes, pass_dense_scan) /= 0, rows)
+            npk = 0
+          end if
+        end if
       end do
+      if (npk > 0) call peaks_block(npk, pk, iand(passes, pass_dense_scan) /= 0, rows)
+      res(i0:i0 + m - 1, :) = transpose(rows(:, 1:m))
     end do
   end subroutine summaries
 
@@ -206,6 +236,7 @@ contains
     pl%branch = merge(1, -1, par(8) >= 0.0_dp)
     pl%sgn = real(pl%branch, dp)
     pl%niv = 0
+    pl%peaks = .false.
     pl%states = .false.
     pl%fast = .false.
     pl%nq = 0
@@ -424,9 +455,10 @@ contains
       end if
     end if
 
-    ! ---- peak speeds: only without a toggle in the range (then the range is one interval)
-    if (iand(passes, pass_peaks) /= 0 .and. nint(row(14)) == 0 .and. pl%niv == 1) &
-      call peaks(pl%p, pl%q, pl%r, pl%s, omega, pl%lo, pl%hie, pl%branch, iand(passes, pass_dense_scan) /= 0, row)
+    ! ---- peak speeds: only without a toggle in the range (then the range is one interval);
+    ! searched for the block's linkages together (peaks_block)
+    pl%peaks = iand(passes, pass_peaks) /= 0 .and. nint(row(14)) == 0 .and. pl%niv == 1
+    pl%omega = omega
   end subroutine finish
 
   !> The rocker's angle unwrapped along each assembled interval of a plan (monotonic between
@@ -794,199 +826,301 @@ contains
     smooth = qmin >= 0.5_dp*min(a, b)
   end function smooth
 
-  !> Peak |omega3| and |omega2| over [lo, hie] (assembled throughout, no toggle): the grid of
-  !> at most 1 deg, scanned coarsely and refined where needed (module header), then every
-  !> sign change of the matching angular acceleration refined to 1e-12 rad.
-  subroutine peaks(p, q, r, s, omega, lo, hie, branch, dense, row)
-    real(dp), intent(in) :: p, q, r, s, omega, lo, hie
-    integer, intent(in) :: branch
+  !> Peak |omega3| and |omega2| over [lo, hie] (assembled throughout, no toggle) of the n
+  !> linkages of pk (one block): the grid of at most 1 deg, scanned coarsely and refined where
+  !> needed (module header), then every sign change of the matching angular acceleration
+  !> refined to 1e-12 rad.  Each stage evaluates the speeds of every linkage of the block in one
+  !> batched call (the coarse scan, the refined grid points, each regula falsi iteration, the
+  !> roots); a bracket advances exactly as it would alone, so the figures are the same bits.
+  subroutine peaks_block(n, pk, dense, rows)
+    integer, intent(in) :: n
+    type(peakplan), intent(inout) :: pk(:)
     logical, intent(in) :: dense
-    real(dp), intent(inout) :: row(ncol)
-    real(dp) :: th(maxscan), w(maxscan, 4), tg(maxscan), g(maxscan, 4), h
-    real(dp) :: ba(maxbr), bb(maxbr), fa(maxbr), fb(maxbr), tx(maxbr), ox(maxbr, 4)
-    real(dp) :: best(2), bestat(2), v
-    integer :: ci(maxscan), gi(maxscan), ist(maxscan), isx(maxbr), bcol(maxbr), side(maxbr)
-    real(dp) :: okc(maxscan), hc, da, db, sg, av, bv, cv, qv, xs, qm
-    integer :: rj(maxscan), m, nco, ng, nref, k, ka, kb, nb, it, j, jr, c, live
+    real(dp), intent(inout) :: rows(:, :)
+    real(dp), allocatable :: qs(:, :), qg(:, :)
+    integer, allocatable :: who(:, :)
+    real(dp) :: tg(maxscan), g(maxscan, 4)
+    real(dp) :: okc(maxscan), hc, da, db, sg, av, bv, cv, qv, xs, qm, v, best(2), bestat(2), t
+    integer :: l, k, j, c, nq, nco, ka, kb, jr, it, iq, nr
+    allocate (qs(maxscan*n + maxbr*n, 11), qg(maxscan*n, 11), who(maxscan*n + maxbr*n, 2))
 
-    m = min(maxscan, max(2, ceiling((hie - lo)/scan_step) + 1))
-    h = (hie - lo)/(m - 1)
-    ! hot-loop: fourbar_summary scan angles
-    do k = 1, m
-      th(k) = (lo + (k - 1)*h)*rad
-    end do
-    th(m) = hie*rad
-    ! the coarse scan (first and last grid points included) in one kernel call
-    nco = 0
-    k = 1
-    do
-      nco = nco + 1
-      ci(nco) = k
-      if (k == m) exit
-      k = min(k + coarse_every, m)
-    end do
-    do j = 1, nco
-      tg(j) = th(ci(j))
-    end do
-    call speeds_at(nco, tg(1:nco), p, q, r, s, branch, g(1:nco, 1), g(1:nco, 2), g(1:nco, 3), &
-                   g(1:nco, 4), ist(1:nco))
-    do j = 1, nco
-      w(ci(j), :) = g(j, :)
-    end do
-    ! the smooth test (see smooth) of every coarse interval, both speeds, in one loop
-    ! hot-loop: fourbar_summary coarse test
-    do j = 1, nco - 1
-      hc = tg(j + 1) - tg(j)
-      okc(j) = 1.0_dp
-      do c = 1, 2
-        da = g(j, 2*c)
-        db = g(j + 1, 2*c)
-        sg = sign(1.0_dp, da)
-        av = sg*da
-        bv = sg*db
-        cv = 6.0_dp*(sg*(g(j + 1, 2*c - 1) - g(j, 2*c - 1))/hc - 0.5_dp*(av + bv))
-        qv = min(av, bv)
-        xs = 0.5_dp + (bv - av)/(2.0_dp*min(cv, -tiny(1.0_dp)))
-        qm = merge(min(qv, av*(1.0_dp - xs) + bv*xs + cv*xs*(1.0_dp - xs)), qv, &
-                   cv < 0.0_dp .and. xs > 0.0_dp .and. xs < 1.0_dp)
-        okc(j) = okc(j)*merge(1.0_dp, 0.0_dp, da*db > 0.0_dp .and. qm >= 0.5_dp*qv)
+    ! ---- the coarse scan (first and last grid points included) of every linkage, one call
+    nq = 0
+    do l = 1, n
+      pk(l)%m = min(maxscan, max(2, ceiling((pk(l)%hie - pk(l)%lo)/scan_step) + 1))
+      pk(l)%h = (pk(l)%hie - pk(l)%lo)/(pk(l)%m - 1)
+      nco = 0
+      k = 1
+      do
+        nco = nco + 1
+        pk(l)%ci(nco) = k
+        nq = nq + 1
+        qs(nq, 1) = grid_angle(pk(l), k)
+        who(nq, 1) = l
+        who(nq, 2) = k
+        if (k == pk(l)%m) exit
+        k = min(k + coarse_every, pk(l)%m)
       end do
+      pk(l)%nco = nco
+      call fill(pk(l), nq - nco + 1, nq)
     end do
-    ! the grid points inside every coarse interval that is not smooth for both speeds
-    ng = 0
-    nref = 0
-    do j = 1, nco - 1
-      ka = ci(j)
-      kb = ci(j + 1)
-      if (okc(j) > 0.0_dp .and. kb - ka >= 2 .and. .not. dense) cycle
-      nref = nref + 1
-      rj(nref) = j
-      do k = ka + 1, kb - 1
-        ng = ng + 1
-        gi(ng) = k
-        tg(ng) = th(k)
+    call batch_speeds(nq, qs)
+    do iq = 1, nq
+      pk(who(iq, 1))%w(who(iq, 2), :) = qs(iq, 7:10)
+    end do
+
+    ! ---- the smooth test (see smooth) of every coarse interval, both speeds; the grid points
+    ! inside every coarse interval that is not smooth for both speeds, of every linkage, one call
+    iq = 0
+    nq = 0
+    do l = 1, n
+      nco = pk(l)%nco
+      do j = 1, nco
+        tg(j) = qs(iq + j, 1)
+        g(j, :) = qs(iq + j, 7:10)
       end do
+      iq = iq + nco
+      ! hot-loop: fourbar_summary coarse test
+      do j = 1, nco - 1
+        hc = tg(j + 1) - tg(j)
+        okc(j) = 1.0_dp
+        do c = 1, 2
+          da = g(j, 2*c)
+          db = g(j + 1, 2*c)
+          sg = sign(1.0_dp, da)
+          av = sg*da
+          bv = sg*db
+          cv = 6.0_dp*(sg*(g(j + 1, 2*c - 1) - g(j, 2*c - 1))/hc - 0.5_dp*(av + bv))
+          qv = min(av, bv)
+          xs = 0.5_dp + (bv - av)/(2.0_dp*min(cv, -tiny(1.0_dp)))
+          qm = merge(min(qv, av*(1.0_dp - xs) + bv*xs + cv*xs*(1.0_dp - xs)), qv, &
+                     cv < 0.0_dp .and. xs > 0.0_dp .and. xs < 1.0_dp)
+          okc(j) = okc(j)*merge(1.0_dp, 0.0_dp, da*db > 0.0_dp .and. qm >= 0.5_dp*qv)
+        end do
+      end do
+      pk(l)%nref = 0
+      nr = nq
+      do j = 1, nco - 1
+        ka = pk(l)%ci(j)
+        kb = pk(l)%ci(j + 1)
+        if (okc(j) > 0.0_dp .and. kb - ka >= 2 .and. .not. dense) cycle
+        pk(l)%nref = pk(l)%nref + 1
+        pk(l)%rj(pk(l)%nref) = j
+        do k = ka + 1, kb - 1
+          nq = nq + 1
+          qg(nq, 1) = grid_angle(pk(l), k)
+          who(nq, 1) = l
+          who(nq, 2) = k
+        end do
+      end do
+      if (nq > nr) call fill_q(qg, pk(l), nr + 1, nq)
     end do
-    if (ng > 0) then
-      call speeds_at(ng, tg(1:ng), p, q, r, s, branch, g(1:ng, 1), g(1:ng, 2), g(1:ng, 3), &
-                     g(1:ng, 4), ist(1:ng))
-      do j = 1, ng
-        w(gi(j), :) = g(j, :)
+    if (nq > 0) then
+      call batch_speeds(nq, qg)
+      do iq = 1, nq
+        pk(who(iq, 1))%w(who(iq, 2), :) = qg(iq, 7:10)
       end do
     end if
-    ! brackets of alpha sign changes on the grid of the refined intervals, both speeds (grid
-    ! order, as a full scan)
-    nb = 0
-    do c = 1, 2
-      do jr = 1, nref
-        do k = ci(rj(jr)), ci(rj(jr) + 1) - 1
-          if (w(k, 2*c)*w(k + 1, 2*c) < 0.0_dp) then
-            call add_bracket(th(k), th(k + 1), w(k, 2*c), w(k + 1, 2*c), c)
-          else if (dense) then
-            cycle
-          else if (.not. smooth(w(k, 2*c - 1), w(k + 1, 2*c - 1), w(k, 2*c), w(k + 1, 2*c), th(k + 1) - th(k))) then
-            call hidden(th(k), th(k + 1), w(k, 2*c - 1), w(k + 1, 2*c - 1), w(k, 2*c), w(k + 1, 2*c), c, 1)
-          end if
+
+    ! ---- brackets of alpha sign changes on the grid of the refined intervals, both speeds (grid
+    ! order, as a full scan); a suspicious interval bisected (hidden), linkage by linkage
+    do l = 1, n
+      pk(l)%nb = 0
+      do c = 1, 2
+        do jr = 1, pk(l)%nref
+          do k = pk(l)%ci(pk(l)%rj(jr)), pk(l)%ci(pk(l)%rj(jr) + 1) - 1
+            associate (w => pk(l)%w)
+              if (w(k, 2*c)*w(k + 1, 2*c) < 0.0_dp) then
+                call add_bracket(pk(l), grid_angle(pk(l), k), grid_angle(pk(l), k + 1), w(k, 2*c), w(k + 1, 2*c), c)
+              else if (dense) then
+                cycle
+              else if (.not. smooth(w(k, 2*c - 1), w(k + 1, 2*c - 1), w(k, 2*c), w(k + 1, 2*c), &
+                                    grid_angle(pk(l), k + 1) - grid_angle(pk(l), k))) then
+                call hidden(pk(l), grid_angle(pk(l), k), grid_angle(pk(l), k + 1), w(k, 2*c - 1), w(k + 1, 2*c - 1), &
+                            w(k, 2*c), w(k + 1, 2*c), c, 1)
+              end if
+            end associate
+          end do
         end do
       end do
     end do
-    ! Illinois regula falsi, every bracket advanced in one kernel call per iteration
+
+    ! ---- Illinois regula falsi: every bracket not yet converged, of every linkage, advanced in
+    ! one call per iteration
     do it = 1, 60
-      live = 0
-      do j = 1, nb
-        if (bb(j) - ba(j) > 1.0e-12_dp) then
-          live = live + 1
-        end if
-        tx(j) = (ba(j)*fb(j) - bb(j)*fa(j))/(fb(j) - fa(j))
-        tx(j) = min(max(tx(j), ba(j)), bb(j))
+      nq = 0
+      do l = 1, n
+        nr = nq
+        do j = 1, pk(l)%nb
+          associate (ba => pk(l)%ba(j), bb => pk(l)%bb(j), fa => pk(l)%fa(j), fb => pk(l)%fb(j))
+            t = (ba*fb - bb*fa)/(fb - fa)
+            t = min(max(t, ba), bb)
+            pk(l)%tx(j) = t
+            if (bb - ba > 1.0e-12_dp) then
+              nq = nq + 1
+              qs(nq, 1) = t
+              who(nq, 1) = l
+              who(nq, 2) = j
+            end if
+          end associate
+        end do
+        if (nq > nr) call fill(pk(l), nr + 1, nq)
       end do
-      if (live == 0) exit
-      call speeds_at(nb, tx(1:nb), p, q, r, s, branch, ox(1:nb, 1), ox(1:nb, 2), ox(1:nb, 3), &
-                     ox(1:nb, 4), isx(1:nb))
-      do j = 1, nb
-        if (bb(j) - ba(j) <= 1.0e-12_dp) cycle
-        v = ox(j, 2*bcol(j))
-        if (v == 0.0_dp) then
-          ba(j) = tx(j); bb(j) = tx(j); fa(j) = 0; fb(j) = 0
-          cycle
-        end if
-        if (sign(1.0_dp, v) == sign(1.0_dp, fa(j))) then
-          ba(j) = tx(j); fa(j) = v
-          if (side(j) == -1) fb(j) = 0.5_dp*fb(j)
-          side(j) = -1
-        else
-          bb(j) = tx(j); fb(j) = v
-          if (side(j) == 1) fa(j) = 0.5_dp*fa(j)
-          side(j) = 1
-        end if
+      if (nq == 0) exit
+      call batch_speeds(nq, qs)
+      do iq = 1, nq
+        l = who(iq, 1)
+        j = who(iq, 2)
+        v = qs(iq, 6 + 2*pk(l)%bcol(j))
+        associate (ba => pk(l)%ba(j), bb => pk(l)%bb(j), fa => pk(l)%fa(j), fb => pk(l)%fb(j), &
+                   tx => pk(l)%tx(j), side => pk(l)%side(j))
+          if (v == 0.0_dp) then
+            ba = tx; bb = tx; fa = 0; fb = 0
+            cycle
+          end if
+          if (sign(1.0_dp, v) == sign(1.0_dp, fa)) then
+            ba = tx; fa = v
+            if (side == -1) fb = 0.5_dp*fb
+            side = -1
+          else
+            bb = tx; fb = v
+            if (side == 1) fa = 0.5_dp*fa
+            side = 1
+          end if
+        end associate
       end do
     end do
-    ! final points: the converged roots
-    do j = 1, nb
-      tx(j) = 0.5_dp*(ba(j) + bb(j))
+
+    ! ---- final points: the converged roots, every linkage in one call
+    nq = 0
+    do l = 1, n
+      nr = nq
+      do j = 1, pk(l)%nb
+        pk(l)%tx(j) = 0.5_dp*(pk(l)%ba(j) + pk(l)%bb(j))
+        nq = nq + 1
+        qs(nq, 1) = pk(l)%tx(j)
+      end do
+      if (nq > nr) call fill(pk(l), nr + 1, nq)
     end do
-    if (nb > 0) call speeds_at(nb, tx(1:nb), p, q, r, s, branch, ox(1:nb, 1), ox(1:nb, 2), ox(1:nb, 3), &
-                               ox(1:nb, 4), isx(1:nb))
+    if (nq > 0) call batch_speeds(nq, qs)
     ! pick the largest |omega| among the range ends and the refined roots (earliest on ties)
-    do c = 1, 2
-      best(c) = w(1, 2*c - 1)
-      bestat(c) = th(1)
-      if (abs(w(m, 2*c - 1)) > abs(best(c))) then
-        best(c) = w(m, 2*c - 1); bestat(c) = th(m)
-      end if
+    iq = 0
+    do l = 1, n
+      associate (w => pk(l)%w, m => pk(l)%m)
+        do c = 1, 2
+          best(c) = w(1, 2*c - 1)
+          bestat(c) = grid_angle(pk(l), 1)
+          if (abs(w(m, 2*c - 1)) > abs(best(c))) then
+            best(c) = w(m, 2*c - 1); bestat(c) = grid_angle(pk(l), m)
+          end if
+        end do
+      end associate
+      nr = pk(l)%nb
+      do j = 1, nr
+        iq = iq + 1
+        c = pk(l)%bcol(j)
+        v = qs(iq, 6 + 2*c - 1)
+        if (nint(qs(iq, 11)) /= st_ok) cycle
+        if (abs(v) > abs(best(c)) .or. (abs(v) == abs(best(c)) .and. pk(l)%tx(j) < bestat(c))) then
+          best(c) = v
+          bestat(c) = pk(l)%tx(j)
+        end if
+      end do
+      rows(15, pk(l)%row) = pk(l)%omega*best(1)
+      rows(16, pk(l)%row) = bestat(1)/rad
+      rows(17, pk(l)%row) = pk(l)%omega*best(2)
+      rows(18, pk(l)%row) = bestat(2)/rad
     end do
-    do j = 1, nb
-      c = bcol(j)
-      v = ox(j, 2*c - 1)
-      if (isx(j) /= st_ok) cycle
-      if (abs(v) > abs(best(c)) .or. (abs(v) == abs(best(c)) .and. tx(j) < bestat(c))) then
-        best(c) = v
-        bestat(c) = tx(j)
-      end if
-    end do
-    row(15) = omega*best(1)
-    row(16) = bestat(1)/rad
-    row(17) = omega*best(2)
-    row(18) = bestat(2)/rad
 
   contains
 
-    subroutine add_bracket(a, b, da, db, col)
-      real(dp), intent(in) :: a, b, da, db
-      integer, intent(in) :: col
-      if (nb >= maxbr) return
-      nb = nb + 1
-      ba(nb) = a; bb(nb) = b
-      fa(nb) = da; fb(nb) = db
-      bcol(nb) = col
-      side(nb) = 0
-    end subroutine add_bracket
+    !> the linkage's parameters in queue rows k1..k2 of qs
+    subroutine fill(pl1, k1, k2)
+      type(peakplan), intent(in) :: pl1
+      integer, intent(in) :: k1, k2
+      call fill_q(qs, pl1, k1, k2)
+    end subroutine fill
+  end subroutine peaks_block
 
-    !> A grid interval whose ends agree in the sign of alpha but which is not smooth: bisected
-    !> (max_depth levels) looking for a hidden pair of sign changes, each one a bracket.
-    recursive subroutine hidden(a, b, ya, yb, da, db, col, depth)
-      real(dp), intent(in) :: a, b, ya, yb, da, db
-      integer, intent(in) :: col, depth
-      real(dp) :: tm(1), o(1, 4), ym, dm
-      integer :: sm(1)
-      if (depth > max_depth) return
-      tm(1) = 0.5_dp*(a + b)
-      call speeds_at(1, tm, p, q, r, s, branch, o(:, 1), o(:, 2), o(:, 3), o(:, 4), sm)
-      if (sm(1) /= st_ok) return
-      ym = o(1, 2*col - 1)
-      dm = o(1, 2*col)
-      if (da*dm < 0.0_dp) then
-        call add_bracket(a, tm(1), da, dm, col)
-      else if (.not. smooth(ya, ym, da, dm, tm(1) - a)) then
-        call hidden(a, tm(1), ya, ym, da, dm, col, depth + 1)
-      end if
-      if (dm*db < 0.0_dp) then
-        call add_bracket(tm(1), b, dm, db, col)
-      else if (.not. smooth(ym, yb, dm, db, b - tm(1))) then
-        call hidden(tm(1), b, ym, yb, dm, db, col, depth + 1)
-      end if
-    end subroutine hidden
+  !> A linkage's parameters (p, q, r, s, branch sign) in rows k1..k2 of a speeds queue.
+  subroutine fill_q(q, pl1, k1, k2)
+    real(dp), intent(inout) :: q(:, :)
+    type(peakplan), intent(in) :: pl1
+    integer, intent(in) :: k1, k2
+    q(k1:k2, 2) = pl1%p
+    q(k1:k2, 3) = pl1%q
+    q(k1:k2, 4) = pl1%r
+    q(k1:k2, 5) = pl1%s
+    q(k1:k2, 6) = pl1%sgn
+  end subroutine fill_q
 
-  end subroutine peaks
+  !> The k-th angle [rad] of a linkage's peak-search grid (its last point exactly the range's end).
+  pure real(dp) function grid_angle(pk, k)
+    type(peakplan), intent(in) :: pk
+    integer, intent(in) :: k
+    if (k == pk%m) then
+      grid_angle = pk%hie*rad
+    else
+      grid_angle = (pk%lo + (k - 1)*pk%h)*rad
+    end if
+  end function grid_angle
+
+  !> The speeds of the n positions queued in q (columns 1-6: crank angle [rad], p, q, r, s,
+  !> branch sign) at unit crank speed: columns 7-10 omega3, alpha3, omega2, alpha2 (the order of
+  !> speeds_at), 11 the status code; blocks of nblk positions, each with its own linkage.
+  subroutine batch_speeds(n, q)
+    integer, intent(in) :: n
+    real(dp), intent(inout), contiguous :: q(:, :)
+    real(dp) :: sn(nblk), c(nblk), xa(nblk), ya(nblk), xb(nblk), yb(nblk), e2x(nblk), e2y(nblk), e3x(nblk), &
+                e3y(nblk), s23(nblk), c23(nblk)
+    integer :: k0, m
+    do k0 = 1, n, nblk
+      m = min(nblk, n - k0 + 1)
+      call pose_block(m, q(k0:k0 + m - 1, 1), q(k0:k0 + m - 1, 2), q(k0:k0 + m - 1, 3), q(k0:k0 + m - 1, 4), &
+                      q(k0:k0 + m - 1, 5), q(k0:k0 + m - 1, 6), sn, c, xa, ya, xb, yb, e2x, e2y, e3x, e3y, &
+                      s23, c23, q(k0:k0 + m - 1, 11))
+      call rates_block(m, q(k0:k0 + m - 1, 3), q(k0:k0 + m - 1, 4), q(k0:k0 + m - 1, 5), 1.0_dp, 0.0_dp, &
+                       sn, c, e2x, e2y, e3x, e3y, s23, c23, q(k0:k0 + m - 1, 11), q(k0:k0 + m - 1, 9), &
+                       q(k0:k0 + m - 1, 7), q(k0:k0 + m - 1, 10), q(k0:k0 + m - 1, 8))
+    end do
+  end subroutine batch_speeds
+
+  subroutine add_bracket(pk, a, b, da, db, col)
+    type(peakplan), intent(inout) :: pk
+    real(dp), intent(in) :: a, b, da, db
+    integer, intent(in) :: col
+    if (pk%nb >= maxbr) return
+    pk%nb = pk%nb + 1
+    pk%ba(pk%nb) = a; pk%bb(pk%nb) = b
+    pk%fa(pk%nb) = da; pk%fb(pk%nb) = db
+    pk%bcol(pk%nb) = col
+    pk%side(pk%nb) = 0
+  end subroutine add_bracket
+
+  !> A grid interval whose ends agree in the sign of alpha but which is not smooth: bisected
+  !> (max_depth levels) looking for a hidden pair of sign changes, each one a bracket.
+  recursive subroutine hidden(pk, a, b, ya, yb, da, db, col, depth)
+    type(peakplan), intent(inout) :: pk
+    real(dp), intent(in) :: a, b, ya, yb, da, db
+    integer, intent(in) :: col, depth
+    real(dp) :: tm(1), o(1, 4), ym, dm
+    integer :: sm(1)
+    if (depth > max_depth) return
+    tm(1) = 0.5_dp*(a + b)
+    call speeds_at(1, tm, pk%p, pk%q, pk%r, pk%s, pk%branch, o(:, 1), o(:, 2), o(:, 3), o(:, 4), sm)
+    if (sm(1) /= st_ok) return
+    ym = o(1, 2*col - 1)
+    dm = o(1, 2*col)
+    if (da*dm < 0.0_dp) then
+      call add_bracket(pk, a, tm(1), da, dm, col)
+    else if (.not. smooth(ya, ym, da, dm, tm(1) - a)) then
+      call hidden(pk, a, tm(1), ya, ym, da, dm, col, depth + 1)
+    end if
+    if (dm*db < 0.0_dp) then
+      call add_bracket(pk, tm(1), b, dm, db, col)
+    else if (.not. smooth(ym, yb, dm, db, b - tm(1))) then
+      call hidden(pk, tm(1), b, ym, yb, dm, db, col, depth + 1)
+    end if
+  end subroutine hidden
 
 end module fourbar_summary
