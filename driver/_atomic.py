@@ -58,7 +58,7 @@ class NameTooLong(DriverError, OSError):
         return (type(self), (str(self.filename),))
 
 
-class UnsafeName(OSError):
+class UnsafeName(DriverError, OSError):
     """An output's path holds a control or bidi character (:mod:`driver._names`): refused before its
     file is opened, the path shown escaped."""
 
@@ -66,7 +66,12 @@ class UnsafeName(OSError):
         import errno
 
         from driver._names import shown
+        self.path = str(path)
         super().__init__(errno.EINVAL, why, shown(path))
+
+    def __reduce__(self) -> tuple[type[UnsafeName], tuple[str, str]]:
+        """Pickle by the path and the reason (the message is made from them)."""
+        return (type(self), (self.path, str(self.strerror)))
 
 
 class OutputSet:
