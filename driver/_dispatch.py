@@ -55,7 +55,7 @@ def run_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, pro
         require("parquet")   # sweeps keep their cases in Parquet: say so before importing them
         from driver import sweep
         outcome = sweep.run_sweep_deck(deck, outdir, formats, plot, progress, jobs=jobs, scheduler=scheduler,
-                                       resume=resume, notify=notify)
+                                       resume=resume, notify=notify, best=report)
         if summary_json:
             from driver.sweep._record import write_sweep_json
             outcome.written.append(write_sweep_json(deck, outdir, int(outcome.exit_code)))

@@ -165,21 +165,21 @@ def test_resume_runs_only_missing_cases(tmp_path, capsys):
 def test_interrupt_keeps_finished_cases_and_leaves_no_partial_file(tmp_path, monkeypatch):
     path = deck(tmp_path, SWEEP_GRID)
     out = tmp_path / "o"
-    from driver.sweep import _engine as engine
-    real = engine._compute
+    from driver.sweep import _chunks as chunks
+    real = chunks.compute_case
 
     def interrupted(task, case, module):
         if case.index == 6:
             raise KeyboardInterrupt
         return real(task, case, module)
 
-    monkeypatch.setattr(engine, "_compute", interrupted)
+    monkeypatch.setattr(chunks, "compute_case", interrupted)
     assert main([str(path), "-o", str(out), "-q", "-j", "1"]) == 130
     names = sorted(p.name for p in (out / "sw").iterdir())
     assert [n for n in names if n.endswith(".json")] == [f"case_{k:04d}.json" for k in range(1, 6)]
     assert not any(n.startswith(".") or n.endswith(".tmp") for n in names)
     assert not (out / "sw.out").exists() and not (out / "sw_summary.csv").exists()
-    monkeypatch.setattr(engine, "_compute", real)
+    monkeypatch.setattr(chunks, "compute_case", real)
     assert main([str(path), "-o", str(out), "-q", "-j", "1", "--resume"]) == 0
     assert len(pd.read_csv(out / "sw_summary.csv")) == 15
 
@@ -197,10 +197,44 @@ def test_design_search_filter_and_kept_rows(tmp_path):
     assert sorted(p.name for p in (out / "sw").glob("*.out")) == ["case_0002.out"]
 
 
+#: the driver of the Ctrl-C test: the command line, its workers forked after a gate is put in
+#: front of every case (``gate/slot-<k>`` claims one of the first 20 places; every later case
+#: says so in ``gate/waiting-<case>`` and waits for ``gate/go``).  So the sweep cannot finish
+#: before the test's SIGINT, which arrives while both workers wait and the driver is idle.
+GATED = """
+import os, sys, time
+from pathlib import Path
+from driver.sweep import _chunks
+gate, real = Path(sys.argv[1]), _chunks.compute_case
+
+def gated(task, case, module):
+    for k in range(20):
+        try:
+            os.close(os.open(gate / f"slot-{k}", os.O_CREAT | os.O_EXCL))
+            return real(task, case, module)
+        except FileExistsError:
+            pass
+    (gate / f"waiting-{case.index}").touch()
+    while not (gate / "go").exists():
+        time.sleep(0.01)
+    return real(task, case, module)
+
+_chunks.compute_case = gated
+from driver._cli import main
+sys.exit(main(sys.argv[2:]))
+"""
+
+
 def test_ctrl_c_on_worker_processes(tmp_path):
-    """Real SIGINT to the whole process group of a 2-worker sweep: prompt exit 130, every
-    started case complete (.json marker <=> .out), no temporary file, then --resume finishes."""
+    """Real SIGINT to the whole process group of a 2-worker sweep: the driver says at once that
+    it cancels the queued cases, lets the running ones finish, exits 130; every started case is
+    complete (.json marker <=> .out), no temporary file is left, then --resume finishes.
+
+    No sleeps decide anything: the signal is sent once 20 cases are complete and a worker
+    waits at the gate (the sweep cannot have finished), and the waiting cases are released
+    only once the driver has announced the interrupt on stderr."""
     import os
+    import select
     import signal
     import subprocess
     import sys
@@ -208,24 +242,44 @@ def test_ctrl_c_on_worker_processes(tmp_path):
     path = deck(tmp_path, "&sweep key1 = 'fourbar.crank', start1 = 1, stop1 = 5, count1 = 30\n"
                           "       key2 = 'fourbar.rocker', start2 = 6, stop2 = 12, count2 = 30 /\n",
                 base=BASE.replace("method = 'listing'", "method = 'exact'"))
-    out = tmp_path / "o"
-    cmd = [sys.executable, "-m", "driver", str(path), "-o", str(out), "-q", "-j", "2"]
-    proc = subprocess.Popen(cmd, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    out, gate = tmp_path / "o", tmp_path / "gate"
+    gate.mkdir()
+    cmd = [str(path), "-o", str(out), "-q", "-j", "2"]
+    proc = subprocess.Popen([sys.executable, "-c", GATED, str(gate), *cmd], start_new_session=True,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     case_dir = out / "sw"
-    deadline = time.time() + 60
-    while time.time() < deadline and (not case_dir.exists() or len(list(case_dir.glob("*.json"))) < 20):
-        time.sleep(0.05)
-    os.killpg(proc.pid, signal.SIGINT)
-    proc.communicate(timeout=60)
-    assert proc.returncode == 130
+    try:
+        deadline = time.monotonic() + 300   # a bound for a broken tool only: nothing below waits on time
+        while not (list(gate.glob("waiting-*")) and case_dir.is_dir()
+                   and len(list(case_dir.glob("*.json"))) >= 20):
+            assert proc.poll() is None and time.monotonic() < deadline, "the sweep ended before its cases waited"
+            time.sleep(0.02)
+        os.killpg(proc.pid, signal.SIGINT)
+        heard = ""
+        while "interrupt: cancelling queued cases" not in heard:   # the driver's own notice
+            assert select.select([proc.stderr], [], [], max(0.0, deadline - time.monotonic()))[0], heard
+            line = proc.stderr.readline()
+            assert line, f"stderr closed before the notice: {heard!r}"
+            heard += line
+        (gate / "go").touch()   # the running cases may finish now
+        _, err = proc.communicate(timeout=300)
+    finally:
+        (gate / "go").touch()
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+    assert proc.returncode == 130, heard + err
+    assert "interrupted: finished outputs are complete" in err
     names = [p.name for p in case_dir.iterdir()]
     assert not [n for n in names if n.startswith(".") or n.endswith(".tmp")]
     done = {n[:-5] for n in names if n.endswith(".json")}
     assert 20 <= len(done) < 900
     assert done == {n[:-4] for n in names if n.endswith(".out")}
     assert not (out / "sw_summary.csv").exists()
-    res = subprocess.run(cmd + ["--resume"], capture_output=True, text=True)
-    assert res.returncode == 0
+    # the running chunks finished in their workers, which wrote their record parts: all resumed
+    res = subprocess.run([sys.executable, "-m", "driver", *cmd[:-3], "-j", "2", "--resume"], capture_output=True,
+                         text=True)
+    assert res.returncode == 0, res.stderr
+    assert f"resume: {len(done)} of 900 cases complete, {900 - len(done)} to run" in res.stdout
     assert len(pd.read_csv(out / "sw_summary.csv")) == 900
 
 

@@ -1,10 +1,28 @@
 """What a sweep reports: the summary frame (one row per case), the fixed-format ``.out``, the
-warnings many cases repeat (printed once), and the sweep's own files written as one set."""
+warnings many cases repeat (printed once), the ``_cases`` tables, and the sweep's own files
+written as one set, from rows in memory (:func:`write_sweep_files`) or streamed from the
+record's parts (:func:`write_streamed`).
+
+**Streamed tables.**  A batch sweep's rows (with ``summary_rows = 'kept'`` its kept and failed
+cases) are in the parts of its resume record, one Parquet file per chunk, in case order.  Above
+:data:`driver.sweep._executor.STREAM_ROWS` rows the driver stops holding them and
+:func:`write_streamed` writes the ``.out``, the ``_summary`` CSV and the ``_summary`` Parquet file
+reading one part at a time, so the driver's memory does not grow with the rows.  The files are
+those the in-memory path writes: the same ``.out`` and CSV bytes, the same Parquet table (in one
+row group per part); the ``.out`` table's column widths, which the widest cell decides, are
+taken in a first pass that writes the body to a scratch file (the case column at the width of
+the last case number) and only redone when a cell did not fit.  Parts whose columns differ in
+type (bad-input rows turn a chunk's summary columns into objects) cannot be streamed this way;
+:func:`write_streamed` then returns None and the caller reads the rows into memory.
+"""
 from __future__ import annotations
 
+import json
 import math
+import shutil
+import tempfile
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
@@ -18,7 +36,19 @@ from driver._output import column_label
 from driver._table import Column, render_table
 from driver.sweep._spec import CaseResult
 
-__all__ = ["summary_frame", "summary_settings", "sweep_text", "Warnings", "write_sweep_files"]
+if TYPE_CHECKING:   # annotations only: pyarrow is imported where a table is read or written
+    import pyarrow as pa
+
+__all__ = ["summary_frame", "summary_settings", "sweep_text", "Warnings", "write_sweep_files", "write_streamed",
+           "read_columns", "Streamed", "CasesTable", "TABLE_ALL_MAX", "CASES_TABLE_MAX", "CASES_TABLE_BYTES"]
+
+#: the sweep's .out lists every case up to this many cases (above: the kept and failed ones)
+TABLE_ALL_MAX = 2000
+#: the combined ``<stem>_cases`` tables are written up to this many written cases (above, the
+#: cases' own Parquet files are the table: ``pyarrow.dataset.dataset(<stem>/, format="parquet")``)
+CASES_TABLE_MAX = 2000
+#: ... and up to this many bytes of them in the driver's memory
+CASES_TABLE_BYTES = 256 * 2**20
 
 
 def summary_settings(module: Any, base: Params, swept: set[str] | None = None) -> dict[str, Any]:
@@ -74,7 +104,7 @@ def summary_frame(results: list[CaseResult], names: list[str]) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def _summary_table(frame: pd.DataFrame, limit: int = 2000, n_cases: int | None = None,
+def _summary_table(frame: pd.DataFrame, limit: int = TABLE_ALL_MAX, n_cases: int | None = None,
                    rows: str = "all") -> list[str]:
     """Fixed-format rendering of the summary frame (kept and failed cases only above ``limit``
     cases; ``frame`` may hold only those already, then ``n_cases`` is the study's total)."""
@@ -247,3 +277,207 @@ def failed_lines(failed: list[tuple[int, dict, str]], n_failed: int) -> list[str
     if n_failed > FAILED_LISTED:
         lines.append(f"    ... and {n_failed - FAILED_LISTED} more (status column of the _summary table)")
     return lines
+
+
+# ----------------------------------------------------------------------------- tables streamed from the record
+
+class Streamed:
+    """What the caller needs after a streamed write: the failed cases (the first
+    :data:`FAILED_LISTED`, in case order), their count, and whether any was bad input."""
+
+    def __init__(self) -> None:
+        self.failed: list[tuple[int, dict, str]] = []
+        self.n_failed = 0
+        self.bad_input = False
+        self.n_kept = 0
+        self.n_rows = 0
+        #: the summary table's schema metadata (pandas columns, attrs), as written
+        self.metadata: dict[bytes, bytes] = {}
+
+
+def _origins(schema: pa.Schema) -> dict[str, str]:
+    """Column -> the pandas dtype it was written from (an object column of numbers is 'object')."""
+    meta = schema.pandas_metadata or {}
+    return {c["name"]: c["numpy_type"] for c in meta.get("columns", []) if c.get("name") is not None}
+
+
+def _uniform(paths: list[Path]) -> pa.Schema | None:
+    """The parts' common schema (without the record's metadata), or None when the parts' columns
+    differ in name, type or the dtype they were written from."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+    first = pq.read_schema(paths[0])
+    for p in paths[1:]:
+        s = pq.read_schema(p)
+        if not s.equals(first, check_metadata=False) or _origins(s) != _origins(first):
+            return None
+    origins = _origins(first)
+    for f in first:   # an object column of logicals with a short name: its width depends on every row
+        if origins.get(f.name) == "object" and pa.types.is_boolean(f.type) and len(f.name) < 6:
+            return None
+    meta = {k: v for k, v in (first.metadata or {}).items() if k != b"sweep"}
+    return first.with_metadata(meta)
+
+
+def _frame(table: pa.Table, origins: dict[str, str]) -> pd.DataFrame:
+    """A part as the DataFrame its worker returned: object columns as Python objects again."""
+    frame = table.to_pandas()
+    for name, kind in origins.items():
+        if kind == "object" and name in frame.columns:
+            frame[name] = pd.Series(table.column(name).to_pylist(), dtype=object)
+    return frame
+
+
+def write_streamed(outdir: Path, stem: str, paths: list[Path], deck: Deck, sw: Params, base: Params,
+                   axes: list[tuple[str, list]], names: list[str], n_cases: int, plot: bool | str = False,
+                   module: Any = None, settings: dict[str, Any] | None = None) -> Streamed | None:
+    """Write ``<stem>.out`` and ``<stem>_summary.{csv,parquet}`` from the record parts ``paths``
+    (case order; each with rows), one part at a time, and with ``plot`` the summary figure (its
+    rows are read back for it), all renamed into place together.  ``settings``
+    (:func:`summary_settings`) go into the Parquet metadata as pandas
+    writes a frame's attrs.  Returns None, writing nothing, when the parts' columns differ in
+    type (see the module)."""
+    import pyarrow.parquet as pq
+
+    from driver._export import write_csv_arrow
+    schema = _uniform(paths)
+    if schema is None:
+        return None
+    origins = _origins(schema)
+    if settings:   # as DataFrame.to_parquet records attrs (with_settings)
+        schema = schema.with_metadata({**(schema.metadata or {}),
+                                       b"PANDAS_ATTRS": json.dumps({"summary_settings": dict(settings)}).encode()})
+    limit_rows = n_cases > TABLE_ALL_MAX   # above: the .out lists the kept and failed cases only
+    result = Streamed()
+    result.metadata = dict(schema.metadata or {})
+    cols: list[Column] = []
+    keys: list[str] = []
+    with tempfile.TemporaryFile("w+", dir=outdir, prefix=f".{stem}.body.") as body, output_set(outdir):
+        widths: list[int] = []
+        need: list[int] = []
+        shown = 0
+        with atomic_open(outdir / f"{stem}_summary.csv", "wb") as csv, \
+                atomic_open(outdir / f"{stem}_summary.parquet", "wb") as pfh:
+            writer = pq.ParquetWriter(pfh, schema)
+            try:
+                for k, path in enumerate(paths):
+                    table = pq.read_table(path)
+                    table = table.replace_schema_metadata(schema.metadata)
+                    writer.write_table(table)
+                    write_csv_arrow(table, csv, header=k == 0)
+                    frame = _frame(table, origins)
+                    if k == 0:
+                        cols, keys = table_columns(frame)
+                        widths = [max(c.width, len(c.header)) for c in cols]
+                        if "case" in keys:   # case numbers grow row by row: the last part's last one is widest
+                            last = pq.read_table(paths[-1], columns=["case"]).column("case")
+                            j = keys.index("case")
+                            widths[j] = max(widths[j], len(str(int(last[len(last) - 1].as_py()))))
+                        need = list(widths)
+                    bad = frame["status"] != "ok"
+                    result.n_rows += len(frame)
+                    result.n_kept += int(frame["kept"].sum())
+                    show = frame[frame["kept"] | bad] if limit_rows else frame
+                    shown += len(show)
+                    for row in table_values(show, cols, keys):
+                        cells = [c.cell(v) for c, v in zip(cols, row)]
+                        need = [max(w, len(v)) for w, v in zip(need, cells)]
+                        body.write("".join(" " * c.sep + v.rjust(w) for c, v, w in zip(cols, cells, widths))
+                                   .rstrip() + "\n")
+                    for _, r in frame[bad].iterrows():
+                        result.n_failed += 1
+                        result.bad_input |= r["status"] == "bad input"
+                        if len(result.failed) < FAILED_LISTED:
+                            result.failed.append((int(r["case"]), {k2: r[k2] for k2 in names}, r["error"]))
+            finally:
+                writer.close()
+        with atomic_open(outdir / f"{stem}.out", "w") as out:
+            head = head_lines(deck, sw, base, axes, n_cases, result.n_kept, result.n_failed)
+            out.write("\n".join(head) + "\n")
+            out.write("".join(" " * c.sep + c.header.rjust(w) for c, w in zip(cols, need)).rstrip() + "\n")
+            if need == widths:
+                body.seek(0)
+                shutil.copyfileobj(body, out)
+            else:   # a cell did not fit its column's width: every row again at the widths found
+                for path in paths:
+                    frame = _frame(pq.read_table(path), origins)
+                    show = frame[frame["kept"] | (frame["status"] != "ok")] if limit_rows else frame
+                    for row in table_values(show, cols, keys):
+                        cells = [c.cell(v) for c, v in zip(cols, row)]
+                        out.write("".join(" " * c.sep + v.rjust(w) for c, v, w in zip(cols, cells, need))
+                                  .rstrip() + "\n")
+            tail = ([not_listed_line(n_cases - shown, sw.summary_rows)] if shown < n_cases else []) \
+                + failed_lines(result.failed, result.n_failed)
+            if tail:
+                out.write("\n".join(tail) + "\n")
+        if plot:   # the figure needs its rows together: read back for it
+            write_sweep_plot(outdir, stem, plot, sw, names, module, read_columns(paths))
+    return result
+
+
+def read_columns(paths: list[Path], columns: list[str] | None = None) -> pd.DataFrame:
+    """The rows of ``paths`` (only ``columns``; None: all) as one frame, object columns as objects."""
+    import pyarrow.parquet as pq
+    frames = []
+    for p in paths:
+        t = pq.read_table(p, columns=columns)
+        frames.append(_frame(t, _origins(pq.read_schema(p))))
+    return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
+
+
+# ----------------------------------------------------------------------------- the _cases tables
+
+class CasesTable:
+    """The ``<stem>_cases`` tables, built from the written cases' Parquet files as the cases
+    arrive (while the workers compute, off the critical path): their Arrow tables and CSV rows,
+    up to :data:`CASES_TABLE_MAX` cases and :data:`CASES_TABLE_BYTES`."""
+
+    def __init__(self, layout: Any):
+        self.layout = layout
+        self.pieces: dict[int, tuple[Any, bytes | None]] = {}
+        self.nbytes = 0
+        self.full = False   # beyond CASES_TABLE_MAX cases or CASES_TABLE_BYTES: no combined table
+
+    def add_chunk(self, res: Any) -> None:
+        """Add the cases of a per-case chunk's result (its record rows) that wrote files."""
+        if self.full or not hasattr(res.rows, "column"):
+            return
+        files, cases = res.rows.column("files").to_pylist(), res.rows.column("case").to_pylist()
+        self.add([c for c, f in zip(cases, files) if f != "[]"])
+
+    def add(self, indices: list[int]) -> None:
+        import pyarrow.parquet as pq
+
+        from driver._export import csv_bytes
+        for k in indices:
+            if self.full:
+                return
+            t = pq.read_table(self.layout.stem(k).with_suffix(".parquet"))
+            try:
+                body = csv_bytes(t, header=False)
+            except TypeError:
+                body = None
+            self.pieces[k] = (t, body)
+            self.nbytes += t.nbytes + len(body or b"")
+            if len(self.pieces) > CASES_TABLE_MAX or self.nbytes > CASES_TABLE_BYTES:
+                self.full, self.pieces = True, {}   # the driver's memory stays bounded
+
+    def table(self, written: list[int]) -> Any:
+        """The combined table of cases ``written`` (in order): a DataFrame, or an (Arrow table, CSV
+        bytes) pair when every case has the same columns; None above CASES_TABLE_MAX cases or
+        CASES_TABLE_BYTES."""
+        if not written or len(written) > CASES_TABLE_MAX or self.full:
+            return None
+        self.add([k for k in written if k not in self.pieces])
+        if self.full:
+            return None
+        import pyarrow as pa
+
+        from driver._export import csv_bytes
+        parts = [self.pieces[k] for k in written]
+        first = parts[0][0].schema
+        bodies = [body for _, body in parts if body is not None]
+        if len(bodies) == len(parts) and all(t.schema.equals(first, check_metadata=False) for t, _ in parts):
+            table = pa.concat_tables([t for t, _ in parts])
+            return table, csv_bytes(table.slice(0, 0)) + b"".join(bodies)
+        return pd.concat([t.to_pandas() for t, _ in parts], ignore_index=True)
