@@ -293,3 +293,61 @@ def test_keep_filter_is_never_code(tmp_path, capsys):
         assert main([str(deck), "-o", str(tmp_path / "out"), "-q", "-j", "1"]) == 2
         assert "key 'keep'" in capsys.readouterr().err
     assert not canary.exists() and not (tmp_path / "out" / "inject.out").exists()
+
+
+def test_the_outcome_carries_the_tables_it_wrote_and_the_best_case(tmp_path):
+    """run_sweep_deck's outcome holds the _summary and _cases tables and the .out exactly as
+    written (what pandas reads back from the files); with best=True the run of the best kept
+    case.  The paper's sweep: crank 2 keeps the largest minimum transmission angle (the
+    paper's conclusion), and its run reproduces the published table and the case's own file."""
+    from driver._deck import read_deck
+    out = tmp_path / "o"
+    oc = sweep.run_sweep_deck(read_deck(INPUTS / "fourbar_paper_sweep.dat"), out, [], False, jobs=2, best=True)
+    stem = out / "fourbar_paper_sweep"
+    written = pd.read_parquet(f"{stem}_summary.parquet")
+    pd.testing.assert_frame_equal(oc.summary, written)
+    assert oc.summary.attrs == written.attrs == {"summary_settings": {"transmission_band_deg": [40.0, 120.0]}}
+    pd.testing.assert_frame_equal(oc.cases, pd.read_parquet(f"{stem}_cases.parquet"))
+    assert oc.text == oc.out == (out / "fourbar_paper_sweep.out").read_text()
+    assert (oc.best_case, oc.best_metric) == (1, "mu_min_deg")
+    assert oc.best is not None and oc.best.params["crank"] == 2.0 and oc.best.name == "fourbar_paper_sweep_case1"
+    assert table_rows(oc.best.out) == published(2)
+    assert oc.best.out == (stem / "case_0001.out").read_text()
+    assert sweep.run_sweep_deck(read_deck(INPUTS / "fourbar_paper_sweep.dat"), tmp_path / "n", [], False,
+                                jobs=1).best is None   # the run only when asked
+
+
+def test_the_best_case_of_a_batch_search_and_of_its_streamed_tables(tmp_path, monkeypatch):
+    """The shipped design search (batch path, kept rows only): the best kept design by its first
+    plotted column (rocker_swing_deg, larger is better) is found by a plain scan of the summary
+    file; the same when the tables are streamed (a lazy summary), and its run gives that swing."""
+    from driver._deck import read_deck
+    from driver._outcome import StreamedSummary
+    from driver.sweep import _executor as executor
+    deck = read_deck(INPUTS / "fourbar_design_search.dat")
+    held = sweep.run_sweep_deck(deck, tmp_path / "held", [], False, jobs=1)
+    written = pd.read_parquet(tmp_path / "held" / "fourbar_design_search_summary.parquet")
+    pd.testing.assert_frame_equal(held.summary, written)
+    best_row, best_swing = None, -1.0
+    for case, status, kept, swing in zip(written["case"], written["status"], written["kept"],
+                                         written["rocker_swing_deg"]):
+        if status == "ok" and kept and swing > best_swing:
+            best_row, best_swing = int(case), float(swing)
+    assert (held.best_case, held.best_metric) == (best_row, "rocker_swing_deg") and held.best is None
+    monkeypatch.setattr(executor, "STREAM_ROWS", 50)
+    streamed = sweep.run_sweep_deck(deck, tmp_path / "streamed", [], False, jobs=1, best=True)
+    assert isinstance(streamed.summary, StreamedSummary) and streamed.best_case == best_row
+    assert streamed.best.summary["rocker_swing_deg"] == pytest.approx(best_swing, rel=1e-12)
+
+
+def test_run_sweep_reads_nothing_back(tmp_path, monkeypatch):
+    """driver.run_sweep builds its result from the engine's outcome: with the Parquet and text
+    readers of pandas and pathlib made to fail, the tables are there all the same."""
+    import driver
+    monkeypatch.setattr(pd, "read_parquet", lambda *a, **k: pytest.fail("read back a Parquet file"))
+    monkeypatch.setattr(pd, "read_csv", lambda *a, **k: pytest.fail("read back a CSV file"))
+    s = driver.run_sweep({"fourbar": {"fixed_link": 12, "crank": 2, "coupler": 15, "rocker": 9, "step_deg": 20}},
+                         grid={"crank": [2, 3, 4, 5]}, jobs=1)
+    assert s.outdir is None and s.summary["fourbar.crank"].tolist() == [2, 3, 4, 5]
+    assert [int(v) for v in s.summary["mu_min_deg"]] == [40, 33, 26, 17]   # the paper's closed-loop minima
+    assert len(s.cases) == 4 * 19 and "fourbar.crank" in s.cases and s.out.startswith("  sweep over &fourbar")

@@ -334,6 +334,32 @@ def test_shrunken_grid_removes_the_old_cases_files(tmp_path):
     assert sorted(p.name for p in (out / "pc").iterdir()) == ["notes.txt"]
 
 
+def test_a_grown_grid_resumes_its_unchanged_cases_across_a_new_chunk_layout(tmp_path, capsys):
+    """Per case, the record's rows count case by case: 129 cases (chunks of 2) grown to 258
+    (chunks of 3) by appending crank values keeps cases 1-129's numbers and values, so only
+    the 129 new ones run; the record then holds the new layout's parts only, and the tables
+    equal a fresh run of the larger grid."""
+    def grown(k: int, name: str) -> Path:
+        cranks = ", ".join(f"{1.5 + 0.05 * i:.2f}" for i in range(k))
+        path = tmp_path / name
+        path.write_text(BASE + f"&sweep key1 = 'fourbar.crank', values1 = {cranks}\n"
+                               "       key2 = 'fourbar.rocker', values2 = 8, 9, 10\n"
+                               "       key3 = 'fourbar.method', values3 = 'exact'\n"
+                               "       case_outputs = 'all' /\n")
+        return path
+    out, fresh = tmp_path / "o", tmp_path / "fresh"
+    assert main([str(grown(43, "g.dat")), "-o", str(out), "-q", "-j", "1"]) == 0
+    assert _record_spans(out, "g") == [(s, min(s + 2, 129)) for s in range(0, 129, 2)]
+    assert main([str(grown(86, "g.dat")), "-o", str(fresh), "-q", "-j", "1"]) == 0
+    capsys.readouterr()
+    assert main([str(grown(86, "g.dat")), "-o", str(out), "-j", "2", "--resume"]) == 0
+    said = capsys.readouterr()
+    assert "resume: 129 of 258 cases complete, 129 to run" in said.out and "redone" not in said.err
+    assert _record_spans(out, "g") == [(s, min(s + 3, 258)) for s in range(0, 258, 3)]
+    pd.testing.assert_frame_equal(summary(out, "g"), summary(fresh, "g"))
+    assert (out / "g.out").read_text() == (fresh / "g.out").read_text()
+
+
 def test_large_sweeps_shard_their_case_files(tmp_path, monkeypatch):
     from driver.sweep import _resume as store
     path = per_case_deck(tmp_path, a=3)                       # 9 cases
