@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import time
 from collections import Counter
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -44,7 +45,24 @@ __all__ = ["assemble", "FAILED_SHOWN"]
 FAILED_SHOWN = 20
 
 
-def assemble(plan: SweepPlan, ran: Ran, tables: CasesTable, where: str, start_cpu: float) -> SweepOutcome:
+@dataclass
+class Tables:
+    """The tables of a sweep before they are written: the ``_summary`` rows (``table``), the
+    rows the ``.out`` and the figure show (``frame``), the ``_cases`` table, the ``.out`` text,
+    the failed cases and counts, and the cases that wrote files (None: not tracked)."""
+
+    table: pd.DataFrame
+    frame: pd.DataFrame
+    cases: Any
+    text: str
+    failed: list[tuple[int, dict, str]]
+    n_ok: int
+    n_kept: int
+    has_files: np.ndarray | None
+    bad_input: bool = False
+
+
+def assemble(plan: SweepPlan, ran: Ran, cases_table: CasesTable, where: str, start_cpu: float) -> SweepOutcome:
     """Write the sweep's tables from what its chunks left (``ran``), and return its outcome:
     counts, failed cases, warnings, the files written, the data, the driver's CPU per phase."""
     c0 = time.process_time()
@@ -55,14 +73,19 @@ def assemble(plan: SweepPlan, ran: Ran, tables: CasesTable, where: str, start_cp
                       seconds=main.wall + (ran.kept.wall if ran.kept else 0.0))
     oc.phases.update(prepare_cpu=c0 - start_cpu - run_cpu, run_wall=oc.seconds, run_cpu=run_cpu, chunk=plan.chunk,
                      chunks=-(-plan.n // plan.chunk), rows=main.n_rows)
-    if ran.resume:
-        oc.notes.append(f"resume: {main.resumed} of {plan.n} cases complete, {plan.n - main.resumed} to run")
-    _say_redone(oc, plan, main.record.redone, "cases")
+    _say_resumed(plan, ran, oc)
     remove_stale_temporaries(plan.outdir, plan.stem)
-    if plan.batch is None:
-        _case_tables(plan, ran, tables, oc)
+    if plan.batch is not None and main.rows is None and _streamed(plan, ran, oc):
+        pass   # too many rows to hold: the tables were written part by part from the record
     else:
-        _batch_tables(plan, ran, tables, oc)
+        tables = _batch_tables(plan, ran, cases_table) if plan.batch is not None else \
+            _case_tables(plan, ran, cases_table, oc)
+        write_sweep_files(plan.outdir, plan.stem, tables.table, tables.cases, tables.text, plan.plot, plan.sw,
+                          plan.names, plan.module, tables.frame, plan.settings)
+        _clean(plan, tables.has_files, written=tables.cases is not None)
+        oc.n_ok, oc.n_kept = tables.n_ok, tables.n_kept
+        _failed(plan, oc, tables.failed, bad_input=tables.bad_input)
+        _data(plan, oc, tables)
     oc.written += [plan.outdir / f"{plan.stem}.out",
                    *(plan.outdir / f"{plan.stem}_summary.{fmt}" for fmt in ("csv", "parquet"))]
     _best(plan, oc)
@@ -70,10 +93,35 @@ def assemble(plan: SweepPlan, ran: Ran, tables: CasesTable, where: str, start_cp
     return oc
 
 
+def _say_resumed(plan: SweepPlan, ran: Ran, oc: SweepOutcome) -> None:
+    """The resume notes (how many cases were complete) and the redone warnings, of each record."""
+    if ran.resume:
+        oc.notes.append(f"resume: {ran.main.resumed} of {plan.n} cases complete, {plan.n - ran.main.resumed} to run")
+    _say_redone(plan, oc, ran.main.record.redone, "cases")
+    if ran.kept is not None:
+        if ran.resume:
+            done, k = ran.kept.resumed, len(ran.kept_cases)
+            oc.notes.append(f"resume: {done} of {k} kept cases' files complete, {k - done} to write")
+        _say_redone(plan, oc, ran.kept.record.redone, "kept cases' files")
+
+
+def _clean(plan: SweepPlan, has_files: np.ndarray | None, written: bool) -> None:
+    """Remove what is no longer the sweep's: case files of cases that write none now (or of
+    another layout), stray temporaries of case files, and a ``_cases`` table that no longer
+    matches the cases (too many for one table now)."""
+    if has_files is not None:
+        remove_stale_case_files(plan.layout, has_files)
+        clean_temporaries(plan.layout)   # of workers of a killed earlier run that outlived its start
+        if not written and has_files.any():
+            for fmt in ("csv", "parquet"):
+                (plan.outdir / f"{plan.stem}_cases.{fmt}").unlink(missing_ok=True)
+
+
 # ----------------------------------------------------------------------------- case by case
 
-def _case_tables(plan: SweepPlan, ran: Ran, tables: CasesTable, oc: SweepOutcome) -> None:
-    """The tables of a per-case sweep, from its record (the rows shown, not every result)."""
+def _case_tables(plan: SweepPlan, ran: Ran, cases_table: CasesTable, oc: SweepOutcome) -> Tables:
+    """The tables of a per-case sweep, from its record (the rows shown, not every result); the
+    warnings many cases repeat go on the outcome once each."""
     sw, n = plan.sw, plan.n
     retain_all = sw.summary_rows == "all" or n <= TABLE_ALL_MAX
     shown: list[CaseResult] = []
@@ -90,6 +138,8 @@ def _case_tables(plan: SweepPlan, ran: Ran, tables: CasesTable, oc: SweepOutcome
         n_kept += bool(r.kept and r.status == ExitCode.OK)
         if retain_all or r.kept or r.status != ExitCode.OK:
             shown.append(r)
+    for line in warnings.lines(plan.deck.path, n):
+        oc.warn(line)
     frame = summary_frame(shown, plan.names) if shown else _empty(plan)
     if plan.shown_columns is not None:   # summary_columns: the tables show only those (and keep's, plot's)
         fixed = {"case", "status", "kept", "error", *plan.names}
@@ -97,19 +147,8 @@ def _case_tables(plan: SweepPlan, ran: Ran, tables: CasesTable, oc: SweepOutcome
     table = frame if sw.summary_rows == "all" else frame[frame["kept"] | (frame["status"] != "ok")]
     failed = [(r.index, r.values, r.error) for r in shown if r.status != ExitCode.OK]
     text = sweep_text(plan.deck, sw, plan.base, plan.axes, n, frame, n_kept, failed, sw.summary_rows)
-    cases = tables.table(written)
-    write_sweep_files(plan.outdir, plan.stem, table, cases, text, plan.plot, sw, plan.names, plan.module, frame,
-                      plan.settings())
-    remove_stale_case_files(plan.layout, has_files)
-    clean_temporaries(plan.layout)   # of workers of a killed earlier run that outlived its start
-    if cases is None and written:
-        for fmt in ("csv", "parquet"):   # an earlier, smaller run's table would no longer match the cases
-            (plan.outdir / f"{plan.stem}_cases.{fmt}").unlink(missing_ok=True)
-    for line in warnings.lines(plan.deck.path, n):
-        oc.warn(line)
-    oc.n_ok, oc.n_kept = n_ok, n_kept
-    _failed(plan, oc, failed, bad_input=any(r.status == ExitCode.BAD_INPUT for r in shown))
-    _data(plan, oc, table, cases, text)
+    return Tables(table, frame, cases_table.table(written), text, failed, n_ok, n_kept, has_files,
+                  any(r.status == ExitCode.BAD_INPUT for r in shown))
 
 
 def _empty(plan: SweepPlan) -> pd.DataFrame:
@@ -118,73 +157,64 @@ def _empty(plan: SweepPlan) -> pd.DataFrame:
 
 # ----------------------------------------------------------------------------- batch
 
-def _batch_tables(plan: SweepPlan, ran: Ran, tables: CasesTable, oc: SweepOutcome) -> None:
-    """The tables of a batch sweep: streamed from the record, or from the rows in memory."""
-    sw, n, main = plan.sw, plan.n, ran.main
-    if main.rows is None:   # too many rows to hold: the tables written part by part from the record
-        paths = main.record.paths(with_rows=True)
-        res = write_streamed(plan.outdir, plan.stem, paths, plan.deck, sw, plan.base, plan.axes, plan.names, n,
-                             plan.plot, plan.module, plan.settings())
-        if res is not None:
-            if n <= 10 * SHARD * SHARD:
-                remove_stale_case_files(plan.layout, np.zeros(n + 1, dtype=bool))
-            oc.n_ok, oc.n_kept = n - res.n_failed, res.n_kept
-            _failed(plan, oc, res.failed, n_failed=res.n_failed, bad_input=res.bad_input)
-            oc.summary, oc.text = StreamedSummary(paths, res.metadata, res.n_rows), None
-            return
-        rows = read_columns(paths)   # parts of differing column types: in memory after all
-    else:
-        rows = main.frame()
+def _streamed(plan: SweepPlan, ran: Ran, oc: SweepOutcome) -> bool:
+    """The tables written part by part from the record, and a lazy summary on the outcome;
+    False (nothing written) when the parts' columns differ in type."""
+    paths = ran.main.record.paths(with_rows=True)
+    res = write_streamed(plan.outdir, plan.stem, paths, plan.deck, plan.sw, plan.base, plan.axes, plan.names, plan.n,
+                         plan.plot, plan.module, plan.settings)
+    if res is None:
+        return False
+    _clean(plan, np.zeros(plan.n + 1, dtype=bool) if plan.n <= 10 * SHARD * SHARD else None, written=False)
+    oc.n_ok, oc.n_kept = plan.n - res.n_failed, res.n_kept
+    _failed(plan, oc, res.failed, n_failed=res.n_failed, bad_input=res.bad_input)
+    oc.summary, oc.text = StreamedSummary(paths, res.metadata, res.n_rows), None
+    return True
+
+
+def _batch_tables(plan: SweepPlan, ran: Ran, cases_table: CasesTable) -> Tables:
+    """The tables of a batch sweep from its rows in memory (or read from the record's parts);
+    the kept cases' failures to write their own files turn their rows failed."""
+    n, main = plan.n, ran.main
+    rows = main.frame() if main.rows is not None else read_columns(main.record.paths(with_rows=True))
     if rows.empty:
         rows = _empty(plan)
     cases = None
     has_files = np.zeros(n + 1, dtype=bool) if n <= 10 * SHARD * SHARD else None
-    if ran.kept is not None:   # the kept cases' own files: their failures turn their rows failed
-        kept = ran.kept
-        if ran.resume:
-            done = kept.resumed
-            oc.notes.append(f"resume: {done} of {len(ran.kept_cases)} kept cases' files complete, "
-                            f"{len(ran.kept_cases) - done} to write")
-        _say_redone(oc, plan, kept.record.redone, "kept cases' files")
-        results = list(kept.record.results())
+    if ran.kept is not None:   # the kept cases' own files
+        results = list(ran.kept.record.results())
         written = [r.index for r in results if r.files]
         if has_files is not None:
             has_files[written] = True
-        cases = tables.table(written)
+        cases = cases_table.table(written)
         for r in results:
             if r.status != ExitCode.OK:
                 cells: list[str | bool | None] = ["failed", False, r.error]
                 rows.loc[rows["case"] == r.index, ["status", "kept", "error"]] = cells
     bad = rows[rows["status"] != "ok"]
     failed = [(int(r["case"]), {k: r[k] for k in plan.names}, r["error"]) for _, r in bad.iterrows()]
-    text = sweep_text(plan.deck, sw, plan.base, plan.axes, n, rows, int(rows["kept"].sum()), failed,
-                      sw.summary_rows)
-    write_sweep_files(plan.outdir, plan.stem, rows, cases, text, plan.plot, sw, plan.names, plan.module, rows,
-                      plan.settings())
-    if has_files is not None:
-        remove_stale_case_files(plan.layout, has_files)
-    oc.n_ok, oc.n_kept = n - len(failed), int(rows["kept"].sum())
-    _failed(plan, oc, failed, bad_input=bool((bad["status"] == "bad input").any()))
-    _data(plan, oc, rows, cases, text)
+    n_kept = int(rows["kept"].sum())
+    text = sweep_text(plan.deck, plan.sw, plan.base, plan.axes, n, rows, n_kept, failed, plan.sw.summary_rows)
+    return Tables(rows, rows, cases, text, failed, n - len(failed), n_kept, has_files,
+                  bool((bad["status"] == "bad input").any()))
 
 
 # ----------------------------------------------------------------------------- the outcome
 
-def _data(plan: SweepPlan, oc: SweepOutcome, table: pd.DataFrame, cases: Any, text: str) -> None:
+def _data(plan: SweepPlan, oc: SweepOutcome, tables: Tables) -> None:
     """The tables on the outcome as they were written (what pandas reads back from them)."""
     import pyarrow as pa
-    settings = plan.settings()
-    summary = pa.Table.from_pandas(with_settings(table, settings), preserve_index=False).to_pandas()
-    summary.attrs = {"summary_settings": dict(settings)} if settings else {}
+    summary = pa.Table.from_pandas(with_settings(tables.table, plan.settings), preserve_index=False).to_pandas()
+    summary.attrs = {"summary_settings": dict(plan.settings)} if plan.settings else {}
     oc.summary = summary
-    if isinstance(cases, tuple):   # (Arrow table, its CSV)
-        oc.cases = cases[0].to_pandas()
-    elif cases is not None:
-        oc.cases = pa.Table.from_pandas(cases, preserve_index=False).to_pandas()
-    oc.text = text
+    if isinstance(tables.cases, tuple):   # (Arrow table, its CSV)
+        oc.cases = tables.cases[0].to_pandas()
+    elif tables.cases is not None:
+        oc.cases = pa.Table.from_pandas(tables.cases, preserve_index=False).to_pandas()
+    oc.text = tables.text
 
 
-def _say_redone(oc: SweepOutcome, plan: SweepPlan, redone: Counter[str], what: str) -> None:
+def _say_redone(plan: SweepPlan, oc: SweepOutcome, redone: Counter[str], what: str) -> None:
     """One warning when a resume found record parts, rows or case files that failed
     verification: how many cases run again, and why."""
     if not redone:

@@ -114,6 +114,7 @@ class SweepPlan:
     cases: CaseTask                 #: the per-case chunk's work (every case, or the kept ones' files)
     batch: BatchPlan | None         #: the batch chunk's work, when the sweep takes the batch path
     chunk: int                      #: cases per chunk of the sweep's record
+    settings: dict[str, Any]        #: the base deck's settings the summary columns depend on
     best: bool = False              #: also run the best kept case for the outcome (``--report``)
     stream: bool = True             #: large batch tables written part by part, not held
 
@@ -133,10 +134,6 @@ class SweepPlan:
     def record(self) -> Path:
         """The resume record's folder."""
         return self.outdir / f"{self.stem}.sweep"
-
-    def settings(self) -> dict[str, Any]:
-        """The base deck's settings the summary columns depend on (recorded with the table)."""
-        return summary_settings(self.module, self.base, {name.partition(".")[2] for name in self.names})
 
 
 def plan_sweep(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, *, scheduler: Any = None,
@@ -168,9 +165,10 @@ def plan_sweep(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, *
         else None
     if bplan is None:
         _refuse_size(sw, grid, MAX_CASES)
+    settings = summary_settings(module, base, {name.partition(".")[2] for name in grid.names})
     return SweepPlan(deck, sw, module, base, grid, Path(outdir), stem_path.name, layout, plot, plotted, shown,
                      estimates, cases, bplan, chunk_size(grid.n, "cases" if bplan is None else "batch", sw.chunk),
-                     best, stream)
+                     settings, best, stream)
 
 
 def _refuse_size(sw: Params, grid: Grid, limit: int) -> None:
