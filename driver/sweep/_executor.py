@@ -187,11 +187,12 @@ def check_shared_folder(client: Any, folder: Path) -> None:
 # ----------------------------------------------------------------------------- execution
 
 def execute(work: Any, spans: Iterable[Span], on_result: Callable[[ChunkResult], None], workers: Workers, *,
-            first_here: bool = False, in_flight: int = 0, what: str = "chunks") -> None:
+            first_here: bool = False, in_flight: int = 0) -> None:
     """Run the chunks ``spans`` of ``work`` (a :class:`~driver.sweep._chunks.BatchPlan` or
     :class:`~driver.sweep._chunks.CaseTask`, started in that order) where ``workers`` say;
-    ``on_result`` gets each chunk's result as it completes (in any order).  ``what`` names the
-    chunks in the Ctrl-C notice.  See the module docstring for the policies."""
+    ``on_result`` gets each chunk's result as it completes (in any order).  See the module
+    docstring for the policies."""
+    what = "cases" if work.kind == "cases" else "chunks"   # as the Ctrl-C notice names them
     todo = iter(spans)
     if not workers.client and workers.jobs > 1 and first_here and POOL_MIN_SECONDS > 0:
         first = next(todo, None)
@@ -412,7 +413,7 @@ def _fill(work: Any, record: Record, workers: Workers, *, resume: bool, progress
     writes = work.kind == "cases" and work.case_outputs != "none"
     if writes and todo:
         workers.require_shared(Path(work.layout.root))
-    folder = str(record.folder) if workers.shares(record.folder) else ""
+    folder = str(record.folder) if todo and workers.shares(record.folder) else ""
     spans = [Span(s, e, cases, "" if s in record.reuse else folder) for s, e, cases in todo if len(cases)]
     for s, e, _ in [t for t in todo if not len(t[2])]:   # every case reused: the part assembled here
         record.add(s, e, None, "", {})
@@ -440,8 +441,7 @@ def _fill(work: Any, record: Record, workers: Workers, *, resume: bool, progress
             bar.update(res.n_ok + res.n_failed)
 
     try:
-        execute(work, spans, on_result, workers, first_here=first_here, what=work.kind if work.kind == "cases"
-                else "chunks")
+        execute(work, spans, on_result, workers, first_here=first_here)
     finally:
         if bar is not None:
             bar.close()

@@ -21,6 +21,7 @@ import json
 import math
 import shutil
 import tempfile
+from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -334,85 +335,107 @@ def write_streamed(outdir: Path, stem: str, paths: list[Path], deck: Deck, sw: P
     """Write ``<stem>.out`` and ``<stem>_summary.{csv,parquet}`` from the record parts ``paths``
     (case order; each with rows), one part at a time, and with ``plot`` the summary figure (its
     rows are read back for it), all renamed into place together.  ``settings``
-    (:func:`summary_settings`) go into the Parquet metadata as pandas
-    writes a frame's attrs.  Returns None, writing nothing, when the parts' columns differ in
-    type (see the module)."""
-    import pyarrow.parquet as pq
-
-    from driver._export import write_csv_arrow
+    (:func:`summary_settings`) go into the Parquet metadata as pandas writes a frame's attrs.
+    Returns None, writing nothing, when the parts' columns differ in type (see the module)."""
     schema = _uniform(paths)
     if schema is None:
         return None
-    origins = _origins(schema)
     if settings:   # as DataFrame.to_parquet records attrs (with_settings)
         schema = schema.with_metadata({**(schema.metadata or {}),
                                        b"PANDAS_ATTRS": json.dumps({"summary_settings": dict(settings)}).encode()})
-    limit_rows = n_cases > TABLE_ALL_MAX   # above: the .out lists the kept and failed cases only
     result = Streamed()
     result.metadata = dict(schema.metadata or {})
-    cols: list[Column] = []
-    keys: list[str] = []
+    table = _StreamedTable(paths, _origins(schema), names, n_cases > TABLE_ALL_MAX)
     with tempfile.TemporaryFile("w+", dir=outdir, prefix=f".{stem}.body.") as body, output_set(outdir):
-        widths: list[int] = []
-        need: list[int] = []
-        shown = 0
         with atomic_open(outdir / f"{stem}_summary.csv", "wb") as csv, \
                 atomic_open(outdir / f"{stem}_summary.parquet", "wb") as pfh:
-            writer = pq.ParquetWriter(pfh, schema)
-            try:
-                for k, path in enumerate(paths):
-                    table = pq.read_table(path)
-                    table = table.replace_schema_metadata(schema.metadata)
-                    writer.write_table(table)
-                    write_csv_arrow(table, csv, header=k == 0)
-                    frame = _frame(table, origins)
-                    if k == 0:
-                        cols, keys = table_columns(frame)
-                        widths = [max(c.width, len(c.header)) for c in cols]
-                        if "case" in keys:   # case numbers grow row by row: the last part's last one is widest
-                            last = pq.read_table(paths[-1], columns=["case"]).column("case")
-                            j = keys.index("case")
-                            widths[j] = max(widths[j], len(str(int(last[len(last) - 1].as_py()))))
-                        need = list(widths)
-                    bad = frame["status"] != "ok"
-                    result.n_rows += len(frame)
-                    result.n_kept += int(frame["kept"].sum())
-                    show = frame[frame["kept"] | bad] if limit_rows else frame
-                    shown += len(show)
-                    for row in table_values(show, cols, keys):
-                        cells = [c.cell(v) for c, v in zip(cols, row)]
-                        need = [max(w, len(v)) for w, v in zip(need, cells)]
-                        body.write("".join(" " * c.sep + v.rjust(w) for c, v, w in zip(cols, cells, widths))
-                                   .rstrip() + "\n")
-                    for _, r in frame[bad].iterrows():
-                        result.n_failed += 1
-                        result.bad_input |= r["status"] == "bad input"
-                        if len(result.failed) < FAILED_LISTED:
-                            result.failed.append((int(r["case"]), {k2: r[k2] for k2 in names}, r["error"]))
-            finally:
-                writer.close()
+            table.first_pass(schema, csv, pfh, body, result)
         with atomic_open(outdir / f"{stem}.out", "w") as out:
-            head = head_lines(deck, sw, base, axes, n_cases, result.n_kept, result.n_failed)
-            out.write("\n".join(head) + "\n")
-            out.write("".join(" " * c.sep + c.header.rjust(w) for c, w in zip(cols, need)).rstrip() + "\n")
-            if need == widths:
-                body.seek(0)
-                shutil.copyfileobj(body, out)
-            else:   # a cell did not fit its column's width: every row again at the widths found
-                for path in paths:
-                    frame = _frame(pq.read_table(path), origins)
-                    show = frame[frame["kept"] | (frame["status"] != "ok")] if limit_rows else frame
-                    for row in table_values(show, cols, keys):
-                        cells = [c.cell(v) for c, v in zip(cols, row)]
-                        out.write("".join(" " * c.sep + v.rjust(w) for c, v, w in zip(cols, cells, need))
-                                  .rstrip() + "\n")
-            tail = ([not_listed_line(n_cases - shown, sw.summary_rows)] if shown < n_cases else []) \
+            out.write("\n".join(head_lines(deck, sw, base, axes, n_cases, result.n_kept, result.n_failed)) + "\n")
+            table.write(out, body)
+            tail = ([not_listed_line(n_cases - table.shown, sw.summary_rows)] if table.shown < n_cases else []) \
                 + failed_lines(result.failed, result.n_failed)
             if tail:
                 out.write("\n".join(tail) + "\n")
         if plot:   # the figure needs its rows together: read back for it
             write_sweep_plot(outdir, stem, plot, sw, names, module, read_columns(paths))
     return result
+
+
+class _StreamedTable:
+    """The ``.out`` table of a streamed sweep: its rows written at the columns' default widths
+    in a first pass over the parts (which also writes the CSV and Parquet summaries and counts
+    the failed cases), and again at the widths found when a cell did not fit."""
+
+    def __init__(self, paths: list[Path], origins: dict[str, str], names: list[str], limit_rows: bool):
+        self.paths, self.origins, self.names, self.limit_rows = paths, origins, names, limit_rows
+        self.cols: list[Column] = []
+        self.keys: list[str] = []
+        self.widths: list[int] = []   # the columns' widths before any row (the case column's: its last number)
+        self.need: list[int] = []     # the widths the rows need
+        self.shown = 0
+
+    def _shown(self, frame: pd.DataFrame) -> pd.DataFrame:
+        """The rows the .out lists: all, or (above TABLE_ALL_MAX cases) the kept and failed ones."""
+        return frame[frame["kept"] | (frame["status"] != "ok")] if self.limit_rows else frame
+
+    def _start(self, frame: pd.DataFrame) -> None:
+        import pyarrow.parquet as pq
+        self.cols, self.keys = table_columns(frame)
+        self.widths = [max(c.width, len(c.header)) for c in self.cols]
+        if "case" in self.keys:   # case numbers grow row by row: the last part's last one is widest
+            last = pq.read_table(self.paths[-1], columns=["case"]).column("case")
+            j = self.keys.index("case")
+            self.widths[j] = max(self.widths[j], len(str(int(last[len(last) - 1].as_py()))))
+        self.need = list(self.widths)
+
+    def _lines(self, frame: pd.DataFrame, widths: list[int]) -> Iterator[tuple[list[str], str]]:
+        for row in table_values(self._shown(frame), self.cols, self.keys):
+            cells = [c.cell(v) for c, v in zip(self.cols, row)]
+            yield cells, "".join(" " * c.sep + v.rjust(w) for c, v, w in zip(self.cols, cells, widths)).rstrip() + "\n"
+
+    def first_pass(self, schema: pa.Schema, csv: Any, pfh: Any, body: Any, result: Streamed) -> None:
+        """Every part once: into the CSV and Parquet summaries, its rows into ``body``, its
+        failed cases and counts into ``result``."""
+        import pyarrow.parquet as pq
+
+        from driver._export import write_csv_arrow
+        writer = pq.ParquetWriter(pfh, schema)
+        try:
+            for k, path in enumerate(self.paths):
+                table = pq.read_table(path).replace_schema_metadata(schema.metadata)
+                writer.write_table(table)
+                write_csv_arrow(table, csv, header=k == 0)
+                frame = _frame(table, self.origins)
+                if k == 0:
+                    self._start(frame)
+                bad = frame["status"] != "ok"
+                result.n_rows += len(frame)
+                result.n_kept += int(frame["kept"].sum())
+                self.shown += len(self._shown(frame))
+                for cells, line in self._lines(frame, self.widths):
+                    self.need = [max(w, len(v)) for w, v in zip(self.need, cells)]
+                    body.write(line)
+                for _, r in frame[bad].iterrows():
+                    result.n_failed += 1
+                    result.bad_input |= r["status"] == "bad input"
+                    if len(result.failed) < FAILED_LISTED:
+                        result.failed.append((int(r["case"]), {k2: r[k2] for k2 in self.names}, r["error"]))
+        finally:
+            writer.close()
+
+    def write(self, out: Any, body: Any) -> None:
+        """The table's header and rows into the .out: the first pass's body, or every row again
+        at the widths found when a cell did not fit its column's width."""
+        import pyarrow.parquet as pq
+        out.write("".join(" " * c.sep + c.header.rjust(w) for c, w in zip(self.cols, self.need)).rstrip() + "\n")
+        if self.need == self.widths:
+            body.seek(0)
+            shutil.copyfileobj(body, out)
+            return
+        for path in self.paths:
+            for _, line in self._lines(_frame(pq.read_table(path), self.origins), self.need):
+                out.write(line)
 
 
 def read_columns(paths: list[Path], columns: list[str] | None = None) -> pd.DataFrame:

@@ -312,7 +312,7 @@ class Record:
         self._todo: list[tuple[int, int, Sequence[int]]] = []
 
     # -- the sequence of cases
-    def case_numbers(self, start: int, stop: int) -> Sequence[int]:
+    def _numbers(self, start: int, stop: int) -> Sequence[int]:
         """The case numbers at positions start..stop-1 of the sequence."""
         if self.cases is None:
             return range(start + 1, stop + 1)
@@ -435,7 +435,7 @@ class Record:
 
     def _left(self, start: int, stop: int) -> Sequence[int]:
         """The cases of chunk start..stop that must run (all, or those not reused)."""
-        cases = self.case_numbers(start, stop)
+        cases = self._numbers(start, stop)
         reused = self.reuse.get(start)
         return cases if not reused else [c for c in cases if c not in reused]
 
@@ -444,14 +444,6 @@ class Record:
         in sequence order.  A chunk whose every case is reused needs no computation: its
         part is assembled from the record (:meth:`add` of an empty result)."""
         return list(self._todo)
-
-    def complete(self, case: int) -> bool:
-        """Whether ``case`` is complete: in a complete chunk, or reused."""
-        pos = self._position(case)
-        if pos < 0:
-            return False
-        start = pos - pos % self.size
-        return start in self.parts or case in self.reuse.get(start, {})
 
     # -- during the run
     def add(self, start: int, stop: int, rows: Any, path: str, counts: dict[str, int]) -> Path:
