@@ -40,7 +40,8 @@ summary-only sweeps a chunk of cases per kernel call.
    which carries the data.
 
 Beside them: :mod:`~driver.sweep._spec` (the &sweep keys, the grid, cases, validation),
-:mod:`~driver.sweep._keep` (the keep filter), :mod:`~driver.sweep._record` (the ``--json`` record).
+:mod:`~driver.sweep._keep` (the keep filter).  The ``--json`` record of a sweep is built from
+its outcome by :mod:`driver._record`.
 """
 from __future__ import annotations
 

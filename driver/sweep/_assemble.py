@@ -19,9 +19,11 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from driver import _expr as expr
 from driver._atomic import remove_stale_temporaries
 from driver._deck import validate
 from driver._outcome import ExitCode, StreamedSummary, SweepOutcome
+from driver._output import best_index
 from driver._runner import compute
 from driver.sweep._executor import Ran
 from driver.sweep._plan import SweepPlan
@@ -29,9 +31,11 @@ from driver.sweep._report import (
     TABLE_ALL_MAX,
     CasesTable,
     Warnings,
+    plotted_columns,
     read_columns,
     summary_frame,
     sweep_text,
+    with_plotted,
     with_settings,
     write_streamed,
     write_sweep_files,
@@ -70,7 +74,7 @@ def assemble(plan: SweepPlan, ran: Ran, cases_table: CasesTable, where: str, sta
     run_cpu = main.cpu + (ran.kept.cpu if ran.kept else 0.0)
     oc = SweepOutcome(deck=str(plan.deck.path), name=plan.stem, outdir=plan.outdir, n_cases=plan.n,
                       workers=where, batch=plan.batch is not None, chunk=plan.chunk, n_resumed=main.resumed,
-                      seconds=main.wall + (ran.kept.wall if ran.kept else 0.0))
+                      seconds=main.wall + (ran.kept.wall if ran.kept else 0.0), study=plan.base.group, sweep=plan.sw)
     oc.phases.update(prepare_cpu=c0 - start_cpu - run_cpu, run_wall=oc.seconds, run_cpu=run_cpu, chunk=plan.chunk,
                      chunks=-(-plan.n // plan.chunk), rows=main.n_rows)
     _say_resumed(plan, ran, oc)
@@ -240,28 +244,27 @@ def _failed(plan: SweepPlan, oc: SweepOutcome, failed: list[tuple[int, dict, str
 def _best(plan: SweepPlan, oc: SweepOutcome) -> None:
     """The best kept case (:attr:`~driver._outcome.SweepOutcome.best_case`) from the summary in
     memory (a streamed one is read only when the run was asked for), and with ``plan.best``
-    its run: the Result the report page shows."""
-    streamed = isinstance(oc.summary, StreamedSummary)
-    if oc.summary is None or (streamed and not plan.best):
+    its run: the Result the report page shows.  The rule is the design-space maps' (their
+    star): the best value of the first plotted column (:func:`~driver.sweep._report.plotted_columns`)
+    where the study says which end is better, else the first kept case."""
+    summary = oc.summary
+    if summary is None or (isinstance(summary, StreamedSummary) and not plan.best):
         return
-    columns = list(oc.summary.columns)
-    metric = _metric(plan, oc.summary, columns)
-    if streamed:
-        assert isinstance(oc.summary, StreamedSummary)
-        frame = oc.summary.kept(["case", "status", *([metric] if metric else [])])
+    if isinstance(summary, StreamedSummary):   # the kept rows, only the columns the rule reads
+        frame = summary.kept([c for c in summary.columns if c in _best_reads(plan)])
     else:
-        assert isinstance(oc.summary, pd.DataFrame)
-        frame = oc.summary[oc.summary["kept"].astype(bool)]
+        frame = summary[summary["kept"].astype(bool)]
     frame = frame[frame["status"] == "ok"]
     if not len(frame):
         return
-    sense = plan.module.sweep_best.get(metric) if metric else None
-    values = pd.to_numeric(frame[metric], errors="coerce") if sense in ("min", "max") else None
-    if values is not None and values.notna().any():
-        at = int(np.argmax(values.fillna(-np.inf)) if sense == "max" else np.argmin(values.fillna(np.inf)))
-        oc.best_case, oc.best_metric = int(frame["case"].iloc[at]), metric
+    shown = with_plotted(frame, plan.sw)
+    wanted = plotted_columns(shown, plan.sw, plan.module)
+    metric = wanted[0] if wanted else None
+    at = best_index(shown, metric, plan.module.sweep_best.get(metric)) if metric else None
+    if at is not None:
+        oc.best_case, oc.best_metric = int(shown.loc[at, "case"]), metric
     else:
-        oc.best_case = int(frame["case"].iloc[0])
+        oc.best_case = int(shown["case"].iloc[0])
     if plan.best:
         case = case_at(plan.grid, oc.best_case)
         try:
@@ -273,20 +276,9 @@ def _best(plan: SweepPlan, oc: SweepOutcome) -> None:
                     f"{exc.__class__.__name__}: {exc}")
 
 
-def _metric(plan: SweepPlan, summary: Any, columns: list[str]) -> str | None:
-    """The summary column the best case is judged by: the first plotted one (``plot_y``), else
-    the study's ``sweep_plot`` columns, else the first numeric one (the report page's maps)."""
-    if isinstance(summary, StreamedSummary):
-        import pyarrow as pa
-        import pyarrow.parquet as pq
-        schema = pq.read_schema(summary.paths[0]) if summary.paths else pa.schema([])
-        numeric_type = {f.name: pa.types.is_integer(f.type) or pa.types.is_floating(f.type) for f in schema}
-        is_number = lambda c: numeric_type.get(c, False)
-    else:
-        is_number = lambda c: (pd.api.types.is_numeric_dtype(summary[c])
-                               and not pd.api.types.is_bool_dtype(summary[c]))
-    keys = set(plan.names)
-    numeric = [c for c in columns if c not in keys and c not in ("case", "kept") and is_number(c)]
-    wanted = [y for y in plan.sw.plot_y if y in numeric] or [c for c in plan.module.sweep_plot if c in numeric][:2] \
-        or numeric[:1]
-    return wanted[0] if wanted else None
+def _best_reads(plan: SweepPlan) -> set[str]:
+    """The summary columns the best-case rule reads: case, status, kept, the plotted columns
+    and the columns their expressions read, the study's ``sweep_plot``."""
+    plotted = [t for t in [plan.sw.plot_x, *plan.sw.plot_y] if t]
+    return {"case", "status", "kept", *plotted, *plan.module.sweep_plot,
+            *(n for t in plotted for n in expr.parse(t).names)}
