@@ -340,6 +340,37 @@ def test_the_best_case_of_a_batch_search_and_of_its_streamed_tables(tmp_path, mo
     assert streamed.best.summary["rocker_swing_deg"] == pytest.approx(best_swing, rel=1e-12)
 
 
+def test_the_best_case_is_the_one_the_maps_mark_and_the_page_names(tmp_path):
+    """One rule for the best case, the design-space maps' star and the report page: the first
+    plotted column (here plot_y = rocker_swing_deg, larger is better; not the study's first
+    sweep_plot column, mu_min_deg, which picks another case) over the kept, ok cases, found again
+    by a plain scan of the summary file; the page names that case and why.  A plotted expression
+    has no better end: the best case is then the first kept case (no metric)."""
+    from driver import _report_page as report_page
+    from driver._deck import read_deck
+    from driver._output import best_index
+    grid = ("key1 = 'fourbar.crank', values1 = 2, 2.5, 3, 3.5\n key2 = 'fourbar.rocker', values2 = 8, 9, 10\n"
+            " keep = 'rocker_swing_deg > 40'\n")
+    path = deck(tmp_path, f"&sweep\n {grid} plot_y = 'rocker_swing_deg' /\n")
+    oc = sweep.run_sweep_deck(read_deck(path), tmp_path / "o", [], False, jobs=1, best=True)
+    written = pd.read_parquet(tmp_path / "o" / "sw_summary.parquet")
+    best, best_value = None, -1.0
+    for case, status, kept, value in zip(written["case"], written["status"], written["kept"],
+                                         written["rocker_swing_deg"]):
+        if status == "ok" and kept and value > best_value:
+            best, best_value = int(case), float(value)
+    kept = written[(written["status"] == "ok") & written["kept"].astype(bool)]
+    assert 0 < len(kept) < len(written)   # the filter keeps some, not all
+    assert best not in (int(kept["case"].iloc[0]), int(kept.loc[kept["mu_min_deg"].idxmax(), "case"]))
+    assert (oc.best_case, oc.best_metric) == (best, "rocker_swing_deg")
+    assert int(written.loc[best_index(written, "rocker_swing_deg", "max"), "case"]) == best   # the maps' star
+    assert oc.best is not None and oc.best.summary["rocker_swing_deg"] == pytest.approx(best_value, rel=1e-12)
+    assert f"Case {best}, largest rocker swing" in report_page.page(oc, read_deck(path))
+    path = deck(tmp_path, f"&sweep\n {grid} plot_y = 'rocker_swing_deg - mu_min_deg' /\n", name="expr.dat")
+    oc = sweep.run_sweep_deck(read_deck(path), tmp_path / "e", [], False, jobs=1)
+    assert (oc.best_case, oc.best_metric) == (int(kept["case"].iloc[0]), None)
+
+
 def test_run_sweep_reads_nothing_back(tmp_path, monkeypatch):
     """driver.run_sweep builds its result from the engine's outcome: with the Parquet and text
     readers of pandas and pathlib made to fail, the tables are there all the same."""
