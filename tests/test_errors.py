@@ -69,7 +69,7 @@ def _instances() -> list[BaseException]:
     from driver._runner import CaseFailure
     from driver._table import TableValueError
     from driver.robust_example._analysis import FitError
-    from driver.sweep._store import SweepBusy
+    from driver.sweep._resume import SweepBusy
     return [driver.DeckError("a.dat", 3, "crank", "must be positive"), CaseFailure("b.dat", 4, None, "diverged"),
             ExprError("not allowed", "__import__"), TableValueError("nan"), PublishedError("missing"),
             FitError("singular"), MissingExtra("parquet", ImportError("No module named 'pyarrow'")),

@@ -22,7 +22,7 @@ __all__ = ["SPEC", "Case", "CaseResult", "MAX_KEYS", "MAX_CASES", "FULL_VALIDATI
            "iter_cases", "case_count", "validate_sweep"]
 
 MAX_KEYS = 9
-#: most cases one per-case sweep deck may have (a batch sweep lists no case: driver.sweep._batch.MAX_CASES)
+#: most cases one per-case sweep deck may have (a batch sweep lists no case: driver.sweep._plan.BATCH_MAX_CASES)
 MAX_CASES = 1_000_000
 #: most values one start/stop/count axis may have (about 0.3 GB as Python floats)
 MAX_AXIS_VALUES = 10_000_000
@@ -85,9 +85,9 @@ def _spec() -> GroupSpec:
         "scheduler": Key("str", check=_no_scheduler_in_deck,
                          doc="refused: the scheduler comes from --scheduler or Dask's configuration"),
         "chunk": Key("int", default=0, check=lambda v: "must not be negative" if v < 0 else None,
-                     doc="cases per task; 0 = chosen by the tool (case by case: from the time of a warm case, "
-                         "not a worker's first; batch path: from the case count, and a small sweep runs in "
-                         "the driver when workers would not pay)"),
+                     doc="cases per chunk; 0 = chosen by the tool from the number of cases alone (each chunk "
+                         "is a part of the resume record, found again with any -j or scheduler; on the batch "
+                         "path a small sweep runs in the driver when workers would not pay)"),
         "case_plots": Key("bool", default=False,
                           doc="with --plot, also draw every written case's own figures (by default --plot "
                               "draws the sweep's summary only: per-case figures cost more than the sweep)"),
@@ -119,13 +119,22 @@ class Grid:
 
     def indices(self, start: int, stop: int) -> list[np.ndarray]:
         """Per axis, the value index of cases start..stop-1 (0-based; product order)."""
-        idx = np.arange(start, stop, dtype=np.int64)
+        return self.indices_at(np.arange(start, stop, dtype=np.int64))
+
+    def indices_at(self, positions: np.ndarray) -> list[np.ndarray]:
+        """Per axis, the value index of the cases at 0-based ``positions`` (case number - 1)."""
+        idx = np.asarray(positions, dtype=np.int64)
         if self.zipped:
             return [idx] * len(self.names)
         return list(np.unravel_index(idx, [len(v) for v in self.values]))
 
     def columns(self, start: int, stop: int) -> dict[str, np.ndarray]:
-        return {name: _array(vals)[ix] for name, vals, ix in zip(self.names, self.values, self.indices(start, stop))}
+        """The swept values of cases start..stop-1 (0-based), one array per swept key."""
+        return self.columns_at(np.arange(start, stop, dtype=np.int64))
+
+    def columns_at(self, positions: np.ndarray) -> dict[str, np.ndarray]:
+        """The swept values of the cases at 0-based ``positions``, one array per swept key."""
+        return {name: _array(vals)[ix] for name, vals, ix in zip(self.names, self.values, self.indices_at(positions))}
 
 
 def _array(vals: list) -> np.ndarray:
