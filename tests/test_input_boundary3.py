@@ -337,12 +337,8 @@ def test_shown_escapes_and_bounds_a_name():
     assert len(long) <= 200 and "(74" in long and long.startswith("nnn") and long.endswith("nnn")
 
 
-# ----------------------------------------------------------------------------- 7. the sweep's part (executor's files)
+# ----------------------------------------------------------------------------- 7. the sweep's part
 
-SWEEP_OWNER = "issue 36 item 7 in driver/sweep/** (helper 'executor'): remove this mark when it passes"
-
-
-@pytest.mark.xfail(strict=True, reason=SWEEP_OWNER)
 def test_a_large_sweep_validates_every_case_before_any_runs(tmp_path, capsys):
     """6 161 cases: every value of each axis is valid alone and every corner is valid, but one
     inner case (start_deg 200, stop_deg 150) is not; it ran the others, wrote, and exited 2."""
@@ -361,7 +357,6 @@ def test_a_large_sweep_validates_every_case_before_any_runs(tmp_path, capsys):
     assert not out.exists() or not any(out.iterdir())
 
 
-@pytest.mark.xfail(strict=True, reason=SWEEP_OWNER)
 def test_a_sweep_record_part_cut_in_half_is_redone_and_said(tmp_path, capsys):
     """The optimiser's resume says how many records it did not believe and why; the sweep's
     redid a part cut in half without a word ('resume: 3 of 4 cases complete, 1 to run')."""

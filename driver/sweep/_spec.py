@@ -330,8 +330,13 @@ def _axis_line(sw: Params, name: str) -> tuple[str, int]:
 
 def validate_sweep(sw: Params, raw: RawGroup, module: Any, grid: Grid) -> dict[int, float]:
     """Refuse the whole sweep (DeckError naming the sweep line and key) before anything runs
-    when a case would be bad input: every value of every axis is validated in the base deck,
-    and every case too for sweeps up to FULL_VALIDATION cases (else the grid's corners).
+    when a case would be bad input.
+
+    Up to FULL_VALIDATION cases every case is validated.  Above, every value of every axis is
+    validated alone, and every combination of the values of the *coupled* axes (keys whose deck
+    checks involve other keys: all of them, unless the study's batch path names a key
+    ``independent``) is validated as a case would be: a check between two swept keys (a start
+    angle past a stop angle) is found in the inner cases too, not only at the grid's corners.
 
     Returns {case: estimated seconds of work} (driver._limits) when every case was validated
     and the study estimates its work (the engine runs the longest cases first), else {}."""
@@ -354,16 +359,44 @@ def validate_sweep(sw: Params, raw: RawGroup, module: Any, grid: Grid) -> dict[i
         return estimates
     axis_values: dict[str, list] = {}
     for n, vals in zip(grid.names, grid.values):
-        uniq: dict[str, Any] = {}
-        for v in vals:
-            uniq.setdefault(repr(v), v)
-        axis_values[n] = list(uniq.values())
+        axis_values[n] = _unique(vals)
         for v in axis_values[n]:
             check({n: v}, None)
-    corners = [[vals[0], vals[-1]] if len(vals) > 1 else vals for vals in axis_values.values()]
-    for combo in itertools.islice(itertools.product(*corners), 512):
-        check(dict(zip(grid.names, combo)), None)
+    for combo in _coupled_combinations(sw, module, grid, axis_values):
+        check(combo, None)
     return {}
+
+
+def _unique(values: Iterable[Any]) -> list[Any]:
+    """The distinct values of an axis, in their first order."""
+    uniq: dict[str, Any] = {}
+    for v in values:
+        uniq.setdefault(repr(v), v)
+    return list(uniq.values())
+
+
+def _coupled_combinations(sw: Params, module: Any, grid: Grid, axis_values: dict[str, list]) -> Iterator[dict[str, Any]]:
+    """Every distinct combination of the coupled axes' values a case of the grid holds (none
+    with fewer than two coupled axes: a value alone was validated).  Refused (DeckError) when
+    there are more than MAX_CASES of them: a sweep that cannot be validated is not run."""
+    independent = set(module.batch.independent) if module.batch is not None else set()
+    coupled = [i for i, n in enumerate(grid.names) if n.partition(".")[2] not in independent]
+    if len(coupled) < 2:
+        return
+    names = [grid.names[i] for i in coupled]
+    if grid.zipped:
+        seen: dict[str, dict[str, Any]] = {}
+        for combo in zip(*(grid.values[i] for i in coupled)):
+            seen.setdefault(repr(combo), dict(zip(names, combo)))
+        yield from seen.values()
+        return
+    count = math.prod(len(axis_values[n]) for n in names)
+    if count > MAX_CASES:
+        raise sw.error("key1", f"the swept keys {', '.join(n.partition('.')[2] for n in names)} are checked together "
+                       f"by the study, and their {count} combinations are beyond the {MAX_CASES} a sweep validates "
+                       "before it runs; coarsen the grid or split the sweep")
+    for combo in itertools.product(*(axis_values[n] for n in names)):
+        yield dict(zip(names, combo))
 
 
 def case_raw(raw: RawGroup, case: Case) -> RawGroup:
