@@ -7,6 +7,8 @@ records tests/test_optimize_resume_verified.py.
 """
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -419,3 +421,18 @@ def test_a_numerical_failure_never_blames_a_key_the_deck_does_not_have(monkeypat
     given = dataclasses.replace(fourbar.STUDY, blame=lambda p, exc: ("crank", "too short"))
     monkeypatch.setattr(_runner, "load_study", lambda group: given)
     assert _runner.numerical_error(params, ZeroDivisionError("x")).key == "crank"
+
+
+@pytest.mark.parametrize("key, line", [("com_distance", "com_distance = 0.05, 0.175, 0.125"),
+                                       ("counterweight_radius", "balance = 'force', counterweight_radius = 0.05, 0.1")])
+def test_a_unit_mismatch_ratio_is_said_in_a_few_digits(tmp_path, capsys, key, line):
+    """A centre of mass 0.05 m from a 1e-140 m crank printed the ratio as a 138-digit number."""
+    deck = tmp_path / "units.dat"
+    deck.write_text("&fourbar fixed_link = 0.30, crank = 1e-140, coupler = 0.35, rocker = 0.25, omega = 20,\n"
+                    "  method = 'exact', step_deg = 10, mass = 0.5, 1.2, 0.9,\n"
+                    f"  {line} /\n")
+    assert main([str(deck), "-o", str(tmp_path / "out"), "-q"]) == 2
+    err = capsys.readouterr().err
+    assert key in err and "times" in err, err
+    assert not re.search(r"\d{12}", err), err      # no run of 138 digits
+    assert re.search(r"\d(\.\d+)?e\+13\d times", err), err    # the ratio, to 3 significant digits
