@@ -177,7 +177,7 @@ def output_set(root: str | Path) -> Iterator[OutputSet]:
     outer set's, or not at all.  Before anything is renamed every target is checked: a folder
     where a file is to go fails the whole set, with nothing of it in place."""
     outer = _CURRENT.get()
-    if outer is not None and (inside(outer.root, root) or os.path.abspath(root) == str(outer.root)):
+    if outer is not None and (inside(outer.root, root) or os.path.abspath(root) == os.path.abspath(outer.root)):
         yield outer
         return
     s = OutputSet(Path(root))

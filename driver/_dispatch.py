@@ -15,6 +15,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from driver._atomic import output_set
 from driver._deck import Deck
 from driver._extras import require
 from driver._outcome import ExitCode, Outcome, RunOutcome
@@ -86,13 +87,18 @@ def _run(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, progres
     after = (*((".html",) if report else ()), *((".json",) if summary_json and kind != "study" else ()))
     stem = output_stem(outdir, deck.path, after) if after else None
     outcome: Outcome
-    if kind == "synthesis":
-        from driver import synthesis
-        outcome = synthesis.run_synthesis_deck(deck, outdir, formats, plot, progress)
-    elif kind == "optimize":
-        from driver import optimize
-        outcome = optimize.run_optimize_deck(deck, outdir, formats, plot, progress, jobs=jobs, resume=resume,
-                                             scheduler=scheduler)
+    if kind in ("synthesis", "optimize"):
+        # the engine's files and its --json record, all together or none (a sweep's cases are
+        # put in place as they finish, for --resume: its record is written after them)
+        with output_set(outdir):
+            if kind == "synthesis":
+                from driver import synthesis
+                outcome = synthesis.run_synthesis_deck(deck, outdir, formats, plot, progress)
+            else:
+                from driver import optimize
+                outcome = optimize.run_optimize_deck(deck, outdir, formats, plot, progress, jobs=jobs, resume=resume,
+                                                     scheduler=scheduler)
+            _record(outcome, stem, summary_json)
     elif kind == "sweep":
         require("parquet")   # sweeps keep their cases in Parquet: say so before importing them
         from driver import sweep
@@ -100,12 +106,18 @@ def _run(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, progres
                                        resume=resume, notify=notify, best=report)
     else:   # a single run writes its record with its other files (as driver.write does)
         outcome = run_study(deck, outdir, formats, plot, progress, summary_json=summary_json)
-    if stem is not None and summary_json and kind != "study":
-        from driver._record import write_record
-        outcome.written.append(write_record(outcome, stem))
+    if kind == "sweep":
+        _record(outcome, stem, summary_json)
     if stem is not None and report:
         _report(deck, stem, outcome)
     return outcome
+
+
+def _record(outcome: Outcome, stem: Path | None, summary_json: bool) -> None:
+    """Write the engine's ``--json`` record ``<stem>.json`` (a single run writes its own)."""
+    if stem is not None and summary_json:
+        from driver._record import write_record
+        outcome.written.append(write_record(outcome, stem))
 
 
 def _report(deck: Deck, stem: Path, outcome: Outcome) -> None:

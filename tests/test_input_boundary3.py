@@ -8,6 +8,7 @@ records tests/test_optimize_resume_verified.py.
 from __future__ import annotations
 
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -436,3 +437,24 @@ def test_a_unit_mismatch_ratio_is_said_in_a_few_digits(tmp_path, capsys, key, li
     assert key in err and "times" in err, err
     assert not re.search(r"\d{12}", err), err      # no run of 138 digits
     assert re.search(r"\d(\.\d+)?e\+13\d times", err), err    # the ratio, to 3 significant digits
+
+
+@pytest.mark.parametrize("deck_name, rel", [("optimize_crank_rocker", True), ("synthesis_function_log", False)])
+def test_an_engine_and_its_json_record_are_put_in_place_together(tmp_path, capsys, monkeypatch, deck_name, rel):
+    """An optimisation (or synthesis) whose --json record could not be written (a full disk) put
+    its .out and .optimum files in place all the same; relative output folders did not join the
+    engine's own set either.  Now the deck fails with none of its files in place."""
+    import driver._record
+
+    def full_disk(outcome, stem):
+        raise OSError(28, "No space left on device", str(stem) + ".json")
+    monkeypatch.setattr(driver._record, "write_record", full_disk)
+    src = Path(__file__).resolve().parents[1] / "inputs" / f"{deck_name}.dat"
+    deck = tmp_path / src.name
+    deck.write_text(src.read_text())
+    out = tmp_path / "out"
+    monkeypatch.chdir(tmp_path)
+    code = main([deck.name if rel else str(deck), "-o", "out" if rel else str(out), "-q", "--json", "-j", "1"])
+    assert code != 0
+    assert "no space left on the device" in capsys.readouterr().err
+    assert not out.exists() or not [p.name for p in out.iterdir() if not p.name.endswith(".journal.jsonl")]
