@@ -458,3 +458,31 @@ def test_an_engine_and_its_json_record_are_put_in_place_together(tmp_path, capsy
     assert code != 0
     assert "no space left on the device" in capsys.readouterr().err
     assert not out.exists() or not [p.name for p in out.iterdir() if not p.name.endswith(".journal.jsonl")]
+
+
+@pytest.mark.parametrize("jobs", ["1", "2"])
+def test_a_library_warning_in_a_sweep_worker_reaches_the_terminal_in_words(tmp_path, capfd, monkeypatch, jobs):
+    """A SciPy or NumPy warning raised inside a sweep's worker process went to the terminal raw
+    (Python's 'file:line: RuntimeWarning: ...'); now each kind comes back with its chunk's result
+    and is said once, in words, as a warning of the sweep."""
+    import warnings
+
+    from driver.sweep import _chunks
+
+    original = _chunks.CHUNK_FUNCTIONS["cases"]
+
+    def noisy(work, span):
+        with np.errstate(over="warn"):
+            np.exp(np.array([1000.0]))
+        return original(work, span)
+    monkeypatch.setitem(_chunks.CHUNK_FUNCTIONS, "cases", noisy)   # forked workers inherit it
+    deck = tmp_path / "sw.dat"
+    deck.write_text("&fourbar fixed_link = 12, crank = 5, coupler = 15, rocker = 9, omega = 5, step_deg = 90 /\n"
+                    "&sweep\n  key1 = 'fourbar.crank', values1 = 2, 3, 4, 5\n  chunk = 1\n/\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("default")
+        assert main([str(deck), "-o", str(tmp_path / "out"), "-q", "-j", jobs]) == 0
+    err = capfd.readouterr().err
+    assert "RuntimeWarning: overflow" not in err.replace("(RuntimeWarning: overflow", ""), err   # no raw line
+    worded = [e for e in err.splitlines() if "warned while the deck ran (RuntimeWarning: overflow" in e]
+    assert len(worded) == 1, err

@@ -78,6 +78,8 @@ def assemble(plan: SweepPlan, ran: Ran, cases_table: CasesTable, where: str, sta
     oc.phases.update(prepare_cpu=c0 - start_cpu - run_cpu, run_wall=oc.seconds, run_cpu=run_cpu, chunk=plan.chunk,
                      chunks=-(-plan.n // plan.chunk), rows=main.n_rows)
     _say_resumed(plan, ran, oc)
+    for text in dict.fromkeys([*main.warnings, *(ran.kept.warnings if ran.kept else [])]):
+        oc.warn(f"{plan.deck.path}: {text}")
     remove_stale_temporaries(plan.outdir, plan.stem)
     if plan.batch is not None and main.rows is None and _streamed(plan, ran, oc):
         pass   # too many rows to hold: the tables were written part by part from the record

@@ -38,6 +38,7 @@ from driver._export import write_tidy
 from driver._outcome import ExitCode
 from driver._runner import compute, write_outputs
 from driver._study import load_study
+from driver._warnings import caught
 from driver.sweep._keep import keep_mask
 from driver.sweep._resume import Layout, json_default, write_part
 from driver.sweep._spec import Case, CaseResult, Grid, case_deck_text, case_raw, iter_cases
@@ -76,6 +77,8 @@ class ChunkResult:
     n_failed: int = 0
     seconds: float = 0.0
     path: str = ""
+    #: what a library warned while the chunk ran, in words (:mod:`driver._warnings`)
+    warnings: tuple[str, ...] = ()
 
     @property
     def counts(self) -> dict[str, int]:
@@ -377,8 +380,12 @@ CHUNK_FUNCTIONS: dict[str, Callable[[Any, Span], ChunkResult]] = {"cases": case_
 
 
 def run_chunk(work: Any, span: Span) -> ChunkResult:
-    """Run ``span`` with the chunk function of ``work``'s kind (what a worker is sent)."""
-    return CHUNK_FUNCTIONS[work.kind](work, span)
+    """Run ``span`` with the chunk function of ``work``'s kind (what a worker is sent); what a
+    library warned meanwhile comes back in words with the result, never on a worker's stderr."""
+    with caught() as said:
+        res = CHUNK_FUNCTIONS[work.kind](work, span)
+    res.warnings = tuple(dict.fromkeys((*res.warnings, *said)))
+    return res
 
 
 def died(work: Any, span: Span, reason: str) -> ChunkResult:
@@ -410,4 +417,5 @@ def merge(span: Span, parts: list[ChunkResult]) -> ChunkResult:
         import pyarrow as pa
         merged = pa.concat_tables(rows)
     return ChunkResult(span.start, span.stop, merged, sum(p.n_ok for p in parts), sum(p.n_kept for p in parts),
-                       sum(p.n_failed for p in parts), sum(p.seconds for p in parts))
+                       sum(p.n_failed for p in parts), sum(p.seconds for p in parts),
+                       warnings=tuple(dict.fromkeys(w for p in parts for w in p.warnings)))

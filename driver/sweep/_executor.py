@@ -342,6 +342,8 @@ class Filled:
     n_rows: int
     wall: float = 0.0
     cpu: float = 0.0
+    #: what a library warned while the chunks ran, in words, each once (:mod:`driver._warnings`)
+    warnings: list[str] = field(default_factory=list)
 
     def frame(self) -> pd.DataFrame:
         """The batch rows of every chunk in case order (resumed chunks' from their parts)."""
@@ -425,8 +427,11 @@ def _fill(work: Any, record: Record, workers: Workers, *, resume: bool, progress
         from tqdm import tqdm
         bar = tqdm(total=record.n, initial=resumed, unit="case", dynamic_ncols=True)
 
+    said: dict[str, None] = {}
+
     def on_result(res: ChunkResult) -> None:
         nonlocal rows, n_rows
+        said.update(dict.fromkeys(res.warnings))
         record.add(res.start, res.stop, res.rows, res.path, res.counts)
         for k, v in res.counts.items():
             counts[k] += v
@@ -446,4 +451,5 @@ def _fill(work: Any, record: Record, workers: Workers, *, resume: bool, progress
         if bar is not None:
             bar.close()
     record.finish()
-    return Filled(record, resumed, counts, rows, n_rows, time.perf_counter() - t0, time.process_time() - c0)
+    return Filled(record, resumed, counts, rows, n_rows, time.perf_counter() - t0, time.process_time() - c0,
+                  list(said))
