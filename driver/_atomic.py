@@ -58,7 +58,7 @@ class NameTooLong(DriverError, OSError):
         return (type(self), (str(self.filename),))
 
 
-class UnsafeName(OSError):
+class UnsafeName(DriverError, OSError):
     """An output's path holds a control or bidi character (:mod:`driver._names`): refused before its
     file is opened, the path shown escaped."""
 
@@ -66,7 +66,12 @@ class UnsafeName(OSError):
         import errno
 
         from driver._names import shown
+        self.path = str(path)
         super().__init__(errno.EINVAL, why, shown(path))
+
+    def __reduce__(self) -> tuple[type[UnsafeName], tuple[str, str]]:
+        """Pickle by the path and the reason (the message is made from them)."""
+        return (type(self), (self.path, str(self.strerror)))
 
 
 class OutputSet:
@@ -172,7 +177,7 @@ def output_set(root: str | Path) -> Iterator[OutputSet]:
     outer set's, or not at all.  Before anything is renamed every target is checked: a folder
     where a file is to go fails the whole set, with nothing of it in place."""
     outer = _CURRENT.get()
-    if outer is not None and (inside(outer.root, root) or os.path.abspath(root) == str(outer.root)):
+    if outer is not None and (inside(outer.root, root) or os.path.abspath(root) == os.path.abspath(outer.root)):
         yield outer
         return
     s = OutputSet(Path(root))

@@ -10,17 +10,18 @@ and report page (:mod:`driver._report_page`) are made from that outcome.
 """
 from __future__ import annotations
 
-import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from driver._atomic import output_set
 from driver._deck import Deck
 from driver._extras import require
 from driver._outcome import ExitCode, Outcome, RunOutcome
 from driver._runner import output_stem, run_study
+from driver._warnings import caught
 
-__all__ = ["ENGINES", "WORDED", "engine_of", "run_deck", "library_warnings"]
+__all__ = ["ENGINES", "engine_of", "run_deck"]
 
 #: the control groups that give a deck to an engine other than a single study run, in the
 #: order they decide, with the Python function that runs such a deck
@@ -41,41 +42,15 @@ def run_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, pro
     once the run has written its outputs).  ``jobs``, ``scheduler`` and ``resume`` apply to
     sweeps and optimisations; ``notify(line)`` hears what cannot wait for the outcome (a sweep's
     Ctrl-C: the queued cases are cancelled).  Returns the engine's outcome, with what a library
-    warned while the deck ran as warnings in words (:func:`library_warnings`); raises DeckError
+    warned while the deck ran as warnings in words (:func:`driver._warnings.caught`); raises DeckError
     for bad input (nothing written) and :class:`~driver._extras.MissingExtra` for a missing
     optional package."""
-    with warnings.catch_warnings(record=True) as caught:   # the filters in force decide what is heard
+    with caught() as said:
         outcome = _run(deck, outdir, formats, plot, progress, jobs=jobs, scheduler=scheduler, resume=resume,
                        summary_json=summary_json, report=report, notify=notify)
-    said = [w for w in caught if issubclass(w.category, WORDED)]
-    for w in caught:   # a developer's warning (DeprecationWarning, ...) goes on as before
-        if not issubclass(w.category, WORDED):
-            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno, source=w.source)
-    for text in library_warnings(said):
+    for text in dict.fromkeys(said):
         outcome.warn(f"{deck.path}: {text}")
     return outcome
-
-
-#: warnings meant for a program's user (NumPy and SciPy numerical warnings, SciPy's
-#: OptimizeWarning and IntegrationWarning, pandas' FutureWarning): said in words
-WORDED = (RuntimeWarning, UserWarning, FutureWarning)
-
-
-def library_warnings(caught: list[warnings.WarningMessage]) -> list[str]:
-    """What a library said while a deck ran (a SciPy RuntimeWarning, a NumPy overflow), each kind
-    once, in words: which library, what it said, and that the run went on; the command line
-    prints them as warnings instead of Python's raw ``file:line: Category: text`` lines."""
-    seen: dict[tuple[str, str, str], int] = {}
-    for w in caught:
-        module = Path(str(w.filename)).parts
-        lib = next((m for m in ("scipy", "numpy", "pandas", "matplotlib", "pyarrow", "f90nml", "dask", "distributed")
-                    if m in module), "driver" if "driver" in module else "a library")
-        text = " ".join(str(w.message).split())
-        text = text if len(text) <= 160 else text[:157] + "..."
-        key = (lib, w.category.__name__, text)
-        seen[key] = seen.get(key, 0) + 1
-    return [f"{lib} warned while the deck ran ({category}: {text}); the run went on, and its results were checked "
-            f"as always (finite numbers, the study's own checks)" for (lib, category, text) in seen]
 
 
 def _run(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, progress: bool = False, *,
@@ -86,13 +61,18 @@ def _run(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, progres
     after = (*((".html",) if report else ()), *((".json",) if summary_json and kind != "study" else ()))
     stem = output_stem(outdir, deck.path, after) if after else None
     outcome: Outcome
-    if kind == "synthesis":
-        from driver import synthesis
-        outcome = synthesis.run_synthesis_deck(deck, outdir, formats, plot, progress)
-    elif kind == "optimize":
-        from driver import optimize
-        outcome = optimize.run_optimize_deck(deck, outdir, formats, plot, progress, jobs=jobs, resume=resume,
-                                             scheduler=scheduler)
+    if kind in ("synthesis", "optimize"):
+        # the engine's files and its --json record, all together or none (a sweep's cases are
+        # put in place as they finish, for --resume: its record is written after them)
+        with output_set(outdir):
+            if kind == "synthesis":
+                from driver import synthesis
+                outcome = synthesis.run_synthesis_deck(deck, outdir, formats, plot, progress)
+            else:
+                from driver import optimize
+                outcome = optimize.run_optimize_deck(deck, outdir, formats, plot, progress, jobs=jobs, resume=resume,
+                                                     scheduler=scheduler)
+            _record(outcome, stem, summary_json)
     elif kind == "sweep":
         require("parquet")   # sweeps keep their cases in Parquet: say so before importing them
         from driver import sweep
@@ -100,12 +80,18 @@ def _run(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, progres
                                        resume=resume, notify=notify, best=report)
     else:   # a single run writes its record with its other files (as driver.write does)
         outcome = run_study(deck, outdir, formats, plot, progress, summary_json=summary_json)
-    if stem is not None and summary_json and kind != "study":
-        from driver._record import write_record
-        outcome.written.append(write_record(outcome, stem))
+    if kind == "sweep":
+        _record(outcome, stem, summary_json)
     if stem is not None and report:
         _report(deck, stem, outcome)
     return outcome
+
+
+def _record(outcome: Outcome, stem: Path | None, summary_json: bool) -> None:
+    """Write the engine's ``--json`` record ``<stem>.json`` (a single run writes its own)."""
+    if stem is not None and summary_json:
+        from driver._record import write_record
+        outcome.written.append(write_record(outcome, stem))
 
 
 def _report(deck: Deck, stem: Path, outcome: Outcome) -> None:

@@ -1,20 +1,22 @@
-"""The code digest that signs resume records, and the axis labels of summary columns.
+"""The code digest that signs resume records, summary columns' axis labels, a summary's best design.
 
 What a study *is* (the :class:`~driver._study.Study` every study package declares as ``STUDY``)
 and the registry of studies are in :mod:`driver._study`; what a run returns (``Result`` and its
 ``Figure`` s) in :mod:`driver._result`.  This module holds the code digest of a study (resume
-records carry it) and the axis labels of summary columns and objectives from a study's
-``labels``.
+records carry it), the axis labels of summary columns and objectives from a study's
+``labels``, and the one rule for a summary's best design (:func:`best_index`: the case a
+sweep reports as its best and its design-space maps mark).
 """
 from __future__ import annotations
 
 import re
 from pathlib import Path
 from types import ModuleType
+from typing import Any
 
 from driver._study import Study
 
-__all__ = ["code_digest", "source_digest", "column_label", "expression_label"]
+__all__ = ["code_digest", "source_digest", "column_label", "expression_label", "best_index"]
 
 
 def code_digest(module: Study | ModuleType | None, *others: ModuleType | None) -> bytes:
@@ -144,3 +146,35 @@ def expression_label(study: Study | None, text: str) -> str:
         if entry:
             words = re.sub(rf"\b{re.escape(n)}\b", entry[0], words)
     return f"{words} [{units.pop()}]" if len(units) == 1 and "" not in units else words
+
+
+def best_index(frame: Any, metric: str, sense: str | None) -> Any:
+    """The frame index of the kept, ok design with the best ``metric``.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        Summary rows (``status`` and ``kept`` columns, where present, select the kept, ok ones).
+    metric : str
+        The column to judge by (non-numbers count as missing).
+    sense : str or None
+        ``'max'`` or ``'min'``: which end is better (the study's ``sweep_best``).
+
+    Returns
+    -------
+    index label or None
+        The row of the largest (``'max'``) or smallest (``'min'``) value, the first of equal
+        ones; None when the sense is not known or no kept, ok row has a number there.
+    """
+    import pandas as pd
+    if sense not in ("min", "max") or metric not in frame:
+        return None
+    ok = frame
+    if "status" in ok:
+        ok = ok[ok["status"] == "ok"]
+    if "kept" in ok:
+        ok = ok[ok["kept"].astype(bool)]
+    m = pd.to_numeric(ok[metric], errors="coerce")
+    if not m.notna().any():
+        return None
+    return m.idxmax() if sense == "max" else m.idxmin()

@@ -7,6 +7,9 @@ records tests/test_optimize_resume_verified.py.
 """
 from __future__ import annotations
 
+import re
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -337,12 +340,8 @@ def test_shown_escapes_and_bounds_a_name():
     assert len(long) <= 200 and "(74" in long and long.startswith("nnn") and long.endswith("nnn")
 
 
-# ----------------------------------------------------------------------------- 7. the sweep's part (executor's files)
+# ----------------------------------------------------------------------------- 7. the sweep's part
 
-SWEEP_OWNER = "issue 36 item 7 in driver/sweep/** (helper 'executor'): remove this mark when it passes"
-
-
-@pytest.mark.xfail(strict=True, reason=SWEEP_OWNER)
 def test_a_large_sweep_validates_every_case_before_any_runs(tmp_path, capsys):
     """6 161 cases: every value of each axis is valid alone and every corner is valid, but one
     inner case (start_deg 200, stop_deg 150) is not; it ran the others, wrote, and exited 2."""
@@ -361,7 +360,6 @@ def test_a_large_sweep_validates_every_case_before_any_runs(tmp_path, capsys):
     assert not out.exists() or not any(out.iterdir())
 
 
-@pytest.mark.xfail(strict=True, reason=SWEEP_OWNER)
 def test_a_sweep_record_part_cut_in_half_is_redone_and_said(tmp_path, capsys):
     """The optimiser's resume says how many records it did not believe and why; the sweep's
     redid a part cut in half without a word ('resume: 3 of 4 cases complete, 1 to run')."""
@@ -424,3 +422,67 @@ def test_a_numerical_failure_never_blames_a_key_the_deck_does_not_have(monkeypat
     given = dataclasses.replace(fourbar.STUDY, blame=lambda p, exc: ("crank", "too short"))
     monkeypatch.setattr(_runner, "load_study", lambda group: given)
     assert _runner.numerical_error(params, ZeroDivisionError("x")).key == "crank"
+
+
+@pytest.mark.parametrize("key, line", [("com_distance", "com_distance = 0.05, 0.175, 0.125"),
+                                       ("counterweight_radius", "balance = 'force', counterweight_radius = 0.05, 0.1")])
+def test_a_unit_mismatch_ratio_is_said_in_a_few_digits(tmp_path, capsys, key, line):
+    """A centre of mass 0.05 m from a 1e-140 m crank printed the ratio as a 138-digit number."""
+    deck = tmp_path / "units.dat"
+    deck.write_text("&fourbar fixed_link = 0.30, crank = 1e-140, coupler = 0.35, rocker = 0.25, omega = 20,\n"
+                    "  method = 'exact', step_deg = 10, mass = 0.5, 1.2, 0.9,\n"
+                    f"  {line} /\n")
+    assert main([str(deck), "-o", str(tmp_path / "out"), "-q"]) == 2
+    err = capsys.readouterr().err
+    assert key in err and "times" in err, err
+    assert not re.search(r"\d{12}", err), err      # no run of 138 digits
+    assert re.search(r"\d(\.\d+)?e\+13\d times", err), err    # the ratio, to 3 significant digits
+
+
+@pytest.mark.parametrize("deck_name, rel", [("optimize_crank_rocker", True), ("synthesis_function_log", False)])
+def test_an_engine_and_its_json_record_are_put_in_place_together(tmp_path, capsys, monkeypatch, deck_name, rel):
+    """An optimisation (or synthesis) whose --json record could not be written (a full disk) put
+    its .out and .optimum files in place all the same; relative output folders did not join the
+    engine's own set either.  Now the deck fails with none of its files in place."""
+    import driver._record
+
+    def full_disk(outcome, stem):
+        raise OSError(28, "No space left on device", str(stem) + ".json")
+    monkeypatch.setattr(driver._record, "write_record", full_disk)
+    src = Path(__file__).resolve().parents[1] / "inputs" / f"{deck_name}.dat"
+    deck = tmp_path / src.name
+    deck.write_text(src.read_text())
+    out = tmp_path / "out"
+    monkeypatch.chdir(tmp_path)
+    code = main([deck.name if rel else str(deck), "-o", "out" if rel else str(out), "-q", "--json", "-j", "1"])
+    assert code != 0
+    assert "no space left on the device" in capsys.readouterr().err
+    assert not out.exists() or not [p.name for p in out.iterdir() if not p.name.endswith(".journal.jsonl")]
+
+
+@pytest.mark.parametrize("jobs", ["1", "2"])
+def test_a_library_warning_in_a_sweep_worker_reaches_the_terminal_in_words(tmp_path, capfd, monkeypatch, jobs):
+    """A SciPy or NumPy warning raised inside a sweep's worker process went to the terminal raw
+    (Python's 'file:line: RuntimeWarning: ...'); now each kind comes back with its chunk's result
+    and is said once, in words, as a warning of the sweep."""
+    import warnings
+
+    from driver.sweep import _chunks
+
+    original = _chunks.CHUNK_FUNCTIONS["cases"]
+
+    def noisy(work, span):
+        with np.errstate(over="warn"):
+            np.exp(np.array([1000.0]))
+        return original(work, span)
+    monkeypatch.setitem(_chunks.CHUNK_FUNCTIONS, "cases", noisy)   # forked workers inherit it
+    deck = tmp_path / "sw.dat"
+    deck.write_text("&fourbar fixed_link = 12, crank = 5, coupler = 15, rocker = 9, omega = 5, step_deg = 90 /\n"
+                    "&sweep\n  key1 = 'fourbar.crank', values1 = 2, 3, 4, 5\n  chunk = 1\n/\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("default")
+        assert main([str(deck), "-o", str(tmp_path / "out"), "-q", "-j", jobs]) == 0
+    err = capfd.readouterr().err
+    assert "RuntimeWarning: overflow" not in err.replace("(RuntimeWarning: overflow", ""), err   # no raw line
+    worded = [e for e in err.splitlines() if "warned while the deck ran (RuntimeWarning: overflow" in e]
+    assert len(worded) == 1, err
