@@ -416,7 +416,10 @@ class _Kinds:
 def _length(data: Any) -> int:
     if hasattr(data, "shape") and hasattr(data, "columns"):   # DataFrame
         return int(data.shape[0])
-    lengths = {len(np.atleast_1d(np.asarray(v, dtype=object))) for v in data.values()} if data else {1}
+    # an array's length from its shape: converting a column to objects only to count it cost more
+    # than the filter itself (issue 37)
+    lengths = {(v.shape[0] if v.ndim else 1) if isinstance(v, np.ndarray) else len(np.atleast_1d(np.asarray(v, dtype=object)))
+               for v in data.values()} if data else {1}
     lengths.discard(1)
     if len(lengths) > 1:
         raise ValueError(f"columns of different lengths {sorted(lengths)}")
