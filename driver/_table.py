@@ -18,9 +18,12 @@ import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from decimal import ROUND_HALF_UP, Context, Decimal, localcontext
-from typing import Protocol, TypeAlias
+from typing import TYPE_CHECKING, Any, Protocol, TypeAlias
 
 from driver._errors import DriverError
+
+if TYPE_CHECKING:   # numpy is imported by the block functions only (a --help imports this module's users)
+    import numpy as np
 
 
 class _Number(Protocol):
@@ -34,7 +37,8 @@ class _Number(Protocol):
 #: a table cell: a number, preformatted text, or None for a blank cell
 Cell: TypeAlias = "_Number | str | None"
 
-__all__ = ["TableValueError", "Column", "fortran_f", "fortran_i", "significant", "render_table"]
+__all__ = ["TableValueError", "Column", "fortran_f", "fortran_i", "significant", "render_table", "fixed_cells",
+           "render_block"]
 
 
 class TableValueError(DriverError, ValueError):
@@ -163,3 +167,115 @@ def render_table(columns: Sequence[Column], rows: Iterable[Sequence[Cell]],
             line += "   " + trailers[k]
         lines.append(line.rstrip())
     return lines
+
+
+def fixed_cells(values: Any, decimals: int, style: str = "modern") -> np.ndarray:
+    """Fortran ``F`` editing at minimal width of a whole array in one call: element for element
+    the text :func:`fortran_f` ``(v, None, decimals, style)`` gives (what a table of many rows
+    needs; ``fortran_f`` one value at a time cost most of a large sweep's ``.out``).
+
+    Each value is scaled by 10**decimals and rounded half away from zero as an integer; where the
+    scaled double lies within one unit in the last place of a half (a tie, or a product that
+    rounding may have moved across one), or beyond 2**50, the value goes through
+    :func:`fortran_f` itself, so the text is the exactly rounded one everywhere.
+
+    Parameters
+    ----------
+    values : array_like of float
+        Finite numbers (any shape; flattened).
+    decimals : int
+        Digits after the decimal point (``d`` of ``Fw.d``).
+    style : {'modern', 'legacy'}
+        As for :func:`fortran_f`.
+
+    Returns
+    -------
+    numpy.ndarray of str
+        One text per value, without padding.
+
+    Raises
+    ------
+    TableValueError
+        For a NaN or an infinity.
+    """
+    import numpy as np
+    x = np.asarray(values, dtype=np.float64).ravel()
+    bad = ~np.isfinite(x)
+    if bad.any():
+        fortran_f(float(x[bad][0]), None, decimals, style)   # raises, in words
+    if style not in ("modern", "legacy"):
+        raise ValueError(f"unknown number style {style!r}")
+    if not 0 <= decimals <= 15:   # 10**decimals and the scaled integers exact in int64
+        return np.array([fortran_f(v, None, decimals, style) for v in x.tolist()], dtype=str)
+    with np.errstate(over="ignore", invalid="ignore"):   # beyond 2**50: the slow path's
+        a = np.abs(x) * 10.0 ** decimals
+        whole = np.floor(a)
+        frac = a - whole                             # exact below 2**52
+        slow = ~(a < 2.0 ** 50) | (np.abs(frac - 0.5) <= np.spacing(a))
+    n = np.where(slow, 0.0, whole + (frac > 0.5)).astype(np.int64)
+    text = _point_digits(n, decimals, style == "legacy")
+    neg = (x < 0) & (n > 0)   # no sign on a value that rounds to zero
+    if neg.any():
+        text = np.where(neg, np.strings.add(b"-", text), text)
+    text = text.astype(str)
+    if slow.any():
+        text = text.astype(object)
+        for i in np.flatnonzero(slow).tolist():
+            text[i] = fortran_f(float(x[i]), None, decimals, style)
+        text = text.astype(str)
+    return text
+
+
+def _point_digits(n: np.ndarray, decimals: int, legacy: bool) -> np.ndarray:
+    """Decimal texts (bytes) of the integers ``n`` >= 0 with a point ``decimals`` digits from the
+    right: digit columns of a byte matrix (one integer division per column), no per-value call."""
+    import numpy as np
+    width = max(decimals + 1, len(str(int(n.max()))) if n.size else 1)
+    powers = 10 ** np.arange(width - 1, -1, -1, dtype=np.int64)
+    m = np.empty((n.size, width + 1), dtype=np.uint8)
+    point = width - decimals              # the point's column in m
+    digits = (n[:, None] // powers) % 10 + ord("0")
+    m[:, :point] = digits[:, :point]
+    m[:, point] = ord(".")
+    m[:, point + 1:] = digits[:, point:]
+    # blanks before the first digit (the one before the point always stays: 0.5, 0.; legacy .5)
+    lead = n[:, None] < powers[:point - 1]
+    m[:, :point - 1][lead] = ord(" ")
+    if legacy and decimals:
+        m[n < powers[point - 1], point - 1] = ord(" ")
+    return np.strings.lstrip(m.view(f"S{width + 1}").ravel())
+
+
+def render_block(columns: Sequence[Column], cells: Sequence[Any], widths: Sequence[int]) -> list[str]:
+    """The table lines of a block of rows given column by column: ``cells[j]`` holds column j's
+    texts (an array or list of str, one per row), each right-justified to ``widths[j]`` after
+    its column's ``sep`` blanks, trailing blanks removed -- the lines :func:`render_table` writes
+    for the same cells and widths, built as one character matrix (each column copied in at once).
+
+    Parameters
+    ----------
+    columns : sequence of Column
+        The table's columns (their ``sep``).
+    cells : sequence of array_like of str
+        Per column, the block's cell texts (equal lengths).
+    widths : sequence of int
+        Per column, the field width (at least each of its cells' lengths: a longer cell would be cut).
+
+    Returns
+    -------
+    list of str
+        One line per row.
+    """
+    import numpy as np
+    if not cells or not len(cells[0]):   # (numpy's rjust fails on an empty array)
+        return []
+    total = sum(c.sep + w for c, w in zip(columns, widths))
+    block = np.full((len(cells[0]), total), ord(" "), dtype=np.uint32)   # UCS-4 code points, one row a line
+    at = 0
+    for c, v, w in zip(columns, cells, widths):
+        at += c.sep
+        if w:
+            field_ = np.strings.rjust(np.asarray(v, dtype=str), w).astype(f"<U{w}")
+            block[:, at:at + w] = field_.view(np.uint32).reshape(-1, w)
+        at += w
+    return np.strings.rstrip(block.view(f"<U{total}").ravel()).tolist() if total else [""] * len(block)

@@ -21,7 +21,6 @@ import json
 import math
 import shutil
 import tempfile
-from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -34,7 +33,7 @@ from driver._deck import Deck, Params
 from driver._export import write_tidy
 from driver._outcome import ExitCode
 from driver._output import column_label
-from driver._table import Column, render_table
+from driver._table import Column, fixed_cells, render_block
 from driver.sweep._spec import CaseResult
 
 if TYPE_CHECKING:   # annotations only: pyarrow is imported where a table is read or written
@@ -113,7 +112,12 @@ def _summary_table(frame: pd.DataFrame, limit: int = TABLE_ALL_MAX, n_cases: int
     n_cases = len(frame) if n_cases is None else n_cases
     show = frame if n_cases <= limit else frame[frame["kept"] | (frame["status"] != "ok")]
     cols, keys = table_columns(frame)
-    lines = render_table(cols, table_values(show, cols, keys))
+    cells = table_cells(show, cols, keys)
+    widths = [max(c.width, len(c.header), n) for c, n in zip(cols, cell_widths(cells))]
+    for c, w in zip(cols, widths):
+        c.widened = w > c.width
+    lines = ["".join(" " * c.sep + c.header.rjust(w) for c, w in zip(cols, widths)).rstrip()]
+    lines += render_block(cols, cells, widths)
     if len(show) < n_cases:
         lines.append(not_listed_line(n_cases - len(show), rows))
     return lines
@@ -144,22 +148,44 @@ def table_columns(frame: pd.DataFrame) -> tuple[list[Column], list[str]]:
     return cols, keys
 
 
-def table_values(show: pd.DataFrame, cols: list[Column], keys: list[str]) -> list[list]:
-    """The .out table's rows of ``show``: values, '-' for a missing or non-finite one."""
-    rows = []
-    for values in zip(*(show[k].tolist() for k in keys)):   # column-wise: no Series per row
-        row = []
-        for c, v in zip(cols, values):
-            if v is None or (isinstance(v, float) and not math.isfinite(v)):
-                row.append("-")
-            elif isinstance(v, (bool, np.bool_)):
-                row.append("yes" if v else "no")
-            elif c.kind == "s":
-                row.append(str(v))
+def table_cells(show: pd.DataFrame, cols: list[Column], keys: list[str]) -> list[np.ndarray]:
+    """The .out table's cells of ``show``, column by column (one formatting call per column of
+    the block, :func:`driver._table.fixed_cells` for the numbers), each an array of str: '-' for
+    a missing or non-finite value, yes/no for a truth value, the column's edit for a number, the
+    text of anything else -- the cells ``Column.cell`` gives value by value."""
+    out = []
+    for c, k in zip(cols, keys):
+        s = show[k]
+        arr = s.to_numpy() if isinstance(s.dtype, np.dtype) else None
+        if arr is not None and arr.dtype.kind == "b":
+            out.append(np.where(arr, "yes", "no"))
+        elif arr is not None and arr.dtype.kind == "f" and c.kind == "f":
+            finite = np.isfinite(arr)
+            text = fixed_cells(arr[finite], c.decimals, c.style)
+            if finite.all():
+                out.append(text)
             else:
-                row.append(v)
-        rows.append(row)
-    return rows
+                cells = np.full(len(arr), "-", dtype=object)
+                cells[finite] = text
+                out.append(cells.astype(str))
+        elif arr is not None and arr.dtype.kind in "iu" and c.kind in "is":
+            out.append(arr.astype(str))
+        else:   # objects (text, or values of mixed kinds): value by value
+            out.append(np.array([_cell(c, v) for v in s.tolist()], dtype=str))
+    return out
+
+
+def cell_widths(cells: list[np.ndarray]) -> list[int]:
+    """The longest text of each column's cells (0 for none)."""
+    return [int(np.strings.str_len(cj).max()) if len(cj) else 0 for cj in cells]
+
+
+def _cell(c: Column, v: Any) -> str:
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return "-"
+    if isinstance(v, (bool, np.bool_)):
+        return "yes" if v else "no"
+    return str(v) if c.kind == "s" else c.cell(v)
 
 
 class Warnings:
@@ -414,10 +440,12 @@ class _StreamedTable:
             self.widths[j] = max(self.widths[j], len(str(int(last[len(last) - 1].as_py()))))
         self.need = list(self.widths)
 
-    def _lines(self, frame: pd.DataFrame, widths: list[int]) -> Iterator[tuple[list[str], str]]:
-        for row in table_values(self._shown(frame), self.cols, self.keys):
-            cells = [c.cell(v) for c, v in zip(self.cols, row)]
-            yield cells, "".join(" " * c.sep + v.rjust(w) for c, v, w in zip(self.cols, cells, widths)).rstrip() + "\n"
+    def _lines(self, frame: pd.DataFrame, widths: list[int]) -> tuple[list[int], str]:
+        """The block's widest cell per column and its lines (one formatting call per column)."""
+        cells = table_cells(self._shown(frame), self.cols, self.keys)
+        need = cell_widths(cells)
+        lines = render_block(self.cols, cells, [max(w, n) for w, n in zip(widths, need)])
+        return need, "".join(line + "\n" for line in lines)
 
     def first_pass(self, schema: pa.Schema, csv: Any, pfh: Any, body: Any, result: Streamed) -> None:
         """Every part once: into the CSV and Parquet summaries, its rows into ``body``, its
@@ -438,9 +466,9 @@ class _StreamedTable:
                 result.n_rows += len(frame)
                 result.n_kept += int(frame["kept"].sum())
                 self.shown += len(self._shown(frame))
-                for cells, line in self._lines(frame, self.widths):
-                    self.need = [max(w, len(v)) for w, v in zip(self.need, cells)]
-                    body.write(line)
+                need, text = self._lines(frame, self.widths)
+                self.need = [max(w, n) for w, n in zip(self.need, need)]
+                body.write(text)
                 for _, r in frame[bad].iterrows():
                     result.n_failed += 1
                     result.bad_input |= r["status"] == "bad input"
@@ -459,8 +487,7 @@ class _StreamedTable:
             shutil.copyfileobj(body, out)
             return
         for path in self.paths:
-            for _, line in self._lines(_frame(pq.read_table(path), self.origins), self.need):
-                out.write(line)
+            out.write(self._lines(_frame(pq.read_table(path), self.origins), self.need)[1])
 
 
 def read_columns(paths: list[Path], columns: list[str] | None = None) -> pd.DataFrame:
