@@ -23,6 +23,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -36,6 +37,7 @@ import bench_slidercrank
 import bench_slidercrank_nl
 import bench_startup
 import bench_ujoint
+import closed_form
 from driver import ujoint as ujoint_study
 from driver.fourbar import _kernel as fourbar_kernel
 from driver.manipulator import _kernel as manipulator_kernel
@@ -287,6 +289,105 @@ def slidercrank_nl(n_el: int, revs: int, repeat: int) -> list[Row]:
                 "band LU (a latency chain like the linear model's solves)")]
 
 
+def shipped_grid() -> np.ndarray:
+    """The shipped design search's 102 400 linkages (inputs/fourbar_design_search.dat) as kernel rows."""
+    c, k, r = np.meshgrid(np.linspace(1, 7, 25), np.linspace(6, 20, 64), np.linspace(4, 16, 64), indexing="ij")
+    m = np.empty((c.size, 8), order="F")
+    m[:, 0], m[:, 1], m[:, 2], m[:, 3], m[:, 4], m[:, 5], m[:, 6], m[:, 7] = 12, c.ravel(), k.ravel(), r.ravel(), 5, 0, 360, 1
+    return m
+
+
+def kernel_before(path: str) -> Any:
+    """The four-bar summary routine of another build of the kernels (``_kernels*.so``, e.g. a main
+    checkout's ``build/cp311/fortran/``), loaded beside this one under another package name."""
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("before_issue37._kernels", path)
+    if spec is None or spec.loader is None:
+        raise ImportError(path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod.fourbar_summary.summaries
+
+
+def search(repeat: int, before: str | None, n: int | None = None) -> list[Row]:
+    """Issue 37: the design search's summary kernel on the shipped grid.  (1) The closed-form
+    passes (class, assembly, toggles, transmission and rocker extremes, swing, time ratio) against
+    the same columns in plain numpy (bench/closed_form.py, vectorised over the linkages; checked
+    against the kernel first): target at most 3x.  (2) With ``before`` (the kernel build before
+    issue 37): the peak-speed pass and the filter passes against that kernel in the same process,
+    every figure compared bit for bit first: target >= 2x for the peak pass."""
+    m = shipped_grid()
+    if n is not None:
+        m = np.asfortranarray(m[:: max(1, len(m) // n)])
+    P, S = fourbar_kernel.FOURBAR_PASSES, fourbar_kernel.Summary
+    closed = P["transmission"] | P["rocker"]
+    got = fourbar_kernel.fourbar_summaries(m, closed)
+    p, q, r, s = (np.ascontiguousarray(m[:, j]) for j in range(4))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ref = closed_form.summary(p, q, r, s)
+        ok = ref["grashof"] != closed_form.CHANGE_POINT   # not handled by the numpy form (41 of 102 400)
+        for name, col in (("grashof", S.GRASHOF), ("assemblable", S.ASSEMBLABLE), ("toggles_in_range", S.TOGGLES_IN_RANGE),
+                          ("rocker_turns", S.ROCKER_TURNS), ("assembled_fraction", S.ASSEMBLED_FRACTION),
+                          ("mu_min_deg", S.MU_MIN_DEG), ("mu_max_deg", S.MU_MAX_DEG), ("rocker_min_deg", S.ROCKER_MIN_DEG),
+                          ("rocker_max_deg", S.ROCKER_MAX_DEG), ("rocker_swing_deg", S.ROCKER_SWING_DEG),
+                          ("time_ratio", S.TIME_RATIO)):
+            # 1e-5 deg: figures at a limit position, where the kernel's states are taken 1e-12 rad inside the arc
+            np.testing.assert_allclose(np.nan_to_num(got[ok, col]), ref[name][ok], rtol=0, atol=1e-5, err_msg=name)
+        tk, tb = interleaved(lambda: fourbar_kernel.fourbar_summaries(m, closed),
+                             lambda: closed_form.summary(p, q, r, s), repeat)
+    nl = len(m)
+    rows = [Row("search: closed-form summary columns (baseline: numpy)", "us/linkage", tk / nl, tb / nl, None, 1 / 3,
+                f"shipped grid ({nl} linkages): class, assembly, toggles, transmission and rocker extremes, swing, time "
+                f"ratio; target <= 3x the numpy closed form ({tk / tb:.2f}x)")]
+    if before is None:
+        return rows
+    old = kernel_before(before)
+    for bits in (closed, P["peaks"], closed | P["peaks"]):
+        np.testing.assert_array_equal(fourbar_kernel.fourbar_summaries(m, bits), old(m, bits))   # bit for bit
+    tk, tb = interleaved(lambda: fourbar_kernel.fourbar_summaries(m, P["peaks"]), lambda: old(m, P["peaks"]), repeat)
+    rows.append(Row("search: peak-speed pass (baseline: kernel before)", "us/linkage", tk / nl, tb / nl, None, 2.0,
+                    "refined peak search of both speeds, a block of linkages per call; the same bits as before"))
+    tk, tb = interleaved(lambda: fourbar_kernel.fourbar_summaries(m, closed), lambda: old(m, closed), repeat)
+    rows.append(Row("search: filter passes (baseline: kernel before)", "us/linkage", tk / nl, tb / nl, None, None,
+                    "the shipped search's filter (transmission band, swing); the same bits as before"))
+    return rows
+
+
+def table(rows: int, repeat: int) -> list[Row]:
+    """Issue 37: the sweep's ``.out`` table of a block of kept rows (the search's columns: case,
+    three swept lengths, status, kept, eleven figures), built column by column (one formatting
+    call per column: driver/_table.py fixed_cells and render_block) against the same table built
+    value by value as before (the baseline: Column.cell per value, render_table per row; the
+    same text is asserted first)."""
+    import pandas as pd
+
+    from driver._table import render_block, render_table
+    from driver.sweep._report import cell_widths, table_cells, table_columns
+    rng = np.random.default_rng(0)
+    frame = pd.DataFrame({"case": np.arange(1, rows + 1) * 7, **{f"fourbar.{k}": np.round(rng.uniform(1, 20, rows), 4)
+                                                                  for k in ("crank", "coupler", "rocker")},
+                          "status": "ok", "kept": True,
+                          **{f"figure_{j}": rng.standard_normal(rows) * 10.0 ** rng.integers(-2, 4, rows) for j in range(11)}})
+    cols, keys = table_columns(frame)
+
+    def per_column() -> list[str]:
+        cells = table_cells(frame, cols, keys)
+        widths = [max(c.width, len(c.header), n) for c, n in zip(cols, cell_widths(cells))]
+        return ["".join(" " * c.sep + c.header.rjust(w) for c, w in zip(cols, widths)).rstrip(),
+                *render_block(cols, cells, widths)]
+
+    def per_value() -> list[str]:
+        values = [["yes" if v is True else ("-" if isinstance(v, float) and not math.isfinite(v) else v)
+                   for v in row] for row in zip(*(frame[k].tolist() for k in keys))]
+        return render_table(cols, values)
+
+    assert per_column() == per_value()
+    tk, tb = interleaved(per_column, per_value, repeat)
+    return [Row("sweep .out table, column by column (baseline: per value)", "us/row", tk / rows, tb / rows, None, None,
+                f"{rows} rows x {len(cols)} columns (11 F10.4 figures): a value's text from integer digit columns, "
+                "exact ties and products within an ulp of one through the per-value editing")]
+
+
 def startup(repeat: int, both: bool = True) -> list[Row]:
     """Issue 37: the command line's CPU per process against ``python -c "import numpy"`` in the same
     rounds (bench/bench_startup.py: each a fresh process, interleaved, medians); the 'baseline' is
@@ -304,7 +405,7 @@ def startup(repeat: int, both: bool = True) -> list[Row]:
 
 
 SCALE = {"ns/position": 1e9, "ns/sample": 1e9, "us/config": 1e6, "us/objective": 1e6, "us/design": 1e6,
-         "ms/revolution": 1e3, "ms/run": 1e3}
+         "ms/revolution": 1e3, "ms/run": 1e3, "us/linkage": 1e6, "us/row": 1e6}
 
 
 def print_table(rows: list[Row]) -> None:
@@ -331,8 +432,11 @@ def main(argv: list[str] | None = None) -> list[Row]:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smaller sizes, fewer repeats")
     ap.add_argument("--smoke", action="store_true", help="tiny sizes (the test suite's check that this runs)")
-    parts = ["fourbar", "manipulator", "ujoint", "slidercrank", "slidercrank_nl", "startup"]
+    parts = ["fourbar", "manipulator", "ujoint", "slidercrank", "slidercrank_nl", "search", "table", "startup"]
     ap.add_argument("--only", choices=parts, action="append", help="run only these parts (repeatable)")
+    ap.add_argument("--before", metavar="SO", default=os.environ.get("BENCH_KERNEL_BEFORE"),
+                    help="the _kernels extension built before issue 37 (e.g. a main checkout's build/cp311/fortran/"
+                         "_kernels*.so): the search rows' 'before' baseline (default: $BENCH_KERNEL_BEFORE)")
     args = ap.parse_args(argv)
     only = set(args.only or parts)
     if args.smoke:
@@ -355,6 +459,10 @@ def main(argv: list[str] | None = None) -> list[Row]:
         rows += slidercrank(sizes["n_el"], sizes["spr"], sizes["base_steps"], max(3, sizes["repeat"] // 3))
     if "slidercrank_nl" in only:
         rows += slidercrank_nl(sizes["nl_el"], sizes["nl_revs"], max(3, sizes["repeat"] // 3))
+    if "search" in only:
+        rows += search(sizes["repeat"], args.before, 2048 if args.smoke else None)
+    if "table" in only:
+        rows += table(512 if args.smoke else 20_000, sizes["repeat"])
     if "startup" in only:
         rows += startup(1 if args.smoke else sizes["repeat"], both=not args.smoke)
     print_table(rows)
