@@ -440,9 +440,10 @@ class _StreamedTable:
             self.widths[j] = max(self.widths[j], len(str(int(last[len(last) - 1].as_py()))))
         self.need = list(self.widths)
 
-    def _lines(self, frame: pd.DataFrame, widths: list[int]) -> tuple[list[int], str]:
-        """The block's widest cell per column and its lines (one formatting call per column)."""
-        cells = table_cells(self._shown(frame), self.cols, self.keys)
+    def _lines(self, shown: pd.DataFrame, widths: list[int]) -> tuple[list[int], str]:
+        """The widest cell per column of the listed rows ``shown`` and their lines (one
+        formatting call per column)."""
+        cells = table_cells(shown, self.cols, self.keys)
         need = cell_widths(cells)
         lines = render_block(self.cols, cells, [max(w, n) for w, n in zip(widths, need)])
         return need, "".join(line + "\n" for line in lines)
@@ -465,8 +466,9 @@ class _StreamedTable:
                 bad = frame["status"] != "ok"
                 result.n_rows += len(frame)
                 result.n_kept += int(frame["kept"].sum())
-                self.shown += len(self._shown(frame))
-                need, text = self._lines(frame, self.widths)
+                shown = self._shown(frame)
+                self.shown += len(shown)
+                need, text = self._lines(shown, self.widths)
                 self.need = [max(w, n) for w, n in zip(self.need, need)]
                 body.write(text)
                 for _, r in frame[bad].iterrows():
@@ -487,7 +489,7 @@ class _StreamedTable:
             shutil.copyfileobj(body, out)
             return
         for path in self.paths:
-            out.write(self._lines(_frame(pq.read_table(path), self.origins), self.need)[1])
+            out.write(self._lines(self._shown(_frame(pq.read_table(path), self.origins)), self.need)[1])
 
 
 def read_columns(paths: list[Path], columns: list[str] | None = None) -> pd.DataFrame:
