@@ -1,7 +1,7 @@
 """The one tidy-table exporter: a pandas frame to CSV or Parquet, atomically.
 
 Tidy means one row per output point (crank angle, time step, design, ...) and
-one column per quantity, with units in the column names (``omega3_rad_s``) or,
+one column per quantity, with units in the column names (``rocker_omega_rad_s``) or,
 where a name cannot say it (``xa`` is in the deck's length unit), in
 ``frame.attrs["units"]`` (:func:`with_units`; Parquet files keep it in their
 metadata).  CSV and Parquet read back with the same dtypes and values: floats
@@ -36,7 +36,7 @@ SUFFIX_UNITS = (("_rad_s2", "rad/s^2"), ("_rad_s", "rad/s"), ("_m_s2", "m/s^2"),
 
 
 def unit_of(name: str, dtype: Any = None) -> str | None:
-    """The unit a column name says (``omega3_rad_s`` -> 'rad/s'); '' for text and logicals;
+    """The unit a column name says (``rocker_omega_rad_s`` -> 'rad/s'); '' for text and logicals;
     None when a numeric column's name does not say it."""
     for suffix, unit in SUFFIX_UNITS:
         if name.endswith(suffix):

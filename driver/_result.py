@@ -54,7 +54,7 @@ class Result:
 
     What :func:`driver.run` and ``driver.<study>.run`` return.  Units are those of the study's
     deck keys; tidy and summary columns carry them in their names (``theta_deg``,
-    ``omega3_rad_s``, ``tau1_Nm``) or in ``tidy.attrs["units"]``.
+    ``rocker_omega_rad_s``, ``tau1_Nm``) or in ``tidy.attrs["units"]``.
 
     Attributes
     ----------

@@ -52,7 +52,7 @@ from driver.fourbar._batch import (
 )
 from driver.fourbar._published import LISTING_DEFECT, LISTING_PRECISION, exact_as_listed
 from driver.fourbar._report import animation_frames
-from driver.fourbar._spec import LABELS, SPEC, SUMMARY_SETTINGS, SWEEP_BEST, SWEEP_PLOT, estimate
+from driver.fourbar._spec import LABELS, RENAMED, SPEC, SUMMARY_SETTINGS, SWEEP_BEST, SWEEP_PLOT, estimate
 
 if TYPE_CHECKING:   # run's keys as typed keywords: generated from SPEC (tools/gen_keyword_signatures.py)
     from driver.fourbar._keywords import run
@@ -71,4 +71,5 @@ STUDY = Study(name="fourbar", package=__name__, spec=SPEC, run=run, estimate=est
                                  pass_names=(*PASS_BITS, "forces")),
               labels=LABELS, sweep_plot=SWEEP_PLOT, sweep_best=SWEEP_BEST, summary_settings=SUMMARY_SETTINGS,
               blame=blame, published=published.compare, animation=animation_frames, figures=f"{__name__}._figures",
+              renamed=RENAMED,
               kernel=kernel)

@@ -371,9 +371,9 @@ class Extremes:
         Extreme rocker angles, deg.
     rocker_min_at, rocker_max_at : float
         Crank angles where they occur, deg.
-    w3_peak, w2_peak : float
+    rocker_omega_peak, coupler_omega_peak : float
         Peak rocker and coupler angular velocity (signed), rad/s.
-    w3_peak_at, w2_peak_at : float
+    rocker_omega_peak_at, coupler_omega_peak_at : float
         Crank angles where they occur, deg.
     assembled_fraction : float
         Fraction of the range where the linkage assembles, dimensionless.
@@ -393,10 +393,10 @@ class Extremes:
     rocker_min_at: float
     rocker_max: float
     rocker_max_at: float
-    w3_peak: float
-    w3_peak_at: float
-    w2_peak: float
-    w2_peak_at: float
+    rocker_omega_peak: float
+    rocker_omega_peak_at: float
+    coupler_omega_peak: float
+    coupler_omega_peak_at: float
     assembled_fraction: float
     rocker_turns: bool = False
     toggles: tuple[float, ...] = ()
@@ -442,8 +442,8 @@ def extremes(p: Params, row: np.ndarray | None = None) -> Extremes | None:
     c = Summary
     return Extremes(row[c.MU_MIN_DEG], row[c.MU_MIN_AT_DEG], row[c.MU_MAX_DEG], row[c.MU_MAX_AT_DEG],
                     row[c.ROCKER_MIN_DEG], row[c.ROCKER_MIN_AT_DEG], row[c.ROCKER_MAX_DEG], row[c.ROCKER_MAX_AT_DEG],
-                    row[c.OMEGA3_PEAK_RAD_S], row[c.OMEGA3_PEAK_AT_DEG], row[c.OMEGA2_PEAK_RAD_S],
-                    row[c.OMEGA2_PEAK_AT_DEG], row[c.ASSEMBLED_FRACTION], bool(row[c.ROCKER_TURNS]), toggles,
+                    row[c.ROCKER_OMEGA_PEAK_RAD_S], row[c.ROCKER_OMEGA_PEAK_AT_DEG], row[c.COUPLER_OMEGA_PEAK_RAD_S],
+                    row[c.COUPLER_OMEGA_PEAK_AT_DEG], row[c.ASSEMBLED_FRACTION], bool(row[c.ROCKER_TURNS]), toggles,
                     row[c.ROCKER_SWING_DEG])
 
 
@@ -486,8 +486,9 @@ def exact_columns(out: np.ndarray, status: np.ndarray, cp: np.ndarray | None = N
     s = State
     vals = {"coupler_deg": deg360(out[:, s.COUPLER_ANGLE]), "rocker_deg": deg360(out[:, s.ROCKER_ANGLE]),
             "transmission_deg": np.degrees(out[:, s.TRANSMISSION_ANGLE]), "xa": out[:, s.XA], "ya": out[:, s.YA],
-            "xb": out[:, s.XB], "yb": out[:, s.YB], "omega2_rad_s": out[:, s.OMEGA2], "omega3_rad_s": out[:, s.OMEGA3],
-            "alpha2_rad_s2": out[:, s.ALPHA2], "alpha3_rad_s2": out[:, s.ALPHA3]}
+            "xb": out[:, s.XB], "yb": out[:, s.YB], "coupler_omega_rad_s": out[:, s.COUPLER_OMEGA],
+            "rocker_omega_rad_s": out[:, s.ROCKER_OMEGA], "coupler_alpha_rad_s2": out[:, s.COUPLER_ALPHA],
+            "rocker_alpha_rad_s2": out[:, s.ROCKER_ALPHA]}
     if coupler is not None:   # loop closure of the solution: |AB| - coupler (round-off only)
         vals["ab_error"] = np.hypot(out[:, s.XB] - out[:, s.XA], out[:, s.YB] - out[:, s.YA]) - coupler
     if cp is not None:

@@ -47,11 +47,11 @@ BATCH_PASSES: dict[str, tuple[str, ...]] = {
     "grashof_class": (), "full_crank_rotation": (), "assemblable": (),
     "mu_min_deg": ("transmission",), "mu_max_deg": ("transmission",), "meets_transmission_band": ("transmission",),
     "rocker_turns_fully": ("rocker",), "rocker_swing_deg": ("rocker",), "toggle_in_range": (),
-    "omega3_peak_rad_s": ("peaks",), "omega2_peak_rad_s": ("peaks",), "assembled_fraction": (),
+    "rocker_omega_peak_rad_s": ("peaks",), "coupler_omega_peak_rad_s": ("peaks",), "assembled_fraction": (),
     "time_ratio": ("rocker",),
     "mu_min_at_deg": ("transmission",), "mu_max_at_deg": ("transmission",), "rocker_min_deg": ("rocker",),
     "rocker_min_at_deg": ("rocker",), "rocker_max_deg": ("rocker",), "rocker_max_at_deg": ("rocker",),
-    "omega3_peak_at_deg": ("peaks",), "omega2_peak_at_deg": ("peaks",), "toggles_in_range": (),
+    "rocker_omega_peak_at_deg": ("peaks",), "coupler_omega_peak_at_deg": ("peaks",), "toggles_in_range": (),
     # decks that give masses: the force summary (summarise_force_batch), a pass of its own
     **{f"{pre}{c}": ("forces",) for pre in ("", "unbalanced_") for c in FORCE_SUMMARY_DOC},
 }
@@ -84,7 +84,7 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     (missing figures as NaN): grashof_class, full_crank_rotation, assemblable, mu_min_deg,
     mu_max_deg, meets_transmission_band (mu within the base deck's ``transmission_band_deg``),
     rocker_turns_fully, rocker_swing_deg, toggle_in_range,
-    omega3_peak_rad_s, omega2_peak_rad_s, assembled_fraction, time_ratio (crank angle of the
+    rocker_omega_peak_rad_s, coupler_omega_peak_rad_s, assembled_fraction, time_ratio (crank angle of the
     rocker's slower stroke over its quicker one, >= 1; missing unless the range holds a full
     turn, assembled throughout, without a toggle, with the rocker oscillating); with ``detail`` also the crank
     angles [deg] of those extremes, the rocker extreme positions [deg] and the number of
@@ -144,7 +144,7 @@ def _assemble(base: Mapping[str, Any], res: np.ndarray, detail: bool, wanted: Co
 
 #: the columns of summarise_batch(detail=True) only
 DETAIL = ("mu_min_at_deg", "mu_max_at_deg", "rocker_min_deg", "rocker_min_at_deg", "rocker_max_deg",
-           "rocker_max_at_deg", "omega3_peak_at_deg", "omega2_peak_at_deg", "toggles_in_range")
+           "rocker_max_at_deg", "rocker_omega_peak_at_deg", "coupler_omega_peak_at_deg", "toggles_in_range")
 
 
 def summary_frame(res: np.ndarray, detail: bool = False, band: tuple[float, float] = BAND,
@@ -166,8 +166,8 @@ def summary_frame(res: np.ndarray, detail: bool = False, band: tuple[float, floa
         "rocker_turns_fully": lambda: ok & (c["rocker_turns"] > 0),
         "rocker_swing_deg": lambda: has(c["rocker_swing_deg"]),
         "toggle_in_range": tog,
-        "omega3_peak_rad_s": lambda: has(c["omega3_peak_rad_s"], ok & ~tog()),
-        "omega2_peak_rad_s": lambda: has(c["omega2_peak_rad_s"], ok & ~tog()),
+        "rocker_omega_peak_rad_s": lambda: has(c["rocker_omega_peak_rad_s"], ok & ~tog()),
+        "coupler_omega_peak_rad_s": lambda: has(c["coupler_omega_peak_rad_s"], ok & ~tog()),
         "assembled_fraction": lambda: np.where(ok, c["assembled_fraction"], 0.0),
         "time_ratio": lambda: np.where(ok & (c["time_ratio"] > 0), c["time_ratio"], np.nan)}
     if detail:
@@ -176,8 +176,8 @@ def summary_frame(res: np.ndarray, detail: bool = False, band: tuple[float, floa
                   "rocker_min_at_deg": lambda: has(c["rocker_min_at_deg"]),
                   "rocker_max_deg": lambda: has(c["rocker_max_deg"]),
                   "rocker_max_at_deg": lambda: has(c["rocker_max_at_deg"]),
-                  "omega3_peak_at_deg": lambda: has(c["omega3_peak_at_deg"], ok & ~tog()),
-                  "omega2_peak_at_deg": lambda: has(c["omega2_peak_at_deg"], ok & ~tog()),
+                  "rocker_omega_peak_at_deg": lambda: has(c["rocker_omega_peak_at_deg"], ok & ~tog()),
+                  "coupler_omega_peak_at_deg": lambda: has(c["coupler_omega_peak_at_deg"], ok & ~tog()),
                   "toggles_in_range": lambda: c["toggles_in_range"].astype(int)}
     keys = build if wanted is None else [k for k in build if k in set(wanted)]
     return pd.DataFrame({k: build[k]() for k in keys}, index=pd.RangeIndex(len(res)))

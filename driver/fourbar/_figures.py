@@ -48,13 +48,14 @@ def _unassembled_spans(theta: np.ndarray, ok: np.ndarray) -> list[tuple[float, f
     return spans
 
 
-#: legend words of the four-bar curves: words first, textbook link numbers (2 crank, 3 coupler,
-#: 4 output link) as symbols; the tidy columns keep the paper's names (omega2 = coupler)
+#: legend words of the four-bar curves: the link's name first (as in every column name:
+#: coupler_omega_rad_s), then its symbol in the one documented numbering (docs/fourbar.md, "Names":
+#: 1 ground, 2 crank, 3 coupler, 4 output link; the pivots O2, O4)
 def _fourbar_names(output: str = "rocker") -> dict[str, str]:
     return {"coupler_deg": r"coupler angle $\theta_3$", "rocker_deg": rf"{output} angle $\theta_4$",
             "transmission_deg": r"transmission angle $\mu$",
-            "omega2_rad_s": r"coupler angular velocity $\omega_3$",
-            "omega3_rad_s": rf"{output} angular velocity $\omega_4$"}
+            "coupler_omega_rad_s": r"coupler angular velocity $\omega_3$",
+            "rocker_omega_rad_s": rf"{output} angular velocity $\omega_4$"}
 
 
 @styled
@@ -72,13 +73,13 @@ def fourbar_curves(exact, listing, title: str, band: Sequence[float] = (40.0, 12
     names = _fourbar_names(output)
     panels = [("link angle [deg]", ["coupler_deg", "rocker_deg"]),
               ("transmission angle [deg]", ["transmission_deg"]),
-              ("angular velocity [rad/s]", ["omega2_rad_s", "omega3_rad_s"])]
+              ("angular velocity [rad/s]", ["coupler_omega_rad_s", "rocker_omega_rad_s"])]
     if axes is None:
         fig, axes = new_figure(3, 1, sharex=True, figsize=(7.4, 7.6))
     else:
         fig = axes[0].figure
     colors = {"coupler_deg": "C0", "rocker_deg": "C1", "transmission_deg": "C2",
-              "omega2_rad_s": "C0", "omega3_rad_s": "C1"}
+              "coupler_omega_rad_s": "C0", "rocker_omega_rad_s": "C1"}
     theta = exact["theta_deg"].to_numpy(dtype=float)
     spans = _unassembled_spans(theta, np.isfinite(exact["transmission_deg"].to_numpy(dtype=float)))
     for ax, (label, keys) in zip(axes, panels):

@@ -36,7 +36,7 @@ class FourbarStatus(KernelStatus):
     ok = int(_kernels.fourbar.st_ok), "ok"
     no_assembly = int(_kernels.fourbar.st_no_assembly), "cannot assemble", "the loop does not close at this crank angle"
     toggle = int(_kernels.fourbar.st_toggle), "toggle", "coupler and rocker in line: the velocities are unbounded"
-    indeterminate = int(_kernels.fourbar.st_indeterminate), "indeterminate", "the crank pin A lies on the rocker pivot O_B"
+    indeterminate = int(_kernels.fourbar.st_indeterminate), "indeterminate", "the crank pin A lies on the rocker pivot O4"
 
 
 #: the four-bar kernels' status codes by name (``FOURBAR_STATUS["no_assembly"]``): :class:`FourbarStatus`
@@ -50,7 +50,7 @@ class State(IntEnum):
     """Columns of :func:`fourbar_exact`'s states.
 
     Angles [rad], pin positions [length], angular velocities [rad/s] and accelerations [rad/s^2] of
-    coupler (2) and rocker (3).
+    the coupler and the rocker, each named after its link (docs/fourbar.md, "Names").
     """
 
     COUPLER_ANGLE = 0
@@ -60,10 +60,10 @@ class State(IntEnum):
     YA = 4
     XB = 5
     YB = 6
-    OMEGA2 = 7
-    OMEGA3 = 8
-    ALPHA2 = 9
-    ALPHA3 = 10
+    COUPLER_OMEGA = 7
+    ROCKER_OMEGA = 8
+    COUPLER_ALPHA = 9
+    ROCKER_ALPHA = 10
 
 
 class Listing(IntEnum):
@@ -209,10 +209,10 @@ class Summary(IntEnum):
     ROCKER_SWING_DEG = 11
     ROCKER_TURNS = 12
     TOGGLES_IN_RANGE = 13
-    OMEGA3_PEAK_RAD_S = 14
-    OMEGA3_PEAK_AT_DEG = 15
-    OMEGA2_PEAK_RAD_S = 16
-    OMEGA2_PEAK_AT_DEG = 17
+    ROCKER_OMEGA_PEAK_RAD_S = 14
+    ROCKER_OMEGA_PEAK_AT_DEG = 15
+    COUPLER_OMEGA_PEAK_RAD_S = 16
+    COUPLER_OMEGA_PEAK_AT_DEG = 17
     TIME_RATIO = 18
 
 
@@ -289,7 +289,7 @@ def fourbar_exact(theta: np.ndarray, p: float, q: float, r: float, s: float, ome
         acceleration [rad/s^2].
     status : numpy.ndarray
         (n,): 0 ok, 1 cannot be assembled, 2 toggle (velocities unbounded, returned as 0),
-        3 indeterminate (A on O_B).
+        3 indeterminate (A on O4).
 
     Raises
     ------

@@ -42,8 +42,8 @@ __all__ = ["run", "listing_text", "exact_table", "summary_lines", "audit", "deck
 
 def _echo(p: Params) -> list[str]:
     """Deck inputs echoed in the English header of exact runs."""
-    rows = [("fixed link O_A-O_B", p.fixed_link, ""), ("crank (driver) O_A-A", p.crank, ""),
-            ("coupler A-B", p.coupler, ""), ("rocker (output) O_B-B", p.rocker, ""),
+    rows = [("fixed link O2-O4", p.fixed_link, ""), ("crank (driver) O2-A", p.crank, ""),
+            ("coupler A-B", p.coupler, ""), ("rocker (output) O4-B", p.rocker, ""),
             ("crank speed", p.omega, "rad/s"), ("crank acceleration", p.alpha, "rad/s^2")]
     return [f"  {name:<24}{fortran_f(v, 12, 4)} {u}".rstrip() for name, v, u in rows]
 
@@ -84,9 +84,11 @@ def exact_table(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarra
     kernel.fourbar_coupler_point)."""
     whole = np.all(np.isclose(theta, np.round(theta)))
     tcol = Column("theta", "i", 5, 0, 2) if whole else Column("theta", "f", 8, 3, 2)
-    cols = [tcol, Column("coupler", "f", 7, 1), Column("rocker", "f", 7, 1), Column("transm", "f", 7, 1)]
+    # headers: the tidy columns' names without their unit (on the line below)
+    cols = [tcol, Column("coupler", "f", 7, 1), Column("rocker", "f", 7, 1), Column("transmission", "f", 7, 1)]
     cols += [Column(h, "f", 9, 4) for h in ("xa", "ya", "xb", "yb")]
-    cols += [Column(h, "f", 10, 4) for h in ("omega2", "omega3")] + [Column(h, "f", 11, 4) for h in ("alpha2", "alpha3")]
+    cols += ([Column(h, "f", 10, 4) for h in ("coupler_omega", "rocker_omega")]
+             + [Column(h, "f", 11, 4) for h in ("coupler_alpha", "rocker_alpha")])
     units = ["[deg]", "[deg]", "[deg]", "[deg]", "", "", "", "", "[rad/s]", "[rad/s]", "[rad/s2]", "[rad/s2]"]
     if cp is not None:
         cols += [Column("xp", "f", 9, 4), Column("yp", "f", 9, 4), Column("vp", "f", 10, 4)]
@@ -96,15 +98,15 @@ def exact_table(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarra
                            np.degrees(out[:, State.TRANSMISSION_ANGLE])])
     rows, trailers = [], []
     d = np.hypot(p.fixed_link - out[:, State.XA], out[:, State.YA])
-    pins, rates = slice(State.XA, State.YB + 1), slice(State.XA, State.ALPHA3 + 1)
+    pins, rates = slice(State.XA, State.YB + 1), slice(State.XA, State.ROCKER_ALPHA + 1)
     for k in range(len(theta)):
         t = int(round(theta[k])) if whole else theta[k]
         if status[k] == ST["indeterminate"]:
             rows.append([t, None, None, None, out[k, State.XA], out[k, State.YA]] + [None] * 6)
-            trailers.append("indeterminate: crank pin A on the rocker pivot O_B, B free on a circle")
+            trailers.append("indeterminate: crank pin A on the rocker pivot O4, B free on a circle")
         elif status[k] == ST["no_assembly"]:
             rows.append([t, None, None, None, out[k, State.XA], out[k, State.YA]] + [None] * 6)
-            trailers.append(f"cannot be assembled: |A O_B| = {d[k]:.4f} outside "
+            trailers.append(f"cannot be assembled: |A O4| = {d[k]:.4f} outside "
                             f"[{abs(p.coupler - p.rocker):g}, {p.coupler + p.rocker:g}]")
         elif status[k] == ST["toggle"]:
             rows.append([t, *ang[k], *out[k, pins]] + [None] * 4)
@@ -145,8 +147,8 @@ def summary_lines(p: Params, g: Grashof, ex: Extremes | None) -> list[str]:
         out.append("    peak speeds .......... unbounded at the toggle positions (theta = "
                    + ", ".join(f"{a:.3f}" for a in ex.toggles) + " deg)")
     else:
-        out += [f"    peak rocker speed .... {ex.w3_peak:.4f} rad/s at theta = {ex.w3_peak_at:.2f} deg",
-                f"    peak coupler speed ... {ex.w2_peak:.4f} rad/s at theta = {ex.w2_peak_at:.2f} deg"]
+        out += [f"    peak rocker speed .... {ex.rocker_omega_peak:.4f} rad/s at theta = {ex.rocker_omega_peak_at:.2f} deg",
+                f"    peak coupler speed ... {ex.coupler_omega_peak:.4f} rad/s at theta = {ex.coupler_omega_peak_at:.2f} deg"]
     if ex.assembled_fraction < 1.0:
         out.append(f"    assemblable .......... about {100 * ex.assembled_fraction:.1f} % of the requested range")
     return out
@@ -167,9 +169,9 @@ def audit(p: Params, theta: np.ndarray, table: np.ndarray, lst_status: np.ndarra
     worst = int(np.argmax(np.where(bad, np.abs(dev), -1)))
     cols = [Column("i", "i", 5, 0), Column("|AB|", "f", 9, 4), Column("dev", "f", 9, 4),
             Column("xb lst", "f", 8, 3), Column("yb lst", "f", 8, 3), Column("xb", "f", 8, 3),
-            Column("yb", "f", 8, 3), Column("oms lst", "f", 9, 4), Column("omega3", "f", 9, 4)]
+            Column("yb", "f", 8, 3), Column("oms lst", "f", 9, 4), Column("rocker_omega", "f", 12, 4)]
     rows = [[int(theta[k]), ab[k], dev[k], table[k, Listing.XB], table[k, Listing.YB], out[k, State.XB],
-             out[k, State.YB], table[k, Listing.OMS], out[k, State.OMEGA3]] for k in np.flatnonzero(bad)]
+             out[k, State.YB], table[k, Listing.OMS], out[k, State.ROCKER_OMEGA]] for k in np.flatnonzero(bad)]
     lines += [f"    {int(bad.sum())} of {len(theta)} rows have a coupler length |AB| different from "
               f"the deck's {p.coupler:g}; largest deviation {dev[worst]:+.4f} at i = {int(theta[worst])}:"]
     lines += ["  " + l for l in render_table(cols, rows)]
@@ -177,7 +179,7 @@ def audit(p: Params, theta: np.ndarray, table: np.ndarray, lst_status: np.ndarra
               "    sigy > 0, sigx > 0 to 'sigma = 2 pi - |atan|' (meant: |atan|), so those rows",
               "    repeat the positions of 360 - i (mirror image) and their velocities are",
               "    wrong; the transmission angle column is still right (it depends on |A O_B| only).",
-              "    Use method = 'exact' for correct values (columns 'xb', 'yb', 'omega3' above)."]
+              "    Use method = 'exact' for correct values (columns 'xb', 'yb', 'rocker_omega' above)."]
     warn = (f"listing rows violate loop closure at {int(bad.sum())} crank angles "
             f"(largest |AB| deviation {dev[worst]:+.4f} at {int(theta[worst])} deg); see the audit in the .out")
     return lines, warn, frame
@@ -221,7 +223,7 @@ def run(params: Params, progress: bool = False) -> Result:
         if warn:
             warnings.append(warn)
         lst_cols = dict(zip(["coupler_deg", "rocker_deg", "transmission_deg", "xa", "ya", "xb", "yb",
-                             "omega2_rad_s", "omega3_rad_s"], table[:, Listing.EPSL:].T))
+                             "coupler_omega_rad_s", "rocker_omega_rad_s"], table[:, Listing.EPSL:].T))
         lst_cols["ab_error"] = np.where(lst_status == ST["ok"], closure["ab_deviation"].to_numpy(), np.nan)
         listing_frame = tidy_frame("listing", theta, lst_cols, lst_status, closure["loop_not_closed"].to_numpy())
         tidy = with_units(pd.concat([listing_frame, exact_frame], ignore_index=True), TIDY_UNITS)
@@ -248,7 +250,7 @@ def output_name(p: Params) -> str:
     """What the output link is called in figures: 'output crank' when it turns fully (a
     double-crank, a drag link), 'rocker' otherwise."""
     g = grashof(p.fixed_link, p.crank, p.coupler, p.rocker)
-    return "output crank" if g.name.startswith("double-crank") else "rocker"
+    return "output crank" if "double-crank" in g.name else "rocker"
 
 
 def deck_figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> list[Figure]:

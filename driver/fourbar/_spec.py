@@ -15,9 +15,9 @@ from driver._deck import GroupSpec, Key, Params, non_negative, positive
 from driver._limits import Estimate
 from driver._study import contract_doc
 
-__all__ = ['SPEC', 'LABELS', 'SWEEP_BEST', 'SWEEP_PLOT', 'SUMMARY_SETTINGS', 'BAND', 'MAX_ANGLE', 'band_of', 'estimate',
-           'FORCE_KEYS', 'FORCE_DEFAULTS', 'FORCE_SUMMARY_DOC', 'LINKS', 'force_value', 'forces_active', 'force_check',
-           'moving_lengths']
+__all__ = ['SPEC', 'LABELS', 'RENAMED', 'SWEEP_BEST', 'SWEEP_PLOT', 'SUMMARY_SETTINGS', 'BAND', 'MAX_ANGLE', 'band_of',
+           'estimate', 'FORCE_KEYS', 'FORCE_DEFAULTS', 'FORCE_SUMMARY_DOC', 'LINKS', 'force_value', 'forces_active',
+           'force_check', 'moving_lengths']
 
 
 MAX_ANGLE = 1.0e6   # |crank angle| [deg] a deck may give (ulp of 1e6 is 1.2e-10 deg)
@@ -239,15 +239,24 @@ LABELS = {"crank": ("crank length", "length units"), "coupler": ("coupler length
           "fixed_link": ("ground link length", "length units"), "omega": ("crank speed", ""),
           "mu_min_deg": ("minimum transmission angle", "deg"), "mu_max_deg": ("maximum transmission angle", "deg"),
           "rocker_swing_deg": ("rocker swing", "deg"),
-          "omega3_peak_rad_s": ("peak rocker speed (signed: the largest in size)", "rad/s"),
-          "omega2_peak_rad_s": ("peak coupler speed (signed: the largest in size)", "rad/s"),
+          "rocker_omega_peak_rad_s": ("peak rocker speed (signed: the largest in size)", "rad/s"),
+          "coupler_omega_peak_rad_s": ("peak coupler speed (signed: the largest in size)", "rad/s"),
           "assembled_fraction": ("fraction of the turn assembled", "-"),
           "time_ratio": ("time ratio (slow / quick stroke)", "-"), **FORCE_LABELS}
 
 
+#: columns renamed (old -> new) when every name came to say its link in words (issue 35; the
+#: paper's listing numbered the coupler 2 and the rocker 3, textbooks 3 and 4): an old name in a
+#: deck, a sweep filter or an &optimize expression is refused with the new one named
+RENAMED = {"omega3_peak_rad_s": "rocker_omega_peak_rad_s", "omega2_peak_rad_s": "coupler_omega_peak_rad_s",
+           "omega3_peak_at_deg": "rocker_omega_peak_at_deg", "omega2_peak_at_deg": "coupler_omega_peak_at_deg",
+           "omega2_rad_s": "coupler_omega_rad_s", "omega3_rad_s": "rocker_omega_rad_s",
+           "alpha2_rad_s2": "coupler_alpha_rad_s2", "alpha3_rad_s2": "rocker_alpha_rad_s2"}
+
+
 #: which way a summary column is better (the design-space maps star the best kept design)
-SWEEP_BEST = {"mu_min_deg": "max", "mu_max_deg": "min", "rocker_swing_deg": "max", "omega3_peak_rad_s": "min",
-              "omega2_peak_rad_s": "min"}
+SWEEP_BEST = {"mu_min_deg": "max", "mu_max_deg": "min", "rocker_swing_deg": "max", "rocker_omega_peak_rad_s": "min",
+              "coupler_omega_peak_rad_s": "min"}
 
 
 #: keys of the base deck the summary columns depend on (transmission_band_deg: meets_transmission_band):
@@ -256,7 +265,7 @@ SUMMARY_SETTINGS = ("transmission_band_deg",)
 
 
 #: what a sweep summary plots when its deck names no plot_y
-SWEEP_PLOT = ("mu_min_deg", "mu_max_deg", "rocker_swing_deg", "omega3_peak_rad_s", "omega2_peak_rad_s",
+SWEEP_PLOT = ("mu_min_deg", "mu_max_deg", "rocker_swing_deg", "rocker_omega_peak_rad_s", "coupler_omega_peak_rad_s",
               "assembled_fraction")
 
 
@@ -264,10 +273,10 @@ SPEC = GroupSpec(
     name="fourbar",
     doc="planar four-bar linkage driven by its crank at constant speed",
     keys={
-        "fixed_link": Key("float", required=True, check=positive, units="length", doc="ground link O_A-O_B"),
-        "crank": Key("float", required=True, check=positive, units="length", doc="input link O_A-A"),
+        "fixed_link": Key("float", required=True, check=positive, units="length", doc="ground link O2-O4 (the paper's O_A-O_B)"),
+        "crank": Key("float", required=True, check=positive, units="length", doc="input link O2-A"),
         "coupler": Key("float", required=True, check=positive, units="length", doc="coupler A-B"),
-        "rocker": Key("float", required=True, check=positive, units="length", doc="output link O_B-B"),
+        "rocker": Key("float", required=True, check=positive, units="length", doc="output link O4-B"),
         "omega": Key("float", default=1.0, units="rad/s", doc="crank angular velocity (ccw positive)"),
         "alpha": Key("float", default=0.0, units="rad/s^2", doc="crank angular acceleration (exact method)"),
         "step_deg": Key("float", required=True, units="deg", doc="crank-angle step"),
@@ -276,7 +285,7 @@ SPEC = GroupSpec(
         "method": Key("str", default="exact", choices=("exact", "listing"),
                       doc="'listing' = published program cell for cell; 'exact' = closed loop"),
         "branch": Key("str", default="open", choices=("open", "crossed"),
-                      doc="'open': B left of the line A->O_B; 'crossed': mirror assembly"),
+                      doc="'open': B left of the line A->O4; 'crossed': mirror assembly"),
         "transmission_band_deg": Key("floats", default=list(BAND), units="deg", check=_band_check,
                                      doc="the transmission-angle band a design should keep to (min, max): the "
                                          "summary's meets_transmission_band, the .out and the figures use it; "

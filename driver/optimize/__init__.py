@@ -73,6 +73,17 @@ def _probe(problem: Problem) -> None:
     Only a clean run (no failure, no warning) proves a column does not exist; otherwise (a buckled
     rod has no strain peaks) a design whose summary lacks a column is infeasible, with that reason.
     """
+    o = problem.opts
+    for key, names in [("summary_columns", o.summary_columns),
+                       ("minimize" if problem.sense > 0 else "maximize", sorted(problem.objective.names))]:
+        refusal = problem.study.renamed_in(names)
+        if refusal:
+            raise o.error(key, refusal)
+    nums = [n for n in range(1, 10) if o[f"constraint{n}"] is not None]
+    for n, c in zip(nums, problem.constraints):
+        refusal = problem.study.renamed_in(sorted(c.whole.names))
+        if refusal:
+            raise o.error(f"constraint{n}", refusal)
     x = [base_value(problem, v) for v in problem.variables]
     try:
         params = design_params(problem, np.array(x))
@@ -87,7 +98,6 @@ def _probe(problem: Problem) -> None:
         return
     from driver import _expr as expr
     frame = pd.DataFrame([summary])
-    o = problem.opts
     exprs = [("minimize" if problem.sense > 0 else "maximize", problem.objective)]
     nums = [n for n in range(1, 10) if o[f"constraint{n}"] is not None]
     exprs += [(f"constraint{n}", c.whole) for n, c in zip(nums, problem.constraints)]
@@ -97,10 +107,6 @@ def _probe(problem: Problem) -> None:
                                          f"(columns: {', '.join(frame.columns)})")
     for key, e in exprs:
         missing = [name for name in sorted(e.names) if name not in frame]
-        renamed = problem.study.renamed
-        if missing and missing[0] in renamed:
-            raise o.error(key, f"summary column '{missing[0]}' of &{problem.raw.name} is now "
-                               f"{renamed[missing[0]]}")
         if missing and clean:   # a clean run of the deck's design has every column its study writes
             raise o.error(key, f"unknown summary column '{missing[0]}' of &{problem.raw.name} "
                                f"(columns: {', '.join(frame.columns)})")

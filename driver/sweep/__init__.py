@@ -164,6 +164,12 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool | st
         columns = [*names, *probe, "case"]
         kinds = {**expr.kinds_of({n: v[0] for n, v in axes if len(v)}), **expr.kinds_of(probe), "case": "number"}
         for key, text in named:
+            try:   # an old column name is answered with its new one (Study.renamed)
+                refusal = module.renamed_in(sorted(expr.parse(text).names))
+            except expr.ExprError:
+                refusal = None
+            if refusal:
+                raise sw.error(key, refusal)
             try:
                 if key == "keep":
                     check_keep(text, columns, kinds)   # one number or logical per case, before any case runs
@@ -178,6 +184,9 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool | st
                 raise sw.error(key, f"{exc.message}" + (f" (at '{exc.token}')" if exc.token else "")
                                + ("" if key == "keep" else f"; summary columns: {', '.join(columns)}")) from None
         if sw.summary_columns:
+            refusal = module.renamed_in(sw.summary_columns)
+            if refusal:
+                raise sw.error("summary_columns", refusal)
             unknown = [c for c in sw.summary_columns if c not in probe]
             if unknown:
                 raise sw.error("summary_columns", f"'{unknown[0]}' is not a summary column of &{base_params.group} "
