@@ -47,6 +47,7 @@ from driver.fourbar._batch import (
     BATCH_INDEPENDENT,
     BATCH_KEYS,
     BATCH_PASSES,
+    batch_refusal,
     summarise,
     summarise_batch,
 )
@@ -68,8 +69,8 @@ __all__ = ["SPEC", "STUDY", "run", "estimate", "summarise", "summarise_batch", "
 STUDY = Study(name="fourbar", package=__name__, spec=SPEC, run=run, estimate=estimate, summarise=summarise,
               batch=BatchSummary(summarise_batch, keys=BATCH_KEYS, ignored=BATCH_IGNORED,
                                  independent=BATCH_INDEPENDENT, passes=BATCH_PASSES,
-                                 pass_names=(*PASS_BITS, "forces")),
+                                 pass_names=(*PASS_BITS, "forces"), refusal=batch_refusal),
               labels=LABELS, sweep_plot=SWEEP_PLOT, sweep_best=SWEEP_BEST, summary_settings=SUMMARY_SETTINGS,
-              blame=blame, published=published.compare, animation=animation_frames, figures=f"{__name__}._figures",
               renamed=RENAMED,
+              blame=blame, published=published.compare, animation=animation_frames, figures=f"{__name__}._figures",
               kernel=kernel)

@@ -14,12 +14,12 @@ import pandas as pd
 from driver._deck import Params
 from driver._study import batch_error, contract_doc
 from driver.fourbar import _kernel as kernel
-from driver.fourbar._analysis import PASS_BITS, SUMMARY_KEYS, param_matrix, summary_rows
+from driver.fourbar._analysis import CLASSES, PASS_BITS, SUMMARY_KEYS, param_matrix, summary_rows
 from driver.fourbar._analysis_forces import cw_radii, props
 from driver.fourbar._kernel import ForceParam
 from driver.fourbar._spec import BAND, FORCE_SUMMARY_DOC, band_of, force_value, forces_active
 
-__all__ = ['BATCH_KEYS', 'BATCH_IGNORED', 'BATCH_INDEPENDENT', 'BATCH_PASSES', 'DETAIL', 'summarise_batch',
+__all__ = ['BATCH_KEYS', 'BATCH_IGNORED', 'BATCH_INDEPENDENT', 'BATCH_PASSES', 'DETAIL', 'summarise_batch', 'batch_refusal',
            'summary_frame', 'summarise', 'summary_of',
            'FORCE_BATCH_KEYS', 'force_frame', 'force_summary', 'summarise_force_batch']
 
@@ -64,11 +64,8 @@ def _pass_mask(wanted: Collection[str] | None) -> int:
     return sum({PASS_BITS[p] for c in wanted for p in BATCH_PASSES.get(c, ()) if p in PASS_BITS})
 
 
-#: kernel Grashof codes -> (class name as grashof() prints it, full crank rotation)
-GRASHOF_NAMES = {"double_crank": ("double-crank (drag link)", True), "crank_rocker": ("crank-rocker", True),
-                 "rocker_crank": ("rocker-crank", False), "double_rocker": ("Grashof double-rocker", False),
-                 "change_point": ("change-point (special Grashof)", True),
-                 "triple_rocker": ("non-Grashof triple-rocker", False)}
+#: kernel class codes -> (class name as grashof() prints it, full crank rotation)
+GRASHOF_NAMES = {k: (CLASSES[k].name, CLASSES[k].full_crank_rotation) for k in CLASSES}
 
 
 @contract_doc
@@ -153,7 +150,7 @@ def summary_frame(res: np.ndarray, detail: bool = False, band: tuple[float, floa
     with ``wanted``, only those columns are built."""
     c = dict(zip(kernel.FOURBAR_SUMMARY_COLUMNS, res.T))
     ok = c["assemblable"] > 0
-    lut = [GRASHOF_NAMES[kernel.FOURBAR_GRASHOF[k]] for k in range(len(GRASHOF_NAMES))]
+    lut = [GRASHOF_NAMES[kernel.FOURBAR_GRASHOF[k]] for k in range(len(kernel.FOURBAR_GRASHOF))]
     tog = lambda: ok & (c["toggles_in_range"] > 0)
     has = lambda v, m=None: np.where(ok if m is None else m, v, np.nan)
     lo, hi = band
@@ -181,6 +178,16 @@ def summary_frame(res: np.ndarray, detail: bool = False, band: tuple[float, floa
                   "toggles_in_range": lambda: c["toggles_in_range"].astype(int)}
     keys = build if wanted is None else [k for k in build if k in set(wanted)]
     return pd.DataFrame({k: build[k]() for k in keys}, index=pd.RangeIndex(len(res)))
+
+
+def batch_refusal(row: Mapping[str, Any]) -> str | None:
+    """Why the study's own run fails the design of a batch row, or None: a chain that cannot move
+    (an impossible or a flat chain) has no position, so its run fails (exit 1); an &optimize design
+    counts as infeasible with that reason on the batch path as it does case by case."""
+    name = row.get("grashof_class")
+    if name in (CLASSES["no_chain"].name, CLASSES["flat_chain"].name):
+        return f"{name}: the chain cannot move (no position over the crank range)"
+    return None
 
 
 @contract_doc

@@ -8,6 +8,7 @@ Drawn in the house style (:mod:`driver.plotting`); this module imports matplotli
 from __future__ import annotations
 
 import math
+import textwrap
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -60,7 +61,7 @@ def _fourbar_names(output: str = "rocker") -> dict[str, str]:
 
 @styled
 def fourbar_curves(exact, listing, title: str, band: Sequence[float] = (40.0, 120.0), output: str = "rocker",
-                   axes=None) -> Figure:
+                   axes=None, chain: str | None = None) -> Figure:
     """Angles, angular velocities and transmission angle against crank angle.
 
     ``exact`` and ``listing`` are tidy frames from driver.fourbar; listing rows are
@@ -68,7 +69,8 @@ def fourbar_curves(exact, listing, title: str, band: Sequence[float] = (40.0, 12
     wrapped into 0-360 deg break at the wrap (no vertical line); crank angles where the
     linkage cannot be assembled are shaded and said so; the transmission-angle ``band``
     [deg] is shaded.  ``output`` names the output link ('rocker', 'output crank').
-    ``axes``: three axes to draw into.
+    ``axes``: three axes to draw into.  ``chain``: the class and reason of a chain that cannot
+    move, written on the panels (which then hold no curve) and in the title.
     """
     names = _fourbar_names(output)
     panels = [("link angle [deg]", ["coupler_deg", "rocker_deg"]),
@@ -84,7 +86,8 @@ def fourbar_curves(exact, listing, title: str, band: Sequence[float] = (40.0, 12
     spans = _unassembled_spans(theta, np.isfinite(exact["transmission_deg"].to_numpy(dtype=float)))
     for ax, (label, keys) in zip(axes, panels):
         for j, (lo, hi) in enumerate(spans):
-            ax.axvspan(lo, hi, color="0.85", alpha=0.6, lw=0, label="cannot be assembled" if j == 0 else None)
+            ax.axvspan(lo, hi, color="0.85", alpha=0.6, lw=0,
+                       label=("cannot be assembled" if not chain else chain.split(":")[0]) if j == 0 else None)
         for k in keys:
             wrap = k.endswith("_deg")
             ax.plot(*(break_wraps(theta, exact[k]) if wrap else (theta, exact[k])), color=colors[k],
@@ -101,8 +104,51 @@ def fourbar_curves(exact, listing, title: str, band: Sequence[float] = (40.0, 12
     for ax in axes:
         ax.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
     axes[-1].set_xlabel(r"crank angle $\theta_2$ [deg]")
-    if title:
-        fig.suptitle(f"{plain_text(title)}: four-bar kinematics")
+    if chain:
+        for ax in axes:
+            ax.text(0.5, 0.5, "no position: " + chain.split(":")[0], transform=ax.transAxes, ha="center",
+                    va="center", color="C3")
+    if title or chain:
+        fig.suptitle((f"{plain_text(title)}: four-bar kinematics" if title else "four-bar kinematics")
+                     + (f"\n{textwrap.fill(plain_text(chain), 80)}" if chain else ""),
+                     fontsize="small" if chain else None)
+    return fig
+
+
+@styled
+def fourbar_chain(lengths: Mapping[str, float], name: str, reason: str, title: str, units: str = "length units",
+                  ax=None) -> Figure:
+    """A chain that cannot move (an impossible or a flat chain, :func:`driver.fourbar.grashof`):
+    its longest link drawn as one bar and the other three laid end to end beside it, so the gap
+    (or the exact match) is seen; the class and its reason in the title.
+
+    ``lengths``: {'fixed link', 'crank', 'coupler', 'rocker': length} in ``units``.  ``ax``: the
+    axes to draw into.
+    """
+    if ax is None:
+        fig, (ax,) = new_figure(1, 1, figsize=(8.6, 3.2))
+    else:
+        fig = ax.figure
+    longest = max(lengths, key=lambda k: lengths[k])
+    others = [k for k in lengths if k != longest]
+    ax.plot([0.0, lengths[longest]], [1.0, 1.0], "-o", color="k", lw=3, ms=5,
+            label=f"longest link: {longest} {lengths[longest]:g}")
+    x = 0.0
+    for j, k in enumerate(others):
+        ax.plot([x, x + lengths[k]], [0.0, 0.0], "-o", color=f"C{j}", lw=3, ms=5, label=f"{k} {lengths[k]:g}")
+        x += lengths[k]
+    gap = lengths[longest] - x
+    if gap > 0:
+        ax.annotate("", xy=(lengths[longest], 0.0), xytext=(x, 0.0),
+                    arrowprops={"arrowstyle": "<->", "color": "C3", "lw": 1.2})
+        ax.text(0.5 * (x + lengths[longest]), 0.12, f"short by {gap:g}", color="C3", ha="center", va="bottom")
+    ax.set_ylim(-0.8, 1.8)
+    ax.set_yticks([])
+    ax.set_xlabel(f"length [{units}]")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
+    what = f"{name}: no position exists" if gap > 0 else f"{name}: it closes only lying flat"
+    ax.set_title((f"{plain_text(title)}: " if title else "") + what + "\n" + textwrap.fill(plain_text(reason), 90),
+                 fontsize="small")
     return fig
 
 

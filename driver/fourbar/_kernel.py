@@ -312,10 +312,13 @@ def fourbar_exact(theta: np.ndarray, p: float, q: float, r: float, s: float, ome
 
 #: columns of fourbar_summaries by name (fortran/fourbar_summary.f90): :class:`Summary`
 FOURBAR_SUMMARY_COLUMNS = tuple(c.name.lower() for c in Summary)
-#: Grashof class codes of fourbar_summaries
+#: class codes of fourbar_summaries (fortran/fourbar_summary.f90 gr_*): Grashof's classes, the
+#: change-point ones (cp_), and the chains that cannot move (no_chain: no position exists;
+#: flat_chain: the longest link equals the other three together)
 FOURBAR_GRASHOF = {int(getattr(_kernels.fourbar_summary, f"gr_{k}")): k for k in
-                   ("double_crank", "crank_rocker", "rocker_crank", "double_rocker", "change_point",
-                    "triple_rocker")}
+                   ("double_crank", "crank_rocker", "rocker_crank", "double_rocker", "triple_rocker",
+                    "cp_double_crank", "cp_crank_rocker", "cp_rocker_crank", "cp_double_rocker",
+                    "no_chain", "flat_chain")}
 
 
 #: pass bits of fourbar_summaries (fortran/fourbar_summary.f90 pass_*); 'dense_scan' with

@@ -78,10 +78,11 @@ def listing_text(p: Params, table: np.ndarray, status: np.ndarray) -> tuple[list
 
 
 def exact_table(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarray,
-                cp: np.ndarray | None = None) -> list[str]:
+                cp: np.ndarray | None = None, chain: Grashof | None = None) -> list[str]:
     """Fixed-format exact table: the listing's ten columns (angles rounded) plus accelerations,
     and the coupler point's position and speed when the deck defines one (``cp`` from
-    kernel.fourbar_coupler_point)."""
+    kernel.fourbar_coupler_point).  ``chain``: the linkage's class (:func:`grashof`); the rows of
+    a chain that cannot move say its class instead of the distance that fails."""
     whole = np.all(np.isclose(theta, np.round(theta)))
     tcol = Column("theta", "i", 5, 0, 2) if whole else Column("theta", "f", 8, 3, 2)
     # headers: the tidy columns' names without their unit (on the line below)
@@ -106,7 +107,9 @@ def exact_table(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarra
             trailers.append("indeterminate: crank pin A on the rocker pivot O4, B free on a circle")
         elif status[k] == ST["no_assembly"]:
             rows.append([t, None, None, None, out[k, State.XA], out[k, State.YA]] + [None] * 6)
-            trailers.append(f"cannot be assembled: |A O4| = {d[k]:.4f} outside "
+            trailers.append(f"{chain.name}: {'no position exists' if chain.name == 'impossible chain' else 'no motion'}"
+                            if chain is not None and not chain.movable else
+                            f"cannot be assembled: |A O4| = {d[k]:.4f} outside "
                             f"[{abs(p.coupler - p.rocker):g}, {p.coupler + p.rocker:g}]")
         elif status[k] == ST["toggle"]:
             rows.append([t, *ang[k], *out[k, pins]] + [None] * 4)
@@ -123,14 +126,25 @@ def exact_table(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarra
     return [lines[0], unit_line] + lines[1:]
 
 
+def _rotation(p: Params, g: Grashof) -> str:
+    """The crank's rotation in words: none (a chain that cannot move), a full turn (through the
+    change points of a change-point linkage, where the links lie in line), or limited by the
+    limit (toggle) crank angles."""
+    lim = limit_angles(p.fixed_link, p.crank, p.coupler, p.rocker)
+    angles = ", ".join(f"{a:.3f}" for a in lim) + " deg"
+    if not g.movable:
+        return "none: " + ("the chain cannot be assembled at any crank angle" if g.name == "impossible chain"
+                           else "the chain lies flat in one position")
+    if g.full_crank_rotation:
+        return "full turn" + (f", through the change point(s) at {angles} (the links in line)" if lim else "")
+    return "limited: limit (toggle) crank angles " + angles
+
+
 def summary_lines(p: Params, g: Grashof, ex: Extremes | None) -> list[str]:
     """Words and numbers after an exact table."""
-    lim = limit_angles(p.fixed_link, p.crank, p.coupler, p.rocker)
     out = ["", "  Summary (closed-loop solution, branch = " + p.branch + ")",
            f"    Grashof class ........ {g.name}  ({g.condition})",
-           "    crank rotation ....... " + ("full turn" if not lim else
-                                           "limited: limit (toggle) crank angles " +
-                                           ", ".join(f"{a:.3f}" for a in lim) + " deg")]
+           "    crank rotation ....... " + _rotation(p, g)]
     if ex is None:
         out.append("    the linkage cannot be assembled anywhere in the requested range")
         return out
@@ -212,8 +226,10 @@ def run(params: Params, progress: bool = False) -> Result:
     cp = coupler_point(p, theta, out, status)
     rows = summary_rows(p)   # the summary kernel, once: the .out's headline figures and the summary
     ex = extremes(p, rows[0])
-    exact_frame = tidy_frame("exact", theta, exact_columns(out, status, cp, p.coupler), status)
+    chain = None if g.movable else g.name.replace(" ", "_")   # the tidy rows' status of a chain that cannot move
+    exact_frame = tidy_frame("exact", theta, exact_columns(out, status, cp, p.coupler), status, chain=chain)
     warnings: list[str] = []
+    failure = run_failure(p, g, ex)
     title = p.title or f"{p.path.stem}"
     if p.method == "listing":
         table, lst_status = listing_grid(p)
@@ -225,25 +241,44 @@ def run(params: Params, progress: bool = False) -> Result:
         lst_cols = dict(zip(["coupler_deg", "rocker_deg", "transmission_deg", "xa", "ya", "xb", "yb",
                              "coupler_omega_rad_s", "rocker_omega_rad_s"], table[:, Listing.EPSL:].T))
         lst_cols["ab_error"] = np.where(lst_status == ST["ok"], closure["ab_deviation"].to_numpy(), np.nan)
-        listing_frame = tidy_frame("listing", theta, lst_cols, lst_status, closure["loop_not_closed"].to_numpy())
+        listing_frame = tidy_frame("listing", theta, lst_cols, lst_status, closure["loop_not_closed"].to_numpy(),
+                                   chain=chain)
         tidy = with_units(pd.concat([listing_frame, exact_frame], ignore_index=True), TIDY_UNITS)
     else:
         listing_frame = None
         lines = [f"  four-bar linkage: closed-loop analysis (method = exact, branch = {p.branch})",
                  f"  deck: {p.path}" + (f" -- {p.title}" if p.title else ""), ""] + _echo(p) + [""]
-        lines += exact_table(p, theta, out, status, cp) + summary_lines(p, g, ex)
+        lines += exact_table(p, theta, out, status, cp, g) + summary_lines(p, g, ex)
         if cp is not None:
             lines += [f"    coupler point P ...... u = {p.coupler_point[0]:g} along A->B, v = {p.coupler_point[1]:g} "
                       "to its left; xp, yp its position, vp its speed [length/s]"]
         if forces_active(p):
-            lines += force_section(p, theta, out, status, exact_frame)
-        for k in np.flatnonzero(status == ST["no_assembly"])[:1]:
+            lines += force_section(p, theta, out, status, exact_frame, None if g.movable else g.name)
+        for k in np.flatnonzero(status == ST["no_assembly"])[:1 if failure is None else 0]:
             warnings.append(f"the linkage cannot be assembled at {int((status == ST['no_assembly']).sum())} "
                             f"of {len(theta)} crank angles (first at {theta[k]:g} deg)")
         tidy = exact_frame
+    if failure:
+        lines += ["", f"  FAILED: {failure}"]
     summary = summary_of(p, rows)
     figs = deck_figures(p, title, listing_frame) + (force_figures(p, title, exact_grid) if forces_active(p) else [])
-    return Result(text="\n".join(lines) + "\n", tidy=tidy, summary=summary, warnings=warnings, figures=figs)
+    return Result(text="\n".join(lines) + "\n", tidy=tidy, summary=summary, warnings=warnings, failure=failure,
+                  figures=figs)
+
+
+def run_failure(p: Params, g: Grashof, ex: Extremes | None) -> str | None:
+    """Why a run produced no motion, or None: a chain that cannot move (its class's reason), or a
+    linkage that assembles nowhere in the deck's crank range (with where it does assemble).  The
+    run then exits 1 (docs/fourbar.md, "Chains that cannot close")."""
+    if not g.movable:
+        return f"{g.name}: {g.reason}"
+    if ex is None:
+        spans = assembly_intervals(p.fixed_link, p.crank, p.coupler, p.rocker)
+        where = "" if not spans else " (it assembles for crank angles " + ", ".join(
+            f"{lo:.3f} to {hi:.3f}" for lo, hi in spans) + " deg)"
+        lo, hi = sorted((p.start_deg, p.stop_deg))
+        return f"the linkage cannot be assembled anywhere in the requested crank range {lo:g} to {hi:g} deg{where}"
+    return None
 
 
 def output_name(p: Params) -> str:
@@ -254,16 +289,24 @@ def output_name(p: Params) -> str:
 
 
 def deck_figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> list[Figure]:
-    """The figures of a run (drawn on demand): the curves and the linkage at its limit positions."""
+    """The figures of a run (drawn on demand): the curves and the linkage at its limit positions;
+    for a chain that cannot move, its links laid out beside its longest (the gap seen)."""
+    g = grashof(p.fixed_link, p.crank, p.coupler, p.rocker)
+    chain = None if g.movable else f"{g.name}: {g.reason}"
+
     def curves():
         from driver.fourbar import _figures as figures  # matplotlib is the optional [plot] extra: imported when drawn
         theta = np.linspace(p.start_deg, p.stop_deg, 721)
         out, st = exact_grid(p, theta)
         exact = tidy_frame("exact", theta, exact_columns(out, st), st)
-        return figures.fourbar_curves(exact, listing, stem_title, band=band_of(p), output=output_name(p))
+        return figures.fourbar_curves(exact, listing, stem_title, band=band_of(p), output=output_name(p),
+                                      chain=chain)
 
     def linkage():
         from driver.fourbar import _figures as figures
+        if not g.movable:
+            return figures.fourbar_chain({"fixed link": p.fixed_link, "crank": p.crank, "coupler": p.coupler,
+                                          "rocker": p.rocker}, g.name, str(g.reason), stem_title)
         lo, hi = sorted((p.start_deg, p.stop_deg))
         # the deck's crank range when it is less than a turn (a function generator's design range)
         theta = np.linspace(lo, hi, 721) if hi - lo < 360.0 else np.linspace(0.0, 360.0, 721)
@@ -300,6 +343,7 @@ def animation_frames(params: Params, result: Result | None = None, n: int = 180)
     motions = rocking_motions(params, max(8, n // 2 // max(
         1, len(assembly_intervals(params.fixed_link, params.crank, params.coupler, params.rocker) or [1]))))
     g = params.fixed_link
+    chain = grashof(params.fixed_link, params.crank, params.coupler, params.rocker)
     phase: list[str] = []
     segments: list[tuple[int, int]] = []
     guides = [Guide(np.array([[0.0, 0.0], [g, 0.0]]), "fixed link")]
@@ -340,4 +384,5 @@ def animation_frames(params: Params, result: Result | None = None, n: int = 180)
         paths=(1, 2, 4) if cp is not None else (1, 2), segments=tuple(segments), frame_name="crank angle",
         caption="The linkage over " + ("its rocking motions between the limit positions (dashed)" if motions
                                        else "one crank turn") + ", positions from the kernel's closed loop.",
-        invalid_note="the linkage cannot be assembled at this crank angle")
+        invalid_note=("the linkage cannot be assembled at this crank angle" if chain.movable
+                      else f"{chain.name}: {chain.reason}"))

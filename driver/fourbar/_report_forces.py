@@ -25,13 +25,15 @@ __all__ = ["force_section", "echo_lines", "table_lines", "summary_lines", "figur
 
 
 def force_section(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarray,
-                  frame: pd.DataFrame) -> list[str]:
-    """The force analysis's lines of the .out; its columns are added to ``frame`` (in place)."""
+                  frame: pd.DataFrame, chain: str | None = None) -> list[str]:
+    """The force analysis's lines of the .out; its columns are added to ``frame`` (in place).
+    ``chain``: the class of a chain that cannot move, said on its rows instead of 'not placed'."""
     fa = analyse(p, out, status)
     for name, values in tidy_columns(fa).items():
         frame[name] = values
     with_units(frame, TIDY_UNITS)
-    words = ["toggle: forces unbounded" if s == ST["toggle"] else "not placed" for s in status]
+    words = ["toggle: forces unbounded" if s == ST["toggle"] else (f"{chain}: no position" if chain else "not placed")
+             for s in status]
     title = ("Force analysis (Newton-Euler, closed form; " +
              ("with the Berkof-Lowen counterweights" if fa.cw is not None else "links as given") + ")")
     return echo_lines(p) + table_lines(theta, fa.forces, fa.ok, words, title) + summary_lines(p, force_summary(p), fa)

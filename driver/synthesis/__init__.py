@@ -329,7 +329,10 @@ def _synthesise_function(p: Params) -> Synthesis:
         lines += ["    precision point   rocker error, this branch [deg]   other branch [deg]"]
         lines += [f"    {xx:15.6f}   {e1:31.3e}   {e2:18.3e}".replace("nan", "  -")
                   for xx, e1, e2 in zip(xs, fd.point_error_deg, fd.other_branch_point_error_deg)]
-        if len(bad):
+        chain = fourbar.grashof(d, fd.crank, fd.coupler, fd.rocker)
+        if not chain.movable:   # Freudenstein's K solve gives lengths, not a chain that closes
+            failure = f"the linkage cannot move ({chain.name}): {chain.reason}"
+        elif len(bad):
             failure = (f"the linkage cannot run the x range on the {p.branch} branch: "
                        f"{len(bad)} of {len(x)} points cannot be assembled or are at a toggle "
                        f"(first at x = {x[bad[0]]:.6g})")
@@ -504,6 +507,9 @@ def _synthesise_path(p: Params) -> Synthesis:
     fp = validate(RawGroup("fourbar", dict(linkage), {}, p.line), fourbar.SPEC, p.path)
     g = fourbar.grashof(fp.fixed_link, fp.crank, fp.coupler, fp.rocker)
     ex = fourbar.extremes(fp)
+    if not g.movable:
+        lines += [f"  Check over a full turn: {g.name} ({g.condition})"]
+        failure = failure or f"the linkage cannot move ({g.name}): {g.reason}"
     if ex is not None:
         lines += [f"  Check over a full turn: {g.name}; assembled {100 * ex.assembled_fraction:.1f} % of the turn; "
                   f"transmission angle {ex.mu_min:.4f} .. {ex.mu_max:.4f} deg"]
