@@ -24,6 +24,7 @@ fields ``x``, ``fun``, ``success``, ``message``, ``nfev``).
 """
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Any
 
@@ -32,10 +33,11 @@ import pandas as pd
 
 from driver import _blas as blas
 from driver._atomic import output_set, write_text
-from driver._deck import Deck, Params, read_deck
+from driver._deck import Deck, DeckError, Params
 from driver._export import write_tidy
 from driver._extras import require
 from driver._outcome import OptimizeOutcome, Optimum
+from driver._pydeck import DeckSource, source_deck
 from driver._result import Figure
 from driver._runner import compute, output_stem, write_outputs
 from driver.optimize import _journal as journal_file
@@ -129,15 +131,17 @@ def base_value(problem: Problem, v) -> float:
 
 
 @blas.one_thread()
-def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[str] | None = None,
+def optimize(deck: DeckSource | Deck, outdir: str | os.PathLike | None = None, formats: list[str] | None = None,
              plot: bool | str = False, jobs: int | None = None, resume: bool = False,
-             scheduler: Any = None) -> OptimizeOutcome:
+             scheduler: Any = None, name: str | None = None) -> OptimizeOutcome:
     """Run an optimisation deck: a study group and an ``&optimize`` group.
 
     Parameters
     ----------
-    deck : Deck, str or path-like
-        The deck, or its file.
+    deck : str, path-like, dict or Deck
+        The deck, as every entry point takes one (``driver.DeckSource``): its file, its text
+        (``"&fourbar ... / &optimize ... /"``), a dict of groups ``{"fourbar": {...},
+        "optimize": {...}}`` (keys in the deck's units), or a parsed Deck.
     outdir : path-like, optional
         Where to write the outputs (``<stem>.out``, the optimum's deck and run, the history);
         None writes nothing.
@@ -152,6 +156,9 @@ def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[
     scheduler : str or dask.distributed.Client, optional
         A Dask scheduler address or client (from the command line or Dask's configuration,
         never from the deck): each batch of designs is spread over its workers.
+    name : str, optional
+        Output stem; default the deck's file stem, or for a deck's text or a dict its study
+        group.
 
     Returns
     -------
@@ -163,14 +170,21 @@ def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[
     Raises
     ------
     DeckError
-        Bad input, before anything is computed or written.
+        Bad input (an unreadable file, a bad key or value, no ``&optimize`` group), before
+        anything is computed or written.
+    TypeError
+        ``deck`` is not a deck source (a number, bytes, ...).
     """
-    if not isinstance(deck, Deck):
-        deck = read_deck(deck)
+    deck = source_deck(deck, name)
+    if "optimize" not in deck.groups or "synthesis" in deck.groups:
+        raise DeckError(deck.path, None, None, "an optimisation deck has a study group and an &optimize group"
+                        + (" and no &synthesis group" if "synthesis" in deck.groups else
+                           f" (found {', '.join('&' + g for g in deck.groups) or 'none'}); run a study deck "
+                           "with driver.run"))
     problem = problem_of(deck)
     _probe(problem)
     formats = list(formats or [])
-    stem = None if outdir is None else output_stem(outdir, deck.path, _suffixes(formats, plot))
+    stem = None if outdir is None else output_stem(Path(outdir), deck.path, _suffixes(formats, plot))
     journal = None if stem is None else journal_file.journal_path(stem)
     found = journal_file.read(problem.fingerprint(), problem.names, stem) if (resume and stem is not None) \
         else journal_file.Resumed()

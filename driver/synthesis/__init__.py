@@ -34,9 +34,10 @@ from driver import _blas as blas
 from driver import _expr as expr
 from driver import fourbar
 from driver._atomic import output_set, write_text
-from driver._deck import Deck, DeckError, GroupSpec, Key, Params, RawGroup, positive, read_deck, validate
+from driver._deck import Deck, DeckError, GroupSpec, Key, Params, RawGroup, positive, validate
 from driver._export import write_tidy
 from driver._outcome import SynthesisOutcome
+from driver._pydeck import DeckSource, source_deck
 from driver._result import Figure
 from driver._runner import compute, output_stem, write_outputs
 from driver.fourbar import _kernel as fourbar_kernel
@@ -529,13 +530,17 @@ def _synthesise_path(p: Params) -> Synthesis:
 # ----------------------------------------------------------------------------- run
 
 @blas.one_thread()
-def synthesise(deck: Deck | str | Path) -> Synthesis:
+def synthesise(deck: DeckSource | Deck, name: str | None = None) -> Synthesis:
     """Run a &synthesis deck: design the linkage, check it, and run its &fourbar deck.
 
     Parameters
     ----------
-    deck : Deck, str or path-like
-        The deck (a ``&synthesis`` group only), or its file.
+    deck : str, path-like, dict or Deck
+        The deck (a ``&synthesis`` group only), as every entry point takes one
+        (``driver.DeckSource``): its file, its text, a dict ``{"synthesis": {...}}`` (keys in
+        the deck's units), or a parsed Deck.
+    name : str, optional
+        The deck's name in messages and titles; default its file stem, or ``synthesis``.
 
     Returns
     -------
@@ -546,10 +551,12 @@ def synthesise(deck: Deck | str | Path) -> Synthesis:
     Raises
     ------
     DeckError
-        Bad input, or another group beside ``&synthesis``.
+        Bad input (an unreadable file, a bad key or value), or another group beside
+        ``&synthesis``.
+    TypeError
+        ``deck`` is not a deck source (a number, bytes, ...).
     """
-    if not isinstance(deck, Deck):
-        deck = read_deck(deck)
+    deck = source_deck(deck, name)
     others = [g for g in deck.groups if g != "synthesis"]
     if others:
         raw = deck.groups[others[0]]
