@@ -94,10 +94,15 @@ class _fourbar_forces:
 
 class _fourbar_summary:
     """Fortran module ``fourbar_summary`` (fortran/*.f90)."""
-    gr_change_point: NDArray[np.int32]
+    gr_cp_crank_rocker: NDArray[np.int32]
+    gr_cp_double_crank: NDArray[np.int32]
+    gr_cp_double_rocker: NDArray[np.int32]
+    gr_cp_rocker_crank: NDArray[np.int32]
     gr_crank_rocker: NDArray[np.int32]
     gr_double_crank: NDArray[np.int32]
     gr_double_rocker: NDArray[np.int32]
+    gr_flat_chain: NDArray[np.int32]
+    gr_no_chain: NDArray[np.int32]
     gr_rocker_crank: NDArray[np.int32]
     gr_triple_rocker: NDArray[np.int32]
     ncol: NDArray[np.int32]
