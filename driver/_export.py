@@ -31,7 +31,7 @@ FORMATS = ("csv", "parquet")
 #: units read from a column name's suffix (longest suffix first)
 SUFFIX_UNITS = (("_rad_s2", "rad/s^2"), ("_rad_s", "rad/s"), ("_m_s2", "m/s^2"), ("_per_s2", "length/s^2"),
                 ("_per_s", "length/s"), ("_microstrain", "1e-6"), ("_deg", "deg"), ("_rpm", "rpm"),
-                ("_Nm", "N m"), ("_m2", "m^2"), ("_mm", "mm"), ("_um", "um"), ("_kg", "kg"), ("_m", "m"),
+                ("_Nm", "N m"), ("_MPa", "MPa"), ("_m2", "m^2"), ("_mm", "mm"), ("_um", "um"), ("_kg", "kg"), ("_m", "m"),
                 ("_N", "N"), ("_s", "s"))
 
 

@@ -15,13 +15,24 @@ from driver._deck import Params
 from driver._study import batch_error, contract_doc
 from driver.fourbar import _kernel as kernel
 from driver.fourbar._analysis import CLASSES, PASS_BITS, SUMMARY_KEYS, param_matrix, summary_rows
-from driver.fourbar._analysis_forces import cw_radii, props
+from driver.fourbar._analysis_forces import counterweights, cw_radii, forces_at, props, scan_angles, stresses_at
 from driver.fourbar._kernel import ForceParam
-from driver.fourbar._spec import BAND, FORCE_SUMMARY_DOC, band_of, force_value, forces_active
+from driver.fourbar._spec import (
+    BAND,
+    FORCE_SUMMARY_DOC,
+    LINKS,
+    STRESS_SUMMARY_DOC,
+    band_of,
+    force_value,
+    forces_active,
+    sections_of,
+    yields_of,
+)
 
 __all__ = ['BATCH_KEYS', 'BATCH_IGNORED', 'BATCH_INDEPENDENT', 'BATCH_PASSES', 'DETAIL', 'summarise_batch', 'batch_refusal',
            'summary_frame', 'summarise', 'summary_of',
-           'FORCE_BATCH_KEYS', 'force_frame', 'force_summary', 'summarise_force_batch']
+           'FORCE_BATCH_KEYS', 'force_frame', 'force_summary', 'summarise_force_batch', 'batch_applies',
+           'stress_summary']
 
 
 #: deck keys a batch may vary (one value per design: the summary kernel's parameters); every
@@ -54,6 +65,8 @@ BATCH_PASSES: dict[str, tuple[str, ...]] = {
     "rocker_omega_peak_at_deg": ("peaks",), "coupler_omega_peak_at_deg": ("peaks",), "toggles_in_range": (),
     # decks that give masses: the force summary (summarise_force_batch), a pass of its own
     **{f"{pre}{c}": ("forces",) for pre in ("", "unbalanced_") for c in FORCE_SUMMARY_DOC},
+    # decks that give link sections too: the link stresses (stress_summary, design by design)
+    **{c: ("forces",) for c in STRESS_SUMMARY_DOC},
 }
 
 
@@ -133,10 +146,63 @@ def _assemble(base: Mapping[str, Any], res: np.ndarray, detail: bool, wanted: Co
     if forces_active(base) and (wanted is None or any(BATCH_PASSES.get(c) == ("forces",) for c in wanted)):
         # force columns when the deck gives masses, and someone reads one
         more = summarise_force_batch(base, force_columns)
+        if sections_of(base) is not None:   # the link stresses, design by design
+            n = len(res)
+            designs = [{**dict(base), **{k: (v[i] if np.ndim(v) > 0 else v) for k, v in force_columns.items()}}
+                       for i in range(n)]
+            more = pd.concat([more, pd.DataFrame([stress_summary(d) for d in designs])], axis=1)
         if wanted is not None:
             more = more[[c for c in more.columns if c in set(wanted)]]
         frame = pd.concat([frame, more], axis=1)
     return frame
+
+
+def batch_applies(base: Mapping[str, Any]) -> bool:
+    """Tell whether designs on ``base`` take the batch path: not with link sections (their
+    stresses are summarised design by design, case by case in a sweep)."""
+    return sections_of(base) is None
+
+
+def stress_summary(p: Mapping[str, Any]) -> dict[str, Any]:
+    """The link stresses of one deck with sections over the force summary's scan of its range:
+    the peak normal stress in each link [MPa] and its crank angle [deg], and with
+    ``yield_strength`` the largest ratio of a peak to its link's yield strength and whether a
+    link yields (:data:`STRESS_SUMMARY_DOC`; None where no position is defined).
+
+    Parameters
+    ----------
+    p : mapping
+        ``&fourbar`` keys with ``mass``, ``section_area`` and ``section_modulus`` (SI).
+
+    Returns
+    -------
+    dict of str to float, bool or None
+        The columns of ``STRESS_SUMMARY_DOC``.
+    """
+    theta = scan_angles(p)
+    out, status = kernel.fourbar_exact(np.radians(theta), p["fixed_link"], p["crank"], p["coupler"], p["rocker"],
+                                       p["omega"], p.get("alpha", 0.0), 1 if p.get("branch", "open") == "open" else -1)
+    pr = counterweights(p).props if force_value(p, "balance") == "force" else props(p)
+    stress = stresses_at(p, out, status, pr, forces_at(p, out, status, pr))
+    ok = status == kernel.FOURBAR_STATUS["ok"]
+    row: dict[str, Any] = {}
+    peaks: list[float | None] = []
+    for j, link in enumerate(LINKS):
+        if stress is None or not ok.any():
+            row[f"{link}_stress_peak_MPa"], row[f"{link}_stress_peak_at_deg"] = None, None
+            peaks.append(None)
+            continue
+        k = int(np.argmax(np.where(ok, stress[:, j], -1.0)))
+        row[f"{link}_stress_peak_MPa"], row[f"{link}_stress_peak_at_deg"] = float(stress[k, j] / 1e6), float(theta[k])
+        peaks.append(float(stress[k, j]))
+    ys = yields_of(p)
+    if ys is None or any(v is None for v in peaks):
+        row["yield_ratio_max"], row["yields"] = None, None
+    else:
+        ratio = max(float(v) / y for v, y in zip(peaks, ys) if v is not None)
+        row["yield_ratio_max"], row["yields"] = ratio, bool(ratio >= 1.0)
+    order = [f"{link}_stress_peak_MPa" for link in LINKS] + [f"{link}_stress_peak_at_deg" for link in LINKS]
+    return {k: row[k] for k in (*order, "yield_ratio_max", "yields")}
 
 
 #: the columns of summarise_batch(detail=True) only

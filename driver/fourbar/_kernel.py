@@ -24,7 +24,8 @@ else:
 __all__ = ['FourbarStatus', 'State', 'Listing', 'Point', 'Force', 'Prop', 'Counterweight', 'ForceParam', 'Summary',
            'SummaryParam', 'FOURBAR_PASSES', 'fourbar_listing', 'fourbar_exact', 'fourbar_coupler_point',
            'fourbar_summaries', 'fourbar_joint_forces', 'fourbar_berkof_lowen', 'fourbar_force_summaries',
-           'FOURBAR_FORCE_SUMMARY_COLUMNS', 'FOURBAR_SUMMARY_COLUMNS', 'FOURBAR_GRASHOF', 'FOURBAR_STATUS']
+           'FOURBAR_FORCE_SUMMARY_COLUMNS', 'FOURBAR_SUMMARY_COLUMNS', 'FOURBAR_GRASHOF', 'FOURBAR_STATUS',
+           'fourbar_link_stresses']
 
 
 class FourbarStatus(KernelStatus):
@@ -448,6 +449,50 @@ def fourbar_berkof_lowen(q: float, r: float, s: float, props: np.ndarray,
     """
     return _kernels.fourbar_forces.berkof_lowen(q, r, s, np.asarray(props, dtype=np.float64),
                                                 np.asarray(radii, dtype=np.float64))
+
+
+def fourbar_link_stresses(states: np.ndarray, status: np.ndarray, p: float, q: float, r: float, s: float,
+                          alpha: float, props: np.ndarray, forces: np.ndarray, section: np.ndarray) -> np.ndarray:
+    """Compute the peak normal stress in each moving link from the joint forces.
+
+    Each link is a straight prismatic bar between its pins carrying the loads of the force
+    analysis's free body where they act (pin forces, driver and load torques, its inertia force
+    and weight at its centre of mass, the load force at the coupler point); the peak of
+    |N|/A + |M|/Z along it (fortran/fourbar_forces.f90 ``link_stresses``).
+
+    Parameters
+    ----------
+    states, status : numpy.ndarray
+        The ``fourbar_exact`` results.
+    p, q, r, s : float
+        Ground, crank, coupler and rocker length, m.
+    alpha : float
+        Crank angular acceleration, rad/s^2.
+    props : numpy.ndarray
+        (18,) link and load properties, as for ``fourbar_joint_forces``.
+    forces : numpy.ndarray
+        (n, 12) ``fourbar_joint_forces`` of the same states and props.
+    section : numpy.ndarray
+        (6,): the section areas of crank, coupler, rocker [m^2], then their elastic section
+        moduli for in-plane bending [m^3].
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, 3): the peak normal stress in crank, coupler and rocker [Pa]; zero where the status
+        is not ok.
+
+    Raises
+    ------
+    ValueError
+        ``section`` does not have 6 positive values.
+    """
+    section = np.ascontiguousarray(section, dtype=np.float64)
+    if section.shape != (6,) or not np.all(section > 0):
+        raise ValueError(f"section must be 6 positive values (areas, moduli), got {section!r}")
+    return _kernels.fourbar_forces.link_stresses(farray(states, 2), np.asarray(status, dtype=np.int32), p, q, r, s,
+                                                 alpha, np.asarray(props, dtype=np.float64), farray(forces, 2),
+                                                 section)
 
 
 #: columns of fourbar_force_summaries (fortran/fourbar_forces.f90 force_summaries)

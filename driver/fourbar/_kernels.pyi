@@ -86,6 +86,22 @@ class _fourbar_forces:
     ) -> NDArray[np.float64]:
         """``fout = joint_forces(states,status,p,q,r,s,omega,alpha1,props,[n])``; shapes fout(n,12)"""
         ...
+    @staticmethod
+    def link_stresses(
+        states: NDArray[np.float64],
+        status: NDArray[np.int32],
+        p: float,
+        q: float,
+        r: float,
+        s: float,
+        alpha1: float,
+        props: NDArray[np.float64],
+        fout: NDArray[np.float64],
+        section: NDArray[np.float64],
+        n: int = ...,
+    ) -> NDArray[np.float64]:
+        """``sout = link_stresses(states,status,p,q,r,s,alpha1,props,fout,section,[n])``; shapes sout(n,3)"""
+        ...
     nbpar: NDArray[np.int32]
     nbres: NDArray[np.int32]
     nforce: NDArray[np.int32]

@@ -34,7 +34,7 @@ from driver.fourbar._analysis import (
 from driver.fourbar._batch import summary_of
 from driver.fourbar._kernel import Listing, Point, State
 from driver.fourbar._report_forces import figures as force_figures
-from driver.fourbar._report_forces import force_section
+from driver.fourbar._report_forces import force_section, yield_warnings
 from driver.fourbar._spec import SPEC, band_of, forces_active
 
 __all__ = ["run", "listing_text", "exact_table", "summary_lines", "audit", "deck_figures", "output_name", "animation_frames"]
@@ -261,6 +261,8 @@ def run(params: Params, progress: bool = False) -> Result:
     if failure:
         lines += ["", f"  FAILED: {failure}"]
     summary = summary_of(p, rows)
+    if forces_active(p):   # a link past its yield strength: said in the .out (force_section) and warned
+        warnings += yield_warnings(p, summary)
     figs = deck_figures(p, title, listing_frame) + (force_figures(p, title, exact_grid) if forces_active(p) else [])
     return Result(text="\n".join(lines) + "\n", tidy=tidy, summary=summary, warnings=warnings, failure=failure,
                   figures=figs)

@@ -16,8 +16,8 @@ from driver._limits import Estimate
 from driver._study import contract_doc
 
 __all__ = ['SPEC', 'LABELS', 'RENAMED', 'SWEEP_BEST', 'SWEEP_PLOT', 'SUMMARY_SETTINGS', 'BAND', 'MAX_ANGLE', 'band_of',
-           'estimate', 'FORCE_KEYS', 'FORCE_DEFAULTS', 'FORCE_SUMMARY_DOC', 'LINKS', 'force_value', 'forces_active',
-           'force_check', 'moving_lengths']
+           'estimate', 'FORCE_KEYS', 'FORCE_DEFAULTS', 'FORCE_SUMMARY_DOC', 'STRESS_SUMMARY_DOC', 'LINKS',
+           'force_value', 'forces_active', 'force_check', 'moving_lengths', 'sections_of', 'yields_of']
 
 
 MAX_ANGLE = 1.0e6   # |crank angle| [deg] a deck may give (ulp of 1e6 is 1.2e-10 deg)
@@ -66,6 +66,26 @@ def _three_non_negative(v: Any) -> str | None:
     return _three(v) or _finite(v) or non_negative(v)
 
 
+def _positive(v: Any) -> str | None:
+    return None if all(math.isfinite(x) and x > 0 for x in v) else "must be positive and finite"
+
+
+#: a yield strength below this [Pa] is taken for a unit mistake (MPa given for Pa)
+MIN_YIELD_PA = 1.0e5
+
+
+def _yield_check(v: Any) -> str | None:
+    if len(v) not in (1, 3):
+        return f"give one value for every link, or three: crank, coupler, rocker (got {len(v)})"
+    bad = _positive(v)
+    if bad:
+        return bad
+    if min(v) < MIN_YIELD_PA:
+        return (f"{min(v):g} Pa is below {MIN_YIELD_PA:g} Pa: yield strengths are in Pa (250 MPa is 2.5e8); "
+                "this looks like MPa")
+    return None
+
+
 FORCE_KEYS: dict[str, Key] = {
     "mass": Key("floats", default=None, units="kg", check=_three_non_negative,
                 doc="masses of crank, coupler, rocker; giving them runs the force analysis (lengths in metres)"),
@@ -91,6 +111,14 @@ FORCE_KEYS: dict[str, Key] = {
     "balance": Key("str", default=None, choices=("none", "force"),
                    doc="'force': Berkof-Lowen counterweights on crank and rocker, balanced analysis reported too "
                        "(default 'none')"),
+    "section_area": Key("floats", default=None, units="m^2", check=lambda v: _three(v) or _positive(v),
+                        doc="cross-section area of crank, coupler, rocker; with section_modulus each link's peak "
+                            "normal stress |N|/A + |M|/Z over the range (the force analysis's loads)"),
+    "section_modulus": Key("floats", default=None, units="m^3", check=lambda v: _three(v) or _positive(v),
+                           doc="elastic section modulus I/c of crank, coupler, rocker for in-plane bending"),
+    "yield_strength": Key("floats", default=None, units="Pa", check=_yield_check,
+                          doc="yield strength of the links' material (one value, or crank, coupler, rocker); "
+                              "with the sections a link whose peak stress reaches it is reported as yielding"),
     "counterweight_radius": Key("floats", default=None, units="m",
                                 check=lambda v: (None if len(v) == 2 else f"give two values: crank, rocker (got {len(v)})")
                                 or (None if all(x > 0 for x in v) else "must be positive"),
@@ -182,6 +210,12 @@ def force_check(p: Params) -> None:
             if rc > MAX_COM_RATIO * L:
                 raise p.error("counterweight_radius", f"{rc:g} m is {rc / L:.0f} times the "
                                                       f"{('crank', 'rocker')[i]} length: a length unit mismatch?")
+    if (p.section_area is None) != (p.section_modulus is None):
+        key = "section_area" if p.section_area is not None else "section_modulus"
+        raise p.error(key, "the link stresses need both section_area (m^2) and section_modulus (m^3)")
+    if p.yield_strength is not None and p.section_area is None:
+        raise p.error("yield_strength", "is compared with the link stresses, which need section_area and "
+                                        "section_modulus")
     fx, fy = force_value(p, "load_force_x"), force_value(p, "load_force_y")
     if (fx != 0.0 or fy != 0.0) and not p.coupler_point:
         key = "load_force_x" if fx != 0.0 else "load_force_y"
@@ -201,10 +235,34 @@ FORCE_SUMMARY_DOC = {
     "flywheel_inertia_kgm2": "flywheel inertia dE / (C_s omega^2) [kg m^2]",
 }
 
+#: the link-stress summary's columns (decks with section_area and section_modulus) and what they are
+STRESS_SUMMARY_DOC = {
+    **{f"{link}_stress_peak_MPa": f"peak normal stress |N|/A + |M|/Z in the {link} [MPa]" for link in LINKS},
+    **{f"{link}_stress_peak_at_deg": f"crank angle of the {link}'s peak stress [deg]" for link in LINKS},
+    "yield_ratio_max": "largest peak stress over the link's yield strength [1]",
+    "yields": "a link's peak stress reaches its yield strength []",
+}
+
 
 #: axis labels of the force summary columns: name -> (words, units)
 FORCE_LABELS = {name: (doc.rsplit(" [", 1)[0], doc.rsplit(" [", 1)[1].rstrip("]"))
-                for name, doc in FORCE_SUMMARY_DOC.items()}
+                for name, doc in (FORCE_SUMMARY_DOC | STRESS_SUMMARY_DOC).items()}
+
+
+def sections_of(p: Mapping[str, Any]) -> list[float] | None:
+    """The link sections of the deck for the kernel's link_stresses: the areas of crank, coupler,
+    rocker [m^2], then their section moduli [m^3]; None without section_area."""
+    if p.get("section_area") is None or p.get("section_modulus") is None:
+        return None
+    return [float(x) for x in (*p["section_area"], *p["section_modulus"])]
+
+
+def yields_of(p: Mapping[str, Any]) -> list[float] | None:
+    """The yield strength of crank, coupler and rocker [Pa] (one deck value for all), or None."""
+    v = p.get("yield_strength")
+    if v is None:
+        return None
+    return [float(v[0])] * 3 if len(v) == 1 else [float(x) for x in v]
 
 
 # ----------------------------------------------------------------------------- the group
