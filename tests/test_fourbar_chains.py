@@ -159,10 +159,15 @@ def test_a_linkage_assembling_on_part_of_the_range_reports_that_part():
     assert f"{a:.3f}" in res.failure
 
 
-def test_a_sweep_summary_names_the_impossible_chains(tmp_path):
+@pytest.mark.parametrize("outputs", ["all", "none"])
+def test_a_sweep_summary_names_the_impossible_chains_on_both_paths(tmp_path, outputs):
+    """A sweep is a design search: an impossible design is an answer its row classifies, not a
+    failed case, whether each case runs in full (its files written) or the batch summarises."""
     deck = tmp_path / "sw.dat"
     deck.write_text("&fourbar fixed_link = 12, crank = 5, coupler = 15, rocker = 9, step_deg = 30 /\n"
-                    "&sweep key1 = 'fourbar.coupler', values1 = 15, 30, 150 /\n")
+                    f"&sweep key1 = 'fourbar.coupler', values1 = 15, 30, 150, case_outputs = '{outputs}' /\n")
     s = driver.run_sweep(deck, jobs=1)
+    assert s.batch == (outputs == "none")
     assert list(s.summary["grashof_class"]) == ["crank-rocker", "impossible chain", "impossible chain"]
-    assert not s.summary["full_crank_rotation"].iloc[1:].any()
+    assert not s.summary["full_crank_rotation"].iloc[1:].any() and not s.summary["assemblable"].iloc[1:].any()
+    assert s.status == 0 and s.n_failed == 0 and (s.summary["status"] == "ok").all()

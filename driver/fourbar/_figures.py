@@ -108,10 +108,11 @@ def fourbar_curves(exact, listing, title: str, band: Sequence[float] = (40.0, 12
         for ax in axes:
             ax.text(0.5, 0.5, "no position: " + chain.split(":")[0], transform=ax.transAxes, ha="center",
                     va="center", color="C3")
-    if title or chain:
+    if chain:
         fig.suptitle((f"{plain_text(title)}: four-bar kinematics" if title else "four-bar kinematics")
-                     + (f"\n{textwrap.fill(plain_text(chain), 80)}" if chain else ""),
-                     fontsize="small" if chain else None)
+                     + f"\n{textwrap.fill(plain_text(chain), 80)}", fontsize="small")
+    elif title:
+        fig.suptitle(f"{plain_text(title)}: four-bar kinematics")
     return fig
 
 

@@ -265,7 +265,7 @@ def run(params: Params, progress: bool = False) -> Result:
         warnings += yield_warnings(p, summary)
     figs = deck_figures(p, title, listing_frame) + (force_figures(p, title, exact_grid) if forces_active(p) else [])
     return Result(text="\n".join(lines) + "\n", tidy=tidy, summary=summary, warnings=warnings, failure=failure,
-                  figures=figs)
+                  figures=figs, design_failure=failure is not None)
 
 
 def run_failure(p: Params, g: Grashof, ex: Extremes | None) -> str | None:

@@ -92,7 +92,7 @@ def _compute(task: Task, case: Case, module) -> tuple[CaseResult, Any, Params | 
         if full or module.summarise is None:
             result = compute(module, params)
             res.summary = dict(result.summary)
-            if result.failure:
+            if result.failure and not result.design_failure:   # a design's own answer is no failed case
                 res.status, res.error = ExitCode.FAILED, result.failure
         else:
             res.summary = dict(module.summarise(params))
@@ -114,7 +114,7 @@ def _write_case(task: Task, case: Case, res: CaseResult, result, params: Params,
     try:
         if result is None:
             result = compute(module, params)
-            if result.failure:
+            if result.failure and not result.design_failure:
                 res.status, res.error = ExitCode.FAILED, result.failure
         res.warnings = list(result.warnings)
         stem = task.layout.stem(case.index)
