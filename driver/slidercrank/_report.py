@@ -188,6 +188,14 @@ def yield_warnings(model: Model, rows: list[tuple[str, float, float | None]]) ->
             for name, w, st in rows if st is not None and st >= ys]
 
 
+def yield_strain(model: Model) -> tuple[float, str] | None:
+    """The rod's yield strain sigma_y / E [microstrain] and what its yield strength is, for the
+    figures; None without a yield strength."""
+    if not model.yield_strength:
+        return None
+    return model.yield_strength / model.modulus * 1e6, f"{model.yield_strength / 1e6:g} MPa, {model.yield_source}"
+
+
 def yield_summary(model: Model, stresses: list[float | None], prefix: str = "") -> dict[str, Any]:
     """The summary's stress columns of one model: the peak over the speeds [MPa], its ratio to the
     yield strength and whether it yields (None without a yield strength)."""
@@ -453,7 +461,8 @@ def run_linear(params: Params, progress: bool = False) -> Result:
         stiffness = "K + K_G" if params.geometric_stiffness else "linear model"
         figures.append(Figure("strain", lambda: figures_module().slidercrank_strain_figure(
             [(f"{c.omega:g} rad/s", c.angle_deg, c.eps_1 * 1e6) for c in good],
-            f"{params.material}: crank-end element axial strain ({stiffness})", above=above, missing=missing)))
+            f"{params.material}: crank-end element axial strain ({stiffness})", above=above, missing=missing,
+            yield_strain=yield_strain(model))))
         figures.append(Figure("deflection", lambda: figures_module().slidercrank_strain_figure(
             [(f"{c.omega:g} rad/s", c.angle_deg, c.mid * 1e3) for c in good],
             f"{params.material}: midpoint deflection ({stiffness})", ylabel="midpoint deflection [mm]",

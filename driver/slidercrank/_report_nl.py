@@ -28,6 +28,7 @@ from driver.slidercrank._report import (
     peak_stress,
     run_linear,
     status_text,
+    yield_strain,
     yield_summary,
     yield_table,
     yield_warnings,
@@ -265,7 +266,8 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
     if good:
         figures.append(Figure("strain_linear_nonlinear", lambda: figures_module().slidercrank_nl_strain_figure(
             [(f"{nl.omega:g} rad/s", lin.angle_deg, lin.eps_1 * 1e6, nl.eps_ax[0] * 1e6) for lin, nl in good],
-            f"{params.material}: crank-end axial strain, linear (dashed) and nonlinear (solid)")))
+            f"{params.material}: crank-end axial strain, linear (dashed) and nonlinear (solid)",
+            yield_strain=yield_strain(model))))
     okn = [nl for nl in nls if nl.ok]
     if okn:
         figures.append(Figure("shapes", lambda: figures_module().slidercrank_nl_shapes_figure(
