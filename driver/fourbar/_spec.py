@@ -190,7 +190,7 @@ def force_check(p: Params) -> None:
     if p.com_distance is not None:
         for i, (d, L) in enumerate(zip(p.com_distance, lengths)):
             if d > MAX_COM_RATIO * L:
-                raise p.error("com_distance", f"{d:g} m for the {LINKS[i]} is {d / L:.0f} times its length "
+                raise p.error("com_distance", f"{d:g} m for the {LINKS[i]} is {d / L:.3g} times its length "
                                               f"{L:g} m: com_distance and the link lengths look like different "
                                               "units (metres are expected)")
     if p.inertia is not None:
@@ -208,7 +208,7 @@ def force_check(p: Params) -> None:
             raise p.error("counterweight_radius", "is used only with balance = 'force'")
         for i, (rc, L) in enumerate(zip(p.counterweight_radius, (lengths[0], lengths[2]))):
             if rc > MAX_COM_RATIO * L:
-                raise p.error("counterweight_radius", f"{rc:g} m is {rc / L:.0f} times the "
+                raise p.error("counterweight_radius", f"{rc:g} m is {rc / L:.3g} times the "
                                                       f"{('crank', 'rocker')[i]} length: a length unit mismatch?")
     if (p.section_area is None) != (p.section_modulus is None):
         key = "section_area" if p.section_area is not None else "section_modulus"

@@ -41,6 +41,7 @@ from driver._pydeck import DeckSource, source_deck
 from driver._result import Figure
 from driver._runner import compute, output_stem, write_outputs
 from driver.fourbar import _kernel as fourbar_kernel
+from driver.synthesis import _budget
 from driver.synthesis import _crank_rocker as cr
 from driver.synthesis._function import FunctionDesign, chebyshev, freudenstein, links_from_k, wrap180
 
@@ -551,8 +552,9 @@ def synthesise(deck: DeckSource | Deck, name: str | None = None) -> Synthesis:
     Raises
     ------
     DeckError
-        Bad input (an unreadable file, a bad key or value), or another group beside
-        ``&synthesis``.
+        Bad input (an unreadable file, a bad key or value), another group beside
+        ``&synthesis``, degenerate path targets, or work or memory beyond the budget
+        (``--max-work``, ``--max-memory``), before anything is computed.
     TypeError
         ``deck`` is not a deck source (a number, bytes, ...).
     """
@@ -563,6 +565,7 @@ def synthesise(deck: DeckSource | Deck, name: str | None = None) -> Synthesis:
         raise DeckError(deck.path, raw.line, None, f"a &synthesis deck has no other group (found &{others[0]}); "
                                                    "it writes the &fourbar deck of its linkage")
     p = validate(deck.groups["synthesis"], SPEC, deck.path)
+    _budget.admit(p)   # over the budget, or degenerate targets: refused before anything is computed
     syn = {"function": _synthesise_function, "crank_rocker": _synthesise_crank_rocker, "path": _synthesise_path}[p.task](p)
     if syn.linkage is not None:
         fp = validate(RawGroup("fourbar", dict(syn.linkage, title=p.title or f"{Path(deck.path).stem} ({p.task} synthesis)"),
