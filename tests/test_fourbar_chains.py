@@ -171,3 +171,59 @@ def test_a_sweep_summary_names_the_impossible_chains_on_both_paths(tmp_path, out
     assert list(s.summary["grashof_class"]) == ["crank-rocker", "impossible chain", "impossible chain"]
     assert not s.summary["full_crank_rotation"].iloc[1:].any() and not s.summary["assemblable"].iloc[1:].any()
     assert s.status == 0 and s.n_failed == 0 and (s.summary["status"] == "ok").all()
+
+
+def test_both_figures_of_an_impossible_chain_name_its_class():
+    import matplotlib
+    matplotlib.use("Agg")
+    res = driver.run(ISSUE)
+    words = []
+    for fig in (f.draw() for f in res.figures):
+        words += [fig.get_suptitle()] + [t.get_text() for ax in fig.axes for t in ax.texts]
+        words += [ax.get_title() for ax in fig.axes]
+    text = " ".join(words)
+    assert {f.name for f in res.figures} >= {"curves", "linkage"}
+    assert "impossible chain" in text and "full turn" not in text and "triple-rocker" not in text
+    # the linkage figure shows how far the longest link is from closing: 150 - (12 + 5 + 9)
+    assert "short by 124" in text
+
+
+def _function_deck(links: tuple[float, float, float, float], theta: np.ndarray, crank_range: float) -> str:
+    """A function-generation deck through three positions of a known linkage (its rocker angles
+    by the kernel's own loop solve are data here: the test is what the check says of the result)."""
+    from driver.fourbar import _kernel as fourbar_kernel
+    d, a, b, c = links
+    out, st = fourbar_kernel.fourbar_exact(np.radians(theta), d, a, b, c, 1.0, 0.0, 1)
+    assert (st == 0).all()
+    psi = np.degrees(out[:, 1])
+    t0 = float(theta[0])
+    return ("&synthesis task = 'function', x_values = " + ", ".join(repr(float(t)) for t in theta)
+            + ", y_values = " + ", ".join(repr(float(v)) for v in psi)
+            + f", x_start = {t0!r}, x_stop = {t0 + crank_range!r}, crank_start_deg = {t0!r},"
+            f" crank_range_deg = {crank_range!r}, rocker_start_deg = {float(psi[0])!r},"
+            f" rocker_range_deg = {float(psi[-1] - psi[0])!r}, fixed_link = {d!r} /\n")
+
+
+@pytest.mark.parametrize("links, crank_range", [((1.0, 0.8, 0.6, 0.7), 100.0),    # triple-rocker, assembles to 91.79 deg
+                                                ((1.0, 0.45, 1.1, 0.9), 100.0)])  # crank-rocker
+def test_a_synthesised_linkage_is_classed_and_its_assembly_limit_found(links, crank_range):
+    from driver.synthesis import synthesise
+    p, q, r, s = links
+    theta = np.array([10.0, 25.0, 40.0])
+    syn = synthesise(_function_deck(links, theta, crank_range))
+    assert (syn.design.crank, syn.design.coupler, syn.design.rocker) == pytest.approx((q, r, s), abs=1e-10)
+    srt = sorted(links)
+    word = "triple-rocker" if srt[0] + srt[3] > srt[1] + srt[2] else "crank-rocker"
+    turns = crank_turns(p, q, r, s)
+    line = next(l for l in syn.text.splitlines() if "class of the linkage" in l)
+    assert word in line and ("turns fully" if turns else "does not turn fully") in line, line
+    # the crank range leaves the assembled interval where |A O4| = r + s: cos(theta) = (p^2 + q^2 - (r + s)^2) / (2 p q)
+    lim = math.degrees(math.acos((p * p + q * q - (r + s) ** 2) / (2 * p * q))) if not turns else math.inf
+    assert fraction(p, q, r, s, 10.0, 10.0 + crank_range) == pytest.approx(
+        min(1.0, (lim - 10.0) / crank_range), abs=1e-5)
+    if turns:
+        assert syn.failure is None
+    else:
+        x = np.linspace(10.0, 10.0 + crank_range, 201)   # the check's default error_points
+        first = x[x > lim][0]
+        assert syn.failure is not None and "cannot be assembled" in syn.failure and f"x = {first:g})" in syn.failure

@@ -332,6 +332,8 @@ def _synthesise_function(p: Params) -> Synthesis:
         lines += [f"    {xx:15.6f}   {e1:31.3e}   {e2:18.3e}".replace("nan", "  -")
                   for xx, e1, e2 in zip(xs, fd.point_error_deg, fd.other_branch_point_error_deg)]
         chain = fourbar.grashof(d, fd.crank, fd.coupler, fd.rocker)
+        lines += [f"    class of the linkage:  {chain.name} ({chain.condition}); the crank "
+                  + ("turns fully" if chain.full_crank_rotation else "does not turn fully")]
         if not chain.movable:   # Freudenstein's K solve gives lengths, not a chain that closes
             failure = f"the linkage cannot move ({chain.name}): {chain.reason}"
         elif len(bad):
