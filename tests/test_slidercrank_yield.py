@@ -99,3 +99,23 @@ def test_the_committed_nonlinear_aluminium_output_says_it_yields():
     assert rows[("nonlinear", 29.32)][1] == "YIELDS" and rows[("nonlinear", 25.13)][1] == "YIELDS"
     assert all(v[1] == "" for (m, _), v in rows.items() if m == "linear")
     assert np.isclose(rows[("nonlinear", 29.32)][0], 580, rtol=0.05)
+
+
+@pytest.mark.parametrize("model", ["linear", "nonlinear"])
+def test_the_strain_figure_marks_the_yield_strain(model):
+    """sigma_y / E by hand drawn at both signs: the aluminium's 276 MPa / 71.7 GPa = 3849
+    microstrain beside the buckled nonlinear rod; a deck's yield strength of 10 MPa (139
+    microstrain) beside the linear model's crank-end strain of some 70."""
+    pytest.importorskip("matplotlib")
+    import matplotlib
+    matplotlib.use("Agg")
+    ys = YIELD["aluminium"] if model == "nonlinear" else 10e6
+    r = driver.slidercrank.run(material="aluminium", speeds=[29.32], model=model, n_elements=16, revolutions=4,
+                               **({} if model == "nonlinear" else {"yield_strength": ys}))
+    name = "strain" if model == "linear" else "strain_linear_nonlinear"
+    ax = r.figure(name).axes[0]
+    eps = ys / E["aluminium"] * 1e6
+    levels = sorted(float(line.get_ydata()[0]) for line in ax.get_lines()
+                    if len(set(line.get_ydata())) == 1 and line.get_linestyle() == ":")
+    assert levels == pytest.approx([-eps, eps], rel=1e-12)
+    assert any("yield strain" in t and f"{ys / 1e6:g} MPa" in t for t in ax.get_legend_handles_labels()[1])
