@@ -227,3 +227,40 @@ def test_a_synthesised_linkage_is_classed_and_its_assembly_limit_found(links, cr
         x = np.linspace(10.0, 10.0 + crank_range, 201)   # the check's default error_points
         first = x[x > lim][0]
         assert syn.failure is not None and "cannot be assembled" in syn.failure and f"x = {first:g})" in syn.failure
+
+
+def _closes(p: float, q: float, r: float, s: float, theta_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(the loop closes, it closes only flat: |A O4| = |r - s| or r + s) at each crank angle."""
+    d = np.sqrt(p * p + q * q - 2 * p * q * np.cos(np.radians(theta_deg)))
+    flat = np.isclose(d, abs(r - s), rtol=0, atol=1e-9) | np.isclose(d, r + s, rtol=0, atol=1e-9)
+    return (d >= abs(r - s) - 1e-9) & (d <= r + s + 1e-9), flat
+
+
+@pytest.mark.parametrize("links", [(0.12, 0.05, 0.15, 0.08),    # change-point crank-rocker: flat at 0 deg
+                                   (0.10, 0.08, 0.03, 0.06)])   # Grashof double-rocker: part of the turn
+def test_the_force_analysis_at_a_change_point_and_on_part_of_the_turn(links):
+    p, q, r, s = links
+    res = driver.fourbar.run(fixed_link=p, crank=q, coupler=r, rocker=s, step_deg=5, mass=[1.0, 1.0, 1.0])
+    t = res.tidy
+    theta = t["theta_deg"].to_numpy()
+    closes, flat = _closes(p, q, r, s, theta)
+    assert res.ok and res.summary["full_crank_rotation"] == crank_turns(p, q, r, s)
+    # forces exactly where the loop closes and does not lie flat (there the pin forces are indeterminate)
+    has_force = t["input_torque_Nm"].notna().to_numpy()
+    assert np.array_equal(has_force, closes & ~flat)
+    assert np.array_equal((t["status"] == "cannot_assemble").to_numpy(), ~closes)
+    if flat.any():
+        assert set(t.loc[flat, "status"]) == {"toggle"}
+        assert "through the change point" in res.out
+    else:
+        assert res.warnings and f"at {int((~closes).sum())} of {len(t)} crank angles" in res.warnings[0]
+
+
+def test_the_batch_assembled_fraction_of_a_partial_linkage_is_the_measure_where_it_closes():
+    grid = np.array([[10.0, 8.0, 3.0, 6.0], [9.0, 7.0, 2.0, 5.0], [7.0, 6.0, 8.0, 4.0], [5.0, 9.0, 3.0, 4.0]])
+    frame = summarise_batch({"fixed_link": 1.0, "crank": 1.0, "coupler": 1.0, "rocker": 1.0, "omega": 1.0,
+                             "start_deg": 0.0, "stop_deg": 360.0, "branch": "open"},
+                            {"fixed_link": grid[:, 0], "crank": grid[:, 1], "coupler": grid[:, 2], "rocker": grid[:, 3]})
+    for (p, q, r, s), got in zip(grid, frame["assembled_fraction"]):
+        want = fraction(p, q, r, s, 0.0, 360.0)
+        assert 0.0 < want < 1.0 and got == pytest.approx(want, abs=1e-5), (p, q, r, s)
