@@ -21,8 +21,10 @@ from __future__ import annotations
 
 import numpy as np
 
-#: Grashof codes as the kernel numbers them (fortran/fourbar_summary.f90 gr_*)
+#: class codes as the kernel numbers them (fortran/fourbar_summary.f90 gr_*); the kernel splits change
+#: points by which links turn (codes 4, 6, 7, 8), which this form does not handle: CHANGE_POINT marks them
 DOUBLE_CRANK, CRANK_ROCKER, ROCKER_CRANK, DOUBLE_ROCKER, CHANGE_POINT, TRIPLE_ROCKER = range(6)
+NO_CHAIN, FLAT_CHAIN = 9, 10   # the longest link longer than (equal to) the other three together
 DEG = 180.0 / np.pi
 
 
@@ -35,7 +37,11 @@ def grashof(p: np.ndarray, q: np.ndarray, r: np.ndarray, s: np.ndarray) -> np.nd
     code = np.where(p == short, DOUBLE_CRANK, np.where(q == short, CRANK_ROCKER,
                                                        np.where(s == short, ROCKER_CRANK, DOUBLE_ROCKER)))
     code = np.where(np.abs(lhs - rhs) <= tol, CHANGE_POINT, code)
-    return np.where(lhs > rhs + tol, TRIPLE_ROCKER, code)
+    code = np.where(lhs > rhs + tol, TRIPLE_ROCKER, code)
+    longest = np.maximum(np.maximum(p, q), np.maximum(r, s))
+    rest = (p + q + r + s) - longest
+    code = np.where(longest >= rest * (1 - 1e-12), FLAT_CHAIN, code)
+    return np.where(longest > rest * (1 + 1e-12), NO_CHAIN, code)
 
 
 def rocker_at(t: np.ndarray, p, q, r, s, branch) -> np.ndarray:

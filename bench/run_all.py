@@ -342,8 +342,13 @@ def search(repeat: int, before: str | None, n: int | None = None) -> list[Row]:
     if before is None:
         return rows
     old = kernel_before(before)
+    # the class codes were split since (issue 35: change points by which links turn, 6-8 -> 4; chains
+    # that cannot move, 9-10 -> 5, the triple-rocker they were counted as); every other figure bit for bit
+    was = np.array([0, 1, 2, 3, 4, 5, 4, 4, 4, 5, 5], dtype=float)
     for bits in (closed, P["peaks"], closed | P["peaks"]):
-        np.testing.assert_array_equal(fourbar_kernel.fourbar_summaries(m, bits), old(m, bits))   # bit for bit
+        new, before = fourbar_kernel.fourbar_summaries(m, bits), old(m, bits)
+        np.testing.assert_array_equal(was[new[:, 0].astype(int)], before[:, 0])
+        np.testing.assert_array_equal(new[:, 1:], before[:, 1:])
     tk, tb = interleaved(lambda: fourbar_kernel.fourbar_summaries(m, P["peaks"]), lambda: old(m, P["peaks"]), repeat)
     rows.append(Row("search: peak-speed pass (baseline: kernel before)", "us/linkage", tk / nl, tb / nl, None, 2.0,
                     "refined peak search of both speeds, a block of linkages per call; the same bits as before"))
