@@ -112,7 +112,8 @@ def test_sweep_table_equals_the_row_by_row_table():
     frame = pd.DataFrame({"case": np.arange(1, n + 1), "fourbar.crank": np.round(rng.uniform(1, 7, n), 5),
                           "status": np.where(np.arange(n) % 50 == 0, "failed", "ok"),
                           "kept": rng.uniform(size=n) < 0.5, "swing_deg": x,
-                          "class": rng.choice(["crank-rocker", "double-rocker"], n),
+                          "class": pd.Series(rng.choice(["crank-rocker", "double-rocker"], n)).where(
+                              np.arange(n) % 11 != 3),   # text with missing values
                           "mixed": pd.Series([None if i % 7 == 0 else float(i) / 3 for i in range(n)], dtype=object),
                           "error": [""] * n})
     assert _summary_table(frame) == row_by_row(frame)

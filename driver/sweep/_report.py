@@ -170,6 +170,8 @@ def table_cells(show: pd.DataFrame, cols: list[Column], keys: list[str]) -> list
                 out.append(cells.astype(str))
         elif arr is not None and arr.dtype.kind in "iu" and c.kind in "is":
             out.append(arr.astype(str))
+        elif c.kind == "s" and isinstance(s.dtype, pd.StringDtype) and s.dtype.na_value is np.nan:
+            out.append(np.asarray(s.to_numpy(dtype=object, na_value="-"), dtype=str))   # text; missing: '-'
         else:   # objects (text, or values of mixed kinds): value by value
             out.append(np.array([_cell(c, v) for v in s.tolist()], dtype=str))
     return out
