@@ -149,31 +149,38 @@ def table_columns(frame: pd.DataFrame) -> tuple[list[Column], list[str]]:
 
 
 def table_cells(show: pd.DataFrame, cols: list[Column], keys: list[str]) -> list[np.ndarray]:
-    """The .out table's cells of ``show``, column by column (one formatting call per column of
-    the block, :func:`driver._table.fixed_cells` for the numbers), each an array of str: '-' for
-    a missing or non-finite value, yes/no for a truth value, the column's edit for a number, the
-    text of anything else -- the cells ``Column.cell`` gives value by value."""
-    out = []
-    for c, k in zip(cols, keys):
+    """The .out table's cells of ``show``, column by column, each an array of str: '-' for a
+    missing or non-finite value, yes/no for a truth value, the column's edit for a number, the
+    text of anything else -- the cells ``Column.cell`` gives value by value.  The numbers of all
+    columns with the same edit go through one :func:`driver._table.fixed_cells` call (a part of
+    a streamed sweep has a few hundred rows: per-call costs would dominate column by column)."""
+    out: list[Any] = [None] * len(cols)
+    numbers: dict[tuple[int, str], list[tuple[int, np.ndarray]]] = {}
+    for j, (c, k) in enumerate(zip(cols, keys)):
         s = show[k]
         arr = s.to_numpy() if isinstance(s.dtype, np.dtype) else None
         if arr is not None and arr.dtype.kind == "b":
-            out.append(np.where(arr, "yes", "no"))
+            out[j] = np.where(arr, "yes", "no")
         elif arr is not None and arr.dtype.kind == "f" and c.kind == "f":
-            finite = np.isfinite(arr)
-            text = fixed_cells(arr[finite], c.decimals, c.style)
-            if finite.all():
-                out.append(text)
-            else:
-                cells = np.full(len(arr), "-", dtype=object)
-                cells[finite] = text
-                out.append(cells.astype(str))
+            numbers.setdefault((c.decimals, c.style), []).append((j, arr))
         elif arr is not None and arr.dtype.kind in "iu" and c.kind in "is":
-            out.append(arr.astype(str))
+            out[j] = arr.astype(str)
         elif c.kind == "s" and isinstance(s.dtype, pd.StringDtype) and s.dtype.na_value is np.nan:
-            out.append(np.asarray(s.to_numpy(dtype=object, na_value="-"), dtype=str))   # text; missing: '-'
+            out[j] = np.asarray(s.to_numpy(dtype=object, na_value="-"), dtype=str)   # text; missing: '-'
         else:   # objects (text, or values of mixed kinds): value by value
-            out.append(np.array([_cell(c, v) for v in s.tolist()], dtype=str))
+            out[j] = np.array([_cell(c, v) for v in s.tolist()], dtype=str)
+    for (decimals, style), group in numbers.items():
+        values = np.concatenate([arr for _, arr in group])
+        finite = np.isfinite(values)
+        cells = fixed_cells(values[finite], decimals, style)
+        if not finite.all():
+            text = np.full(len(values), "-", dtype=object)
+            text[finite] = cells
+            cells = text.astype(str)
+        at = 0
+        for j, arr in group:
+            out[j] = cells[at:at + len(arr)]
+            at += len(arr)
     return out
 
 
