@@ -1462,8 +1462,9 @@ contains
       row(7) = at(2)
       row(8) = best(2) - best(1)
       if (periodic == 1) then
-        ang = modulo(at(2) - at(1), span)
-        if (ang > 0.0_dp .and. ang < span) row(9) = max(ang, span - ang)/min(ang, span - ang)
+        ! the kinematic period of a crank is one turn (a 720 deg load cycle holds two strokes each)
+        ang = modulo(at(2) - at(1), 2*pi)
+        if (ang > 0.0_dp .and. ang < 2*pi) row(9) = max(ang, 2*pi - ang)/min(ang, 2*pi - ang)
       end if
     end subroutine output_extremes
 

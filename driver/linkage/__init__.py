@@ -1,0 +1,46 @@
+"""Any planar linkage [issue 38]: the ``&linkage`` group.
+
+A mechanism is a driver (a crank turning about a ground pivot, or a block moving along a
+ground guide) followed by class-II Assur groups (dyads RRR, RRP, PRR, RPR, PRP), each attached
+to points already placed, with points on any link (tracers, attachments, load points).
+The kernel (fortran/linkage.f90) solves positions, velocities and accelerations of every joint
+and point, every link's angle and rates and every slide; assembly failures, toggles and dead
+centres per group; joint forces, the driving torque (or force), shaking force and moment,
+group by group in closed form; flywheel energy; and batched summaries for sweeps and
+&optimize.  Deck grammar, sign conventions and equations: docs/linkage.md.
+
+The package's private modules, by job: ``_spec`` (deck keys, checks, labels, budget), ``_model``
+(the deck's mechanism compiled into the kernel's program), ``_kernel`` (the Fortran wrappers,
+columns named by IntEnums), ``_analysis`` (a deck through the kernel, events, tidy table),
+``_batch`` (many designs in one kernel call; the summary), ``_flywheel`` (a turning-moment
+table), ``_report`` (the run), ``_frames`` (drawing data), ``_figures``.
+"""
+from __future__ import annotations
+
+from driver._study import BatchSummary, Study
+from driver.linkage import _kernel as kernel
+from driver.linkage._analysis import Event, Motion, events, inputs, solve, tidy_frame
+from driver.linkage._batch import (
+    BATCH_ELEMENTS,
+    BATCH_IGNORED,
+    BATCH_INDEPENDENT,
+    BATCH_KEYS,
+    refusal,
+    summarise,
+    summarise_batch,
+)
+from driver.linkage._flywheel import TableFlywheel, table_flywheel
+from driver.linkage._frames import animation_frames
+from driver.linkage._model import Dyad, Mechanism, compile_deck
+from driver.linkage._report import run
+from driver.linkage._spec import LABELS, SPEC, SUMMARY_SETTINGS, SWEEP_BEST, SWEEP_PLOT, estimate
+
+__all__ = ["SPEC", "STUDY", "run", "estimate", "summarise", "summarise_batch", "compile_deck", "solve", "inputs",
+           "events", "tidy_frame", "table_flywheel", "animation_frames", "Mechanism", "Dyad", "Motion", "Event",
+           "TableFlywheel", "BATCH_KEYS", "LABELS", "kernel"]
+
+STUDY = Study(name="linkage", package=__name__, spec=SPEC, run=run, estimate=estimate, summarise=summarise,
+              batch=BatchSummary(summarise_batch, keys=BATCH_KEYS, ignored=BATCH_IGNORED,
+                                 independent=BATCH_INDEPENDENT, elements=BATCH_ELEMENTS, refusal=refusal),
+              labels=LABELS, sweep_plot=SWEEP_PLOT, sweep_best=SWEEP_BEST, summary_settings=SUMMARY_SETTINGS,
+              figures=f"{__name__}._figures", kernel=kernel)

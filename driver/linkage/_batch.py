@@ -1,0 +1,242 @@
+"""The linkage batch summary: many designs of one mechanism in one kernel call (sweeps,
+&optimize), and the summary of one deck (the same kernel row).
+
+A batch varies numbers only (the topology is the base deck's): each varied key (or list
+element ``key(i)``) is applied to the base deck once per distinct value and compiled -- so
+every design is checked exactly as a deck would be -- and the kernel's number vectors of the
+designs are the base's plus the changes of their values (fortran/linkage.f90 summaries)."""
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Collection, Mapping
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from driver._deck import DeckError, Params
+from driver._study import contract_doc
+from driver.linkage import _kernel as kernel
+from driver.linkage._kernel import NSUM_DYAD, NSUM_LINK, NSUM_SLIDE, SummaryCol
+from driver.linkage._model import Mechanism, compile_deck
+
+__all__ = ["BATCH_KEYS", "BATCH_IGNORED", "BATCH_INDEPENDENT", "BATCH_ELEMENTS", "summarise_batch", "summarise",
+           "summary_of", "summary_frame", "scan_of", "refusal"]
+
+#: deck keys a batch may vary (numbers of the mechanism, its loads and the scan)
+BATCH_KEYS = ("pivot_xy", "guide_xy", "guide_deg", "driver_length", "omega", "alpha", "dyad_dims", "dyad_modes",
+              "point_uv", "mass", "com_uv", "inertia", "gravity", "load_xy", "torques", "guide_force_scale",
+              "guide_force", "speed_fluctuation", "start", "stop", "turning_moment")
+#: list keys whose single elements ('key(i)', 1-based) a batch may set
+BATCH_ELEMENTS = ("pivot_xy", "guide_xy", "guide_deg", "dyad_dims", "dyad_modes", "point_uv", "mass", "com_uv",
+                  "inertia", "gravity", "load_xy", "torques", "guide_force", "turning_moment")
+#: keys accepted in a batch that leave the summary unchanged
+BATCH_IGNORED = ("title", "step")
+#: keys whose deck checks involve no other key
+BATCH_INDEPENDENT = ("omega", "alpha", "speed_fluctuation", "title", "step")
+_ELEMENT = re.compile(r"([a-z_]+)\((\d+)\)")
+
+
+def scan_of(p: Mapping[str, Any], mech: Mechanism) -> tuple[float, float, bool]:
+    """The summary's scan of one cycle: first input, span (rad for a crank: the load cycle;
+    length for an input slider: start to stop) and whether it is periodic."""
+    if mech.driver == "crank":
+        return math.radians(float(p["start"])), math.radians(float(p["cycle_deg"])), True
+    return float(p["start"]), float(p["stop"]) - float(p["start"]), False
+
+
+def _with(base: Params, key: str, index: int | None, value: Any) -> Params:
+    """``base`` with one key (or one element of a list key, 1-based) replaced, re-checked."""
+    values = dict(base)
+    if index is None:
+        values[key] = value
+    else:
+        cur = list(base[key] if base[key] is not None else [])
+        if not 1 <= index <= len(cur):
+            raise base.error(key, f"element {index} does not exist ({key} has {len(cur)} values)")
+        cur[index - 1] = value
+        values[key] = cur
+    q = Params(base.group, base.path, values, {k: base.line_of(k) for k in base}, base.line, base.given | {key})
+    from driver.linkage._spec import SPEC
+    k = SPEC.keys[key]
+    if k.check is not None:
+        msg = k.check(values[key])
+        if msg:
+            raise base.error(key, msg)
+    return q
+
+
+def _numbers(base: Params, mech: Mechanism, columns: Mapping[str, Any], n: int) -> np.ndarray:
+    """(n, numbers + 3) kernel rows: the base design's numbers plus each varied value's change."""
+    b = np.concatenate([mech.numbers(), np.zeros(3)])
+    x0, span, _ = scan_of(base, mech)
+    b[-3:] = (x0, span, float(base["speed_fluctuation"]))
+    rows = np.tile(b, (n, 1))
+    for name, vals in columns.items():
+        m = _ELEMENT.fullmatch(name)
+        key, index = (m.group(1), int(m.group(2))) if m else (name, None)
+        vals = np.broadcast_to(np.asarray(vals), (n,))
+        uniq, inverse = np.unique(vals, return_inverse=True)
+        delta = np.empty((len(uniq), len(b)))
+        for u, v in enumerate(uniq):
+            v = v.item() if hasattr(v, "item") else v
+            try:
+                q = _with(base, key, index, v)
+                mq = compile_deck(q)
+            except DeckError as exc:
+                i = int(np.argmax(inverse == u))
+                raise DeckError(exc.path, exc.line, exc.key, f"design {i}: {exc.message}") from None
+            if len(mq.numbers()) != len(b) - 3:
+                raise base.error(key, "changes the mechanism's layout (a batch varies numbers only)")
+            nq = np.concatenate([mq.numbers(), np.zeros(3)])
+            xq, sq, _ = scan_of(q, mq)
+            nq[-3:] = (xq, sq, float(q["speed_fluctuation"]))
+            delta[u] = nq - b
+        rows += delta[inverse]
+    return np.asfortranarray(rows)
+
+
+@contract_doc
+def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None = None,
+                    wanted: Collection[str] | None = None) -> pd.DataFrame:
+    """Summarise many designs of one mechanism in one Fortran call: one row per design.
+
+    Parameters
+    ----------
+    base : Params
+        A validated ``&linkage`` deck: the mechanism whose numbers the designs change.
+    columns : mapping of str to array, optional
+        {key or 'key(i)': n values} for keys in ``BATCH_KEYS`` (elements of ``BATCH_ELEMENTS``),
+        in the deck's units; ``'linkage.key'`` is accepted for ``'key'``; scalars broadcast.
+    wanted : collection of str, optional
+        Only these summary columns (all are computed; the kernel's row is one pass).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per design: the columns of :func:`summarise` (units in their names; missing
+        figures NaN).
+
+    %(batch_raises)s
+    """
+    if not isinstance(base, Params):
+        raise TypeError("base must be a validated &linkage deck (Params)")
+    columns = {k.partition(".")[2] if k.startswith("linkage.") else k: v for k, v in (columns or {}).items()}
+    for k in columns:
+        m = _ELEMENT.fullmatch(k)
+        key = m.group(1) if m else k
+        if key in BATCH_IGNORED:
+            continue
+        if key not in BATCH_KEYS or (m and key not in BATCH_ELEMENTS):
+            raise base.error(key if key in base else None, f"{k!r} is not a &linkage number a batch may vary "
+                                                             f"({', '.join(BATCH_KEYS)})")
+    columns = {k: v for k, v in columns.items() if (_ELEMENT.fullmatch(k) or k) and
+               (_ELEMENT.fullmatch(k).group(1) if _ELEMENT.fullmatch(k) else k) not in BATCH_IGNORED}
+    sizes = {np.size(v) for v in columns.values() if np.ndim(v) > 0}
+    if len(sizes) > 1:
+        raise base.error(None, f"batch columns have different lengths {sorted(sizes)}")
+    n = sizes.pop() if sizes else 1
+    mech = compile_deck(base)
+    rows = kernel.summaries(mech, _numbers(base, mech, columns, n), base["scan_points"], mech.driver == "crank")
+    frame = summary_frame(base, mech, rows)
+    if wanted is not None:
+        frame = frame[[c for c in frame.columns if c in set(wanted)]]
+    return frame
+
+
+def summary_frame(p: Mapping[str, Any], mech: Mechanism, res: np.ndarray) -> pd.DataFrame:
+    """Kernel rows -> the summary columns (the one place both paths go through)."""
+    c = SummaryCol
+    crank = mech.driver == "crank"
+    xin = np.degrees if crank else (lambda v: v)
+    whole = res[:, c.ASSEMBLED_FRACTION] >= 1.0
+    has = lambda v, m: np.where(m, v, np.nan)
+    out_is_link = mech.output[0] == 1
+    ou = np.degrees if out_is_link else (lambda v: v)
+    full_turn = out_is_link & whole & (res[:, c.STROKE] == 0.0) & (res[:, c.OUTPUT_MAX] == 0.0)
+    rrr = any(d.kind == "rrr" for d in mech.dyads)
+    sliding = any(d.kind != "rrr" for d in mech.dyads)
+    cols: dict[str, Any] = {
+        "assembled_fraction": res[:, c.ASSEMBLED_FRACTION],
+        "assemblable": whole,
+        "toggle_in_range": res[:, c.TOGGLES] > 0,
+        "output_min": has(ou(res[:, c.OUTPUT_MIN]), whole & ~full_turn),
+        "output_min_at": has(xin(res[:, c.OUTPUT_MIN_AT]), whole & ~full_turn),
+        "output_max": has(ou(res[:, c.OUTPUT_MAX]), whole & ~full_turn),
+        "output_max_at": has(xin(res[:, c.OUTPUT_MAX_AT]), whole & ~full_turn),
+        "stroke": has(ou(res[:, c.STROKE]), whole & ~full_turn),
+        "time_ratio": has(res[:, c.TIME_RATIO], whole & (res[:, c.TIME_RATIO] > 0)),
+        "mu_min_deg": has(np.degrees(res[:, c.MU_MIN]), np.full(len(res), rrr) & (res[:, c.ASSEMBLED_FRACTION] > 0)),
+        "mu_min_at": has(xin(res[:, c.MU_MIN_AT]), np.full(len(res), rrr) & (res[:, c.ASSEMBLED_FRACTION] > 0)),
+        "mu_max_deg": has(np.degrees(res[:, c.MU_MAX]), np.full(len(res), rrr) & (res[:, c.ASSEMBLED_FRACTION] > 0)),
+        "mu_max_at": has(xin(res[:, c.MU_MAX_AT]), np.full(len(res), rrr) & (res[:, c.ASSEMBLED_FRACTION] > 0)),
+        "pressure_max_deg": has(np.degrees(res[:, c.PRESSURE_MAX]),
+                                np.full(len(res), sliding) & (res[:, c.ASSEMBLED_FRACTION] > 0)),
+    }
+    if mech.forces:
+        f = res[:, c.ASSEMBLED_FRACTION] > 0
+        cols |= {"torque_peak": has(res[:, c.TORQUE_PEAK], f), "torque_peak_at": has(xin(res[:, c.TORQUE_PEAK_AT]), f),
+                 "torque_mean": has(res[:, c.TORQUE_MEAN], whole), "torque_rms": has(res[:, c.TORQUE_RMS], whole),
+                 "shaking_force_peak_N": has(res[:, c.SHAKING_FORCE_PEAK], f),
+                 "shaking_moment_peak_Nm": has(res[:, c.SHAKING_MOMENT_PEAK], f)}
+        if crank:
+            cols |= {"energy_fluctuation_J": has(res[:, c.ENERGY_FLUCTUATION], whole),
+                     "flywheel_inertia_kgm2": has(res[:, c.FLYWHEEL_INERTIA],
+                                                  whole & (res[:, c.FLYWHEEL_INERTIA] > 0))}
+    base = len(SummaryCol)
+    f = res[:, c.ASSEMBLED_FRACTION] > 0
+    for i, name in enumerate(mech.links[1:]):
+        j = base + NSUM_LINK * i
+        cols[f"omega_peak_{name}_rad_s"] = has(res[:, j], f)
+        cols[f"alpha_peak_{name}_rad_s2"] = has(res[:, j + 1], f)
+    base += NSUM_LINK * (len(mech.links) - 1)
+    for i, (name, _, _) in enumerate(mech.slides):
+        j = base + NSUM_SLIDE * i
+        cols[f"slide_min_{name}"] = has(res[:, j], whole)
+        cols[f"slide_max_{name}"] = has(res[:, j + 1], whole)
+        cols[f"slide_rate_peak_{name}"] = has(res[:, j + 2], f)
+        cols[f"slide_accel_peak_{name}"] = has(res[:, j + 3], f)
+    base += NSUM_SLIDE * mech.nslides
+    for i, d in enumerate(mech.dyads):
+        j = base + NSUM_DYAD * i
+        word = "mu" if d.kind == "rrr" else "pressure"
+        cols[f"{word}_min_deg_{d.joints[2]}"] = has(np.degrees(res[:, j]), f)
+        cols[f"{word}_max_deg_{d.joints[2]}"] = has(np.degrees(res[:, j + 1]), f)
+    return pd.DataFrame(cols, index=pd.RangeIndex(len(res)))
+
+
+def refusal(row: Mapping[str, Any]) -> str | None:
+    """Why the study's own run would refuse a design of a summary row: never (a linkage that
+    cannot be assembled is reported, not refused)."""
+    return None
+
+
+def summary_rows(p: Params, mech: Mechanism | None = None) -> tuple[Mechanism, np.ndarray]:
+    """The kernel's summary row of one deck: (mechanism, (1, width) row)."""
+    mech = mech or compile_deck(p)
+    return mech, kernel.summaries(mech, _numbers(p, mech, {}, 1), p.scan_points, mech.driver == "crank")
+
+
+@contract_doc
+def summarise(params: Params) -> dict:
+    """Summarise one deck: the headline figures only, without the tables.
+
+    %(summarise)s
+    """
+    return summary_of(params)
+
+
+def summary_of(p: Params, rows: tuple[Mechanism, np.ndarray] | None = None) -> dict:
+    """Headline figures of one deck as a dict (missing -> None)."""
+    mech, res = rows or summary_rows(p)
+    row = summary_frame(p, mech, res).iloc[0].to_dict()
+    out = {k: (None if isinstance(v, float) and math.isnan(v) else
+               bool(v) if isinstance(v, (bool, np.bool_)) else
+               float(v) if isinstance(v, np.floating) else v) for k, v in row.items()}
+    if p.turning_moment is not None:
+        from driver.linkage._flywheel import table_flywheel
+        tm = table_flywheel(p)
+        out |= {"table_torque_mean_Nm": tm.mean, "table_energy_fluctuation_J": tm.fluctuation,
+                "table_flywheel_inertia_kgm2": tm.inertia}
+    return out

@@ -1,0 +1,251 @@
+"""The linkage study's kernel wrappers: fortran/linkage.f90 (any planar linkage: kinematics,
+kinetostatics, turning-moment energy, batched summaries).
+
+Thin wrappers over the compiled extension (loaded once by :mod:`driver._fortran`): inputs are
+converted once to Fortran-ordered arrays, nothing is looped in Python.  The kernel's output
+columns are named once, here, by IntEnums (as pymsis names its Fortran columns).
+"""
+from __future__ import annotations
+
+from enum import IntEnum
+from typing import NamedTuple
+
+import numpy as np
+
+from driver._fortran import _kernels, farray
+from driver.linkage._model import Mechanism
+
+__all__ = ["Status", "LinkCol", "PointCol", "SlideCol", "JointCol", "DriverCol", "ShakeCol", "EnergyCol",
+           "SummaryCol", "Want", "Analysis", "analyse", "table_energy", "summaries", "summary_width",
+           "NSUM_LINK", "NSUM_SLIDE", "NSUM_DYAD"]
+
+_K = _kernels.linkage
+
+
+class Status(IntEnum):
+    """Status of a group at a position (fortran/linkage.f90 st_*)."""
+
+    OK = int(_K.st_ok)
+    NO_ASSEMBLY = int(_K.st_no_assembly)
+    TOGGLE = int(_K.st_toggle)
+    INDETERMINATE = int(_K.st_indeterminate)
+    UNPLACED = int(_K.st_unplaced)
+
+
+class Want(IntEnum):
+    """What analyse computes besides the kinematics (bits)."""
+
+    CONTINUITY = int(_K.want_continuity)
+    FORCES = int(_K.want_forces)
+
+
+class LinkCol(IntEnum):
+    """Columns of a link's kinematics: angle [rad], angular velocity [rad/s], acceleration [rad/s^2]."""
+
+    ANGLE = 0
+    OMEGA = 1
+    ALPHA = 2
+
+
+class PointCol(IntEnum):
+    """Columns of a point's kinematics [length, length/s, length/s^2]."""
+
+    X = 0
+    Y = 1
+    VX = 2
+    VY = 3
+    AX = 4
+    AY = 5
+
+
+class SlideCol(IntEnum):
+    """Columns of a slide: displacement along its guide, its rate and acceleration (relative)."""
+
+    S = 0
+    V = 1
+    A = 2
+
+
+class JointCol(IntEnum):
+    """Columns of a group's joint forces: joints A, B, C each (fx, fy, couple) [N, N m]."""
+
+    AX = 0
+    AY = 1
+    AQ = 2
+    BX = 3
+    BY = 4
+    BQ = 5
+    CX = 6
+    CY = 7
+    CQ = 8
+
+
+class DriverCol(IntEnum):
+    """Columns of the driver's forces: the reaction at its pivot or guide (fx, fy, couple) and
+    the driving torque [N m] (crank) or force [N] (slider)."""
+
+    FX = 0
+    FY = 1
+    Q = 2
+    DRIVE = 3
+
+
+class ShakeCol(IntEnum):
+    """Columns of the shaking force (x, y) [N] and moment about the origin [N m]."""
+
+    FX = 0
+    FY = 1
+    M = 2
+
+
+class EnergyCol(IntEnum):
+    """Columns of table_energy's result."""
+
+    MEAN_TORQUE = 0
+    ENERGY_FLUCTUATION = 1
+    FLYWHEEL_INERTIA = 2
+    AT_MAX = 3
+    AT_MIN = 4
+    WORK = 5
+    TORQUE_MAX = 6
+    TORQUE_MIN = 7
+
+
+class SummaryCol(IntEnum):
+    """The head columns of a summary row (fortran/linkage.f90 summaries); angles in rad,
+    inputs in rad (crank) or length (slider)."""
+
+    ASSEMBLED_FRACTION = 0
+    NOT_ASSEMBLED = 1
+    TOGGLES = 2
+    OUTPUT_MIN = 3
+    OUTPUT_MIN_AT = 4
+    OUTPUT_MAX = 5
+    OUTPUT_MAX_AT = 6
+    STROKE = 7
+    TIME_RATIO = 8
+    MU_MIN = 9
+    MU_MAX = 10
+    PRESSURE_MAX = 11
+    TORQUE_PEAK = 12
+    TORQUE_PEAK_AT = 13
+    TORQUE_MEAN = 14
+    TORQUE_RMS = 15
+    SHAKING_FORCE_PEAK = 16
+    SHAKING_MOMENT_PEAK = 17
+    ENERGY_FLUCTUATION = 18
+    FLYWHEEL_INERTIA = 19
+    MU_MIN_AT = 20
+    MU_MAX_AT = 21
+
+
+NSUM_HEAD = int(_K.nsum_head)
+NSUM_LINK, NSUM_SLIDE, NSUM_DYAD = int(_K.nsum_link), int(_K.nsum_slide), int(_K.nsum_dyad)
+assert NSUM_HEAD == len(SummaryCol)
+
+
+class Analysis(NamedTuple):
+    """The kernel's answer at n inputs (positions first): ``links`` (n, 3, links) by
+    :class:`LinkCol`, ``points`` (n, 6, points) by :class:`PointCol`, ``slides`` (n, 3, slides)
+    by :class:`SlideCol`, ``quality`` (n, groups) transmission or pressure angle [rad],
+    ``status`` (n, groups) :class:`Status`, ``joints`` (n, 9, groups) by :class:`JointCol`,
+    ``driver`` (n, 4) by :class:`DriverCol`, ``shaking`` (n, 3) by :class:`ShakeCol`."""
+
+    links: np.ndarray
+    points: np.ndarray
+    slides: np.ndarray
+    quality: np.ndarray
+    status: np.ndarray
+    joints: np.ndarray
+    driver: np.ndarray
+    shaking: np.ndarray
+
+
+def analyse(mech: Mechanism, x: np.ndarray, forces: bool | None = None, continuity: bool = True) -> Analysis:
+    """Solve the mechanism at inputs ``x``: kinematics, and forces when it has bodies.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The compiled mechanism (:func:`driver.linkage._model.compile_deck`).
+    x : numpy.ndarray
+        Inputs in order: crank angles [rad] or slides [length].
+    forces : bool, optional
+        Run the kinetostatics (default: when the mechanism has bodies).
+    continuity : bool, default True
+        Follow each group's assembly through change points (fortran/linkage.f90).
+
+    Returns
+    -------
+    Analysis
+        The kernel's arrays (see :class:`Analysis`).
+    """
+    x = farray(np.atleast_1d(x), 1)
+    want = (int(Want.CONTINUITY) if continuity else 0) | (int(Want.FORCES) if (mech.forces if forces is None
+                                                                                else forces) else 0)
+    i, r = mech.integers(), mech.reals()
+    out = _K.analyse(mech.nslides, x, i["idrv"], r["rdrv"], i["ipts"], r["rpts"],
+                     i["igd"], r["rgd"], i["idy"], r["rdy"], r["rl"], r["grav"], i["ild"], r["rld"], r["rtq"],
+                     i["ift"], r["tab"], r["rft"], want)
+    a = Analysis(*out)
+    if not mech.slides:
+        a = a._replace(slides=a.slides[:, :, :0])
+    return a
+
+
+def table_energy(theta: np.ndarray, torque: np.ndarray, cs: float, omega: float) -> np.ndarray:
+    """Energy of a turning-moment diagram (torque linear between the given angles).
+
+    Parameters
+    ----------
+    theta : numpy.ndarray
+        Crank angles of one cycle, ascending [rad].
+    torque : numpy.ndarray
+        Torque at each angle [N m].
+    cs : float
+        Coefficient of speed fluctuation [1].
+    omega : float
+        Mean crank speed [rad/s].
+
+    Returns
+    -------
+    numpy.ndarray
+        (8,) by :class:`EnergyCol`: mean torque [N m], energy fluctuation [J], flywheel inertia
+        [kg m^2], angles of the energy's maximum and minimum [rad], the cycle's work [J], largest
+        and smallest torque [N m].
+    """
+    return _K.table_energy(farray(theta, 1), farray(torque, 1), float(cs), float(omega))
+
+
+def summary_width(mech: Mechanism) -> int:
+    """Columns of a summary row of ``mech``."""
+    return NSUM_HEAD + NSUM_LINK * (len(mech.links) - 1) + NSUM_SLIDE * mech.nslides + NSUM_DYAD * len(mech.dyads)
+
+
+def summaries(mech: Mechanism, numbers: np.ndarray, nscan: int, periodic: bool, forces: bool | None = None) -> np.ndarray:
+    """Summaries of many designs of one mechanism in one kernel call.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The mechanism (its integer program is shared by every design).
+    numbers : numpy.ndarray
+        (designs, numbers + 3): each design's :meth:`Mechanism.numbers`, then the scan's first
+        input, span [rad or length] and the coefficient of speed fluctuation.
+    nscan : int
+        Scan points of the cycle.
+    periodic : bool
+        A crank's cycle (no end point) or a slider's range (both ends).
+    forces : bool, optional
+        Include the kinetostatic figures (default: when the mechanism has bodies).
+
+    Returns
+    -------
+    numpy.ndarray
+        (designs, :func:`summary_width`) rows (fortran/linkage.f90 summaries, :class:`SummaryCol`).
+    """
+    i = mech.integers()
+    want = int(Want.CONTINUITY) | (int(Want.FORCES) if (mech.forces if forces is None else forces) else 0)
+    return _K.summaries(farray(numbers, 2), len(mech.links), mech.nslides, mech.reals()["tab"].shape[0], i["idrv"],
+                        i["ipts"], i["igd"], i["idy"], i["ild"], i["ift"], int(nscan), int(bool(periodic)),
+                        np.array(mech.output, dtype=np.int32), want, summary_width(mech))
