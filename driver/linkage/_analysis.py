@@ -84,7 +84,14 @@ def solve(p: Params, x: np.ndarray | None = None, mech: Mechanism | None = None)
     mech = mech or compile_deck(p)
     x = inputs(p) if x is None else np.asarray(x, dtype=np.float64)
     xk = np.radians(x) if mech.driver == "crank" else x
-    return Motion(mech, x, xk, kernel.analyse(mech, xk))
+    a = kernel.analyse(mech, xk)
+    prr = [d for d, dy in enumerate(mech.dyads) if dy.kind == "prr"]
+    if prr:   # the kernel solves PRR as RRP from its other end: joints back in the deck's order
+        j = a.joints.copy()
+        for d in prr:
+            j[:, 0:3, d], j[:, 3:6, d], j[:, 6:9, d] = a.joints[:, 3:6, d], a.joints[:, 0:3, d], -a.joints[:, 6:9, d]
+        a = a._replace(joints=j)
+    return Motion(mech, x, xk, a)
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:

@@ -340,10 +340,12 @@ def compile_deck(p: Mapping[str, Any]) -> Mechanism:
         else:
             a2 = need_guide(js[1], "dyad_joints", where)
             at2 = mech.guides[a2 - 1][1]
-        if at1 == at2 and at1 != 1:
-            raise p.error("dyad_joints", f"{where} attaches both ends to link {mech.links[at1 - 1]!r}: with it the "
-                                         "group is a rigid triangle (zero mobility, not a class-II group); give its "
-                                         "points as points of that link instead")
+        if at1 == at2:
+            raise p.error("dyad_joints", f"{where} attaches both ends to the {'link ' if at1 != 1 else ''}"
+                                         f"{mech.links[at1 - 1]!r}: with it the group is rigid (it cannot move, the "
+                                         "mechanism's mobility is not one: over-constrained); attach one end to a "
+                                         "moving link" + (", or give its points as points of that link" if at1 != 1
+                                                          else ""))
         if kind == "rrr" and not (d1 > 0 and d2 > 0):
             raise p.error("dyad_dims", f"{where}: the link lengths must be positive (got {d1:g}, {d2:g})")
         if kind == "rrp" and not d1 > 0:
