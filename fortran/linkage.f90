@@ -1184,17 +1184,17 @@ contains
     if (nt < 2) return
     nseg = nt - 1
     if (periodic) nseg = nt
-    work = 0.0_dp
-    do k = 1, nseg
-      call seg(k, x0, x1, f0, f1)
-      work = work + 0.5_dp*(f0 + f1)*(x1 - x0)
-    end do
     if (periodic) then
       span = (th(nt) - th(1))*real(nt, dp)/real(nt - 1, dp)
     else
       span = th(nt) - th(1)
     end if
     if (span <= 0.0_dp) return
+    work = 0.0_dp
+    do k = 1, nseg
+      call seg(k, x0, x1, f0, f1)
+      work = work + 0.5_dp*(f0 + f1)*(x1 - x0)
+    end do
     tm = work/span
     e = 0.0_dp
     emax = 0.0_dp
@@ -1277,8 +1277,8 @@ contains
   !>   per link: peak omega, peak alpha (signed: the largest in size)
   !>   per slide: minimum, maximum, peak rate, peak acceleration
   !>   per dyad: smallest and largest transmission or pressure angle [rad]
-  !> Extremes of the output are refined between scan points on the cubic Hermite model
-  !> (position and its derivative at both ends); peaks of the other quantities by the parabola
+  !> Extremes of the output are refined between scan points on the quintic Hermite model
+  !> (position and its first and second derivatives at both ends); peaks of the other quantities by the parabola
   !> through three scan points.  Figures that need the whole cycle assembled (stroke, time
   !> ratio, torque mean, energy) are 0 unless it is.
   subroutine summaries(nds, nr, prm, nl, np, ng, nd, ns, nld, nt, idrv, ipts, igd, idy, ild, ift, nscan, &
@@ -1291,13 +1291,13 @@ contains
     real(dp) :: rpts(np, 2), rgd(ng, 3), rdrv(3), rdy(nd, 3), rl(nl, 4), grav(2), rld(nld, 2), rtq(nl), &
                 rft(3), tab(nt, 2), x0, span, cs, h
     real(dp), allocatable :: x(:), lk(:, :, :), pk(:, :, :), sk(:, :, :), qa(:, :), fk(:, :, :), fd(:, :), &
-                             sh(:, :), y(:), dy(:), row(:), en(:)
+                             sh(:, :), y(:), dy(:), ddy(:), row(:), en(:)
     integer, allocatable :: st(:, :)
     integer :: i, k, o, l, j, d, c, n, nok
     logical :: whole
     n = max(nscan, 2)
     allocate (x(n), lk(n, 3, nl), pk(n, 6, np), sk(n, 3, max(ns, 1)), qa(n, nd), fk(n, 9, nd), fd(n, 4), &
-              sh(n, 3), st(n, nd), y(n), dy(n), row(ncol), en(nenergy))
+              sh(n, 3), st(n, nd), y(n), dy(n), ddy(n), row(ncol), en(nenergy))
     do i = 1, nds
       o = 0
       call take(rpts, 2*np)
@@ -1340,10 +1340,18 @@ contains
         y = sk(:, 1, iout(2))
         dy = sk(:, 2, iout(2))
       end if
+      ! derivatives over the input: y' = rate / w, y'' = (acceleration - a y') / w^2
+      if (iout(1) == 1) then
+        ddy = lk(:, 3, iout(2))
+      else
+        ddy = sk(:, 3, iout(2))
+      end if
       if (rdrv(2) /= 0.0_dp) then
         dy = dy/rdrv(2)
+        ddy = (ddy - rdrv(3)*dy)/rdrv(2)**2
       else
         dy = 0.0_dp
+        ddy = 0.0_dp
       end if
       if (whole) call output_extremes()
       ! transmission and pressure angles
@@ -1413,10 +1421,10 @@ contains
       end do
     end function ok_rows
 
-    !> Extremes of the output y over the scan, refined on the cubic Hermite model, the stroke
+    !> Extremes of the output y over the scan, refined on the quintic Hermite model, the stroke
     !> and the time ratio (periodic scans).  An output link that turns fully has none.
     subroutine output_extremes()
-      real(dp) :: best(2), at(2), v, t, ang, yend
+      real(dp) :: best(2), at(2), v, t, ang, yend, tie
       integer :: kk, k2, nseg
       if (periodic == 1 .and. iout(1) == 1) then
         ! a link that comes back turned by a multiple of 2 pi turns fully
@@ -1445,12 +1453,14 @@ contains
         end if
         yend = y(k2)
         if (dy(kk)*dy(k2) < 0.0_dp) then
-          call hermite_extremum(y(kk), yend, dy(kk)*h, dy(k2)*h, t, v)
-          if (v < best(1)) then
+          call hermite_extremum(y(kk), yend, dy(kk)*h, dy(k2)*h, ddy(kk)*h*h, ddy(k2)*h*h, t, v)
+          ! the earliest of equal extremes (a 720 deg cycle repeats the motion: ties within rounding)
+          tie = 1.0e-12_dp*(abs(best(2) - best(1)) + abs(v))
+          if (v < best(1) - tie .or. (abs(v - best(1)) <= tie .and. x(kk) + t*h < at(1))) then
             best(1) = v
             at(1) = x(kk) + t*h
           end if
-          if (v > best(2)) then
+          if (v > best(2) + tie .or. (abs(v - best(2)) <= tie .and. x(kk) + t*h < at(2))) then
             best(2) = v
             at(2) = x(kk) + t*h
           end if
@@ -1493,34 +1503,56 @@ contains
 
   end subroutine summaries
 
-  !> The extremum of the cubic Hermite interpolant on [0, 1] with end values y0, y1 and end
-  !> slopes d0, d1 (per unit of the interval) where the slope changes sign: t and the value.
-  pure subroutine hermite_extremum(y0, y1, d0, d1, t, v)
-    real(dp), intent(in) :: y0, y1, d0, d1
+  !> The extremum of the quintic Hermite interpolant on [0, 1] with end values y0, y1, first
+  !> derivatives d0, d1 and second derivatives s0, s1 (per unit of the interval), where the slope
+  !> changes sign (d0 d1 < 0): t and the value.  Newton on the slope, kept inside its bracket
+  !> (bisection when a step leaves it).
+  pure subroutine hermite_extremum(y0, y1, d0, d1, s0, s1, t, v)
+    real(dp), intent(in) :: y0, y1, d0, d1, s0, s1
     real(dp), intent(out) :: t, v
-    real(dp) :: a, b, c, disc, q, t1, t2, h00, h10, h01, h11
-    ! p'(t) = a t^2 + b t + c changes sign once on [0, 1] (d0 d1 < 0)
-    a = 6.0_dp*(y0 - y1) + 3.0_dp*(d0 + d1)
-    b = 6.0_dp*(y1 - y0) - 4.0_dp*d0 - 2.0_dp*d1
-    c = d0
-    disc = max(b*b - 4.0_dp*a*c, 0.0_dp)
-    ! the stable pair of roots: q = -(b + sign(b) sqrt(disc)) / 2, t = q / a and c / q
-    q = -0.5_dp*(b + sign(sqrt(disc), b))
-    t1 = -1.0_dp
-    t2 = -1.0_dp
-    if (a /= 0.0_dp) t1 = q/a
-    if (q /= 0.0_dp) t2 = c/q
-    if (t1 >= 0.0_dp .and. t1 <= 1.0_dp) then
-      t = t1
-    else
-      t = t2
-    end if
-    t = min(max(t, 0.0_dp), 1.0_dp)
-    h00 = (1.0_dp + 2.0_dp*t)*(1.0_dp - t)**2
-    h10 = t*(1.0_dp - t)**2
-    h01 = t*t*(3.0_dp - 2.0_dp*t)
-    h11 = t*t*(t - 1.0_dp)
-    v = h00*y0 + h10*d0 + h01*y1 + h11*d1
+    real(dp) :: lo, hi, f, fp, flo, tn
+    integer :: it
+    lo = 0.0_dp
+    hi = 1.0_dp
+    flo = d0
+    ! the cubic Hermite's estimate: the linear zero of the slope
+    t = d0/(d0 - d1)
+    do it = 1, 60
+      call slope(t, f, fp)
+      if (f == 0.0_dp) exit
+      if (sign(1.0_dp, f) == sign(1.0_dp, flo)) then
+        lo = t
+        flo = f
+      else
+        hi = t
+      end if
+      tn = t - f/fp
+      if (.not. (tn > lo .and. tn < hi)) tn = 0.5_dp*(lo + hi)
+      if (abs(tn - t) <= 1.0e-15_dp) then
+        t = tn
+        exit
+      end if
+      t = tn
+    end do
+    v = (1.0_dp - 10.0_dp*t**3 + 15.0_dp*t**4 - 6.0_dp*t**5)*y0 + (t - 6.0_dp*t**3 + 8.0_dp*t**4 - 3.0_dp*t**5)*d0 &
+        + 0.5_dp*(t**2 - 3.0_dp*t**3 + 3.0_dp*t**4 - t**5)*s0 + 0.5_dp*(t**3 - 2.0_dp*t**4 + t**5)*s1 &
+        + (-4.0_dp*t**3 + 7.0_dp*t**4 - 3.0_dp*t**5)*d1 + (10.0_dp*t**3 - 15.0_dp*t**4 + 6.0_dp*t**5)*y1
+
+  contains
+
+    pure subroutine slope(tt, f, fp)
+      real(dp), intent(in) :: tt
+      real(dp), intent(out) :: f, fp
+      f = (-30.0_dp*tt**2 + 60.0_dp*tt**3 - 30.0_dp*tt**4)*y0 + (1.0_dp - 18.0_dp*tt**2 + 32.0_dp*tt**3 &
+          - 15.0_dp*tt**4)*d0 + 0.5_dp*(2.0_dp*tt - 9.0_dp*tt**2 + 12.0_dp*tt**3 - 5.0_dp*tt**4)*s0 &
+          + 0.5_dp*(3.0_dp*tt**2 - 8.0_dp*tt**3 + 5.0_dp*tt**4)*s1 + (-12.0_dp*tt**2 + 28.0_dp*tt**3 &
+          - 15.0_dp*tt**4)*d1 + (30.0_dp*tt**2 - 60.0_dp*tt**3 + 30.0_dp*tt**4)*y1
+      fp = (-60.0_dp*tt + 180.0_dp*tt**2 - 120.0_dp*tt**3)*y0 + (-36.0_dp*tt + 96.0_dp*tt**2 - 60.0_dp*tt**3)*d0 &
+           + 0.5_dp*(2.0_dp - 18.0_dp*tt + 36.0_dp*tt**2 - 20.0_dp*tt**3)*s0 &
+           + 0.5_dp*(6.0_dp*tt - 24.0_dp*tt**2 + 20.0_dp*tt**3)*s1 + (-24.0_dp*tt + 84.0_dp*tt**2 &
+           - 60.0_dp*tt**3)*d1 + (60.0_dp*tt - 180.0_dp*tt**2 + 120.0_dp*tt**3)*y1
+    end subroutine slope
+
   end subroutine hermite_extremum
 
   !> Unwrapped angle: consecutive values differ by less than pi.
