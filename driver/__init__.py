@@ -32,8 +32,8 @@ __all__ = ["run", "run_sweep", "write", "compare", "read_deck", "studies", "keys
            "DeckError", "ExitCode", "Message", "RunOutcome", "FilesOutcome", "SweepOutcome"]
 
 #: the public subpackages and modules (every other module of the package is private)
-PUBLIC_MODULES = ("fourbar", "linkage", "ujoint", "slidercrank", "manipulator", "robust_example", "sweep", "optimize", "synthesis",
-                  "plotting")
+PUBLIC_MODULES = ("fourbar", "ujoint", "slidercrank", "manipulator", "robust_example", "sweep", "optimize", "synthesis",
+                  "plotting", "linkage")
 
 _API = {"run": "driver._api", "run_sweep": "driver._api", "write": "driver._api", "studies": "driver._api",
         "keys": "driver._api", "compare": "driver._compare", "read_deck": "driver._deck",

@@ -119,6 +119,95 @@ class _kinds:
     sp: NDArray[np.int32]
 
 
+class _linkage:
+    """Fortran module ``linkage`` (fortran/*.f90)."""
+    @staticmethod
+    def analyse(
+        ns: int,
+        x: NDArray[np.float64],
+        idrv: NDArray[np.int32],
+        rdrv: NDArray[np.float64],
+        ipts: NDArray[np.int32],
+        rpts: NDArray[np.float64],
+        igd: NDArray[np.int32],
+        rgd: NDArray[np.float64],
+        idy: NDArray[np.int32],
+        rdy: NDArray[np.float64],
+        rl: NDArray[np.float64],
+        grav: NDArray[np.float64],
+        ild: NDArray[np.int32],
+        rld: NDArray[np.float64],
+        rtq: NDArray[np.float64],
+        ift: NDArray[np.int32],
+        tab: NDArray[np.float64],
+        rft: NDArray[np.float64],
+        want: int,
+        n: int = ...,
+        nl: int = ...,
+        np: int = ...,
+        ng: int = ...,
+        nd: int = ...,
+        nld: int = ...,
+        nt: int = ...,
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.int32], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+        """``lk,pk,sk,qa,st,fk,fd,sh = analyse(ns,x,idrv,rdrv,ipts,rpts,igd,rgd,idy,rdy,rl,grav,ild,rld,rtq,ift,tab,rft,want,[n,nl,np,ng,nd,nld,nt])``; shapes lk(n,3,nl), pk(n,6,np), sk(n,3,ns), qa(n,nd), st(n,nd), fk(n,9,nd), fd(n,4), sh(n,3)"""
+        ...
+    drv_crank: NDArray[np.int32]
+    drv_slider: NDArray[np.int32]
+    dy_prp: NDArray[np.int32]
+    dy_rpr: NDArray[np.int32]
+    dy_rrp: NDArray[np.int32]
+    dy_rrr: NDArray[np.int32]
+    nenergy: NDArray[np.int32]
+    nsum_dyad: NDArray[np.int32]
+    nsum_head: NDArray[np.int32]
+    nsum_link: NDArray[np.int32]
+    nsum_slide: NDArray[np.int32]
+    st_indeterminate: NDArray[np.int32]
+    st_no_assembly: NDArray[np.int32]
+    st_ok: NDArray[np.int32]
+    st_toggle: NDArray[np.int32]
+    st_unplaced: NDArray[np.int32]
+    @staticmethod
+    def summaries(
+        prm: NDArray[np.float64],
+        nl: int,
+        ns: int,
+        nt: int,
+        idrv: NDArray[np.int32],
+        ipts: NDArray[np.int32],
+        igd: NDArray[np.int32],
+        idy: NDArray[np.int32],
+        ild: NDArray[np.int32],
+        ift: NDArray[np.int32],
+        nscan: int,
+        periodic: int,
+        iout: NDArray[np.int32],
+        want: int,
+        ncol: int,
+        nds: int = ...,
+        nr: int = ...,
+        np: int = ...,
+        ng: int = ...,
+        nd: int = ...,
+        nld: int = ...,
+    ) -> NDArray[np.float64]:
+        """``res = summaries(prm,nl,ns,nt,idrv,ipts,igd,idy,ild,ift,nscan,periodic,iout,want,ncol,[nds,nr,np,ng,nd,nld])``; shapes res(nds,ncol)"""
+        ...
+    @staticmethod
+    def table_energy(
+        th: NDArray[np.float64],
+        tq: NDArray[np.float64],
+        cs: float,
+        omega: float,
+        nt: int = ...,
+    ) -> NDArray[np.float64]:
+        """``res = table_energy(th,tq,cs,omega,[nt])``; shapes res(8)"""
+        ...
+    want_continuity: NDArray[np.int32]
+    want_forces: NDArray[np.int32]
+
+
 class _manipulator:
     """Fortran module ``manipulator`` (fortran/*.f90)."""
     @staticmethod
@@ -491,6 +580,7 @@ fourbar: _fourbar
 fourbar_forces: _fourbar_forces
 fourbar_summary: _fourbar_summary
 kinds: _kinds
+linkage: _linkage
 manipulator: _manipulator
 manipulator_summary: _manipulator_summary
 slidercrank: _slidercrank

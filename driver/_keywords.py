@@ -11,7 +11,7 @@ from numpy.typing import NDArray
 from driver._deck import Params
 from driver._result import Result
 
-__all__ = ["fourbar", "manipulator", "robust_example", "slidercrank", "ujoint"]
+__all__ = ["fourbar", "linkage", "manipulator", "robust_example", "slidercrank", "ujoint"]
 
 
 @overload
@@ -53,6 +53,66 @@ def fourbar(
 def fourbar(params: Params | None = None, /, progress: bool = False, **keys: Any) -> Result:
     """The signature of ``driver.fourbar.run`` (its docstring has the keys)."""
     raise NotImplementedError("a signature only: call driver.fourbar.run")
+
+
+@overload
+def linkage(params: Params, /, progress: bool = False) -> Result: ...
+
+
+@overload
+def linkage(
+    *,
+    progress: bool = False,
+    title: str = "",
+    pivots: str | Sequence[str] = ...,
+    pivot_xy: float | Sequence[float] | NDArray[Any] = ...,
+    guides: str | Sequence[str] = ...,
+    guide_on: str | Sequence[str] = ...,
+    guide_xy: float | Sequence[float] | NDArray[Any] = ...,
+    guide_deg: float | Sequence[float] | NDArray[Any] = ...,
+    driver: Literal["crank", "slider"] = "crank",
+    driver_joints: str | Sequence[str],
+    driver_link: str = "",
+    driver_length: float = 0.0,
+    omega: float = 1.0,
+    alpha: float = 0.0,
+    start: float = 0.0,
+    stop: float = 360.0,
+    step: float,
+    dyads: Literal["rrr", "rrp", "prr", "rpr", "prp"] | Sequence[Literal["rrr", "rrp", "prr", "rpr", "prp"]] = ...,
+    dyad_joints: str | Sequence[str] = ...,
+    dyad_links: str | Sequence[str] = ...,
+    dyad_dims: float | Sequence[float] | NDArray[Any] = ...,
+    dyad_modes: int | Sequence[int] | NDArray[Any] = ...,
+    points: str | Sequence[str] = ...,
+    point_on: str | Sequence[str] = ...,
+    point_uv: float | Sequence[float] | NDArray[Any] = ...,
+    output: str = "",
+    scan_points: int = 720,
+    bodies: str | Sequence[str] = ...,
+    mass: float | Sequence[float] | NDArray[Any] = ...,
+    com_uv: float | Sequence[float] | NDArray[Any] = ...,
+    inertia: float | Sequence[float] | NDArray[Any] = ...,
+    gravity: float | Sequence[float] | NDArray[Any] = ...,
+    loads: str | Sequence[str] = ...,
+    load_xy: float | Sequence[float] | NDArray[Any] = ...,
+    torque_links: str | Sequence[str] = ...,
+    torques: float | Sequence[float] | NDArray[Any] = ...,
+    guide_force_on: str = "",
+    guide_force_over: Literal["input", "slide"] = "input",
+    guide_force_x: float | Sequence[float] | NDArray[Any] = ...,
+    guide_force: float | Sequence[float] | NDArray[Any] = ...,
+    guide_force_scale: float = 1.0,
+    cycle_deg: float = 360.0,
+    speed_fluctuation: float = 0.02,
+    turning_moment_deg: float | Sequence[float] | NDArray[Any] = ...,
+    turning_moment: float | Sequence[float] | NDArray[Any] = ...,
+) -> Result: ...
+
+
+def linkage(params: Params | None = None, /, progress: bool = False, **keys: Any) -> Result:
+    """The signature of ``driver.linkage.run`` (its docstring has the keys)."""
+    raise NotImplementedError("a signature only: call driver.linkage.run")
 
 
 @overload

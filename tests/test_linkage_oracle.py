@@ -264,7 +264,6 @@ def test_input_power_balances_energy_rate(case):
     assume(good.any())
     mech, a = m.mech, m.a
     w_in = mech.omega
-    org = kernel_frames(m)
     power_in = a.driver[:, DriverCol.DRIVE] * w_in
     rate = np.zeros(len(m.x))
     loads = np.zeros(len(m.x))
@@ -282,8 +281,6 @@ def test_input_power_balances_energy_rate(case):
         ay = a.points[:, PointCol.AY, j] + alp * rx - om * om * ry
         rate += mass * (vx * ax + vy * ay) + inertia * om * alp - mass * (g[0] * vx + g[1] * vy)
         loads += mech.torque[l - 1] * om
-        del org
-        org = None
     for i, (fx, fy) in zip(mech.load_points, mech.load_xy):
         loads += fx * a.points[:, PointCol.VX, i - 1] + fy * a.points[:, PointCol.VY, i - 1]
     if mech.gf_block:

@@ -111,8 +111,10 @@ def events(m: Motion) -> list[Event]:
                            ("indeterminate", Status.INDETERMINATE)):
             for a, b in _runs(st[:, d] == code):
                 out.append(Event(what, d + 1, dy.name, float(m.x[a]), float(m.x[b])))
-        rate = _follower_rate(m, d)
+        rate, accel = _follower_rate(m, d)
         ok = st[:, d] == Status.OK
+        w = m.mech.omega
+        scale = math.radians(1.0) if m.mech.driver == "crank" else 1.0   # input unit -> kernel unit
         for k in range(len(m.x) - 1):
             if not (ok[k] and ok[k + 1]):
                 continue
@@ -120,24 +122,41 @@ def events(m: Motion) -> list[Event]:
             if r0 == 0.0 and k > 0:
                 continue
             if r0 == 0.0 or r0 * r1 < 0.0:
-                t = 0.0 if r0 == 0.0 else r0 / (r0 - r1)
-                xc = float(m.x[k] + t * (m.x[k + 1] - m.x[k]))
+                h = m.x[k + 1] - m.x[k]
+                t = 0.0 if r0 == 0.0 else _hermite_root(r0, r1, accel[k] / w * h * scale if w else 0.0,
+                                                         accel[k + 1] / w * h * scale if w else 0.0)
+                xc = float(m.x[k] + t * h)
                 out.append(Event("dead_centre", d + 1, dy.name, xc, xc))
     return out
 
 
-def _follower_rate(m: Motion, d: int) -> np.ndarray:
-    """The rate whose sign change is a dead centre of group d: its slide's rate (RRP, PRR, RPR,
-    PRP's second block), else its second link's angular velocity relative to the link its
+def _hermite_root(r0: float, r1: float, d0: float, d1: float) -> float:
+    """Where the cubic Hermite interpolant on [0, 1] (end values r0, r1 of opposite signs, end
+    slopes d0, d1 per unit of the interval) is zero; the linear zero when it has none inside."""
+    a = 2 * r0 - 2 * r1 + d0 + d1
+    b = -3 * r0 + 3 * r1 - 2 * d0 - d1
+    roots = [z.real for z in np.roots([a, b, d0, r0]) if abs(z.imag) < 1e-12 and -1e-12 <= z.real <= 1 + 1e-12]
+    lin = r0 / (r0 - r1)
+    return float(min(roots, key=lambda z: abs(z - lin))) if roots else float(lin)
+
+
+def _follower_rate(m: Motion, d: int) -> tuple[np.ndarray, np.ndarray]:
+    """The rate whose sign change is a dead centre of group d, and its time derivative: its
+    slide's rate (RRP, PRR, PRP's second block), the slotted link's angular velocity relative to
+    its pivot's link (RPR), else the second link's angular velocity relative to the link its
     second attachment is on (RRR)."""
     dy = m.mech.dyads[d]
+    L = m.a.links
+    if dy.kind == "rpr":
+        carrier = m.mech.points[dy.a1 - 1][1] - 1
+        return L[:, LinkCol.OMEGA, dy.k1 - 1] - L[:, LinkCol.OMEGA, carrier], \
+            L[:, LinkCol.ALPHA, dy.k1 - 1] - L[:, LinkCol.ALPHA, carrier]
     if dy.slide:
         j = dy.slide - 1 + (1 if dy.kind == "prp" else 0)
-        if dy.kind == "rpr":   # the slotted link turning about its pivot
-            return m.a.links[:, LinkCol.OMEGA, dy.k1 - 1] - m.a.links[:, LinkCol.OMEGA, m.mech.points[dy.a1 - 1][1] - 1]
-        return m.a.slides[:, SlideCol.V, j]
-    carrier = m.mech.points[dy.a2 - 1][1]
-    return m.a.links[:, LinkCol.OMEGA, dy.k2 - 1] - m.a.links[:, LinkCol.OMEGA, carrier - 1]
+        return m.a.slides[:, SlideCol.V, j], m.a.slides[:, SlideCol.A, j]
+    carrier = m.mech.points[dy.a2 - 1][1] - 1
+    return L[:, LinkCol.OMEGA, dy.k2 - 1] - L[:, LinkCol.OMEGA, carrier], \
+        L[:, LinkCol.ALPHA, dy.k2 - 1] - L[:, LinkCol.ALPHA, carrier]
 
 
 def tidy_frame(m: Motion) -> pd.DataFrame:
@@ -146,7 +165,7 @@ def tidy_frame(m: Motion) -> pd.DataFrame:
     mech, a = m.mech, m.a
     xname, xunit = input_label(mech)
     forces = mech.forces
-    ang = "rad" if False else "deg"
+    ang = "deg"
     pieces: list[pd.DataFrame] = []
     n = len(m.x)
     placed_rows = m.placed

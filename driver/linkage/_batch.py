@@ -38,6 +38,12 @@ BATCH_INDEPENDENT = ("omega", "alpha", "speed_fluctuation", "title", "step")
 _ELEMENT = re.compile(r"([a-z_]+)\((\d+)\)")
 
 
+def _key_of(name: str) -> str:
+    """The deck key of a batch column ('key' or 'key(i)')."""
+    m = _ELEMENT.fullmatch(name)
+    return m.group(1) if m else name
+
+
 def scan_of(p: Mapping[str, Any], mech: Mechanism) -> tuple[float, float, bool]:
     """The summary's scan of one cycle: first input, span (rad for a crank: the load cycle;
     length for an input slider: start to stop) and whether it is periodic."""
@@ -131,8 +137,7 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
         if key not in BATCH_KEYS or (m and key not in BATCH_ELEMENTS):
             raise base.error(key if key in base else None, f"{k!r} is not a &linkage number a batch may vary "
                                                              f"({', '.join(BATCH_KEYS)})")
-    columns = {k: v for k, v in columns.items() if (_ELEMENT.fullmatch(k) or k) and
-               (_ELEMENT.fullmatch(k).group(1) if _ELEMENT.fullmatch(k) else k) not in BATCH_IGNORED}
+    columns = {k: v for k, v in columns.items() if _key_of(k) not in BATCH_IGNORED}
     sizes = {np.size(v) for v in columns.values() if np.ndim(v) > 0}
     if len(sizes) > 1:
         raise base.error(None, f"batch columns have different lengths {sorted(sizes)}")

@@ -153,19 +153,20 @@ def turning_moment(p: Params, title: str = "", ax: Any = None) -> Figure:
     deck's table), its mean, and the energy above the mean with its band (max - min: the
     energy fluctuation the flywheel absorbs)."""
     if ax is None:
-        fig, axes = new_figure(2, 1, sharex=True, figsize=(7.0, 5.4))
+        fig, axs = new_figure(2, 1, sharex=True, figsize=(7.0, 5.4))
+        axes = list(axs)
     else:
         fig, axes = ax.figure, [ax, ax.twinx()]
-    curves = []
+    curves: list[tuple[str, np.ndarray, np.ndarray]] = []
     if p.turning_moment is not None:
         curves.append(("table", np.asarray(p.turning_moment_deg, float), np.asarray(p.turning_moment, float)))
     mech_forces = p.bodies is not None
     if mech_forces:
         from driver.linkage._analysis import solve
-        x = p.start + np.linspace(0.0, p.cycle_deg, 721)
-        m = solve(p, x)
+        xs = p.start + np.linspace(0.0, p.cycle_deg, 721)
+        m = solve(p, xs)
         if np.all(m.a.status == Status.OK):
-            curves.append(("analysis (driving torque)", x, m.a.driver[:, DriverCol.DRIVE]))
+            curves.append(("analysis (driving torque)", xs, m.a.driver[:, DriverCol.DRIVE]))
     for i, (label, x, t) in enumerate(curves):
         col = _COLOURS[i]
         work = np.trapezoid(t, np.radians(x))

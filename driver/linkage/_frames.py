@@ -81,7 +81,7 @@ def frames(p: Params, n: int = 180) -> tuple[Motion, dict[str, Any]]:
     pts = {name: np.column_stack([m.a.points[:, PointCol.X, j], m.a.points[:, PointCol.Y, j]])
            for j, name in enumerate(mech.point_names)}
     pins = {}
-    for lname, guide in mech.blocks.items():
+    for lname in mech.blocks:
         joints = mech.link_joints.get(lname, [])
         pins[lname] = joints[0] if joints else ""
     data = {"input": m.x, "ok": placed, "points": pts,

@@ -477,14 +477,14 @@ def _forces(p: Params, mech: Mechanism) -> None:
     if p.loads is not None:
         forces = _group(p, "load_xy", p.load_xy, 2, "load")
         _same_length(p, "load_xy", len(forces), len(p.loads), "forces")
-        for name, f in zip(p.loads, forces):
+        for name, fxy in zip(p.loads, forces):
             if name not in mech.point_names:
                 raise p.error("loads", f"unknown point {name!r}")
             idx = mech.point_index(name)
             if mech.points[idx - 1][1] == 1:
                 raise p.error("loads", f"{name!r} is a ground pivot: a load there moves nothing")
             mech.load_points.append(idx)
-            mech.load_xy.append((float(f[0]), float(f[1])))
+            mech.load_xy.append((float(fxy[0]), float(fxy[1])))
     if (p.torque_links is None) != (p.torques is None):
         raise p.error("torques" if p.torques is not None else "torque_links", "give torque_links and torques together")
     if p.torque_links is not None:
@@ -499,7 +499,8 @@ def _forces(p: Params, mech: Mechanism) -> None:
                                             f"{', '.join(mech.slide_names) or 'none'})")
         if p.guide_force_x is None or p.guide_force is None:
             raise p.error("guide_force_on", "give the table too: guide_force_x and guide_force")
-        x, f = np.asarray(p.guide_force_x, float), np.asarray(p.guide_force, float)
+        x: np.ndarray = np.asarray(p.guide_force_x, float)
+        f: np.ndarray = np.asarray(p.guide_force, float)
         _same_length(p, "guide_force", len(f), len(x), "forces")
         if len(x) < 2 or np.any(np.diff(x) <= 0):
             raise p.error("guide_force_x", "give at least two abscissae, strictly ascending")

@@ -9,14 +9,17 @@ from typing import Any
 
 import numpy as np
 
+from driver import _keywords
 from driver._deck import Params
 from driver._result import Figure, Result
 from driver._runner import keyword_run
+from driver._signatures import keyword_signature
 from driver._table import Column, render_table
 from driver.linkage._analysis import JOINT_WORDS, Event, Motion, events, input_label, solve, tidy_frame
 from driver.linkage._batch import summary_of, summary_rows
 from driver.linkage._kernel import DriverCol, JointCol, LinkCol, PointCol, ShakeCol, SlideCol, Status
 from driver.linkage._model import Mechanism
+from driver.linkage._spec import SPEC
 
 __all__ = ["run", "mechanism_lines", "event_lines", "summary_lines", "tables", "deck_figures"]
 
@@ -34,7 +37,7 @@ def _decimals(values: np.ndarray, digits: int = 6) -> int:
     return int(min(8, max(1, digits - 1 - math.floor(math.log10(big)))))
 
 
-def _num(v: float, digits: int = 6) -> str:
+def _num(v: Any, digits: int = 6) -> str:
     """A number in words with at most ``digits`` significant digits (%g style; no '-0')."""
     text = f"{v:.{digits}g}"
     return "0" if float(text) == 0 else text
@@ -58,9 +61,9 @@ def mechanism_lines(p: Params, mech: Mechanism) -> list[str]:
     piv = [f"{n} ({_num(u)}, {_num(v)})" for n, link, u, v in mech.points if link == 1]
     if piv:
         out.append("    ground pivots ..... " + ", ".join(piv))
-    for name, link, x, y, a in mech.guides:
+    for name, link, x, y, ang in mech.guides:
         out.append(f"    guide {name:<12} on {mech.links[link - 1]} through ({_num(x)}, {_num(y)}) at "
-                   f"{_num(math.degrees(a))} deg")
+                   f"{_num(math.degrees(ang))} deg")
     if mech.driver == "crank":
         anchor = mech.point_names[mech.driver_anchor - 1]
         out.append(f"    driver ............ crank '{mech.links[mech.driver_link - 1]}' {anchor} -> {mech.driver_pin}, "
@@ -204,7 +207,7 @@ def event_lines(m: Motion, evs: list[Event]) -> list[str]:
     for e in evs:
         by.setdefault((e.group, e.what), []).append(e)
     for (g, what), es in sorted(by.items()):
-        spans = ", ".join(_num(e.first, 7) if e.first == e.last else f"{_num(e.first, 7)}..{_num(e.last, 7)}"
+        spans = ", ".join(_at(e.first) if e.first == e.last else f"{_num(e.first, 7)}..{_num(e.last, 7)}"
                           for e in es[:12]) + (f" (and {len(es) - 12} more)" if len(es) > 12 else "")
         out.append(f"    group {g} ({es[0].name}): {word[what]} at input {spans} {xunit}")
     return out
@@ -248,7 +251,8 @@ def summary_lines(p: Params, mech: Mechanism, s: dict[str, Any]) -> list[str]:
             out.append(f"    driving {drive} ....... peak {_num(s['torque_peak'])} {du} at {_at(s['torque_peak_at'])} "
                        f"{xunit}")
         if s.get("torque_mean") is not None:
-            out.append(f"    driving {drive} ....... mean {_scaled(s['torque_mean'], s['torque_rms'])} {du}, RMS {_num(s['torque_rms'])} {du}")
+            out.append(f"    driving {drive} ....... mean {_scaled(s['torque_mean'], s['torque_rms'])} {du}, "
+                       f"RMS {_num(s['torque_rms'])} {du}")
         if s.get("shaking_force_peak_N") is not None:
             out.append(f"    shaking .............. peak force {_num(s['shaking_force_peak_N'])} N, peak moment "
                        f"{_num(s['shaking_moment_peak_Nm'])} N m")
@@ -265,6 +269,7 @@ def summary_lines(p: Params, mech: Mechanism, s: dict[str, Any]) -> list[str]:
     return out
 
 
+@keyword_signature(_keywords.linkage, SPEC)
 @keyword_run
 def run(params: Params, progress: bool = False) -> Result:
     """Analyse a planar linkage built from a driver and class-II groups (dyads).
@@ -309,7 +314,7 @@ def deck_figures(p: Params, title: str) -> list[Figure]:
     """The figures of a run, drawn on demand: the mechanism at one pose with the tracer paths,
     the motion curves, the forces, the turning-moment diagram with the flywheel's energy band."""
     def draw(name: str) -> Any:
-        from driver.linkage import _figures as figures   # matplotlib (the [plot] extra) only when drawn
+        from driver.linkage import _figures as figures  # matplotlib (the [plot] extra) only when drawn
         return getattr(figures, name)(p, title)
 
     figs = [Figure("linkage", lambda: draw("linkage_drawing")), Figure("curves", lambda: draw("motion_curves"))]

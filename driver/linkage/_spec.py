@@ -69,7 +69,7 @@ def _check(p: Params) -> None:
     if n > MAX_POSITIONS:
         raise p.error("step", f"{n:.3g} input positions; at most {MAX_POSITIONS:g} (use a coarser step)")
     from driver.linkage._flywheel import check as check_table
-    from driver.linkage._model import compile_deck   # the mechanism's own checks, with file, line, key
+    from driver.linkage._model import compile_deck  # the mechanism's own checks, with file, line, key
     compile_deck(p)
     check_table(p)
 
@@ -95,7 +95,10 @@ SUMMARY_SETTINGS = ("scan_points",)
 #: what a sweep summary plots when its deck names none
 SWEEP_PLOT = ("stroke", "time_ratio", "mu_min_deg", "pressure_max_deg", "assembled_fraction")
 
-_NAMES = dict(kind="strs", check=_names)
+def _named(**kw: Any) -> Key:
+    """A key holding names (strings checked by _names)."""
+    return Key("strs", check=_names, **kw)
+
 
 SPEC = GroupSpec(
     name="linkage",
@@ -103,12 +106,12 @@ SPEC = GroupSpec(
     keys={
         "title": Key("str", default="", doc="free text echoed in the output"),
         # ---- the frame
-        "pivots": Key(**_NAMES, default=[], doc="names of the ground pivots"),
+        "pivots": _named(default=[], doc="names of the ground pivots"),
         "pivot_xy": Key("floats", default=[], units="length", check=_pairs,
                         doc="x, y of each ground pivot (pairs, in the order of pivots)"),
-        "guides": Key(**_NAMES, default=[], doc="names of the slider guides given here (lines fixed to the "
+        "guides": _named(default=[], doc="names of the slider guides given here (lines fixed to the "
                                                "ground or to a link; an RPR group names its own slot)"),
-        "guide_on": Key(**_NAMES, default=None, doc="the link each guide is fixed to (default: 'ground' for all)"),
+        "guide_on": _named(default=None, doc="the link each guide is fixed to (default: 'ground' for all)"),
         "guide_xy": Key("floats", default=[], units="length", check=_pairs,
                         doc="a point of each guide (pairs) in its link's frame (the ground's: x, y)"),
         "guide_deg": Key("floats", default=[], units="deg", check=_finite,
@@ -117,7 +120,7 @@ SPEC = GroupSpec(
         "driver": Key("str", default="crank", choices=("crank", "slider"),
                       doc="'crank': a link turning about a ground pivot; 'slider': a block moving along a "
                           "ground guide"),
-        "driver_joints": Key(**_NAMES, required=True,
+        "driver_joints": _named(required=True,
                              doc="crank: its ground pivot and the name of its pin; slider: its guide and the "
                                  "name of its pin"),
         "driver_link": Key("str", default="", doc="the driver link's name (default 'crank' or 'slider')"),
@@ -133,10 +136,10 @@ SPEC = GroupSpec(
         # ---- the groups
         "dyads": Key("strs", default=[], choices=DYAD_TYPES,
                      doc="the type of each group, solved in this order: RRR, RRP, PRR, RPR, PRP"),
-        "dyad_joints": Key(**_NAMES, default=[],
+        "dyad_joints": _named(default=[],
                            doc="three names per group: its first and second attachment (points, or guides "
                                "for a P end) and the name of the new joint (RPR: of its new slot guide)"),
-        "dyad_links": Key(**_NAMES, default=[], doc="two link names per group, in the order of its letters"),
+        "dyad_links": _named(default=[], doc="two link names per group, in the order of its letters"),
         "dyad_dims": Key("floats", default=[], units="length", check=_pairs,
                          doc="two numbers per group: RRR the two link lengths; RRP rod length, pin offset; "
                              "PRR pin offset, rod length; RPR slot offset, pin offset; PRP the pin's offsets "
@@ -145,9 +148,9 @@ SPEC = GroupSpec(
                           else "each mode is +1 or -1",
                           doc="assembly mode of each group (+1 or -1; docs/linkage.md; default +1)"),
         # ---- points on links
-        "points": Key(**_NAMES, default=[], doc="names of points fixed to moving links (tracers, attachments, "
+        "points": _named(default=[], doc="names of points fixed to moving links (tracers, attachments, "
                                                "load points)"),
-        "point_on": Key(**_NAMES, default=[], doc="the link of each point"),
+        "point_on": _named(default=[], doc="the link of each point"),
         "point_uv": Key("floats", default=[], units="length", check=_pairs,
                         doc="each point in its link's frame: u along the link's x-axis, v to its left"),
         "output": Key("str", default="", doc="the output element for the summary: a slide (its block's link "
@@ -156,7 +159,7 @@ SPEC = GroupSpec(
                            else "between 16 and 100000",
                            doc="input positions of the summary's scan of one cycle"),
         # ---- kinetostatics
-        "bodies": Key(**_NAMES, default=None, doc="links with mass (giving them runs the force analysis; "
+        "bodies": _named(default=None, doc="links with mass (giving them runs the force analysis; "
                                                    "SI units)"),
         "mass": Key("floats", default=None, units="kg", check=_non_negative, doc="mass of each body"),
         "com_uv": Key("floats", default=None, units="m", check=_pairs,
@@ -165,9 +168,9 @@ SPEC = GroupSpec(
                        doc="moment of inertia of each body about its centre of mass (default 0)"),
         "gravity": Key("floats", default=None, units="m/s^2", check=lambda v: _finite(v) or
                        (None if len(v) == 2 else "give gx, gy"), doc="gravity vector (default 0, -9.81)"),
-        "loads": Key(**_NAMES, default=None, doc="points where external forces act"),
+        "loads": _named(default=None, doc="points where external forces act"),
         "load_xy": Key("floats", default=None, units="N", check=_pairs, doc="force at each load point (pairs)"),
-        "torque_links": Key(**_NAMES, default=None, doc="links with an external torque"),
+        "torque_links": _named(default=None, doc="links with an external torque"),
         "torques": Key("floats", default=None, units="N m", check=_finite, doc="torque on each (ccw +)"),
         "guide_force_on": Key("str", default="", doc="the slider block a tabulated force acts on (along its "
                                                       "guide; the reaction on the guide's link)"),
