@@ -39,6 +39,8 @@
 !> Per position (columns of the outputs, positions first, Fortran order):
 !>   lk(k, 1:3, l)  angle [rad, atan2 range], omega [rad/s], alpha [rad/s^2] of link l
 !>   pk(k, 1:6, p)  x, y, vx, vy, ax, ay of point p
+!>                  (the ground's columns -- link 1 and its points -- are not written: they are
+!>                  constant, and the caller fills them once per buffer)
 !>   sk(k, 1:3, j)  slide, slide rate and slide acceleration of slide j (relative to its guide)
 !>   qa(k, d)       RRR: transmission angle between the two links at J3 [0, pi];
 !>                  RRP: pressure angle between the rod and the guide [0, pi/2];
@@ -106,29 +108,61 @@ contains
 
   !> Positions, velocities, accelerations (and forces with want bit 2) at the inputs x(1:n)
   !> (crank angle [rad] or slide [length], in order).  See the module header.
-  subroutine analyse(n, nl, np, ng, nd, ns, nld, nt, x, idrv, rdrv, ipts, rpts, igd, rgd, idy, rdy, &
+  subroutine analyse(n, nl, np, ng, nd, ns, nld, nt, nf, x, idrv, rdrv, ipts, rpts, igd, rgd, idy, rdy, &
                      rl, grav, ild, rld, rtq, ift, tab, rft, want, lk, pk, sk, qa, st, fk, fd, sh)
     !f2py threadsafe
-    integer, intent(in) :: n, nl, np, ng, nd, ns, nld, nt
+    integer, intent(in) :: n, nl, np, ng, nd, ns, nld, nt, nf   ! nf: rows of the force outputs (n, or 1 unused)
     real(dp), intent(in) :: x(n), rdrv(3), rpts(np, 2), rgd(ng, 3), rdy(nd, 3), rl(nl, 4), grav(2)
     integer, intent(in) :: idrv(4), ipts(np), igd(ng), idy(nd, 6), ild(nld), ift(4), want
     real(dp), intent(in) :: rld(nld, 2), rtq(nl), tab(nt, 2), rft(3)
-    real(dp), intent(out) :: lk(n, 3, nl), pk(n, 6, np), sk(n, 3, ns), qa(n, nd), fk(n, 9, nd), fd(n, 4), &
-                             sh(n, 3)
-    integer, intent(out) :: st(n, nd)
-    real(dp), allocatable :: modes(:, :), chr(:, :, :)
-    integer :: d, first, k0, m
-    logical :: cont
+    ! outputs: overwritten (intent inout so that callers can reuse their buffers)
+    real(dp), intent(inout) :: lk(n, 3, nl), pk(n, 6, np), sk(n, 3, ns), qa(n, nd), fk(nf, 9, nd), fd(nf, 4), &
+                               sh(nf, 3)
+    !f2py intent(in,out) :: lk, pk, sk, qa, fk, fd, sh
+    integer, intent(inout) :: st(n, nd)
+    !f2py intent(in,out) :: st
+    real(dp), allocatable :: modes(:, :), chr(:, :, :), pose(:, :, :), att(:, :, :, :)
+    real(dp) :: ring(3, 4, nd)
+    integer :: d, first, k0, m, flagk
+    logical :: cont, store
 
     allocate (modes(n, nd))
     do d = 1, nd
       modes(:, d) = merge(1.0_dp, -1.0_dp, rdy(d, 3) >= 0.0_dp)
     end do
     cont = iand(want, want_continuity) /= 0 .and. n >= 4
-    allocate (chr(merge(n, 1, cont), 4, nd))
-    if (ns > 0) sk = 0.0_dp
+    if (iand(want, want_forces) /= 0 .and. nf < n) error stop "linkage analyse: force outputs need n rows"
+    ! first pass: each block checks in cache whether any group might change assembly (the
+    ! continuity test below without a flip so far); only then are the new joints stored and scanned
+    store = .false.
+    flagk = 0
+    ring = 0.0_dp
+    allocate (chr(1, 4, nd))
+    ! block work arrays, made once: link frames, and the groups' attachments (those on the ground
+    ! -- pivots, fixed guides -- are constant and filled here once)
+    allocate (pose(nb, npose, nl), att(nb, natt, 2, nd))
+    pose(:, :, 1) = 0.0_dp
+    pose(:, p_c, 1) = 1.0_dp
+    pose(:, p_ok, 1) = 1.0_dp
+    pose(:, p_rt, 1) = 1.0_dp
+    do d = 1, nd
+      if (idy(d, 1) == dy_prp) then
+        if (igd(idy(d, 2)) == 1) call guide_of(nb, 1, rgd(idy(d, 2), :), pose(:, :, 1), att(:, :, 1, d))
+      else if (ipts(idy(d, 2)) == 1) then
+        call point_of(nb, 1, rpts(idy(d, 2), :), pose(:, :, 1), att(:, :, 1, d))
+      end if
+      if (idy(d, 1) == dy_rrp .or. idy(d, 1) == dy_prp) then
+        if (igd(idy(d, 3)) == 1) call guide_of(nb, 1, rgd(idy(d, 3), :), pose(:, :, 1), att(:, :, 2, d))
+      else if (ipts(idy(d, 3)) == 1) then
+        call point_of(nb, 1, rpts(idy(d, 3), :), pose(:, :, 1), att(:, :, 2, d))
+      end if
+    end do
     call solve_rows(1)
-    if (.not. cont) return
+    if (.not. cont .or. flagk == 0) return
+    deallocate (chr)
+    allocate (chr(n, 4, nd))
+    store = .true.
+    call solve_rows(1)
     do d = 1, nd
       if (idy(d, 1) == dy_prp) cycle
       first = 0
@@ -143,13 +177,49 @@ contains
       integer, intent(in) :: k1
       do k0 = k1, n, nb
         m = min(nb, n - k0 + 1)
-        call solve_block(m, k0, n, nl, np, ng, nd, ns, nld, nt, x, idrv, rdrv, ipts, rpts, igd, rgd, idy, rdy, &
-                         rl, grav, ild, rld, rtq, ift, tab, rft, want, modes, cont, chr, lk, pk, sk, qa, st, &
-                         fk, fd, sh)
+        call solve_block(m, k0, n, nl, np, ng, nd, ns, nld, nt, nf, x, idrv, rdrv, ipts, rpts, igd, rgd, idy, &
+                         rdy, rl, grav, ild, rld, rtq, ift, tab, rft, want, modes, cont, store, chr, ring, flagk, &
+                         pose, att, lk, pk, sk, qa, st, fk, fd, sh)
       end do
     end subroutine solve_rows
 
   end subroutine analyse
+
+  !> The continuity test of one group over one block, in cache, assuming no flip so far: flagk
+  !> becomes the first input (global row) where the other assembly's new joint is nearer than
+  !> the chosen one to the quadratic extrapolation of the three previous joints (ring: the
+  !> chosen joints of the block before, carried over).
+  subroutine prescan(m, k0, n, ex, st, ring, flagk)
+    integer, intent(in) :: m, k0, n, st(n)
+    real(dp), intent(in) :: ex(nb, nex)
+    real(dp), intent(inout) :: ring(3, 4)
+    integer, intent(inout) :: flagk
+    real(dp) :: ch(nb + 3, 4), px, py, ec, ea
+    integer :: flag(nb + 3), k, kg, c
+    do c = 1, 4
+      ch(1:3, c) = ring(:, c)
+      ch(4:m + 3, c) = ex(1:m, 9 + c)
+    end do
+    ! hot-loop: linkage continuity pre-scan
+    do k = 4, m + 3
+      px = 3.0_dp*(ch(k - 1, 1) - ch(k - 2, 1)) + ch(k - 3, 1)
+      py = 3.0_dp*(ch(k - 1, 2) - ch(k - 2, 2)) + ch(k - 3, 2)
+      ec = (ch(k, 1) - px)**2 + (ch(k, 2) - py)**2
+      ea = (ch(k, 3) - px)**2 + (ch(k, 4) - py)**2
+      flag(k) = merge(1, 0, ea < ec)
+    end do
+    do k = 4, m + 3
+      kg = k0 + k - 4
+      if (flag(k) == 0 .or. kg < 4) cycle
+      if (all(st(kg - 3:kg) == st_ok .or. st(kg - 3:kg) == st_toggle) .and. st(kg) == st_ok) then
+        flagk = kg
+        exit
+      end if
+    end do
+    do c = 1, 4
+      ring(:, c) = ch(m + 1:m + 3, c)
+    end do
+  end subroutine prescan
 
   !> The continuity scan of one dyad over the current solution: where the other assembly's
   !> new joint (chr(k, 3:4)) is nearer than the chosen one (chr(k, 1:2)) to the quadratic
@@ -162,7 +232,29 @@ contains
     integer, intent(inout) :: first
     real(dp) :: cx(4), cy(4), px, py, ec, ea, ax, ay, par
     logical :: okk(4)
-    integer :: k, j
+    integer :: k, j, k1
+    integer, allocatable :: flag(:)
+    ! fast path: with no flip so far, the first position where the other assembly is nearer
+    ! to the extrapolation is found by a loop without a dependency between positions
+    k1 = 0
+    if (n < 4) return
+    allocate (flag(n))
+    ! hot-loop: linkage continuity pre-scan
+    do k = 4, n
+      px = 3.0_dp*(chr(k - 1, 1) - chr(k - 2, 1)) + chr(k - 3, 1)
+      py = 3.0_dp*(chr(k - 1, 2) - chr(k - 2, 2)) + chr(k - 3, 2)
+      ec = (chr(k, 1) - px)**2 + (chr(k, 2) - py)**2
+      ea = (chr(k, 3) - px)**2 + (chr(k, 4) - py)**2
+      flag(k) = merge(1, 0, ea < ec)
+    end do
+    do k = 4, n
+      if (flag(k) == 0) cycle
+      if (all(st(k - 3:k) == st_ok .or. st(k - 3:k) == st_toggle) .and. st(k) == st_ok) then
+        k1 = k
+        exit
+      end if
+    end do
+    if (k1 == 0) return
     par = 1.0_dp
     cx = 0.0_dp
     cy = 0.0_dp
@@ -196,28 +288,25 @@ contains
   end subroutine follow
 
   !> One block of analyse: rows k0..k0+m-1 (m <= nb).
-  subroutine solve_block(m, k0, n, nl, np, ng, nd, ns, nld, nt, x, idrv, rdrv, ipts, rpts, igd, rgd, idy, rdy, &
-                         rl, grav, ild, rld, rtq, ift, tab, rft, want, modes, cont, chr, lk, pk, sk, qa, st, &
-                         fk, fd, sh)
-    integer, intent(in) :: m, k0, n, nl, np, ng, nd, ns, nld, nt
+  subroutine solve_block(m, k0, n, nl, np, ng, nd, ns, nld, nt, nf, x, idrv, rdrv, ipts, rpts, igd, rgd, idy, &
+                         rdy, rl, grav, ild, rld, rtq, ift, tab, rft, want, modes, cont, store, chr, ring, flagk, &
+                         pose, att, lk, pk, sk, qa, st, fk, fd, sh)
+    integer, intent(in) :: m, k0, n, nl, np, ng, nd, ns, nld, nt, nf
     real(dp), intent(in) :: x(n), rdrv(3), rpts(np, 2), rgd(ng, 3), rdy(nd, 3), rl(nl, 4), grav(2)
     integer, intent(in) :: idrv(4), ipts(np), igd(ng), idy(nd, 6), ild(nld), ift(4), want
     real(dp), intent(in) :: rld(nld, 2), rtq(nl), tab(nt, 2), rft(3), modes(n, nd)
-    logical, intent(in) :: cont
-    real(dp), intent(inout) :: chr(:, :, :)
-    real(dp), intent(inout) :: lk(n, 3, nl), pk(n, 6, np), sk(n, 3, ns), qa(n, nd), fk(n, 9, nd), fd(n, 4), &
-                               sh(n, 3)
+    logical, intent(in) :: cont, store
+    real(dp), intent(inout) :: chr(:, :, :), ring(3, 4, nd)
+    integer, intent(inout) :: flagk
+    real(dp), intent(inout) :: pose(nb, npose, nl), att(nb, natt, 2, nd)
+    real(dp), intent(inout) :: lk(n, 3, nl), pk(n, 6, np), sk(n, 3, ns), qa(n, nd), fk(nf, 9, nd), fd(nf, 4), &
+                               sh(nf, 3)
     integer, intent(inout) :: st(n, nd)
-    real(dp) :: pose(nb, npose, nl), a1(nb, natt), a2(nb, natt), ex(nb, nex)
+    real(dp) :: a1(nb, natt), ex(nb, nex)
     real(dp) :: wk(nb, 3, nl), rx(nb, 9), sn(nb), cs(nb), tmp(nb), drf(nb, 4), fx(nb), fy(nb), q(nb), okr(nb)
     integer :: l, p, dd, kind, k1, s0, c
     k1 = k0 + m - 1
-    ! ground: the world frame, at rest
-    pose(1:m, :, 1) = 0.0_dp
-    pose(1:m, p_c, 1) = 1.0_dp
-    pose(1:m, p_ok, 1) = 1.0_dp
-    pose(1:m, p_rt, 1) = 1.0_dp
-    ! driver
+    ! driver (the ground's frame, pose(:, :, 1), is set once by analyse)
     l = idrv(3)
     if (idrv(1) == drv_crank) then
       call sincos_array(m, x(k0:k1), sn, cs)
@@ -231,33 +320,40 @@ contains
         sk(k0:k1, 3, idrv(4)) = rdrv(3)
       end if
     end if
-    ! dyads in order
+    ! dyads in order; an attachment on a moving link is evaluated here, one on the ground was
+    ! filled by analyse
     do dd = 1, nd
       kind = idy(dd, 1)
+      if (kind == dy_prp) then
+        l = igd(idy(dd, 2))
+        if (l /= 1) call guide_of(m, l, rgd(idy(dd, 2), :), pose(:, :, l), att(:, :, 1, dd))
+      else
+        l = ipts(idy(dd, 2))
+        if (l /= 1) call point_of(m, l, rpts(idy(dd, 2), :), pose(:, :, l), att(:, :, 1, dd))
+      end if
+      if (kind == dy_rrp .or. kind == dy_prp) then
+        l = igd(idy(dd, 3))
+        if (l /= 1) call guide_of(m, l, rgd(idy(dd, 3), :), pose(:, :, l), att(:, :, 2, dd))
+      else
+        l = ipts(idy(dd, 3))
+        if (l /= 1) call point_of(m, l, rpts(idy(dd, 3), :), pose(:, :, l), att(:, :, 2, dd))
+      end if
       select case (kind)
       case (dy_rrr)
-        call point_of(m, ipts(idy(dd, 2)), rpts(idy(dd, 2), :), pose(:, :, ipts(idy(dd, 2))), a1)
-        call point_of(m, ipts(idy(dd, 3)), rpts(idy(dd, 3), :), pose(:, :, ipts(idy(dd, 3))), a2)
-        call dyad_rrr(m, rdy(dd, 1), rdy(dd, 2), modes(k0:k1, dd), a1, a2, pose(:, :, idy(dd, 4)), &
-                      pose(:, :, idy(dd, 5)), ex)
+        call dyad_rrr(m, rdy(dd, 1), rdy(dd, 2), modes(k0:k1, dd), att(:, :, 1, dd), att(:, :, 2, dd), &
+                      pose(:, :, idy(dd, 4)), pose(:, :, idy(dd, 5)), ex)
       case (dy_rrp)
-        call point_of(m, ipts(idy(dd, 2)), rpts(idy(dd, 2), :), pose(:, :, ipts(idy(dd, 2))), a1)
-        call guide_of(m, igd(idy(dd, 3)), rgd(idy(dd, 3), :), pose(:, :, igd(idy(dd, 3))), a2)
-        call dyad_rrp(m, rdy(dd, 1), rdy(dd, 2), modes(k0:k1, dd), a1, a2, pose(:, :, idy(dd, 4)), &
-                      pose(:, :, idy(dd, 5)), ex)
+        call dyad_rrp(m, rdy(dd, 1), rdy(dd, 2), modes(k0:k1, dd), att(:, :, 1, dd), att(:, :, 2, dd), &
+                      pose(:, :, idy(dd, 4)), pose(:, :, idy(dd, 5)), ex)
       case (dy_rpr)
-        call point_of(m, ipts(idy(dd, 2)), rpts(idy(dd, 2), :), pose(:, :, ipts(idy(dd, 2))), a1)
-        call point_of(m, ipts(idy(dd, 3)), rpts(idy(dd, 3), :), pose(:, :, ipts(idy(dd, 3))), a2)
-        call dyad_rpr(m, rdy(dd, 1), modes(k0:k1, dd), a1, a2, pose(:, :, idy(dd, 4)), &
+        call dyad_rpr(m, rdy(dd, 1), modes(k0:k1, dd), att(:, :, 1, dd), att(:, :, 2, dd), pose(:, :, idy(dd, 4)), &
                       pose(:, :, idy(dd, 5)), ex)
       case default
-        call guide_of(m, igd(idy(dd, 2)), rgd(idy(dd, 2), :), pose(:, :, igd(idy(dd, 2))), a1)
-        call guide_of(m, igd(idy(dd, 3)), rgd(idy(dd, 3), :), pose(:, :, igd(idy(dd, 3))), a2)
-        call dyad_prp(m, rdy(dd, 1), rdy(dd, 2), a1, a2, pose(:, :, idy(dd, 4)), pose(:, :, idy(dd, 5)), ex)
+        call dyad_prp(m, rdy(dd, 1), rdy(dd, 2), att(:, :, 1, dd), att(:, :, 2, dd), pose(:, :, idy(dd, 4)), &
+                      pose(:, :, idy(dd, 5)), ex)
       end select
       st(k0:k1, dd) = nint(ex(1:m, 1))
-      call atan2_array(m, ex(:, 2), ex(:, 3), tmp)
-      qa(k0:k1, dd) = tmp(1:m)
+      call atan2_array(m, ex(:, 2), ex(:, 3), qa(k0:k1, dd))
       s0 = idy(dd, 6)
       if (s0 > 0) then
         sk(k0:k1, 1, s0) = ex(1:m, 4)
@@ -269,32 +365,29 @@ contains
           sk(k0:k1, 3, s0 + 1) = ex(1:m, 9)
         end if
       end if
-      if (cont) then
-        do c = 1, 4
-          chr(k0:k1, c, dd) = ex(1:m, 9 + c)
-        end do
+      if (cont .and. kind /= dy_prp) then
+        if (store) then
+          do c = 1, 4
+            chr(k0:k1, c, dd) = ex(1:m, 9 + c)
+          end do
+        else if (flagk == 0) then
+          call prescan(m, k0, n, ex, st(:, dd), ring(:, :, dd), flagk)
+        end if
       end if
     end do
-    ! links: angle, omega, alpha
-    do l = 1, nl
-      call atan2_array(m, pose(:, p_s, l), pose(:, p_c, l), tmp)
-      lk(k0:k1, 1, l) = tmp(1:m)*pose(1:m, p_ok, l)
-      lk(k0:k1, 2, l) = pose(1:m, p_w, l)
-      lk(k0:k1, 3, l) = pose(1:m, p_al, l)
+    ! moving links: angle (an unplaced link's frame is (1, 0): angle 0), omega, alpha; the
+    ! ground's are filled once by analyse
+    do l = 2, nl
+      call atan2_array(m, pose(:, p_s, l), pose(:, p_c, l), lk(k0:k1, 1, l))
+      call copy2(m, pose(:, p_w, l), pose(:, p_al, l), lk(k0:k1, 2, l), lk(k0:k1, 3, l))
     end do
-    ! points
+    ! points on moving links, written straight into the outputs (the ground's: by analyse)
     do p = 1, np
-      call point_of(m, ipts(p), rpts(p, :), pose(:, :, ipts(p)), a1)
-      do c = 1, 6
-        pk(k0:k1, c, p) = a1(1:m, c)
-      end do
+      if (ipts(p) == 1) cycle
+      call point_out(m, rpts(p, 1), rpts(p, 2), pose(:, :, ipts(p)), pk(k0:k1, 1, p), pk(k0:k1, 2, p), &
+                     pk(k0:k1, 3, p), pk(k0:k1, 4, p), pk(k0:k1, 5, p), pk(k0:k1, 6, p))
     end do
-    if (iand(want, want_forces) == 0) then
-      fk(k0:k1, :, :) = 0.0_dp
-      fd(k0:k1, :) = 0.0_dp
-      sh(k0:k1, :) = 0.0_dp
-      return
-    end if
+    if (iand(want, want_forces) == 0) return
     ! ---- forces: each link's known load, the dyads from the last, then the driver
     wk(1:m, :, 1) = 0.0_dp
     do l = 2, nl
@@ -439,6 +532,43 @@ contains
   end function interp
 
   ! ======================================================================== kinematics blocks
+
+  !> b1 = a1, b2 = a2 over m rows.
+  subroutine copy2(m, a1, a2, b1, b2)
+    integer, intent(in) :: m
+    real(dp), intent(in) :: a1(nb), a2(nb)
+    real(dp), intent(inout) :: b1(m), b2(m)
+    integer :: k
+    ! hot-loop: linkage copy
+    do k = 1, m
+      b1(k) = a1(k)
+      b2(k) = a2(k)
+    end do
+  end subroutine copy2
+
+  !> A point (u, v) of a moving link straight into six output columns: position, velocity,
+  !> acceleration (zero where the link is not placed; rates zero where they are unknown).
+  subroutine point_out(m, u, v, pose, x, y, vx, vy, ax, ay)
+    integer, intent(in) :: m
+    real(dp), intent(in) :: u, v, pose(nb, npose)
+    real(dp), intent(inout) :: x(m), y(m), vx(m), vy(m), ax(m), ay(m)
+    real(dp) :: rx, ry, ok, w, al
+    integer :: k
+    ! hot-loop: linkage point out
+    do k = 1, m
+      ok = pose(k, p_ok)
+      rx = u*pose(k, p_c) - v*pose(k, p_s)
+      ry = u*pose(k, p_s) + v*pose(k, p_c)
+      w = pose(k, p_w)
+      al = pose(k, p_al)
+      x(k) = ok*(pose(k, p_ox) + rx)
+      y(k) = ok*(pose(k, p_oy) + ry)
+      vx(k) = pose(k, p_vx) - w*ry
+      vy(k) = pose(k, p_vy) + w*rx
+      ax(k) = pose(k, p_ax) - al*ry - w*w*rx
+      ay(k) = pose(k, p_ay) + al*rx - w*w*ry
+    end do
+  end subroutine point_out
 
   !> The crank's pose: origin the pivot (px, py), x-axis (c, s), omega w, alpha al.
   subroutine crank_pose(m, px, py, c, s, w, al, pose)
@@ -642,12 +772,6 @@ contains
       ex(k, 1) = st
       ex(k, 2) = abs(e1x*e2y - e1y*e2x)*placed
       ex(k, 3) = e1x*e2x + e1y*e2y
-      ex(k, 4) = 0.0_dp
-      ex(k, 5) = 0.0_dp
-      ex(k, 6) = 0.0_dp
-      ex(k, 7) = 0.0_dp
-      ex(k, 8) = 0.0_dp
-      ex(k, 9) = 0.0_dp
       ex(k, 10) = jx*placed
       ex(k, 11) = jy*placed
       ex(k, 12) = (jx + 2*sgn*h*dy)*placed
@@ -741,9 +865,6 @@ contains
       ex(k, 4) = s*placed
       ex(k, 5) = sd
       ex(k, 6) = sdd
-      ex(k, 7) = 0.0_dp
-      ex(k, 8) = 0.0_dp
-      ex(k, 9) = 0.0_dp
       ex(k, 10) = jx*placed
       ex(k, 11) = jy*placed
       ex(k, 12) = (jx - 2*sgn*root*ux)*placed
@@ -826,9 +947,6 @@ contains
       ex(k, 4) = s*placed
       ex(k, 5) = sd
       ex(k, 6) = sdd
-      ex(k, 7) = 0.0_dp
-      ex(k, 8) = 0.0_dp
-      ex(k, 9) = 0.0_dp
       ! continuity: the slot's point at distance |b| from p, and the other assembly's
       ex(k, 10) = (p(k, 1) + bl*ux)*placed
       ex(k, 11) = (p(k, 2) + bl*uy)*placed
@@ -932,10 +1050,6 @@ contains
       ex(k, 7) = s2
       ex(k, 8) = sd2
       ex(k, 9) = sdd2
-      ex(k, 10) = 0.0_dp
-      ex(k, 11) = 0.0_dp
-      ex(k, 12) = 0.0_dp
-      ex(k, 13) = 0.0_dp
     end do
   end subroutine dyad_prp
 
@@ -1292,12 +1406,13 @@ contains
                 rft(3), tab(nt, 2), x0, span, cs, h
     real(dp), allocatable :: x(:), lk(:, :, :), pk(:, :, :), sk(:, :, :), qa(:, :), fk(:, :, :), fd(:, :), &
                              sh(:, :), y(:), dy(:), ddy(:), row(:), en(:)
+    logical, allocatable :: okrow(:)
     integer, allocatable :: st(:, :)
     integer :: i, k, o, l, j, d, c, n, nok
     logical :: whole
     n = max(nscan, 2)
     allocate (x(n), lk(n, 3, nl), pk(n, 6, np), sk(n, 3, max(ns, 1)), qa(n, nd), fk(n, 9, nd), fd(n, 4), &
-              sh(n, 3), st(n, nd), y(n), dy(n), ddy(n), row(ncol), en(nenergy))
+              sh(n, 3), st(n, nd), y(n), dy(n), ddy(n), row(ncol), en(nenergy), okrow(n))
     do i = 1, nds
       o = 0
       call take(rpts, 2*np)
@@ -1321,13 +1436,13 @@ contains
       do k = 1, n
         x(k) = x0 + h*real(k - 1, dp)
       end do
-      call analyse(n, nl, np, ng, nd, max(ns, 1), nld, nt, x, idrv, rdrv, ipts, rpts, igd, rgd, idy, rdy, &
+      call analyse(n, nl, np, ng, nd, max(ns, 1), nld, nt, n, x, idrv, rdrv, ipts, rpts, igd, rgd, idy, rdy, &
                    rl, grav, ild, rld, rtq, ift, tab, rft, want, lk, pk, sk, qa, st, fk, fd, sh)
       row = 0.0_dp
-      nok = 0
       do k = 1, n
-        if (all(st(k, :) == st_ok)) nok = nok + 1
+        okrow(k) = all(st(k, :) == st_ok)
       end do
+      nok = count(okrow)
       row(1) = real(nok, dp)/real(n, dp)
       row(2) = real(count(any(st /= st_ok .and. st /= st_toggle, dim=2)), dp)
       row(3) = real(count(any(st == st_toggle, dim=2)), dp)
@@ -1371,8 +1486,8 @@ contains
       ! link and slide peaks
       do l = 2, nl
         j = nsum_head + nsum_link*(l - 2)
-        row(j + 1) = peak(n, lk(:, 2, l), ok_rows(), periodic == 1)
-        row(j + 2) = peak(n, lk(:, 3, l), ok_rows(), periodic == 1)
+        row(j + 1) = peak(n, lk(:, 2, l), okrow, periodic == 1)
+        row(j + 2) = peak(n, lk(:, 3, l), okrow, periodic == 1)
       end do
       do l = 1, ns
         j = nsum_head + nsum_link*(nl - 1) + nsum_slide*(l - 1)
@@ -1380,12 +1495,12 @@ contains
           row(j + 1) = minval(sk(:, 1, l))
           row(j + 2) = maxval(sk(:, 1, l))
         end if
-        row(j + 3) = peak(n, sk(:, 2, l), ok_rows(), periodic == 1)
-        row(j + 4) = peak(n, sk(:, 3, l), ok_rows(), periodic == 1)
+        row(j + 3) = peak(n, sk(:, 2, l), okrow, periodic == 1)
+        row(j + 4) = peak(n, sk(:, 3, l), okrow, periodic == 1)
       end do
       ! forces
       if (iand(want, want_forces) /= 0 .and. nok > 0) then
-        call peak_at(n, fd(:, 4), ok_rows(), periodic == 1, h, x0, row(13), row(14))
+        call peak_at(n, fd(:, 4), okrow, periodic == 1, h, x0, row(13), row(14))
         row(17) = maxval(hypot(sh(:, 1), sh(:, 2)))
         row(18) = maxval(abs(sh(:, 3)))
         if (whole) then
@@ -1412,14 +1527,6 @@ contains
       if (cnt > 0) a(1:cnt) = prm(i, o + 1:o + cnt)
       o = o + cnt
     end subroutine take
-
-    function ok_rows() result(okv)
-      logical :: okv(n)
-      integer :: kk
-      do kk = 1, n
-        okv(kk) = all(st(kk, :) == st_ok)
-      end do
-    end function ok_rows
 
     !> Extremes of the output y over the scan, refined on the quintic Hermite model, the stroke
     !> and the time ratio (periodic scans).  An output link that turns fully has none.

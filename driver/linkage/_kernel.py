@@ -7,12 +7,13 @@ columns are named once, here, by IntEnums (as pymsis names its Fortran columns).
 """
 from __future__ import annotations
 
+import weakref
 from enum import IntEnum
 from typing import NamedTuple
 
 import numpy as np
 
-from driver._fortran import _kernels, farray
+from driver._fortran import _kernels, farray, spare_buffer
 from driver.linkage._model import Mechanism
 
 __all__ = ["Status", "LinkCol", "PointCol", "SlideCol", "JointCol", "DriverCol", "ShakeCol", "EnergyCol",
@@ -184,13 +185,48 @@ def analyse(mech: Mechanism, x: np.ndarray, forces: bool | None = None, continui
     want = (int(Want.CONTINUITY) if continuity else 0) | (int(Want.FORCES) if (mech.forces if forces is None
                                                                                 else forces) else 0)
     i, r = mech.integers(), mech.reals()
-    out = _K.analyse(mech.nslides, x, i["idrv"], r["rdrv"], i["ipts"], r["rpts"],
+    n, nl, npt, nd, ns = x.shape[0], len(mech.links), len(mech.points), len(mech.dyads), mech.nslides
+    bufs = [spare_buffer(f"linkage.{name}", shape, np.float64) for name, shape in
+            (("lk", (n, 3, nl)), ("pk", (n, 6, npt)), ("sk", (n, 3, ns)), ("qa", (n, nd)))]
+    st = spare_buffer("linkage.st", (n, nd), np.int32)
+    _fill_ground(mech, bufs[0], bufs[1])
+    nf = n if want & int(Want.FORCES) else 1     # no forces asked: one unused row
+    fbufs = [spare_buffer(f"linkage.{name}", shape, np.float64) for name, shape in
+             (("fk", (nf, 9, nd)), ("fd", (nf, 4)), ("sh", (nf, 3)))]
+    out = _K.analyse(x, i["idrv"], r["rdrv"], i["ipts"], r["rpts"],
                      i["igd"], r["rgd"], i["idy"], r["rdy"], r["rl"], r["grav"], i["ild"], r["rld"], r["rtq"],
-                     i["ift"], r["tab"], r["rft"], want)
+                     i["ift"], r["tab"], r["rft"], want, *bufs, st, *fbufs)
     a = Analysis(*out)
+    if nf < n:   # no force analysis: zero-size force arrays, not garbage
+        a = a._replace(joints=np.zeros((0, 9, nd)),
+                       driver=np.zeros((0, 4)), shaking=np.zeros((0, 3)))
     if not mech.slides:
         a = a._replace(slides=a.slides[:, :, :0])
     return a
+
+
+#: the ground columns of a reused output buffer: name -> (weak reference to the buffer, what they hold)
+_GROUND: dict[str, tuple[weakref.ref, tuple]] = {}
+
+
+def _fill_ground(mech: Mechanism, lk: np.ndarray, pk: np.ndarray) -> None:
+    """Write the ground's columns of the output buffers (the kernel leaves them: constant), unless
+    the buffer is the very array an earlier call filled with exactly these (a reused spare:
+    the weak reference proves it is the same living object, whose ground columns nothing else
+    writes)."""
+    ground = tuple((j, u, v) for j, (_, link, u, v) in enumerate(mech.points) if link == 1)
+    for name, buf, contents in (("lk", lk, ()), ("pk", pk, ground)):
+        held = _GROUND.get(name)
+        if held is not None and held[0]() is buf and held[1] == contents:
+            continue
+        if name == "lk":
+            buf[:, :, 0] = 0.0
+        else:
+            for j, u, v in ground:
+                buf[:, 0, j] = u
+                buf[:, 1, j] = v
+                buf[:, 2:, j] = 0.0
+        _GROUND[name] = (weakref.ref(buf), contents)
 
 
 def table_energy(theta: np.ndarray, torque: np.ndarray, cs: float, omega: float) -> np.ndarray:
