@@ -73,8 +73,37 @@ def _with(base: Params, key: str, index: int | None, value: Any) -> Params:
     return q
 
 
+#: a column with more distinct values than this is applied through its affine map (below)
+AFFINE_FROM = 16
+
+
+def _design(base: Params, key: str, index: int | None, value: Any, b: np.ndarray, u: int,
+            inverse: np.ndarray) -> np.ndarray:
+    """The kernel row of the base deck with one value changed (checked as a deck would be)."""
+    try:
+        q = _with(base, key, index, value)
+        mq = compile_deck(q)
+    except DeckError as exc:
+        i = int(np.argmax(inverse == u))
+        raise DeckError(exc.path, exc.line, exc.key, f"design {i}: {exc.message}") from None
+    nq = np.concatenate([mq.numbers(), np.zeros(3)])
+    if len(nq) != len(b):
+        raise base.error(key, "changes the mechanism's layout (a batch varies numbers only)")
+    xq, sq, _ = scan_of(q, mq)
+    nq[-3:] = (xq, sq, float(q["speed_fluctuation"]))
+    return nq
+
+
 def _numbers(base: Params, mech: Mechanism, columns: Mapping[str, Any], n: int) -> np.ndarray:
-    """(n, numbers + 3) kernel rows: the base design's numbers plus each varied value's change."""
+    """(n, numbers + 3) kernel rows: the base design's numbers plus each varied value's change.
+
+    A column with few distinct values is compiled once per value (every design checked as a
+    deck).  One with many (an optimiser's, a fine grid's) goes through its affine map: the
+    kernel numbers depend on a deck number linearly (a copy, degrees to radians, an offset
+    summed with another), which three compiled values establish and check; its values are then
+    checked by the key's own check and the mechanism's at the column's two extremes (its checks
+    are bounds: every value between two valid ones is valid); a column whose map is not affine
+    is compiled value by value."""
     b = np.concatenate([mech.numbers(), np.zeros(3)])
     x0, span, _ = scan_of(base, mech)
     b[-3:] = (x0, span, float(base["speed_fluctuation"]))
@@ -84,21 +113,31 @@ def _numbers(base: Params, mech: Mechanism, columns: Mapping[str, Any], n: int) 
         key, index = (m.group(1), int(m.group(2))) if m else (name, None)
         vals = np.broadcast_to(np.asarray(vals), (n,))
         uniq, inverse = np.unique(vals, return_inverse=True)
+        numeric = uniq.dtype.kind in "fiu"
+        if numeric and len(uniq) > AFFINE_FROM:
+            lo, hi = float(uniq[0]), float(uniq[-1])
+            nlo = _design(base, key, index, lo, b, 0, inverse)
+            nhi = _design(base, key, index, hi, b, len(uniq) - 1, inverse)
+            mid = float(uniq[len(uniq) // 2])
+            nmid = _design(base, key, index, mid, b, len(uniq) // 2, inverse)
+            slope = (nhi - nlo) / (hi - lo)
+            pred = nlo + slope * (mid - lo)
+            if np.all(np.abs(pred - nmid) <= 1e-12 * (np.abs(nmid) + np.abs(nlo) + np.abs(nhi) + 1e-300)):
+                from driver.linkage._spec import SPEC
+                check = SPEC.keys[key].check
+                for u, v in enumerate(uniq):
+                    if index is not None:
+                        whole = list(base[key])
+                        whole[index - 1] = float(v)
+                    msg = check(whole if index is not None else float(v)) if check is not None else None
+                    if msg:
+                        i = int(np.argmax(inverse == u))
+                        raise base.error(key, f"design {i}: {msg}")
+                rows += (nlo - b)[None, :] + slope[None, :] * (uniq[inverse] - lo)[:, None]
+                continue
         delta = np.empty((len(uniq), len(b)))
         for u, v in enumerate(uniq):
-            v = v.item() if hasattr(v, "item") else v
-            try:
-                q = _with(base, key, index, v)
-                mq = compile_deck(q)
-            except DeckError as exc:
-                i = int(np.argmax(inverse == u))
-                raise DeckError(exc.path, exc.line, exc.key, f"design {i}: {exc.message}") from None
-            if len(mq.numbers()) != len(b) - 3:
-                raise base.error(key, "changes the mechanism's layout (a batch varies numbers only)")
-            nq = np.concatenate([mq.numbers(), np.zeros(3)])
-            xq, sq, _ = scan_of(q, mq)
-            nq[-3:] = (xq, sq, float(q["speed_fluctuation"]))
-            delta[u] = nq - b
+            delta[u] = _design(base, key, index, v.item() if hasattr(v, "item") else v, b, u, inverse) - b
         rows += delta[inverse]
     return np.asfortranarray(rows)
 
