@@ -123,7 +123,6 @@ class _linkage:
     """Fortran module ``linkage`` (fortran/*.f90)."""
     @staticmethod
     def analyse(
-        ns: int,
         x: NDArray[np.float64],
         idrv: NDArray[np.int32],
         rdrv: NDArray[np.float64],
@@ -142,15 +141,25 @@ class _linkage:
         tab: NDArray[np.float64],
         rft: NDArray[np.float64],
         want: int,
+        lk: NDArray[np.float64],
+        pk: NDArray[np.float64],
+        sk: NDArray[np.float64],
+        qa: NDArray[np.float64],
+        st: NDArray[np.int32],
+        fk: NDArray[np.float64],
+        fd: NDArray[np.float64],
+        sh: NDArray[np.float64],
         n: int = ...,
         nl: int = ...,
         np: int = ...,
         ng: int = ...,
         nd: int = ...,
+        ns: int = ...,
         nld: int = ...,
         nt: int = ...,
+        nf: int = ...,
     ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.int32], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-        """``lk,pk,sk,qa,st,fk,fd,sh = analyse(ns,x,idrv,rdrv,ipts,rpts,igd,rgd,idy,rdy,rl,grav,ild,rld,rtq,ift,tab,rft,want,[n,nl,np,ng,nd,nld,nt])``; shapes lk(n,3,nl), pk(n,6,np), sk(n,3,ns), qa(n,nd), st(n,nd), fk(n,9,nd), fd(n,4), sh(n,3)"""
+        """``lk,pk,sk,qa,st,fk,fd,sh = analyse(x,idrv,rdrv,ipts,rpts,igd,rgd,idy,rdy,rl,grav,ild,rld,rtq,ift,tab,rft,want,lk,pk,sk,qa,st,fk,fd,sh,[n,nl,np,ng,nd,ns,nld,nt,nf])``; shapes lk(n,3,nl), pk(n,6,np), sk(n,3,ns), qa(n,nd), st(n,nd), fk(nf,9,nd), fd(nf,4), sh(nf,3)"""
         ...
     drv_crank: NDArray[np.int32]
     drv_slider: NDArray[np.int32]

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from driver._study import BatchSummary, Study
 from driver.linkage import _kernel as kernel
+from driver.linkage import _published as published
 from driver.linkage._analysis import Event, Motion, events, inputs, solve, tidy_frame
 from driver.linkage._batch import (
     BATCH_ELEMENTS,
@@ -35,12 +36,11 @@ from driver.linkage._model import Dyad, Mechanism, compile_deck
 from driver.linkage._report import run
 from driver.linkage._spec import LABELS, SPEC, SUMMARY_SETTINGS, SWEEP_BEST, SWEEP_PLOT, estimate
 
-__all__ = ["SPEC", "STUDY", "run", "estimate", "summarise", "summarise_batch", "compile_deck", "solve", "inputs",
-           "events", "tidy_frame", "table_flywheel", "animation_frames", "Mechanism", "Dyad", "Motion", "Event",
-           "TableFlywheel", "BATCH_KEYS", "LABELS", "kernel"]
+__all__ = ["SPEC", "STUDY", "run", "estimate", "summarise", "summarise_batch", "compile_deck", "solve",
+           "table_flywheel", "animation_frames", "BATCH_KEYS", "LABELS", "kernel"]
 
 STUDY = Study(name="linkage", package=__name__, spec=SPEC, run=run, estimate=estimate, summarise=summarise,
               batch=BatchSummary(summarise_batch, keys=BATCH_KEYS, ignored=BATCH_IGNORED,
                                  independent=BATCH_INDEPENDENT, elements=BATCH_ELEMENTS, refusal=refusal),
               labels=LABELS, sweep_plot=SWEEP_PLOT, sweep_best=SWEEP_BEST, summary_settings=SUMMARY_SETTINGS,
-              figures=f"{__name__}._figures", kernel=kernel)
+              published=published.compare, figures=f"{__name__}._figures", kernel=kernel)

@@ -80,7 +80,23 @@ def inputs(p: Params) -> np.ndarray:
 
 
 def solve(p: Params, x: np.ndarray | None = None, mech: Mechanism | None = None) -> Motion:
-    """Run the kernel at the deck's inputs (or at ``x``, in the deck's units)."""
+    """Run the kernel at the deck's inputs.
+
+    Parameters
+    ----------
+    p : Params
+        A validated ``&linkage`` deck.
+    x : numpy.ndarray, optional
+        Inputs in the deck's units (deg for a crank, length for an input slider), in order;
+        default the deck's ``start``..``stop`` by ``step``.
+    mech : Mechanism, optional
+        The deck's compiled mechanism, when the caller has it.
+
+    Returns
+    -------
+    Motion
+        The inputs and the kernel's arrays (joint forces in the deck's order of each group).
+    """
     mech = mech or compile_deck(p)
     x = inputs(p) if x is None else np.asarray(x, dtype=np.float64)
     xk = np.radians(x) if mech.driver == "crank" else x

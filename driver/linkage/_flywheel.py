@@ -47,7 +47,19 @@ def check(p: Params) -> None:
 
 
 def table_flywheel(p: Params) -> TableFlywheel:
-    """The flywheel of the deck's turning-moment diagram."""
+    """Size the flywheel of the deck's turning-moment diagram.
+
+    Parameters
+    ----------
+    p : Params
+        A validated ``&linkage`` deck with ``turning_moment_deg`` and ``turning_moment``
+        (``omega`` the mean speed [rad/s], ``speed_fluctuation`` the coefficient C_s).
+
+    Returns
+    -------
+    TableFlywheel
+        Mean torque [N m], energy fluctuation [J], flywheel inertia [kg m^2] and the rest.
+    """
     r = kernel.table_energy(np.radians(np.asarray(p.turning_moment_deg, float)), np.asarray(p.turning_moment, float),
                             p.speed_fluctuation, p.omega)
     return TableFlywheel(float(r[EnergyCol.MEAN_TORQUE]), float(r[EnergyCol.ENERGY_FLUCTUATION]),

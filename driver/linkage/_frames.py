@@ -93,9 +93,25 @@ def frames(p: Params, n: int = 180) -> tuple[Motion, dict[str, Any]]:
 
 
 def animation_frames(params: Params, result: Result | None = None, n: int = 180) -> dict[str, Any] | None:
-    """The report page's animation data (JSON-ready, rounded to 6 digits): one frame per input over
-    one cycle, the generic points/links/blocks/guides/ground/paths of :func:`frames`, and
-    ``box_points`` bounding the drawing."""
+    """Make the report page's animation data: the mechanism's frames over one cycle.
+
+    Parameters
+    ----------
+    params : Params
+        A validated ``&linkage`` deck.
+    result : Result, optional
+        The deck's run (not needed: the frames come from the kernel).
+    n : int, default 180
+        Frames over one cycle.
+
+    Returns
+    -------
+    dict
+        JSON-ready (rounded to 6 digits): ``kind`` 'mechanism', ``input`` (deck units), ``ok``,
+        ``points`` {name: [[x, y], ...]}, ``links`` [[name, [joint names]]], ``blocks`` [[link,
+        pin, guide]], ``guides`` {name: {point, direction}}, ``ground`` (pivot names),
+        ``paths`` (tracer names) and ``box_points`` bounding the drawing [length].
+    """
     _, f = frames(params, n)
     r = lambda a: np.round(np.asarray(a, dtype=float), 6).tolist()
     ok = f["ok"]

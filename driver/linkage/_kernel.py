@@ -83,8 +83,11 @@ class JointCol(IntEnum):
 
 
 class DriverCol(IntEnum):
-    """Columns of the driver's forces: the reaction at its pivot or guide (fx, fy, couple) and
-    the driving torque [N m] (crank) or force [N] (slider)."""
+    """Columns of the driver's forces.
+
+    The reaction at its pivot or guide (fx, fy [N], couple [N m]) and the driving torque [N m]
+    (crank) or force [N] (slider).
+    """
 
     FX = 0
     FY = 1
@@ -114,8 +117,10 @@ class EnergyCol(IntEnum):
 
 
 class SummaryCol(IntEnum):
-    """The head columns of a summary row (fortran/linkage.f90 summaries); angles in rad,
-    inputs in rad (crank) or length (slider)."""
+    """The head columns of a summary row (fortran/linkage.f90 summaries).
+
+    Angles in rad, inputs in rad (crank) or length (slider).
+    """
 
     ASSEMBLED_FRACTION = 0
     NOT_ASSEMBLED = 1
@@ -147,11 +152,27 @@ assert NSUM_HEAD == len(SummaryCol)
 
 
 class Analysis(NamedTuple):
-    """The kernel's answer at n inputs (positions first): ``links`` (n, 3, links) by
-    :class:`LinkCol`, ``points`` (n, 6, points) by :class:`PointCol`, ``slides`` (n, 3, slides)
-    by :class:`SlideCol`, ``quality`` (n, groups) transmission or pressure angle [rad],
-    ``status`` (n, groups) :class:`Status`, ``joints`` (n, 9, groups) by :class:`JointCol`,
-    ``driver`` (n, 4) by :class:`DriverCol`, ``shaking`` (n, 3) by :class:`ShakeCol`."""
+    """The kernel's answer at n inputs (positions first).
+
+    Attributes
+    ----------
+    links : numpy.ndarray
+        (n, 3, links) by :class:`LinkCol` (the ground first).
+    points : numpy.ndarray
+        (n, 6, points) by :class:`PointCol`.
+    slides : numpy.ndarray
+        (n, 3, slides) by :class:`SlideCol`.
+    quality : numpy.ndarray
+        (n, groups) transmission or pressure angle [rad].
+    status : numpy.ndarray
+        (n, groups) :class:`Status`.
+    joints : numpy.ndarray
+        (n, 9, groups) by :class:`JointCol` (no rows without the force analysis).
+    driver : numpy.ndarray
+        (n, 4) by :class:`DriverCol` (no rows without the force analysis).
+    shaking : numpy.ndarray
+        (n, 3) by :class:`ShakeCol` (no rows without the force analysis).
+    """
 
     links: np.ndarray
     points: np.ndarray
@@ -232,8 +253,10 @@ def _fill_ground(mech: Mechanism, lk: np.ndarray, pk: np.ndarray) -> None:
 
 def reusable_call(mech: Mechanism, x: np.ndarray, forces: bool | None = None,
                   continuity: bool = True) -> Callable[[], tuple]:
-    """A call of the kernel on fixed inputs and output arrays made once (benchmarks: the cost
-    of the kernel itself, its outputs reused as the four-bar's ``out=`` buffers are).
+    """Make a call of the kernel on fixed inputs and output arrays made once.
+
+    For benchmarks: the cost of the kernel itself, its outputs reused as the four-bar's
+    ``out=`` buffers are.
 
     Parameters
     ----------
@@ -291,12 +314,23 @@ def table_energy(theta: np.ndarray, torque: np.ndarray, cs: float, omega: float)
 
 
 def summary_width(mech: Mechanism) -> int:
-    """Columns of a summary row of ``mech``."""
+    """Count the columns of a summary row.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The compiled mechanism.
+
+    Returns
+    -------
+    int
+        Head columns, then per moving link, per slide and per group.
+    """
     return NSUM_HEAD + NSUM_LINK * (len(mech.links) - 1) + NSUM_SLIDE * mech.nslides + NSUM_DYAD * len(mech.dyads)
 
 
 def summaries(mech: Mechanism, numbers: np.ndarray, nscan: int, periodic: bool, forces: bool | None = None) -> np.ndarray:
-    """Summaries of many designs of one mechanism in one kernel call.
+    """Summarise many designs of one mechanism in one kernel call.
 
     Parameters
     ----------
