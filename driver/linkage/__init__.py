@@ -20,7 +20,7 @@ from __future__ import annotations
 from driver._study import BatchSummary, Study
 from driver.linkage import _kernel as kernel
 from driver.linkage import _published as published
-from driver.linkage._analysis import Event, Motion, events, inputs, solve, tidy_frame
+from driver.linkage._analysis import solve
 from driver.linkage._batch import (
     BATCH_ELEMENTS,
     BATCH_IGNORED,
@@ -30,9 +30,9 @@ from driver.linkage._batch import (
     summarise,
     summarise_batch,
 )
-from driver.linkage._flywheel import TableFlywheel, table_flywheel
+from driver.linkage._flywheel import table_flywheel
 from driver.linkage._frames import animation_frames
-from driver.linkage._model import Dyad, Mechanism, compile_deck
+from driver.linkage._model import compile_deck
 from driver.linkage._report import run
 from driver.linkage._spec import LABELS, SPEC, SUMMARY_SETTINGS, SWEEP_BEST, SWEEP_PLOT, estimate
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import weakref
 from collections.abc import Callable
 from enum import IntEnum
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -217,7 +217,8 @@ def analyse(mech: Mechanism, x: np.ndarray, forces: bool | None = None, continui
              (("fk", (nf, 9, nd)), ("fd", (nf, 4)), ("sh", (nf, 3)))]
     out = _K.analyse(x, i["idrv"], r["rdrv"], i["ipts"], r["rpts"],
                      i["igd"], r["rgd"], i["idy"], r["rdy"], r["rl"], r["grav"], i["ild"], r["rld"], r["rtq"],
-                     i["ift"], r["tab"], r["rft"], want, *bufs, st, *fbufs)
+                     i["ift"], r["tab"], r["rft"], want, bufs[0], bufs[1], bufs[2], bufs[3], st, fbufs[0],
+                     fbufs[1], fbufs[2])
     a = Analysis(*out)
     if nf < n:   # no force analysis: zero-size force arrays, not garbage
         a = a._replace(joints=np.zeros((0, 9, nd)),
@@ -284,9 +285,10 @@ def reusable_call(mech: Mechanism, x: np.ndarray, forces: bool | None = None,
     st = np.zeros((n, nd), dtype=np.int32, order="F")
     fbufs = [np.zeros(shape, order="F") for shape in ((nf, 9, nd), (nf, 4), (nf, 3))]
     _fill_ground(mech, bufs[0], bufs[1])
-    args = (x, i["idrv"], r["rdrv"], i["ipts"], r["rpts"], i["igd"], r["rgd"], i["idy"], r["rdy"], r["rl"],
+    args: tuple[Any, ...] = (x, i["idrv"], r["rdrv"], i["ipts"], r["rpts"], i["igd"], r["rgd"], i["idy"], r["rdy"], r["rl"],
             r["grav"], i["ild"], r["rld"], r["rtq"], i["ift"], r["tab"], r["rft"], want, *bufs, st, *fbufs)
-    return lambda: _K.analyse(*args)
+    kernel: Any = _K.analyse
+    return lambda: kernel(*args)
 
 
 def table_energy(theta: np.ndarray, torque: np.ndarray, cs: float, omega: float) -> np.ndarray:
