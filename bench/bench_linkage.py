@@ -184,9 +184,9 @@ SWEEP_DECK = """&linkage
   scan_points = {scan}
 /
 &sweep
-  key1 = 'linkage.dyad_dims(3)', start1 = 0.19, stop1 = 0.24, count1 = {c1}
-  key2 = 'linkage.dyad_dims(4)', start2 = 0.17, stop2 = 0.21, count2 = {c2}
-  keep = 'time_ratio >= 1.3 and mu_min_deg >= 30'
+  key1 = 'linkage.driver_length', start1 = 0.06, stop1 = 0.12, count1 = {c1}
+  key2 = 'linkage.omega', start2 = 5.0, stop2 = 15.0, count2 = {c2}
+  keep = 'time_ratio >= 1.38 and stroke >= 29.5'
   case_outputs = 'none'
   summary_rows = 'kept'
 /

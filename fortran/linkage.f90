@@ -121,9 +121,28 @@ contains
     !f2py intent(in,out) :: lk, pk, sk, qa, fk, fd, sh
     integer, intent(inout) :: st(n, nd)
     !f2py intent(in,out) :: st
-    real(dp), allocatable :: modes(:, :), chr(:, :, :), pose(:, :, :), att(:, :, :, :)
+    real(dp), allocatable :: pose(:, :, :), att(:, :, :, :)
+    allocate (pose(nb, npose, nl), att(nb, natt, 2, nd))
+    call analyse_core(n, nl, np, ng, nd, ns, nld, nt, nf, x, idrv, rdrv, ipts, rpts, igd, rgd, idy, rdy, &
+                      rl, grav, ild, rld, rtq, ift, tab, rft, want, lk, pk, sk, qa, st, fk, fd, sh, pose, att)
+  end subroutine analyse
+
+  !> analyse's work, with the block work arrays of the caller (summaries makes them once for
+  !> all its designs): pose(nb, npose, nl) and att(nb, natt, 2, nd), overwritten.
+  subroutine analyse_core(n, nl, np, ng, nd, ns, nld, nt, nf, x, idrv, rdrv, ipts, rpts, igd, rgd, idy, rdy, &
+                          rl, grav, ild, rld, rtq, ift, tab, rft, want, lk, pk, sk, qa, st, fk, fd, sh, pose, att)
+    integer, intent(in) :: n, nl, np, ng, nd, ns, nld, nt, nf   ! nf: rows of the force outputs (n, or 1 unused)
+    real(dp), intent(in) :: x(n), rdrv(3), rpts(np, 2), rgd(ng, 3), rdy(nd, 3), rl(nl, 4), grav(2)
+    integer, intent(in) :: idrv(4), ipts(np), igd(ng), idy(nd, 6), ild(nld), ift(4), want
+    real(dp), intent(in) :: rld(nld, 2), rtq(nl), tab(nt, 2), rft(3)
+    ! outputs: overwritten (intent inout so that callers can reuse their buffers)
+    real(dp), intent(inout) :: lk(n, 3, nl), pk(n, 6, np), sk(n, 3, ns), qa(n, nd), fk(nf, 9, nd), fd(nf, 4), &
+                               sh(nf, 3)
+    integer, intent(inout) :: st(n, nd)
+    real(dp), intent(inout) :: pose(nb, npose, nl), att(nb, natt, 2, nd)
+    real(dp), allocatable :: modes(:, :), chr(:, :, :)
     real(dp) :: ring(3, 4, nd)
-    integer :: d, first, k0, m, flagk
+    integer :: d, first, k0, m, flagk, mb
     logical :: cont, store
 
     allocate (modes(n, nd))
@@ -140,21 +159,21 @@ contains
     allocate (chr(1, 4, nd))
     ! block work arrays, made once: link frames, and the groups' attachments (those on the ground
     ! -- pivots, fixed guides -- are constant and filled here once)
-    allocate (pose(nb, npose, nl), att(nb, natt, 2, nd))
-    pose(:, :, 1) = 0.0_dp
-    pose(:, p_c, 1) = 1.0_dp
-    pose(:, p_ok, 1) = 1.0_dp
-    pose(:, p_rt, 1) = 1.0_dp
+    mb = min(nb, n)   ! the rows a block uses
+    pose(1:mb, :, 1) = 0.0_dp
+    pose(1:mb, p_c, 1) = 1.0_dp
+    pose(1:mb, p_ok, 1) = 1.0_dp
+    pose(1:mb, p_rt, 1) = 1.0_dp
     do d = 1, nd
       if (idy(d, 1) == dy_prp) then
-        if (igd(idy(d, 2)) == 1) call guide_of(nb, 1, rgd(idy(d, 2), :), pose(:, :, 1), att(:, :, 1, d))
+        if (igd(idy(d, 2)) == 1) call guide_of(mb, 1, rgd(idy(d, 2), :), pose(:, :, 1), att(:, :, 1, d))
       else if (ipts(idy(d, 2)) == 1) then
-        call point_of(nb, 1, rpts(idy(d, 2), :), pose(:, :, 1), att(:, :, 1, d))
+        call point_of(mb, 1, rpts(idy(d, 2), :), pose(:, :, 1), att(:, :, 1, d))
       end if
       if (idy(d, 1) == dy_rrp .or. idy(d, 1) == dy_prp) then
-        if (igd(idy(d, 3)) == 1) call guide_of(nb, 1, rgd(idy(d, 3), :), pose(:, :, 1), att(:, :, 2, d))
+        if (igd(idy(d, 3)) == 1) call guide_of(mb, 1, rgd(idy(d, 3), :), pose(:, :, 1), att(:, :, 2, d))
       else if (ipts(idy(d, 3)) == 1) then
-        call point_of(nb, 1, rpts(idy(d, 3), :), pose(:, :, 1), att(:, :, 2, d))
+        call point_of(mb, 1, rpts(idy(d, 3), :), pose(:, :, 1), att(:, :, 2, d))
       end if
     end do
     call solve_rows(1)
@@ -183,7 +202,7 @@ contains
       end do
     end subroutine solve_rows
 
-  end subroutine analyse
+  end subroutine analyse_core
 
   !> The continuity test of one group over one block, in cache, assuming no flip so far: flagk
   !> becomes the first input (global row) where the other assembly's new joint is nearer than
@@ -1407,12 +1426,14 @@ contains
     real(dp), allocatable :: x(:), lk(:, :, :), pk(:, :, :), sk(:, :, :), qa(:, :), fk(:, :, :), fd(:, :), &
                              sh(:, :), y(:), dy(:), ddy(:), row(:), en(:)
     logical, allocatable :: okrow(:)
+    real(dp), allocatable :: pose(:, :, :), att(:, :, :, :)
     integer, allocatable :: st(:, :)
     integer :: i, k, o, l, j, d, c, n, nok
     logical :: whole
     n = max(nscan, 2)
     allocate (x(n), lk(n, 3, nl), pk(n, 6, np), sk(n, 3, max(ns, 1)), qa(n, nd), fk(n, 9, nd), fd(n, 4), &
               sh(n, 3), st(n, nd), y(n), dy(n), ddy(n), row(ncol), en(nenergy), okrow(n))
+    allocate (pose(nb, npose, nl), att(nb, natt, 2, nd))   ! the blocks' work arrays, once for all designs
     do i = 1, nds
       o = 0
       call take(rpts, 2*np)
@@ -1436,8 +1457,8 @@ contains
       do k = 1, n
         x(k) = x0 + h*real(k - 1, dp)
       end do
-      call analyse(n, nl, np, ng, nd, max(ns, 1), nld, nt, n, x, idrv, rdrv, ipts, rpts, igd, rgd, idy, rdy, &
-                   rl, grav, ild, rld, rtq, ift, tab, rft, want, lk, pk, sk, qa, st, fk, fd, sh)
+      call analyse_core(n, nl, np, ng, nd, max(ns, 1), nld, nt, n, x, idrv, rdrv, ipts, rpts, igd, rgd, idy, &
+                        rdy, rl, grav, ild, rld, rtq, ift, tab, rft, want, lk, pk, sk, qa, st, fk, fd, sh, pose, att)
       row = 0.0_dp
       do k = 1, n
         okrow(k) = all(st(k, :) == st_ok)
