@@ -58,7 +58,7 @@ def test_import_driver_is_cheap_and_exports_a_small_documented_surface():
     for name in driver.__all__:
         obj = getattr(driver, name)
         assert obj.__doc__ and len(obj.__doc__) > 40, name
-    assert set(driver.studies()) == {"fourbar", "manipulator", "robust_example", "slidercrank", "ujoint"}
+    assert set(driver.studies()) == {"fourbar", "linkage", "manipulator", "robust_example", "slidercrank", "ujoint"}
     assert driver.fourbar.run.__doc__
     assert (Path(driver.__file__).parent / "py.typed").exists()
     with pytest.raises(AttributeError):

@@ -111,7 +111,7 @@ def test_shared_docstring_sections_are_filled_in_where_used():
     assert "rod : float\n        Rod length, m." in (f.__doc__ or "") and "%(other)s" in (f.__doc__ or "")
     g = fill_doc(rod="x")(lambda: None)
     assert g.__doc__ is None
-    for study in ("fourbar", "manipulator", "robust_example", "slidercrank", "ujoint"):
+    for study in ("fourbar", "linkage", "manipulator", "robust_example", "slidercrank", "ujoint"):
         doc = importlib.import_module(f"driver.{study}").estimate.__doc__
         assert "%(" not in doc and HOOK_SECTIONS["estimate"] in doc, study
 
