@@ -213,8 +213,8 @@ contains
     real(dp), intent(in) :: ex(nb, nex)
     real(dp), intent(inout) :: ring(3, 4)
     integer, intent(inout) :: flagk
-    real(dp) :: ch(nb + 3, 4), px, py, ec, ea
-    integer :: flag(nb + 3), k, kg, c
+    real(dp) :: ch(nb + 3, 4), px, py, ec, ea, flag(nb + 3)   ! flags as reals: one vector width
+    integer :: k, kg, c
     do c = 1, 4
       ch(1:3, c) = ring(:, c)
       ch(4:m + 3, c) = ex(1:m, 9 + c)
@@ -225,11 +225,11 @@ contains
       py = 3.0_dp*(ch(k - 1, 2) - ch(k - 2, 2)) + ch(k - 3, 2)
       ec = (ch(k, 1) - px)**2 + (ch(k, 2) - py)**2
       ea = (ch(k, 3) - px)**2 + (ch(k, 4) - py)**2
-      flag(k) = merge(1, 0, ea < ec)
+      flag(k) = merge(1.0_dp, 0.0_dp, ea < ec)
     end do
     do k = 4, m + 3
       kg = k0 + k - 4
-      if (flag(k) == 0 .or. kg < 4) cycle
+      if (flag(k) == 0.0_dp .or. kg < 4) cycle
       if (all(st(kg - 3:kg) == st_ok .or. st(kg - 3:kg) == st_toggle) .and. st(kg) == st_ok) then
         flagk = kg
         exit
@@ -251,29 +251,7 @@ contains
     integer, intent(inout) :: first
     real(dp) :: cx(4), cy(4), px, py, ec, ea, ax, ay, par
     logical :: okk(4)
-    integer :: k, j, k1
-    integer, allocatable :: flag(:)
-    ! fast path: with no flip so far, the first position where the other assembly is nearer
-    ! to the extrapolation is found by a loop without a dependency between positions
-    k1 = 0
-    if (n < 4) return
-    allocate (flag(n))
-    ! hot-loop: linkage continuity pre-scan
-    do k = 4, n
-      px = 3.0_dp*(chr(k - 1, 1) - chr(k - 2, 1)) + chr(k - 3, 1)
-      py = 3.0_dp*(chr(k - 1, 2) - chr(k - 2, 2)) + chr(k - 3, 2)
-      ec = (chr(k, 1) - px)**2 + (chr(k, 2) - py)**2
-      ea = (chr(k, 3) - px)**2 + (chr(k, 4) - py)**2
-      flag(k) = merge(1, 0, ea < ec)
-    end do
-    do k = 4, n
-      if (flag(k) == 0) cycle
-      if (all(st(k - 3:k) == st_ok .or. st(k - 3:k) == st_toggle) .and. st(k) == st_ok) then
-        k1 = k
-        exit
-      end if
-    end do
-    if (k1 == 0) return
+    integer :: k, j
     par = 1.0_dp
     cx = 0.0_dp
     cy = 0.0_dp
@@ -557,12 +535,8 @@ contains
     integer, intent(in) :: m
     real(dp), intent(in) :: a1(nb), a2(nb)
     real(dp), intent(inout) :: b1(m), b2(m)
-    integer :: k
-    ! hot-loop: linkage copy
-    do k = 1, m
-      b1(k) = a1(k)
-      b2(k) = a2(k)
-    end do
+    b1(1:m) = a1(1:m)
+    b2(1:m) = a2(1:m)
   end subroutine copy2
 
   !> A point (u, v) of a moving link straight into six output columns: position, velocity,
