@@ -1408,6 +1408,7 @@ contains
     allocate (x(n), lk(n, 3, nl), pk(n, 6, np), sk(n, 3, max(ns, 1)), qa(n, nd), fk(n, 9, nd), fd(n, 4), &
               sh(n, 3), st(n, nd), y(n), dy(n), ddy(n), row(ncol), en(nenergy), okrow(n))
     allocate (pose(nb, npose, nl), att(nb, natt, 2, nd))   ! the blocks' work arrays, once for all designs
+    sk = 0.0_dp   ! a mechanism without slides is given one inert slide, never written by analyse
     do i = 1, nds
       o = 0
       call take(rpts, 2*np)
