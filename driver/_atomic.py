@@ -26,6 +26,8 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import IO
 
+from driver._errors import DriverError
+
 __all__ = ["atomic_open", "write_text", "output_set", "OutputSet", "inside", "remove_stale_temporaries",
            "file_digest", "DIGEST_CHARS", "own_folder", "refuse_link", "LinkRefused", "NAME_MAX", "NameTooLong"]
 
@@ -33,7 +35,7 @@ __all__ = ["atomic_open", "write_text", "output_set", "OutputSet", "inside", "re
 NAME_MAX = 255
 
 
-class NameTooLong(OSError):
+class NameTooLong(DriverError, OSError):
     """An output file's name is longer than :data:`NAME_MAX` bytes: refused before its file (or
     its temporary) is created; inside an output set nothing of the set is renamed into place."""
 
@@ -42,6 +44,10 @@ class NameTooLong(OSError):
         n = len(os.fsencode(Path(path).name))
         super().__init__(errno.ENAMETOOLONG, f"the name has {n} bytes and a file name may have {NAME_MAX}",
                          str(path))
+
+    def __reduce__(self) -> tuple[type[NameTooLong], tuple[str]]:
+        """Pickle by the path (the message is made from it)."""
+        return (type(self), (str(self.filename),))
 
 
 class OutputSet:
@@ -229,13 +235,17 @@ def file_digest(path: str | Path, follow: bool = False) -> str | None:
     return h.hexdigest()[:DIGEST_CHARS]
 
 
-class LinkRefused(PermissionError):
+class LinkRefused(DriverError, PermissionError):
     """A symbolic link where the tool keeps a folder or file of its own (one line)."""
 
     def __init__(self, path: str | Path):
         super().__init__(1, "is a symbolic link where this tool keeps its own files; it creates and deletes "
                             "files only in folders it made (remove the link, or give the real folder as -o OUTDIR)",
                          str(path))
+
+    def __reduce__(self) -> tuple[type[LinkRefused], tuple[str]]:
+        """Pickle by the path (the message is made from it)."""
+        return (type(self), (str(self.filename),))
 
 
 def refuse_link(path: str | Path) -> None:

@@ -152,16 +152,10 @@ def _on_sigterm(signum: int, frame: object) -> None:
 
 def keys_help(group: str) -> str | None:
     """Every key of namelist group ``group`` with kind, units, default and doc; None if no such group."""
-    from driver._runner import CONTROL_GROUPS
-    if group in CONTROL_GROUPS:
-        import importlib
-        spec = importlib.import_module(f"driver.{group}").SPEC
-    else:
-        from driver._study import load_study
-        study = load_study(group)
-        if study is None:
-            return None
-        spec = study.spec
+    from driver._study import group_spec
+    spec = group_spec(group)
+    if spec is None:
+        return None
     lines = [f"&{spec.name}: {spec.doc}".rstrip(": "), ""]
     for name, key in spec.keys.items():
         req = "required" if key.required else f"default {key.default!r}"
@@ -229,9 +223,11 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--format", dest="formats", action="append", choices=FORMATS, default=[],
                         help="also write the tidy table in this format (repeatable)")
     parser.add_argument("--json", action="store_true",
-                        help="also write the run's summary (headline figures, warnings) as <stem>.json; for an "
-                             "optimisation its result (x, fun, success, status, message, nit, nfev, constraints), "
-                             "for a synthesis its linkage and checks, for a sweep its cases and summary table")
+                        help="also write the run's record as <stem>.json, one schema for every engine "
+                             "(driver/record.schema.json, docs/json.md): engine, study, name, deck, ok, exit_code, "
+                             "messages, summary, files and the engine's own section (a single run's failure and "
+                             "warnings, a sweep's cases, an optimisation's x, fun, constraints, a synthesis's "
+                             "linkage and checks); with --compare, one record per deck on stdout (JSON Lines)")
     parser.add_argument("--plot", action="store_true", help="write figures <stem>_<name>.png (see --plot-format)")
     parser.add_argument("--plot-format", choices=PLOT_FORMATS, default=None,
                         help="figure file format (implies --plot; default png); the same inputs give "
@@ -294,6 +290,8 @@ def _main(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
         return _examples(args)
     if not args.decks:
         parser.error("no deck given (python -m driver --examples lists the shipped example decks)")
+    if args.compare and args.json:
+        return _compare_json(args.decks)
     if args.compare:
         from driver._compare import CompareOutcome, compare_decks
         try:
@@ -338,6 +336,24 @@ def _main(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
     finally:
         _restore_signals(handlers)
         limits.restore(configured)
+    return status
+
+
+def _compare_json(decks: list[Path]) -> int:
+    """--compare --json: each deck's comparison as one line of JSON on stdout (its record,
+    driver._record), its errors on stderr too; the worst deck's exit status."""
+    from driver._compare import compare_decks
+    from driver._record import compare_record, record_text
+    status: int = ExitCode.OK
+    try:
+        for deck in decks:
+            part = compare_decks([deck])
+            for message in part.messages:
+                print(message, file=sys.stderr)
+            print(record_text(compare_record(part, deck), indent=None), end="", flush=True)
+            status = max(status, part.exit_code)
+    except BrokenPipeError:
+        _quiet_stdout()
     return status
 
 

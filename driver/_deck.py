@@ -31,6 +31,7 @@ from typing import Any
 import f90nml
 
 from driver._groupspec import DeckError, GroupSpec, Key, Params
+from driver._study import group_spec
 
 __all__ = ["DeckError", "Key", "GroupSpec", "Params", "RawGroup", "Deck", "read_deck", "validate"]
 
@@ -254,22 +255,11 @@ _KNOWN: dict[str, frozenset[str] | None] = {}
 
 
 def _known_keys(group: str) -> frozenset[str] | None:
-    """The keys of group ``group`` (a study's or &sweep, &optimize, &synthesis), or None when
-    no module declares it (the runner then refuses the group itself)."""
+    """The keys of group ``group`` (a study's or &sweep, &optimize, &synthesis), or None when the
+    registry knows no such group (the runner then refuses the group itself)."""
     if group not in _KNOWN:
-        import importlib
-        keys = None
-        try:
-            if group in ("sweep", "optimize", "synthesis"):
-                spec = importlib.import_module(f"driver.{group}").SPEC
-            else:
-                from driver._study import load_study
-                study = load_study(group)
-                spec = study.spec if study is not None else None
-            keys = frozenset(spec.keys) if isinstance(spec, GroupSpec) else None
-        except Exception:   # a module that fails to import declares no keys here
-            keys = None
-        _KNOWN[group] = keys
+        spec = group_spec(group)
+        _KNOWN[group] = frozenset(spec.keys) if spec is not None else None
     return _KNOWN[group]
 
 

@@ -5,7 +5,8 @@ A deck with a ``&synthesis`` group is a synthesis (:mod:`driver.synthesis`), els
 a sweep (:mod:`driver.sweep`), else one study run (:mod:`driver._runner`).  The command line
 (:func:`driver._cli.run_deck`) runs every deck through :func:`run_deck`; the Python API refuses
 a deck for the wrong entry point by :func:`engine_of`.  Nothing here prints: every engine
-returns an :class:`~driver._outcome.Outcome`.
+returns an :class:`~driver._outcome.Outcome`, and its ``--json`` record (:mod:`driver._record`)
+and report page (:mod:`driver._report_page`) are made from that outcome.
 """
 from __future__ import annotations
 
@@ -16,7 +17,7 @@ from typing import Any
 from driver._deck import Deck
 from driver._extras import require
 from driver._outcome import ExitCode, Outcome, RunOutcome
-from driver._runner import output_stem, run_study, study_of
+from driver._runner import output_stem, run_study
 
 __all__ = ["ENGINES", "engine_of", "run_deck"]
 
@@ -35,56 +36,52 @@ def run_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, pro
              jobs: int | None = None, scheduler: Any = None, resume: bool = False, summary_json: bool = False,
              report: bool = False, notify: Callable[[str], None] | None = None) -> Outcome:
     """Run ``deck`` by its engine and write its outputs to ``outdir``; ``summary_json`` also its
-    ``<stem>.json``, ``report`` its report page ``<stem>.html`` (:mod:`driver._report_page`,
-    once the run has written its outputs).  ``jobs``, ``scheduler`` and ``resume`` apply to
-    sweeps and optimisations; ``notify(line)`` hears what cannot wait for the outcome (a sweep's
-    Ctrl-C: the queued cases are cancelled).  Returns the engine's outcome; raises DeckError for bad input
-    (nothing written) and :class:`~driver._extras.MissingExtra` for a missing optional package."""
+    ``--json`` record ``<stem>.json``, ``report`` its report page ``<stem>.html``, both made from
+    the engine's outcome once its run has written its outputs.  ``jobs``, ``scheduler`` and
+    ``resume`` apply to sweeps and optimisations; ``notify(line)`` hears what cannot wait for the
+    outcome (a sweep's Ctrl-C: the queued cases are cancelled).  Returns the engine's outcome;
+    raises DeckError for bad input (nothing written) and :class:`~driver._extras.MissingExtra`
+    for a missing optional package."""
     kind = engine_of(deck)
-    if report:   # the page's name is known now: refused before the run, not after it
-        output_stem(outdir, deck.path, (".html",))
+    # the names of what is made from the outcome, known now: refused before the run, not after it
+    after = (*((".html",) if report else ()), *((".json",) if summary_json and kind != "study" else ()))
+    stem = output_stem(outdir, deck.path, after) if after else None
     outcome: Outcome
     if kind == "synthesis":
         from driver import synthesis
-        outcome = synthesis.run_synthesis_deck(deck, outdir, formats, plot, progress, summary_json=summary_json)
+        outcome = synthesis.run_synthesis_deck(deck, outdir, formats, plot, progress)
     elif kind == "optimize":
         from driver import optimize
-        outcome = optimize.run_optimize_deck(deck, outdir, formats, plot, progress, summary_json=summary_json,
-                                             jobs=jobs, resume=resume, scheduler=scheduler)
+        outcome = optimize.run_optimize_deck(deck, outdir, formats, plot, progress, jobs=jobs, resume=resume,
+                                             scheduler=scheduler)
     elif kind == "sweep":
         require("parquet")   # sweeps keep their cases in Parquet: say so before importing them
         from driver import sweep
         outcome = sweep.run_sweep_deck(deck, outdir, formats, plot, progress, jobs=jobs, scheduler=scheduler,
-                                       resume=resume, notify=notify)
-        if summary_json:
-            from driver.sweep._record import write_sweep_json
-            outcome.written.append(write_sweep_json(deck, outdir, int(outcome.exit_code)))
-    else:
+                                       resume=resume, notify=notify, best=report)
+    else:   # a single run writes its record with its other files (as driver.write does)
         outcome = run_study(deck, outdir, formats, plot, progress, summary_json=summary_json)
-    if report:
-        _report(deck, outdir, kind, outcome)
+    if stem is not None and summary_json and kind != "study":
+        from driver._record import write_record
+        outcome.written.append(write_record(outcome, stem))
+    if stem is not None and report:
+        _report(deck, stem, outcome)
     return outcome
 
 
-def _report(deck: Deck, outdir: Path, kind: str, outcome: Outcome) -> None:
+def _report(deck: Deck, stem: Path, outcome: Outcome) -> None:
     """Write the deck's report page after its run (not after bad input: nothing is written then).
     For a single run a failure to build it is a run failure (it propagates); for a sweep,
     optimisation or synthesis it is an error message, and the deck's exit status becomes 1."""
     from driver import _report_page as report_page
-    stem = output_stem(outdir, deck.path, (".html",))
     path = stem.with_name(stem.name + ".html")
     if isinstance(outcome, RunOutcome):
-        _, params = study_of(deck)
-        outcome.written.append(report_page.write_report(path, report_page.page_for_result(outcome.result, deck,
-                                                                                         params)))
+        outcome.written.append(report_page.write_report(path, report_page.page(outcome, deck)))
         return
-    status = outcome.exit_code
-    if status == ExitCode.BAD_INPUT:
+    if outcome.exit_code == ExitCode.BAD_INPUT:
         return
-    build = {"sweep": report_page.page_for_sweep, "optimize": report_page.page_for_optimize,
-             "synthesis": report_page.page_for_synthesis}[kind]
     try:
-        outcome.written.append(report_page.write_report(path, build(deck, outdir, stem.name, int(status))))
+        outcome.written.append(report_page.write_report(path, report_page.page(outcome, deck)))
     except (KeyboardInterrupt, BrokenPipeError):
         raise
     except Exception as exc:

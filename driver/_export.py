@@ -10,7 +10,6 @@ are written in shortest round-trip form and always as floats (``30.0``, never
 """
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -24,7 +23,7 @@ if TYPE_CHECKING:   # annotations only: keeps `python -m driver --help` light
     import pandas as pd
     import pyarrow as pa
 
-__all__ = ["FORMATS", "write_tidy", "csv_bytes", "with_units", "unit_of", "json_safe", "summary_json_text"]
+__all__ = ["FORMATS", "write_tidy", "csv_bytes", "with_units", "unit_of", "json_safe"]
 
 FORMATS = ("csv", "parquet")
 
@@ -168,12 +167,3 @@ def json_safe(value: Any) -> Any:
     if isinstance(value, Path):
         return str(value)
     return str(value)
-
-
-def summary_json_text(result: Any) -> str:
-    """The machine-readable summary of one run (``<stem>.json``): study, name, success,
-    failure, warnings and the summary figures (units in their names)."""
-    record = {"study": result.study, "name": result.name, "ok": result.failure is None,
-              "failure": result.failure, "warnings": list(result.warnings),
-              "summary": json_safe(result.summary)}
-    return json.dumps(record, indent=1, allow_nan=False) + "\n"

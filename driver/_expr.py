@@ -33,6 +33,8 @@ from typing import Any
 
 import numpy as np
 
+from driver._errors import DriverError
+
 __all__ = ["Expr", "ExprError", "FUNCTIONS", "parse", "kinds_of", "MAX_LENGTH", "MAX_NODES"]
 
 #: longest expression text accepted (characters) and largest syntax tree (nodes)
@@ -42,7 +44,7 @@ MAX_DIGITS = 40
 _DECIMAL = re.compile(r"(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?", re.ASCII)
 
 
-class ExprError(ValueError):
+class ExprError(DriverError, ValueError):
     """An expression the language does not allow; ``token`` is the offending piece of text."""
 
     def __init__(self, message: str, token: str | None = None):

@@ -11,7 +11,9 @@ from __future__ import annotations
 import importlib
 from types import ModuleType
 
-__all__ = ["EXTRAS", "MissingExtra", "available", "require"]
+from driver._errors import DriverError
+
+__all__ = ["EXTRAS", "MissingExtra", "available", "require", "missing_extra"]
 
 #: extra -> (module it provides, what needs it)
 EXTRAS: dict[str, tuple[str, str]] = {
@@ -21,7 +23,7 @@ EXTRAS: dict[str, tuple[str, str]] = {
 }
 
 
-class MissingExtra(ImportError):
+class MissingExtra(DriverError, ImportError):
     """A feature's optional dependency is not installed; the message says how to install it."""
 
     def __init__(self, extra: str, cause: ImportError | None = None):
@@ -29,7 +31,11 @@ class MissingExtra(ImportError):
         super().__init__(f"{what} need the Python package '{module}', which is not installed "
                          f"({cause}); install it with: pip install 'mechanism-driver[{extra}]' "
                          f"(or [all] for every optional feature)", name=module)
-        self.extra = extra
+        self.extra, self.cause = extra, cause
+
+    def __reduce__(self) -> tuple[type[MissingExtra], tuple[str, ImportError | None]]:
+        """Pickle by the extra and its cause (the message is made from them)."""
+        return (type(self), (self.extra, self.cause))
 
 
 def require(extra: str) -> ModuleType:
@@ -39,6 +45,14 @@ def require(extra: str) -> ModuleType:
         return importlib.import_module(module)
     except ImportError as exc:
         raise MissingExtra(extra, exc) from exc
+
+
+def missing_extra(exc: ImportError) -> MissingExtra | None:
+    """The :class:`MissingExtra` for an import that failed because an extra's module is not
+    installed (``exc.name`` is that module or one of its submodules); None for any other failure."""
+    name = (exc.name or "").partition(".")[0]
+    extra = next((e for e, (module, _) in EXTRAS.items() if module == name), None)
+    return None if extra is None else MissingExtra(extra, exc)
 
 
 def available(extra: str) -> bool:

@@ -1,7 +1,11 @@
 """The loader of the private Fortran extension ``driver._kernels``, shared by every study.
 
 It imports the extension once (with words on what to do when it is not built) and holds
-:func:`farray` and the spare output buffers of large kernel outputs (:func:`release_spares`).
+:func:`farray` and the one wrapper of every kernel's status word (:class:`KernelStatus`,
+:func:`kernel_status`: a status a kernel returns is a member of its kernel's status table, and a
+code that means the kernel refused its call becomes a :class:`driver._errors.KernelError`, a
+``driver.DriverError``; as pyshtools turns every Fortran exit status into one exception type and
+SciPy's ``_odepack_py`` keeps one message table per routine).
 Each study wraps its own modules of the extension in its ``kernel.py``
 (``driver.fourbar._kernel``, ``driver.ujoint._kernel``, ...; named in its ``Study.kernel``):
 wrappers convert inputs once to Fortran-ordered float64 (f2py would otherwise copy C-ordered
@@ -10,11 +14,13 @@ wrappers convert inputs once to Fortran-ordered float64 (f2py would otherwise co
 """
 from __future__ import annotations
 
-import sys
-import threading
+from enum import IntEnum
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
+
+from driver._errors import KernelError
 
 try:
     from driver import _kernels  # noqa: F401 - the studies' kernel modules take it from here
@@ -29,7 +35,7 @@ except ImportError as _exc:
     raise ImportError(f"the Fortran kernels (driver._kernels) cannot be loaded: {_exc}; reinstall "
                       f"mechanism-driver (see docs/install.md)") from _exc
 
-__all__ = ["farray", "release_spares", "spare_buffer"]
+__all__ = ["farray", "KernelStatus", "kernel_status"]
 
 
 def farray(x, ndim: int | None = None) -> np.ndarray:
@@ -43,50 +49,62 @@ def farray(x, ndim: int | None = None) -> np.ndarray:
     return a
 
 
-# ----------------------------------------------------------------------------- output buffers
+# ----------------------------------------------------------------------------- status words
 
-#: outputs at least this large [bytes] are kept for the next call of the same shape (smaller
-#: ones come from numpy's own cache and cost no page faults)
-SPARE_MIN_BYTES = 1 << 20
-_spares: dict[str, np.ndarray] = {}
-_spares_lock = threading.Lock()
+class KernelStatus(IntEnum):
+    """Base of a kernel's status table: one subclass per kernel, its members the Fortran module's
+    status parameters (``st_no_assembly`` -> ``no_assembly``, so ``Status["no_assembly"]`` reads
+    as the Fortran does), each with its words for reports and messages.
 
+    A member is declared ``name = code, what, why, refused``: ``what`` a short heading, ``why`` the
+    explanation, ``refused`` True for a code that means the kernel refused its call (bad
+    arguments: a wrapper's mistake, never the deck's), which :func:`kernel_status` raises.  A
+    status of each element of a result (a crank angle where the linkage does not assemble) is a
+    result, named by the same table and not checked: the kernel writes only its table's codes.
+    """
 
-def _refs(store: dict[str, np.ndarray], name: str) -> int:
-    """References to ``store[name]`` as this function sees them (for :data:`_FREE_REFS`)."""
-    a = store.get(name)
-    return sys.getrefcount(a)
+    what: str
+    why: str
+    refused: bool
 
-
-#: what :func:`_refs` counts for an array only ``store`` holds, measured on this interpreter (the
-#: count of the dict entry, the local name and getrefcount's argument differs between versions)
-_FREE_REFS = _refs({"probe": np.empty(1)}, "probe")
-
-
-def spare_buffer(name: str, shape: tuple[int, ...], dtype: type[np.generic]) -> np.ndarray:
-    """A fresh-to-the-caller output array of ``shape`` (Fortran order) for kernel output ``name``.
-
-    A large output array (``SPARE_MIN_BYTES`` or more) is remembered; the next call of the
-    same output and shape gets the same memory back when nobody holds it any more -- no
-    reference to it or to a view of it (numpy views and pandas columns built without a copy
-    hold their base) -- instead of new memory whose first touch costs a page fault per 4 KiB
-    (at 10^6 four-bar positions, 88 MB: most of the call).  An array still held anywhere is
-    never handed out again: the caller then gets new memory, which becomes the spare."""
-    dt = np.dtype(dtype)
-    if int(np.prod(shape)) * dt.itemsize < SPARE_MIN_BYTES:
-        return np.empty(shape, dtype=dt, order="F")
-    with _spares_lock:
-        # held only by the dict (counted as for the probe array at import): nobody else has it
-        if name in _spares and _refs(_spares, name) == _FREE_REFS:
-            a = _spares[name]
-            if a.shape == shape and a.dtype == dt:
-                return a
-        a = np.empty(shape, dtype=dt, order="F")
-        _spares[name] = a
-        return a
+    def __new__(cls, code: int, what: str = "", why: str = "", refused: bool = False) -> KernelStatus:
+        member = int.__new__(cls, code)
+        member._value_ = code
+        member.what, member.why, member.refused = what, why, refused
+        return member
 
 
-def release_spares() -> None:
-    """Forget the remembered output arrays (their memory is freed once nobody holds them)."""
-    with _spares_lock:
-        _spares.clear()
+S = TypeVar("S", bound=KernelStatus)
+
+
+def kernel_status(codes: type[S], code: int, routine: str) -> S:
+    """The member of status table ``codes`` for the status word ``code`` a kernel returned.
+
+    Parameters
+    ----------
+    codes : type of KernelStatus
+        The kernel's status table.
+    code : int
+        The status word.
+    routine : str
+        The kernel routine, ``'<fortran module>.<routine>'`` (named in the error).
+
+    Returns
+    -------
+    KernelStatus
+        The member (an int: it compares equal to the code).
+
+    Raises
+    ------
+    driver._errors.KernelError
+        The code means the kernel refused its call, or the table has no such code.
+    """
+    try:
+        member = codes(int(code))
+    except ValueError:
+        raise KernelError(routine, int(code), f"not a status of {codes.__name__} "
+                                              f"({', '.join(f'{m.value} {m.name}' for m in codes)})") from None
+    if member.refused:
+        raise KernelError(routine, member.value, f"{member.what}: {member.why}")
+    return member
+

@@ -1,6 +1,7 @@
 """What a deck group may hold and what it holds once validated: the declaration of a key
 (:class:`Key`) and of a group (:class:`GroupSpec`), the validated values (:class:`Params`) and
-the bad-input error (:class:`DeckError`).  Plain data with no dependency inside the driver, so
+the bad-input error (:class:`DeckError`).  Plain data with no dependency inside the driver (but the
+exception base of :mod:`driver._errors`), so
 that the deck reader (:mod:`driver._deck`, which re-exports them), the budget
 (:mod:`driver._limits`) and the study contract (:mod:`driver._study`) can use them without
 importing each other."""
@@ -11,15 +12,17 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from driver._errors import DriverError
+
 __all__ = ["KINDS", "DeckError", "Key", "GroupSpec", "Params"]
 
 KINDS = ("float", "int", "str", "bool", "floats", "ints", "strs", "list")
 
 
-class DeckError(ValueError):
+class DeckError(DriverError, ValueError):
     """Bad input: names the deck, the line and the key (exit status 2).
 
-    A ``ValueError``; ``str()`` is ``'<path>:<line>: key '<key>': <message>'``.
+    A :class:`driver.DriverError` and a ``ValueError``; ``str()`` is ``'<path>:<line>: key '<key>': <message>'``.
 
     Parameters
     ----------

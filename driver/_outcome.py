@@ -12,6 +12,7 @@ fields, ``success``/``status``/``message`` where they mean something.
 from __future__ import annotations
 
 import enum
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -19,9 +20,14 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:   # annotations only
     import pandas as pd
 
-    from driver._result import Result
+    from driver._deck import Params
+    from driver._result import Figure, Result
+    from driver.optimize._evaluate import Evaluator, Record
+    from driver.optimize._methods import HistoryRow, MethodResult
+    from driver.optimize._problem import Problem
 
-__all__ = ["ExitCode", "Message", "Outcome", "RunOutcome", "FilesOutcome", "SweepOutcome"]
+__all__ = ["ExitCode", "Message", "Outcome", "RunOutcome", "FilesOutcome", "SweepOutcome", "OptimizeOutcome",
+           "Optimum", "SynthesisOutcome"]
 
 
 class ExitCode(enum.IntEnum):
@@ -151,6 +157,73 @@ class FilesOutcome(Outcome):
 
 
 @dataclass(kw_only=True)
+class SynthesisOutcome(FilesOutcome):
+    """What a synthesis did (:func:`driver.synthesis.run_synthesis_deck`).
+
+    The linkage, its tables and its run, the files written, and the failure of its check as
+    data.
+
+    Parameters
+    ----------
+    value : Synthesis
+        The synthesis (:class:`driver.synthesis.Synthesis`); its parts are the properties below.
+    name : str
+        The outputs' stem.
+    text : str
+        The report, as ``<stem>.out`` holds it.
+    linkage_deck : str
+        The linkage as a complete ``&fourbar`` deck (``<stem>.linkage.dat``); '' without one.
+    figures : list of Figure
+        The synthesis's own figures (the structural error, the path through the targets),
+        drawn on demand; the linkage's are ``result.figures``.
+    """
+
+    name: str = ""
+    text: str = ""
+    linkage_deck: str = ""
+    figures: list[Figure] = field(default_factory=list)
+
+    @property
+    def task(self) -> str:
+        """``'function'``, ``'crank_rocker'`` or ``'path'``."""
+        return str(self.value.params.task)
+
+    @property
+    def linkage(self) -> dict[str, Any] | None:
+        """The linkage's ``&fourbar`` deck values; None when no linkage was found.
+
+        Lengths are in the deck's length unit, angles in deg.
+        """
+        return self.value.linkage
+
+    @property
+    def table(self) -> pd.DataFrame:
+        """The task's table: structural error (function), family (crank-rocker), targets (path)."""
+        return self.value.table
+
+    @property
+    def table_name(self) -> str:
+        """The table's file suffix (``'_error'``, ``'_family'``, ``'_targets'``)."""
+        return str(self.value.table_name)
+
+    @property
+    def checks(self) -> dict[str, float]:
+        """The exact kernel's checks of the design, units in the names where they have one."""
+        return dict(self.value.checks)
+
+    @property
+    def result(self) -> Result | None:
+        """The four-bar study's run of the linkage (its tables, summary and figures)."""
+        return self.value.study_result
+
+    @property
+    def params(self) -> Params | None:
+        """The linkage's validated ``&fourbar`` keys (what :attr:`result` was run from)."""
+        return None if self.result is None else self.result.params
+
+
+
+@dataclass(kw_only=True)
 class SweepOutcome(Outcome):
     """What a sweep did (:func:`driver.sweep.run_sweep_deck`, :func:`driver.run_sweep`).
 
@@ -193,14 +266,26 @@ class SweepOutcome(Outcome):
         Wall time of the cases, s.
     phases : dict of str to float
         The driver's CPU time per phase (``prepare_cpu``, ``run_cpu``, ``finish_cpu`` ...), s.
-    summary : pandas.DataFrame or None
+    summary : pandas.DataFrame, a lazy handle or None
         One row per case: case number, the swept keys, status, kept, the study's headline
-        figures (units in their names), error.
+        figures (units in their names), error; the summary table the sweep wrote.  A sweep
+        that streamed its rows holds a handle on them (its ``to_pandas()`` reads them).
     cases : pandas.DataFrame or None
         The tidy rows of every case that wrote its outputs, a column per swept key; None
         when no case did.
     text : str
         The fixed-format summary ``.out``.
+    study : str
+        The study group swept.
+    sweep : Params or None
+        The validated ``&sweep`` group (its plotted columns, keep filter, rows).
+    best : Result or None
+        The full run of the best case (the case the report page draws), when the engine was
+        asked for it (``best=True``, as ``--report`` asks); None otherwise or without a kept case.
+    best_case : int or None
+        Its case number.
+    best_by : str
+        Why it is the best, in words (``'largest minimum transmission angle'``).
     """
 
     deck: str = ""
@@ -219,9 +304,14 @@ class SweepOutcome(Outcome):
     chunk: int = 0
     seconds: float = 0.0
     phases: dict[str, float] = field(default_factory=dict)
-    summary: pd.DataFrame | None = None
+    summary: Any = None
     cases: pd.DataFrame | None = None
     text: str = ""
+    study: str = ""
+    sweep: Params | None = None
+    best: Result | None = None
+    best_case: int | None = None
+    best_by: str = ""
 
     @property
     def exit_code(self) -> ExitCode:
@@ -253,3 +343,175 @@ class SweepOutcome(Outcome):
     def __repr__(self) -> str:
         return (f"<SweepResult {self.name!r}: {self.n_cases} cases, {self.n_ok} ok, {self.n_kept} kept; "
                 f"status {self.status}" + (f"; files in {self.outdir}" if self.outdir else "") + ">")
+
+
+def _finite(v: Any) -> float | None:
+    """``v`` as a float, or None when it is missing or not finite."""
+    return float(v) if v is not None and math.isfinite(v) else None
+
+
+@dataclass(frozen=True)
+class Optimum:
+    """The design an optimisation reports, run through the full study.
+
+    Attributes
+    ----------
+    x : dict of str to float
+        The design, ``{'group.key': value}`` in the variables' deck units.
+    objective : float
+        Its objective, in the objective expression's units.
+    constraints : list of dict
+        Each constraint's kind, value, margin, tolerance and whether it is met.
+    result : Result
+        The study's full run of the design (its tables, summary and figures).
+    params : Params
+        The validated study group of the design (what ``result`` was run from).
+    deck : str
+        The design as a complete deck (``<stem>.optimum.dat``).
+    converged : bool
+        The method converged: the design is an optimum, not only the best found.
+    """
+
+    x: dict[str, float]
+    objective: float
+    constraints: list[dict]
+    result: Result
+    params: Params
+    deck: str
+    converged: bool
+
+
+@dataclass
+class OptimizeOutcome(Outcome):
+    """Result of an optimisation, shaped like ``scipy.optimize.OptimizeResult``.
+
+    Also an :class:`~driver._outcome.Outcome`: files written, warnings and errors as messages,
+    notes.  Values are in the units of the deck keys and summary columns they name.
+    ``driver.optimize.OptimizeOutcome`` is this class.
+
+    Attributes
+    ----------
+    problem : Problem
+        The problem the ``&optimize`` group declared (variables, objective, constraints).
+    x : DesignVector or None
+        Best feasible design, ``{'group.key': value}`` in the variables' deck units (and an
+        array by ``np.asarray(x)``, names in ``x.names``); None when none is feasible.
+    fun : float or None
+        Its objective value, in the objective expression's units (not sign-flipped).
+    success : bool
+        The method converged and ``x`` is feasible: ``x`` is an optimum.
+    message : str
+        The method's words.
+    nfev : int
+        Designs evaluated (each distinct design once).
+    best : Record or None
+        The evaluation record of ``x``.
+    check : Record or None
+        The optimum re-run by the full study.
+    method : MethodResult
+        What the method returned (iterations, convergence, starts, polish).
+    history : list of HistoryRow
+        The best feasible design after each generation, iteration or grid batch.
+    evaluator : Evaluator
+        Every design evaluated (``evaluator.frame()``: feasibility, reason, margins, summary).
+    study_result : Result or None
+        The study's full run at the optimum (also ``optimum.result``).
+    name : str
+        The outputs' stem (the deck's file stem).
+    history_table : pandas.DataFrame or None
+        The history as a table (``<stem>_history.csv``): step, evaluations, feasible,
+        objective and the variables.
+    evaluations : pandas.DataFrame or None
+        Every design evaluated (``<stem>_evals.parquet``): variables, feasibility and reason,
+        objective, margins and the study's summary columns.
+    text : str
+        The report, as ``<stem>.out`` holds it.
+    optimum : Optimum or None
+        The reported design with its full run; None when no design is feasible.
+    figures : list of Figure
+        The convergence plot and the map of the designs evaluated, drawn on demand.
+    """
+
+    problem: Problem
+    x: dict[str, float] | None
+    fun: float | None
+    success: bool
+    message: str
+    nfev: int
+    best: Record | None
+    check: Record | None
+    method: MethodResult
+    history: list[HistoryRow]
+    evaluator: Evaluator
+    study_result: Any = None
+    name: str = ""
+    history_table: pd.DataFrame | None = None
+    evaluations: pd.DataFrame | None = None
+    text: str = ""
+    optimum: Optimum | None = None
+    figures: list[Figure] = field(default_factory=list)
+
+    @property
+    def status(self) -> int:
+        """0 optimum, 1 not converged (``x`` the best feasible design found), 2 no feasible design."""
+        return 0 if self.success else (2 if self.x is None else 1)
+
+    @property
+    def exit_code(self) -> ExitCode:
+        """1 when the method did not converge or the optimum's full run failed, else 0."""
+        failed = not self.success or (self.check is not None and self.study_result is not None
+                                      and bool(self.study_result.failure))
+        return ExitCode.FAILED if failed else super().exit_code
+
+    @property
+    def nit(self) -> int:
+        """Iterations: generations for differential evolution, all starts' for local methods."""
+        return int(self.method.iterations)
+
+    @property
+    def constraints(self) -> list[dict]:
+        """Constraint values and margins at x (empty without a feasible design)."""
+        if self.best is None:
+            return []
+        r, out = self.best, []
+        for k, c in enumerate(self.problem.constraints):
+            kind = "equality" if c.equality else ("inequality" if c.sense else "condition")
+            out.append({"constraint": c.text, "kind": kind,
+                        "value": _finite(r.values[k]) if (c.numeric and r.values) else None,
+                        "margin": _finite(r.margins[k]) if r.margins else None,
+                        "tolerance": _finite(r.tols[k]) if (c.numeric and r.tols) else None,
+                        "met": bool(r.met[k]) if r.met else False})
+        return out
+
+    def to_dict(self) -> dict:
+        """Return the result as plain data: the ``optimize`` section of the ``--json`` record.
+
+        Returns
+        -------
+        dict
+            Scipy's fields, the constraints at ``x``, the starts of a local method and the
+            polish of differential evolution (JSON-safe; values in their deck units).
+        """
+        p = self.problem
+        rec = {"objective": p.objective_text,
+               "x": None if self.x is None else [float(v) for v in self.x.values()], "x_names": p.names,
+               "fun": self.fun, "success": self.success, "status": self.status, "message": self.message,
+               "nit": self.nit, "nfev": self.nfev, "constraint_tol": p.opts.constraint_tol,
+               "constraints": self.constraints,
+               "warnings": list(self.study_result.warnings) if self.study_result is not None else []}
+        if self.method.starts:
+            rec["starts"] = [{"start": r["start"], "x0": [float(v) for v in r["x0"]],
+                              "end": [float(v) for v in r["x"]], "objective": _finite(_float(r["objective"])),
+                              "feasible": bool(r["feasible"]), "settled": bool(r["settled"]),
+                              "reached": bool(r.get("reached", False)), "method_success": bool(r["success"]),
+                              "method_message": r["message"], "iterations": r["iterations"]} for r in self.method.starts]
+        if self.method.polish is not None:
+            rec["polish"] = self.method.polish["text"]
+        return rec
+
+
+def _float(v: Any) -> float | None:
+    try:
+        return float(v)
+    except (TypeError, ValueError):
+        return None

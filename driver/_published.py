@@ -26,6 +26,8 @@ from typing import Any, NamedTuple
 import numpy as np
 import pandas as pd
 
+from driver._errors import DriverError
+
 __all__ = ["PUBLISHED_DIR", "Published", "PrintedCell", "printed_cells", "PublishedError", "match_line", "records",
            "read_listing", "read_blocks", "matches", "listing_rows", "LISTING_COLUMNS", "agrees_printed", "cell", "numeric_cell",
            "one_digit_apart", "decimals"]
@@ -45,7 +47,7 @@ PUBLISHED_DIR = _published_dir()
 _MATCH = re.compile(r"^\W*match:\s*(\w+)((?:\s+\w+=\S+)*)\s*$")
 
 
-class PublishedError(ValueError):
+class PublishedError(DriverError, ValueError):
     """A published file is missing or not in its documented layout."""
 
 

@@ -18,20 +18,21 @@ import numpy as np
 from driver import _blas as blas
 from driver import _limits as limits
 from driver._atomic import NAME_MAX, inside, output_set, remove_stale_temporaries, write_text
-from driver._deck import Deck, DeckError, Params, validate
-from driver._export import FORMATS, summary_json_text, write_tidy
+from driver._deck import Deck, DeckError, GroupSpec, Params, validate
+from driver._export import FORMATS, write_tidy
 from driver._outcome import RunOutcome
 from driver._pydeck import deck_of
 from driver._result import Result
-from driver._study import REGISTRY, Study, load_study, registered, study_names
+from driver._signatures import sign
+from driver._study import ENGINES, Study, load_study, registered, study_names
 from driver._table import TableValueError
 
 __all__ = ["CONTROL_GROUPS", "CaseFailure", "RunOutcome", "available_studies", "study_of", "run_study", "write_outputs",
-           "keyword_run",
+           "study_run",
            "output_stem", "check_finite", "compute", "numerical_error"]
 
-#: groups handled by the driver itself rather than by a study module
-CONTROL_GROUPS = ("sweep", "optimize", "synthesis")
+#: groups handled by the driver's engines rather than by a study (driver._study.ENGINES)
+CONTROL_GROUPS = tuple(ENGINES)
 
 
 def available_studies() -> dict[str, Study]:
@@ -97,8 +98,9 @@ def study_suffixes(formats: list[str], summary_json: bool) -> tuple[str, ...]:
 
 def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool | str,
                   summary_json: bool = False, clean: bool = True) -> list[Path]:
-    """Write the .out file, extra files, tidy tables, the summary as ``<stem>.json`` (when
-    ``summary_json``) and figures (``plot``: True for PNG, or 'png', 'svg', 'pdf') for one case.
+    """Write the .out file, extra files, tidy tables, figures (``plot``: True for PNG, or 'png',
+    'svg', 'pdf') and the ``--json`` record as ``<stem>.json`` (when ``summary_json``;
+    :func:`driver._record.result_record`) for one case.
 
     ``plot`` is False (no figures), True (PNG) or a format of :data:`driver._output.PLOT_FORMATS`.
 
@@ -115,12 +117,14 @@ def write_outputs(result: Result, stem: Path, formats: list[str], plot: bool | s
             written.append(write_text(stem.with_name(stem.name + suffix), text))
         for fmt in formats:
             written.append(write_tidy(result.tidy, stem, fmt))
-        if summary_json:
-            written.append(write_text(stem.with_name(stem.name + ".json"), summary_json_text(result)))
         if plot and result.figures:
             from driver.plotting import save_figure
             for fig in result.figures:
                 written.append(save_figure(fig.draw(), stem.with_name(f"{stem.name}_{fig.name}.png"), plot))
+        if summary_json:   # last: the record lists the files written with it
+            from driver._record import record_text, result_record
+            written.append(write_text(stem.with_name(stem.name + ".json"),
+                                      record_text(result_record(result, written, stem.parent, stem.name))))
     # the set replaces an earlier run's: its tidy tables in formats not written now go
     for fmt in FORMATS:
         old = stem.with_name(f"{stem.name}.{fmt}")
@@ -225,28 +229,25 @@ def run_study(deck: Deck, outdir: Path | None, formats: list[str], plot: bool | 
     return outcome
 
 
-def keyword_run(run: Callable[..., Result]) -> Callable[..., Result]:
-    """Decorator for a study's ``run``: accept validated Params (the runner's call) or the deck's
-    keys as keyword arguments, e.g. ``driver.fourbar.run(fixed_link=12, crank=5, coupler=15,
-    rocker=9, step_deg=20)``.  Keywords are validated by the study's SPEC exactly like a deck
-    (errors are :class:`driver._deck.DeckError`); the result is the runner's, as for a deck
-    (:func:`run_study`, the outputs named after the study group)."""
-    @functools.wraps(run)
-    def wrapper(params: Any = None, /, progress: bool = False, **keys: Any) -> Result:
-        group = _group_of(run.__module__)
-        if params is not None:
-            if keys:
-                raise TypeError(f"{group}.run() takes validated params or deck keys, not both")
-            return run(params, progress=progress)
-        return run_study(deck_of({group: keys}, None), None, [], False, progress=progress).result
+def study_run(spec: GroupSpec) -> Callable[[Callable[..., Result]], Callable[..., Result]]:
+    """Decorator of every study's entry point ``run(params, progress=False) -> Result``: the one
+    place that makes it callable with validated Params (the runner's call) or with the keys of
+    ``spec`` as keyword arguments, e.g. ``driver.fourbar.run(fixed_link=12, crank=5, coupler=15,
+    rocker=9, step_deg=20)``.  Keywords are validated by the SPEC exactly like a deck (errors are
+    :class:`driver._deck.DeckError`); the result is the runner's, as for a deck (:func:`run_study`,
+    the outputs named after the study group).  ``help()``, IDEs and :func:`inspect.signature` see
+    the keys with their types, units and defaults (:func:`driver._signatures.sign`); type checkers
+    see them in the study's generated ``_keywords.pyi``."""
+    def decorate(run: Callable[..., Result]) -> Callable[..., Result]:
+        @functools.wraps(run)
+        def wrapper(params: Any = None, /, progress: bool = False, **keys: Any) -> Result:
+            if params is not None:
+                if keys:
+                    raise TypeError(f"{spec.name}.run() takes validated params or deck keys, not both")
+                return run(params, progress=progress)
+            return run_study(deck_of({spec.name: keys}, None), None, [], False, progress=progress).result
 
-    return wrapper
+        sign(wrapper, spec)
+        return wrapper
 
-
-def _group_of(module: str) -> str:
-    """The registered study group whose package holds module ``module`` (its own name's last part
-    when none does: a study being written that is not registered yet)."""
-    for group, package in REGISTRY.items():
-        if module == package or module.startswith(package + "."):
-            return group
-    return module.rpartition(".")[2]
+    return decorate

@@ -1,15 +1,18 @@
 """Typed keyword signatures of the studies' ``run``, from each study's SPEC.
 
 A study's ``run`` takes validated :class:`~driver._deck.Params` (the runner's call) or the
-deck's keys as keyword arguments (:func:`driver._output.keyword_run`).  The keys are declared
+deck's keys as keyword arguments (:func:`driver._runner.study_run`).  The keys are declared
 once, in the study's :class:`~driver._deck.GroupSpec`; this module turns that declaration into
 
 - the run's runtime signature and numpydoc docstring (every key with its type, units,
   default or "required", and allowed values), so ``help(driver.fourbar.run)``, IDEs and
-  :func:`inspect.signature` list the keys -- :func:`keyword_signature` attaches them;
-- the static signatures of ``driver/_keywords.py`` (``tools/gen_keyword_signatures.py``
-  writes it; tests/test_keyword_signatures.py fails while it is stale), so a type checker
-  refuses a misspelt key: ``driver.fourbar.run(fixed_lnik=12)`` is a mypy error.
+  :func:`inspect.signature` list the keys -- :func:`sign` attaches them;
+- the static signature in the study's own package, ``driver/<study>/_keywords.pyi``
+  (:func:`render_stub`; ``tools/gen_keyword_signatures.py`` writes it, tests/test_keyword_signatures.py
+  fails while it is stale), so a type checker refuses a misspelt key:
+  ``driver.fourbar.run(fixed_lnik=12)`` is a mypy error.  Only type checkers read it: the
+  study's ``__init__`` imports it under ``TYPE_CHECKING``, so a new study imports (and its
+  generator runs) before its stub exists.
 
 Types follow what the deck reader accepts: ``float``/``int``/``str``/``bool`` keys their
 scalar (an int for a float), list keys a scalar, a sequence or a numpy array, keys with
@@ -19,15 +22,14 @@ from __future__ import annotations
 
 import inspect
 import textwrap
-from collections.abc import Callable, Sequence
-from typing import Any, TypeVar
+from collections.abc import Callable
+from typing import Any
 
 from driver._deck import GroupSpec, Key
 
-__all__ = ["NOT_GIVEN", "key_type", "unit_text", "run_docstring", "run_signature", "keyword_signature",
-           "render_module"]
+__all__ = ["NOT_GIVEN", "key_type", "unit_text", "run_docstring", "run_signature", "sign", "render_stub"]
 
-#: the Python type of each Key.kind, as annotation text (driver/_keywords.py imports these names)
+#: the Python type of each Key.kind, as annotation text (a study's _keywords.pyi imports these names)
 KIND_TYPES = {
     "float": "float",
     "int": "int",
@@ -182,57 +184,38 @@ def run_signature(spec: GroupSpec) -> inspect.Signature:
     return inspect.Signature(params, return_annotation="Result")
 
 
-F = TypeVar("F", bound=Callable[..., Any])
+def sign(run: Callable[..., Any], spec: GroupSpec) -> None:
+    """Give a study's ``run`` the signature and docstring of ``spec``'s keys at run time (for
+    ``help()``, IDEs and :func:`inspect.signature`); :func:`driver._runner.study_run` calls it."""
+    run.__signature__ = run_signature(spec)  # type: ignore[attr-defined]  # a function takes any attribute; inspect reads it
+    run.__doc__ = run_docstring(spec, run.__doc__ or "")
 
 
-def keyword_signature(typed: F, spec: GroupSpec) -> Callable[[Callable[..., Any]], F]:
-    """Decorator for a study's ``run`` (outside :func:`driver._output.keyword_run`): type it as
-    ``typed``, its generated signature in ``driver/_keywords.py`` (for type checkers), and give it
-    the signature and docstring of ``spec``'s keys at run time (for ``help()`` and IDEs)."""
-    def apply(run: Callable[..., Any]) -> F:
-        run.__signature__ = run_signature(spec)  # type: ignore[attr-defined]  # a function takes any attribute; inspect reads it
-        run.__doc__ = run_docstring(spec, run.__doc__ or "")
-        return run  # type: ignore[return-value]   # the same callable; ``typed`` is its static signature
-    return apply
-
-
-def render_module(specs: Sequence[GroupSpec]) -> str:
-    """Text of ``driver/_keywords.py``: per study, an overloaded ``run`` signature (validated
-    Params, or the keys as keyword-only arguments with their types and defaults)."""
-    out = ['"""Static signatures of the studies\' ``run`` (type checkers and IDEs).  GENERATED from each',
-           "study's SPEC by tools/gen_keyword_signatures.py (driver._signatures.render_module): do not",
-           'edit; tests/test_keyword_signatures.py fails while it is stale."""',
-           "from __future__ import annotations",
-           "",
-           "from collections.abc import Sequence",
-           "from typing import Any, Literal, overload",
-           "",
-           "from numpy.typing import NDArray",
-           "",
-           "from driver._deck import Params",
-           "from driver._result import Result",
-           "",
-           f"__all__ = [{', '.join(_py(s.name) for s in specs)}]"]
-    for spec in specs:
-        keys = []
-        for name, key in spec.keys.items():
-            scalar_default = _has_default(key) and not isinstance(key.default, (list, tuple))
-            keys.append(f"    {name}: {key_type(key)}" + ("" if key.required else
-                                                           f" = {_default_text(key)}" if scalar_default else " = ..."))
-        out += ["", "",
-                "@overload",
-                f"def {spec.name}(params: Params, /, progress: bool = False) -> Result: ...",
-                "",
-                "",
-                "@overload",
-                f"def {spec.name}(",
-                "    *,",
-                "    progress: bool = False,"]
-        out += [k + "," for k in keys]
-        out += [") -> Result: ...",
-                "",
-                "",
-                f"def {spec.name}(params: Params | None = None, /, progress: bool = False, **keys: Any) -> Result:",
-                f'    """The signature of ``driver.{spec.name}.run`` (its docstring has the keys)."""',
-                f'    raise NotImplementedError("a signature only: call driver.{spec.name}.run")']
-    return "\n".join(out) + "\n"
+def render_stub(spec: GroupSpec) -> str:
+    """Text of a study's ``_keywords.pyi`` (in its own package): the overloaded static signature
+    of its ``run`` -- validated Params, or the keys of ``spec`` as keyword-only arguments with
+    their types and defaults.  Only type checkers read it (the study's ``__init__`` imports it
+    under ``TYPE_CHECKING``), so a study imports and runs before its stub exists."""
+    keys = []
+    for name, key in spec.keys.items():
+        scalar_default = _has_default(key) and not isinstance(key.default, (list, tuple))
+        keys.append(f"    {name}: {key_type(key)}" + ("" if key.required else
+                                                       f" = {_default_text(key)}" if scalar_default else " = ..."))
+    body = ["@overload",
+            "def run(params: Params, /, progress: bool = False) -> Result: ...",
+            "@overload",
+            "def run(",
+            "    *,",
+            "    progress: bool = False,",
+            *(k + "," for k in keys),
+            ") -> Result: ..."]
+    text = "\n".join(body)
+    typing_names = sorted({"overload", *(n for n in ("Any", "Literal") if f"{n}[" in text or f"{n}]" in text)})
+    imports = (["from collections.abc import Sequence"] if "Sequence[" in text else []) \
+        + [f"from typing import {', '.join(typing_names)}", ""] \
+        + (["from numpy.typing import NDArray", ""] if "NDArray[" in text else []) \
+        + ["from driver._deck import Params", "from driver._result import Result"]
+    head = [f'"""Static signature of ``{spec.name}.run`` for type checkers and IDEs: the keys of its SPEC as typed',
+            "keyword arguments.  GENERATED from the SPEC by tools/gen_keyword_signatures.py",
+            '(driver._signatures.render_stub): do not edit; tests/test_keyword_signatures.py fails while it is stale."""']
+    return "\n".join([*head, *imports, "", '__all__ = ["run"]', "", *body]) + "\n"

@@ -14,9 +14,9 @@ checked when the package is imported (:meth:`Study.__post_init__`): a study with
 ``estimate`` cannot register (the absurd-request budget of :mod:`driver._limits` applies to every
 study), a misspelt batch key or a pass table naming an unknown pass raises at import.
 
-Adding a study: the package (spec, analysis, report, figures, published, kernel; batch when it
-has a batch summary), its Fortran kernel with a line in ``fortran/meson.build``, and one line
-in :data:`REGISTRY`.
+Adding a study: the package in the layers of :data:`LAYERS` (spec, analysis, figures, report,
+published; kernel with a kernel, batch with a batch summary), its Fortran kernel with its line in
+``fortran/meson.build``, and one line in :data:`REGISTRY`.
 """
 from __future__ import annotations
 
@@ -28,14 +28,16 @@ from types import MappingProxyType, ModuleType
 from typing import TYPE_CHECKING, Any
 
 from driver._docs import fill_doc
-from driver._groupspec import GroupSpec
+from driver._extras import missing_extra
+from driver._groupspec import GroupSpec, Params
 
 if TYPE_CHECKING:
-    from driver._groupspec import Params
     from driver._limits import Estimate
+    from driver._mechanism import MechanismFrames
     from driver._result import Result
 
-__all__ = ["Study", "BatchSummary", "REGISTRY", "load_study", "study_names", "registered"]
+__all__ = ["Study", "BatchSummary", "REGISTRY", "ENGINES", "LAYERS", "REQUIRED_LAYERS", "layer_of", "load_study",
+           "study_names", "registered", "group_spec", "batch_error"]
 
 #: the studies, by namelist group: group -> the package that binds ``STUDY``.  Imported only
 #: when a deck (or a caller) names the group, so ``python -m driver --help`` stays light.
@@ -47,6 +49,32 @@ REGISTRY: dict[str, str] = {
     "slidercrank": "driver.slidercrank",
     "ujoint": "driver.ujoint",
 }
+
+#: the engines' control groups, by group: the package whose ``SPEC`` declares the group's keys (a
+#: deck with one of them is run by that engine: driver._dispatch decides which).  Imported only
+#: when a deck (or a caller) names the group.
+ENGINES: dict[str, str] = {
+    "sweep": "driver.sweep",
+    "optimize": "driver.optimize",
+    "synthesis": "driver.synthesis",
+}
+
+#: the layers of a study package, in dependency order (docs/layout.md): a module may import only
+#: modules of an earlier layer or of its own.  A module is its layer (``_report``) or an extra of
+#: it named after it (``_report_nl``, ``_analysis_forces``); ``__init__``, and any module that only
+#: hands names on (the four-bar's ``_forces``), is the package's face, above every layer.
+LAYERS = ("_kernel", "_spec", "_analysis", "_tables", "_batch", "_figures", "_report", "_published")
+#: the layers every study has (``_kernel`` too when it has a kernel, ``_batch`` a batch path)
+REQUIRED_LAYERS = ("_spec", "_analysis", "_figures", "_report", "_published")
+
+
+def layer_of(module: str) -> str | None:
+    """The layer (:data:`LAYERS`) of a study module by its name (``'_report_nl'`` -> ``'_report'``),
+    or None for a module of no layer (the package's face)."""
+    name = module.rpartition(".")[2]
+    mine = [layer for layer in LAYERS if name == layer or name.startswith(layer + "_")]
+    return max(mine, key=len) if mine else None
+
 
 _SENSES = ("max", "min")
 
@@ -94,6 +122,14 @@ HOOK_SECTIONS = {
 #: fills the ``%(estimate)s``/``%(summarise)s``/``%(batch_raises)s`` fields of a study hook's
 #: docstring with the contract's sections
 contract_doc = fill_doc(**HOOK_SECTIONS)
+
+
+def batch_error(base: Mapping[str, Any], key: str | None, message: str) -> Exception:
+    """The error a batch summary raises for a bad value (``%(batch_raises)s`` of the contract): a
+    DeckError at the key's deck line when ``base`` is a deck's Params, else a ValueError."""
+    if isinstance(base, Params):
+        return base.error(key, message)
+    return ValueError(f"{key}: {message}" if key else message)
 
 
 @dataclass(frozen=True)
@@ -194,10 +230,11 @@ class Study:
                  is due to
     published    ``published(params, result) -> list[dict]``: the run compared cell by cell
                  with the published tables (:mod:`driver._compare`), or None
-    animation    ``animation(params, result, n) -> dict | None``: the mechanism's positions at ``n``
-                 crank angles over one turn for the report page's animation (crank pin ``A``,
-                 driven pin ``B``, coupler point ``P``, ``ground``, ``kind`` 'rocker' or 'slider',
-                 ``box_points``; :func:`driver._report_page.mechanism_animation`), or None
+    animation    ``animation(params, result, n) -> MechanismFrames``: the mechanism's motion for
+                 the report page's animation, about ``n`` frames (a crank turn), ``result`` the
+                 run of ``params`` when there is one (its deflections, its optimum): per frame the
+                 named points, once the links between them, fixed pivots, guides and traced paths
+                 (:class:`driver._mechanism.MechanismFrames`); or None
     figures      the dotted name of the study's figure module (drawn in the house style of
                  :mod:`driver.plotting`; imported only when a figure is drawn, matplotlib being
                  the optional [plot] extra), or None
@@ -218,7 +255,7 @@ class Study:
     renamed: Mapping[str, str] = field(default_factory=dict)
     blame: Callable[[Params, BaseException], tuple[str, str] | None] | None = None
     published: Callable[[Params, Result], list[dict]] | None = None
-    animation: Callable[[Params, Result | None, int], dict | None] | None = None
+    animation: Callable[[Params, Result | None, int], MechanismFrames] | None = None
     figures: str | None = None
     kernel: ModuleType | None = None
 
@@ -288,6 +325,29 @@ def load_study(group: str) -> Study | None:
     if not isinstance(study, Study) or study.name != group:
         raise TypeError(f"{package} is registered as study &{group} but binds no STUDY = Study(name={group!r}, ...)")
     return study
+
+
+def group_spec(group: str) -> GroupSpec | None:
+    """The keys of namelist group ``group``: a registered study's spec or an engine's ``SPEC``; None
+    when no one declares the group (the runner refuses it, naming the known groups).
+
+    A registered package that fails to import, or binds no study, raises (a broken study is a bug
+    to see, never a group silently unknown); an engine whose optional package is not installed
+    raises :class:`~driver._extras.MissingExtra`, which names the extra that installs it."""
+    if group in ENGINES:
+        try:
+            engine = importlib.import_module(ENGINES[group])
+        except ImportError as exc:
+            extra = missing_extra(exc)
+            if extra is None:
+                raise
+            raise extra from exc
+        spec = getattr(engine, "SPEC", None)
+        if not isinstance(spec, GroupSpec) or spec.name != group:
+            raise TypeError(f"{ENGINES[group]} is registered as engine &{group} but binds no SPEC of that group")
+        return spec
+    study = load_study(group)
+    return None if study is None else study.spec
 
 
 def study_names() -> list[str]:

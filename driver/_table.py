@@ -20,6 +20,8 @@ from dataclasses import dataclass, field
 from decimal import ROUND_HALF_UP, Context, Decimal, localcontext
 from typing import Protocol, TypeAlias
 
+from driver._errors import DriverError
+
 
 class _Number(Protocol):
     """A Python or numpy number: what a numeric table cell holds."""
@@ -35,7 +37,7 @@ Cell: TypeAlias = "_Number | str | None"
 __all__ = ["TableValueError", "Column", "fortran_f", "fortran_i", "significant", "render_table"]
 
 
-class TableValueError(ValueError):
+class TableValueError(DriverError, ValueError):
     """A NaN or infinite number was about to reach a table."""
 
 

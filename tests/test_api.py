@@ -18,6 +18,7 @@ import driver
 from conftest import INPUTS, ROOT
 from driver import _cli as cli
 from driver._deck import read_deck
+from driver._study import REGISTRY
 
 CRANK5 = dict(fixed_link=12.0, crank=5.0, coupler=15.0, rocker=9.0, omega=5.0, step_deg=20)
 
@@ -53,12 +54,12 @@ def test_import_driver_is_cheap_and_exports_a_small_documented_surface():
     heavy, names = res.stdout.splitlines()
     assert heavy == "[]"
     assert ast.literal_eval(names) == sorted(["run", "run_sweep", "write", "compare", "read_deck", "studies", "keys",
-                                              "Result", "Figure", "SweepResult", "DeckError", "ExitCode", "Message",
-                                              "RunOutcome", "FilesOutcome", "SweepOutcome"])
+                                              "Result", "Figure", "SweepResult", "DriverError", "DeckError", "ExitCode",
+                                              "Message", "RunOutcome", "FilesOutcome", "SweepOutcome"])
     for name in driver.__all__:
         obj = getattr(driver, name)
         assert obj.__doc__ and len(obj.__doc__) > 40, name
-    assert set(driver.studies()) == {"fourbar", "linkage", "manipulator", "robust_example", "slidercrank", "ujoint"}
+    assert set(driver.studies()) == set(REGISTRY)   # every registered study, by its registry line alone
     assert driver.fourbar.run.__doc__
     assert (Path(driver.__file__).parent / "py.typed").exists()
     with pytest.raises(AttributeError):

@@ -37,7 +37,7 @@ def test_run_all_smoke(run_all, capsys):
     nl, = [r for r in rows if r.name.startswith("slider-crank nonlinear rod")]
     assert nl.target_s is None and nl.target_ratio == pytest.approx(1 / 25)   # issue 29: <= 25x the linear time
     # issue 27 (targets only above the sizes where fresh memory costs page faults: not at --smoke sizes)
-    assert "four-bar exact, default path vs fresh arrays" in names
+    assert "four-bar exact, out= buffers vs fresh arrays" in names
     assert "slider-crank: study's record vs all fields" in names
     for r in rows:
         assert r.kernel_s > 0 and r.baseline_s > 0 and r.limit

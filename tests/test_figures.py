@@ -338,9 +338,15 @@ def test_optimisation_convergence_figure_names_its_objective_with_units(tmp_path
                     "maximize = 'rocker_swing_deg'\nmethod = 'slsqp', starts = 1\n/\n")
     oc = optimize(deck, tmp_path / "out", plot="svg", jobs=1)
     svg = [p for p in oc.written if p.suffix == ".svg"]
-    assert [p.name for p in svg] == ["opt.optimum_curves.svg", "opt.optimum_linkage.svg", "opt_convergence.svg"]
+    assert [p.name for p in svg] == ["opt.optimum_curves.svg", "opt.optimum_linkage.svg", "opt_convergence.svg",
+                                     "opt_designs.svg"]
     from driver.optimize import _report as report
     fig = report.convergence_figure(oc.problem, report.history_frame(oc.problem, oc.history),
                                     oc.evaluator.frame(), "opt")
     assert fig.axes[0].get_ylabel() == "rocker swing [deg]"
+    # the designs evaluated: the one variable against the objective, the optimum starred where x is
+    designs = oc.figures[1].draw().axes[0]
+    assert designs.get_xlabel().startswith("coupler") and designs.get_ylabel() == "rocker swing [deg]"
+    star = next(line for line in designs.get_lines() if line.get_label() == "optimum")
+    assert star.get_xdata()[0] == pytest.approx(oc.x["fourbar.coupler"]) and star.get_ydata()[0] == pytest.approx(oc.fun)
     assert fig.axes[1].get_ylabel() == "|best so far - final best| [deg]"   # the gap in the objective's unit

@@ -22,11 +22,23 @@ How an import becomes an edge ``A -> B`` (B a module of ``driver``):
 
 The test can fail: :func:`test_the_finder_sees_a_circle` runs the same finder on a synthetic
 package with a deferred circular import.
+
+Inside every study package one dependency order holds (``driver._study.LAYERS``, docs/layout.md):
+``_kernel`` -> ``_spec`` -> ``_analysis`` -> ``_tables`` -> ``_batch`` -> ``_figures`` -> ``_report``
+-> ``_published``, a module importing only modules of an earlier layer or of its own (an extra
+named after its layer, ``_report_nl``, belongs to it); the package's face (``__init__`` and any
+module that only hands names on) stands above them and no layer imports it.  The example study
+(tests/example_study/pendulum) is held to the same order, and a synthetic package shows that the
+check sees a module importing a later layer and a layer importing the face.
 """
 from __future__ import annotations
 
 import ast
 from pathlib import Path
+
+import pytest
+
+from driver._study import LAYERS, REGISTRY, layer_of
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -170,3 +182,77 @@ def test_driver_has_no_import_circle() -> None:
     found = circles(graph)
     assert not found, "import circles:\n" + "\n".join(
         f"  {len(c)} modules: " + "; ".join(_ties(graph, c)) for c in found)
+
+
+# ----------------------------------------------------------------------------- the order inside a study
+
+#: statements a face may hold: it hands names on and declares, it computes nothing
+_FACE_STATEMENTS = (ast.Import, ast.ImportFrom, ast.Assign, ast.AnnAssign, ast.Expr)
+
+
+def is_face(path: Path) -> bool:
+    """A module that only hands names on: imports, assignments, its docstring, ``if TYPE_CHECKING:``
+    imports and a PEP 562 ``__getattr__``/``__dir__`` (names handed on on first use)."""
+    for node in ast.parse(path.read_text()).body:
+        if isinstance(node, ast.If) and _type_checking_only(node):
+            continue
+        if isinstance(node, ast.FunctionDef) and node.name in ("__getattr__", "__dir__"):
+            continue
+        if not isinstance(node, _FACE_STATEMENTS) or (isinstance(node, ast.Expr) and not isinstance(node.value, ast.Constant)):
+            return False
+    return True
+
+
+def order_breaches(root: Path, package: str) -> list[str]:
+    """Imports inside study package ``package`` (dotted, under ``root``) that break the layer order:
+    a layer importing a later layer or a face, or a module of no layer that is no face."""
+    graph = import_graph(root, package.split(".")[0])
+    folder = root.joinpath(*package.split("."))
+    mine = {m: g for m, g in graph.items() if m == package or m.startswith(package + ".")}
+    rank = {layer: i for i, layer in enumerate(LAYERS)}
+    found = []
+    for module in sorted(mine):
+        path = folder / "__init__.py" if module == package else folder / (module.rpartition(".")[2] + ".py")
+        layer = None if module == package else layer_of(module)
+        if layer is None and not is_face(path):
+            found.append(f"{module}: neither a layer of {LAYERS} (or an extra named after one) nor a face")
+            continue
+        for target in sorted(t for t in mine[module] if t in mine):
+            other = None if target == package else layer_of(target)
+            if layer is None:
+                continue                           # a face may hand on any layer's names
+            if other is None:
+                found.append(f"{module} -> {target}: a layer imports the package's face")
+            elif rank[other] > rank[layer]:
+                found.append(f"{module} -> {target}: {layer} imports the later layer {other}")
+    return found
+
+
+def test_the_order_check_sees_a_breach(tmp_path: Path) -> None:
+    pkg = tmp_path / "driver" / "toy"
+    pkg.mkdir(parents=True)
+    (tmp_path / "driver" / "__init__.py").write_text("")
+    (pkg / "__init__.py").write_text("from driver.toy._report import run\nfrom driver.toy import _faced as faced\n")
+    (pkg / "_faced.py").write_text('"""A face."""\nfrom driver.toy._spec import SPEC as KEYS\n\n'
+                                   "def __getattr__(name):\n    from driver.toy import _figures\n    return 1\n")
+    (pkg / "_spec.py").write_text("from driver.toy._analysis import thing\nSPEC = 1\n")       # a later layer
+    (pkg / "_analysis.py").write_text("thing = 1\n")
+    (pkg / "_analysis_more.py").write_text("from driver.toy._analysis import thing\n")        # its own layer
+    (pkg / "_figures.py").write_text("from driver.toy import _faced\n")                      # the face
+    (pkg / "_report.py").write_text("from driver.toy._analysis_more import thing\nrun = 1\n")
+    (pkg / "_helpers.py").write_text("def f():\n    return 1\n")                             # no layer, no face
+    assert order_breaches(tmp_path, "driver.toy") == [
+        "driver.toy._figures -> driver.toy._faced: a layer imports the package's face",
+        f"driver.toy._helpers: neither a layer of {LAYERS} (or an extra named after one) nor a face",
+        "driver.toy._spec -> driver.toy._analysis: _spec imports the later layer _analysis"]
+
+
+@pytest.mark.parametrize("package", sorted(p for g, p in REGISTRY.items() if p == f"driver.{g}"))
+def test_every_study_package_keeps_the_one_dependency_order(package: str) -> None:
+    assert not order_breaches(ROOT, package)
+
+
+def test_the_example_study_keeps_the_one_dependency_order() -> None:
+    assert (ROOT / "tests" / "example_study" / "pendulum" / "__init__.py").is_file()
+    assert not order_breaches(ROOT / "tests", "example_study.pendulum")
+

@@ -1,9 +1,11 @@
-"""driver/_kernels.pyi, the type stub of the f2py extension, says what the built module accepts.
+"""Each study's kernel stub (``driver/<study>/_kernels.pyi``) says what the built module accepts.
 
-The stub is generated (tools/gen_kernel_stub.py) from the signatures f2py documents on
-each wrapper; these tests fail when the committed stub is stale, and check its reading of
-the f2py signatures against the module itself: every routine and parameter named, the
+The stubs are generated (tools/gen_kernel_stub.py) from the signatures f2py documents on
+each wrapper, one per study in its own package (the Fortran modules named after the study);
+these tests fail when a committed stub is stale, and check its reading of the f2py signatures
+against the module itself: every module of a study and every routine and parameter named, the
 argument count the wrapper really enforces, the result count and dtypes it really returns.
+The shared ``driver/_kernels.pyi`` names no study (adding one leaves it as it is).
 """
 from __future__ import annotations
 
@@ -14,10 +16,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from driver import _kernels
+from driver._fortran import _kernels
+from driver._study import load_study, study_names
 
 ROOT = Path(__file__).resolve().parents[1]
-STUB = ROOT / "driver" / "_kernels.pyi"
 
 
 def _generator():
@@ -28,23 +30,45 @@ def _generator():
 
 
 def _stub_classes() -> dict[str, dict[str, ast.FunctionDef]]:
-    tree = ast.parse(STUB.read_text())
-    return {c.name: {f.name: f for f in c.body if isinstance(f, ast.FunctionDef)}
-            for c in tree.body if isinstance(c, ast.ClassDef)}
+    """Every class of every study's committed stub, by name (``_fourbar``): its routines."""
+    out = {}
+    for stub in sorted((ROOT / "driver").glob("*/_kernels.pyi")):
+        tree = ast.parse(stub.read_text())
+        out |= {c.name: {f.name: f for f in c.body if isinstance(f, ast.FunctionDef)}
+                for c in tree.body if isinstance(c, ast.ClassDef)}
+    return out
 
 
-def test_committed_stub_is_fresh():
-    """Regenerating from the built module gives the committed file (else: run the tool)."""
-    assert STUB.read_text() == _generator().render(_kernels), \
-        "driver/_kernels.pyi is stale: run .venv/bin/python tools/gen_kernel_stub.py"
+def test_committed_stubs_are_fresh_and_in_their_studies_packages():
+    """Regenerating from the built module gives each study's committed file (else: run the tool),
+    and there is no stub but the studies'."""
+    written = _generator().stubs(_kernels)
+    assert written, "no study has a kernel stub"
+    for path, text in written.items():
+        rel = path.relative_to(ROOT)
+        assert path.is_file() and path.read_text() == text, \
+            f"{rel} is stale: run .venv/bin/python tools/gen_kernel_stub.py {path.parent.name}"
+        assert load_study(path.parent.name).kernel is not None, rel
+    assert set(written) == set((ROOT / "driver").glob("*/_kernels.pyi"))
+    shared = (ROOT / "driver" / "_kernels.pyi").read_text()
+    assert not [s for s in study_names() if s in shared]
+
+
+def test_every_fortran_module_belongs_to_one_study_or_is_a_shared_building_block():
+    gen = _generator()
+    owners = {m: gen.owner(m, study_names()) for m in gen.fortran_modules(_kernels)}
+    assert {m for m, o in owners.items() if o is None} == {"kinds", "vecmath"}, owners
+    assert gen.owner("fourbar_forces", ["fourbar", "fourbar_forces"]) == "fourbar_forces"   # the longest name
+    assert gen.owner("fourbarx", ["fourbar"]) is None
 
 
 def test_stub_names_every_module_and_routine():
     classes = _stub_classes()
-    for mname in dir(_kernels):
-        mod = getattr(_kernels, mname)
-        if type(mod).__name__ != "fortran":
+    gen = _generator()
+    for mname in gen.fortran_modules(_kernels):
+        if gen.owner(mname, study_names()) is None:
             continue
+        mod = getattr(_kernels, mname)
         routines = {a for a in dir(mod) if type(getattr(mod, a)).__name__ == "fortran"}
         assert set(classes[f"_{mname}"]) == routines, mname
 

@@ -2,9 +2,9 @@
 
 Truth is each study's SPEC (the keys the deck reader validates against): the runtime
 signature and docstring must name every key with its default (or say it is required), its
-units and its allowed values; the committed static signatures (driver/_keywords.py) must be
-what the generator makes of the SPECs today; and mypy must refuse a misspelt key or a value
-outside a key's choices, and accept a correct call.
+units and its allowed values; each study's committed static signature (``_keywords.pyi`` in its
+own package) must be what the generator makes of its SPEC today; and mypy must refuse a
+misspelt key or a value outside a key's choices, and accept a correct call.
 """
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ import pytest
 
 from driver._deck import DeckError, GroupSpec
 from driver._runner import available_studies
-from driver._signatures import NOT_GIVEN, unit_text
+from driver._signatures import NOT_GIVEN, render_stub, unit_text
 
 ROOT = Path(__file__).resolve().parents[1]
 STUDIES = sorted(available_studies())
@@ -27,11 +27,9 @@ STUDIES = sorted(available_studies())
 TYPED = [g for g in STUDIES if hasattr(available_studies()[g].run, "__signature__")]
 
 
-def _spec(group: str):
-    """The deck keys of study ``group`` (its module's SPEC, or its study contract's spec)."""
-    study = available_studies()[group]
-    spec = getattr(study, "spec", None)   # a study package's 'spec' may be its spec module
-    return spec if isinstance(spec, GroupSpec) else study.SPEC
+def _spec(group: str) -> GroupSpec:
+    """The deck keys of study ``group`` (its study contract's spec)."""
+    return available_studies()[group].spec
 
 
 def _tool():
@@ -41,16 +39,49 @@ def _tool():
     return mod
 
 
-def test_committed_static_signatures_are_fresh():
-    from driver._signatures import render_module
-    committed = (ROOT / "driver" / "_keywords.py").read_text()
-    assert committed == render_module(_tool().specs()), \
-        "driver/_keywords.py is stale: run .venv/bin/python tools/gen_keyword_signatures.py"
+@pytest.mark.parametrize("group", STUDIES)
+def test_each_study_has_its_static_signature_fresh_in_its_own_package(group):
+    study = available_studies()[group]
+    stub = Path(study.module.__file__).parent / "_keywords.pyi"
+    written = _tool().stubs([group])
+    assert list(written) == [stub]
+    assert stub.is_file() and stub.read_text() == written[stub], \
+        f"{stub.relative_to(ROOT)} is stale: run .venv/bin/python tools/gen_keyword_signatures.py {group}"
 
 
-def test_every_study_has_a_static_signature():
-    import driver._keywords as kw
-    assert sorted(kw.__all__) == STUDIES
+def test_no_shared_generated_signature_file():
+    """Nothing outside the studies' packages holds a study's signature (a new study edits no shared file)."""
+    assert not (ROOT / "driver" / "_keywords.py").exists()
+    assert sorted(p.parent.name for p in (ROOT / "driver").rglob("_keywords.pyi")) == STUDIES
+
+
+def test_a_study_imports_without_its_stub(tmp_path, monkeypatch):
+    """The stub is read by type checkers only: a study package whose ``_keywords.pyi`` is not
+    written yet imports and runs (the generator imports the study to write it)."""
+    import shutil
+
+    import driver
+    from driver._deck import read_deck
+    from driver._runner import study_of
+    from driver._study import REGISTRY, load_study
+    from driver.robust_example import SPEC
+    pkg = tmp_path / "nostub"
+    shutil.copytree(Path(available_studies()["robust_example"].module.__file__).parent, pkg,
+                    ignore=shutil.ignore_patterns("_keywords.pyi", "__pycache__"))
+    for f in pkg.glob("*.py"):   # the copy is a package of its own: its absolute imports point at itself
+        f.write_text(f.read_text().replace("driver.robust_example", "nostub"))
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.setitem(REGISTRY, "robust_example", "nostub")
+    try:
+        study = load_study("robust_example")
+        assert study is not None and study.package == "nostub" and not (pkg / "_keywords.pyi").exists()
+        assert list(_tool().stubs(["robust_example"]).values()) == [render_stub(SPEC)]
+        deck = read_deck(ROOT / "inputs" / "robust_example.dat")
+        result = study.run(study_of(deck)[1])
+        assert result.ok and result.summary == driver.robust_example.run(study_of(deck)[1]).summary
+    finally:
+        for name in [m for m in sys.modules if m == "nostub" or m.startswith("nostub.")]:
+            del sys.modules[name]
 
 
 @pytest.mark.parametrize("group", TYPED)

@@ -195,6 +195,8 @@ def test_json_records_of_optimisation_synthesis_and_sweep(tmp_path):
                                            "fourbar_paper_sweep.dat")]
     assert main([*map(str, decks), "-o", str(tmp_path), "-q", "--json"]) == 0
     opt = json.loads((tmp_path / "optimize_manipulator_torque.json").read_text())
+    assert opt["engine"] == "optimize" and opt["ok"] is True
+    opt = opt["optimize"]
     assert opt["success"] is True and opt["status"] == 0 and opt["nfev"] > 0 and opt["nit"] > 0
     assert opt["x_names"] == ["manipulator.designs_l1", "manipulator.designs_l2"]
     l1, l2 = opt["x"]
@@ -204,6 +206,6 @@ def test_json_records_of_optimisation_synthesis_and_sweep(tmp_path):
     assert abs(eq["value"] - 47.25) <= eq["tolerance"] == pytest.approx(1e-7 * 47.25)
     assert eq["margin"] == pytest.approx(-abs(l1 * l1 + l2 * l2 - 47.25), abs=1e-12)
     syn = json.loads((tmp_path / "synthesis_crank_rocker.json").read_text())
-    assert syn["ok"] is True and syn["linkage"]["crank"] == pytest.approx(4.126, abs=1e-3)
+    assert syn["ok"] is True and syn["synthesis"]["linkage"]["crank"] == pytest.approx(4.126, abs=1e-3)
     sw = json.loads((tmp_path / "fourbar_paper_sweep.json").read_text())
-    assert sw["kind"] == "sweep" and sw["rows"] == 4 and sw["swept_keys"] == ["fourbar.crank"]
+    assert sw["engine"] == "sweep" and sw["sweep"]["rows"] == 4 and sw["sweep"]["swept_keys"] == ["fourbar.crank"]

@@ -51,21 +51,31 @@ SLIDERCRANK = """! aluminium rod of the paper, coarse mesh for a quick report
 /
 """
 
+#: a single Hooke joint: its output angle has a closed form, tan(theta_out) = cos(beta) tan(theta)
+UJOINT_ONE = """! one Hooke joint at 30 deg
+&ujoint
+  beta = 30.0
+  rpm = 30.0
+/
+"""
+
 #: deck stem -> what the page must hold (an animation, design-space maps)
 PAGES = {"crank5": {"anim": "fourbar"}, "nongrashof": {"anim": "fourbar"},
          "crank5_coupler_point": {"anim": "fourbar"}, "slidercrank_small": {"anim": "slidercrank"},
-         "ujoint_option1": {}, "manipulator_case1_report": {}, "robust_example": {},
-         "fourbar_paper_sweep": {"anim": "fourbar", "section": "design-space"},
-         "optimize_crank_rocker": {"anim": "fourbar", "section": "convergence"},
+         "ujoint_option1": {"anim": "ujoint"}, "ujoint_one": {"anim": "ujoint"},
+         "manipulator_case1_report": {"anim": "manipulator"}, "robust_example": {},
+         "fourbar_paper_sweep": {"anim": "fourbar", "section": "best"},
+         "optimize_crank_rocker": {"anim": "fourbar", "section": "optimum"},
          "synthesis_path": {"anim": "fourbar", "section": "linkage"}}
+WRITTEN = {"slidercrank_small": SLIDERCRANK, "ujoint_one": UJOINT_ONE}
 
 
 @pytest.fixture(scope="module")
 def pages(tmp_path_factory):
     out = tmp_path_factory.mktemp("report")
-    small = out / "slidercrank_small.dat"
-    small.write_text(SLIDERCRANK)
-    decks = [str(INPUTS / f"{n}.dat") for n in PAGES if n != "slidercrank_small"] + [str(small)]
+    for name, text in WRITTEN.items():
+        (out / f"{name}.dat").write_text(text)
+    decks = [str(INPUTS / f"{n}.dat") for n in PAGES if n not in WRITTEN] + [str(out / f"{n}.dat") for n in WRITTEN]
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     proc = subprocess.run([sys.executable, "-m", "driver", *decks, "--report", "-q", "-o", str(out / "out")],
                           capture_output=True, text=True, env=env, timeout=900)
@@ -124,22 +134,28 @@ def test_page_renders_offline(pages, browser, stem):
 
 
 def _parts(browser) -> dict:
+    """The animation's parts as drawn: every link's points (by name) and every pin or dot (by name)."""
     return browser.eval("""(() => { const r = document.querySelector('.anim');
-        const g = s => r.querySelector("[data-part='" + s + "']");
-        const num = (e, a) => parseFloat(e.getAttribute(a));
-        const c = g('crank'), A = g('A'), B = g('B'), k = g('coupler'), o = g('out'), blk = g('block');
-        return {theta: r.querySelector('output').textContent,
-                crank: [num(c,'x1'), num(c,'y1'), num(c,'x2'), num(c,'y2')],
-                A: [num(A,'cx'), num(A,'cy')], B: [num(B,'cx'), num(B,'cy')],
-                coupler: k.getAttribute('points'), rod: k.getAttribute('d'), visible: k.style.visibility,
-                out: o ? [num(o,'x1'), num(o,'y1'), num(o,'x2'), num(o,'y2')] : null,
-                block: blk ? [num(blk,'x') + num(blk,'width') / 2, num(blk,'y') + num(blk,'height') / 2] : null,
-                note: r.querySelector("[data-part='note']").style.visibility}; })()""")
+        const xy = s => s.trim().split(/\\s+/).map(p => p.split(',').map(Number));
+        const links = {}, dots = {};
+        r.querySelectorAll('[data-link]').forEach(e => { links[e.getAttribute('data-link')] = {
+            visible: e.style.visibility, tag: e.tagName,
+            points: e.tagName === 'line' ? [[+e.getAttribute('x1'), +e.getAttribute('y1')],
+                                            [+e.getAttribute('x2'), +e.getAttribute('y2')]]
+                                         : xy(e.getAttribute('points') || '')}; });
+        r.querySelectorAll('[data-point]').forEach(e => { dots[e.getAttribute('data-point')] =
+            [+e.getAttribute('cx'), +e.getAttribute('cy')]; });
+        return {label: r.querySelector('output').textContent, links: links, dots: dots,
+                note: r.querySelector("[data-role='note']").style.visibility}; })()""")
 
 
 def _move(browser, k: int) -> None:
     browser.eval(f"""(() => {{ const s = document.querySelector('.anim input[type=range]');
         s.value = {k}; s.dispatchEvent(new Event('input')); }})()""")
+
+
+def _frames(browser) -> int:
+    return int(browser.eval("document.querySelector('.anim input[type=range]').max")) + 1
 
 
 @pytest.mark.parametrize("stem, lengths", [
@@ -158,81 +174,139 @@ def test_animation_follows_the_slider(pages, browser, stem, lengths):
         lengths = dict(lengths, mid=(ang[order], mid[order]), scale=0.06 * 0.505 / np.abs(mid).max())
     browser.events.clear()
     browser.open(pages / f"{stem}.html")
-    n = int(browser.eval("document.querySelector('.anim input[type=range]').max")) + 1
+    n = _frames(browser)
     seen = []
+    r = lengths["crank"]
     for k in (0, n // 8, n // 3, n // 2, (3 * n) // 4):
         _move(browser, k)
         p = _parts(browser)
-        if lengths and lengths.get("rocking"):   # the frame's crank angle, then the stroke and branch
-            theta = float(browser.eval(f"JSON.parse(document.querySelector('.anim script[type=\\'application/json\\']')"
-                                       f".textContent).theta[{k}]"))
-            assert p["theta"].startswith(f"{theta:.0f}\u00b0 ") and "assembly" in p["theta"]
-        else:
-            theta = 360.0 * k / n
-            assert p["theta"] == f"{theta:.0f}\u00b0"
+        crank = np.array(p["links"]["crank"]["points"])
+        a = np.array(p["dots"]["A"])
+        # the crank from its pivot at the origin to the pin A, at the crank's length
+        assert np.allclose(crank[0], [0.0, 0.0]) and np.allclose(crank[1], a)
+        assert math.isclose(np.hypot(*a), r, rel_tol=1e-5)
+        theta = math.degrees(math.atan2(a[1], a[0]))
+        if lengths.get("rocking"):   # the frame's crank angle, then the stroke and branch
+            assert p["label"].startswith(f"{theta:.0f}\u00b0 ") and "assembly" in p["label"]
+        else:                        # the crank turns through the frames evenly, as the label says
+            assert p["label"] == f"{360.0 * k / n:.0f}\u00b0"
+            assert math.isclose(math.cos(math.radians(theta - 360.0 * k / n)), 1.0, abs_tol=1e-9)
         seen.append(p)
-        if lengths is None:
-            continue
-        a = np.array(p["A"])
-        r = lengths["crank"]
-        # the crank pin where the crank angle says (closed form), the crank drawn to it
-        assert np.allclose(a, [r * math.cos(math.radians(theta)), r * math.sin(math.radians(theta))], atol=1e-4 * r)
-        assert np.allclose(p["crank"][2:], a) and np.allclose(p["crank"][:2], [0.0, 0.0])
-        b = np.array(p["B"])
+        b = np.array(p["dots"]["B"])
         if "rocker" in lengths:   # loop closure of the drawn linkage: every link keeps its length
-            assert p["visible"] == "visible"
-            assert math.isclose(np.hypot(*(b - a)), lengths["coupler"], rel_tol=1e-4)
-            assert math.isclose(np.hypot(b[0] - lengths["ground"], b[1]), lengths["rocker"], rel_tol=1e-4)
-            assert np.allclose(p["out"], [lengths["ground"], 0.0, *b])
+            coupler, rocker = p["links"]["coupler"], p["links"]["rocker"]
+            assert coupler["visible"] == "visible"
+            assert np.allclose(coupler["points"], [a, b])
+            assert math.isclose(np.hypot(*(b - a)), lengths["coupler"], rel_tol=1e-5)
+            assert math.isclose(np.hypot(b[0] - lengths["ground"], b[1]), lengths["rocker"], rel_tol=1e-5)
+            assert np.allclose(rocker["points"], [[lengths["ground"], 0.0], b])
         else:                     # the slider on its guide, the rod at its length
-            assert abs(b[1]) < 1e-9 and math.isclose(np.hypot(*(b - a)), lengths["rod"], rel_tol=1e-4)
-            assert np.allclose(p["block"], b, atol=1e-6)
-            # the rod drawn from A to B, bowed by its midpoint deflection (magnified as the caption says)
-            nums = [float(v) for v in re.findall(r"-?[0-9.]+(?:e-?[0-9]+)?", p["rod"])]
-            start, ctrl, end = np.array(nums[:2]), np.array(nums[2:4]), np.array(nums[4:6])
-            assert np.allclose(start, a) and np.allclose(end, b)
-            mid_drawn = 0.25 * start + 0.5 * ctrl + 0.25 * end   # the quadratic Bezier at t = 1/2
+            assert abs(b[1]) < 1e-9 and math.isclose(np.hypot(*(b - a)), lengths["rod"], rel_tol=1e-5)
+            block = np.array(p["links"]["slider"]["points"])
+            assert p["links"]["slider"]["tag"] == "polygon" and np.allclose(block.mean(axis=0), b, atol=1e-6)
+            # the rod drawn from A to B through its nodes, its middle node off the chord by the midpoint
+            # deflection (magnified as the caption says), to the left of A->B
+            rod = np.array(p["links"]["connecting rod"]["points"])
+            assert np.allclose(rod[0], a) and np.allclose(rod[-1], b) and len(rod) % 2 == 1
             chord = (b - a) / np.hypot(*(b - a))
-            off = mid_drawn - 0.5 * (a + b)
-            bow = float(chord[0] * off[1] - chord[1] * off[0])   # signed distance to the left of A->B
-            assert bow == pytest.approx(lengths["scale"] * np.interp(theta, *lengths["mid"], period=360.0),
+            off = rod[len(rod) // 2] - 0.5 * (a + b)
+            bow = float(chord[0] * off[1] - chord[1] * off[0])
+            assert bow == pytest.approx(lengths["scale"] * np.interp(theta % 360.0, *lengths["mid"], period=360.0),
                                         abs=1e-6 * lengths["rod"])
     # the drawing changes with the slider
-    assert len({tuple(p["A"]) for p in seen}) == len(seen)
+    assert len({tuple(p["dots"]["A"]) for p in seen}) == len(seen)
     assert browser.errors() == []
-    if lengths and lengths.get("rocking"):
+    if lengths.get("rocking"):
         # the non-Grashof linkage cannot turn: it rocks between its closed-form limit angles, out
         # on the open assembly and back on the crossed, always assembled (no "cannot be assembled")
-        F = browser.eval("JSON.parse(document.querySelector(\".anim script[type='application/json']\").textContent)")
         g, a, b, c = (lengths[k] for k in ("ground", "crank", "coupler", "rocker"))
         limit = math.degrees(math.acos((g * g + a * a - (b + c) ** 2) / (2 * g * a)))
-        th = np.array(F["theta"])
-        assert th.max() == pytest.approx(limit, abs=1e-4) and th.min() == pytest.approx(-limit, abs=1e-4)
-        top = int(np.argmax(th))
-        assert np.all(np.diff(th[:top + 1]) > 0) and np.all(np.diff(th[top + 1:]) < 0)   # reverses once, at the limit
-        assert all("open" in f for f in F["phase"][:top + 1]) and all("crossed" in f for f in F["phase"][top + 1:])
-        states = []
-        for k in range(0, n, 3):
+        th, phase, states = [], [], []
+        for k in range(n):
             _move(browser, k)
             q = _parts(browser)
+            A, B = np.array(q["dots"]["A"]), np.array(q["dots"]["B"])
+            th.append(math.degrees(math.atan2(A[1], A[0])))
+            phase.append(q["label"])
             states.append(q["note"])
-            A, B = np.array(q["A"]), np.array(q["B"])
-            assert math.isclose(np.hypot(*(B - A)), b, rel_tol=1e-4)
-            assert math.isclose(np.hypot(B[0] - g, B[1]), c, rel_tol=1e-4)
+            assert math.isclose(np.hypot(*(B - A)), b, rel_tol=1e-5)
+            assert math.isclose(np.hypot(B[0] - g, B[1]), c, rel_tol=1e-5)
+        th = np.array(th)
+        assert th.max() == pytest.approx(limit, abs=1e-3) and th.min() == pytest.approx(-limit, abs=1e-3)
+        top = int(np.argmax(th))
+        assert np.all(np.diff(th[:top + 1]) > 0) and np.all(np.diff(th[top + 1:]) < 0)   # reverses once, at the limit
+        assert all("open" in f for f in phase[:top + 1]) and all("crossed" in f for f in phase[top + 1:])
         assert set(states) == {"hidden"}
-        limits = browser.eval("document.querySelectorAll(\".anim [data-part='limit']\").length")
+        limits = browser.eval("Array.from(document.querySelectorAll(\".anim [data-role='guide'] title\"))"
+                              ".filter(t => t.textContent.startsWith('limit position')).length")
         assert limits == 2
+
+
+def test_ujoint_animation_turns_the_output_as_the_closed_form(pages, browser):
+    """One Hooke joint at 30 deg: the page's output deviation at every frame is the closed form
+    atan(cos(beta) tan(theta)) - theta (about its mean, zero over a turn); the shafts keep their length."""
+    browser.events.clear()
+    browser.open(pages / "ujoint_one.html")
+    n = _frames(browser)
+    beta = math.radians(30.0)
+    for k in range(0, n, 7):
+        _move(browser, k)
+        p = _parts(browser)
+        theta = 2 * math.pi * k / n
+        closed = math.degrees(math.atan2(math.cos(beta) * math.sin(theta), math.cos(theta)) - theta)
+        closed = (closed + 180.0) % 360.0 - 180.0
+        m = re.fullmatch(r"(\d+)\u00b0, output ([+-]\d+\.\d\d)\u00b0 from uniform rotation", p["label"])
+        assert m and int(m.group(1)) == round(math.degrees(theta)), p["label"]
+        assert float(m.group(2)) == pytest.approx(closed, abs=0.0051)
+        for shaft in ("input shaft", "output shaft"):
+            assert p["links"][shaft]["visible"] == "visible"
+    assert browser.errors() == []
+
+
+def test_manipulator_animation_reaches_each_workspace_point(pages, browser):
+    """The deck's designs (l1, l2) = (5.61, 3.97) and (4.86, 4.86): at each frame that says 'at Pi' the
+    drawn tip is the workspace point and the links keep their lengths (inverse kinematics checked
+    by forward kinematics on the page)."""
+    browser.events.clear()
+    browser.open(pages / "manipulator_case1_report.html")
+    points = {1: (1, 5), 2: (2, 7), 3: (3, 7), 4: (4, 6)}
+    reached = set()
+    for k in range(_frames(browser)):
+        _move(browser, k)
+        p = _parts(browser)
+        m = re.search(r"l\u2081 = ([0-9.]+) m, l\u2082 = ([0-9.]+) m\) at P(\d)", p["label"])
+        if not m:
+            continue
+        l1, l2, i = float(m.group(1)), float(m.group(2)), int(m.group(3))
+        elbow, tip = np.array(p["dots"]["elbow"]), np.array(p["dots"]["tip"])
+        assert np.allclose(tip, points[i], atol=1e-6)
+        assert math.isclose(np.hypot(*elbow), l1, rel_tol=1e-6) and math.isclose(np.hypot(*(tip - elbow)), l2, rel_tol=1e-6)
+        reached.add((l1, i))
+    assert reached == {(l1, i) for l1 in (5.61, 4.86) for i in points}
+    assert browser.errors() == []
+
+
+def test_every_mechanism_moves_by_the_same_script(pages):
+    """The four-bar, the slider-crank, the shaft chain and the arm are animated by one script, the
+    same text on every page (templates/animation.js), and the page names no mechanism."""
+    scripts = set()
+    for stem in ("crank5", "slidercrank_small", "ujoint_option1", "manipulator_case1_report"):
+        html = (pages / f"{stem}.html").read_text()
+        found = re.findall(r"<script>(.*?)</script>", html, re.S)
+        assert len(found) == 1, stem
+        scripts.add(found[0])
+    assert len(scripts) == 1
 
 
 def test_play_button_moves_the_mechanism(pages, browser):
     browser.events.clear()
     browser.open(pages / "crank5.html")
-    before = _parts(browser)["A"]
+    before = _parts(browser)["dots"]["A"]
     browser.eval("document.querySelector('.anim button').click()")
     browser.eval("new Promise(r => setTimeout(r, 400))")
     after = _parts(browser)
     browser.eval("document.querySelector('.anim button').click()")
-    assert after["A"] != before and after["theta"] != "0\u00b0"
+    assert after["dots"]["A"] != before and after["label"] != "0\u00b0"
     assert browser.errors() == []
 
 

@@ -241,7 +241,7 @@ def test_linear_only_options_are_refused(tmp_path, line, key):
 
 
 def test_growth_ratio_definition():
-    from driver.slidercrank._nonlinear import growth_ratio, scatter
+    from driver.slidercrank._analysis_nl import growth_ratio, scatter
     assert growth_ratio(np.ones(8)) == 0.0
     assert growth_ratio(np.array([2.0, 1.0] * 6)) == 0.0                 # period 2: steady
     assert growth_ratio(1.1 ** np.arange(12)) == pytest.approx(0.1)      # 10 % a revolution

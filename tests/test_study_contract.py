@@ -29,14 +29,16 @@ from driver import _limits as limits
 from driver._deck import DeckError, GroupSpec, Key, read_deck
 from driver._limits import Estimate
 from driver._runner import CONTROL_GROUPS, compute, study_of
-from driver._study import REGISTRY, BatchSummary, Study, load_study, study_names
+from driver._signatures import render_stub
+from driver._study import REGISTRY, REQUIRED_LAYERS, BatchSummary, Study, load_study, study_names
 from driver.sweep import _batch as sweep_batch
 
 ROOT = Path(__file__).resolve().parents[1]
 INPUTS = ROOT / "inputs"
 EXAMPLE = Path(__file__).resolve().parent / "example_study" / "pendulum"
 
-STUDIES = ("fourbar", "linkage", "manipulator", "robust_example", "slidercrank", "ujoint")
+#: every registered study: a new study is in every test below by its registry line alone
+STUDIES = tuple(study_names())
 
 
 def _decks_of(group: str) -> list[Path]:
@@ -52,7 +54,7 @@ def _decks_of(group: str) -> list[Path]:
 # ----------------------------------------------------------------------------- the registry
 
 def test_the_registry_is_an_explicit_list_and_names_every_study():
-    assert study_names() == sorted(REGISTRY) == list(STUDIES)
+    assert study_names() == sorted(REGISTRY) == list(STUDIES) and len(STUDIES) >= 5
     for name in ("_cli", "_deck", "sweep", "optimize", "plotting", "_fortran", "_output", "_study", "fourbar._forces"):
         assert load_study(name) is None          # no module-name probing: what is not listed is no study
     assert set(driver.studies()) == set(STUDIES)
@@ -62,6 +64,25 @@ def test_a_registered_package_without_a_study_is_an_error_not_skipped(monkeypatc
     monkeypatch.setitem(REGISTRY, "table", "driver._table")
     with pytest.raises(TypeError, match="binds no STUDY"):
         load_study("table")
+
+
+def test_the_deck_reader_asks_the_registry_for_every_group(monkeypatch, tmp_path):
+    """Studies and engines alike (group_spec); an unknown group is None (the runner names the
+    known ones); a registered package that is broken is an error to see, not an unknown group."""
+    from driver import sweep
+    from driver._study import ENGINES, group_spec
+    assert group_spec("sweep") is sweep.SPEC and set(ENGINES) == set(CONTROL_GROUPS)
+    assert group_spec("fourbar") is load_study("fourbar").spec and group_spec("no_such_group") is None
+    deck = tmp_path / "d.dat"
+    deck.write_text("&broken x = 1 /\n")
+    monkeypatch.setitem(REGISTRY, "broken", "driver._no_such_module")
+    monkeypatch.delitem(deck_module._KNOWN, "broken", raising=False)
+    with pytest.raises(ModuleNotFoundError, match="driver._no_such_module"):
+        read_deck(deck)
+    deck_module._KNOWN.pop("broken", None)
+    deck.write_text("&unheard_of x = 1 /\n")
+    with pytest.raises(DeckError, match="unknown group &unheard_of"):
+        study_of(read_deck(deck))
 
 
 # ----------------------------------------------------------------------------- every registered study
@@ -101,13 +122,13 @@ def test_estimate_gives_sane_numbers_for_every_shipped_deck_of_the_study(name):
 
 
 #: the files every study package has (plus _kernel.py with a kernel, _batch.py with a batch path): private
-#: modules behind the package's public names
-LAYOUT = {"__init__.py", "_spec.py", "_analysis.py", "_report.py", "_figures.py", "_published.py"}
+#: modules behind the package's public names, one per layer of the contract (driver._study.LAYERS)
+LAYOUT = {"__init__.py", *(f"{layer}.py" for layer in REQUIRED_LAYERS)}
 
 
-@pytest.mark.parametrize("name", STUDIES)
-def test_every_study_has_the_one_layout(name):
-    s = load_study(name)
+def _check_layout(s: Study) -> None:
+    """The study's package has one file per required layer (and _kernel/_batch when it declares a
+    kernel/a batch path), each hook where its layer is, and a face without code."""
     folder = Path(s.module.__file__).parent
     files = {p.name for p in folder.glob("*.py")}
     need = LAYOUT | ({"_kernel.py"} if s.kernel is not None else set()) | ({"_batch.py"} if s.batch is not None else set())
@@ -116,29 +137,98 @@ def test_every_study_has_the_one_layout(name):
     assert s.published is not None and s.published.__module__ == f"{s.package}._published"
     assert s.kernel is None or s.kernel.__name__ == f"{s.package}._kernel"
     assert s.run.__module__.startswith(f"{s.package}._report") and s.estimate.__module__ == f"{s.package}._spec"
-    # the package's __init__ holds its public names and STUDY only: imports, __all__, assignments (no code)
+    # the package's __init__ holds its public names and STUDY only: imports, __all__, assignments (no
+    # code); run is its generated static signature to type checkers (``if TYPE_CHECKING:``)
     init = ast.parse((folder / "__init__.py").read_text())
-    kinds = {type(n) for n in init.body[1:]}
+    kinds = {type(n) for n in init.body[1:] if not _typed_run(n, s.package)}
     assert kinds <= {ast.ImportFrom, ast.Import, ast.Assign, ast.AnnAssign}, kinds
+    assert any(_typed_run(n, s.package) for n in init.body), "run is not typed by the study's _keywords.pyi"
+    assert (folder / "_keywords.pyi").is_file()
+
+
+@pytest.mark.parametrize("name", STUDIES)
+def test_every_study_has_the_one_layout(name):
+    _check_layout(load_study(name))
+
+
+def _typed_run(node: ast.stmt, package: str) -> bool:
+    """``if TYPE_CHECKING: from <package>._keywords import run`` / ``else: from <package>._<module> import run``."""
+    return (isinstance(node, ast.If) and isinstance(node.test, ast.Name) and node.test.id == "TYPE_CHECKING"
+            and len(node.body) == len(node.orelse) == 1
+            and all(isinstance(b, ast.ImportFrom) and [a.name for a in b.names] == ["run"]
+                    for b in (*node.body, *node.orelse))
+            and isinstance(node.body[0], ast.ImportFrom)
+            and (node.body[0].module == f"{package}._keywords" or (node.body[0].level, node.body[0].module) == (1, "_keywords")))
+
+
+def study_references(source: str, names: tuple[str, ...]) -> list[str]:
+    """Where ``source`` (a module's code) names one of the studies ``names`` the way per-study code
+    does: an import of ``driver.<name>`` or a dotted ``driver.<name>`` (in code or in a string), a
+    ``&<name>`` group in a string, the name as a string compared against (``==``, ``in`` and their
+    collections, a ``match`` case), or a dict keyed by two study names or more (a per-study table).
+    A bare word is no reference: a study's name may be an ordinary word of the shared code too
+    (a synthesis's "linkage" is no &linkage).  Docstrings are not code."""
+    tree = ast.parse(source)
+    names_set = set(names)
+    found: list[str] = []
+    dotted = re.compile(r"\bdriver\.(%s)\b" % "|".join(map(re.escape, names)))
+    group = re.compile(r"&(%s)\b" % "|".join(map(re.escape, names)))
+    docstrings = set()
+    for node in ast.walk(tree):
+        body = getattr(node, "body", None)
+        if isinstance(body, list) and body and isinstance(body[0], ast.Expr) \
+                and isinstance(body[0].value, ast.Constant) and isinstance(body[0].value.value, str):
+            docstrings.add(id(body[0].value))
+
+    def strings(node: ast.AST) -> list[str]:
+        if isinstance(node, ast.Constant) and isinstance(node.value, str):
+            return [node.value]
+        if isinstance(node, (ast.Tuple, ast.List, ast.Set)):
+            return [s for e in node.elts for s in strings(e)]
+        return []
+
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            found += [f"import {a.name}" for a in node.names if dotted.search(a.name)]
+        elif isinstance(node, ast.ImportFrom) and node.module:
+            mods = [node.module] + [f"{node.module}.{a.name}" for a in node.names]
+            found += [f"from {node.module} import" for m in mods[:1] if any(dotted.search(x) for x in mods)]
+        elif isinstance(node, ast.Attribute) and dotted.search(ast.unparse(node)) and \
+                isinstance(node.value, ast.Name) and node.value.id == "driver":
+            found.append(ast.unparse(node))
+        elif isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in docstrings:
+            found += [f"string {node.value!r}" for rx in (dotted, group) if rx.search(node.value)]
+        elif isinstance(node, ast.Compare):
+            found += [f"compares with {v!r}" for part in (node.left, *node.comparators) for v in strings(part)
+                      if v in names_set]
+        elif isinstance(node, ast.MatchValue):
+            found += [f"case {v!r}" for v in strings(node.value) if v in names_set]
+        elif isinstance(node, ast.Dict):
+            keys = [k.value for k in node.keys if isinstance(k, ast.Constant) and k.value in names_set]
+            if len(keys) >= 2:
+                found.append(f"a table keyed by {sorted(keys)}")
+    return found
+
+
+def test_the_reference_finder_sees_per_study_code():
+    names = ("fourbar", "linkage")
+    assert study_references('"""A linkage page."""\nlinkage = 1\nSection("linkage")\nx.linkage_deck\n', names) == []
+    seen = study_references(
+        "import driver.fourbar\nfrom driver.linkage import run\nimport driver\ndriver.fourbar.run()\n"
+        "importlib.import_module('driver.linkage')\nmsg = 'see &fourbar'\nif study == 'linkage': pass\n"
+        "ok = g in ('fourbar', 'x')\nT = {'fourbar': 1, 'linkage': 2}\n"
+        "match g:\n    case 'fourbar':\n        pass\n", names)
+    assert len(seen) == 9, seen   # every line after "import driver" once
 
 
 def test_shared_modules_hold_no_per_study_code():
     """plotting keeps the house style and the shared figures, compare the comparison machinery,
-    kernels the loader: no study group is named in their code (docstrings aside)."""
-    for module in ("plotting", "_compare", "_fortran", "_published", "_runner", "_limits", "_report_page"):
-        tree = ast.parse((ROOT / "driver" / f"{module}.py").read_text())
-        for node in ast.walk(tree):
-            body = getattr(node, "body", None)
-            if isinstance(body, list) and body and isinstance(body[0], ast.Expr) \
-                    and isinstance(body[0].value, ast.Constant) and isinstance(body[0].value.value, str):
-                body[0].value.value = ""   # the docstring
-        code = ast.unparse(tree)
-        for node in ast.walk(tree):   # 'linkage' is also a word of these modules' text: looked for in code only
-            if isinstance(node, ast.Constant) and isinstance(node.value, str):
-                node.value = ""
-        bare = ast.unparse(tree)
-        for name in STUDIES:
-            assert not re.search(rf"\b{name}\b", bare if name == "linkage" else code), (module, name)
+    kernels the loader, the page its generic sections: none of them imports, names or branches on
+    a study group (:func:`study_references`)."""
+    files = [ROOT / "driver" / f"{m}.py" for m in ("plotting", "_compare", "_fortran", "_published", "_runner",
+                                                     "_limits", "_record", "_mechanism")]
+    for path in files + sorted((ROOT / "driver" / "_report_page").glob("*.py")):   # the page is a package
+        assert not study_references(path.read_text(), STUDIES), (path.stem, study_references(path.read_text(), STUDIES))
 
 
 def _same(a: pd.Series, b: pd.Series) -> bool:
@@ -147,7 +237,8 @@ def _same(a: pd.Series, b: pd.Series) -> bool:
     return a.astype(object).where(a.notna(), None).tolist() == b.astype(object).where(b.notna(), None).tolist()
 
 
-@pytest.mark.parametrize("name", [n for n in STUDIES if n in ("fourbar", "manipulator", "ujoint")])
+@pytest.mark.parametrize("name", [n for n in STUDIES if (s := load_study(n)) is not None and s.batch is not None
+                                  and s.batch.passes is not None])
 def test_batch_pass_table_agrees_with_the_summary_columns(name):
     """Each column a pass table names, asked for alone, has the value the full summary gives it
     (a column whose pass the table forgot would come back zero or missing); the headline
@@ -182,7 +273,7 @@ def _optional(s: Study, column: str) -> bool:
     return False
 
 
-@pytest.mark.parametrize("name", ["fourbar", "manipulator"])
+@pytest.mark.parametrize("name", [n for n in STUDIES if (s := load_study(n)) is not None and s.summarise is not None])
 def test_summarise_gives_the_run_summary(name):
     s = load_study(name)
     assert s.summarise is not None
@@ -268,9 +359,14 @@ def _ode_period_and_swing(length: float, g: float, theta0: float, t: np.ndarray)
 
 
 def test_adding_a_study_is_one_folder_and_one_registry_line(pendulum):
-    """The example lives in one folder of the house layout; no file of driver/ names it."""
-    files = sorted(p.name for p in EXAMPLE.glob("*.py"))
-    assert files == ["__init__.py", "_batch.py", "_figures.py", "_kernel.py", "_report.py", "_spec.py"]
+    """The example lives in one folder in exactly the house layout (every layer it needs, its
+    generated stub fresh); no file of driver/ names it (tests/test_new_study.py runs it as a real
+    package of a scratch repository)."""
+    files = sorted(p.name for p in EXAMPLE.iterdir() if p.suffix in (".py", ".pyi"))
+    assert files == ["__init__.py", "_analysis.py", "_batch.py", "_figures.py", "_kernel.py", "_keywords.pyi",
+                     "_published.py", "_report.py", "_spec.py"]
+    _check_layout(pendulum)
+    assert (EXAMPLE / "_keywords.pyi").read_text() == render_stub(pendulum.spec)
     for src in (ROOT / "driver").rglob("*.py"):
         assert "pendulum" not in src.read_text(), src
     assert isinstance(pendulum, Study) and pendulum.name in study_names()
@@ -291,6 +387,10 @@ def test_example_study_runs_through_the_driver_and_matches_the_equation_of_motio
     assert res.tidy["theta_deg"].iloc[-1] == pytest.approx(-amplitude, abs=1e-6)   # half a period: the other side
     if amplitude == 90.0:
         assert res.summary["period_ratio"] == pytest.approx(1.1803406, abs=5e-8)   # 2 K(1/2) / pi, textbooks
+        cells = pendulum.published(res.params, res)   # K(45 deg) of the published table, to its 10 decimals
+        assert [(c["printed"], c["status"]) for c in cells] == [("1.8540746773", "identical")], cells
+    else:
+        assert pendulum.published(res.params, res) == []   # no row of the table for this amplitude
 
 
 def test_example_study_deck_sweep_budget_and_figures(pendulum, tmp_path):

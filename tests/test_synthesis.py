@@ -154,8 +154,10 @@ def test_path_generation_through_five_points_verified_by_the_kernel(tmp_path):
     deck = tmp_path / "path.dat"
     deck.write_text(text.replace("maxiter = 200, popsize = 10", "maxiter = 60, popsize = 8"))
     syn = synthesise(deck)
-    from driver.synthesis import _path_figure
-    assert _path_figure(syn, tmp_path / "path_path.png", "path").stat().st_size > 0
+    from driver.plotting import save_figure
+    from driver.synthesis import synthesis_figures
+    (figure,) = synthesis_figures(syn, "path")
+    assert figure.name == "path" and save_figure(figure.draw(), tmp_path / "path_path.png").stat().st_size > 0
     assert syn.failure is None
     q = syn.design.parts
     targets = np.column_stack([syn.params.target_x, syn.params.target_y])

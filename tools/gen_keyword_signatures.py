@@ -1,36 +1,42 @@
-"""Write ``driver/_keywords.py``, the static keyword signatures of every study's ``run``.
+"""Write each study's ``_keywords.pyi``: the static keyword signature of its ``run``, in its own package.
 
-The signatures are generated from each study's SPEC (the deck keys, their kinds, defaults
-and allowed values) by :func:`driver._signatures.render_module`; a type checker then refuses a
-misspelt or mistyped key in ``driver.<study>.run(...)``.  Run after adding a study or changing
-a SPEC (tests/test_keyword_signatures.py fails while the committed file is stale)::
+The signature is generated from the study's SPEC (the deck keys, their kinds, defaults and
+allowed values) by :func:`driver._signatures.render_stub` into ``driver/<study>/_keywords.pyi``;
+a type checker then refuses a misspelt or mistyped key in ``driver.<study>.run(...)``.  Only
+type checkers read the stub (the study's ``__init__`` imports it under ``TYPE_CHECKING``), so a
+new study imports, runs and is registered before its stub exists: write it once the SPEC is
+there, and again after a SPEC changes (tests/test_keyword_signatures.py fails while a committed
+stub is stale)::
 
-    .venv/bin/python tools/gen_keyword_signatures.py
+    .venv/bin/python tools/gen_keyword_signatures.py            # every registered study
+    .venv/bin/python tools/gen_keyword_signatures.py linkage    # one study
 """
 from __future__ import annotations
 
 import sys
 from pathlib import Path
 
-TARGET = Path(__file__).resolve().parents[1] / "driver" / "_keywords.py"
+STUB = "_keywords.pyi"
 
 
-def specs() -> list:
-    """The SPEC of every study the runner knows, in name order (a study module's ``SPEC``, or
-    the ``spec`` of its study contract)."""
-    from driver._deck import GroupSpec
-    from driver._runner import available_studies
-    out = []
-    for _, study in sorted(available_studies().items()):
-        spec = getattr(study, "spec", None)   # a study package's 'spec' may be its spec module
-        out.append(spec if isinstance(spec, GroupSpec) else getattr(study, "SPEC"))  # noqa: B009 - a study module
+def stubs(groups: list[str] | None = None) -> dict[Path, str]:
+    """{path of the study's ``_keywords.pyi``: its text} for the registered studies ``groups``
+    (default every one); the stub lies beside the study package's ``__init__.py``."""
+    from driver._signatures import render_stub
+    from driver._study import load_study, study_names
+    out = {}
+    for group in groups or study_names():
+        study = load_study(group)
+        if study is None:
+            raise SystemExit(f"gen_keyword_signatures: &{group} is not a registered study (driver._study.REGISTRY)")
+        out[Path(str(study.module.__file__)).parent / STUB] = render_stub(study.spec)
     return out
 
 
-def main() -> int:
-    from driver._signatures import render_module
-    TARGET.write_text(render_module(specs()))
-    print(f"wrote {TARGET}")
+def main(argv: list[str] | None = None) -> int:
+    for path, text in stubs(list(sys.argv[1:] if argv is None else argv)).items():
+        path.write_text(text)
+        print(f"wrote {path}")
     return 0
 
 

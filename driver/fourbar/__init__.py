@@ -8,19 +8,24 @@ accelerations, Grashof class, limit and toggle positions and a summary.
 Lengths in any consistent unit; angles in degrees in decks and tables; crank
 speed in rad/s, accelerations in rad/s^2.
 
-The package's private modules, by job: ``_spec`` (deck keys, checks, labels, the budget estimate), ``_analysis``
-(Grashof class, states through the kernel, extremes), ``_batch`` (many designs in one kernel
-call; the summary), ``_report`` (the run: .out, tidy table, summary), ``_figures``, ``_published``
-(the published listing tables and their defects), ``_kernel`` (the Fortran wrappers) and
-``_forces`` (the force analysis).
+The package's private modules, in their dependency order (docs/layout.md): ``_kernel`` (the
+Fortran wrappers), ``_spec`` (deck keys and checks, the force keys included, labels, the budget
+estimate), ``_analysis`` (Grashof class, states and the summary kernel, extremes) and
+``_analysis_forces`` (joint forces, torque, shaking, balancing), ``_batch`` (many designs in one
+kernel call; the summary and the force summary), ``_figures``, ``_report`` (the run: .out, tidy
+table, summary) and ``_report_forces`` (its force section), ``_published`` (the published listing
+tables and their defects); ``_forces`` is the face of the force analysis (``driver.fourbar.forces``).
 """
 from __future__ import annotations
+
+from typing import TYPE_CHECKING
 
 from driver._study import BatchSummary, Study
 from driver.fourbar import _forces as forces
 from driver.fourbar import _kernel as kernel
 from driver.fourbar import _published as published
 from driver.fourbar._analysis import (
+    PASS_BITS,
     ST,
     Extremes,
     Grashof,
@@ -42,13 +47,17 @@ from driver.fourbar._batch import (
     BATCH_INDEPENDENT,
     BATCH_KEYS,
     BATCH_PASSES,
-    PASS_BITS,
     summarise,
     summarise_batch,
 )
 from driver.fourbar._published import LISTING_DEFECT, LISTING_PRECISION, exact_as_listed
-from driver.fourbar._report import animation_frames, run
+from driver.fourbar._report import animation_frames
 from driver.fourbar._spec import LABELS, SPEC, SUMMARY_SETTINGS, SWEEP_BEST, SWEEP_PLOT, estimate
+
+if TYPE_CHECKING:   # run's keys as typed keywords: generated from SPEC (tools/gen_keyword_signatures.py)
+    from driver.fourbar._keywords import run
+else:
+    from driver.fourbar._report import run
 
 __all__ = ["SPEC", "STUDY", "run", "estimate", "summarise", "summarise_batch", "BATCH_KEYS", "BATCH_PASSES", "grashof",
            "limit_angles", "assembly_intervals", "rocking_motions", "Motion", "crank_angles", "exact_grid", "coupler_point",

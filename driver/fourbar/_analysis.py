@@ -3,19 +3,23 @@ through the kernel, the extremes over the crank range, and the tidy columns of t
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from driver._deck import Params
 from driver._export import with_units
+from driver._study import batch_error
 from driver.fourbar import _kernel as kernel
-from driver.fourbar._batch import summary_rows
+from driver.fourbar._kernel import Point, State, Summary, SummaryParam
 
 __all__ = ['ST', 'Grashof', 'grashof', 'limit_angles', 'assembly_intervals', 'Motion', 'rocking_motions',
            'crank_angles', 'exact_grid', 'coupler_point', 'listing_grid', 'deg360', 'Extremes', 'toggles_in_range',
-           'extremes', 'TIDY_UNITS', 'tidy_frame', 'exact_columns', 'blame']
+           'extremes', 'TIDY_UNITS', 'tidy_frame', 'exact_columns', 'blame', 'SUMMARY_KEYS', 'PASS_BITS', 'param_matrix',
+           'summary_rows']
 
 
 ST = kernel.FOURBAR_STATUS
@@ -310,6 +314,49 @@ def deg360(rad: np.ndarray) -> np.ndarray:
     return np.where(d >= 359.95, d - 360.0, d)
 
 
+# ----------------------------------------------------------------------------- the summary kernel
+
+#: the summary kernel's parameters, in its column order (fortran/fourbar_summary.f90): deck keys
+SUMMARY_KEYS = tuple(c.name.lower() for c in SummaryParam)
+
+
+#: the kernel's pass bits (fortran/fourbar_summary.f90 pass_*)
+PASS_BITS = {"transmission": kernel.FOURBAR_PASSES["transmission"], "rocker": kernel.FOURBAR_PASSES["rocker"],
+             "peaks": kernel.FOURBAR_PASSES["peaks"]}
+
+
+def param_matrix(base: Mapping[str, Any], columns: Mapping[str, Any], n: int) -> np.ndarray:
+    """The summary kernel's (n, 8) parameter matrix (:data:`SUMMARY_KEYS`): base values, overridden column by
+    column; a bad value raises DeckError at its deck line (``base`` a deck's Params) or ValueError."""
+    cols = {}
+    for key in SUMMARY_KEYS:
+        v = columns.get(key, base[key])
+        if key == "branch":
+            v = np.asarray(v)
+            if v.dtype.kind in "US":
+                bad = ~np.isin(v, ("open", "crossed"))
+                if bad.any():
+                    raise batch_error(base, "branch", f"must be 'open' or 'crossed' (got {v[np.argmax(bad)]!r})")
+                v = np.where(v == "open", 1.0, -1.0)
+        v = np.broadcast_to(np.asarray(v, dtype=np.float64), (n,))
+        bad = ~np.isfinite(v)
+        if key in ("fixed_link", "crank", "coupler", "rocker"):
+            bad |= ~(v > 0)
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise batch_error(base, key, f"design {i} has {float(v[i])!r} (lengths must be positive, all values finite)")
+        cols[key] = v
+    m = np.empty((n, len(SummaryParam)), dtype=np.float64, order="F")
+    for j, key in enumerate(SUMMARY_KEYS):
+        m[:, j] = cols[key]
+    return m
+
+
+def summary_rows(p: Params) -> np.ndarray:
+    """The summary kernel's row of one deck, every pass: (1, 19) (fortran/fourbar_summary.f90)."""
+    return kernel.fourbar_summaries(param_matrix(p, {}, 1), sum(PASS_BITS.values()))
+
+
 @dataclass
 class Extremes:
     """Headline figures over the analysed crank range (exact solution), from the batch kernel.
@@ -378,7 +425,7 @@ def extremes(p: Params, row: np.ndarray | None = None) -> Extremes | None:
         Validated ``&fourbar`` keys.
     row : numpy.ndarray, optional
         The deck's row of the summary kernel when the caller has it
-        (``driver.fourbar._batch.summary_rows``); computed otherwise.
+        (:func:`summary_rows`); computed otherwise.
 
     Returns
     -------
@@ -389,11 +436,15 @@ def extremes(p: Params, row: np.ndarray | None = None) -> Extremes | None:
     lo, hi = sorted((p.start_deg, p.stop_deg))
     if row is None:
         row = summary_rows(p)[0]
-    if not row[1]:
+    if not row[Summary.ASSEMBLABLE]:
         return None
     toggles = toggles_in_range(p.fixed_link, p.crank, p.coupler, p.rocker, lo, hi)
-    return Extremes(row[3], row[4], row[5], row[6], row[7], row[8], row[9], row[10],
-                    row[14], row[15], row[16], row[17], row[2], bool(row[12]), toggles, row[11])
+    c = Summary
+    return Extremes(row[c.MU_MIN_DEG], row[c.MU_MIN_AT_DEG], row[c.MU_MAX_DEG], row[c.MU_MAX_AT_DEG],
+                    row[c.ROCKER_MIN_DEG], row[c.ROCKER_MIN_AT_DEG], row[c.ROCKER_MAX_DEG], row[c.ROCKER_MAX_AT_DEG],
+                    row[c.OMEGA3_PEAK_RAD_S], row[c.OMEGA3_PEAK_AT_DEG], row[c.OMEGA2_PEAK_RAD_S],
+                    row[c.OMEGA2_PEAK_AT_DEG], row[c.ASSEMBLED_FRACTION], bool(row[c.ROCKER_TURNS]), toggles,
+                    row[c.ROCKER_SWING_DEG])
 
 
 #: units of the tidy columns whose names do not say them ('length': the deck's length unit)
@@ -432,15 +483,16 @@ def tidy_frame(method: str, theta: np.ndarray, cols: dict[str, np.ndarray], stat
 
 def exact_columns(out: np.ndarray, status: np.ndarray, cp: np.ndarray | None = None,
                    coupler: float | None = None) -> dict[str, np.ndarray]:
-    vals = {"coupler_deg": deg360(out[:, 0]), "rocker_deg": deg360(out[:, 1]),
-            "transmission_deg": np.degrees(out[:, 2]), "xa": out[:, 3], "ya": out[:, 4],
-            "xb": out[:, 5], "yb": out[:, 6], "omega2_rad_s": out[:, 7], "omega3_rad_s": out[:, 8],
-            "alpha2_rad_s2": out[:, 9], "alpha3_rad_s2": out[:, 10]}
+    s = State
+    vals = {"coupler_deg": deg360(out[:, s.COUPLER_ANGLE]), "rocker_deg": deg360(out[:, s.ROCKER_ANGLE]),
+            "transmission_deg": np.degrees(out[:, s.TRANSMISSION_ANGLE]), "xa": out[:, s.XA], "ya": out[:, s.YA],
+            "xb": out[:, s.XB], "yb": out[:, s.YB], "omega2_rad_s": out[:, s.OMEGA2], "omega3_rad_s": out[:, s.OMEGA3],
+            "alpha2_rad_s2": out[:, s.ALPHA2], "alpha3_rad_s2": out[:, s.ALPHA3]}
     if coupler is not None:   # loop closure of the solution: |AB| - coupler (round-off only)
-        vals["ab_error"] = np.hypot(out[:, 5] - out[:, 3], out[:, 6] - out[:, 4]) - coupler
+        vals["ab_error"] = np.hypot(out[:, s.XB] - out[:, s.XA], out[:, s.YB] - out[:, s.YA]) - coupler
     if cp is not None:
-        vals.update({"xp": cp[:, 0], "yp": cp[:, 1], "vxp_per_s": cp[:, 2], "vyp_per_s": cp[:, 3],
-                     "axp_per_s2": cp[:, 4], "ayp_per_s2": cp[:, 5]})
+        vals.update({"xp": cp[:, Point.X], "yp": cp[:, Point.Y], "vxp_per_s": cp[:, Point.VX],
+                     "vyp_per_s": cp[:, Point.VY], "axp_per_s2": cp[:, Point.AX], "ayp_per_s2": cp[:, Point.AY]})
     nope = (status == ST["no_assembly"]) | (status == ST["indeterminate"])
     tog = status == ST["toggle"]
     for k, v in vals.items():

@@ -1,5 +1,7 @@
 """The four-bar batch summary: many designs in one kernel call (sweeps, &optimize), and the
-summary of one deck (the same kernel row)."""
+summary of one deck (the same kernel row); with ``mass`` given, the force summary (issue 26:
+peak, mean and RMS torque, peak pin forces, shaking force and moment, energy fluctuation and
+flywheel inertia) the same way, in one call of the force-summary kernel."""
 from __future__ import annotations
 
 import math
@@ -10,18 +12,22 @@ import numpy as np
 import pandas as pd
 
 from driver._deck import Params
-from driver._study import contract_doc
-from driver.fourbar import _forces as forces
+from driver._study import batch_error, contract_doc
 from driver.fourbar import _kernel as kernel
-from driver.fourbar._spec import BAND, band_of
+from driver.fourbar._analysis import PASS_BITS, SUMMARY_KEYS, param_matrix, summary_rows
+from driver.fourbar._analysis_forces import cw_radii, props
+from driver.fourbar._kernel import ForceParam
+from driver.fourbar._spec import BAND, FORCE_SUMMARY_DOC, band_of, force_value, forces_active
 
-__all__ = ['BATCH_KEYS', 'BATCH_IGNORED', 'BATCH_INDEPENDENT', 'BATCH_PASSES', 'PASS_BITS', 'DETAIL',
-           'param_matrix', 'summarise_batch', 'summary_rows', 'summary_frame', 'summarise', 'summary_of']
+__all__ = ['BATCH_KEYS', 'BATCH_IGNORED', 'BATCH_INDEPENDENT', 'BATCH_PASSES', 'DETAIL', 'summarise_batch',
+           'summary_frame', 'summarise', 'summary_of',
+           'FORCE_BATCH_KEYS', 'force_frame', 'force_summary', 'summarise_force_batch']
 
 
-#: deck keys a batch may vary (one value per design); every other key of &fourbar leaves the
-#: summary unchanged (alpha, step_deg, method, title, coupler_point) and is accepted but ignored
-BATCH_KEYS = ("fixed_link", "crank", "coupler", "rocker", "omega", "start_deg", "stop_deg", "branch")
+#: deck keys a batch may vary (one value per design: the summary kernel's parameters); every
+#: other key of &fourbar leaves the summary unchanged (alpha, step_deg, method, title,
+#: coupler_point) and is accepted but ignored
+BATCH_KEYS = SUMMARY_KEYS
 
 
 BATCH_IGNORED = ("alpha", "step_deg", "method", "title", "coupler_point")
@@ -46,14 +52,9 @@ BATCH_PASSES: dict[str, tuple[str, ...]] = {
     "mu_min_at_deg": ("transmission",), "mu_max_at_deg": ("transmission",), "rocker_min_deg": ("rocker",),
     "rocker_min_at_deg": ("rocker",), "rocker_max_deg": ("rocker",), "rocker_max_at_deg": ("rocker",),
     "omega3_peak_at_deg": ("peaks",), "omega2_peak_at_deg": ("peaks",), "toggles_in_range": (),
-    # decks that give masses: the force summary (driver/fourbar/_forces.py), a pass of its own
-    **{f"{pre}{c}": ("forces",) for pre in ("", "unbalanced_") for c in forces.SUMMARY_DOC},
+    # decks that give masses: the force summary (summarise_force_batch), a pass of its own
+    **{f"{pre}{c}": ("forces",) for pre in ("", "unbalanced_") for c in FORCE_SUMMARY_DOC},
 }
-
-
-#: the kernel's pass bits (fortran/fourbar_summary.f90 pass_*)
-PASS_BITS = {"transmission": kernel.FOURBAR_PASSES["transmission"], "rocker": kernel.FOURBAR_PASSES["rocker"],
-             "peaks": kernel.FOURBAR_PASSES["peaks"]}
 
 
 def _pass_mask(wanted: Collection[str] | None) -> int:
@@ -68,39 +69,6 @@ GRASHOF_NAMES = {"double_crank": ("double-crank (drag link)", True), "crank_rock
                  "rocker_crank": ("rocker-crank", False), "double_rocker": ("Grashof double-rocker", False),
                  "change_point": ("change-point (special Grashof)", True),
                  "triple_rocker": ("non-Grashof triple-rocker", False)}
-
-
-def _bad(base: Mapping[str, Any], key: str | None, message: str) -> Exception:
-    """A DeckError at the key's deck line when ``base`` is a deck's Params, else a ValueError."""
-    if isinstance(base, Params):
-        return base.error(key, message)
-    return ValueError(f"{key}: {message}" if key else message)
-
-
-def param_matrix(base: Mapping[str, Any], columns: Mapping[str, Any], n: int) -> np.ndarray:
-    """The kernel's (n, 8) parameter matrix: base values, overridden column by column."""
-    cols = {}
-    for key in BATCH_KEYS:
-        v = columns.get(key, base[key])
-        if key == "branch":
-            v = np.asarray(v)
-            if v.dtype.kind in "US":
-                bad = ~np.isin(v, ("open", "crossed"))
-                if bad.any():
-                    raise _bad(base, "branch", f"must be 'open' or 'crossed' (got {v[np.argmax(bad)]!r})")
-                v = np.where(v == "open", 1.0, -1.0)
-        v = np.broadcast_to(np.asarray(v, dtype=np.float64), (n,))
-        bad = ~np.isfinite(v)
-        if key in ("fixed_link", "crank", "coupler", "rocker"):
-            bad |= ~(v > 0)
-        if bad.any():
-            i = int(np.argmax(bad))
-            raise _bad(base, key, f"design {i} has {float(v[i])!r} (lengths must be positive, all values finite)")
-        cols[key] = v
-    m = np.empty((n, 8), dtype=np.float64, order="F")
-    for j, key in enumerate(BATCH_KEYS):
-        m[:, j] = cols[key]
-    return m
 
 
 @contract_doc
@@ -149,30 +117,25 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     columns = {k.partition(".")[2] if k.startswith("fourbar.") else k: v for k, v in (columns or {}).items()}
     unknown = [k for k in columns if k not in BATCH_KEYS and k not in BATCH_IGNORED]
     if unknown:
-        raise _bad(base, unknown[0], f"not a &fourbar key the summary depends on ({', '.join(BATCH_KEYS)})")
-    force_columns = {k: v for k, v in columns.items() if k in forces.BATCH_KEYS}
+        raise batch_error(base, unknown[0], f"not a &fourbar key the summary depends on ({', '.join(BATCH_KEYS)})")
+    force_columns = {k: v for k, v in columns.items() if k in FORCE_BATCH_KEYS}
     columns = {k: v for k, v in columns.items() if k in BATCH_KEYS}
     sizes = {np.size(v) for v in columns.values() if np.ndim(v) > 0}
     if len(sizes) > 1:
-        raise _bad(base, None, f"batch columns have different lengths {sorted(sizes)}")
+        raise batch_error(base, None, f"batch columns have different lengths {sorted(sizes)}")
     n = sizes.pop() if sizes else 1
     res = kernel.fourbar_summaries(param_matrix(base, columns, n), _pass_mask(wanted))
     return _assemble(base, res, detail or (wanted is not None and any(c in DETAIL for c in wanted)), wanted,
                      force_columns)
 
 
-def summary_rows(p: Params) -> np.ndarray:
-    """The summary kernel's row of one deck, every pass: (1, 19) (fortran/fourbar_summary.f90)."""
-    return kernel.fourbar_summaries(param_matrix(p, {}, 1), _pass_mask(None))
-
-
 def _assemble(base: Mapping[str, Any], res: np.ndarray, detail: bool, wanted: Collection[str] | None,
               force_columns: Mapping[str, Any]) -> pd.DataFrame:
     """The summary frame of kernel rows ``res`` (and the force columns when the deck gives masses)."""
     frame = summary_frame(res, detail, band_of(base), wanted)
-    if forces.active(base) and (wanted is None or any(BATCH_PASSES.get(c) == ("forces",) for c in wanted)):
-        # force columns (driver/fourbar/_forces.py) when the deck gives masses, and someone reads one
-        more = forces.summarise_force_batch(base, force_columns)
+    if forces_active(base) and (wanted is None or any(BATCH_PASSES.get(c) == ("forces",) for c in wanted)):
+        # force columns when the deck gives masses, and someone reads one
+        more = summarise_force_batch(base, force_columns)
         if wanted is not None:
             more = more[[c for c in more.columns if c in set(wanted)]]
         frame = pd.concat([frame, more], axis=1)
@@ -238,3 +201,105 @@ def summary_of(p: Params, res: np.ndarray | None = None) -> dict:
     return {k: (None if isinstance(v, float) and math.isnan(v) else
                 bool(v) if isinstance(v, (bool, np.bool_)) else
                 float(v) if isinstance(v, np.floating) else v) for k, v in row.items()}
+
+
+# ----------------------------------------------------------------------------- the force summary (decks with mass)
+
+#: deck keys a force batch may vary, in the kernel's parameter order where they map to one column
+FORCE_BATCH_KEYS = ("fixed_link", "crank", "coupler", "rocker", "omega", "alpha", "start_deg", "stop_deg", "branch",
+              "mass", "inertia", "com_distance", "com_angle_deg", "gravity", "load_torque", "load_force_x",
+              "load_force_y", "coupler_point", "speed_fluctuation", "balance", "counterweight_radius")
+
+
+def _force_row(p: Mapping[str, Any]) -> np.ndarray:
+    """One row of the batch kernel's (31) parameters from a deck-like mapping."""
+    pr = props(p)
+    bal = 1.0 if force_value(p, "balance") == "force" else 0.0
+    return np.concatenate([[p["fixed_link"], p["crank"], p["coupler"], p["rocker"], p["omega"], p.get("alpha", 0.0),
+                            p.get("start_deg", 0.0), p.get("stop_deg", 360.0),
+                            1.0 if p.get("branch", "open") == "open" else -1.0],
+                           pr, [force_value(p, "speed_fluctuation"), bal, *cw_radii(p)]])
+
+
+def force_frame(res: np.ndarray, prefix: str = "") -> pd.DataFrame:
+    """Force-summary kernel rows -> the force summary columns (NaN where a figure does not exist)."""
+    c = dict(zip(kernel.FOURBAR_FORCE_SUMMARY_COLUMNS, res.T))
+    anyok = c["defined_fraction"] > 0
+    full = c["defined_fraction"] >= 1.0
+    out: dict[str, np.ndarray] = {}
+    for name in FORCE_SUMMARY_DOC:
+        v = c[name]
+        mask = full if name in ("torque_mean_Nm", "torque_rms_Nm", "energy_fluctuation_J",
+                                "flywheel_inertia_kgm2") else anyok
+        if name == "flywheel_inertia_kgm2":
+            mask = mask & (v > 0)
+        out[prefix + name] = np.where(mask, v, np.nan)
+    return pd.DataFrame(out)
+
+
+def force_summary(p: Params) -> dict[str, Any]:
+    """Summarise the forces of one deck: one row of the batch kernel.
+
+    Parameters
+    ----------
+    p : Params
+        Validated ``&fourbar`` keys (lengths in m with ``mass``).
+
+    Returns
+    -------
+    dict of str to float or None
+        ``FORCE_SUMMARY_DOC``'s figures, units in their names (``torque_peak_Nm``,
+        ``energy_fluctuation_J``, ``flywheel_inertia_kgm2``), None where one does not exist;
+        with ``balance = 'force'`` of the balanced linkage, and the linkage as given's
+        prefixed ``unbalanced_``.
+    """
+    d = summarise_force_batch(p).iloc[0].to_dict()
+    return {str(k): (None if isinstance(v, float) and math.isnan(v) else float(v)) for k, v in d.items()}
+
+
+def summarise_force_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None = None) -> pd.DataFrame:
+    """Summarise the forces of many designs in one Fortran call: one row per design.
+
+    Parameters
+    ----------
+    base : mapping
+        A validated ``&fourbar`` Params with ``mass`` given (lengths in m).
+    columns : mapping of str to array, optional
+        {key: n values} for scalar keys in ``FORCE_BATCH_KEYS`` (``'fourbar.crank'`` accepted), or
+        ``mass``/``inertia``/``com_distance``/``com_angle_deg`` as (n, 3) arrays, in the
+        keys' deck units (kg, kg m^2, m, deg); scalars broadcast.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per design, the columns of ``FORCE_SUMMARY_DOC`` (units in their names); with
+        ``balance = 'force'`` of the balanced linkage, and the same columns prefixed
+        ``unbalanced_`` for the linkage as given.
+    """
+    columns = {k.partition(".")[2] if k.startswith("fourbar.") else k: v for k, v in (columns or {}).items()}
+    bad = [k for k in columns if k not in FORCE_BATCH_KEYS]
+    if bad:
+        raise ValueError(f"{bad[0]}: not a key the force summary depends on ({', '.join(FORCE_BATCH_KEYS)})")
+    sizes = {len(v) for v in columns.values() if np.ndim(v) > 0}
+    if len(sizes) > 1:
+        raise ValueError(f"batch columns have different lengths {sorted(sizes)}")
+    n = sizes.pop() if sizes else 1
+    rows = np.empty((n, kernel.N_FORCE_PARAMS), order="F")
+    for i in range(n):
+        d = dict(base)
+        for k, v in columns.items():
+            d[k] = v[i] if np.ndim(v) > 0 else v
+        for key in ("fixed_link", "crank", "coupler", "rocker"):
+            if not (float(d[key]) > 0):
+                raise ValueError(f"{key}: design {i} has {d[key]!r} (lengths must be positive)")
+        for key in ("mass", "inertia"):
+            if d.get(key) is not None and np.any(np.asarray(d[key], dtype=float) < 0):
+                raise ValueError(f"{key}: design {i} has a negative value")
+        rows[i] = _force_row(d)
+    if not np.all(np.isfinite(rows)):
+        raise ValueError("batch values must be finite")
+    frame = force_frame(kernel.fourbar_force_summaries(rows))
+    if rows[:, ForceParam.BALANCE].any():   # balanced designs: the figures without counterweights follow
+        rows[:, ForceParam.BALANCE] = 0.0
+        frame = pd.concat([frame, force_frame(kernel.fourbar_force_summaries(rows), "unbalanced_")], axis=1)
+    return frame

@@ -1,5 +1,6 @@
-"""The four-bar figures: angle, speed and transmission-angle curves against the crank angle, and the
-linkage drawn over its turn at its limit positions.
+"""The four-bar figures: angle, speed and transmission-angle curves against the crank angle, the
+linkage drawn over its turn at its limit positions, and the force analysis's input torque, pin
+forces and shaking force (each drawn into axes the caller gives).
 
 Drawn in the house style (:mod:`driver.plotting`); this module imports matplotlib (the optional
 [plot] extra), so the study imports it only when a figure is drawn.
@@ -7,7 +8,8 @@ Drawn in the house style (:mod:`driver.plotting`); this module imports matplotli
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any
 
 import matplotlib
 import matplotlib.colors
@@ -15,7 +17,12 @@ import matplotlib.ticker
 import numpy as np
 from matplotlib.figure import Figure
 
+from driver.fourbar._kernel import Force, Point
+from driver.fourbar._kernel import State as S
 from driver.plotting import new_figure, plain_text, styled
+
+if TYPE_CHECKING:
+    from driver.fourbar._analysis_forces import ForceAnalysis
 
 
 def break_wraps(x: np.ndarray, y: np.ndarray, period: float = 360.0) -> tuple[np.ndarray, np.ndarray]:
@@ -138,10 +145,10 @@ def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.nd
     runs = _runs(ok)
     full = bool(ok.all()) and np.ptp(theta) >= 359.0
     for j, r in enumerate(runs if not full else [np.arange(len(ok))]):
-        ax.plot(out[r, 3], out[r, 4], color="0.55", lw=0.9, label="path of A (crank pin)" if j == 0 else None)
-        ax.plot(out[r, 5], out[r, 6], color="C3", lw=1.3, label=f"path of B ({output} pin)" if j == 0 else None)
+        ax.plot(out[r, S.XA], out[r, S.YA], color="0.55", lw=0.9, label="path of A (crank pin)" if j == 0 else None)
+        ax.plot(out[r, S.XB], out[r, S.YB], color="C3", lw=1.3, label=f"path of B ({output} pin)" if j == 0 else None)
         if point is not None:
-            ax.plot(point[r, 0], point[r, 1], color="C4", lw=1.3, ls="--",
+            ax.plot(point[r, Point.X], point[r, Point.Y], color="C4", lw=1.3, ls="--",
                     label="path of coupler point P" if j == 0 else None)
     if listing is not None:
         ax.plot(listing["xb"], listing["yb"], "x", color="k", ms=5, label="B (listing)")
@@ -151,17 +158,17 @@ def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.nd
     picks = idx[np.linspace(0, len(idx) - 1, n_poses, endpoint=not full).astype(int)] if len(idx) else []
     for j, k in enumerate(picks):
         c = cmap(j / max(1, n_poses - 1))
-        xs = [0.0, out[k, 3], out[k, 5], ground]
-        ys = [0.0, out[k, 4], out[k, 6], 0.0]
+        xs = [0.0, out[k, S.XA], out[k, S.XB], ground]
+        ys = [0.0, out[k, S.YA], out[k, S.YB], 0.0]
         ax.plot(xs, ys, "-o", color=c, ms=3, lw=1.5, label=rf"$\theta_2$ = {theta[k]:.0f}°")
         if point is not None:
-            tri = np.array([[out[k, 3], out[k, 4]], [out[k, 5], out[k, 6]], point[k], [out[k, 3], out[k, 4]]])
+            tri = np.array([[out[k, S.XA], out[k, S.YA]], [out[k, S.XB], out[k, S.YB]], point[k], [out[k, S.XA], out[k, S.YA]]])
             ax.fill(tri[:, 0], tri[:, 1], color=c, alpha=0.15, lw=0)
             ax.plot(tri[:, 0], tri[:, 1], color=c, lw=1.0)
             ax.plot(*point[k], "o", color=c, ms=3.5)
     for j, (angle, row) in enumerate(limits):
-        xs = [0.0, row[3], row[5], ground]
-        ys = [0.0, row[4], row[6], 0.0]
+        xs = [0.0, row[S.XA], row[S.XB], ground]
+        ys = [0.0, row[S.YA], row[S.YB], 0.0]
         ax.plot(xs, ys, "--", color="k", lw=1.1, label="limit (toggle) positions" if j == 0 else None)
         _limit_label(ax, row, rf"$\theta_2$ = {angle:.1f}°")
     ax.plot([0.0, ground], [0.0, 0.0], color="k", lw=2.5)
@@ -188,7 +195,7 @@ def _deg(value: float, digits: int = 1) -> str:
 def _limit_label(ax, row: np.ndarray, text: str) -> None:
     """A limit position's label beside its crank pin A, pushed outward (away from the crank
     pivot) on a white ground so it does not sit on the pose lines."""
-    x, y = float(row[3]), float(row[4])
+    x, y = float(row[S.XA]), float(row[S.YA])
     r = math.hypot(x, y) or 1.0
     ux, uy = x / r, y / r
     ax.annotate(text, (x, y), xytext=(14 * ux, 14 * uy), textcoords="offset points", fontsize=8,
@@ -210,37 +217,37 @@ def _rocking_drawing(ax, ground: float, motions: Sequence[dict], title: str, uni
         first = int(np.asarray(m["branch"])[0])
         tag = "" if n_m == 1 else f" (motion {i + 1})"
         fwd, back = np.flatnonzero(stroke == 0), np.flatnonzero(stroke == 1)
-        ax.plot(out[fwd, 3], out[fwd, 4], color="0.55", lw=0.9, label="path of A (crank pin): an arc" if i == 0 else None)
-        ax.plot(out[fwd, 5], out[fwd, 6], color="C3", lw=1.3,
+        ax.plot(out[fwd, S.XA], out[fwd, S.YA], color="0.55", lw=0.9, label="path of A (crank pin): an arc" if i == 0 else None)
+        ax.plot(out[fwd, S.XB], out[fwd, S.YB], color="C3", lw=1.3,
                 label=f"path of B, out on the {word[first]} assembly" if i == 0 else None)
-        ax.plot(out[back, 5], out[back, 6], color="C3", lw=1.3, ls="--",
+        ax.plot(out[back, S.XB], out[back, S.YB], color="C3", lw=1.3, ls="--",
                 label=f"path of B, back on the {word[-first]} assembly" if i == 0 else None)
         pt = m.get("point")
         if pt is not None:
             pt = np.asarray(pt)
-            ax.plot(pt[fwd, 0], pt[fwd, 1], color="C4", lw=1.2, label="path of coupler point P" if i == 0 else None)
-            ax.plot(pt[back, 0], pt[back, 1], color="C4", lw=1.2, ls="--")
+            ax.plot(pt[fwd, Point.X], pt[fwd, Point.Y], color="C4", lw=1.2, label="path of coupler point P" if i == 0 else None)
+            ax.plot(pt[back, Point.X], pt[back, Point.Y], color="C4", lw=1.2, ls="--")
         # poses: three inside each stroke (the limits are drawn on their own)
         at = [1 / 3, 2 / 3] if n_m > 1 else [0.2, 0.5, 0.8]   # fractions of a stroke's samples
         picks = [fwd[int(f * (len(fwd) - 1))] for f in at] + [back[int(f * (len(back) - 1))] for f in at]
         for j, k in enumerate(picks):
             c = cmap((j + 0.5) / len(picks))
             back_pose = stroke[k] == 1
-            xs = [0.0, out[k, 3], out[k, 5], ground]
-            ys = [0.0, out[k, 4], out[k, 6], 0.0]
+            xs = [0.0, out[k, S.XA], out[k, S.XB], ground]
+            ys = [0.0, out[k, S.YA], out[k, S.YB], 0.0]
             arrow = "\u2192" if not back_pose else "\u2190"
             ax.plot(xs, ys, "-o", color=c, ms=3, lw=1.4, ls=":" if back_pose else "-", alpha=0.95,
                     label=(rf"$\theta_2$ = {_deg(theta[k], 0)}° {arrow} {word[int(np.asarray(m['branch'])[k])]}"
                            + tag))
             if pt is not None:
-                tri = np.array([[out[k, 3], out[k, 4]], [out[k, 5], out[k, 6]], pt[k], [out[k, 3], out[k, 4]]])
+                tri = np.array([[out[k, S.XA], out[k, S.YA]], [out[k, S.XB], out[k, S.YB]], pt[k], [out[k, S.XA], out[k, S.YA]]])
                 ax.fill(tri[:, 0], tri[:, 1], color=c, alpha=0.12, lw=0)
                 ax.plot(tri[:, 0], tri[:, 1], color=c, lw=0.9, ls=":" if back_pose else "-")
         for end, angle in ((fwd[0], m["lo"]), (fwd[-1], m["hi"])):
             row = out[end]
-            ax.plot([0.0, row[3], row[5], ground], [0.0, row[4], row[6], 0.0], "--", color="k", lw=1.1,
+            ax.plot([0.0, row[S.XA], row[S.XB], ground], [0.0, row[S.YA], row[S.YB], 0.0], "--", color="k", lw=1.1,
                     label="limit positions (the crank reverses)" if i == 0 and end == fwd[0] else None)
-            ax.plot([row[3]], [row[4]], "o", color="k", ms=4)
+            ax.plot([row[S.XA]], [row[S.YA]], "o", color="k", ms=4)
             _limit_label(ax, row, rf"limit $\theta_2$ = {_deg(angle)}°")
     ax.plot([0.0, ground], [0.0, 0.0], color="k", lw=2.5)
     ax.plot([0.0, ground], [0.0, 0.0], "^", color="k", ms=9, label="ground pivots $O_2$, $O_4$")
@@ -264,3 +271,119 @@ def _rocking_drawing(ax, ground: float, motions: Sequence[dict], title: str, uni
 
 
 # ----------------------------------------------------------------------------- figures of a run
+
+
+# ----------------------------------------------------------------------------- the force analysis
+
+def plot_torque(theta: np.ndarray, fa: ForceAnalysis, p: Mapping[str, Any], ax: Any) -> Any:
+    """Plot the input torque against crank angle, its mean, and the energy fluctuation dE.
+
+    dE is shaded between the torque curve and the mean; with balancing the torque of the
+    linkage without counterweights is dashed.
+
+    Parameters
+    ----------
+    theta : numpy.ndarray
+        Crank angles, deg.
+    fa : ForceAnalysis
+        The forces (``driver.fourbar.forces.analyse``).
+    p : mapping
+        The ``&fourbar`` keys.
+    ax : matplotlib.axes.Axes
+        The axes to draw into (crank angle in deg, torque in N m, dE in J in the legend).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        ``ax``.
+    """
+    t = np.where(fa.ok, fa.forces[:, Force.INPUT_TORQUE], np.nan)
+    ax.plot(theta, t, color="C0", label="input torque")
+    if fa.ok.all() and len(theta) > 1:
+        mean = np.trapezoid(t, theta) / (theta[-1] - theta[0])
+        e = np.concatenate([[0.0], np.cumsum(0.5 * (t[1:] + t[:-1] - 2 * mean) * np.diff(np.radians(theta)))])
+        ax.axhline(mean, color="C1", lw=1, label=f"mean {mean:.3f} N m")
+        ax.fill_between(theta, t, mean, color="C0", alpha=0.15,
+                        label=f"dE = {e.max() - e.min():.4g} J (max - min of the area)")
+    if fa.unbalanced is not None:
+        ax.plot(theta, np.where(fa.ok, fa.unbalanced[:, Force.INPUT_TORQUE], np.nan), "--", color="C3",
+                label="without counterweights")
+    ax.set_xlabel("crank angle [deg]")
+    ax.set_ylabel("input torque [N m]")
+    ax.legend(fontsize=7, loc="best")
+    return ax
+
+
+def plot_pin_polars(fa: ForceAnalysis, axes: Any) -> Any:
+    """Plot the force at each pin over the cycle on polar axes.
+
+    Angle = direction of the force, radius = its magnitude in N; with balancing, the
+    unbalanced linkage's dashed.
+
+    Parameters
+    ----------
+    fa : ForceAnalysis
+        The forces (``driver.fourbar.forces.analyse``).
+    axes : sequence of matplotlib.axes.Axes
+        Four polar axes: O2, A, B, O4.
+
+    Returns
+    -------
+    sequence of matplotlib.axes.Axes
+        ``axes``.
+    """
+    names = ("O2 (ground on crank)", "A (crank on coupler)", "B (coupler on rocker)", "O4 (ground on rocker)")
+    pins = ((Force.F_O2_X, Force.F_O2_Y), (Force.F_A_X, Force.F_A_Y), (Force.F_B_X, Force.F_B_Y),
+            (Force.F_O4_X, Force.F_O4_Y))
+    for j, ax in enumerate(np.ravel(axes)[:4]):
+        fx = np.where(fa.ok, fa.forces[:, pins[j][0]], np.nan)
+        fy = np.where(fa.ok, fa.forces[:, pins[j][1]], np.nan)
+        ax.plot(np.arctan2(fy, fx), np.hypot(fx, fy), color="C0", lw=1,
+                label="balanced" if fa.unbalanced is not None else "as given")
+        if fa.unbalanced is not None:
+            bx = np.where(fa.ok, fa.unbalanced[:, pins[j][0]], np.nan)
+            by = np.where(fa.ok, fa.unbalanced[:, pins[j][1]], np.nan)
+            ax.plot(np.arctan2(by, bx), np.hypot(bx, by), color="C3", lw=1, ls="--", label="unbalanced")
+        ax.set_title(f"F at {names[j]} [N]", fontsize=8)
+    np.ravel(axes)[0].legend(fontsize=6, loc="lower left")
+    return axes
+
+
+def plot_shaking(theta: np.ndarray, fa: ForceAnalysis, ax: Any, polar_ax: Any | None = None) -> Any:
+    """Plot the shaking force magnitude against crank angle, and its locus, before and after balancing.
+
+    Parameters
+    ----------
+    theta : numpy.ndarray
+        Crank angles, deg.
+    fa : ForceAnalysis
+        The forces (``driver.fourbar.forces.analyse``).
+    ax : matplotlib.axes.Axes
+        Axes for |shaking force| (N) against crank angle (deg).
+    polar_ax : matplotlib.axes.Axes, optional
+        Axes for the locus F_y against F_x (N, equal scales).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        ``ax``.
+    """
+    before = fa.unbalanced if fa.unbalanced is not None else fa.forces
+    shaking = [Force.SHAKING_X, Force.SHAKING_Y]
+    s = np.where(fa.ok[:, None], before[:, shaking], np.nan)
+    ax.plot(theta, np.hypot(*s.T), color="C0", label="unbalanced")
+    if polar_ax is not None:
+        polar_ax.plot(s[:, 0], s[:, 1], color="C0", label="unbalanced")
+    if fa.unbalanced is not None:
+        b = np.where(fa.ok[:, None], fa.forces[:, shaking], np.nan)
+        ax.plot(theta, np.hypot(*b.T), "--", color="C3", label="balanced (Berkof-Lowen)")
+        if polar_ax is not None:
+            polar_ax.plot(b[:, 0], b[:, 1], "o", ms=3, color="C3", label="balanced (Berkof-Lowen)")
+    ax.set_xlabel("crank angle [deg]")
+    ax.set_ylabel("|shaking force| [N]")
+    ax.legend(fontsize=7)
+    if polar_ax is not None:
+        polar_ax.set_xlabel("shaking force x [N]")
+        polar_ax.set_ylabel("shaking force y [N]")
+        polar_ax.set_aspect("equal", adjustable="datalim")
+    return ax

@@ -9,19 +9,227 @@ back.  Each kernel's physics and units are documented in its Fortran source.
 """
 from __future__ import annotations
 
+from enum import IntEnum
+from typing import TYPE_CHECKING
+
 import numpy as np
 
-from driver._fortran import _kernels, farray, spare_buffer
+from driver._fortran import KernelStatus, farray
 
-__all__ = ['FOURBAR_PASSES', 'fourbar_listing', 'fourbar_exact', 'fourbar_coupler_point', 'fourbar_summaries',
-           'fourbar_joint_forces', 'fourbar_berkof_lowen', 'fourbar_force_summaries',
+if TYPE_CHECKING:   # the study's modules of the extension, typed (generated: tools/gen_kernel_stub.py)
+    from driver.fourbar import _kernels
+else:
+    from driver._fortran import _kernels
+
+__all__ = ['FourbarStatus', 'State', 'Listing', 'Point', 'Force', 'Prop', 'Counterweight', 'ForceParam', 'Summary',
+           'SummaryParam', 'FOURBAR_PASSES', 'fourbar_listing', 'fourbar_exact', 'fourbar_coupler_point',
+           'fourbar_summaries', 'fourbar_joint_forces', 'fourbar_berkof_lowen', 'fourbar_force_summaries',
            'FOURBAR_FORCE_SUMMARY_COLUMNS', 'FOURBAR_SUMMARY_COLUMNS', 'FOURBAR_GRASHOF', 'FOURBAR_STATUS']
 
 
-#: status codes of the four-bar kernels (fortran/fourbar.f90)
-FOURBAR_STATUS = {"ok": int(_kernels.fourbar.st_ok), "no_assembly": int(_kernels.fourbar.st_no_assembly),
-                  "toggle": int(_kernels.fourbar.st_toggle),
-                  "indeterminate": int(_kernels.fourbar.st_indeterminate)}
+class FourbarStatus(KernelStatus):
+    """Status of each crank angle of the four-bar kernels (fortran/fourbar.f90 ``st_*``).
+
+    A result of the position, never an error of the call.
+    """
+
+    ok = int(_kernels.fourbar.st_ok), "ok"
+    no_assembly = int(_kernels.fourbar.st_no_assembly), "cannot assemble", "the loop does not close at this crank angle"
+    toggle = int(_kernels.fourbar.st_toggle), "toggle", "coupler and rocker in line: the velocities are unbounded"
+    indeterminate = int(_kernels.fourbar.st_indeterminate), "indeterminate", "the crank pin A lies on the rocker pivot O_B"
+
+
+#: the four-bar kernels' status codes by name (``FOURBAR_STATUS["no_assembly"]``): :class:`FourbarStatus`
+FOURBAR_STATUS: type[FourbarStatus] = FourbarStatus
+
+
+# ----------------------------------------------------------------------------- the kernels' column layouts
+# Each kernel array's columns, named once (as pymsis names its model's outputs): ``out[:, State.XB]``.
+
+class State(IntEnum):
+    """Columns of :func:`fourbar_exact`'s states.
+
+    Angles [rad], pin positions [length], angular velocities [rad/s] and accelerations [rad/s^2] of
+    coupler (2) and rocker (3).
+    """
+
+    COUPLER_ANGLE = 0
+    ROCKER_ANGLE = 1
+    TRANSMISSION_ANGLE = 2
+    XA = 3
+    YA = 4
+    XB = 5
+    YB = 6
+    OMEGA2 = 7
+    OMEGA3 = 8
+    ALPHA2 = 9
+    ALPHA3 = 10
+
+
+class Listing(IntEnum):
+    """Columns of :func:`fourbar_listing`'s table.
+
+    Crank angle, epsl, phi, beta [whole deg, truncated], pin positions [length], omr, oms [rad/s]
+    (single precision, as printed).
+    """
+
+    THETA = 0
+    EPSL = 1
+    PHI = 2
+    BETA = 3
+    XA = 4
+    YA = 5
+    XB = 6
+    YB = 7
+    OMR = 8
+    OMS = 9
+
+
+class Point(IntEnum):
+    """Columns of :func:`fourbar_coupler_point`.
+
+    Position [length], velocity [length/s] and acceleration [length/s^2] of a point fixed to the
+    coupler.
+    """
+
+    X = 0
+    Y = 1
+    VX = 2
+    VY = 3
+    AX = 4
+    AY = 5
+
+
+class Force(IntEnum):
+    """Columns of :func:`fourbar_joint_forces`.
+
+    Input torque [N m], the force on each pin (x, y) [N], the shaking force (x, y) [N] and moment
+    about O2 [N m].
+    """
+
+    INPUT_TORQUE = 0
+    F_O2_X = 1
+    F_O2_Y = 2
+    F_A_X = 3
+    F_A_Y = 4
+    F_B_X = 5
+    F_B_Y = 6
+    F_O4_X = 7
+    F_O4_Y = 8
+    SHAKING_X = 9
+    SHAKING_Y = 10
+    SHAKING_MOMENT = 11
+
+
+class Prop(IntEnum):
+    """The 18 link and load properties of the force kernels.
+
+    Masses [kg], inertias about the centres of mass [kg m^2], centre-of-mass distances [m] and
+    angles [rad] of crank, coupler and rocker (each ``+ 0``, ``+ 1``, ``+ 2`` from its first),
+    gravity [m/s^2], load torque on the rocker [N m], load force at the coupler point (x, y) [N],
+    the point's u, v [m].
+    """
+
+    MASS = 0
+    INERTIA = 3
+    COM_DISTANCE = 6
+    COM_ANGLE = 9
+    GRAVITY = 12
+    LOAD_TORQUE = 13
+    LOAD_FORCE_X = 14
+    LOAD_FORCE_Y = 15
+    POINT_U = 16
+    POINT_V = 17
+
+
+#: the number of link and load properties (the length of a ``props`` array)
+N_PROPS = Prop.POINT_V + 1
+
+
+class Counterweight(IntEnum):
+    """The six results of :func:`fourbar_berkof_lowen`.
+
+    Crank counterweight mass x radius [kg m] and angle [rad], the rocker's the same, the two
+    counterweight masses [kg].
+    """
+
+    CRANK_MR = 0
+    CRANK_ANGLE = 1
+    ROCKER_MR = 2
+    ROCKER_ANGLE = 3
+    CRANK_MASS = 4
+    ROCKER_MASS = 5
+
+
+class ForceParam(IntEnum):
+    """The 31 columns of a :func:`fourbar_force_summaries` design.
+
+    The lengths p, q, r, s [m], omega [rad/s], alpha [rad/s^2], the crank range [deg], branch, the 18
+    :class:`Prop` (from ``PROPS``), the speed fluctuation, the balance flag and the two
+    counterweight radii [m].
+    """
+
+    P = 0
+    Q = 1
+    R = 2
+    S = 3
+    OMEGA = 4
+    ALPHA = 5
+    START_DEG = 6
+    STOP_DEG = 7
+    BRANCH = 8
+    PROPS = 9
+    SPEED_FLUCTUATION = 27
+    BALANCE = 28
+    CRANK_CW_RADIUS = 29
+    ROCKER_CW_RADIUS = 30
+
+
+#: the number of columns of a force-summary design
+N_FORCE_PARAMS = ForceParam.ROCKER_CW_RADIUS + 1
+
+
+class Summary(IntEnum):
+    """Columns of :func:`fourbar_summaries` (fortran/fourbar_summary.f90).
+
+    Named as the summary's (``FOURBAR_SUMMARY_COLUMNS``): angles in deg, speeds in rad/s, flags 0/1.
+    """
+
+    GRASHOF = 0
+    ASSEMBLABLE = 1
+    ASSEMBLED_FRACTION = 2
+    MU_MIN_DEG = 3
+    MU_MIN_AT_DEG = 4
+    MU_MAX_DEG = 5
+    MU_MAX_AT_DEG = 6
+    ROCKER_MIN_DEG = 7
+    ROCKER_MIN_AT_DEG = 8
+    ROCKER_MAX_DEG = 9
+    ROCKER_MAX_AT_DEG = 10
+    ROCKER_SWING_DEG = 11
+    ROCKER_TURNS = 12
+    TOGGLES_IN_RANGE = 13
+    OMEGA3_PEAK_RAD_S = 14
+    OMEGA3_PEAK_AT_DEG = 15
+    OMEGA2_PEAK_RAD_S = 16
+    OMEGA2_PEAK_AT_DEG = 17
+    TIME_RATIO = 18
+
+
+class SummaryParam(IntEnum):
+    """The 8 columns of a :func:`fourbar_summaries` design, named as the deck keys they take.
+
+    Lengths [length], crank speed [rad/s], the crank range [deg], branch (+1 open, -1 crossed).
+    """
+
+    FIXED_LINK = 0
+    CRANK = 1
+    COUPLER = 2
+    ROCKER = 3
+    OMEGA = 4
+    START_DEG = 5
+    STOP_DEG = 6
+    BRANCH = 7
 
 
 def fourbar_listing(p: float, q: float, r: float, s: float, omega: float,
@@ -91,23 +299,19 @@ def fourbar_exact(theta: np.ndarray, p: float, q: float, r: float, s: float, ome
     theta = farray(np.atleast_1d(theta), 1)
     n = theta.shape[0]
     if out is None:
-        out = spare_buffer("fourbar_exact.out", (n, 11), np.float64)
+        out = np.empty((n, 11), order="F")
     elif not (out.flags.f_contiguous and out.dtype == np.float64 and out.shape == (n, 11)):
         raise ValueError("out must be a Fortran-ordered float64 array of shape (n, 11); "
                          "f2py would otherwise work on a hidden copy")
     if status is None:
-        status = spare_buffer("fourbar_exact.status", (n,), np.int32)
+        status = np.empty(n, dtype=np.int32)
     elif not (status.dtype == np.int32 and status.shape == (n,)):
         raise ValueError("status must be an int32 array of shape (n,)")
     return _kernels.fourbar.exact_states(theta, p, q, r, s, omega, alpha, int(branch), out, status)
 
 
-#: columns of fourbar_summaries (fortran/fourbar_summary.f90)
-FOURBAR_SUMMARY_COLUMNS = ("grashof", "assemblable", "assembled_fraction", "mu_min_deg", "mu_min_at_deg",
-                           "mu_max_deg", "mu_max_at_deg", "rocker_min_deg", "rocker_min_at_deg",
-                           "rocker_max_deg", "rocker_max_at_deg", "rocker_swing_deg", "rocker_turns",
-                           "toggles_in_range", "omega3_peak_rad_s", "omega3_peak_at_deg",
-                           "omega2_peak_rad_s", "omega2_peak_at_deg", "time_ratio")
+#: columns of fourbar_summaries by name (fortran/fourbar_summary.f90): :class:`Summary`
+FOURBAR_SUMMARY_COLUMNS = tuple(c.name.lower() for c in Summary)
 #: Grashof class codes of fourbar_summaries
 FOURBAR_GRASHOF = {int(getattr(_kernels.fourbar_summary, f"gr_{k}")): k for k in
                    ("double_crank", "crank_rocker", "rocker_crank", "double_rocker", "change_point",
@@ -212,8 +416,8 @@ def fourbar_joint_forces(states: np.ndarray, status: np.ndarray, p: float, q: fl
         ``props`` does not have 18 values.
     """
     props = np.ascontiguousarray(props, dtype=np.float64)
-    if props.shape != (18,):
-        raise ValueError(f"props must have 18 values, got shape {props.shape}")
+    if props.shape != (N_PROPS,):
+        raise ValueError(f"props must have {N_PROPS} values, got shape {props.shape}")
     return _kernels.fourbar_forces.joint_forces(farray(states, 2), np.asarray(status, dtype=np.int32),
                                                 p, q, r, s, omega, alpha, props)
 
@@ -273,6 +477,6 @@ def fourbar_force_summaries(params: np.ndarray) -> np.ndarray:
         ``params`` does not have 31 columns.
     """
     params = farray(params, 2)
-    if params.shape[1] != 31:
-        raise ValueError(f"params must have 31 columns, got {params.shape[1]}")
+    if params.shape[1] != N_FORCE_PARAMS:
+        raise ValueError(f"params must have {N_FORCE_PARAMS} columns, got {params.shape[1]}")
     return _kernels.fourbar_forces.force_summaries(params)

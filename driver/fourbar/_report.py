@@ -3,19 +3,15 @@ the closed loop, or the closed-loop table with accelerations, coupler point and 
 (``method = 'exact'``); the summary lines, tidy table, summary and figures."""
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 import pandas as pd
 
-from driver import _keywords
 from driver._deck import Params
 from driver._export import with_units
+from driver._mechanism import Guide, Link, MechanismFrames
 from driver._result import Figure, Result
-from driver._runner import keyword_run
-from driver._signatures import keyword_signature
+from driver._runner import study_run
 from driver._table import Column, fortran_f, render_table
-from driver.fourbar import _forces as forces
 from driver.fourbar._analysis import (
     ST,
     TIDY_UNITS,
@@ -32,10 +28,14 @@ from driver.fourbar._analysis import (
     limit_angles,
     listing_grid,
     rocking_motions,
+    summary_rows,
     tidy_frame,
 )
-from driver.fourbar._batch import summary_of, summary_rows
-from driver.fourbar._spec import SPEC, band_of
+from driver.fourbar._batch import summary_of
+from driver.fourbar._kernel import Listing, Point, State
+from driver.fourbar._report_forces import figures as force_figures
+from driver.fourbar._report_forces import force_section
+from driver.fourbar._spec import SPEC, band_of, forces_active
 
 __all__ = ["run", "listing_text", "exact_table", "summary_lines", "audit", "deck_figures", "output_name", "animation_frames"]
 
@@ -65,13 +65,13 @@ def listing_text(p: Params, table: np.ndarray, status: np.ndarray) -> tuple[list
     rows, trailers = [], []
     for row, st in zip(table, status):
         if st == ST["no_assembly"]:
-            rows.append([int(row[0])] + [None] * 9)
+            rows.append([int(row[Listing.THETA])] + [None] * 9)
             trailers.append("cannot be assembled: the listing's arccos argument leaves [-1, 1]")
         elif st == ST["toggle"]:
-            rows.append([int(row[0])] + list(row[1:8]) + [None, None])
+            rows.append([int(row[Listing.THETA])] + list(row[Listing.EPSL:Listing.YB + 1]) + [None, None])
             trailers.append("toggle: sin(phi - epsl) = 0, velocities unbounded")
         else:
-            rows.append([int(row[0])] + list(row[1:]))
+            rows.append([int(row[Listing.THETA])] + list(row[Listing.EPSL:]))
             trailers.append("")
     lines = render_table(cols, rows, trailers)
     return head + [lines[0], ""] + lines[1:], cols
@@ -91,24 +91,26 @@ def exact_table(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarra
     if cp is not None:
         cols += [Column("xp", "f", 9, 4), Column("yp", "f", 9, 4), Column("vp", "f", 10, 4)]
         units += ["", "", "[len/s]"]
-        extra = np.column_stack([cp[:, 0], cp[:, 1], np.hypot(cp[:, 2], cp[:, 3])])
-    ang = np.column_stack([deg360(out[:, 0]), deg360(out[:, 1]), np.degrees(out[:, 2])])
+        extra = np.column_stack([cp[:, Point.X], cp[:, Point.Y], np.hypot(cp[:, Point.VX], cp[:, Point.VY])])
+    ang = np.column_stack([deg360(out[:, State.COUPLER_ANGLE]), deg360(out[:, State.ROCKER_ANGLE]),
+                           np.degrees(out[:, State.TRANSMISSION_ANGLE])])
     rows, trailers = [], []
-    d = np.hypot(p.fixed_link - out[:, 3], out[:, 4])
+    d = np.hypot(p.fixed_link - out[:, State.XA], out[:, State.YA])
+    pins, rates = slice(State.XA, State.YB + 1), slice(State.XA, State.ALPHA3 + 1)
     for k in range(len(theta)):
         t = int(round(theta[k])) if whole else theta[k]
         if status[k] == ST["indeterminate"]:
-            rows.append([t, None, None, None, out[k, 3], out[k, 4]] + [None] * 6)
+            rows.append([t, None, None, None, out[k, State.XA], out[k, State.YA]] + [None] * 6)
             trailers.append("indeterminate: crank pin A on the rocker pivot O_B, B free on a circle")
         elif status[k] == ST["no_assembly"]:
-            rows.append([t, None, None, None, out[k, 3], out[k, 4]] + [None] * 6)
+            rows.append([t, None, None, None, out[k, State.XA], out[k, State.YA]] + [None] * 6)
             trailers.append(f"cannot be assembled: |A O_B| = {d[k]:.4f} outside "
                             f"[{abs(p.coupler - p.rocker):g}, {p.coupler + p.rocker:g}]")
         elif status[k] == ST["toggle"]:
-            rows.append([t, *ang[k], *out[k, 3:7]] + [None] * 4)
+            rows.append([t, *ang[k], *out[k, pins]] + [None] * 4)
             trailers.append("toggle: coupler and rocker collinear, velocity unbounded")
         else:
-            rows.append([t, *ang[k], *out[k, 3:11]])
+            rows.append([t, *ang[k], *out[k, rates]])
             trailers.append("")
         if cp is not None:
             placed = status[k] in (ST["ok"], ST["toggle"])
@@ -153,7 +155,7 @@ def summary_lines(p: Params, g: Grashof, ex: Extremes | None) -> list[str]:
 def audit(p: Params, theta: np.ndarray, table: np.ndarray, lst_status: np.ndarray,
           out: np.ndarray, status: np.ndarray) -> tuple[list[str], str | None, pd.DataFrame]:
     """Rows of the listing that violate loop closure, compared with the exact solution."""
-    ab = np.hypot(table[:, 6] - table[:, 4], table[:, 7] - table[:, 5])
+    ab = np.hypot(table[:, Listing.XB] - table[:, Listing.XA], table[:, Listing.YB] - table[:, Listing.YA])
     dev = ab - p.coupler
     good = (lst_status == ST["ok"]) & (status == ST["ok"])
     bad = good & (np.abs(dev) > 1e-4 * p.coupler)
@@ -166,8 +168,8 @@ def audit(p: Params, theta: np.ndarray, table: np.ndarray, lst_status: np.ndarra
     cols = [Column("i", "i", 5, 0), Column("|AB|", "f", 9, 4), Column("dev", "f", 9, 4),
             Column("xb lst", "f", 8, 3), Column("yb lst", "f", 8, 3), Column("xb", "f", 8, 3),
             Column("yb", "f", 8, 3), Column("oms lst", "f", 9, 4), Column("omega3", "f", 9, 4)]
-    rows = [[int(theta[k]), ab[k], dev[k], table[k, 6], table[k, 7], out[k, 5], out[k, 6], table[k, 9], out[k, 8]]
-            for k in np.flatnonzero(bad)]
+    rows = [[int(theta[k]), ab[k], dev[k], table[k, Listing.XB], table[k, Listing.YB], out[k, State.XB],
+             out[k, State.YB], table[k, Listing.OMS], out[k, State.OMEGA3]] for k in np.flatnonzero(bad)]
     lines += [f"    {int(bad.sum())} of {len(theta)} rows have a coupler length |AB| different from "
               f"the deck's {p.coupler:g}; largest deviation {dev[worst]:+.4f} at i = {int(theta[worst])}:"]
     lines += ["  " + l for l in render_table(cols, rows)]
@@ -181,8 +183,7 @@ def audit(p: Params, theta: np.ndarray, table: np.ndarray, lst_status: np.ndarra
     return lines, warn, frame
 
 
-@keyword_signature(_keywords.fourbar, SPEC)
-@keyword_run
+@study_run(SPEC)
 def run(params: Params, progress: bool = False) -> Result:
     """Analyse a planar four-bar linkage driven by its crank over a range of crank angles.
 
@@ -220,7 +221,7 @@ def run(params: Params, progress: bool = False) -> Result:
         if warn:
             warnings.append(warn)
         lst_cols = dict(zip(["coupler_deg", "rocker_deg", "transmission_deg", "xa", "ya", "xb", "yb",
-                             "omega2_rad_s", "omega3_rad_s"], table[:, 1:].T))
+                             "omega2_rad_s", "omega3_rad_s"], table[:, Listing.EPSL:].T))
         lst_cols["ab_error"] = np.where(lst_status == ST["ok"], closure["ab_deviation"].to_numpy(), np.nan)
         listing_frame = tidy_frame("listing", theta, lst_cols, lst_status, closure["loop_not_closed"].to_numpy())
         tidy = with_units(pd.concat([listing_frame, exact_frame], ignore_index=True), TIDY_UNITS)
@@ -232,29 +233,15 @@ def run(params: Params, progress: bool = False) -> Result:
         if cp is not None:
             lines += [f"    coupler point P ...... u = {p.coupler_point[0]:g} along A->B, v = {p.coupler_point[1]:g} "
                       "to its left; xp, yp its position, vp its speed [length/s]"]
-        if forces.active(p):
-            lines += _force_section(p, theta, out, status, exact_frame)
+        if forces_active(p):
+            lines += force_section(p, theta, out, status, exact_frame)
         for k in np.flatnonzero(status == ST["no_assembly"])[:1]:
             warnings.append(f"the linkage cannot be assembled at {int((status == ST['no_assembly']).sum())} "
                             f"of {len(theta)} crank angles (first at {theta[k]:g} deg)")
         tidy = exact_frame
     summary = summary_of(p, rows)
-    figs = deck_figures(p, title, listing_frame) + (forces.figures(p, title, exact_grid) if forces.active(p) else [])
+    figs = deck_figures(p, title, listing_frame) + (force_figures(p, title, exact_grid) if forces_active(p) else [])
     return Result(text="\n".join(lines) + "\n", tidy=tidy, summary=summary, warnings=warnings, figures=figs)
-
-
-def _force_section(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarray,
-                   frame: pd.DataFrame) -> list[str]:
-    """The force analysis's lines of the .out; its columns are added to ``frame`` (in place)."""
-    fa = forces.analyse(p, out, status)
-    for name, values in forces.tidy_columns(fa).items():
-        frame[name] = values
-    with_units(frame, TIDY_UNITS)
-    words = ["toggle: forces unbounded" if s == ST["toggle"] else "not placed" for s in status]
-    title = ("Force analysis (Newton-Euler, closed form; " +
-             ("with the Berkof-Lowen counterweights" if fa.cw is not None else "links as given") + ")")
-    return (forces.echo_lines(p) + forces.table_lines(theta, fa.forces, fa.ok, words, title)
-            + forces.summary_lines(p, forces.summary(p), fa))
 
 
 def output_name(p: Params) -> str:
@@ -293,7 +280,7 @@ def deck_figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> li
         for a in limit_angles(p.fixed_link, p.crank, p.coupler, p.rocker):
             if theta[0] - 1e-9 <= a <= theta[-1] + 1e-9 or hi - lo >= 360.0:
                 row, rst = exact_grid(p, np.array([a]))
-                if rst[0] != ST["no_assembly"] and np.all(np.isfinite(row[0, 3:7])):
+                if rst[0] != ST["no_assembly"] and np.all(np.isfinite(row[0, State.XA:State.YB + 1])):
                     limits.append((a, row[0]))
         return figures.fourbar_linkage(p.fixed_link, theta, out, st == ST["ok"], listing, stem_title,
                                        point=None if cp is None else cp[:, :2], output=output_name(p),
@@ -302,14 +289,18 @@ def deck_figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> li
     return [Figure("curves", curves), Figure("linkage", linkage)]
 
 
-def animation_frames(params: Params, result: Result | None = None, n: int = 180) -> dict[str, Any] | None:
+def animation_frames(params: Params, result: Result | None = None, n: int = 180) -> MechanismFrames:
     """The linkage's positions at ``n`` crank angles over one turn, for the report page's animation
-    (:func:`driver._report_page.mechanism_animation`): crank pin A, coupler pin B, coupler point P;
-    for a crank that cannot turn, its rocking motions (out on one assembly branch, back on the
-    other) with their phases, segments and limit positions."""
+    (:class:`driver._mechanism.MechanismFrames`): the ground pivots O2 and O4, crank pin A, coupler
+    pin B and coupler point P, from the kernel's closed-loop states; for a crank that cannot turn,
+    its rocking motions (out on one assembly branch, back on the other) with their strokes in the
+    frame labels, each motion a segment, and the limit positions dashed."""
     motions = rocking_motions(params, max(8, n // 2 // max(
         1, len(assembly_intervals(params.fixed_link, params.crank, params.coupler, params.rocker) or [1]))))
-    extra: dict[str, Any] = {}
+    g = params.fixed_link
+    phase: list[str] = []
+    segments: list[tuple[int, int]] = []
+    guides = [Guide(np.array([[0.0, 0.0], [g, 0.0]]), "fixed link")]
     if motions:   # a crank that cannot turn: it rocks between its limit positions, out on one
         # assembly branch and back on the other; each assembly interval a motion of its own
         theta = np.concatenate([m.theta for m in motions])
@@ -318,26 +309,33 @@ def animation_frames(params: Params, result: Result | None = None, n: int = 180)
         word = {1: "open", -1: "crossed"}
         tag = (lambda i: "") if len(motions) == 1 else (lambda i: f", motion {i + 1} of {len(motions)}")
         arrow = {0: "\u2192", 1: "\u2190"}   # forward stroke, return stroke
-        extra["phase"] = [f"{arrow[int(st)]} {word[int(b)]} assembly{tag(i)}"
-                          for i, m in enumerate(motions) for st, b in zip(m.stroke, m.branch)]
+        phase = [f" {arrow[int(st)]} {word[int(b)]} assembly{tag(i)}"
+                 for i, m in enumerate(motions) for st, b in zip(m.stroke, m.branch)]
         starts = np.cumsum([0] + [len(m.theta) for m in motions])
-        extra["segments"] = [[int(a), int(b)] for a, b in zip(starts[:-1], starts[1:])]
-        extra["limits"] = [[np.round(m.out[k, 3:7], 5).tolist() for k in (0, len(m.theta) // 2 - 1)] for m in motions]
-        extra["limit_angles"] = [[m.lo, m.hi] for m in motions]
+        segments = [(int(a), int(b)) for a, b in zip(starts[:-1], starts[1:])]
+        for m in motions:   # the limit positions, where the crank reverses: O2-A-B-O4 dashed
+            for ang, k in ((m.lo, 0), (m.hi, len(m.theta) // 2 - 1)):
+                guides.append(Guide(np.vstack([[0.0, 0.0], m.out[k, 3:5], m.out[k, 5:7], [g, 0.0]]),
+                                    f"limit position: crank angle {ang:.1f}\u00b0 (the crank reverses)", dashed=True))
     else:
         theta = np.linspace(0.0, 360.0, n, endpoint=False)
         out, status = exact_grid(params, theta)
     ok = (status != ST["no_assembly"]) & (status != ST["indeterminate"])
     cp = coupler_point(params, theta, out, status)
-    g = params.fixed_link
-    frames = {"theta": theta.tolist(), "ok": ok.astype(int).tolist(),
-              "A": np.round(out[:, 3:5], 5).tolist(), "B": np.round(np.where(ok[:, None], out[:, 5:7], 0.0), 5).tolist(),
-              "P": None if cp is None else np.round(np.where(ok[:, None], cp[:, :2], 0.0), 5).tolist(),
-              "ground": [[0.0, 0.0], [g, 0.0]], "kind": "rocker",
-              "names": {"crank": "crank", "out": "rocker"}, **extra}
-    frames["theta"] = np.round(theta, 6).tolist()
-    pts = [out[:, 3:5], out[ok][:, 5:7], np.array([[0.0, 0.0], [g, 0.0]])]
+    names = ("O2", "A", "B", "O4") + (("P",) if cp is not None else ())
+    pts = np.full((len(theta), len(names), 2), np.nan)
+    pts[:, 0] = 0.0
+    pts[:, 3] = (g, 0.0)
+    pts[:, 1] = out[:, 3:5]
+    pts[ok, 2] = out[ok, 5:7]
     if cp is not None:
-        pts.append(cp[ok][:, :2])
-    frames["box_points"] = np.vstack(pts)
-    return frames
+        pts[ok, 4] = cp[ok, :2]
+    coupler = Link("coupler", (1, 2, 4), body=True) if cp is not None else Link("coupler", (1, 2))
+    return MechanismFrames(
+        names=names, points=pts, links=(Link("crank", (0, 1)), coupler, Link(output_name(params), (3, 2))),
+        labels=tuple(f"{t:.0f}\u00b0" + (phase[k] if phase else "") for k, t in enumerate(np.round(theta, 6))),
+        ground=(0, 3), joints=(1, 2), markers=(4,) if cp is not None else (), guides=tuple(guides),
+        paths=(1, 2, 4) if cp is not None else (1, 2), segments=tuple(segments), frame_name="crank angle",
+        caption="The linkage over " + ("its rocking motions between the limit positions (dashed)" if motions
+                                       else "one crank turn") + ", positions from the kernel's closed loop.",
+        invalid_note="the linkage cannot be assembled at this crank angle")

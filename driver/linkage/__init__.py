@@ -17,6 +17,8 @@ table), ``_report`` (the run), ``_frames`` (drawing data), ``_figures``.
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from driver._study import BatchSummary, Study
 from driver.linkage import _kernel as kernel
 from driver.linkage import _published as published
@@ -33,8 +35,12 @@ from driver.linkage._batch import (
 from driver.linkage._flywheel import table_flywheel
 from driver.linkage._frames import animation_frames
 from driver.linkage._model import compile_deck
-from driver.linkage._report import run
 from driver.linkage._spec import LABELS, SPEC, SUMMARY_SETTINGS, SWEEP_BEST, SWEEP_PLOT, estimate
+
+if TYPE_CHECKING:   # run's keys as typed keywords: generated from SPEC (tools/gen_keyword_signatures.py)
+    from driver.linkage._keywords import run
+else:
+    from driver.linkage._report import run
 
 __all__ = ["SPEC", "STUDY", "run", "estimate", "summarise", "summarise_batch", "compile_deck", "solve",
            "table_flywheel", "animation_frames", "BATCH_KEYS", "LABELS", "kernel"]

@@ -10,12 +10,17 @@ from __future__ import annotations
 import weakref
 from collections.abc import Callable
 from enum import IntEnum
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
-from driver._fortran import _kernels, farray, spare_buffer
+from driver._fortran import farray
 from driver.linkage._model import Mechanism
+
+if TYPE_CHECKING:   # the study's modules of the extension, typed (generated: tools/gen_kernel_stub.py)
+    from driver.linkage import _kernels
+else:
+    from driver._fortran import _kernels
 
 __all__ = ["reusable_call", "Status", "LinkCol", "PointCol", "SlideCol", "JointCol", "DriverCol", "ShakeCol", "EnergyCol",
            "SummaryCol", "Want", "Analysis", "analyse", "table_energy", "summaries", "summary_width",
@@ -208,13 +213,11 @@ def analyse(mech: Mechanism, x: np.ndarray, forces: bool | None = None, continui
                                                                                 else forces) else 0)
     i, r = mech.integers(), mech.reals()
     n, nl, npt, nd, ns = x.shape[0], len(mech.links), len(mech.points), len(mech.dyads), mech.nslides
-    bufs = [spare_buffer(f"linkage.{name}", shape, np.float64) for name, shape in
-            (("lk", (n, 3, nl)), ("pk", (n, 6, npt)), ("sk", (n, 3, ns)), ("qa", (n, nd)))]
-    st = spare_buffer("linkage.st", (n, nd), np.int32)
+    bufs = [np.zeros(shape, order="F") for shape in ((n, 3, nl), (n, 6, npt), (n, 3, ns), (n, nd))]
+    st = np.zeros((n, nd), dtype=np.int32, order="F")
     _fill_ground(mech, bufs[0], bufs[1])
     nf = n if want & int(Want.FORCES) else 1     # no forces asked: one unused row
-    fbufs = [spare_buffer(f"linkage.{name}", shape, np.float64) for name, shape in
-             (("fk", (nf, 9, nd)), ("fd", (nf, 4)), ("sh", (nf, 3)))]
+    fbufs = [np.zeros(shape, order="F") for shape in ((nf, 9, nd), (nf, 4), (nf, 3))]
     out = _K.analyse(x, i["idrv"], r["rdrv"], i["ipts"], r["rpts"],
                      i["igd"], r["rgd"], i["idy"], r["rdy"], r["rl"], r["grav"], i["ild"], r["rld"], r["rtq"],
                      i["ift"], r["tab"], r["rft"], want, bufs[0], bufs[1], bufs[2], bufs[3], st, fbufs[0],

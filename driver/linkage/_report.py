@@ -9,11 +9,9 @@ from typing import Any
 
 import numpy as np
 
-from driver import _keywords
 from driver._deck import Params
 from driver._result import Figure, Result
-from driver._runner import keyword_run
-from driver._signatures import keyword_signature
+from driver._runner import study_run
 from driver._table import Column, render_table
 from driver.linkage._analysis import JOINT_WORDS, Event, Motion, events, input_label, solve, tidy_frame
 from driver.linkage._batch import summary_of, summary_rows
@@ -269,8 +267,7 @@ def summary_lines(p: Params, mech: Mechanism, s: dict[str, Any]) -> list[str]:
     return out
 
 
-@keyword_signature(_keywords.linkage, SPEC)
-@keyword_run
+@study_run(SPEC)
 def run(params: Params, progress: bool = False) -> Result:
     """Analyse a planar linkage built from a driver and class-II groups (dyads).
 

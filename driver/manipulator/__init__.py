@@ -30,6 +30,8 @@ report/exact differences), :mod:`._report` (the run: text, tidy table, summary) 
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from driver._study import BatchSummary, Study
 from driver.manipulator import _kernel as kernel
 from driver.manipulator import _published as published
@@ -44,9 +46,14 @@ from driver.manipulator._batch import (
     summarise,
     summarise_batch,
 )
-from driver.manipulator._report import TIDY_UNITS, run, table_frame
+from driver.manipulator._report import TIDY_UNITS, animation_frames, table_frame
 from driver.manipulator._spec import LABELS, RENAMED, SPEC, SWEEP_BEST, SWEEP_PLOT, estimate
 from driver.manipulator._tables import NOT_REPRODUCIBLE, REASONS, TEXT_REASONS, TIDY_NAMES
+
+if TYPE_CHECKING:   # run's keys as typed keywords: generated from SPEC (tools/gen_keyword_signatures.py)
+    from driver.manipulator._keywords import run
+else:
+    from driver.manipulator._report import run
 
 __all__ = ["SPEC", "run", "Workspace", "tolerance_box", "round_half_up", "REASONS", "NOT_REPRODUCIBLE", "TEXT_REASONS",
            "TIDY_NAMES", "TIDY_UNITS", "table_frame", "LABELS", "SWEEP_PLOT", "SWEEP_BEST", "estimate", "optima",
@@ -58,4 +65,5 @@ STUDY = Study(name="manipulator", package=__name__, spec=SPEC, run=run, estimate
                                  independent=BATCH_INDEPENDENT, passes=BATCH_PASSES,
                                  pass_names=("indices", "target", "tolerance", "walk"), refusal=batch_refusal),
               labels=LABELS, sweep_plot=SWEEP_PLOT, sweep_best=SWEEP_BEST, renamed=RENAMED,
-              published=published.compare, figures=f"{__name__}._figures", kernel=kernel)
+              published=published.compare, animation=animation_frames, figures=f"{__name__}._figures",
+              kernel=kernel)

@@ -18,7 +18,7 @@ from driver._deck import Params
 from driver.manipulator import _kernel as kernel
 
 __all__ = ["STATUS", "SIGNIFICANT", "DESIGN_STATUS", "round_half_up", "Workspace", "Conv", "optima", "tolerance_box",
-           "design_status"]
+           "design_status", "workspace_columns", "sweep_columns", "design_torque_columns"]
 
 STATUS = kernel.MANIPULATOR_STATUS
 #: significant digits of every number column outside report mode (the report's fixed decimals
@@ -271,3 +271,39 @@ def sweep_l1_values(p: Params, conv: Conv) -> np.ndarray:
         raise p.error("sweep_l1_start", f"{p.sweep_l1_start:g} m is beyond the C_rob radius {top:.4f} m: the sweep "
                                         "along C_rob would be empty (give a smaller start or a sweep_count)")
     return p.sweep_l1_start + p.sweep_l1_step * np.arange(n)
+
+
+# ----------------------------------------------------------------------------- summary columns
+
+def workspace_columns(p: Params, ws: Workspace, conv: Conv) -> dict[str, Any]:
+    """Summary columns of the workspace and of C_rob (lengths [m], areas [m^2])."""
+    opt = optima(conv.c_pairs)
+    return {"mode": p.mode, "n_points": ws.n, "r_m": ws.r, "R_m": ws.R, "mean_d2_m2": ws.mean_d2,
+            "crob_radius_m": conv.radius, "crob_c_m2": conv.c_pairs, "ri2_min": math.sqrt(ws.n),
+            "dexterity_l1_m": opt["dexterity"][0], "dexterity_l2_m": opt["dexterity"][1],
+            "manipulability_l1_m": opt["manipulability"][0], "manipulability_l2_m": opt["manipulability"][1]}
+
+
+def sweep_columns(sweep: dict) -> dict[str, Any]:
+    """Summary columns of the least signed sum tau1 + tau2 along C_rob (Table 4.8's 'total
+    torque', as the report ranks it); none when no row reaches the target."""
+    tot = np.where(sweep["ok"], sweep["tau"].sum(1), np.inf)
+    if not np.isfinite(tot).any():
+        return {}
+    k = int(np.argmin(tot))
+    return {"sweep_min_tau_sum_signed_Nm": float(tot[k]), "sweep_min_l1_m": float(sweep["l1"][k]),
+            "sweep_min_l2_m": float(sweep["l2"][k]), "sweep_min_row": k + 1,
+            "sweep_min_reaches_workspace": bool(sweep["reach_all"][k])}
+
+
+def design_torque_columns(tau1: Any, tau2: Any, ok: Any) -> dict[str, Any]:
+    """The design's torques at the target [N m]: the signed sum tau1 + tau2 (the report's 'total
+    torque': a negative torque lowers it, so it is no measure of effort), the demand |tau1| + |tau2|
+    and the peak max(|tau1|, |tau2|) (the arm holds one pose: no trajectory, so no peak over time).
+    Scalars or arrays (the batch path); missing (None / NaN) where ``ok`` is false."""
+    t1, t2 = np.asarray(tau1, dtype=float), np.asarray(tau2, dtype=float)
+    cols = {"design_tau_sum_signed_Nm": t1 + t2, "design_torque_demand_Nm": np.abs(t1) + np.abs(t2),
+            "design_peak_torque_Nm": np.fmax(np.abs(t1), np.abs(t2))}
+    if np.ndim(t1) == 0:
+        return {k: (float(v) if ok else None) for k, v in cols.items()}
+    return {k: np.where(ok, v, np.nan) for k, v in cols.items()}

@@ -25,10 +25,20 @@ import numpy as np
 import pandas as pd
 
 from driver._deck import Params
-from driver._study import contract_doc
+from driver._study import batch_error, contract_doc
 from driver.manipulator import _kernel as kernel
-from driver.manipulator._analysis import STATUS, Conv, Workspace, design_list, design_status, round_half_up
-from driver.manipulator._report import design_torque_columns, sweep_columns, workspace_columns
+from driver.manipulator._analysis import (
+    STATUS,
+    Conv,
+    Workspace,
+    design_list,
+    design_status,
+    design_torque_columns,
+    round_half_up,
+    sweep_columns,
+    workspace_columns,
+)
+from driver.manipulator._kernel import SummaryParam, Torque
 from driver.manipulator._tables import table_4_8
 
 __all__ = ["BATCH_KEYS", "BATCH_IGNORED", "BATCH_INDEPENDENT", "BATCH_PASSES", "BATCH_PASS_SUFFIXES", "summarise_batch",
@@ -82,13 +92,6 @@ def _passes(wanted: Collection[str] | None) -> set[str]:
 _WALKS: dict[tuple, dict[str, Any]] = {}
 
 
-def _bad(base: Mapping[str, Any], key: str | None, message: str) -> Exception:
-    """A DeckError at the key's deck line when ``base`` is a deck's Params, else a ValueError."""
-    if isinstance(base, Params):
-        return base.error(key, message)
-    return ValueError(f"{key}: {message}" if key else message)
-
-
 def _as_params(base: Mapping[str, Any]) -> Params:
     if isinstance(base, Params):
         return base
@@ -106,7 +109,7 @@ def _column(base: Mapping[str, Any], key: str, v: Any, n: int, check) -> np.ndar
     bad = ~np.isfinite(a) | ~check(a)
     if bad.any():
         i = int(np.argmax(bad))
-        raise _bad(base, key, f"design {i} has {float(a[i])!r}")
+        raise batch_error(base, key, f"design {i} has {float(a[i])!r}")
     return a
 
 
@@ -120,21 +123,21 @@ def _lengths(base: Mapping[str, Any], columns: dict[str, Any], n: int, conv: Con
     for key in ("designs_l1", "designs_l2"):
         v = columns[key] if key in columns else base[key]
         if v is None:
-            raise _bad(base, key, "designs_l1 and designs_l2 must be given together")
+            raise batch_error(base, key, "designs_l1 and designs_l2 must be given together")
         a = np.asarray(v, dtype=np.float64)
         a = a.reshape(n, -1) if key in columns else np.broadcast_to(a.ravel(), (n, a.size))
         bad = ~np.isfinite(a) | ~(a > 0)
         if bad.any():
             i = int(np.argmax(bad.any(1)))
-            raise _bad(base, key, f"design {i} has {a[i].tolist()!r} (lengths must be positive and finite)")
+            raise batch_error(base, key, f"design {i} has {a[i].tolist()!r} (lengths must be positive and finite)")
         out.append(a)
     l1, l2 = out
     if l1.shape != l2.shape:
-        raise _bad(base, "designs_l2", f"gives {l2.shape[1]} lengths per design but designs_l1 gives {l1.shape[1]}")
+        raise batch_error(base, "designs_l2", f"gives {l2.shape[1]} lengths per design but designs_l1 gives {l1.shape[1]}")
     k = l1.shape[1]
     names = base["design_names"]
     if names is not None and len(names) != k:
-        raise _bad(base, "design_names", f"gives {len(names)} names for {k} designs")
+        raise batch_error(base, "design_names", f"gives {len(names)} names for {k} designs")
     return list(names or [f"Design {i + 1}" for i in range(k)]), l1, l2
 
 
@@ -200,11 +203,11 @@ def _arrays(base: Mapping[str, Any], columns: Mapping[str, Any] | None,
     columns = {k.partition(".")[2] if k.startswith("manipulator.") else k: v for k, v in (columns or {}).items()}
     unknown = [k for k in columns if k not in BATCH_KEYS and k not in BATCH_IGNORED]
     if unknown:
-        raise _bad(base, unknown[0], f"not a &manipulator key the summary takes per design ({', '.join(BATCH_KEYS)})")
+        raise batch_error(base, unknown[0], f"not a &manipulator key the summary takes per design ({', '.join(BATCH_KEYS)})")
     columns = {k: v for k, v in columns.items() if k in BATCH_KEYS}
     sizes = {np.shape(v)[0] for v in columns.values() if np.ndim(v) > 0}
     if len(sizes) > 1:
-        raise _bad(base, None, f"batch columns have different lengths {sorted(sizes)}")
+        raise batch_error(base, None, f"batch columns have different lengths {sorted(sizes)}")
     n = sizes.pop() if sizes else 1
     if n == 0:
         return {k: v[:0] for k, v in _arrays(base, None).items()}
@@ -214,24 +217,26 @@ def _arrays(base: Mapping[str, Any], columns: Mapping[str, Any] | None,
     k = l1.shape[1]
     if ("target_x" in columns or "target_y" in columns) and \
             (columns.get("target_x", p.target_x) is None or columns.get("target_y", p.target_y) is None):
-        raise _bad(base, "target_y" if "target_x" in columns else "target_x",
-                   "target_x and target_y must be given together")
+        raise batch_error(base, "target_y" if "target_x" in columns else "target_x",
+                         "target_x and target_y must be given together")
     tx0, ty0 = (p.target_x, p.target_y) if p.target_x is not None else (float(ws.x[0]), float(ws.y[0]))
     finite = lambda a: np.ones(a.shape, bool)
     tx = _column(base, "target_x", columns.get("target_x", tx0), n, finite)
     ty = _column(base, "target_y", columns.get("target_y", ty0), n, finite)
     if ((tx == 0.0) & (ty == 0.0)).any():
         i = int(np.argmax((tx == 0.0) & (ty == 0.0)))
-        raise _bad(base, "target_x", f"design {i}: the target point is the base (0, 0)")
+        raise batch_error(base, "target_x", f"design {i}: the target point is the base (0, 0)")
     mpl = _column(base, "mass_per_length", columns.get("mass_per_length", p.mass_per_length), n, lambda a: a > 0)
     g = _column(base, "gravity", columns.get("gravity", p.gravity), n, lambda a: a >= 0)
     eps = _column(base, "tolerance_bound", columns.get("tolerance_bound", p.tolerance_bound), n, lambda a: a >= 1e-9)
 
     # every design of every deck in one kernel call (rows deck-major: deck i, design j -> i k + j)
-    prm = np.empty((n * k, 7), dtype=np.float64, order="F")
-    prm[:, 0], prm[:, 1] = l1.ravel(), l2.ravel()
-    for j, v in enumerate((tx, ty, mpl, g, eps), start=2):
-        prm[:, j] = np.repeat(v, k)
+    sp = SummaryParam
+    prm = np.empty((n * k, len(sp)), dtype=np.float64, order="F")
+    prm[:, sp.L1], prm[:, sp.L2] = l1.ravel(), l2.ravel()
+    for col, v in ((sp.TARGET_X, tx), (sp.TARGET_Y, ty), (sp.MASS_PER_LENGTH, mpl), (sp.GRAVITY, g),
+                   (sp.TOLERANCE_BOUND, eps)):
+        prm[:, col] = np.repeat(v, k)
     rates = [*p.joint_rates, *p.joint_accels]
     unit = _mc_samples(p.mc_seed, p.mc_samples)
     bits = sum(b for k, b in kernel.MANIPULATOR_PASSES.items() if k in passes)
@@ -325,13 +330,14 @@ def _report_torques(p: Params, prm: np.ndarray, r: dict[str, np.ndarray], n: int
     else:
         used = np.array([[round_half_up(a, 2), round_half_up(180.0 - abs(b), 2)] for a, b in zip(t1, t2)])
         used = used.reshape(-1, 2)
-    tau = np.empty((n * k, 2))
-    for gv in np.unique(prm[:, 5]):      # the torque kernel takes one g per call
-        m = prm[:, 5] == gv
-        tau[m] = kernel.manipulator_torques(prm[m, 0], prm[m, 1], np.radians(used[m, 0]), np.radians(used[m, 1]),
-                                             p.joint_rates, p.joint_accels, prm[m, 4] * prm[m, 0],
-                                             prm[m, 4] * prm[m, 1], float(gv))
-    return tau[:, 0].reshape(n, k), tau[:, 1].reshape(n, k)
+    sp = SummaryParam
+    tau = np.empty((n * k, len(Torque)))
+    for gv in np.unique(prm[:, sp.GRAVITY]):      # the torque kernel takes one g per call
+        m = prm[:, sp.GRAVITY] == gv
+        l1, l2, mpl = prm[m, sp.L1], prm[m, sp.L2], prm[m, sp.MASS_PER_LENGTH]
+        tau[m] = kernel.manipulator_torques(l1, l2, np.radians(used[m, 0]), np.radians(used[m, 1]),
+                                             p.joint_rates, p.joint_accels, mpl * l1, mpl * l2, float(gv))
+    return tau[:, Torque.TAU1].reshape(n, k), tau[:, Torque.TAU2].reshape(n, k)
 
 
 @contract_doc

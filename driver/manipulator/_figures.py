@@ -124,7 +124,7 @@ def design_space_figure(p: Params, ws: Workspace, conv: Conv, used: dict):
     """The (l1, l2) design space: reach conditions, iso-RI2 ellipses, C_rob, the optima and the designs."""
     field_l = np.linspace(0.05, ws.R + 1.0, 161)
     L1, L2 = np.meshgrid(field_l, field_l)
-    ri = kernel.manipulator_design_indices(ws.x, ws.y, L1.ravel(), L2.ravel())[0][:, 1].reshape(L1.shape)
+    ri = kernel.manipulator_design_indices(ws.x, ws.y, L1.ravel(), L2.ravel())[0][:, kernel.Index.RI2].reshape(L1.shape)
     levels = p.ri2_levels or [math.sqrt(ws.n)]
     return manipulator_design_space(ws.r, ws.R, math.sqrt(conv.c_pairs), L1, L2, ri, float(ws.d2.sum()), ws.n,
                                     levels, optima(conv.c_pairs), used["names"], used["l1"], used["l2"],
@@ -133,6 +133,6 @@ def design_space_figure(p: Params, ws: Workspace, conv: Conv, used: dict):
 
 def torque_figure(sweep: dict, conv: Conv, title: str = ""):
     """Motor torques along C_rob (Table 4.8), where the target is out of reach left blank."""
-    return manipulator_torque_crob(sweep["l1"], np.where(sweep["ok"], sweep["tau"][:, 0], np.nan),
-                                   np.where(sweep["ok"], sweep["tau"][:, 1], np.nan), conv.c_sweep,
+    return manipulator_torque_crob(sweep["l1"], np.where(sweep["ok"], sweep["tau"][:, kernel.Torque.TAU1], np.nan),
+                                   np.where(sweep["ok"], sweep["tau"][:, kernel.Torque.TAU2], np.nan), conv.c_sweep,
                                    violates=sweep["ok"] & ~sweep["reach_all"], title=title)

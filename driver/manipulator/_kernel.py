@@ -8,20 +8,75 @@ back.  Each kernel's physics and units are documented in its Fortran source.
 """
 from __future__ import annotations
 
+from enum import IntEnum
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from driver._docs import fill_doc
-from driver._fortran import _kernels, farray
+from driver._fortran import KernelStatus, farray
 
-__all__ = ['MANIPULATOR_PASSES', 'MANIPULATOR_STATUS', 'manipulator_arm_states', 'manipulator_torques',
-           'manipulator_ik', 'manipulator_design_indices', 'manipulator_position_errors',
-           'manipulator_design_summaries', 'MANIPULATOR_SUMMARY_PARAMS', 'MANIPULATOR_SUMMARY_COLUMNS']
+if TYPE_CHECKING:   # the study's modules of the extension, typed (generated: tools/gen_kernel_stub.py)
+    from driver.manipulator import _kernels
+else:
+    from driver._fortran import _kernels
+
+__all__ = ['ManipulatorStatus', 'Torque', 'Index', 'SummaryParam', 'MANIPULATOR_PASSES', 'MANIPULATOR_STATUS',
+           'manipulator_arm_states', 'manipulator_torques', 'manipulator_ik', 'manipulator_design_indices',
+           'manipulator_position_errors', 'manipulator_design_summaries', 'MANIPULATOR_SUMMARY_PARAMS',
+           'MANIPULATOR_SUMMARY_COLUMNS']
 
 
-#: status codes of the 2R manipulator kernels (fortran/manipulator.f90)
-MANIPULATOR_STATUS = {"ok": int(_kernels.manipulator.st_ok),
-                      "unreachable": int(_kernels.manipulator.st_unreachable),
-                      "degenerate": int(_kernels.manipulator.st_degenerate)}
+class ManipulatorStatus(KernelStatus):
+    """Status of each point of the 2R arm's inverse kinematics (fortran/manipulator.f90 ``st_*``).
+
+    A result of the point, never an error of the call.
+    """
+
+    ok = int(_kernels.manipulator.st_ok), "ok"
+    unreachable = int(_kernels.manipulator.st_unreachable), "unreachable", "the point lies outside the arm's reach"
+    degenerate = int(_kernels.manipulator.st_degenerate), "degenerate", "a link of no length, or the point at the base"
+
+
+#: the 2R kernels' status codes by name (``MANIPULATOR_STATUS["ok"]``): :class:`ManipulatorStatus`
+MANIPULATOR_STATUS: type[ManipulatorStatus] = ManipulatorStatus
+
+
+# ----------------------------------------------------------------------------- the kernels' column layouts
+
+class Torque(IntEnum):
+    """Columns of the joint torques [N m] (:func:`manipulator_torques`, :func:`manipulator_arm_states`).
+    """
+
+    TAU1 = 0
+    TAU2 = 1
+
+
+class Index(IntEnum):
+    """Columns of :func:`manipulator_design_indices`'s ``ri``.
+
+    The robustness indices RI1, RI2, RI3 (dimensionless).
+    """
+
+    RI1 = 0
+    RI2 = 1
+    RI3 = 2
+
+
+class SummaryParam(IntEnum):
+    """Columns of a :func:`manipulator_design_summaries` design.
+
+    Link lengths l1, l2 [m], the target point [m], mass per length [kg/m], gravity [m/s^2], the
+    tolerance bound [m].
+    """
+
+    L1 = 0
+    L2 = 1
+    TARGET_X = 2
+    TARGET_Y = 3
+    MASS_PER_LENGTH = 4
+    GRAVITY = 5
+    TOLERANCE_BOUND = 6
 
 
 _doc = fill_doc(
@@ -198,8 +253,8 @@ def manipulator_position_errors(th1, th2, dl) -> np.ndarray:
     return _kernels.manipulator.position_errors(th1, th2, farray(dl, 2))
 
 
-#: columns of the parameter matrix of :func:`manipulator_design_summaries`
-MANIPULATOR_SUMMARY_PARAMS = ("l1", "l2", "target_x", "target_y", "mass_per_length", "gravity", "tolerance_bound")
+#: columns of the parameter matrix of :func:`manipulator_design_summaries` by name: :class:`SummaryParam`
+MANIPULATOR_SUMMARY_PARAMS = tuple(c.name.lower() for c in SummaryParam)
 #: columns of its result (fortran/manipulator_summary.f90)
 MANIPULATOR_SUMMARY_COLUMNS = ("ri1", "ri2", "ri3", "sum_c2", "reach", "target_status", "theta1_deg", "theta2_deg",
                                "tau1", "tau2", "reaches_points", "dl1", "dl2", "mc_max")

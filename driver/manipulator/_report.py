@@ -9,12 +9,11 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from driver import _keywords
 from driver._deck import Params
 from driver._export import with_units
+from driver._mechanism import Link, MechanismFrames
 from driver._result import Figure, Result
-from driver._runner import keyword_run
-from driver._signatures import keyword_signature
+from driver._runner import study_run
 from driver._table import fortran_f
 from driver.manipulator import _kernel as kernel
 from driver.manipulator._analysis import (
@@ -23,14 +22,18 @@ from driver.manipulator._analysis import (
     Workspace,
     design_list,
     design_status,
+    design_torque_columns,
     optima,
     round_half_up,
+    sweep_columns,
     target_point,
+    workspace_columns,
 )
+from driver.manipulator._kernel import Torque
 from driver.manipulator._spec import SPEC
 from driver.manipulator._tables import TIDY_NAMES, Table, mode_differences, report_tables, tolerance_table
 
-__all__ = ["run", "TIDY_UNITS", "table_frame"]
+__all__ = ["run", "TIDY_UNITS", "table_frame", "animation_frames"]
 
 
 def _header(p: Params, ws: Workspace, conv: Conv) -> list[str]:
@@ -131,46 +134,12 @@ def table_frame(tidy: pd.DataFrame, table: str) -> pd.DataFrame:
     return wide
 
 
-def workspace_columns(p: Params, ws: Workspace, conv: Conv) -> dict[str, Any]:
-    """Summary columns of the workspace and of C_rob (lengths [m], areas [m^2])."""
-    opt = optima(conv.c_pairs)
-    return {"mode": p.mode, "n_points": ws.n, "r_m": ws.r, "R_m": ws.R, "mean_d2_m2": ws.mean_d2,
-            "crob_radius_m": conv.radius, "crob_c_m2": conv.c_pairs, "ri2_min": math.sqrt(ws.n),
-            "dexterity_l1_m": opt["dexterity"][0], "dexterity_l2_m": opt["dexterity"][1],
-            "manipulability_l1_m": opt["manipulability"][0], "manipulability_l2_m": opt["manipulability"][1]}
-
-
-def sweep_columns(sweep: dict) -> dict[str, Any]:
-    """Summary columns of the least signed sum tau1 + tau2 along C_rob (Table 4.8's 'total
-    torque', as the report ranks it); none when no row reaches the target."""
-    tot = np.where(sweep["ok"], sweep["tau"].sum(1), np.inf)
-    if not np.isfinite(tot).any():
-        return {}
-    k = int(np.argmin(tot))
-    return {"sweep_min_tau_sum_signed_Nm": float(tot[k]), "sweep_min_l1_m": float(sweep["l1"][k]),
-            "sweep_min_l2_m": float(sweep["l2"][k]), "sweep_min_row": k + 1,
-            "sweep_min_reaches_workspace": bool(sweep["reach_all"][k])}
-
-
-def design_torque_columns(tau1: Any, tau2: Any, ok: Any) -> dict[str, Any]:
-    """The design's torques at the target [N m]: the signed sum tau1 + tau2 (the report's 'total
-    torque': a negative torque lowers it, so it is no measure of effort), the demand |tau1| + |tau2|
-    and the peak max(|tau1|, |tau2|) (the arm holds one pose: no trajectory, so no peak over time).
-    Scalars or arrays (the batch path); missing (None / NaN) where ``ok`` is false."""
-    t1, t2 = np.asarray(tau1, dtype=float), np.asarray(tau2, dtype=float)
-    cols = {"design_tau_sum_signed_Nm": t1 + t2, "design_torque_demand_Nm": np.abs(t1) + np.abs(t2),
-            "design_peak_torque_Nm": np.fmax(np.abs(t1), np.abs(t2))}
-    if np.ndim(t1) == 0:
-        return {k: (float(v) if ok else None) for k, v in cols.items()}
-    return {k: np.where(ok, v, np.nan) for k, v in cols.items()}
-
-
 def _summary(p: Params, ws: Workspace, conv: Conv, used: dict, sweep: dict, tol: list[dict]) -> dict[str, Any]:
     s = workspace_columns(p, ws, conv)
     for i, name in enumerate(used["names"]):
         key = name.lower().replace(" ", "_")
-        s[f"{key}_tau1_Nm"] = float(used["tau"][i, 0]) if used["ok"][i] else None
-        s[f"{key}_tau2_Nm"] = float(used["tau"][i, 1]) if used["ok"][i] else None
+        s[f"{key}_tau1_Nm"] = float(used["tau"][i, Torque.TAU1]) if used["ok"][i] else None
+        s[f"{key}_tau2_Nm"] = float(used["tau"][i, Torque.TAU2]) if used["ok"][i] else None
     for rec in tol:
         key = rec["name"].lower().replace(" ", "_")
         s[f"{key}_dl_m"] = rec["dl1"]
@@ -189,8 +158,7 @@ def _summary(p: Params, ws: Workspace, conv: Conv, used: dict, sweep: dict, tol:
     return s
 
 
-@keyword_signature(_keywords.manipulator, SPEC)
-@keyword_run
+@study_run(SPEC)
 def run(params: Params, progress: bool = False) -> Result:
     """Synthesise a planar 2R arm robustly for a workspace of points (the report's chapter 4).
 
@@ -310,3 +278,47 @@ def _figures():
     """The study's figure module, imported when a figure is drawn (matplotlib is the optional [plot] extra)."""
     from driver.manipulator import _figures as figures
     return figures
+
+
+def animation_frames(params: Params, result: Result | None = None, n: int = 180) -> MechanismFrames:
+    """The 2R arm of each design at the workspace points, for the report page's animation
+    (:class:`driver._mechanism.MechanismFrames`): the joint angles from the kernel's inverse
+    kinematics (:func:`~driver.manipulator.kernel.manipulator_ik`, the deck's elbow branch) at
+    each point, moving linearly in joint space from one point to the next; a design that cannot
+    reach a point is not drawn there.  The designs are the deck's, else the optima on C_rob."""
+    ws = Workspace(np.array(params.points_x, float), np.array(params.points_y, float))
+    names_d, l1s, l2s = design_list(params, Conv(params.mode == "report", ws))
+    m = ws.n
+    steps = max(4, n // max(1, len(l1s) * m))        # frames per move from one point to the next
+    px, py = np.append(ws.x, ws.x[0]), np.append(ws.y, ws.y[0])   # a tour of the points, back to the first
+    pts: list[list[np.ndarray]] = []
+    labels: list[str] = []
+    segments: list[tuple[int, int]] = []
+    for name, l1, l2 in zip(names_d, l1s, l2s):
+        th1, th2, st = kernel.manipulator_ik(l1, l2, px, py, params.elbow)
+        q = np.where((st == 0)[:, None], np.column_stack([th1, th2]), np.nan)
+        if np.isfinite(q).all():   # each move the short way round (the angles are modulo a turn)
+            q = np.unwrap(q, axis=0)
+        start = len(labels)
+        for i in range(m):
+            for j in range(steps):
+                t = j / steps
+                a, b = (1.0 - t) * q[i] + t * q[i + 1]
+                elbow = l1 * np.array([math.cos(a), math.sin(a)])
+                pts.append([elbow, elbow + l2 * np.array([math.cos(a + b), math.sin(a + b)])])
+                where = (f"at P{i + 1} ({ws.x[i]:g}, {ws.y[i]:g})" if j == 0 else
+                         f"P{i + 1} \u2192 P{(i + 1) % m + 1} (joint angles interpolated)")
+                labels.append(f"{name} (l\u2081 = {l1:g} m, l\u2082 = {l2:g} m) {where}")
+        segments.append((start, len(labels)))
+    arm = np.array(pts)
+    fixed = np.vstack([[0.0, 0.0], np.column_stack([ws.x, ws.y])])
+    names = ("A", "elbow", "tip", *(f"P{i + 1}" for i in range(m)))
+    points = np.concatenate([np.broadcast_to(fixed[:1], (len(arm), 1, 2)), arm,
+                             np.broadcast_to(fixed[1:], (len(arm), m, 2))], axis=1)
+    return MechanismFrames(
+        names=names, points=points, links=(Link("link 1", (0, 1)), Link("link 2", (1, 2))), labels=tuple(labels),
+        ground=(0,), joints=(1,), markers=(2, *range(3, 3 + m)), paths=(2,), segments=tuple(segments),
+        periodic=False, frame_name="pose", units="m",
+        caption=f"Each design's arm at the workspace points P1..P{m} (inverse kinematics from the kernel, elbow "
+                f"branch {params.elbow:+d}), moving linearly in joint space between them.",
+        invalid_note="the design cannot reach this point")

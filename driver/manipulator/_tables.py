@@ -24,6 +24,7 @@ from driver.manipulator._analysis import (
     target_point,
     tolerance_box,
 )
+from driver.manipulator._kernel import Index, Torque
 
 __all__ = ["Table", "REASONS", "NOT_REPRODUCIBLE", "TEXT_REASONS", "TIDY_NAMES"]
 
@@ -95,7 +96,7 @@ def _t42(p: Params, conv: Conv) -> Table:
         l2 = math.sqrt(c - v * v)
         assert ri is not None   # v is valid, so there are valid designs
         ok = bool(ri[2][j])
-        rows.append([f"{i + 1}.", float(ri[0][j, 1]), v, l2, "yes" if ok else "no"])
+        rows.append([f"{i + 1}.", float(ri[0][j, Index.RI2]), v, l2, "yes" if ok else "no"])
         trailers.append("" if ok else "violates the reach conditions (4.4)")
         j += 1
     cols = [Column("No.", "s", 4), Column("RI2", "f", 8, 4), Column("l1", "f", 8, 3), Column("l2", "f", 8, 3),
@@ -113,7 +114,7 @@ def _t44(p: Params, conv: Conv) -> Table:
     rows = []
     for j, (name, key) in enumerate((("Dexterity", "dexterity"), ("Workspace", "manipulability"))):
         l1, l2 = opt[key]
-        rows.append([name, l1, l2, float(ri[0][j, 1]), "yes" if ri[2][j] else "no"])
+        rows.append([name, l1, l2, float(ri[0][j, Index.RI2]), "yes" if ri[2][j] else "no"])
     cols = [Column("Criterion", "s", 10), Column("l1opt", "f", 8, d), Column("l2opt", "f", 8, d),
             Column("RI2", "f", 8, 4), Column("reach", "s", 6)]
     notes = ["Dexterity: l2 = l1 sqrt(2)/2 on C_rob, Workspace (manipulability w = l1 l2 |s2|): l1 = l2"]
@@ -145,7 +146,8 @@ def _torque_tables(p: Params, conv: Conv) -> tuple[Table, Table, Table, dict[str
         a2 = float(ang["shown2"][i]) if good else None
         r45.append([name, l1[i], l2[i], m1[i], m2[i], g, a1, a2])
         r46.append([name, l1[i], l2[i], a1, a2, *p.joint_rates, *p.joint_accels])
-        r47.append([name, l1[i], l2[i], float(tau[i, 0]) if good else None, float(tau[i, 1]) if good else None])
+        r47.append([name, l1[i], l2[i], float(tau[i, Torque.TAU1]) if good else None,
+                    float(tau[i, Torque.TAU2]) if good else None])
         tr.append("" if good else why)
     cols45 = [Column("Design", "s", 10), Column("l1", "f", 6, 2), Column("l2", "f", 6, 2), Column("m1", "f", 6, 1),
               Column("m2", "f", 6, 1), Column("g", "f", 5, 1), Column("theta1", "f", 8, 2), Column("theta2", "f", 8, 2)]
@@ -188,9 +190,9 @@ def _designs_table(p: Params, conv: Conv) -> Table:
     rows, trailers = [], []
     for i, name in enumerate(names):
         ok = st[i] == STATUS["ok"]
-        rows.append([name, l1[i], l2[i], float(ri[i, 0]) if ri[i, 0] > 0 else None, float(ri[i, 1]),
-                     float(ri[i, 2]), float(w[i]) if ok else None, float(kappa[i]) if ok and kappa[i] > 0 else None,
-                     "yes" if reach[i] else "no"])
+        rows.append([name, l1[i], l2[i], float(ri[i, Index.RI1]) if ri[i, Index.RI1] > 0 else None,
+                     float(ri[i, Index.RI2]), float(ri[i, Index.RI3]), float(w[i]) if ok else None,
+                     float(kappa[i]) if ok and kappa[i] > 0 else None, "yes" if reach[i] else "no"])
         trailers.append("target out of reach of this design" if not ok else
                         "" if kappa[i] > 0 else "kappa blank: J is singular at the target (arm stretched "
                                                 "or folded, w = 0), so cond(J) is infinite")
@@ -230,7 +232,7 @@ def table_4_8(p: Params, conv: Conv) -> tuple[Table, dict[str, Any]]:
             continue
         row = [f"{i + 1}.", l1[i], l2[i], m1[i], m2[i], g]
         if ok:
-            row += [float(t1[i]), float(t2[i]), float(tau[i, 0]), float(tau[i, 1])]
+            row += [float(t1[i]), float(t2[i]), float(tau[i, Torque.TAU1]), float(tau[i, Torque.TAU2])]
             trailers.append("" if ri[2][i] else "violates the workspace reach conditions")
         else:
             row += [None] * 4

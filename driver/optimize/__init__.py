@@ -24,9 +24,6 @@ fields ``x``, ``fun``, ``success``, ``message``, ``nfev``).
 """
 from __future__ import annotations
 
-import json
-import math
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -35,18 +32,19 @@ import pandas as pd
 
 from driver import _blas as blas
 from driver._atomic import output_set, write_text
-from driver._deck import Deck, read_deck
+from driver._deck import Deck, Params, read_deck
 from driver._export import write_tidy
 from driver._extras import require
-from driver._outcome import ExitCode, Outcome
+from driver._outcome import OptimizeOutcome, Optimum
+from driver._result import Figure
 from driver._runner import compute, output_stem, write_outputs
 from driver.optimize import _journal as journal_file
 from driver.optimize import _report as report
 from driver.optimize._evaluate import Evaluator, Record, design_params
-from driver.optimize._methods import HistoryRow, MethodResult, run_method
+from driver.optimize._methods import HistoryRow, run_method
 from driver.optimize._problem import SPEC, Problem, problem_of
 
-__all__ = ["SPEC", "OptimizeOutcome", "optimize", "run_optimize_deck", "problem_of"]
+__all__ = ["SPEC", "OptimizeOutcome", "Optimum", "optimize", "run_optimize_deck", "problem_of"]
 
 #: methods whose every step is free of BLAS (their evaluations are the deterministic kernel's): the
 #: best design they evaluated is the same on every machine
@@ -67,123 +65,6 @@ class DesignVector(dict):
 
     def __array__(self, dtype: Any = None, copy: Any = None) -> np.ndarray:
         return np.array(list(self.values()), dtype=dtype or np.float64)
-
-
-@dataclass
-class OptimizeOutcome(Outcome):
-    """Result of an optimisation, shaped like ``scipy.optimize.OptimizeResult``.
-
-    Also an :class:`~driver._outcome.Outcome`: files written, warnings and errors as messages,
-    notes.  Values are in the units of the deck keys and summary columns they name.
-
-    Attributes
-    ----------
-    problem : Problem
-        The problem the ``&optimize`` group declared (variables, objective, constraints).
-    x : DesignVector or None
-        Best feasible design, ``{'group.key': value}`` in the variables' deck units (and an
-        array by ``np.asarray(x)``, names in ``x.names``); None when none is feasible.
-    fun : float or None
-        Its objective value, in the objective expression's units (not sign-flipped).
-    success : bool
-        The method converged and ``x`` is feasible: ``x`` is an optimum.
-    message : str
-        The method's words.
-    nfev : int
-        Designs evaluated (each distinct design once).
-    best : Record or None
-        The evaluation record of ``x``.
-    check : Record or None
-        The optimum re-run by the full study.
-    method : MethodResult
-        What the method returned (iterations, convergence, starts, polish).
-    history : list of HistoryRow
-        The best feasible design after each generation, iteration or grid batch.
-    evaluator : Evaluator
-        Every design evaluated (``evaluator.frame()``: feasibility, reason, margins, summary).
-    study_result : Result or None
-        The study's full run at the optimum.
-    """
-
-    problem: Problem
-    x: dict[str, float] | None
-    fun: float | None
-    success: bool
-    message: str
-    nfev: int
-    best: Record | None
-    check: Record | None
-    method: MethodResult
-    history: list[HistoryRow]
-    evaluator: Evaluator
-    study_result: Any = None
-
-    @property
-    def status(self) -> int:
-        """0 optimum, 1 not converged (``x`` the best feasible design found), 2 no feasible design."""
-        return 0 if self.success else (2 if self.x is None else 1)
-
-    @property
-    def exit_code(self) -> ExitCode:
-        """1 when the method did not converge or the optimum's full run failed, else 0."""
-        failed = not self.success or (self.check is not None and self.study_result is not None
-                                      and bool(self.study_result.failure))
-        return ExitCode.FAILED if failed else super().exit_code
-
-    @property
-    def nit(self) -> int:
-        """Iterations: generations for differential evolution, all starts' for local methods."""
-        return int(self.method.iterations)
-
-    @property
-    def constraints(self) -> list[dict]:
-        """Constraint values and margins at x (empty without a feasible design)."""
-        if self.best is None:
-            return []
-        r, out = self.best, []
-        for k, c in enumerate(self.problem.constraints):
-            kind = "equality" if c.equality else ("inequality" if c.sense else "condition")
-            num = lambda v: (float(v) if v is not None and math.isfinite(v) else None)
-            out.append({"constraint": c.text, "kind": kind,
-                        "value": num(r.values[k]) if (c.numeric and r.values) else None,
-                        "margin": num(r.margins[k]) if r.margins else None,
-                        "tolerance": num(r.tols[k]) if (c.numeric and r.tols) else None,
-                        "met": bool(r.met[k]) if r.met else False})
-        return out
-
-    def to_dict(self) -> dict:
-        """Return the result as plain data: the ``--json`` record.
-
-        Returns
-        -------
-        dict
-            Scipy's fields, the constraints at ``x``, the starts of a local method and the
-            polish of differential evolution (JSON-safe; values in their deck units).
-        """
-        p = self.problem
-        rec = {"study": p.study.spec.name, "deck": str(p.deck.path), "objective": p.objective_text,
-               "x": None if self.x is None else [float(v) for v in self.x.values()], "x_names": p.names,
-               "fun": self.fun, "success": self.success, "status": self.status, "message": self.message,
-               "nit": self.nit, "nfev": self.nfev, "constraint_tol": p.opts.constraint_tol,
-               "constraints": self.constraints,
-               "warnings": list(self.study_result.warnings) if self.study_result is not None else []}
-        if self.method.starts:
-            rec["starts"] = [{"start": r["start"], "x0": [float(v) for v in r["x0"]],
-                              "end": [float(v) for v in r["x"]], "objective": _num(r["objective"]),
-                              "feasible": bool(r["feasible"]), "settled": bool(r["settled"]),
-                              "reached": bool(r.get("reached", False)), "method_success": bool(r["success"]),
-                              "method_message": r["message"], "iterations": r["iterations"]} for r in self.method.starts]
-        if self.method.polish is not None:
-            rec["polish"] = self.method.polish["text"]
-        return rec
-
-
-def _num(v: Any) -> float | None:
-    try:
-        v = float(v)
-    except (TypeError, ValueError):
-        return None
-    return v if math.isfinite(v) else None
 
 
 def _probe(problem: Problem) -> None:
@@ -311,58 +192,74 @@ def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[
         rec = Record(0, best.x, "failed" if result.failure else "ok", result.failure or "", dict(result.summary))
         probe._score([rec])
         check = rec
+    name = Path(deck.path).stem if stem is None else stem.name
     outcome = OptimizeOutcome(problem, None if best is None else DesignVector(zip(problem.names, best.x)),
                               None if best is None else best.objective, bool(mres.converged and best is not None),
-                              mres.message, len(ev.records), best, check, mres, history, ev, study_result=result)
+                              mres.message, len(ev.records), best, check, mres, history, ev, study_result=result,
+                              name=name)
+    _tables(outcome, params, [] if stem is None else [f"{stem.name}.optimum.dat"])
     if stem is not None:
         with output_set(stem.parent):   # the run's files all together, or none
-            outcome.written = _write(outcome, stem, params, formats, plot, njobs)
+            outcome.written = _write(outcome, stem, formats, plot)
         if journal is not None and journal.exists():
             journal.unlink()
     return outcome
 
 
-def _suffixes(formats: list[str], plot: bool | str) -> tuple[str, ...]:
-    """What a run appends to the deck's stem, known before it runs (the optimum's figures are not)."""
-    return (".out", ".optimum.dat", ".optimum.out", "_history.csv", "_evals.parquet", journal_file.SUFFIX,
-            *(s for fmt in formats for s in (f"_evals.{fmt}", f"_history.{fmt}", f".optimum.{fmt}")),
-            *(("_convergence.png",) if plot else ()))
-
-
-def _write(oc: OptimizeOutcome, stem: Path, params, formats: list[str], plot: bool | str, jobs: int) -> list[Path]:
+def _tables(oc: OptimizeOutcome, params: Params | None, files: list[str]) -> None:
+    """The outcome's data, as its files hold it: the history and evaluations tables, the report
+    text, the optimum (its deck and full run) and the figures (``files``: the optimum deck's
+    name, as the report cites it; none when nothing is written)."""
     p, ev = oc.problem, oc.evaluator
-    written: list[Path] = []
-    files: list[str] = []
-    if oc.best is not None:
-        opt_stem = stem.with_name(stem.name + ".optimum")
-        written.append(write_text(opt_stem.with_suffix(".optimum.dat"),
-                                  report.optimum_deck(p, params, oc.best, oc.success)))
-        files = [str(Path(opt_stem.name + ".dat"))]
-        written += write_outputs(oc.study_result, opt_stem, formats, plot)
     evals = ev.frame()
     evals.insert(1, "base", p.fingerprint())
     evals.attrs[journal_file.DIGEST_KEY] = journal_file.table_digests(evals, p.names)   # verified on --resume
     if report.settings_of(p):   # the band behind summary.meets_transmission_band, with the table
         evals.attrs["summary_settings"] = report.settings_of(p)
     hist = report.history_frame(p, oc.history)
-    text = report.report_text(p, ev, oc.method, oc.history, oc.best, oc.check, files,
-                              ev.jobs, list(oc.study_result.warnings) if oc.study_result is not None else [])
-    written.append(write_text(stem.with_name(stem.name + ".out"), text))
-    written.append(write_tidy(hist, stem.with_name(stem.name + "_history"), "csv"))
+    warnings = list(oc.study_result.warnings) if oc.study_result is not None else []
+    oc.history_table, oc.evaluations = hist, evals
+    oc.text = report.report_text(p, ev, oc.method, oc.history, oc.best, oc.check, files, ev.jobs, warnings)
+    if oc.best is not None and oc.x is not None and params is not None:
+        oc.optimum = Optimum(dict(oc.x), float(oc.best.objective), oc.constraints, oc.study_result, params,
+                             report.optimum_deck(p, params, oc.best, oc.success), oc.success)
+    title = Path(p.deck.path).stem
+    x = None if oc.x is None else dict(oc.x)
+    oc.figures = [Figure("convergence", lambda: report.convergence_figure(p, hist, evals, title)),
+                  Figure("designs", lambda: report.designs_figure(p, evals, title, x, oc.fun))]
+
+
+def _suffixes(formats: list[str], plot: bool | str) -> tuple[str, ...]:
+    """What a run appends to the deck's stem, known before it runs (the optimum's figures are not)."""
+    return (".out", ".optimum.dat", ".optimum.out", "_history.csv", "_evals.parquet", journal_file.SUFFIX,
+            *(s for fmt in formats for s in (f"_evals.{fmt}", f"_history.{fmt}", f".optimum.{fmt}")),
+            *(("_convergence.png", "_designs.png") if plot else ()))
+
+
+def _write(oc: OptimizeOutcome, stem: Path, formats: list[str], plot: bool | str) -> list[Path]:
+    """Write the outcome's files: the optimum's deck and run, the report, the tables, the figures."""
+    written: list[Path] = []
+    if oc.optimum is not None:
+        opt_stem = stem.with_name(stem.name + ".optimum")
+        written.append(write_text(opt_stem.with_suffix(".optimum.dat"), oc.optimum.deck))
+        written += write_outputs(oc.optimum.result, opt_stem, formats, plot)
+    assert oc.history_table is not None and oc.evaluations is not None
+    written.append(write_text(stem.with_name(stem.name + ".out"), oc.text))
+    written.append(write_tidy(oc.history_table, stem.with_name(stem.name + "_history"), "csv"))
     for fmt in dict.fromkeys(["parquet"] + formats):
-        written.append(write_tidy(evals, stem.with_name(stem.name + "_evals"), fmt))
+        written.append(write_tidy(oc.evaluations, stem.with_name(stem.name + "_evals"), fmt))
     if "parquet" in formats:
-        written.append(write_tidy(hist, stem.with_name(stem.name + "_history"), "parquet"))
+        written.append(write_tidy(oc.history_table, stem.with_name(stem.name + "_history"), "parquet"))
     if plot:
         from driver.plotting import save_figure
-        fig = report.convergence_figure(p, hist, evals, Path(p.deck.path).stem)
-        written.append(save_figure(fig, stem.with_name(stem.name + "_convergence.png"), plot))
+        for fig in oc.figures:
+            written.append(save_figure(fig.draw(), stem.with_name(f"{stem.name}_{fig.name}.png"), plot))
     return written
 
 
 def run_optimize_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, progress: bool = False,
                       jobs: int | None = None, resume: bool = False,
-                      scheduler: Any = None, summary_json: bool = False, **_: Any) -> OptimizeOutcome:
+                      scheduler: Any = None, **_: Any) -> OptimizeOutcome:
     """Run an optimisation deck and write its outputs: the command line's entry.
 
     Parameters
@@ -383,8 +280,6 @@ def run_optimize_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool |
         Reuse the evaluation journal in ``outdir``.
     scheduler : str or dask.distributed.Client, optional
         A Dask scheduler address or client.
-    summary_json : bool, default False
-        Also write ``<stem>.json``.
     **_ : dict
         Options of other engines, ignored.
 
@@ -405,10 +300,6 @@ def run_optimize_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool |
     if scheduler:
         require("dask")
     oc = optimize(deck, outdir, formats, plot, jobs, resume, scheduler or None)
-    if summary_json:
-        stem = output_stem(outdir, deck.path, (".json",))
-        oc.written.append(write_text(stem.with_name(stem.name + ".json"),
-                                     json.dumps(oc.to_dict(), indent=1, allow_nan=False) + "\n"))
     if oc.evaluator.resume_note:
         oc.warn(f"{deck.path}: resume: {oc.evaluator.resume_note}")
     if oc.study_result is not None:

@@ -14,7 +14,7 @@ from driver.optimize._evaluate import Evaluator, Record
 from driver.optimize._methods import HistoryRow, MethodResult
 from driver.optimize._problem import Problem
 
-__all__ = ["optimum_deck", "report_text", "history_frame", "convergence_figure"]
+__all__ = ["optimum_deck", "report_text", "history_frame", "convergence_figure", "designs_figure"]
 
 
 def _g(v: Any) -> str:
@@ -240,3 +240,35 @@ def convergence_figure(p: Problem, history: pd.DataFrame, evals: pd.DataFrame, t
     return plotting.convergence_plot(history, evals, expression_label(p.study, p.objective.text),
                                      "minimize" if p.sense > 0 else "maximize",
                                      title=plotting.plain_text(f"{title}: {p.objective_text}"))
+
+
+def designs_figure(p: Problem, evals: pd.DataFrame, title: str, x: dict[str, float] | None = None,
+                   fun: float | None = None):
+    """The designs evaluated, over the first two design variables (the objective against the one
+    variable of a one-variable problem): feasible ones coloured by the objective, infeasible ones
+    grey crosses, the reported design ``x`` (objective ``fun``) starred (a scatter: an optimiser's
+    designs are not on a grid)."""
+    from driver import plotting
+    from driver._output import column_label, expression_label
+    objective = expression_label(p.study, p.objective.text)
+    vx = p.names[0]
+    vy = p.names[1] if len(p.names) > 1 else "objective"
+    ok = evals["feasible"].astype(bool)
+    feas, bad = evals[ok], evals[~ok]
+    with plotting.style():
+        fig, (ax,) = plotting.new_figure(1, 1, figsize=(6.4, 4.4))
+        ax.plot(bad[vx], bad[vy], "x", ms=3, color="0.6", label="infeasible designs", rasterized=len(bad) > 2000)
+        sc = ax.scatter(feas[vx], feas[vy], c=feas["objective"], s=10, cmap="viridis", label="feasible designs",
+                        rasterized=len(feas) > 2000)
+        if len(feas):
+            cb = fig.colorbar(sc, ax=ax)
+            cb.set_label(plotting.wrap(objective, 40))
+            plotting.plain_numbers(cb.ax)
+        if x is not None:
+            ax.plot([x[vx]], [x[vy] if vy != "objective" else fun], "*", ms=16, color="C3", mec="k", label="optimum")
+        ax.set_xlabel(column_label(p.study, vx))
+        ax.set_ylabel(column_label(p.study, vy) if vy != "objective" else objective)
+        plotting.plain_numbers(ax)
+        ax.legend(loc="best")
+        ax.set_title(plotting.plain_text(f"{title}: designs evaluated"))
+    return fig

@@ -24,12 +24,18 @@ The package's private modules, by job: ``_spec`` (deck keys, the cross-check, th
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from driver._study import Study
 from driver.robust_example import _published as published
 from driver.robust_example._analysis import analyse, quadratic_fit
-from driver.robust_example._published import MODE_REASONS, NOT_REPRODUCIBLE
-from driver.robust_example._report import run
-from driver.robust_example._spec import SPEC, estimate
+from driver.robust_example._published import NOT_REPRODUCIBLE
+from driver.robust_example._spec import MODE_REASONS, SPEC, estimate
+
+if TYPE_CHECKING:   # run's keys as typed keywords: generated from SPEC (tools/gen_keyword_signatures.py)
+    from driver.robust_example._keywords import run
+else:
+    from driver.robust_example._report import run
 
 __all__ = ["SPEC", "STUDY", "run", "estimate", "quadratic_fit", "analyse", "MODE_REASONS", "NOT_REPRODUCIBLE"]
 

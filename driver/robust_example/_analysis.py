@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from driver._deck import Params
+from driver._errors import DriverError
 
 __all__ = ["MAX_COND", "FitError", "quadratic_fit", "tmin", "stationary", "analyse"]
 
@@ -18,7 +19,7 @@ __all__ = ["MAX_COND", "FitError", "quadratic_fit", "tmin", "stationary", "analy
 MAX_COND = 1e12
 
 
-class FitError(ValueError):
+class FitError(DriverError, ValueError):
     """The targets do not determine a quadratic (singular or ill-conditioned normal equations)."""
 
 

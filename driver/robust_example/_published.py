@@ -6,18 +6,9 @@ from driver import _published as record
 from driver._deck import Params
 from driver._published import numeric_cell
 from driver._result import Result
+from driver.robust_example._spec import MODE_REASONS
 
-__all__ = ["MODE_REASONS", "NOT_REPRODUCIBLE", "compare"]
-
-
-#: why mode = 'report' and mode = 'exact' differ, by result item
-MODE_REASONS = {
-    "eq28": "report fits ln of the std rounded to 7 dp (as printed in Table 2.2)",
-    "eq211": "report fits the means rounded to 4 dp (as printed in Table 2.5)",
-    "eq212": "report fits ln of the std rounded to 7 dp (as printed in Table 2.5)",
-    "eq29": "follows from the fit (2.8)",
-    "eq213": "follows from the fit (2.12)",
-}
+__all__ = ["NOT_REPRODUCIBLE", "compare"]
 
 
 #: printed results of section 2.3 that the printed data do not give, (item, index) -> why

@@ -8,16 +8,13 @@ from decimal import Decimal
 import numpy as np
 import pandas as pd
 
-from driver import _keywords
 from driver._deck import Params
 from driver._export import with_units
 from driver._result import Figure, Result
-from driver._runner import keyword_run
-from driver._signatures import keyword_signature
+from driver._runner import study_run
 from driver._table import Column, render_table
 from driver.robust_example._analysis import analyse, tmin
-from driver.robust_example._published import MODE_REASONS
-from driver.robust_example._spec import SPEC
+from driver.robust_example._spec import MODE_REASONS, SPEC
 
 __all__ = ["run", "TIDY_UNITS"]
 
@@ -73,8 +70,7 @@ def _compare(name: str, printed: list[float] | None, computed: np.ndarray,
 TIDY_UNITS = {"index": "1", "value": "unit of item"}
 
 
-@keyword_signature(_keywords.robust_example, SPEC)
-@keyword_run
+@study_run(SPEC)
 def run(params: Params, progress: bool = False) -> Result:
     """Estimate the robust target of Taylor's (1996) example three ways ([Ma'arif 2006], 2.3).
 

@@ -7,7 +7,17 @@ from driver._deck import GroupSpec, Key, Params, non_empty, positive
 from driver._limits import Estimate
 from driver._study import contract_doc
 
-__all__ = ["SPEC", "estimate"]
+__all__ = ["SPEC", "MODE_REASONS", "estimate"]
+
+
+#: why mode = 'report' and mode = 'exact' differ, by result item
+MODE_REASONS = {
+    "eq28": "report fits ln of the std rounded to 7 dp (as printed in Table 2.2)",
+    "eq211": "report fits the means rounded to 4 dp (as printed in Table 2.5)",
+    "eq212": "report fits ln of the std rounded to 7 dp (as printed in Table 2.5)",
+    "eq29": "follows from the fit (2.8)",
+    "eq213": "follows from the fit (2.12)",
+}
 
 
 def _three(v: Any) -> str | None:

@@ -285,7 +285,7 @@ def run_case(model: Model, params: Params, omega: float, n_el: int, alpha: float
     s = np.linspace(0.0, model.length, 41)
     n_rigid = kernel.slidercrank_axial_force(theta, s, omega, model.r2, model.length, model.rho_a, model.m_s)
     peak_c = max(0.0, float(-n_rigid.min()))
-    status = {v: k for k, v in kernel.SLIDERCRANK_STATUS.items()}[res["status"]]
+    status = res["status"].name   # the kernel's status table (SimulateStatus): 'ok', 'buckled', ...
     case = Case(omega, n_el, status, dt, euler_ratio=peak_c / p_euler, peak_compression=peak_c)
     if status != "ok":
         t_fail = max(res["fail_step"], 0) * dt

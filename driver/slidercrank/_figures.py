@@ -16,6 +16,7 @@ from matplotlib.figure import Figure
 from driver._deck import Params
 from driver.plotting import new_figure, plain_text, styled
 from driver.slidercrank._analysis import Case, history
+from driver.slidercrank._kernel import Shape
 from driver.slidercrank._spec import Model
 
 
@@ -207,8 +208,9 @@ def slidercrank_nl_shapes_figure(series: Sequence[tuple[str, tuple[float, float]
     fig, ax = _own_axes(ax, (7.4, 4.4))
     for k, (label, (a1, _a2), shapes) in enumerate(series):   # the dotted line's angle is not labelled
         s = np.linspace(0.0, length, shapes.shape[0])
-        ax.plot(s, shapes[:, 0] * 1e3, color=f"C{k % 10}", lw=1.2, label=f"{label}, theta2 = {a1:.0f} deg")
-        ax.plot(s, shapes[:, 1] * 1e3, color=f"C{k % 10}", lw=0.8, ls=":")
+        ax.plot(s, shapes[:, Shape.LARGEST_DEFLECTION] * 1e3, color=f"C{k % 10}", lw=1.2,
+                label=f"{label}, theta2 = {a1:.0f} deg")
+        ax.plot(s, shapes[:, Shape.LARGEST_COMPRESSION] * 1e3, color=f"C{k % 10}", lw=0.8, ls=":")
     ax.axhline(0.0, color="k", lw=0.6)
     ax.set_xlabel("position along the rod from the crank pin [m]")
     ax.set_ylabel("lateral deflection from the chord [mm]")

@@ -8,23 +8,41 @@ back.  Each kernel's physics and units are documented in its Fortran source.
 """
 from __future__ import annotations
 
-from typing import Any
+from enum import IntEnum
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from driver._docs import fill_doc
-from driver._fortran import _kernels, farray
+from driver._fortran import KernelStatus, farray, kernel_status
 
-__all__ = ['SLIDERCRANK_STATUS', 'SLIDERCRANK_PROFILE', 'slidercrank_simulate', 'slidercrank_matrices',
-           'slidercrank_rigid', 'slidercrank_axial_force', 'slidercrank_frequencies', 'SLIDERCRANK_NL_STATUS',
-           'slidercrank_nl_simulate', 'slidercrank_column_static', 'slidercrank_corot_element']
+if TYPE_CHECKING:   # the study's modules of the extension, typed (generated: tools/gen_kernel_stub.py)
+    from driver.slidercrank import _kernels
+else:
+    from driver._fortran import _kernels
+
+__all__ = ['SimulateStatus', 'NonlinearStatus', 'Shape', 'SLIDERCRANK_STATUS', 'SLIDERCRANK_PROFILE', 'slidercrank_simulate',
+           'slidercrank_matrices', 'slidercrank_rigid', 'slidercrank_axial_force', 'slidercrank_frequencies',
+           'SLIDERCRANK_NL_STATUS', 'slidercrank_nl_simulate', 'slidercrank_column_static',
+           'slidercrank_corot_element']
 
 
-#: status codes of the slider-crank kernel (fortran/slidercrank.f90)
-SLIDERCRANK_STATUS = {"ok": int(_kernels.slidercrank.st_ok), "buckled": int(_kernels.slidercrank.st_buckled),
-                      "diverged": int(_kernels.slidercrank.st_diverged),
-                      "not_spd": int(_kernels.slidercrank.st_not_spd),
-                      "bad_args": int(_kernels.slidercrank.st_bad_args)}
+class SimulateStatus(KernelStatus):
+    """Status word of the linear rod's time loop (fortran/slidercrank.f90 ``st_*``).
+
+    Each with the words a report prints for it; ``bad_args`` (the kernel refused its call) raises.
+    """
+
+    ok = int(_kernels.slidercrank.st_ok), "ok"
+    buckled = int(_kernels.slidercrank.st_buckled), "STATIC INSTABILITY", "K + K_G lost definiteness (the rod buckles)"
+    diverged = (int(_kernels.slidercrank.st_diverged), "LIMIT L/20",
+                "elastic deflection exceeded L/20 (or a rotation 0.25 rad): the linear model is no longer valid")
+    not_spd = int(_kernels.slidercrank.st_not_spd), "NOT SPD", "the iteration matrix is not positive definite"
+    bad_args = int(_kernels.slidercrank.st_bad_args), "BAD ARGUMENTS", "the kernel refused its arguments", True
+
+
+#: the linear rod's status codes by name (``SLIDERCRANK_STATUS["ok"]``): :class:`SimulateStatus`
+SLIDERCRANK_STATUS: type[SimulateStatus] = SimulateStatus
 _SC_START = {"rest": 0, "quasistatic": 1, "given": 2}
 
 
@@ -113,7 +131,7 @@ def slidercrank_simulate(n_elements: int, crank_radius: float, rod_length: float
     with eps_max_el / eps_min_el the (first, 0-based) element holding it, outer_max the
     largest outer-fibre strain, n_avg_1 element 1's rigid-body force [N], and with ``lag`` > 0
     lag_change: max over elements of |eps_ax[:, j] - eps_ax[:, j - lag]| (0 for j < lag);
-    q_end, qd_end final state; status (a SLIDERCRANK_STATUS value) and fail_step.
+    q_end, qd_end final state; status (a :class:`SimulateStatus`) and fail_step.
     """
     nq = 3 * int(n_elements)
     q0 = farray(np.zeros(nq) if q_init is None else q_init, 1)
@@ -125,7 +143,8 @@ def slidercrank_simulate(n_elements: int, crank_radius: float, rod_length: float
     names = ("eps_ax", "eps_of", "n_avg", "mid", "slider", "elong", "prof", "q_end", "qd_end", "status",
              "fail_step")
     res: dict[str, Any] = dict(zip(names, out))   # arrays and the integer status words
-    res["status"], res["fail_step"] = int(res["status"]), int(res["fail_step"])
+    res["status"] = kernel_status(SimulateStatus, res["status"], "slidercrank.simulate")
+    res["fail_step"] = int(res["fail_step"])
     prof = res.pop("prof")
     for k, name in enumerate(SLIDERCRANK_PROFILE):
         res[name] = prof[k]
@@ -261,11 +280,34 @@ def slidercrank_frequencies(rho_a: float, ea: float, ei: float, rod_length: floa
 
 # ----------------------------------------------------------------------------- slidercrank, nonlinear rod
 
-#: status codes of the nonlinear slider-crank kernel (fortran/slidercrank_nl.f90)
-SLIDERCRANK_NL_STATUS = {"ok": int(_kernels.slidercrank_nl.nl_ok), "limit": int(_kernels.slidercrank_nl.nl_limit),
-                         "not_spd": int(_kernels.slidercrank_nl.nl_not_spd),
-                         "bad_args": int(_kernels.slidercrank_nl.nl_bad_args),
-                         "no_convergence": int(_kernels.slidercrank_nl.nl_no_convergence)}
+class NonlinearStatus(KernelStatus):
+    """Status word of the nonlinear rod's kernels (fortran/slidercrank_nl.f90 ``nl_*``).
+
+    Each with the words a report prints for it; ``bad_args`` (the kernel refused its call) raises.
+    """
+
+    ok = int(_kernels.slidercrank_nl.nl_ok), "ok"
+    limit = int(_kernels.slidercrank_nl.nl_limit), "COLLAPSE", "the lateral deflection passed L/2: the rod has folded up"
+    not_spd = int(_kernels.slidercrank_nl.nl_not_spd), "NOT SPD", "the Newton matrix is not positive definite"
+    bad_args = int(_kernels.slidercrank_nl.nl_bad_args), "BAD ARGUMENTS", "the kernel refused its arguments", True
+    no_convergence = (int(_kernels.slidercrank_nl.nl_no_convergence), "NO CONVERGENCE",
+                      "Newton did not converge even after the allowed step cuts; reduce the time step "
+                      "(steps_per_rev) or raise max_step_cuts")
+
+
+#: the nonlinear rod's status codes by name (``SLIDERCRANK_NL_STATUS["ok"]``): :class:`NonlinearStatus`
+SLIDERCRANK_NL_STATUS: type[NonlinearStatus] = NonlinearStatus
+
+
+class Shape(IntEnum):
+    """Columns of :func:`slidercrank_nl_simulate`'s ``shapes`` (and of its ``shape_step``).
+
+    The rod's lateral deflection [m] at the step of largest deflection and at the step of largest
+    crank-end compression.
+    """
+
+    LARGEST_DEFLECTION = 0
+    LARGEST_COMPRESSION = 1
 
 
 @_doc
@@ -318,7 +360,7 @@ def slidercrank_nl_simulate(n_elements: int, crank_radius: float, rod_length: fl
     shapes (n_elements + 1, 2) lateral deflection profiles [m] at the recorded steps
     shape_step (largest deflection, largest crank-end compression); stats (Newton solves,
     most solves in a step, step cuts, deepest cut level, steps completed); status (a
-    SLIDERCRANK_NL_STATUS value), fail_step, fail_iter.
+    :class:`NonlinearStatus`), fail_step, fail_iter.
     """
     n_rev = max(1, -(-int(n_steps) // int(steps_per_rev)))
     out = _kernels.slidercrank_nl.simulate_nl(
@@ -328,14 +370,15 @@ def slidercrank_nl_simulate(n_elements: int, crank_radius: float, rod_length: fl
     names = ("eps_ax", "eps_of", "lat_max", "mid", "elong", "slider", "energy", "rev_lat", "rev_eps", "shapes",
              "shape_step", "stats", "status", "fail_step", "fail_iter")
     res: dict[str, Any] = dict(zip(names, out))   # arrays and the integer status words
-    for key in ("status", "fail_step", "fail_iter"):
+    res["status"] = kernel_status(NonlinearStatus, res["status"], "slidercrank_nl.simulate_nl")
+    for key in ("fail_step", "fail_iter"):
         res[key] = int(res[key])
     return res
 
 
 def slidercrank_column_static(n_elements: int, length: float, ea: float, ei: float, load: float,
                               imperfection: float, tol: float = 1e-10,
-                              max_iterations: int = 500) -> tuple[float, float, int, int]:
+                              max_iterations: int = 500) -> tuple[float, float, int, NonlinearStatus]:
     """Solve a static pinned-pinned column of co-rotational elements under an end load.
 
     Parameters
@@ -365,13 +408,19 @@ def slidercrank_column_static(n_elements: int, length: float, ea: float, ei: flo
         End shortening, m.
     iterations : int
         Newton solves used.
-    status : int
-        A ``SLIDERCRANK_NL_STATUS`` value.
+    status : NonlinearStatus
+        ``ok``, or ``no_convergence`` (an int: it compares equal to the Fortran code).
+
+    Raises
+    ------
+    driver._errors.KernelError
+        The kernel refused its arguments (``n_elements`` odd or below 2, ``tol`` or
+        ``max_iterations`` not positive).
     """
     n = int(n_elements)
     _q, mid, short, iters, status = _kernels.slidercrank_nl.column_static(
         n, 3 * n, length, ea, ei, load, imperfection, tol, int(max_iterations))
-    return float(mid), float(short), int(iters), int(status)
+    return float(mid), float(short), int(iters), kernel_status(NonlinearStatus, status, "slidercrank_nl.column_static")
 
 
 def slidercrank_corot_element(le: float, ea: float, ei: float, p: np.ndarray,

@@ -13,6 +13,7 @@ from tqdm import tqdm
 
 from driver._deck import Params
 from driver._export import with_units
+from driver._mechanism import Guide, Link, MechanismFrames
 from driver._result import Figure, Result
 from driver._table import Cell, Column, render_table
 from driver.slidercrank import _kernel as kernel
@@ -411,25 +412,47 @@ def run_linear(params: Params, progress: bool = False) -> Result:
                   figures=figures)
 
 
-def animation_frames(params: Params, result: Result | None = None, n: int = 180) -> dict[str, Any] | None:
+#: interior nodes of the rod drawn in the report page's animation when its deflection is known
+ROD_NODES = 7
+
+
+def animation_frames(params: Params, result: Result | None = None, n: int = 180) -> MechanismFrames:
     """The mechanism's positions at ``n`` crank angles over one turn, for the report page's animation
-    (:func:`driver._report_page.mechanism_animation`): crank pin A, slider B, and with ``result`` the
-    elastic rod's midpoint deflection, magnified."""
+    (:class:`driver._mechanism.MechanismFrames`): crank pivot O, crank pin A and slider pin B from
+    the kernel's rigid kinematics, the slider block on its guide and, with ``result``, the elastic
+    rod bowed by its midpoint deflection (magnified; drawn as the parabola through it, at
+    :data:`ROD_NODES` interior nodes)."""
     model = model_of(params)
     r, length = float(model.r2), float(model.length)
     theta = np.linspace(0.0, 360.0, n, endpoint=False)
     states = kernel.slidercrank_rigid(np.radians(theta), 1.0, r, length)
     a = np.column_stack([r * np.cos(np.radians(theta)), r * np.sin(np.radians(theta))])
     b = np.column_stack([states[:, 3], np.zeros_like(theta)])
-    frames = {"theta": theta.tolist(), "ok": [1] * len(theta), "A": np.round(a, 6).tolist(),
-              "B": np.round(b, 6).tolist(), "P": None, "ground": [[0.0, 0.0], [float(b[:, 0].max()), 0.0]],
-              "kind": "slider", "names": {"crank": "crank", "out": "slider"}}
-    frames["box_points"], frames["pad_y"] = np.vstack([a, b, [[0.0, 0.0]]]), 0.25 * r
-    frames["bow"], frames["bow_note"] = _rod_bow(result, theta, length)
-    return frames
+    w, h = 0.5 * r, 0.25 * r   # the slider block
+    corners = np.array([[-w / 2, -h / 2], [w / 2, -h / 2], [w / 2, h / 2], [-w / 2, h / 2]])
+    bow, note = _rod_bow(result, theta, length)
+    names = ["O", "A", "B", "K1", "K2", "K3", "K4"]
+    parts = [np.zeros_like(a), a, b, *(b + c for c in corners)]
+    rod: tuple[int, ...] = (1, 2)
+    if bow is not None:   # the rod's nodes on the parabola through the magnified midpoint deflection
+        chord = b - a
+        normal = np.column_stack([-chord[:, 1], chord[:, 0]]) / np.hypot(chord[:, 0], chord[:, 1])[:, None]
+        for j in range(1, ROD_NODES + 1):
+            t = j / (ROD_NODES + 1)
+            names.append(f"R{j}")
+            parts.append(a + t * chord + (4.0 * t * (1.0 - t) * np.asarray(bow))[:, None] * normal)
+        rod = (1, *range(7, 7 + ROD_NODES), 2)
+    x0, x1 = float(b[:, 0].min()) - w, float(b[:, 0].max()) + w
+    caption = "The slider-crank over one crank turn, rigid positions from the kernel"
+    return MechanismFrames(
+        names=tuple(names), points=np.stack(parts, axis=1),
+        links=(Link("crank", (0, 1)), Link("connecting rod", rod), Link("slider", (3, 4, 5, 6), body=True)),
+        labels=tuple(f"{t:.0f}\u00b0" for t in theta), ground=(0,), joints=(1, 2), paths=(1,), frame_name="crank angle",
+        guides=(Guide(np.array([[x0, -h / 2], [x1, -h / 2]]), "slider guide"),),
+        units="m", caption=caption + ("; " + note if note else "") + ".")
 
 
-def _rod_bow(result: Result | None, theta: np.ndarray, length: float) -> tuple[list[float] | None, str]:
+def _rod_bow(result: Result | None, theta: np.ndarray, length: float) -> tuple[np.ndarray | None, str]:
     """The elastic rod's midpoint deflection [m] at the animation's crank angles, magnified so
     its largest is 6 % of the rod (from the run's tidy table: the fastest crank speed that ran),
     and the words saying so; (None, '') without one."""
@@ -447,5 +470,5 @@ def _rod_bow(result: Result | None, theta: np.ndarray, length: float) -> tuple[l
         return None, ""
     scale = 0.06 * length / peak
     bow = np.interp(theta, ang, mid, period=360.0) * scale
-    return np.round(bow, 7).tolist(), (f"rod deflection magnified {scale:.3g} times "
-                                       f"(midpoint deflection at {w:g} rad/s, largest {peak * 1e3:.3g} mm)")
+    return bow, (f"rod deflection magnified {scale:.3g} times "
+                 f"(midpoint deflection at {w:g} rad/s, largest {peak * 1e3:.3g} mm)")

@@ -13,29 +13,21 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
-from driver import _keywords
 from driver._deck import Params
 from driver._export import with_units
 from driver._result import Figure, Result
-from driver._runner import keyword_run
-from driver._signatures import keyword_signature
+from driver._runner import study_run
 from driver._table import Cell, Column, render_table
 from driver.slidercrank._analysis import Case, run_case, static_onset
-from driver.slidercrank._nonlinear import IRREGULAR, NLCase, onset_search, run_nl_case
+from driver.slidercrank._analysis_nl import IRREGULAR, NLCase, onset_search, run_nl_case
+from driver.slidercrank._kernel import NonlinearStatus
 from driver.slidercrank._report import Derived, figures_module, header_lines, run_linear, status_text
 from driver.slidercrank._spec import SPEC, model_of, rayleigh
 
-NL_STATUS_TEXT = {
-    "limit": ("COLLAPSE", "the lateral deflection passed L/2: the rod has folded up"),
-    "no_convergence": ("NO CONVERGENCE", "Newton did not converge even after the allowed step cuts; "
-                                         "reduce the time step (steps_per_rev) or raise max_step_cuts"),
-    "not_spd": ("NOT SPD", "the Newton matrix is not positive definite"),
-    "bad_args": ("BAD ARGUMENTS", "the kernel refused its arguments"),
-}
-
 
 def nl_status_text(c: NLCase) -> str:
-    what, why = NL_STATUS_TEXT[c.status]
+    status = NonlinearStatus[c.status]   # the kernel's status table: its words
+    what, why = status.what, status.why
     where = f"at step {c.fail_step} (theta2 = {c.fail_angle_deg:.2f} deg, revolution {c.fail_rev})"
     if c.status == "no_convergence":
         where += f" after {c.fail_iter} Newton solves and {c.deepest_cut} step halvings"
@@ -90,7 +82,7 @@ def _per_revolution(cases: list[NLCase]) -> list[str]:
     for c in cases:
         done = min(nrev, max(c.steps_done - 1, 0) // c.steps_per_rev + 1) if c.steps_done else 0
         rows.append([c.omega] + [float(c.rev_lat[k]) * 1e3 if k < done else "-" for k in range(nrev)])
-        trailers.append("" if c.ok else NL_STATUS_TEXT[c.status][0])
+        trailers.append("" if c.ok else NonlinearStatus[c.status].what)
     return ["Table 6  Peak lateral deflection of the nonlinear rod in each revolution [mm]", ""] + \
         render_table(cols, rows, trailers)
 
@@ -227,7 +219,7 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
     warnings: list[str] = []
     failure = None
     for lin, nl in pairs:
-        if nl.status in ("no_convergence", "not_spd", "bad_args"):
+        if nl.status in ("no_convergence", "not_spd"):
             failure = f"crank speed {nl.omega:g} rad/s, {nl.n_elements} elements, nonlinear: {nl_status_text(nl)}"
             warnings.append(failure)
         elif nl.collapsed:
@@ -270,8 +262,7 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
                   summary=_summary(pairs, tol, limit, onset), warnings=warnings, failure=failure, figures=figures)
 
 
-@keyword_signature(_keywords.slidercrank, SPEC)
-@keyword_run
+@study_run(SPEC)
 def run(params: Params, progress: bool = False) -> Result:
     """Simulate a slider-crank with an elastic connecting rod at one or more crank speeds.
 

@@ -34,14 +34,9 @@ MIN_STEPS_PER_BENDING_PERIOD = 20
 MIN_STEPS_PER_REV = 36
 EULER_WARN = 0.8
 MAX_ELEMENTS = 5000
-#: what each failed case status means (the kernel's triggers, fortran/slidercrank.f90)
-STATUS_TEXT = {
-    "buckled": ("STATIC INSTABILITY", "K + K_G lost definiteness (the rod buckles)"),
-    "diverged": ("LIMIT L/20", "elastic deflection exceeded L/20 (or a rotation 0.25 rad): "
-                               "the linear model is no longer valid"),
-    "not_spd": ("NOT SPD", "the iteration matrix is not positive definite"),
-    "bad_args": ("BAD ARGUMENTS", "the kernel refused its arguments"),
-}
+#: what each failed case status means, (heading, why): the kernel's status table
+#: (``driver.slidercrank.kernel.SimulateStatus``, fortran/slidercrank.f90)
+STATUS_TEXT = {s.name: (s.what, s.why) for s in kernel.SimulateStatus if s != kernel.SimulateStatus.ok}
 
 #: Simeon (1996) / IVP test set "crank": published initial values (ini = 1, consistent) of the
 #: modal coordinates q1, q2 (lateral sin(pi x), sin(2 pi x)), q3, q4 (axial, quadratic: midpoint

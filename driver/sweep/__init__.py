@@ -96,7 +96,7 @@ def _base_hash(raw: RawGroup) -> str:
 
 def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, progress: bool = False,
                    jobs: int | None = None, scheduler: Any = None, resume: bool = False,
-                   notify: Callable[[str], None] | None = None) -> SweepOutcome:
+                   notify: Callable[[str], None] | None = None, best: bool = False) -> SweepOutcome:
     """Run a deck with a &sweep group and write its files; print nothing.
 
     Parameters
@@ -121,6 +121,8 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool | st
         ``notify(line)`` hears what cannot wait for the outcome: on Ctrl-C, that the queued cases
         are cancelled while the running ones finish (the command line prints it on stderr at
         once). Default: nothing is said, the ``KeyboardInterrupt`` being the news.
+    best : bool, default False
+        Also run the best case in full (``outcome.best``: what the report page draws).
 
     Returns
     -------
@@ -206,9 +208,13 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool | st
     else:
         bplan = None
     with store.sweep_lock(outdir, stem_path.name):   # one run at a time writes a sweep's files
-        if bplan is not None:
-            return run.batch(bplan, sig)
-        return run.cases(sig, estimates)
+        oc = run.batch(bplan, sig) if bplan is not None else run.cases(sig, estimates)
+    oc.study, oc.sweep = base_params.group, sw
+    if best and oc.summary is not None:
+        from driver.sweep._best import attach_best
+        summary = oc.summary.to_pandas() if hasattr(oc.summary, "to_pandas") else oc.summary
+        attach_best(oc, summary, sw, module, raw, grid)
+    return oc
 
 
 class _CasesTable:
@@ -368,6 +374,7 @@ class _Run:
         cases = pieces.table(written)
         write_sweep_files(self.outdir, self.stem, table, cases, text, self.plot, sw, names, self.module, frame,
                           self._settings())
+        oc.summary, oc.text = table, text
         store.remove_stale_case_files(layout, has_files)
         store.clean_temporaries(layout)   # of workers of a killed earlier run that outlived its start
         oc.phases["finish_cpu"] = time.process_time() - c_end
@@ -393,6 +400,7 @@ class _Run:
                                     self.plot, self.module, self._settings())
         if res is None:
             return False
+        oc.summary = stream.Parts(rows.paths)   # the streamed rows stay in the record's parts
         if n <= 10 * store.SHARD * store.SHARD:
             store.remove_stale_case_files(self.layout, np.zeros(n + 1, dtype=bool))
         oc.n_ok, oc.n_kept, oc.seconds, oc.chunk = n - res.n_failed, res.n_kept, elapsed, chunk
@@ -503,6 +511,7 @@ class _Run:
         remove_stale_temporaries(self.outdir, self.stem)
         write_sweep_files(self.outdir, self.stem, rows, cases, text, self.plot, sw, names, self.module, rows,
                           self._settings())
+        oc.summary, oc.text = rows, text
         if has_files is not None:
             store.remove_stale_case_files(self.layout, has_files)
         oc.phases["finish_cpu"] = time.process_time() - c_run

@@ -18,7 +18,8 @@ from driver._output import column_label
 from driver._table import Column, render_table
 from driver.sweep._spec import CaseResult
 
-__all__ = ["summary_frame", "summary_settings", "sweep_text", "Warnings", "write_sweep_files"]
+__all__ = ["summary_frame", "summary_settings", "sweep_text", "Warnings", "write_sweep_files", "summary_figures",
+           "plotted_columns", "with_plotted"]
 
 
 def summary_settings(module: Any, base: Params, swept: set[str] | None = None) -> dict[str, Any]:
@@ -181,23 +182,37 @@ def write_sweep_files(outdir: Path, stem: str, table: pd.DataFrame, cases: Any, 
 
 def write_sweep_plot(outdir: Path, stem: str, plot: bool | str, sw: Params, names: list[str], module: Any,
                      shown: pd.DataFrame) -> None:
-    """The sweep's summary figure(s) of the rows ``shown``."""
-    from driver.plotting import save_figure, sweep_summary
+    """The sweep's summary figure(s) of the rows ``shown`` (:func:`summary_figures`)."""
+    from driver.plotting import save_figure
+    for k, fig in enumerate(summary_figures(shown, sw, names, module, stem)):
+        save_figure(fig, outdir / f"{stem}_summary{'' if k == 0 else f'_{k + 1}'}.png", plot)
+
+
+def with_plotted(shown: pd.DataFrame, sw: Params) -> pd.DataFrame:
+    """``shown`` with a column for each plotted expression (``plot_x``, ``plot_y``) it lacks."""
     shown = shown.copy()
     for name in [sw.plot_x, *sw.plot_y]:   # a plotted expression becomes a column
         if name and name not in shown.columns:
             shown[name] = expr.parse(name).evaluate(shown)
+    return shown
+
+
+def plotted_columns(shown: pd.DataFrame, sw: Params, module: Any) -> list[str]:
+    """The summary columns a sweep plots: the deck's ``plot_y``, else the study's first ``sweep_plot``."""
+    return [y for y in sw.plot_y if y in shown] or [c for c in module.sweep_plot if c in shown][:1]
+
+
+def summary_figures(shown: pd.DataFrame, sw: Params, names: list[str], module: Any, stem: str) -> list[Any]:
+    """The sweep's summary figure(s) of the rows ``shown`` (what ``--plot`` writes and the report
+    page shows): maps of the plotted columns over a grid of 2-3 numeric keys, else the summary
+    lines and strips (:func:`driver.plotting.sweep_summary`)."""
+    from driver.plotting import is_grid, sweep_maps, sweep_summary
+    shown = with_plotted(shown, sw)
     labels = {c: column_label(module, c) for c in shown.columns}
-    from driver.plotting import is_grid, sweep_maps
     if is_grid(shown, names) and not sw.zip:   # a design space: maps over the keys, not strips
-        ys = [y for y in sw.plot_y if y in shown] or [c for c in module.sweep_plot
-                                                     if c in shown][:1]
-        for k, fig in enumerate(sweep_maps(shown, names, ys[:3], labels, module.sweep_best,
-                                           stem, sw.summary_rows == "kept")):
-            save_figure(fig, outdir / f"{stem}_summary{'' if k == 0 else f'_{k + 1}'}.png", plot)
-    else:
-        save_figure(sweep_summary(shown, names, sw.plot_x, sw.plot_y, stem, labels,
-                                  module.sweep_plot), outdir / f"{stem}_summary.png", plot)
+        ys = plotted_columns(shown, sw, module)
+        return list(sweep_maps(shown, names, ys[:3], labels, module.sweep_best, stem, sw.summary_rows == "kept"))
+    return [sweep_summary(shown, names, sw.plot_x, sw.plot_y, stem, labels, module.sweep_plot)]
 
 
 def sweep_text(deck: Deck, sw: Params, base: Params, axes: list[tuple[str, list]], n_cases: int,

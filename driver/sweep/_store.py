@@ -40,6 +40,7 @@ import numpy as np
 import driver
 from driver._atomic import DIGEST_CHARS, atomic_open, file_digest, own_folder, refuse_link, remove_stale_temporaries
 from driver._deck import RawGroup
+from driver._errors import DriverError
 from driver._outcome import ExitCode
 from driver.sweep._spec import CaseResult, Grid, case_at
 
@@ -118,12 +119,16 @@ def case_signature(raw: RawGroup, swept: list[str], deck_path: str, keep: str, c
                       keep, case_outputs, sorted(formats), str(case_plot)], module)
 
 
-class SweepBusy(OSError):
+class SweepBusy(DriverError, OSError):
     """Another run holds the lock of this sweep's record (one line)."""
 
     def __init__(self, folder: Path):
         super().__init__(16, "another run is writing this sweep; wait for it to finish (or give another -o OUTDIR)",
                          str(folder))
+
+    def __reduce__(self) -> tuple[type[SweepBusy], tuple[Path]]:
+        """Pickle by the folder (the message is made from it)."""
+        return (type(self), (Path(self.filename),))
 
 
 @contextlib.contextmanager

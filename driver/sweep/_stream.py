@@ -32,7 +32,7 @@ from driver._deck import Deck, Params
 from driver._table import Column
 from driver.sweep._report import FAILED_LISTED, failed_lines, head_lines, not_listed_line, table_columns, table_values
 
-__all__ = ["STREAM_ROWS", "write_streamed", "Streamed"]
+__all__ = ["STREAM_ROWS", "write_streamed", "Streamed", "Parts"]
 
 #: above this many rows (kept and failed cases) a batch sweep's tables are written part by part
 STREAM_ROWS = 20_000
@@ -173,3 +173,18 @@ def read_columns(paths: list[Path], columns: list[str] | None = None) -> pd.Data
         t = pq.read_table(p, columns=columns)
         frames.append(_frame(t, _origins(pq.read_schema(p))))
     return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
+
+
+class Parts:
+    """A lazy handle on a streamed sweep's summary rows, kept in the record's parts: read when
+    asked (:meth:`to_pandas`)."""
+
+    def __init__(self, paths: list[Path]):
+        self.paths = list(paths)
+
+    def to_pandas(self, columns: list[str] | None = None) -> pd.DataFrame:
+        """The rows (only ``columns``; None: all) as one frame."""
+        return read_columns(self.paths, columns)
+
+    def __len__(self) -> int:
+        return sum(pq.read_metadata(p).num_rows for p in self.paths)

@@ -36,13 +36,14 @@ from driver import fourbar
 from driver._atomic import output_set, write_text
 from driver._deck import Deck, DeckError, GroupSpec, Key, Params, RawGroup, positive, read_deck, validate
 from driver._export import write_tidy
-from driver._outcome import FilesOutcome
+from driver._outcome import SynthesisOutcome
+from driver._result import Figure
 from driver._runner import compute, output_stem, write_outputs
 from driver.fourbar import _kernel as fourbar_kernel
 from driver.synthesis import _crank_rocker as cr
 from driver.synthesis._function import FunctionDesign, chebyshev, freudenstein, links_from_k, wrap180
 
-__all__ = ["SPEC", "Synthesis", "synthesise", "run_synthesis_deck"]
+__all__ = ["SPEC", "Synthesis", "SynthesisOutcome", "synthesise", "synthesis_figures", "run_synthesis_deck"]
 
 ST = fourbar_kernel.FOURBAR_STATUS
 
@@ -311,7 +312,7 @@ def _synthesise_function(p: Params) -> Synthesis:
         crank_deg = fd.crank_start_deg + (x - x0) / (xf - x0) * p.crank_range_deg
         out, st = fourbar_kernel.fourbar_exact(np.radians(crank_deg), d, fd.crank, fd.coupler, fd.rocker, 1.0, 0.0, sgn)
         desired_psi = fd.rocker_start_deg + (curve(x) - y0) / (yf - y0) * p.rocker_range_deg
-        err = wrap180(np.degrees(out[:, 1]) - desired_psi)
+        err = wrap180(np.degrees(out[:, fourbar_kernel.State.ROCKER_ANGLE]) - desired_psi)
         err = np.where(st == ST["ok"], err, np.nan)
         y_gen = curve(x) + err / p.rocker_range_deg * (yf - y0)
         fd.x, fd.y_desired, fd.y_generated, fd.rocker_error_deg, fd.status = x, curve(x), y_gen, err, st
@@ -319,7 +320,8 @@ def _synthesise_function(p: Params) -> Synthesis:
         pr = fd.rocker_start_deg + (ys - y0) / (yf - y0) * p.rocker_range_deg
         for s, attr in ((sgn, "point_error_deg"), (-sgn, "other_branch_point_error_deg")):
             o2, s2 = fourbar_kernel.fourbar_exact(np.radians(pc), d, fd.crank, fd.coupler, fd.rocker, 1.0, 0.0, s)
-            setattr(fd, attr, np.where(s2 == ST["ok"], wrap180(np.degrees(o2[:, 1]) - pr), np.nan))
+            psi2 = np.degrees(o2[:, fourbar_kernel.State.ROCKER_ANGLE])
+            setattr(fd, attr, np.where(s2 == ST["ok"], wrap180(psi2 - pr), np.nan))
         worst = int(np.nanargmax(np.abs(err))) if np.isfinite(err).any() else 0
         tol_deg = 1e-6 if len(xs) == 3 else math.inf
         bad = np.flatnonzero(st != ST["ok"])
@@ -350,7 +352,7 @@ def _synthesise_function(p: Params) -> Synthesis:
                               "structural_error": y_gen - fd.y_desired, "rocker_error_deg": err,
                               "status": np.array(["ok", "cannot_assemble", "toggle", "indeterminate"])[st]})
         good = st == ST["ok"]
-        mu = np.degrees(out[good, 2]) if good.any() else np.array([])
+        mu = np.degrees(out[good, fourbar_kernel.State.TRANSMISSION_ANGLE]) if good.any() else np.array([])
         warnings = _quality_warnings(p, d, {"crank": fd.crank, "coupler": fd.coupler, "rocker": fd.rocker},
                                      float(mu.min()) if mu.size else None, float(mu.max()) if mu.size else None)
         lines += [f"  WARNING: {w} (over the x range)" if "transmission" in w else f"  WARNING: {w}" for w in warnings]
@@ -557,9 +559,8 @@ def synthesise(deck: Deck | str | Path) -> Synthesis:
     return syn
 
 
-def _path_figure(syn: Synthesis, path: Path, title: str, fmt: bool | str = True) -> Path:
+def _path_figure(syn: Synthesis, title: str) -> Any:
     """The linkage, its coupler curve and the target points, in the linkage deck's frame."""
-    from driver import plotting
     from driver.fourbar import _figures as fourbar_figures
     from driver.synthesis import _path as pg
     q = syn.design.parts
@@ -574,19 +575,56 @@ def _path_figure(syn: Synthesis, path: Path, title: str, fmt: bool | str = True)
     ax = fig.axes[0]
     ax.plot(tk[:, 0], tk[:, 1], "s", mfc="none", mec="k", ms=7, label="target points")
     ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)   # beside the drawing
-    return plotting.save_figure(fig, path, fmt)
+    return fig
 
 
-def synthesis_record(syn: Synthesis) -> dict[str, Any]:
-    """The ``--json`` record of a synthesis: task, linkage, checks, failure and warnings."""
-    from driver._export import json_safe
-    return json_safe({"kind": "synthesis", "task": syn.params.task, "deck": str(syn.params.path),
-                      "ok": syn.failure is None, "failure": syn.failure, "warnings": list(syn.warnings),
-                      "linkage": syn.linkage, "checks": syn.checks})
+def _error_figure(syn: Synthesis, title: str) -> Any:
+    """Function generation: the desired and generated y(x) and the structural error, the
+    precision points marked where the two meet."""
+    from driver import plotting
+    fd = syn.design
+    fig = plotting.line_panels(fd.x, [("y", {"desired y(x)": fd.y_desired, "generated": fd.y_generated}),
+                                      ("structural error", {"error": fd.y_generated - fd.y_desired})],
+                               "x", title=f"{title}: function generation")
+    # the precision points: where the generated function meets y(x) (zero structural error)
+    top, err = fig.axes
+    top.plot(fd.x_points, fd.y_points, "o", ms=6, mfc="white", mec="k", zorder=5, label="precision points")
+    err.plot(fd.x_points, np.zeros_like(fd.x_points), "o", ms=6, mfc="white", mec="k", zorder=5,
+             label="precision points")
+    err.axhline(0.0, color="0.5", lw=0.8)
+    top.legend()
+    err.legend()
+    return fig
+
+
+def synthesis_figures(syn: Synthesis, title: str) -> list[Figure]:
+    """List the synthesis's own figures, drawn on demand.
+
+    Parameters
+    ----------
+    syn : Synthesis
+        The synthesis (:func:`synthesise`).
+    title : str
+        The figures' title (the deck's stem).
+
+    Returns
+    -------
+    list of Figure
+        The structural error of a function generation (``'error'``), the linkage and its
+        coupler curve through the targets of a path generation (``'path'``); none for a
+        crank-rocker.
+    """
+    if syn.design is None:
+        return []
+    if syn.params.task == "function" and len(syn.design.x):
+        return [Figure("error", lambda: _error_figure(syn, title))]
+    if syn.params.task == "path":
+        return [Figure("path", lambda: _path_figure(syn, title))]
+    return []
 
 
 def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, progress: bool = False,
-                       summary_json: bool = False, **_: Any) -> FilesOutcome:
+                       **_: Any) -> SynthesisOutcome:
     """Synthesise a linkage and write its files: the command line's entry.
 
     Parameters
@@ -601,16 +639,14 @@ def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool 
         Write the figures (``True`` or a figure format: ``'png'``, ``'svg'``, ``'pdf'``).
     progress : bool, default False
         Unused (a synthesis shows no progress bar); the engines' common signature.
-    summary_json : bool, default False
-        Also write ``<stem>.json``.
     **_ : dict
         Options of other engines, ignored.
 
     Returns
     -------
-    FilesOutcome
-        The files written, the warnings and the failure as data, the :class:`Synthesis` as
-        ``value``.
+    SynthesisOutcome
+        The linkage, its tables and its run, the files written, the warnings and the failure
+        as data (the :class:`Synthesis` as ``value``).
 
     Raises
     ------
@@ -620,44 +656,29 @@ def run_synthesis_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool 
     syn = synthesise(deck)
     stem = output_stem(outdir, deck.path, (".out", ".linkage.dat", ".linkage.out", f"{syn.table_name}.csv",
                                            *(f".linkage.{fmt}" for fmt in formats),
-                                           *((".json",) if summary_json else ()),
                                            *(("_error.png", "_path.png") if plot else ())))
+    text = syn.text.rstrip() + "\n"
+    if syn.linkage is not None:
+        text += f"\n  linkage deck {stem.name}.linkage.dat; its exact analysis in {stem.name}.linkage.out\n"
+    outcome = SynthesisOutcome(failure=syn.failure, value=syn, name=stem.name, text=text,
+                               figures=synthesis_figures(syn, Path(deck.path).stem))
+    if syn.linkage is not None:
+        head = f"! four-bar synthesised by {deck.path} ({syn.params.task})" + (
+            "" if syn.failure is None else f"; FAILED CHECK: {syn.failure}")
+        outcome.linkage_deck = head + "\n" + str(f90nml.Namelist({"fourbar": syn.linkage})) + "\n"
     written = []
     with output_set(stem.parent):   # the deck's files all together, or none
         if syn.linkage is not None:
-            head = f"! four-bar synthesised by {deck.path} ({syn.params.task})" + (
-                "" if syn.failure is None else f"; FAILED CHECK: {syn.failure}")
-            written.append(write_text(stem.with_name(stem.name + ".linkage.dat"),
-                                      head + "\n" + str(f90nml.Namelist({"fourbar": syn.linkage})) + "\n"))
+            written.append(write_text(stem.with_name(stem.name + ".linkage.dat"), outcome.linkage_deck))
             written += write_outputs(syn.study_result, stem.with_name(stem.name + ".linkage"), formats, plot)
-        text = syn.text.rstrip() + "\n"
-        if syn.linkage is not None:
-            text += f"\n  linkage deck {stem.name}.linkage.dat; its exact analysis in {stem.name}.linkage.out\n"
         written.append(write_text(stem.with_name(stem.name + ".out"), text))
-        if summary_json:
-            import json
-            written.append(write_text(stem.with_name(stem.name + ".json"),
-                                      json.dumps(synthesis_record(syn), indent=1, allow_nan=False) + "\n"))
         if len(syn.table):
             written.append(write_tidy(syn.table, stem.with_name(stem.name + syn.table_name), "csv"))
-        if plot and syn.params.task == "function" and syn.design is not None and len(syn.design.x):
+        if plot:
             from driver import plotting
-            fd = syn.design
-            fig = plotting.line_panels(fd.x, [("y", {"desired y(x)": fd.y_desired, "generated": fd.y_generated}),
-                                              ("structural error", {"error": fd.y_generated - fd.y_desired})],
-                                       "x", title=f"{Path(deck.path).stem}: function generation")
-            # the precision points: where the generated function meets y(x) (zero structural error)
-            top, err = fig.axes
-            top.plot(fd.x_points, fd.y_points, "o", ms=6, mfc="white", mec="k", zorder=5, label="precision points")
-            err.plot(fd.x_points, np.zeros_like(fd.x_points), "o", ms=6, mfc="white", mec="k", zorder=5,
-                     label="precision points")
-            err.axhline(0.0, color="0.5", lw=0.8)
-            top.legend()
-            err.legend()
-            written.append(plotting.save_figure(fig, stem.with_name(stem.name + "_error.png"), plot))
-    if plot and syn.params.task == "path" and syn.design is not None:
-        written.append(_path_figure(syn, stem.with_name(stem.name + "_path.png"), Path(deck.path).stem, plot))
-    outcome = FilesOutcome(written=written, failure=syn.failure, value=syn)
+            for fig in outcome.figures:
+                written.append(plotting.save_figure(fig.draw(), stem.with_name(f"{stem.name}_{fig.name}.png"), plot))
+    outcome.written = written
     for w in syn.warnings:
         outcome.warn(f"{deck.path}: {w}")
     if syn.failure:

@@ -105,7 +105,7 @@ def evaluate(pp: PathProblem, x: np.ndarray) -> PathDesign:
         motion[pp.samples:] = True
     bad = motion & ~ok
     viol += float(bad.mean()) * 10.0
-    mu = np.degrees(out[:, 2])
+    mu = np.degrees(out[:, fourbar_kernel.State.TRANSMISSION_ANGLE])
     lo, hi = pp.mu_band
     if (motion & ok).any():
         m = mu[motion & ok]

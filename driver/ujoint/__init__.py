@@ -26,6 +26,8 @@ wrappers).
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from driver._study import BatchSummary, Study
 from driver.ujoint import _kernel as kernel
 from driver.ujoint import _published as published
@@ -55,7 +57,7 @@ from driver.ujoint._batch import (
     batch_applies,
     summarise_batch,
 )
-from driver.ujoint._report import run
+from driver.ujoint._report import animation_frames
 from driver.ujoint._spec import (
     BAND_TOL,
     CONVENTIONS,
@@ -69,6 +71,11 @@ from driver.ujoint._spec import (
     estimate,
 )
 
+if TYPE_CHECKING:   # run's keys as typed keywords: generated from SPEC (tools/gen_keyword_signatures.py)
+    from driver.ujoint._keywords import run
+else:
+    from driver.ujoint._report import run
+
 __all__ = ["SPEC", "STUDY", "run", "estimate", "Chain", "Design", "StartRun", "evaluate", "optimise",
            "objective_scale", "pick_best", "yoke_shifts", "phases_for", "cross_check", "summarise_batch",
            "batch_applies", "BATCH_KEYS", "BATCH_PASSES", "BATCH_IGNORED", "BATCH_INDEPENDENT", "BATCH_ELEMENTS",
@@ -80,4 +87,5 @@ STUDY = Study(name="ujoint", package=__name__, spec=SPEC, run=run, estimate=esti
                                  independent=BATCH_INDEPENDENT, passes=BATCH_PASSES,
                                  pass_names=("objective", "speed", "equivalent"), applies=batch_applies,
                                  elements=BATCH_ELEMENTS),
-              labels=LABELS, sweep_plot=SWEEP_PLOT, published=published.compare, figures=f"{__name__}._figures", kernel=kernel)
+              labels=LABELS, sweep_plot=SWEEP_PLOT, published=published.compare, animation=animation_frames,
+              figures=f"{__name__}._figures", kernel=kernel)

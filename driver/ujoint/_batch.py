@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from driver._deck import Params
+from driver._study import batch_error
 from driver.ujoint._kernel import (
     UJOINT_MODELS,
     UJOINT_OBJECTIVES,
@@ -65,17 +65,10 @@ def batch_applies(base: Mapping[str, Any]) -> bool:
     return int(base["option"]) == 0
 
 
-def _bad(base: Mapping[str, Any], key: str | None, message: str) -> Exception:
-    """A DeckError at the key's deck line when ``base`` is a deck's Params, else a ValueError."""
-    if isinstance(base, Params):
-        return base.error(key, message)
-    return ValueError(f"{key}: {message}" if key else message)
-
-
 def _design_count(base: Mapping[str, Any], columns: dict[str, Any]) -> int:
     sizes = {np.shape(v)[0] for v in columns.values() if np.ndim(v) > 0}
     if len(sizes) > 1:
-        raise _bad(base, None, f"batch columns have different lengths {sorted(sizes)}")
+        raise batch_error(base, None, f"batch columns have different lengths {sorted(sizes)}")
     return sizes.pop() if sizes else 1
 
 
@@ -86,24 +79,24 @@ def _list_column(base: Mapping[str, Any], key: str, whole: Any, elements: dict[i
         a = np.asarray(whole, dtype=np.float64)
         a = a[:, None] if a.ndim == 1 else (a.reshape(1, 1) if a.ndim == 0 else a)
         if a.ndim != 2:
-            raise _bad(base, key, f"a batch column of lists must be (designs, values); got shape {a.shape}")
+            raise batch_error(base, key, f"a batch column of lists must be (designs, values); got shape {a.shape}")
         a = np.broadcast_to(a, (nd, a.shape[1]))
     elif base.get(key) is not None:
         a = np.broadcast_to(np.asarray(base[key], dtype=np.float64), (nd, len(base[key])))
     elif elements:
-        raise _bad(base, key, f"'{key}(i)' sets one element of '{key}', which the base deck does not give")
+        raise batch_error(base, key, f"'{key}(i)' sets one element of '{key}', which the base deck does not give")
     else:
         return None
     if elements:
         a = a.copy()
         for i, v in elements.items():
             if not 1 <= i <= a.shape[1]:
-                raise _bad(base, key, f"'{key}({i})': '{key}' has {a.shape[1]} value(s)")
+                raise batch_error(base, key, f"'{key}({i})': '{key}' has {a.shape[1]} value(s)")
             a[:, i - 1] = np.broadcast_to(np.asarray(v, dtype=np.float64), (nd,))
     bad = ~np.isfinite(a)
     if bad.any():
         i = int(np.argmax(bad.any(axis=1)))
-        raise _bad(base, key, f"design {i} has a non-finite value")
+        raise batch_error(base, key, f"design {i} has a non-finite value")
     return a
 
 
@@ -113,7 +106,7 @@ def _choice_column(base: Mapping[str, Any], key: str, columns: dict[str, Any], n
     assert allowed is not None   # called for the choice keys only
     bad = ~np.isin(v, allowed)
     if bad.any():
-        raise _bad(base, key, f"must be one of {', '.join(map(repr, allowed))} (got {v[np.argmax(bad)]!r})")
+        raise batch_error(base, key, f"must be one of {', '.join(map(repr, allowed))} (got {v[np.argmax(bad)]!r})")
     return v
 
 
@@ -137,7 +130,7 @@ def _number_column(base: Mapping[str, Any], key: str, columns: dict[str, Any], n
         what = "must be a whole number of at least 8"
     if bad.any():
         i = int(np.argmax(bad))
-        raise _bad(base, key, f"design {i} has {float(v[i])!r}: {what}")
+        raise batch_error(base, key, f"design {i} has {float(v[i])!r}: {what}")
     return v
 
 
@@ -192,8 +185,8 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
         A bad value otherwise.
     """
     if not batch_applies(base):
-        raise _bad(base, "option", f"option {base['option']} optimises inside each case; the batch path "
-                                   "evaluates given designs (option 0)")
+        raise batch_error(base, "option", f"option {base['option']} optimises inside each case; the batch path "
+                                         "evaluates given designs (option 0)")
     cols: dict[str, Any] = {}
     elems: dict[str, dict[int, Any]] = {}
     for k, v in (columns or {}).items():
@@ -204,13 +197,13 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
         elif k in BATCH_KEYS:
             cols[k] = v
         elif k not in BATCH_IGNORED:
-            raise _bad(base, k, f"not a &ujoint key the summary depends on ({', '.join(BATCH_KEYS)}; "
-                                f"elements of {', '.join(BATCH_ELEMENTS)} as 'key(i)')")
+            raise batch_error(base, k, f"not a &ujoint key the summary depends on ({', '.join(BATCH_KEYS)}; "
+                                      f"elements of {', '.join(BATCH_ELEMENTS)} as 'key(i)')")
     nd = _design_count(base, {**cols, **{f"{k}({i})": v for k, e in elems.items() for i, v in e.items()}})
     axes = base.get("axes") is not None
     if axes and ({"beta", "rho"} & (set(cols) | set(elems))):
-        raise _bad(base, "axes", "the base deck's 'axes' fix the joint and plane angles; a batch cannot vary "
-                                 "'beta' or 'rho' then")
+        raise batch_error(base, "axes", "the base deck's 'axes' fix the joint and plane angles; a batch cannot vary "
+                                       "'beta' or 'rho' then")
     if axes:   # as joint_geometry (the base deck is valid): kernel radians -> degrees
         b_rad, r_rad, _ = ujoint_geometry(np.asarray(base["axes"], dtype=np.float64).reshape(-1, 3))
         beta: np.ndarray = np.broadcast_to(b_rad / DEG, (nd, b_rad.size))
@@ -218,42 +211,42 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     else:
         given_beta = _list_column(base, "beta", cols.get("beta"), elems.get("beta", {}), nd)
         if given_beta is None:
-            raise _bad(base, None, "give the joint angles 'beta' (deg) or the shaft directions 'axes'")
+            raise batch_error(base, None, "give the joint angles 'beta' (deg) or the shaft directions 'axes'")
         beta = given_beta
         rho = _list_column(base, "rho", cols.get("rho"), elems.get("rho", {}), nd)
     n = beta.shape[1]
     bad = ~((beta > -90.0) & (beta < 90.0))
     if bad.any():
         i = int(np.argmax(bad.any(axis=1)))
-        raise _bad(base, "beta", f"design {i}: a joint angle must lie strictly between -90 and 90 deg "
-                                 f"(got {beta[i][bad[i]][0]})")
+        raise batch_error(base, "beta", f"design {i}: a joint angle must lie strictly between -90 and 90 deg "
+                                       f"(got {beta[i][bad[i]][0]})")
     given = {k for k in ("phi", "delta") if k in cols or k in elems or base.get(k) is not None}
     if len(given) > 1:
-        raise _bad(base, "delta", "give the phases either as 'phi' (90 = in phase) or as 'delta' "
-                                  "(0 = in phase), not both")
+        raise batch_error(base, "delta", "give the phases either as 'phi' (90 = in phase) or as 'delta' "
+                                        "(0 = in phase), not both")
     if given:
         key = given.pop()
         given_phi = _list_column(base, key, cols.get(key), elems.get(key, {}), nd)
         assert given_phi is not None   # the key is given
         phi = given_phi
         if phi.shape[1] != n - 1:
-            raise _bad(base, key, f"a chain of {n} joint(s) has {n - 1} intermediate shaft(s), so "
-                                  f"{n - 1} phase(s); got {phi.shape[1]}")
+            raise batch_error(base, key, f"a chain of {n} joint(s) has {n - 1} intermediate shaft(s), so "
+                                        f"{n - 1} phase(s); got {phi.shape[1]}")
         if key == "delta":
             phi = phi + 90.0
     else:
         phi = np.full((nd, n - 1), 90.0)
     if rho is not None and rho.shape[1] != n - 1:
-        raise _bad(base, "rho", f"a chain of {n} joint(s) has {n - 1} plane angle(s) between successive "
-                                f"joints; got {rho.shape[1]}")
+        raise batch_error(base, "rho", f"a chain of {n} joint(s) has {n - 1} plane angle(s) between successive "
+                                      f"joints; got {rho.shape[1]}")
     model = _choice_column(base, "model", cols, nd)
     phasing = _choice_column(base, "phasing", cols, nd)
     exact = model == "exact"
     if rho is not None and not exact.all():
-        raise _bad(base, "axes" if axes else "rho", "plane angles need model = 'exact' (the paper's model "
-                                                    "is coplanar)")
+        raise batch_error(base, "axes" if axes else "rho", "plane angles need model = 'exact' (the paper's model "
+                                                          "is coplanar)")
     if exact.any() and ("phasing" in cols or "phasing" in getattr(base, "given", ())):
-        raise _bad(base, "phasing", "applies only to model = 'paper' (the exact chain has no phasing choice)")
+        raise batch_error(base, "phasing", "applies only to model = 'paper' (the exact chain has no phasing choice)")
     code = _codes(np.where(exact, "exact", phasing), UJOINT_MODELS)
     kind = _codes(_choice_column(base, "objective", cols, nd), UJOINT_OBJECTIVES)
     rpm = _number_column(base, "rpm", cols, nd)

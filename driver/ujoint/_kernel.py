@@ -8,13 +8,34 @@ back.  Each kernel's physics and units are documented in its Fortran source.
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from driver._docs import fill_doc
-from driver._fortran import _kernels, farray
+from driver._fortran import KernelStatus, farray, kernel_status
 
-__all__ = ['UJOINT_PASSES', 'UJOINT_MODELS', 'UJOINT_OBJECTIVES', 'ujoint_speed', 'ujoint_objective',
+if TYPE_CHECKING:   # the study's modules of the extension, typed (generated: tools/gen_kernel_stub.py)
+    from driver.ujoint import _kernels
+else:
+    from driver._fortran import _kernels
+
+__all__ = ['UjointStatus', 'UJOINT_PASSES', 'UJOINT_MODELS', 'UJOINT_OBJECTIVES', 'ujoint_speed', 'ujoint_objective',
            'ujoint_equivalent', 'ujoint_geometry', 'ujoint_summaries', 'UJOINT_SUMMARY_COLUMNS']
+
+
+class UjointStatus(KernelStatus):
+    """Status words of the chain kernels (fortran/ujoint.f90 ``st_*``).
+
+    Of the resultant angle (chain_equivalent, a summary column) and of a 3-D chain's geometry
+    (chain_geometry).
+    """
+
+    ok = int(_kernels.ujoint.st_ok), "ok"
+    res_undefined = (int(_kernels.ujoint.st_res_undefined), "no resultant angle",
+                     "a phase minus its plane angle is not a multiple of 90 deg")
+    zero_axis = int(_kernels.ujoint.st_zero_axis), "zero axis", "a shaft direction of zero length"
+    right_angle = int(_kernels.ujoint.st_right_angle), "right angle", "a joint angle of 90 deg or more"
 
 
 #: model codes of fortran/ujoint.f90: the paper's eq. 13 as printed, the paper's text
@@ -136,7 +157,8 @@ def ujoint_equivalent(model: int, beta, phi, rho, tol: float = 1e-7) -> tuple[fl
     """
     b, ph, rh = _ujoint_chain(beta, phi, rho)
     be, br, st = _kernels.ujoint.chain_equivalent(int(model), b, ph, rh, float(tol))
-    return float(be), (float(br) if st == int(_kernels.ujoint.st_ok) else None)
+    defined = kernel_status(UjointStatus, st, "ujoint.chain_equivalent") == UjointStatus.ok
+    return float(be), (float(br) if defined else None)
 
 
 #: columns of ujoint_summaries (fortran/ujoint.f90 chain_summaries)
@@ -205,7 +227,7 @@ def ujoint_summaries(model: int, kind: int, beta, phi, rho, m: int, tol: float =
                                            tol=float(tol), passes=int(passes))
 
 
-def ujoint_geometry(axes) -> tuple[np.ndarray, np.ndarray, int]:
+def ujoint_geometry(axes) -> tuple[np.ndarray, np.ndarray, UjointStatus]:
     """Compute joint angles and plane angles of a 3-D chain from its shaft directions.
 
     Parameters
@@ -219,9 +241,10 @@ def ujoint_geometry(axes) -> tuple[np.ndarray, np.ndarray, int]:
         (n,) joint angles, rad.
     rho : numpy.ndarray
         (n-1,) angles between the planes of successive joints, rad.
-    status : int
-        0 ok, 2 an axis of zero length, 3 a joint angle of 90 deg or more.
+    status : UjointStatus
+        ``ok``, ``zero_axis`` (an axis of zero length) or ``right_angle`` (a joint angle of 90
+        deg or more); an int, equal to the Fortran code.
     """
     a = farray(np.asarray(axes, dtype=np.float64).T, 2)
     beta, rho, status = _kernels.ujoint.chain_geometry(a)
-    return beta, rho, int(status)
+    return beta, rho, kernel_status(UjointStatus, status, "ujoint.chain_geometry")

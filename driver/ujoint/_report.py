@@ -11,12 +11,11 @@ import textwrap
 import numpy as np
 import pandas as pd
 
-from driver import _keywords
 from driver._deck import Params
 from driver._export import with_units
+from driver._mechanism import Link, MechanismFrames
 from driver._result import Figure, Result
-from driver._runner import keyword_run
-from driver._signatures import keyword_signature
+from driver._runner import study_run
 from driver._table import Cell, Column, fortran_f, render_table
 from driver.ujoint._analysis import (
     TIE_RTOL,
@@ -34,7 +33,7 @@ from driver.ujoint._analysis import (
     start_points,
     yoke_shifts,
 )
-from driver.ujoint._kernel import UJOINT_MODELS
+from driver.ujoint._kernel import UJOINT_MODELS, ujoint_speed
 from driver.ujoint._spec import BAND_TOL, CONVENTIONS, DEG, OPTIONS, SPEC, joint_geometry, per_joint, phases_deg
 
 
@@ -344,8 +343,7 @@ def _result_dat(params: Params, chain: Chain, designs: list[Design], best: Desig
     return "\n".join(lines) + "\n"
 
 
-@keyword_signature(_keywords.ujoint, SPEC)
-@keyword_run
+@study_run(SPEC)
 def run(params: Params, progress: bool = False) -> Result:
     """Analyse (option 0) or optimise (options 1-3) a chain of Hooke joints on a shaft line.
 
@@ -428,3 +426,94 @@ def _figures():
     """The study's figure module, imported when a figure is drawn (matplotlib is the optional [plot] extra)."""
     from driver.ujoint import _figures as figures
     return figures
+
+
+#: the axonometric view of the shaft chain: turned by the azimuth about the vertical, then tilted
+#: by the elevation (joint 1's plane is the x-y plane, the input shaft along x) [deg]
+VIEW_AZIMUTH_DEG, VIEW_ELEVATION_DEG = 30.0, 20.0
+#: the yokes' radius, in shaft lengths (every shaft is drawn one unit long)
+YOKE_RADIUS = 0.22
+
+
+def _rotation(axis: np.ndarray, angle: float) -> np.ndarray:
+    """The rotation matrix by ``angle`` [rad] about the unit vector ``axis`` (Rodrigues)."""
+    k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    return np.eye(3) + math.sin(angle) * k + (1.0 - math.cos(angle)) * (k @ k)
+
+
+def _chain_axes(params: Params, beta_deg: np.ndarray, rho_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The shafts' unit directions (n+1, 3) and the joints' plane normals (n, 3): the deck's
+    ``axes`` when given, else built from the joint and plane angles (joint 1 in the x-y plane,
+    successive bends alternating, a Z arrangement; the sign of a bend does not change a Hooke
+    joint's motion, its cosine does)."""
+    if params.axes is not None:
+        a = np.asarray(params.axes, float).reshape(-1, 3)
+        a = a / np.linalg.norm(a, axis=1)[:, None]
+        normals, last = [], np.array([0.0, 0.0, 1.0])
+        for k in range(len(a) - 1):
+            c = np.cross(a[k], a[k + 1])
+            last = c / np.linalg.norm(c) if np.linalg.norm(c) > 1e-12 else last
+            normals.append(last)
+        return a, np.array(normals)
+    axes, normals = [np.array([1.0, 0.0, 0.0])], [np.array([0.0, 0.0, 1.0])]
+    for k, b in enumerate(beta_deg):
+        axes.append(_rotation(normals[k], (1 if k % 2 == 0 else -1) * b * DEG) @ axes[k])
+        if k < len(beta_deg) - 1:
+            normals.append(_rotation(axes[-1], rho_deg[k] * DEG) @ normals[k])
+    return np.array(axes), np.array(normals)
+
+
+def animation_frames(params: Params, result: Result | None = None, n: int = 180) -> MechanismFrames:
+    """The shaft chain over one input turn, for the report page's animation
+    (:class:`driver._mechanism.MechanismFrames`): an oblique view of the shafts (each drawn one
+    unit long) and of one yoke per shaft, each turned by its shaft's angle from the kernel's exact
+    chain (:func:`~driver.ujoint.kernel.ujoint_speed`, the chain up to that shaft) at the run's
+    design (the optimum of an optimising ``result``, else the deck's).  Each frame's label gives
+    the output shaft's deviation from uniform rotation."""
+    beta0, rho_given = joint_geometry(params)
+    nj = beta0.size
+    s = dict(getattr(result, "summary", None) or {})
+    beta = np.array([s.get(f"beta_{k + 1}_deg", beta0[k]) for k in range(nj)], float)
+    phi = np.array([s.get(f"phi_{k + 1}_deg", v) for k, v in enumerate(phases_deg(params, nj))], float)
+    rho = np.zeros(nj - 1) if rho_given is None else np.asarray(rho_given, float)
+    theta = np.linspace(0.0, 360.0, n, endpoint=False)
+    th = np.radians(theta)
+    exact = UJOINT_MODELS["exact"]
+    psi = [th] + [ujoint_speed(exact, beta[:k] * DEG, phi[:k - 1] * DEG, rho[:k - 1] * DEG, th)[2]
+                  for k in range(1, nj + 1)]
+    axes, normals = _chain_axes(params, beta, rho)
+    centres = [-axes[0]]                 # the input shaft's far end, the joints, the output shaft's end
+    for k in range(nj + 1):
+        centres.append(centres[-1] + axes[k])
+    az, el = math.radians(VIEW_AZIMUTH_DEG), math.radians(VIEW_ELEVATION_DEG)
+
+    def view(p: np.ndarray) -> np.ndarray:   # (..., 3) -> (..., 2): turned, tilted, depth dropped
+        depth = -p[..., 0] * math.sin(az) + p[..., 2] * math.cos(az)
+        return np.stack([p[..., 0] * math.cos(az) + p[..., 2] * math.sin(az),
+                         p[..., 1] * math.cos(el) + depth * math.sin(el)], axis=-1)
+
+    names = ["E0", *(f"J{k + 1}" for k in range(nj)), "E1"]
+    parts = [np.broadcast_to(view(c), (n, 2)) for c in centres]
+    shaft = ["input shaft", *(f"intermediate shaft {k}" for k in range(1, nj)), "output shaft"]
+    links = [Link(shaft[k], (k, k + 1), colour=k) for k in range(nj + 1)]
+    for k in range(nj + 1):   # the yoke of shaft k at its middle, at the shaft's angle from its joint plane's normal
+        u = normals[max(k - 1, 0)]
+        u = u - (u @ axes[k]) * axes[k]
+        u /= np.linalg.norm(u)
+        v = np.cross(axes[k], u)
+        e = np.cos(psi[k])[:, None] * u + np.sin(psi[k])[:, None] * v
+        mid = 0.5 * (centres[k] + centres[k + 1])
+        names += [f"Y{k}a", f"Y{k}b"]
+        parts += [view(mid + YOKE_RADIUS * e), view(mid - YOKE_RADIUS * e)]
+        links.append(Link(f"yoke of the {shaft[k]}", (len(names) - 2, len(names) - 1), colour=k))
+    dev = np.degrees(np.unwrap(psi[-1]) - th)
+    dev = np.round(dev - dev.mean(), 2) + 0.0   # no '-0.00'
+    design = "optimum" if params.option and result is not None else "deck's"
+    model = "" if params.model == "exact" else (f" (the deck's model, '{params.model}', gives the output speed; "
+                                                "the shafts' angles are the exact chain's)")
+    return MechanismFrames(
+        names=tuple(names), points=np.stack(parts, axis=1), links=tuple(links),
+        labels=tuple(f"{t:.0f}\u00b0, output {d:+.2f}\u00b0 from uniform rotation" for t, d in zip(theta, dev)),
+        joints=tuple(range(1, nj + 1)), paths=(nj + 2, len(names) - 2), frame_name="input shaft angle",
+        caption=f"The shaft chain in an axonometric view (each shaft drawn one unit long, not to scale) at the {design} "
+                f"design, each yoke turned by its shaft's angle in the kernel's exact chain{model}.")

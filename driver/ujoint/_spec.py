@@ -12,7 +12,7 @@ import numpy as np
 from driver._deck import GroupSpec, Key, Params, non_empty, positive
 from driver._limits import Estimate
 from driver._study import contract_doc
-from driver.ujoint._kernel import ujoint_geometry
+from driver.ujoint._kernel import UjointStatus, ujoint_geometry
 
 DEG = math.pi / 180.0
 OPTIONS = {0: "analyse only", 1: "phases free, joint angles fixed",
@@ -138,7 +138,7 @@ def joint_geometry(params: Params) -> tuple[np.ndarray, np.ndarray | None]:
                 raise params.error("axes", f"shaft {k} direction ({', '.join(map(str, v))}) has zero "
                                            "length; every shaft needs a nonzero direction")
         beta_rad, rho_rad, status = ujoint_geometry(a)
-        if status != 0:
+        if status != UjointStatus.ok:
             k = int(np.argmax(beta_rad >= 0.5 * math.pi))
             raise params.error("axes", f"joint {k + 1} bends by {beta_rad[k] / DEG:.4f} deg; a joint angle "
                                        "must lie strictly between -90 and 90 deg")

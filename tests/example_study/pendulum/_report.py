@@ -1,31 +1,27 @@
-"""One &pendulum deck run: the period, the half swing tabulated, the summary."""
+"""One &pendulum deck run: the period, the half swing tabulated, the summary and the figure."""
 from __future__ import annotations
 
-import numpy as np
 import pandas as pd
 
 from driver._deck import Params
 from driver._export import with_units
 from driver._result import Figure, Result
-from driver._runner import keyword_run
+from driver._runner import study_run
 from driver._table import Column, render_table
 
-from . import _kernel as kernel
-from ._batch import summarise_batch
+from ._analysis import half_swing
+from ._batch import summarise
+from ._spec import SPEC
+
+__all__ = ["run"]
 
 
-def summarise(params: Params) -> dict:
-    """The summary of one deck (one row of the batch summary)."""
-    return {k: float(v) for k, v in summarise_batch(params).iloc[0].items()}
-
-
-@keyword_run
+@study_run(SPEC)
 def run(params: Params, progress: bool = False) -> Result:
     """Period and half swing of the deck's rod."""
     p = params
     s = summarise(p)
-    t = np.linspace(0.0, 0.5 * s["period_s"], p.points)
-    theta = np.degrees(kernel.swing(p.length, p.gravity, np.radians(p.amplitude_deg), t))
+    t, theta = half_swing(p, s["period_s"])
     lines = [f"  rigid pendulum: uniform rod L = {p.length:g} m, g = {p.gravity:g} m/s^2, "
              f"amplitude {p.amplitude_deg:g} deg" + (f" -- {p.title}" if p.title else ""), "",
              f"    period ............... {s['period_s']:.6f} s",

@@ -133,7 +133,7 @@ def run_nl_case(model: Model, params: Params, omega: float, n_el: int, alpha: fl
         n_el, model.r2, model.length, model.rho_a, model.ea, model.ei, model.depth / 2, model.m_s, omega, dt,
         n_steps, spr, rec_start, spr + 1, alpha, beta, hht=params.hht_alpha, start=params.start, tol=params.newton_tolerance,
         max_iterations=params.newton_max_iterations, max_cuts=params.max_step_cuts, energy=energy)
-    status = {v: k for k, v in kernel.SLIDERCRANK_NL_STATUS.items()}[res["status"]]
+    status = res["status"].name   # the kernel's status table (NonlinearStatus): 'ok', 'limit', ...
     st = res["stats"]
     case = NLCase(omega, n_el, status, dt, spr, solves=int(st[0]), max_solves=int(st[1]), cuts=int(st[2]),
                   deepest_cut=int(st[3]), steps_done=int(st[4]), fail_step=res["fail_step"],

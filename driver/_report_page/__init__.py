@@ -1,0 +1,69 @@
+"""The report page of a deck (``--report``): one self-contained HTML file, ``<stem>.html``, built
+from the engine's outcome.
+
+Everything a reader needs is inside the one file, so it opens offline, mails as one attachment
+and prints: the run's metadata (tool version, build, date), its warnings, the figures as inline
+SVG, the fixed-format tables and the headline figures, the comparison with the published cells
+where the deck reproduces a published table, the deck itself, and an animation of the mechanism
+(the study's :class:`~driver._mechanism.MechanismFrames`, moved by a few lines of JavaScript).
+Sweeps get the maps of their summary and their best case; optimisations their convergence, the
+designs evaluated and the optimum; a synthesis its linkage.
+
+The page is data (:mod:`~driver._report_page._blocks`: sections of blocks, made from the outcome
+by :mod:`~driver._report_page._sections`) drawn by Jinja2 templates with autoescaping
+(``templates/``): no markup is built from strings in Python.  No network, no external file: no
+``<link>``, no ``src=`` to anything but inline data.  The page builder never prints; the command
+line reports the path written.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from driver._report_page._animation import ANIMATION_FRAMES, animation_view
+from driver._report_page._figures import figure_svg, plain
+from driver._report_page._render import render_fragment, render_page, run_metadata
+from driver._report_page._sections import page_of, result_sections
+
+if TYPE_CHECKING:
+    from driver._deck import Deck
+    from driver._outcome import Outcome
+    from driver._result import Result
+
+__all__ = ["MAX_PAGE_BYTES", "ANIMATION_FRAMES", "page", "fragment", "write_report", "figure_svg", "plain",
+           "run_metadata", "animation_view"]
+
+#: the page size the browser test holds every shipped report to [bytes] (the SVG figures are most of it)
+MAX_PAGE_BYTES = 6_000_000
+
+
+def page(outcome: Outcome, deck: Deck | None = None) -> str:
+    """The report page of an engine's outcome.
+
+    Parameters
+    ----------
+    outcome : Outcome
+        A :class:`~driver._outcome.RunOutcome`, :class:`~driver._outcome.SweepOutcome`,
+        :class:`~driver._outcome.OptimizeOutcome` or :class:`~driver._outcome.SynthesisOutcome`.
+    deck : Deck, optional
+        The deck it ran (echoed on the page); without one, the run's keys are.
+
+    Returns
+    -------
+    str
+        The page's HTML.
+    """
+    return render_page(page_of(outcome, deck))
+
+
+def fragment(result: Result) -> str:
+    """A run's animation, figures, headline figures and tables as an HTML fragment, without the
+    page around them (for a notebook's rich display), made by the page's own templates."""
+    sections, _ = result_sections(result, result.params, None, "")
+    return render_fragment(sections)
+
+
+def write_report(path: Path, text: str) -> Path:
+    """Write the page atomically as ``path`` (``<stem>.html``)."""
+    from driver._atomic import write_text
+    return write_text(Path(path), text)
