@@ -38,7 +38,7 @@ class Joint:
 
 
 class Oracle:
-    """The mechanism ``mech`` (driver.linkage._model.Mechanism) solved independently."""
+    """The mechanism ``mech`` (driver.linkage._kernel_program.Mechanism) solved independently."""
 
     def __init__(self, mech):
         self.m = mech
@@ -346,7 +346,7 @@ def params_of(text: str, name: str = "deck.dat"):
 
 def kernel_frames(motion) -> np.ndarray:
     """(n, 3 (links - 1)): each moving link's frame (origin x, y, angle) from the kernel's answer."""
-    from driver.linkage._frames import _origins
+    from driver.linkage._analysis_frames import _origins
     from driver.linkage._kernel import LinkCol, PointCol
     mech, a = motion.mech, motion.a
     org = _origins(mech)

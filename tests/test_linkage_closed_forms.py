@@ -15,7 +15,7 @@ from conftest import INPUTS
 from driver._deck import read_deck, validate
 from driver.linkage import SPEC, compile_deck, summarise
 from driver.linkage._analysis import solve
-from driver.linkage._frames import _origins
+from driver.linkage._analysis_frames import _origins
 from driver.linkage._kernel import DriverCol, EnergyCol, LinkCol, PointCol, SlideCol, table_energy
 from linkage_oracle import params_of
 

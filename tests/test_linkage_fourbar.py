@@ -16,15 +16,17 @@ from driver.fourbar import SPEC as FOURBAR_SPEC
 from driver.fourbar import _forces as fforces
 from driver.fourbar import _kernel as fk
 from driver.fourbar._analysis import crank_angles
+from driver.fourbar._spec import force_value
 from driver.linkage import compile_deck
 from driver.linkage._analysis import solve
-from driver.linkage._kernel import DriverCol, JointCol, LinkCol, ShakeCol, Status
+from driver.linkage._kernel import DriverCol, JointCol, LinkageStatus, LinkCol, ShakeCol
 from linkage_oracle import params_of
 
 DECKS = sorted(p.stem for p in INPUTS.glob("*.dat")
                if read_deck(p).groups.get("fourbar") is not None and "sweep" not in read_deck(p).groups
                and "optimize" not in read_deck(p).groups)
 TOL = 1e-12
+S, F = fk.State, fk.Force   # the four-bar kernels' columns, by name
 
 
 def _fourbar(stem: str):
@@ -41,9 +43,9 @@ def _as_linkage(fp) -> str:
              f"dyad_dims={fp.coupler!r},{fp.rocker!r}, dyad_modes={branch}"]
     if fforces.active(fp):
         props = fforces.props(fp)
-        if fforces.value(fp, "balance") == "force":
+        if force_value(fp, "balance") == "force":
             props, _ = fk.fourbar_berkof_lowen(fp.crank, fp.coupler, fp.rocker, props,
-                                               tuple(fforces.value(fp, "counterweight_radius") or
+                                               tuple(force_value(fp, "counterweight_radius") or
                                                      (fp.crank, fp.rocker)))
         m, inertia, d, phi = props[0:3], props[3:6], props[6:9], props[9:12]
         com = [(di * math.cos(ph), di * math.sin(ph)) for di, ph in zip(d, phi)]
@@ -74,35 +76,35 @@ def test_four_bar_as_a_group_is_the_fourbar_study(stem):
     out, status = fk.fourbar_exact(np.radians(theta), fp.fixed_link, fp.crank, fp.coupler, fp.rocker, fp.omega,
                                    fp.alpha, 1 if fp.branch == "open" else -1)
     ok = status == fk.FOURBAR_STATUS["ok"]
-    assert np.array_equal(m.a.status[:, 0] == Status.OK, ok)
-    assert np.array_equal(m.a.status[:, 0] == Status.NO_ASSEMBLY, status == fk.FOURBAR_STATUS["no_assembly"])
+    assert np.array_equal(m.a.status[:, 0] == LinkageStatus.ok, ok)
+    assert np.array_equal(m.a.status[:, 0] == LinkageStatus.no_assembly, status == fk.FOURBAR_STATUS["no_assembly"])
     if not ok.any():
         return
     a = m.a
-    _close(a.links[ok, LinkCol.ANGLE, 2], out[ok, 0], "coupler angle")
-    _close(a.links[ok, LinkCol.ANGLE, 3], out[ok, 1], "rocker angle")
-    _close(a.quality[ok, 0], out[ok, 2], "transmission angle")
-    _close(a.links[ok, LinkCol.OMEGA, 2], out[ok, 7], "coupler omega")
-    _close(a.links[ok, LinkCol.OMEGA, 3], out[ok, 8], "rocker omega")
-    _close(a.links[ok, LinkCol.ALPHA, 2], out[ok, 9], "coupler alpha")
-    _close(a.links[ok, LinkCol.ALPHA, 3], out[ok, 10], "rocker alpha")
+    _close(a.links[ok, LinkCol.ANGLE, 2], out[ok, S.COUPLER_ANGLE], "coupler angle")
+    _close(a.links[ok, LinkCol.ANGLE, 3], out[ok, S.ROCKER_ANGLE], "rocker angle")
+    _close(a.quality[ok, 0], out[ok, S.TRANSMISSION_ANGLE], "transmission angle")
+    _close(a.links[ok, LinkCol.OMEGA, 2], out[ok, S.OMEGA2], "coupler omega")
+    _close(a.links[ok, LinkCol.OMEGA, 3], out[ok, S.OMEGA3], "rocker omega")
+    _close(a.links[ok, LinkCol.ALPHA, 2], out[ok, S.ALPHA2], "coupler alpha")
+    _close(a.links[ok, LinkCol.ALPHA, 3], out[ok, S.ALPHA3], "rocker alpha")
     if not mech.forces:
         return
     props = fforces.props(fp)
-    if fforces.value(fp, "balance") == "force":
+    if force_value(fp, "balance") == "force":
         props, _ = fk.fourbar_berkof_lowen(fp.crank, fp.coupler, fp.rocker, props,
-                                           tuple(fforces.value(fp, "counterweight_radius") or (fp.crank, fp.rocker)))
+                                           tuple(force_value(fp, "counterweight_radius") or (fp.crank, fp.rocker)))
     f = fk.fourbar_joint_forces(out, status, fp.fixed_link, fp.crank, fp.coupler, fp.rocker, fp.omega, fp.alpha,
                                 props)
-    _close(a.driver[ok, DriverCol.DRIVE], f[ok, 0], "input torque")
-    _close(a.driver[ok][:, [DriverCol.FX, DriverCol.FY]], f[ok, 1:3], "F_O2")
-    _close(a.joints[ok][:, [JointCol.AX, JointCol.AY], 0], f[ok, 3:5], "F_A")
-    _close(a.joints[ok][:, [JointCol.CX, JointCol.CY], 0], f[ok, 5:7], "F_B")
-    _close(a.joints[ok][:, [JointCol.BX, JointCol.BY], 0], f[ok, 7:9], "F_O4")
+    _close(a.driver[ok, DriverCol.DRIVE], f[ok, F.INPUT_TORQUE], "input torque")
+    _close(a.driver[ok][:, [DriverCol.FX, DriverCol.FY]], f[ok][:, [F.F_O2_X, F.F_O2_Y]], "F_O2")
+    _close(a.joints[ok][:, [JointCol.AX, JointCol.AY], 0], f[ok][:, [F.F_A_X, F.F_A_Y]], "F_A")
+    _close(a.joints[ok][:, [JointCol.CX, JointCol.CY], 0], f[ok][:, [F.F_B_X, F.F_B_Y]], "F_B")
+    _close(a.joints[ok][:, [JointCol.BX, JointCol.BY], 0], f[ok][:, [F.F_O4_X, F.F_O4_Y]], "F_O4")
     # a balanced linkage's shaking force is rounding: measured on the linkage's own force scale
-    fscale = float(np.max(np.abs(f[ok, 1:9])))
-    _close(a.shaking[ok][:, [ShakeCol.FX, ShakeCol.FY]], f[ok, 9:11], "shaking force", fscale)
-    _close(a.shaking[ok, ShakeCol.M], f[ok, 11], "shaking moment", fscale * fp.fixed_link)
+    fscale = float(np.max(np.abs(f[ok, F.F_O2_X:F.F_O4_Y + 1])))
+    _close(a.shaking[ok][:, [ShakeCol.FX, ShakeCol.FY]], f[ok][:, [F.SHAKING_X, F.SHAKING_Y]], "shaking force", fscale)
+    _close(a.shaking[ok, ShakeCol.M], f[ok, F.SHAKING_MOMENT], "shaking moment", fscale * fp.fixed_link)
 
 
 def test_shipped_deck_is_crank5():
@@ -116,6 +118,6 @@ def test_shipped_deck_is_crank5():
     m = solve(lp, theta)
     out, status = fk.fourbar_exact(np.radians(theta), 12, 5, 15, 9, 5.0, 0.0, 1)
     cp = fk.fourbar_coupler_point(np.radians(theta), out, status, 5, 5.0, 0.0, 7.5, 3.0)
-    _close(m.a.links[:, LinkCol.OMEGA, 3], out[:, 8], "rocker omega")
+    _close(m.a.links[:, LinkCol.OMEGA, 3], out[:, S.OMEGA3], "rocker omega")
     j = m.mech.point_index("P") - 1
     _close(m.a.points[:, :, j], cp, "coupler point")

@@ -15,7 +15,7 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from driver.linkage._analysis import solve
-from driver.linkage._kernel import DriverCol, JointCol, LinkCol, PointCol, ShakeCol, SlideCol, Status
+from driver.linkage._kernel import DriverCol, JointCol, LinkageStatus, LinkCol, PointCol, ShakeCol, SlideCol
 from linkage_oracle import Oracle, kernel_frames, params_of
 
 TOL = 1e-9
@@ -268,7 +268,7 @@ def test_input_power_balances_energy_rate(case):
     rate = np.zeros(len(m.x))
     loads = np.zeros(len(m.x))
     g = np.array(mech.gravity)
-    from driver.linkage._frames import _origins
+    from driver.linkage._analysis_frames import _origins
     origins = _origins(mech)
     for l in range(2, len(mech.links) + 1):
         mass, gu, gv, inertia = mech.body[l - 1]
@@ -314,4 +314,4 @@ def test_shipped_decks_match_the_independent_solver(deck):
             for col, ref in ((PointCol.X, ps[0]), (PointCol.VX, vs[0]), (PointCol.AX, as_[0])):
                 scale = np.max(np.abs(m.a.points[:, col, :])) + 1e-12
                 assert abs(m.a.points[k, col, j] - ref) <= TOL * scale, (deck, k, pt[0], col)
-        assert np.all(m.a.status[k] == Status.OK)
+        assert np.all(m.a.status[k] == LinkageStatus.ok)

@@ -171,8 +171,9 @@ def study_references(source: str, names: tuple[str, ...]) -> list[str]:
     tree = ast.parse(source)
     names_set = set(names)
     found: list[str] = []
-    dotted = re.compile(r"\bdriver\.(%s)\b" % "|".join(map(re.escape, names)))
-    group = re.compile(r"&(%s)\b" % "|".join(map(re.escape, names)))
+    alternatives = "|".join(map(re.escape, names))
+    dotted = re.compile(rf"\bdriver\.({alternatives})\b")
+    group = re.compile(rf"&({alternatives})\b")
     docstrings = set()
     for node in ast.walk(tree):
         body = getattr(node, "body", None)

@@ -9,11 +9,14 @@ centres per group; joint forces, the driving torque (or force), shaking force an
 group by group in closed form; flywheel energy; and batched summaries for sweeps and
 &optimize.  Deck grammar, sign conventions and equations: docs/linkage.md.
 
-The package's private modules, by job: ``_spec`` (deck keys, checks, labels, budget), ``_model``
-(the deck's mechanism compiled into the kernel's program), ``_kernel`` (the Fortran wrappers,
-columns named by IntEnums), ``_analysis`` (a deck through the kernel, events, tidy table),
-``_batch`` (many designs in one kernel call; the summary), ``_flywheel`` (a turning-moment
-table), ``_report`` (the run), ``_frames`` (drawing data), ``_figures``.
+The package's private modules, in the layers of every study (docs/layout.md): ``_kernel`` (the
+Fortran wrappers, columns and status named by enums) with ``_kernel_program`` (the kernel's
+program of one mechanism: plain data); ``_spec`` (deck keys, checks, labels, budget) with
+``_spec_model`` (the deck's mechanism resolved, checked and compiled); ``_analysis`` (a deck
+through the kernel, events, tidy table) with ``_analysis_flywheel`` (a turning-moment table)
+and ``_analysis_frames`` (poses as drawing data; the report page's animation); ``_batch`` (many
+designs in one kernel call; the summary); ``_figures``; ``_report`` (the run); ``_published``
+(the textbook closed forms).
 """
 from __future__ import annotations
 
@@ -23,6 +26,8 @@ from driver._study import BatchSummary, Study
 from driver.linkage import _kernel as kernel
 from driver.linkage import _published as published
 from driver.linkage._analysis import solve
+from driver.linkage._analysis_flywheel import table_flywheel
+from driver.linkage._analysis_frames import animation_frames
 from driver.linkage._batch import (
     BATCH_ELEMENTS,
     BATCH_IGNORED,
@@ -32,10 +37,8 @@ from driver.linkage._batch import (
     summarise,
     summarise_batch,
 )
-from driver.linkage._flywheel import table_flywheel
-from driver.linkage._frames import animation_frames
-from driver.linkage._model import compile_deck
 from driver.linkage._spec import LABELS, SPEC, SUMMARY_SETTINGS, SWEEP_BEST, SWEEP_PLOT, estimate
+from driver.linkage._spec_model import compile_deck
 
 if TYPE_CHECKING:   # run's keys as typed keywords: generated from SPEC (tools/gen_keyword_signatures.py)
     from driver.linkage._keywords import run
@@ -49,4 +52,4 @@ STUDY = Study(name="linkage", package=__name__, spec=SPEC, run=run, estimate=est
               batch=BatchSummary(summarise_batch, keys=BATCH_KEYS, ignored=BATCH_IGNORED,
                                  independent=BATCH_INDEPENDENT, elements=BATCH_ELEMENTS, refusal=refusal),
               labels=LABELS, sweep_plot=SWEEP_PLOT, sweep_best=SWEEP_BEST, summary_settings=SUMMARY_SETTINGS,
-              published=published.compare, figures=f"{__name__}._figures", kernel=kernel)
+              published=published.compare, animation=animation_frames, figures=f"{__name__}._figures", kernel=kernel)

@@ -12,8 +12,9 @@ import pandas as pd
 
 from driver._deck import Params
 from driver.linkage import _kernel as kernel
-from driver.linkage._kernel import Analysis, DriverCol, JointCol, LinkCol, PointCol, ShakeCol, SlideCol, Status
-from driver.linkage._model import Mechanism, compile_deck
+from driver.linkage._kernel import Analysis, DriverCol, JointCol, LinkageStatus, LinkCol, PointCol, ShakeCol, SlideCol
+from driver.linkage._kernel_program import Mechanism
+from driver.linkage._spec_model import compile_deck
 
 __all__ = ["Motion", "Event", "inputs", "solve", "events", "tidy_frame", "input_label", "JOINT_WORDS"]
 
@@ -43,12 +44,12 @@ class Motion:
     @property
     def ok(self) -> np.ndarray:
         """Rows where every group is assembled with known rates."""
-        return np.all(self.a.status == Status.OK, axis=1)
+        return np.all(self.a.status == LinkageStatus.ok, axis=1)
 
     @property
     def placed(self) -> np.ndarray:
         """Rows where every group is placed (a toggle is placed)."""
-        return np.all((self.a.status == Status.OK) | (self.a.status == Status.TOGGLE), axis=1)
+        return np.all((self.a.status == LinkageStatus.ok) | (self.a.status == LinkageStatus.toggle), axis=1)
 
 
 @dataclass(frozen=True)
@@ -123,12 +124,12 @@ def events(m: Motion) -> list[Event]:
     out: list[Event] = []
     st = m.a.status
     for d, dy in enumerate(m.mech.dyads):
-        for what, code in (("no_assembly", Status.NO_ASSEMBLY), ("toggle", Status.TOGGLE),
-                           ("indeterminate", Status.INDETERMINATE)):
+        for what, code in (("no_assembly", LinkageStatus.no_assembly), ("toggle", LinkageStatus.toggle),
+                           ("indeterminate", LinkageStatus.indeterminate)):
             for a, b in _runs(st[:, d] == code):
                 out.append(Event(what, d + 1, dy.name, float(m.x[a]), float(m.x[b])))
         rate, accel = _follower_rate(m, d)
-        ok = st[:, d] == Status.OK
+        ok = st[:, d] == LinkageStatus.ok
         w = m.mech.omega
         scale = math.radians(1.0) if m.mech.driver == "crank" else 1.0   # input unit -> kernel unit
         for k in range(len(m.x) - 1):

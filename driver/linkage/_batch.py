@@ -19,7 +19,8 @@ from driver._deck import DeckError, Params
 from driver._study import contract_doc
 from driver.linkage import _kernel as kernel
 from driver.linkage._kernel import NSUM_DYAD, NSUM_LINK, NSUM_SLIDE, SummaryCol
-from driver.linkage._model import Mechanism, compile_deck
+from driver.linkage._kernel_program import Mechanism
+from driver.linkage._spec_model import compile_deck
 
 __all__ = ["BATCH_KEYS", "BATCH_IGNORED", "BATCH_INDEPENDENT", "BATCH_ELEMENTS", "summarise_batch", "summarise",
            "summary_of", "summary_frame", "scan_of", "refusal"]
@@ -279,7 +280,7 @@ def summary_of(p: Params, rows: tuple[Mechanism, np.ndarray] | None = None) -> d
                bool(v) if isinstance(v, (bool, np.bool_)) else
                float(v) if isinstance(v, np.floating) else v) for k, v in row.items()}
     if p.turning_moment is not None:
-        from driver.linkage._flywheel import table_flywheel
+        from driver.linkage._analysis_flywheel import table_flywheel
         tm = table_flywheel(p)
         out |= {"table_torque_mean_Nm": tm.mean, "table_energy_fluctuation_J": tm.fluctuation,
                 "table_flywheel_inertia_kgm2": tm.inertia}

@@ -15,8 +15,8 @@ from matplotlib.figure import Figure
 
 from driver._deck import Params
 from driver.linkage._analysis import input_label
-from driver.linkage._frames import frames
-from driver.linkage._kernel import DriverCol, LinkCol, ShakeCol, SlideCol, Status
+from driver.linkage._analysis_frames import frames
+from driver.linkage._kernel import DriverCol, LinkageStatus, LinkCol, ShakeCol, SlideCol
 from driver.plotting import new_figure, plain_text, styled
 
 __all__ = ["linkage_drawing", "motion_curves", "force_curves", "turning_moment"]
@@ -92,8 +92,8 @@ def motion_curves(p: Params, title: str = "", axes: Any = None) -> Figure:
         fig, axes = new_figure(npanel, 1, sharex=True, figsize=(7.0, 2.1 * npanel + 0.6))
     else:
         fig = axes[0].figure
-    placed = np.all((a.status == Status.OK) | (a.status == Status.TOGGLE), axis=1)
-    ok = np.all(a.status == Status.OK, axis=1)
+    placed = np.all((a.status == LinkageStatus.ok) | (a.status == LinkageStatus.toggle), axis=1)
+    ok = np.all(a.status == LinkageStatus.ok, axis=1)
     for i, name in enumerate(mech.links[1:], start=1):
         col = _COLOURS[(i - 1) % len(_COLOURS)]
         ang = np.degrees(np.unwrap(a.links[:, LinkCol.ANGLE, i]))
@@ -129,7 +129,7 @@ def force_curves(p: Params, title: str = "", axes: Any = None) -> Figure:
         fig, axes = new_figure(3, 1, sharex=True, figsize=(7.0, 7.0))
     else:
         fig = axes[0].figure
-    ok = np.all(a.status == Status.OK, axis=1)
+    ok = np.all(a.status == LinkageStatus.ok, axis=1)
     crank = m.mech.driver == "crank"
     axes[0].plot(m.x, np.where(ok, a.driver[:, DriverCol.DRIVE], np.nan), color=_COLOURS[0])
     axes[0].set_ylabel("driving torque [N m]" if crank else "driving force [N]")
@@ -165,7 +165,7 @@ def turning_moment(p: Params, title: str = "", ax: Any = None) -> Figure:
         from driver.linkage._analysis import solve
         xs = p.start + np.linspace(0.0, p.cycle_deg, 721)
         m = solve(p, xs)
-        if np.all(m.a.status == Status.OK):
+        if np.all(m.a.status == LinkageStatus.ok):
             curves.append(("analysis (driving torque)", xs, m.a.driver[:, DriverCol.DRIVE]))
     for i, (label, x, t) in enumerate(curves):
         col = _COLOURS[i]

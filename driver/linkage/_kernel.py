@@ -14,29 +14,34 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
-from driver._fortran import farray
-from driver.linkage._model import Mechanism
+from driver._fortran import KernelStatus, farray
+from driver.linkage._kernel_program import Mechanism
 
 if TYPE_CHECKING:   # the study's modules of the extension, typed (generated: tools/gen_kernel_stub.py)
     from driver.linkage import _kernels
 else:
     from driver._fortran import _kernels
 
-__all__ = ["reusable_call", "Status", "LinkCol", "PointCol", "SlideCol", "JointCol", "DriverCol", "ShakeCol", "EnergyCol",
+__all__ = ["reusable_call", "LinkageStatus", "LinkCol", "PointCol", "SlideCol", "JointCol", "DriverCol", "ShakeCol", "EnergyCol",
            "SummaryCol", "Want", "Analysis", "analyse", "table_energy", "summaries", "summary_width",
            "NSUM_LINK", "NSUM_SLIDE", "NSUM_DYAD"]
 
 _K = _kernels.linkage
 
 
-class Status(IntEnum):
-    """Status of a group at a position (fortran/linkage.f90 st_*)."""
+class LinkageStatus(KernelStatus):
+    """Status of a group at an input position (fortran/linkage.f90 ``st_*``).
 
-    OK = int(_K.st_ok)
-    NO_ASSEMBLY = int(_K.st_no_assembly)
-    TOGGLE = int(_K.st_toggle)
-    INDETERMINATE = int(_K.st_indeterminate)
-    UNPLACED = int(_K.st_unplaced)
+    A result of the position, never an error of the call.
+    """
+
+    ok = int(_K.st_ok), "ok"
+    no_assembly = int(_K.st_no_assembly), "cannot be assembled", "the group's two links cannot reach each other"
+    toggle = (int(_K.st_toggle), "toggle (velocities unbounded)",
+              "the group's two constraint directions are parallel: its rates are unbounded (set to 0)")
+    indeterminate = (int(_K.st_indeterminate), "indeterminate",
+                     "the group's attachments coincide: its position is not determined")
+    unplaced = int(_K.st_unplaced), "not placed", "a link the group attaches to is not placed"
 
 
 class Want(IntEnum):
@@ -170,7 +175,7 @@ class Analysis(NamedTuple):
     quality : numpy.ndarray
         (n, groups) transmission or pressure angle [rad].
     status : numpy.ndarray
-        (n, groups) :class:`Status`.
+        (n, groups) :class:`LinkageStatus`.
     joints : numpy.ndarray
         (n, 9, groups) by :class:`JointCol` (no rows without the force analysis).
     driver : numpy.ndarray
@@ -195,7 +200,7 @@ def analyse(mech: Mechanism, x: np.ndarray, forces: bool | None = None, continui
     Parameters
     ----------
     mech : Mechanism
-        The compiled mechanism (:func:`driver.linkage._model.compile_deck`).
+        The compiled mechanism (:func:`driver.linkage._spec_model.compile_deck`).
     x : numpy.ndarray
         Inputs in order: crank angles [rad] or slides [length].
     forces : bool, optional

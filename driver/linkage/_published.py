@@ -16,7 +16,8 @@ import math
 from driver._deck import Params
 from driver._published import cell
 from driver._result import Result
-from driver.linkage._model import Mechanism, compile_deck
+from driver.linkage._kernel_program import Mechanism
+from driver.linkage._spec_model import compile_deck
 
 __all__ = ["compare", "closed_forms"]
 

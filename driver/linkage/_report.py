@@ -15,16 +15,14 @@ from driver._runner import study_run
 from driver._table import Column, render_table
 from driver.linkage._analysis import JOINT_WORDS, Event, Motion, events, input_label, solve, tidy_frame
 from driver.linkage._batch import summary_of, summary_rows
-from driver.linkage._kernel import DriverCol, JointCol, LinkCol, PointCol, ShakeCol, SlideCol, Status
-from driver.linkage._model import Mechanism
+from driver.linkage._kernel import DriverCol, JointCol, LinkageStatus, LinkCol, PointCol, ShakeCol, SlideCol
+from driver.linkage._kernel_program import Mechanism
 from driver.linkage._spec import SPEC
 
 __all__ = ["run", "mechanism_lines", "event_lines", "summary_lines", "tables", "deck_figures"]
 
 #: value columns of one printed table (wider tables are split)
 TABLE_WIDTH = 7
-STATUS_WORDS = {Status.NO_ASSEMBLY: "cannot be assembled", Status.TOGGLE: "toggle (velocities unbounded)",
-                Status.INDETERMINATE: "indeterminate", Status.UNPLACED: "not placed"}
 
 
 def _decimals(values: np.ndarray, digits: int = 6) -> int:
@@ -96,8 +94,8 @@ def _trailers(m: Motion) -> list[str]:
     """Per row: the groups that are not assembled, in words."""
     out = []
     for k in range(len(m.x)):
-        words = [f"{d.name}: {STATUS_WORDS[Status(int(s))]}" for d, s in zip(m.mech.dyads, m.a.status[k])
-                 if s != Status.OK]
+        words = [f"{d.name}: {LinkageStatus(int(s)).what}" for d, s in zip(m.mech.dyads, m.a.status[k])
+                 if s != LinkageStatus.ok]
         out.append("; ".join(words))
     return out
 
@@ -168,7 +166,7 @@ def tables(m: Motion) -> list[str]:
     heads = [("mu " if d.kind == "rrr" else "press ") + d.joints[2] for d in mech.dyads]
     out += _table("Transmission (mu) and pressure angles", m, heads,
                   [np.degrees(a.quality[:, i]) for i in range(len(mech.dyads))],
-                  [a.status[:, i] == Status.OK for i in range(len(mech.dyads))], "deg", trail)
+                  [a.status[:, i] == LinkageStatus.ok for i in range(len(mech.dyads))], "deg", trail)
     if mech.forces:
         drive = "torque" if mech.driver == "crank" else "force"
         heads = [f"driving {drive[0]}", "shake Fx", "shake Fy", "shake M"]
@@ -299,10 +297,10 @@ def run(params: Params, progress: bool = False) -> Result:
     bad = ~m.placed
     if bad.any():
         k = int(np.argmax(bad))
-        d = int(np.argmax(m.a.status[k] != Status.OK))
+        d = int(np.argmax(m.a.status[k] != LinkageStatus.ok))
         warnings.append(f"the linkage cannot be assembled at {int(bad.sum())} of {len(m.x)} inputs (first at "
                         f"{m.x[k]:g}: group {d + 1}, {mech.dyads[d].name}, "
-                        f"{STATUS_WORDS[Status(int(m.a.status[k, d]))]})")
+                        f"{LinkageStatus(int(m.a.status[k, d])).what})")
     return Result(text="\n".join(lines) + "\n", tidy=tidy_frame(m), summary=s, warnings=warnings,
                   figures=deck_figures(p, title))
 
@@ -315,7 +313,7 @@ def deck_figures(p: Params, title: str) -> list[Figure]:
         return getattr(figures, name)(p, title)
 
     figs = [Figure("linkage", lambda: draw("linkage_drawing")), Figure("curves", lambda: draw("motion_curves"))]
-    from driver.linkage._model import compile_deck
+    from driver.linkage._spec_model import compile_deck
     mech = compile_deck(p)
     if mech.forces:
         figs.append(Figure("forces", lambda: draw("force_curves")))

@@ -57,7 +57,7 @@ def positions_count(p: Params) -> float:
 
 
 def _check(p: Params) -> None:
-    """Cross-key checks: the input range, then the mechanism (driver.linkage._model.compile_deck)."""
+    """Cross-key checks: the input range, then the mechanism (driver.linkage._spec_model.compile_deck)."""
     if p.step == 0:
         raise p.error("step", "must not be 0 (the input would never advance)")
     for key in ("start", "stop"):
@@ -68,10 +68,9 @@ def _check(p: Params) -> None:
     n = positions_count(p)
     if n > MAX_POSITIONS:
         raise p.error("step", f"{n:.3g} input positions; at most {MAX_POSITIONS:g} (use a coarser step)")
-    from driver.linkage._flywheel import check as check_table
-    from driver.linkage._model import compile_deck  # the mechanism's own checks, with file, line, key
+    from driver.linkage._spec_model import check_turning_moment, compile_deck  # with file, line, key
     compile_deck(p)
-    check_table(p)
+    check_turning_moment(p)
 
 
 #: axis labels of summary columns and deck keys (driver._output.column_label): name -> (words, units)

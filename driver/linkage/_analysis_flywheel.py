@@ -12,7 +12,7 @@ from driver._deck import Params
 from driver.linkage import _kernel as kernel
 from driver.linkage._kernel import EnergyCol
 
-__all__ = ["TableFlywheel", "check", "table_flywheel"]
+__all__ = ["TableFlywheel", "table_flywheel"]
 
 
 @dataclass(frozen=True)
@@ -30,20 +30,6 @@ class TableFlywheel:
     work: float
     torque_max: float
     torque_min: float
-
-
-def check(p: Params) -> None:
-    """The diagram's keys: given together, equal lengths, at least two angles, ascending."""
-    a, t = p.turning_moment_deg, p.turning_moment
-    if (a is None) != (t is None):
-        raise p.error("turning_moment" if a is None else "turning_moment_deg",
-                      "give turning_moment_deg and turning_moment together")
-    if a is None:
-        return
-    if len(a) != len(t):
-        raise p.error("turning_moment", f"gives {len(t)} torques for {len(a)} angles")
-    if len(a) < 2 or np.any(np.diff(a) <= 0):
-        raise p.error("turning_moment_deg", "give at least two crank angles, strictly ascending")
 
 
 def table_flywheel(p: Params) -> TableFlywheel:
