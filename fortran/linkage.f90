@@ -83,15 +83,24 @@ module linkage
                                 st_unplaced = 4
   integer, parameter, public :: dy_rrr = 1, dy_rrp = 2, dy_rpr = 3, dy_prp = 4
   integer, parameter, public :: drv_crank = 1, drv_slider = 2
-  !> want bits of analyse
-  integer, parameter, public :: want_continuity = 1, want_forces = 2
+  !> want bits of analyse: what it computes besides the kinematics, and which outputs it writes
+  !> (an output not asked for is not written: the caller's array keeps what it held; the status
+  !> is always written)
+  integer, parameter, public :: want_continuity = 1, want_forces = 2, want_angles = 4, want_link_rates = 8, &
+                                want_points = 16, want_point_rates = 32, want_quality = 64, want_slides = 128
+  !> every kinematic output
+  integer, parameter, public :: want_kinematics = 252
   !> columns of a summary row before the per-element columns (see summaries), and per element
   integer, parameter, public :: nsum_head = 22, nsum_link = 2, nsum_slide = 4, nsum_dyad = 2
   !> columns of table_energy's result
   integer, parameter, public :: nenergy = 8
 
-  integer, parameter :: nb = 256
+  !> rows of a block: its work arrays (the links' frames, the groups' attachments) stay in the
+  !> first-level cache (64: measured against 32, 128 and 256 in bench/bench_linkage.py)
+  integer, parameter :: nb = 64
   real(dp), parameter :: tol = 1.0e-13_dp
+  !> extremes within this fraction of the scale are ties: the first (the earliest input) is taken
+  real(dp), parameter :: tie_rel = 1.0e-12_dp
   real(dp), parameter :: pi = 3.14159265358979323846_dp
   ! pose columns of a link in a block
   integer, parameter :: p_ox = 1, p_oy = 2, p_c = 3, p_s = 4, p_vx = 5, p_vy = 6, p_w = 7, p_ax = 8, &
@@ -124,14 +133,17 @@ contains
     real(dp), allocatable :: pose(:, :, :), att(:, :, :, :)
     allocate (pose(nb, npose, nl), att(nb, natt, 2, nd))
     call analyse_core(n, nl, np, ng, nd, ns, nld, nt, nf, x, idrv, rdrv, ipts, rpts, igd, rgd, idy, rdy, &
-                      rl, grav, ild, rld, rtq, ift, tab, rft, want, lk, pk, sk, qa, st, fk, fd, sh, pose, att)
+                      rl, grav, ild, rld, rtq, ift, tab, rft, want, 0, lk, pk, sk, qa, st, fk, fd, sh, pose, att)
   end subroutine analyse
 
   !> analyse's work, with the block work arrays of the caller (summaries makes them once for
-  !> all its designs): pose(nb, npose, nl) and att(nb, natt, 2, nd), overwritten.
+  !> all its designs): pose(nb, npose, nl) and att(nb, natt, 2, nd), overwritten.  alink > 0:
+  !> of the link angles (want_angles) only link alink's (the summaries' output link).
   subroutine analyse_core(n, nl, np, ng, nd, ns, nld, nt, nf, x, idrv, rdrv, ipts, rpts, igd, rgd, idy, rdy, &
-                          rl, grav, ild, rld, rtq, ift, tab, rft, want, lk, pk, sk, qa, st, fk, fd, sh, pose, att)
+                          rl, grav, ild, rld, rtq, ift, tab, rft, want, alink, lk, pk, sk, qa, st, fk, fd, sh, &
+                          pose, att)
     integer, intent(in) :: n, nl, np, ng, nd, ns, nld, nt, nf   ! nf: rows of the force outputs (n, or 1 unused)
+    integer, intent(in) :: alink
     real(dp), intent(in) :: x(n), rdrv(3), rpts(np, 2), rgd(ng, 3), rdy(nd, 3), rl(nl, 4), grav(2)
     integer, intent(in) :: idrv(4), ipts(np), igd(ng), idy(nd, 6), ild(nld), ift(4), want
     real(dp), intent(in) :: rld(nld, 2), rtq(nl), tab(nt, 2), rft(3)
@@ -164,6 +176,17 @@ contains
     pose(1:mb, p_c, 1) = 1.0_dp
     pose(1:mb, p_ok, 1) = 1.0_dp
     pose(1:mb, p_rt, 1) = 1.0_dp
+    ! a crank's frame but its direction is constant too: filled here once, each block writes (c, s)
+    if (idrv(1) == drv_crank) then
+      pose(1:mb, :, idrv(3)) = 0.0_dp
+      pose(1:mb, p_ox, idrv(3)) = rpts(idrv(2), 1)
+      pose(1:mb, p_oy, idrv(3)) = rpts(idrv(2), 2)
+      pose(1:mb, p_c, idrv(3)) = 1.0_dp
+      pose(1:mb, p_w, idrv(3)) = rdrv(2)
+      pose(1:mb, p_al, idrv(3)) = rdrv(3)
+      pose(1:mb, p_ok, idrv(3)) = 1.0_dp
+      pose(1:mb, p_rt, idrv(3)) = 1.0_dp
+    end if
     do d = 1, nd
       if (idy(d, 1) == dy_prp) then
         if (igd(idy(d, 2)) == 1) call guide_of(mb, 1, rgd(idy(d, 2), :), pose(:, :, 1), att(:, :, 1, d))
@@ -197,8 +220,8 @@ contains
       do k0 = k1, n, nb
         m = min(nb, n - k0 + 1)
         call solve_block(m, k0, n, nl, np, ng, nd, ns, nld, nt, nf, x, idrv, rdrv, ipts, rpts, igd, rgd, idy, &
-                         rdy, rl, grav, ild, rld, rtq, ift, tab, rft, want, modes, cont, store, chr, ring, flagk, &
-                         pose, att, lk, pk, sk, qa, st, fk, fd, sh)
+                         rdy, rl, grav, ild, rld, rtq, ift, tab, rft, want, alink, modes, cont, store, chr, ring, &
+                         flagk, pose, att, lk, pk, sk, qa, st, fk, fd, sh)
       end do
     end subroutine solve_rows
 
@@ -213,30 +236,53 @@ contains
     real(dp), intent(in) :: ex(nb, nex)
     real(dp), intent(inout) :: ring(3, 4)
     integer, intent(inout) :: flagk
-    real(dp) :: ch(nb + 3, 4), px, py, ec, ea, flag(nb + 3)   ! flags as reals: one vector width
-    integer :: k, kg, c
+    real(dp) :: ch(6, 4), px, py, ec, ea, flag(nb), any_flag   ! flags as reals: one vector width
+    integer :: k, kg, c, j
+    ! the block's first three rows extrapolate from the ring (the block before's last three)
     do c = 1, 4
       ch(1:3, c) = ring(:, c)
-      ch(4:m + 3, c) = ex(1:m, 9 + c)
+      ch(4:3 + min(m, 3), c) = ex(1:min(m, 3), 9 + c)
     end do
-    ! hot-loop: linkage continuity pre-scan
-    do k = 4, m + 3
-      px = 3.0_dp*(ch(k - 1, 1) - ch(k - 2, 1)) + ch(k - 3, 1)
-      py = 3.0_dp*(ch(k - 1, 2) - ch(k - 2, 2)) + ch(k - 3, 2)
-      ec = (ch(k, 1) - px)**2 + (ch(k, 2) - py)**2
-      ea = (ch(k, 3) - px)**2 + (ch(k, 4) - py)**2
+    any_flag = 0.0_dp
+    do k = 1, min(m, 3)
+      j = k + 3
+      px = 3.0_dp*(ch(j - 1, 1) - ch(j - 2, 1)) + ch(j - 3, 1)
+      py = 3.0_dp*(ch(j - 1, 2) - ch(j - 2, 2)) + ch(j - 3, 2)
+      ec = (ch(j, 1) - px)**2 + (ch(j, 2) - py)**2
+      ea = (ch(j, 3) - px)**2 + (ch(j, 4) - py)**2
       flag(k) = merge(1.0_dp, 0.0_dp, ea < ec)
+      any_flag = max(any_flag, flag(k))
     end do
-    do k = 4, m + 3
-      kg = k0 + k - 4
-      if (flag(k) == 0.0_dp .or. kg < 4) cycle
-      if (all(st(kg - 3:kg) == st_ok .or. st(kg - 3:kg) == st_toggle) .and. st(kg) == st_ok) then
-        flagk = kg
-        exit
-      end if
+    ! the rest from the block itself (the chosen joint in ex(:, 10:11), the other in ex(:, 12:13))
+    ! hot-loop: linkage continuity pre-scan
+    do k = 4, m
+      px = 3.0_dp*(ex(k - 1, 10) - ex(k - 2, 10)) + ex(k - 3, 10)
+      py = 3.0_dp*(ex(k - 1, 11) - ex(k - 2, 11)) + ex(k - 3, 11)
+      ec = (ex(k, 10) - px)**2 + (ex(k, 11) - py)**2
+      ea = (ex(k, 12) - px)**2 + (ex(k, 13) - py)**2
+      flag(k) = merge(1.0_dp, 0.0_dp, ea < ec)
+      any_flag = max(any_flag, flag(k))
     end do
+    if (any_flag > 0.0_dp) then   ! rare: look at the positions flagged
+      do k = 1, m
+        kg = k0 + k - 1
+        if (flag(k) == 0.0_dp .or. kg < 4) cycle
+        if (all(st(kg - 3:kg) == st_ok .or. st(kg - 3:kg) == st_toggle) .and. st(kg) == st_ok) then
+          flagk = kg
+          exit
+        end if
+      end do
+    end if
+    ! the ring: the last three rows (with the ring's own when the block has fewer)
     do c = 1, 4
-      ring(:, c) = ch(m + 1:m + 3, c)
+      do k = 1, 3
+        j = m - 3 + k
+        if (j >= 1) then
+          ring(k, c) = ex(j, 9 + c)
+        else
+          ring(k, c) = ring(k + m, c)
+        end if
+      end do
     end do
   end subroutine prescan
 
@@ -286,9 +332,9 @@ contains
 
   !> One block of analyse: rows k0..k0+m-1 (m <= nb).
   subroutine solve_block(m, k0, n, nl, np, ng, nd, ns, nld, nt, nf, x, idrv, rdrv, ipts, rpts, igd, rgd, idy, &
-                         rdy, rl, grav, ild, rld, rtq, ift, tab, rft, want, modes, cont, store, chr, ring, flagk, &
-                         pose, att, lk, pk, sk, qa, st, fk, fd, sh)
-    integer, intent(in) :: m, k0, n, nl, np, ng, nd, ns, nld, nt, nf
+                         rdy, rl, grav, ild, rld, rtq, ift, tab, rft, want, alink, modes, cont, store, chr, ring, &
+                         flagk, pose, att, lk, pk, sk, qa, st, fk, fd, sh)
+    integer, intent(in) :: m, k0, n, nl, np, ng, nd, ns, nld, nt, nf, alink
     real(dp), intent(in) :: x(n), rdrv(3), rpts(np, 2), rgd(ng, 3), rdy(nd, 3), rl(nl, 4), grav(2)
     integer, intent(in) :: idrv(4), ipts(np), igd(ng), idy(nd, 6), ild(nld), ift(4), want
     real(dp), intent(in) :: rld(nld, 2), rtq(nl), tab(nt, 2), rft(3), modes(n, nd)
@@ -300,18 +346,20 @@ contains
                                sh(nf, 3)
     integer, intent(inout) :: st(n, nd)
     real(dp) :: a1(nb, natt), ex(nb, nex)
-    real(dp) :: wk(nb, 3, nl), rx(nb, 9), sn(nb), cs(nb), tmp(nb), drf(nb, 4), fx(nb), fy(nb), q(nb), okr(nb)
+    real(dp) :: wk(nb, 3, nl), rx(nb, 9), tmp(nb), drf(nb, 4), fx(nb), fy(nb), q(nb), okr(nb)
     integer :: l, p, dd, kind, k1, s0, c
+    logical :: forces, slides
     k1 = k0 + m - 1
+    forces = iand(want, want_forces) /= 0
+    slides = iand(want, want_slides) /= 0 .or. forces   ! a guide force over the slide reads them
     ! driver (the ground's frame, pose(:, :, 1), is set once by analyse)
     l = idrv(3)
     if (idrv(1) == drv_crank) then
-      call sincos_array(m, x(k0:k1), sn, cs)
-      call crank_pose(m, rpts(idrv(2), 1), rpts(idrv(2), 2), cs, sn, rdrv(2), rdrv(3), pose(:, :, l))
+      call sincos_array(m, x(k0:k1), pose(:, p_s, l), pose(:, p_c, l))   ! the rest of its frame is constant
     else
       call guide_of(m, igd(idrv(2)), rgd(idrv(2), :), pose(:, :, igd(idrv(2))), a1)
       call slider_pose(m, x(k0:k1), rdrv(1), rdrv(2), rdrv(3), a1, pose(:, :, l))
-      if (idrv(4) > 0) then
+      if (idrv(4) > 0 .and. slides) then
         sk(k0:k1, 1, idrv(4)) = x(k0:k1)
         sk(k0:k1, 2, idrv(4)) = rdrv(2)
         sk(k0:k1, 3, idrv(4)) = rdrv(3)
@@ -350,9 +398,9 @@ contains
                       pose(:, :, idy(dd, 5)), ex)
       end select
       st(k0:k1, dd) = nint(ex(1:m, 1))
-      call atan2_array(m, ex(:, 2), ex(:, 3), qa(k0:k1, dd))
+      if (iand(want, want_quality) /= 0) call atan2_array(m, ex(:, 2), ex(:, 3), qa(k0:k1, dd))
       s0 = idy(dd, 6)
-      if (s0 > 0) then
+      if (s0 > 0 .and. slides) then
         sk(k0:k1, 1, s0) = ex(1:m, 4)
         sk(k0:k1, 2, s0) = ex(1:m, 5)
         sk(k0:k1, 3, s0) = ex(1:m, 6)
@@ -372,19 +420,33 @@ contains
         end if
       end if
     end do
-    ! moving links: angle (an unplaced link's frame is (1, 0): angle 0), omega, alpha; the
-    ! ground's are filled once by analyse
+    ! moving links: angle (an unplaced link's frame is (1, 0): angle 0; a crank's is its input
+    ! brought into (-pi, pi], no arctangent), omega, alpha; the ground's are filled once by the caller
     do l = 2, nl
-      call atan2_array(m, pose(:, p_s, l), pose(:, p_c, l), lk(k0:k1, 1, l))
-      call copy2(m, pose(:, p_w, l), pose(:, p_al, l), lk(k0:k1, 2, l), lk(k0:k1, 3, l))
+      if (iand(want, want_angles) /= 0 .and. (alink == 0 .or. l == alink)) then
+        if (l == idrv(3) .and. idrv(1) == drv_crank) then
+          call wrap_angle(m, x(k0:k1), lk(k0:k1, 1, l))
+        else
+          call atan2_array(m, pose(:, p_s, l), pose(:, p_c, l), lk(k0:k1, 1, l))
+        end if
+      end if
+      if (iand(want, want_link_rates) /= 0) call copy2(m, pose(:, p_w, l), pose(:, p_al, l), lk(k0:k1, 2, l), &
+                                                       lk(k0:k1, 3, l))
     end do
-    ! points on moving links, written straight into the outputs (the ground's: by analyse)
+    ! points on moving links, written straight into the outputs (the ground's: by the caller)
     do p = 1, np
       if (ipts(p) == 1) cycle
-      call point_out(m, rpts(p, 1), rpts(p, 2), pose(:, :, ipts(p)), pk(k0:k1, 1, p), pk(k0:k1, 2, p), &
-                     pk(k0:k1, 3, p), pk(k0:k1, 4, p), pk(k0:k1, 5, p), pk(k0:k1, 6, p))
+      if (iand(want, want_points) /= 0 .and. iand(want, want_point_rates) /= 0) then   ! one pass
+        call point_out(m, rpts(p, 1), rpts(p, 2), pose(:, :, ipts(p)), pk(k0:k1, 1, p), pk(k0:k1, 2, p), &
+                       pk(k0:k1, 3, p), pk(k0:k1, 4, p), pk(k0:k1, 5, p), pk(k0:k1, 6, p))
+      else if (iand(want, want_points) /= 0) then
+        call point_at(m, rpts(p, 1), rpts(p, 2), pose(:, :, ipts(p)), pk(k0:k1, 1, p), pk(k0:k1, 2, p))
+      else if (iand(want, want_point_rates) /= 0) then
+        call point_rates(m, rpts(p, 1), rpts(p, 2), pose(:, :, ipts(p)), pk(k0:k1, 3, p), pk(k0:k1, 4, p), &
+                         pk(k0:k1, 5, p), pk(k0:k1, 6, p))
+      end if
     end do
-    if (iand(want, want_forces) == 0) return
+    if (.not. forces) return
     ! ---- forces: each link's known load, the dyads from the last, then the driver
     wk(1:m, :, 1) = 0.0_dp
     do l = 2, nl
@@ -539,6 +601,21 @@ contains
     b2(1:m) = a2(1:m)
   end subroutine copy2
 
+  !> x brought into (-pi, pi]: a crank's angle from its input, as atan2(sin x, cos x) gives it.
+  subroutine wrap_angle(m, x, a)
+    integer, intent(in) :: m
+    real(dp), intent(in) :: x(m)
+    real(dp), intent(inout) :: a(m)
+    real(dp), parameter :: twopi = 2*pi, magic = 6755399441055744.0_dp   ! 1.5 * 2**52: rounds to nearest
+    real(dp) :: t
+    integer :: k
+    ! hot-loop: linkage crank angle
+    do k = 1, m
+      t = x(k) - twopi*((x(k)*(1.0_dp/twopi) + magic) - magic)
+      a(k) = merge(t + twopi, t, t <= -pi)
+    end do
+  end subroutine wrap_angle
+
   !> A point (u, v) of a moving link straight into six output columns: position, velocity,
   !> acceleration (zero where the link is not placed; rates zero where they are unknown).
   subroutine point_out(m, u, v, pose, x, y, vx, vy, ax, ay)
@@ -563,28 +640,44 @@ contains
     end do
   end subroutine point_out
 
-  !> The crank's pose: origin the pivot (px, py), x-axis (c, s), omega w, alpha al.
-  subroutine crank_pose(m, px, py, c, s, w, al, pose)
+  !> The position of a point (u, v) of a moving link straight into two output columns (zero
+  !> where the link is not placed).
+  subroutine point_at(m, u, v, pose, x, y)
     integer, intent(in) :: m
-    real(dp), intent(in) :: px, py, c(nb), s(nb), w, al
-    real(dp), intent(inout) :: pose(nb, npose)
+    real(dp), intent(in) :: u, v, pose(nb, npose)
+    real(dp), intent(inout) :: x(m), y(m)
+    real(dp) :: ok, rx, ry
     integer :: k
-    ! hot-loop: linkage crank pose
+    ! hot-loop: linkage point position
     do k = 1, m
-      pose(k, p_ox) = px
-      pose(k, p_oy) = py
-      pose(k, p_c) = c(k)
-      pose(k, p_s) = s(k)
-      pose(k, p_vx) = 0.0_dp
-      pose(k, p_vy) = 0.0_dp
-      pose(k, p_w) = w
-      pose(k, p_ax) = 0.0_dp
-      pose(k, p_ay) = 0.0_dp
-      pose(k, p_al) = al
-      pose(k, p_ok) = 1.0_dp
-      pose(k, p_rt) = 1.0_dp
+      ok = pose(k, p_ok)
+      rx = u*pose(k, p_c) - v*pose(k, p_s)
+      ry = u*pose(k, p_s) + v*pose(k, p_c)
+      x(k) = ok*(pose(k, p_ox) + rx)
+      y(k) = ok*(pose(k, p_oy) + ry)
     end do
-  end subroutine crank_pose
+  end subroutine point_at
+
+  !> The velocity and acceleration of a point (u, v) of a moving link straight into four output
+  !> columns (zero where its rates are unknown).
+  subroutine point_rates(m, u, v, pose, vx, vy, ax, ay)
+    integer, intent(in) :: m
+    real(dp), intent(in) :: u, v, pose(nb, npose)
+    real(dp), intent(inout) :: vx(m), vy(m), ax(m), ay(m)
+    real(dp) :: rx, ry, w, al
+    integer :: k
+    ! hot-loop: linkage point rates
+    do k = 1, m
+      rx = u*pose(k, p_c) - v*pose(k, p_s)
+      ry = u*pose(k, p_s) + v*pose(k, p_c)
+      w = pose(k, p_w)
+      al = pose(k, p_al)
+      vx(k) = pose(k, p_vx) - w*ry
+      vy(k) = pose(k, p_vy) + w*rx
+      ax(k) = pose(k, p_ax) - al*ry - w*w*rx
+      ay(k) = pose(k, p_ay) + al*rx - w*w*ry
+    end do
+  end subroutine point_rates
 
   !> The input slider's pose: its pin at Pg + x u + e n on the ground guide g (columns of
   !> guide_of), velocity v u, acceleration a u.
@@ -693,10 +786,13 @@ contains
     real(dp), intent(inout) :: o1(nb, npose), o2(nb, npose), ex(nb, nex)
     real(dp) :: r2, s2, dx, dy, d2, a, h2, h, jx, jy, e1x, e1y, e2x, e2y, a1x, a1y, a2x, a2y
     real(dp) :: isno, istog, isdeg, st, degst, dmin2, inok, placed, ok, det, dvx, dvy, w1, w2, cx, cy, &
-                al1, al2, sgn, rt
+                al1, al2, sgn, rt, id2, idet, il1, il2
     integer :: k
+    ! one division per position for each of d2 and det, the link lengths' reciprocals once
     r2 = l1*l1
     s2 = l2*l2
+    il1 = 1.0_dp/l1
+    il2 = 1.0_dp/l2
     dmin2 = (tol*(l1 + l2))**2
     degst = merge(real(st_indeterminate, dp), real(st_no_assembly, dp), abs(l1 - l2) <= tol*(l1 + l2))
     ! hot-loop: linkage dyad rrr
@@ -707,8 +803,9 @@ contains
       dx = q(k, 1) - p(k, 1)
       dy = q(k, 2) - p(k, 2)
       d2 = max(dx*dx + dy*dy, tiny(1.0_dp))
-      a = (d2 + r2 - s2)/(2*d2)
-      h2 = r2/d2 - a*a
+      id2 = 1.0_dp/d2
+      a = (d2 + r2 - s2)*(0.5_dp*id2)
+      h2 = r2*id2 - a*a
       isno = merge(1.0_dp, 0.0_dp, h2 < -tol)
       istog = merge(1.0_dp, 0.0_dp, h2 <= tol)*(1.0_dp - isno)
       isdeg = merge(1.0_dp, 0.0_dp, d2 <= dmin2)
@@ -724,20 +821,21 @@ contains
       a1y = jy - p(k, 2)
       a2x = jx - q(k, 1)
       a2y = jy - q(k, 2)
-      e1x = a1x/l1
-      e1y = a1y/l1
-      e2x = a2x/l2
-      e2y = a2y/l2
+      e1x = a1x*il1
+      e1y = a1y*il1
+      e2x = a2x*il2
+      e2y = a2y*il2
       ! w1 A1_perp - w2 A2_perp = vQ - vP, det = A1 x A2 (zero at the toggle)
       det = ok*(a1x*a2y - a1y*a2x) + (1.0_dp - ok)
+      idet = ok/det
       dvx = q(k, 3) - p(k, 3)
       dvy = q(k, 4) - p(k, 4)
-      w1 = ok*(dvx*a2x + dvy*a2y)/det
-      w2 = ok*(dvx*a1x + dvy*a1y)/det
+      w1 = (dvx*a2x + dvy*a2y)*idet
+      w2 = (dvx*a1x + dvy*a1y)*idet
       cx = q(k, 5) - p(k, 5) + w1*w1*a1x - w2*w2*a2x
       cy = q(k, 6) - p(k, 6) + w1*w1*a1y - w2*w2*a2y
-      al1 = ok*(cx*a2x + cy*a2y)/det
-      al2 = ok*(cx*a1x + cy*a1y)/det
+      al1 = (cx*a2x + cy*a2y)*idet
+      al2 = (cx*a1x + cy*a1y)*idet
       o1(k, p_ox) = p(k, 1)*placed
       o1(k, p_oy) = p(k, 2)*placed
       o1(k, p_c) = e1x*placed + (1.0_dp - placed)
@@ -779,8 +877,9 @@ contains
     real(dp), intent(inout) :: o1(nb, npose), o2(nb, npose), ex(nb, nex)
     real(dp) :: ux, uy, nx, ny, wx, wy, sf, hh, disc, root, s, jx, jy, a1x, a1y, sgn, inok, rt
     real(dp) :: isno, istog, st, placed, ok, det, rx, ry, vqx, vqy, dvx, dvy, w1, sd, aqx, aqy, cx, cy, al1, sdd
-    real(dp) :: wk, ak
+    real(dp) :: wk, ak, il1, idet
     integer :: k
+    il1 = 1.0_dp/l1
     ! hot-loop: linkage dyad rrp
     do k = 1, m
       sgn = mode(k)
@@ -794,7 +893,7 @@ contains
       wy = p(k, 2) - g(k, 2)
       sf = wx*ux + wy*uy
       hh = wx*nx + wy*ny - e
-      disc = 1.0_dp - (hh/l1)**2
+      disc = 1.0_dp - (hh*il1)**2
       isno = merge(1.0_dp, 0.0_dp, disc < -tol)
       istog = merge(1.0_dp, 0.0_dp, disc <= tol)*(1.0_dp - isno)
       st = st_no_assembly*isno + st_toggle*istog
@@ -816,21 +915,22 @@ contains
       vqy = g(k, 8) + wk*rx
       ! w1 A1_perp - sd u = vQ - vP;  det = A1 . u (zero with the rod square to the guide)
       det = ok*(a1x*ux + a1y*uy) + (1.0_dp - ok)
+      idet = ok/det
       dvx = vqx - p(k, 3)
       dvy = vqy - p(k, 4)
       ! Cramer with c1 = A1_perp, c2 = -u: w1 = (r x c2) / det, sd = (c1 x r) / det
-      w1 = ok*(-dvx*uy + dvy*ux)/det
-      sd = ok*(-(a1y*dvy + a1x*dvx))/det
+      w1 = (-dvx*uy + dvy*ux)*idet
+      sd = (-(a1y*dvy + a1x*dvx))*idet
       aqx = g(k, 10) - ak*ry - wk*wk*rx
       aqy = g(k, 11) + ak*rx - wk*wk*ry
       cx = aqx + 2*wk*sd*nx - p(k, 5) + w1*w1*a1x
       cy = aqy + 2*wk*sd*ny - p(k, 6) + w1*w1*a1y
-      al1 = ok*(-cx*uy + cy*ux)/det
-      sdd = ok*(-(a1y*cy + a1x*cx))/det
+      al1 = (-cx*uy + cy*ux)*idet
+      sdd = (-(a1y*cy + a1x*cx))*idet
       o1(k, p_ox) = p(k, 1)*placed
       o1(k, p_oy) = p(k, 2)*placed
-      o1(k, p_c) = a1x/l1*placed + (1.0_dp - placed)
-      o1(k, p_s) = a1y/l1*placed
+      o1(k, p_c) = a1x*il1*placed + (1.0_dp - placed)
+      o1(k, p_s) = a1y*il1*placed
       o1(k, p_vx) = p(k, 3)*ok
       o1(k, p_vy) = p(k, 4)*ok
       o1(k, p_w) = w1
@@ -873,7 +973,7 @@ contains
     real(dp), intent(in) :: e, mode(m), p(nb, natt), q(nb, natt)
     real(dp), intent(inout) :: o1(nb, npose), o2(nb, npose), ex(nb, nex)
     real(dp) :: bx, by, d2, disc, s, ux, uy, nx, ny, sgn, inok, rt, isno, istog, isdeg, st, placed, ok, det
-    real(dp) :: dvx, dvy, w1, sd, cx, cy, al1, sdd, dd, bl, dmin
+    real(dp) :: dvx, dvy, w1, sd, cx, cy, al1, sdd, dd, bl, dmin, idd, ibl, idet
     integer :: k
     ! hot-loop: linkage dyad rpr
     do k = 1, m
@@ -884,32 +984,35 @@ contains
       by = q(k, 2) - p(k, 2)
       d2 = bx*bx + by*by
       dd = max(d2, tiny(1.0_dp))
+      idd = 1.0_dp/dd
       bl = sqrt(dd)
+      ibl = 1.0_dp/bl
       dmin = tol*max(abs(e), bl)
       ! q on p with no offset: the slot may point anywhere
       isdeg = merge(1.0_dp, 0.0_dp, bl <= dmin .or. d2 == 0.0_dp)
-      disc = 1.0_dp - (e/bl)**2
+      disc = 1.0_dp - (e*ibl)**2
       isno = merge(1.0_dp, 0.0_dp, disc < -tol)*(1.0_dp - isdeg)
       istog = merge(1.0_dp, 0.0_dp, disc <= tol)*(1.0_dp - isno)*(1.0_dp - isdeg)
       st = st_no_assembly*isno + st_toggle*istog + st_indeterminate*isdeg
       st = inok*st + (1.0_dp - inok)*st_unplaced
       s = sgn*bl*sqrt(max(disc, 0.0_dp))
-      ux = (s*bx + e*by)/dd
-      uy = (s*by - e*bx)/dd
+      ux = (s*bx + e*by)*idd
+      uy = (s*by - e*bx)*idd
       nx = -uy
       ny = ux
       placed = inok*(1.0_dp - isno)*(1.0_dp - isdeg)
       ok = placed*(1.0_dp - istog)*rt
       ! w1 b_perp + sd u = vQ - vP;  det = b_perp x u = -s (zero at the toggle)
       det = ok*(-s) + (1.0_dp - ok)
+      idet = ok/det
       dvx = q(k, 3) - p(k, 3)
       dvy = q(k, 4) - p(k, 4)
-      w1 = ok*(dvx*uy - dvy*ux)/det
-      sd = ok*(-by*dvy - bx*dvx)/det
+      w1 = (dvx*uy - dvy*ux)*idet
+      sd = (-by*dvy - bx*dvx)*idet
       cx = q(k, 5) - p(k, 5) + w1*w1*bx - 2*w1*sd*nx
       cy = q(k, 6) - p(k, 6) + w1*w1*by - 2*w1*sd*ny
-      al1 = ok*(cx*uy - cy*ux)/det
-      sdd = ok*(-by*cy - bx*cx)/det
+      al1 = (cx*uy - cy*ux)*idet
+      sdd = (-by*cy - bx*cx)*idet
       o1(k, p_ox) = p(k, 1)*placed
       o1(k, p_oy) = p(k, 2)*placed
       o1(k, p_c) = ux*placed + (1.0_dp - placed)
@@ -943,8 +1046,8 @@ contains
       ! continuity: the slot's point at distance |b| from p, and the other assembly's
       ex(k, 10) = (p(k, 1) + bl*ux)*placed
       ex(k, 11) = (p(k, 2) + bl*uy)*placed
-      ex(k, 12) = (p(k, 1) + bl*(-s*bx + e*by)/dd)*placed
-      ex(k, 13) = (p(k, 2) + bl*(-s*by - e*bx)/dd)*placed
+      ex(k, 12) = (p(k, 1) + bl*(-s*bx + e*by)*idd)*placed
+      ex(k, 13) = (p(k, 2) + bl*(-s*by - e*bx)*idd)*placed
     end do
   end subroutine dyad_rpr
 
@@ -955,7 +1058,7 @@ contains
     real(dp), intent(inout) :: o1(nb, npose), o2(nb, npose), ex(nb, nex)
     real(dp) :: u1x, u1y, u2x, u2y, n1x, n1y, n2x, n2y, rx, ry, det, s1, s2, jx, jy, inok, rt, par, isdeg
     real(dp) :: st, placed, ok, v1x, v1y, v2x, v2y, dvx, dvy, sd1, sd2, a1x, a1y, a2x, a2y, cx, cy, sdd1, sdd2
-    real(dp) :: r1x, r1y, r2x, r2y, w1, w2, al1, al2, dt, scale
+    real(dp) :: r1x, r1y, r2x, r2y, w1, w2, al1, al2, dt, scale, idt
     integer :: k
     ! hot-loop: linkage dyad prp
     do k = 1, m
@@ -981,8 +1084,9 @@ contains
       placed = inok*(1.0_dp - par)
       ok = placed*rt
       dt = placed*det + (1.0_dp - placed)
-      s1 = placed*(-rx*u2y + ry*u2x)/dt
-      s2 = placed*(u1x*ry - u1y*rx)/dt
+      idt = placed/dt
+      s1 = (-rx*u2y + ry*u2x)*idt
+      s2 = (u1x*ry - u1y*rx)*idt
       jx = g1(k, 1) + e1*n1x + s1*u1x
       jy = g1(k, 2) + e1*n1y + s1*u1y
       r1x = jx - g1(k, 5)
@@ -1000,16 +1104,17 @@ contains
       dvx = v2x - v1x
       dvy = v2y - v1y
       dt = ok*det + (1.0_dp - ok)
-      sd1 = ok*(-dvx*u2y + dvy*u2x)/dt
-      sd2 = ok*(u1x*dvy - u1y*dvx)/dt
+      idt = ok/dt
+      sd1 = (-dvx*u2y + dvy*u2x)*idt
+      sd2 = (u1x*dvy - u1y*dvx)*idt
       a1x = g1(k, 10) - al1*r1y - w1*w1*r1x + 2*w1*sd1*n1x
       a1y = g1(k, 11) + al1*r1x - w1*w1*r1y + 2*w1*sd1*n1y
       a2x = g2(k, 10) - al2*r2y - w2*w2*r2x + 2*w2*sd2*n2x
       a2y = g2(k, 11) + al2*r2x - w2*w2*r2y + 2*w2*sd2*n2y
       cx = a2x - a1x
       cy = a2y - a1y
-      sdd1 = ok*(-cx*u2y + cy*u2x)/dt
-      sdd2 = ok*(u1x*cy - u1y*cx)/dt
+      sdd1 = (-cx*u2y + cy*u2x)*idt
+      sdd2 = (u1x*cy - u1y*cx)*idt
       o1(k, p_ox) = jx*placed
       o1(k, p_oy) = jy*placed
       o1(k, p_c) = u1x*placed + (1.0_dp - placed)
@@ -1402,9 +1507,14 @@ contains
     logical, allocatable :: okrow(:)
     real(dp), allocatable :: pose(:, :, :), att(:, :, :, :)
     integer, allocatable :: st(:, :)
-    integer :: i, k, o, l, j, d, c, n, nok
+    integer :: i, k, o, l, j, d, c, n, nok, wk, alink
     logical :: whole
     n = max(nscan, 2)
+    ! the outputs the summary reads: the output link's angle only, the links' rates, the
+    ! transmission and pressure angles, the slides (no points)
+    wk = ior(iand(want, want_continuity + want_forces), want_angles + want_link_rates + want_quality + want_slides)
+    alink = -1
+    if (iout(1) == 1) alink = iout(2)
     allocate (x(n), lk(n, 3, nl), pk(n, 6, np), sk(n, 3, max(ns, 1)), qa(n, nd), fk(n, 9, nd), fd(n, 4), &
               sh(n, 3), st(n, nd), y(n), dy(n), ddy(n), row(ncol), en(nenergy), okrow(n))
     allocate (pose(nb, npose, nl), att(nb, natt, 2, nd))   ! the blocks' work arrays, once for all designs
@@ -1433,7 +1543,8 @@ contains
         x(k) = x0 + h*real(k - 1, dp)
       end do
       call analyse_core(n, nl, np, ng, nd, max(ns, 1), nld, nt, n, x, idrv, rdrv, ipts, rpts, igd, rgd, idy, &
-                        rdy, rl, grav, ild, rld, rtq, ift, tab, rft, want, lk, pk, sk, qa, st, fk, fd, sh, pose, att)
+                        rdy, rl, grav, ild, rld, rtq, ift, tab, rft, wk, alink, lk, pk, sk, qa, st, fk, fd, sh, &
+                        pose, att)
       row = 0.0_dp
       do k = 1, n
         okrow(k) = all(st(k, :) == st_ok)
@@ -1694,7 +1805,9 @@ contains
       at = x0
       return
     end if
-    k = maxloc(w, 1, mask=okv)
+    ! the first of the largest within rounding (a symmetric motion's +peak and -peak tie: which
+    ! one is larger in the last bits must not choose the sign printed)
+    k = findloc(okv .and. w >= maxval(w, mask=okv)*(1.0_dp - tie_rel), .true., 1)
     call parabola(n, v, okv, per, k, h, x0, sign(1.0_dp, v(k)), val, at)
   end subroutine peak_at
 
@@ -1715,13 +1828,16 @@ contains
     real(dp), intent(in) :: v(n), sgn, h, x0
     logical, intent(in) :: okv(n), per
     real(dp), intent(out) :: val, at
+    real(dp) :: best
     integer :: k
     if (.not. any(okv)) then
       val = 0.0_dp
       at = x0
       return
     end if
-    k = maxloc(sgn*v, 1, mask=okv)
+    best = maxval(sgn*v, mask=okv)
+    ! the first of the extremes within rounding of the best (ties in the last bits choose nothing)
+    k = findloc(okv .and. sgn*v >= best - tie_rel*(maxval(abs(v), mask=okv)), .true., 1)
     call parabola(n, v, okv, per, k, h, x0, sgn, val, at)
   end subroutine extreme
 

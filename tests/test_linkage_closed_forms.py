@@ -161,3 +161,34 @@ def test_engine_flywheel_is_the_energy_of_its_own_torque():
     r = table_energy(np.radians(x), m.a.driver[:, DriverCol.DRIVE], p.speed_fluctuation, p.omega)
     assert s["energy_fluctuation_J"] == pytest.approx(r[EnergyCol.ENERGY_FLUCTUATION], rel=2e-4)
     assert s["torque_mean"] == pytest.approx(r[EnergyCol.MEAN_TORQUE], rel=1e-4)
+
+
+@pytest.mark.parametrize("step", [0.5, 5.0])
+def test_parallelogram_stays_a_parallelogram_through_its_change_points(step):
+    """A parallelogram four-bar (crank = rocker = r, coupler = ground = g) passes two change points
+    a turn (theta = 0 and 180 deg: all pins on the ground line, where its parallelogram and
+    anti-parallelogram assemblies meet).  Followed through them (branch continuity, the kernel's
+    default), it stays the parallelogram: the rocker turns with the crank (its angle is the crank's)
+    and the coupler stays parallel to the ground, at every input of two turns; the group's mode
+    changes sign at each change point.  With the mode held fixed (continuity off) it turns into
+    the anti-parallelogram after the first one, which the same check sees."""
+    r, g = 3.0, 7.0
+    text = (f"pivots='O2','O4', pivot_xy=0,0, {g},0\n"
+            f"driver_joints='O2','A', driver_length={r}, omega=2.0, alpha=0.5, start={step / 2}, "
+            f"stop={720 - step / 2}, step={step}\n"
+            f"dyads='RRR', dyad_joints='A','O4','B', dyad_links='coupler','rocker', dyad_dims={g},{r}, dyad_modes=1")
+    p = params_of(text)
+    mech = compile_deck(p)
+    m = solve(p, mech=mech)
+    th = np.radians(m.x)
+    wrap = lambda a: np.angle(np.exp(1j * a))   # angle differences into (-pi, pi]
+    assert np.all(m.a.status[:, 0] == 0)
+    assert np.max(np.abs(wrap(m.a.links[:, LinkCol.ANGLE, 3] - th))) <= 1e-9
+    assert np.max(np.abs(wrap(m.a.links[:, LinkCol.ANGLE, 2]))) <= 1e-9
+    # the rates: near a change point the group's velocity equations are near singular (its links
+    # nearly in line; 0.25 deg away, the determinant is 4e-3 of its largest), which costs digits
+    assert np.max(np.abs(m.a.links[:, LinkCol.OMEGA, 3] - 2.0)) <= 1e-8 * 2.0
+    assert np.max(np.abs(m.a.links[:, LinkCol.ALPHA, 3] - 0.5)) <= 1e-6 * 4.5
+    from driver.linkage import _kernel as kernel
+    held = kernel.analyse(mech, th, continuity=False)
+    assert np.max(np.abs(wrap(held.links[:, LinkCol.ANGLE, 3] - th))) > 0.1

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import weakref
 from collections.abc import Callable
-from enum import IntEnum
-from typing import TYPE_CHECKING, Any, NamedTuple
+from enum import IntEnum, IntFlag
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -44,11 +44,25 @@ class LinkageStatus(KernelStatus):
     unplaced = int(_K.st_unplaced), "not placed", "a link the group attaches to is not placed"
 
 
-class Want(IntEnum):
-    """What analyse computes besides the kinematics (bits)."""
+class Want(IntFlag):
+    """What analyse computes besides the kinematics, and which of its outputs it writes (bits;
+    fortran/linkage.f90 ``want_*``).  An output not asked for is not written (zero in the arrays
+    the wrapper makes); the status of each group is always written.
+
+    ``KINEMATICS`` every kinematic output; ``JOINTS`` the points' positions, velocities and
+    accelerations (what pylinkage's kinematics step gives); ``POINTS`` their positions only.
+    """
 
     CONTINUITY = int(_K.want_continuity)
     FORCES = int(_K.want_forces)
+    ANGLES = int(_K.want_angles)
+    LINK_RATES = int(_K.want_link_rates)
+    POINTS = int(_K.want_points)
+    POINT_RATES = int(_K.want_point_rates)
+    QUALITY = int(_K.want_quality)
+    SLIDES = int(_K.want_slides)
+    KINEMATICS = int(_K.want_kinematics)
+    JOINTS = int(_K.want_points) | int(_K.want_point_rates)
 
 
 class LinkCol(IntEnum):
@@ -194,7 +208,34 @@ class Analysis(NamedTuple):
     shaking: np.ndarray
 
 
-def analyse(mech: Mechanism, x: np.ndarray, forces: bool | None = None, continuity: bool = True) -> Analysis:
+def buffers(mech: Mechanism, n: int, forces: bool | None = None) -> tuple[np.ndarray, ...]:
+    """Make the output arrays of :func:`analyse` once, to pass as its ``out`` call after call.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The compiled mechanism.
+    n : int
+        Inputs per call.
+    forces : bool, optional
+        Room for the kinetostatics (default: when the mechanism has bodies).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        The kernel's eight output arrays (Fortran order), zero; the ground's columns filled.
+    """
+    nl, npt, nd, ns = len(mech.links), len(mech.points), len(mech.dyads), mech.nslides
+    nf = n if (mech.forces if forces is None else forces) else 1     # no forces: one unused row
+    bufs = [np.zeros(shape, order="F") for shape in ((n, 3, nl), (n, 6, npt), (n, 3, ns), (n, nd))]
+    bufs.append(np.zeros((n, nd), dtype=np.int32, order="F"))
+    bufs += [np.zeros(shape, order="F") for shape in ((nf, 9, nd), (nf, 4), (nf, 3))]
+    _fill_ground(mech, bufs[0], bufs[1])
+    return tuple(bufs)
+
+
+def analyse(mech: Mechanism, x: np.ndarray, forces: bool | None = None, continuity: bool = True,
+            outputs: Want = Want.KINEMATICS, out: tuple[np.ndarray, ...] | None = None) -> Analysis:
     """Solve the mechanism at inputs ``x``: kinematics, and forces when it has bodies.
 
     Parameters
@@ -207,64 +248,73 @@ def analyse(mech: Mechanism, x: np.ndarray, forces: bool | None = None, continui
         Run the kinetostatics (default: when the mechanism has bodies).
     continuity : bool, default True
         Follow each group's assembly through change points (fortran/linkage.f90).
+    outputs : Want, default Want.KINEMATICS
+        The kinematic outputs to write (:class:`Want` bits ``ANGLES``, ``LINK_RATES``,
+        ``POINTS``, ``POINT_RATES``, ``QUALITY``, ``SLIDES``); the others are not written (zero
+        in arrays made here).  Everything is computed either way: this saves the stores.
+    out : tuple of numpy.ndarray, optional
+        Output arrays made by :func:`buffers` for this mechanism and ``len(x)`` inputs, reused
+        (no allocation; the result's arrays are views of them).
 
     Returns
     -------
     Analysis
         The kernel's arrays (see :class:`Analysis`).
     """
-    x = farray(np.atleast_1d(x), 1)
-    want = (int(Want.CONTINUITY) if continuity else 0) | (int(Want.FORCES) if (mech.forces if forces is None
-                                                                                else forces) else 0)
+    x = farray(x if type(x) is np.ndarray and x.ndim == 1 else np.atleast_1d(x), 1)
+    do_forces = mech.forces if forces is None else forces
+    want = (_CONTINUITY if continuity else 0) | (_FORCES if do_forces else 0) | (int(outputs) & _KINEMATICS)
     i, r = mech.integers(), mech.reals()
-    n, nl, npt, nd, ns = x.shape[0], len(mech.links), len(mech.points), len(mech.dyads), mech.nslides
-    bufs = [np.zeros(shape, order="F") for shape in ((n, 3, nl), (n, 6, npt), (n, 3, ns), (n, nd))]
-    st = np.zeros((n, nd), dtype=np.int32, order="F")
-    _fill_ground(mech, bufs[0], bufs[1])
-    nf = n if want & int(Want.FORCES) else 1     # no forces asked: one unused row
-    fbufs = [np.zeros(shape, order="F") for shape in ((nf, 9, nd), (nf, 4), (nf, 3))]
-    out = _K.analyse(x, i["idrv"], r["rdrv"], i["ipts"], r["rpts"],
-                     i["igd"], r["rgd"], i["idy"], r["rdy"], r["rl"], r["grav"], i["ild"], r["rld"], r["rtq"],
-                     i["ift"], r["tab"], r["rft"], want, bufs[0], bufs[1], bufs[2], bufs[3], st, fbufs[0],
-                     fbufs[1], fbufs[2])
-    a = Analysis(*out)
-    if nf < n:   # no force analysis: zero-size force arrays, not garbage
-        a = a._replace(joints=np.zeros((0, 9, nd)),
-                       driver=np.zeros((0, 4)), shaking=np.zeros((0, 3)))
-    if not mech.slides:
-        a = a._replace(slides=a.slides[:, :, :0])
-    return a
+    n = x.shape[0]
+    bufs = buffers(mech, n, do_forces) if out is None else out
+    if bufs[0].shape[0] != n or (do_forces and bufs[5].shape[0] != n):
+        raise ValueError(f"out: buffers for {bufs[0].shape[0]} inputs{'' if bufs[5].shape[0] > 1 else ' without forces'}"
+                         f", called with {n}{' and forces' if do_forces else ''}")
+    if out is not None:
+        _fill_ground(mech, bufs[0], bufs[1])
+    lk, pk, sk, qa, st, fk, fd, sh = _K.analyse(x, i["idrv"], r["rdrv"], i["ipts"], r["rpts"], i["igd"], r["rgd"],
+                                                i["idy"], r["rdy"], r["rl"], r["grav"], i["ild"], r["rld"], r["rtq"],
+                                                i["ift"], r["tab"], r["rft"], want, bufs[0], bufs[1], bufs[2],
+                                                bufs[3], bufs[4], bufs[5], bufs[6], bufs[7])
+    if not do_forces:   # no force analysis: zero-size force arrays, not an unused row
+        fk, fd, sh = fk[:0], fd[:0], sh[:0]
+    return Analysis(lk, pk, sk if mech.slides else sk[:, :, :0], qa, st, fk, fd, sh)
 
 
-#: the ground columns of a reused output buffer: name -> (weak reference to the buffer, what they hold)
-_GROUND: dict[str, tuple[weakref.ref, tuple]] = {}
+#: the want bits as plain ints (no enum arithmetic per call)
+_CONTINUITY, _FORCES, _KINEMATICS = int(Want.CONTINUITY), int(Want.FORCES), int(Want.KINEMATICS)
+
+
+#: the ground columns of output buffers: id -> (weak reference to the buffer, what they hold)
+_GROUND: dict[int, tuple[weakref.ref, tuple]] = {}
 
 
 def _fill_ground(mech: Mechanism, lk: np.ndarray, pk: np.ndarray) -> None:
     """Write the ground's columns of the output buffers (the kernel leaves them: constant), unless
-    the buffer is the very array an earlier call filled with exactly these (a reused spare:
-    the weak reference proves it is the same living object, whose ground columns nothing else
-    writes)."""
+    the buffer is the very array an earlier call filled with exactly these (the weak reference
+    proves it is the same living object, whose ground columns nothing else writes)."""
     ground = tuple((j, u, v) for j, (_, link, u, v) in enumerate(mech.points) if link == 1)
-    for name, buf, contents in (("lk", lk, ()), ("pk", pk, ground)):
-        held = _GROUND.get(name)
+    for buf, contents in ((lk, ("links",)), (pk, ground)):
+        held = _GROUND.get(id(buf))
         if held is not None and held[0]() is buf and held[1] == contents:
             continue
-        if name == "lk":
+        if buf is lk:
             buf[:, :, 0] = 0.0
         else:
             for j, u, v in ground:
                 buf[:, 0, j] = u
                 buf[:, 1, j] = v
                 buf[:, 2:, j] = 0.0
-        _GROUND[name] = (weakref.ref(buf), contents)
+        for key in [k for k, (ref, _) in _GROUND.items() if ref() is None]:
+            del _GROUND[key]
+        _GROUND[id(buf)] = (weakref.ref(buf), contents)
 
 
-def reusable_call(mech: Mechanism, x: np.ndarray, forces: bool | None = None,
-                  continuity: bool = True) -> Callable[[], tuple]:
-    """Make a call of the kernel on fixed inputs and output arrays made once.
+def reusable_call(mech: Mechanism, x: np.ndarray, forces: bool | None = None, continuity: bool = True,
+                  outputs: Want = Want.KINEMATICS) -> Callable[[], Analysis]:
+    """Make a call of :func:`analyse` on fixed inputs and output arrays made once.
 
-    For benchmarks: the cost of the kernel itself, its outputs reused as the four-bar's
+    For benchmarks: the kernel through its wrapper, its outputs reused as the four-bar's
     ``out=`` buffers are.
 
     Parameters
@@ -277,26 +327,17 @@ def reusable_call(mech: Mechanism, x: np.ndarray, forces: bool | None = None,
         Run the kinetostatics (default: when the mechanism has bodies).
     continuity : bool, default True
         Follow each group's assembly.
+    outputs : Want, default Want.KINEMATICS
+        The outputs written (see :func:`analyse`).
 
     Returns
     -------
     callable
-        ``call()`` runs the kernel and returns its raw outputs (the arrays of :class:`Analysis`).
+        ``call()`` runs the kernel and returns its :class:`Analysis`.
     """
     x = farray(np.atleast_1d(x), 1)
-    want = (int(Want.CONTINUITY) if continuity else 0) | (int(Want.FORCES) if (mech.forces if forces is None
-                                                                                else forces) else 0)
-    i, r = mech.integers(), mech.reals()
-    n, nl, npt, nd, ns = x.shape[0], len(mech.links), len(mech.points), len(mech.dyads), mech.nslides
-    nf = n if want & int(Want.FORCES) else 1
-    bufs = [np.zeros(shape, order="F") for shape in ((n, 3, nl), (n, 6, npt), (n, 3, ns), (n, nd))]
-    st = np.zeros((n, nd), dtype=np.int32, order="F")
-    fbufs = [np.zeros(shape, order="F") for shape in ((nf, 9, nd), (nf, 4), (nf, 3))]
-    _fill_ground(mech, bufs[0], bufs[1])
-    args: tuple[Any, ...] = (x, i["idrv"], r["rdrv"], i["ipts"], r["rpts"], i["igd"], r["rgd"], i["idy"], r["rdy"], r["rl"],
-            r["grav"], i["ild"], r["rld"], r["rtq"], i["ift"], r["tab"], r["rft"], want, *bufs, st, *fbufs)
-    kernel: Any = _K.analyse
-    return lambda: kernel(*args)
+    bufs = buffers(mech, x.shape[0], forces)
+    return lambda: analyse(mech, x, forces, continuity, outputs, bufs)
 
 
 def table_energy(theta: np.ndarray, torque: np.ndarray, cs: float, omega: float) -> np.ndarray:

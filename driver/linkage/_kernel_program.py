@@ -90,6 +90,8 @@ class Mechanism:
     gf_table: np.ndarray = field(default_factory=lambda: np.zeros((2, 2)))
     gf_period: float = 0.0
     gf_scale: float = 1.0
+    #: the kernel's arrays, made on first use (the mechanism is not changed once compiled)
+    _arrays: dict[str, dict[str, np.ndarray]] = field(default_factory=dict, repr=False, compare=False)
 
     # ------------------------------------------------------------------ lookups
     def link_index(self, name: str) -> int:
@@ -118,7 +120,13 @@ class Mechanism:
     # ------------------------------------------------------------------ the kernel's program
     def integers(self) -> dict[str, np.ndarray]:
         """The kernel's integer arrays (shared by every design of a batch); empty lists padded
-        with one inert entry (f2py and zero-size arrays)."""
+        with one inert entry (f2py and zero-size arrays).  Made once: read them, do not change
+        them."""
+        if "integers" not in self._arrays:
+            self._arrays["integers"] = self._integers()
+        return self._arrays["integers"]
+
+    def _integers(self) -> dict[str, np.ndarray]:
         ipts = np.array([p[1] for p in self.points], dtype=np.int32)
         igd = np.array([g[1] for g in self.guides] or [1], dtype=np.int32)
         idy = np.array([[d.code, d.a1, d.a2, d.k1, d.k2, d.slide] for d in self.dyads],
@@ -130,7 +138,13 @@ class Mechanism:
         return {"idrv": idrv, "ipts": ipts, "igd": igd, "idy": idy, "ild": ild, "ift": ift}
 
     def reals(self) -> dict[str, np.ndarray]:
-        """The kernel's real arrays of this design (the ones :meth:`numbers` packs)."""
+        """The kernel's real arrays of this design (the ones :meth:`numbers` packs).  Made once:
+        read them, do not change them."""
+        if "reals" not in self._arrays:
+            self._arrays["reals"] = self._reals()
+        return self._arrays["reals"]
+
+    def _reals(self) -> dict[str, np.ndarray]:
         rpts = np.array([[p[2], p[3]] for p in self.points], dtype=np.float64, order="F")
         rgd = np.array([[g[2], g[3], g[4]] for g in self.guides] or [[0.0, 0.0, 0.0]], dtype=np.float64, order="F")
         rdrv = np.array([self.driver_length, self.omega, self.alpha], dtype=np.float64)

@@ -98,8 +98,15 @@ class _linkage:
     ) -> NDArray[np.float64]:
         """``res = table_energy(th,tq,cs,omega,[nt])``; shapes res(8)"""
         ...
+    want_angles: NDArray[np.int32]
     want_continuity: NDArray[np.int32]
     want_forces: NDArray[np.int32]
+    want_kinematics: NDArray[np.int32]
+    want_link_rates: NDArray[np.int32]
+    want_point_rates: NDArray[np.int32]
+    want_points: NDArray[np.int32]
+    want_quality: NDArray[np.int32]
+    want_slides: NDArray[np.int32]
 
 
 linkage: _linkage
