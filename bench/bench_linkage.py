@@ -186,7 +186,7 @@ SWEEP_DECK = """&linkage
 &sweep
   key1 = 'linkage.driver_length', start1 = 0.06, stop1 = 0.12, count1 = {c1}
   key2 = 'linkage.omega', start2 = 5.0, stop2 = 15.0, count2 = {c2}
-  keep = 'time_ratio >= 1.38 and stroke >= 29.5'
+  keep = 'time_ratio >= 1.384 and stroke >= 29.8'
   case_outputs = 'none'
   summary_rows = 'kept'
 /

@@ -90,6 +90,9 @@ module linkage
                                 want_points = 16, want_point_rates = 32, want_quality = 64, want_slides = 128
   !> every kinematic output
   integer, parameter, public :: want_kinematics = 252
+  !> passes of summaries: the output's extremes (stroke, time ratio); the transmission and
+  !> pressure angles; the links' and slides' peaks; the forces (torque, shaking, flywheel)
+  integer, parameter, public :: pass_output = 1, pass_quality = 2, pass_peaks = 4, pass_forces = 8
   !> columns of a summary row before the per-element columns (see summaries), and per element
   integer, parameter, public :: nsum_head = 22, nsum_link = 2, nsum_slide = 4, nsum_dyad = 2
   !> columns of table_energy's result
@@ -133,17 +136,22 @@ contains
     real(dp), allocatable :: pose(:, :, :), att(:, :, :, :)
     allocate (pose(nb, npose, nl), att(nb, natt, 2, nd))
     call analyse_core(n, nl, np, ng, nd, ns, nld, nt, nf, x, idrv, rdrv, ipts, rpts, igd, rgd, idy, rdy, &
-                      rl, grav, ild, rld, rtq, ift, tab, rft, want, 0, lk, pk, sk, qa, st, fk, fd, sh, pose, att)
+                      rl, grav, ild, rld, rtq, ift, tab, rft, want, 0, 0, lk, pk, sk, qa, st, fk, fd, sh, pose, att, &
+                      .true.)
   end subroutine analyse
 
   !> analyse's work, with the block work arrays of the caller (summaries makes them once for
-  !> all its designs): pose(nb, npose, nl) and att(nb, natt, 2, nd), overwritten.  alink > 0:
-  !> of the link angles (want_angles) only link alink's (the summaries' output link).
+  !> all its designs): pose(nb, npose, nl) and att(nb, natt, 2, nd), overwritten.  asel, rsel:
+  !> the links whose angles (want_angles) and rates (want_link_rates) are written: 0 all, l > 0
+  !> link l only (the summaries' output link).  fresh: pose is new (else it holds an earlier
+  !> call's of the same mechanism and number of inputs: the ground's frame and the crank's
+  !> constant columns are kept, its design-dependent ones rewritten).
   subroutine analyse_core(n, nl, np, ng, nd, ns, nld, nt, nf, x, idrv, rdrv, ipts, rpts, igd, rgd, idy, rdy, &
-                          rl, grav, ild, rld, rtq, ift, tab, rft, want, alink, lk, pk, sk, qa, st, fk, fd, sh, &
-                          pose, att)
+                          rl, grav, ild, rld, rtq, ift, tab, rft, want, asel, rsel, lk, pk, sk, qa, st, fk, fd, &
+                          sh, pose, att, fresh)
     integer, intent(in) :: n, nl, np, ng, nd, ns, nld, nt, nf   ! nf: rows of the force outputs (n, or 1 unused)
-    integer, intent(in) :: alink
+    integer, intent(in) :: asel, rsel
+    logical, intent(in) :: fresh
     real(dp), intent(in) :: x(n), rdrv(3), rpts(np, 2), rgd(ng, 3), rdy(nd, 3), rl(nl, 4), grav(2)
     integer, intent(in) :: idrv(4), ipts(np), igd(ng), idy(nd, 6), ild(nld), ift(4), want
     real(dp), intent(in) :: rld(nld, 2), rtq(nl), tab(nt, 2), rft(3)
@@ -172,20 +180,24 @@ contains
     ! block work arrays, made once: link frames, and the groups' attachments (those on the ground
     ! -- pivots, fixed guides -- are constant and filled here once)
     mb = min(nb, n)   ! the rows a block uses
-    pose(1:mb, :, 1) = 0.0_dp
-    pose(1:mb, p_c, 1) = 1.0_dp
-    pose(1:mb, p_ok, 1) = 1.0_dp
-    pose(1:mb, p_rt, 1) = 1.0_dp
+    if (fresh) then
+      pose(1:mb, :, 1) = 0.0_dp
+      pose(1:mb, p_c, 1) = 1.0_dp
+      pose(1:mb, p_ok, 1) = 1.0_dp
+      pose(1:mb, p_rt, 1) = 1.0_dp
+    end if
     ! a crank's frame but its direction is constant too: filled here once, each block writes (c, s)
     if (idrv(1) == drv_crank) then
-      pose(1:mb, :, idrv(3)) = 0.0_dp
+      if (fresh) then
+        pose(1:mb, :, idrv(3)) = 0.0_dp
+        pose(1:mb, p_c, idrv(3)) = 1.0_dp
+        pose(1:mb, p_ok, idrv(3)) = 1.0_dp
+        pose(1:mb, p_rt, idrv(3)) = 1.0_dp
+      end if
       pose(1:mb, p_ox, idrv(3)) = rpts(idrv(2), 1)
       pose(1:mb, p_oy, idrv(3)) = rpts(idrv(2), 2)
-      pose(1:mb, p_c, idrv(3)) = 1.0_dp
       pose(1:mb, p_w, idrv(3)) = rdrv(2)
       pose(1:mb, p_al, idrv(3)) = rdrv(3)
-      pose(1:mb, p_ok, idrv(3)) = 1.0_dp
-      pose(1:mb, p_rt, idrv(3)) = 1.0_dp
     end if
     do d = 1, nd
       if (idy(d, 1) == dy_prp) then
@@ -220,8 +232,8 @@ contains
       do k0 = k1, n, nb
         m = min(nb, n - k0 + 1)
         call solve_block(m, k0, n, nl, np, ng, nd, ns, nld, nt, nf, x, idrv, rdrv, ipts, rpts, igd, rgd, idy, &
-                         rdy, rl, grav, ild, rld, rtq, ift, tab, rft, want, alink, modes, cont, store, chr, ring, &
-                         flagk, pose, att, lk, pk, sk, qa, st, fk, fd, sh)
+                         rdy, rl, grav, ild, rld, rtq, ift, tab, rft, want, asel, rsel, modes, cont, store, chr, &
+                         ring, flagk, pose, att, lk, pk, sk, qa, st, fk, fd, sh)
       end do
     end subroutine solve_rows
 
@@ -332,9 +344,9 @@ contains
 
   !> One block of analyse: rows k0..k0+m-1 (m <= nb).
   subroutine solve_block(m, k0, n, nl, np, ng, nd, ns, nld, nt, nf, x, idrv, rdrv, ipts, rpts, igd, rgd, idy, &
-                         rdy, rl, grav, ild, rld, rtq, ift, tab, rft, want, alink, modes, cont, store, chr, ring, &
-                         flagk, pose, att, lk, pk, sk, qa, st, fk, fd, sh)
-    integer, intent(in) :: m, k0, n, nl, np, ng, nd, ns, nld, nt, nf, alink
+                         rdy, rl, grav, ild, rld, rtq, ift, tab, rft, want, asel, rsel, modes, cont, store, chr, &
+                         ring, flagk, pose, att, lk, pk, sk, qa, st, fk, fd, sh)
+    integer, intent(in) :: m, k0, n, nl, np, ng, nd, ns, nld, nt, nf, asel, rsel
     real(dp), intent(in) :: x(n), rdrv(3), rpts(np, 2), rgd(ng, 3), rdy(nd, 3), rl(nl, 4), grav(2)
     integer, intent(in) :: idrv(4), ipts(np), igd(ng), idy(nd, 6), ild(nld), ift(4), want
     real(dp), intent(in) :: rld(nld, 2), rtq(nl), tab(nt, 2), rft(3), modes(n, nd)
@@ -423,15 +435,15 @@ contains
     ! moving links: angle (an unplaced link's frame is (1, 0): angle 0; a crank's is its input
     ! brought into (-pi, pi], no arctangent), omega, alpha; the ground's are filled once by the caller
     do l = 2, nl
-      if (iand(want, want_angles) /= 0 .and. (alink == 0 .or. l == alink)) then
+      if (iand(want, want_angles) /= 0 .and. (asel == 0 .or. l == asel)) then
         if (l == idrv(3) .and. idrv(1) == drv_crank) then
           call wrap_angle(m, x(k0:k1), lk(k0:k1, 1, l))
         else
           call atan2_array(m, pose(:, p_s, l), pose(:, p_c, l), lk(k0:k1, 1, l))
         end if
       end if
-      if (iand(want, want_link_rates) /= 0) call copy2(m, pose(:, p_w, l), pose(:, p_al, l), lk(k0:k1, 2, l), &
-                                                       lk(k0:k1, 3, l))
+      if (iand(want, want_link_rates) /= 0 .and. (rsel == 0 .or. l == rsel)) &
+        call copy2(m, pose(:, p_w, l), pose(:, p_al, l), lk(k0:k1, 2, l), lk(k0:k1, 3, l))
     end do
     ! points on moving links, written straight into the outputs (the ground's: by the caller)
     do p = 1, np
@@ -1469,13 +1481,15 @@ contains
   ! ======================================================================== summaries
 
   !> Summaries of nds designs of one mechanism (one topology, the numbers varying) in one call.
-  !> Each design's numbers are one row of prm, packed in this order (see driver/linkage/_model.py):
+  !> Each design's numbers are one column of prm (contiguous), packed in this order (see
+  !> driver/linkage/_kernel_program.py):
   !>   rpts (np x 2, column-major), rgd (ng x 3), rdrv (3), rdy (nd x 3), rl (nl x 4), grav (2),
   !>   rld (nld x 2), rtq (nl), rft (3), tab (nt x 2), then scan: x0, span, cs.
   !> The scan: nscan inputs from x0 over span (periodic = 1: a crank's cycle, without the end
   !> point; 0: both ends).  iout = (kind, index): the output element, 1 a link's angle, 2 a slide.
-  !> want as analyse (forces when the deck gives masses).
-  !> res(i, :) the summary row: nsum_head columns, then nsum_link per moving link (2..nl),
+  !> want as analyse (forces when the deck gives masses); passes: the sum of the pass_* bits to
+  !> run (a pass not run leaves its columns 0; the others are the same whichever passes run).
+  !> res(:, i) the summary row of design i: nsum_head columns, then nsum_link per moving link (2..nl),
   !> nsum_slide per slide, nsum_dyad per dyad:
   !>   1 assembled fraction (all dyads st_ok)    2 positions not assembled   3 toggle positions
   !>   4, 5 output minimum and its input          6, 7 output maximum and its input
@@ -1494,29 +1508,44 @@ contains
   !> through three scan points.  Figures that need the whole cycle assembled (stroke, time
   !> ratio, torque mean, energy) are 0 unless it is.
   subroutine summaries(nds, nr, prm, nl, np, ng, nd, ns, nld, nt, idrv, ipts, igd, idy, ild, ift, nscan, &
-                       periodic, iout, want, ncol, res)
+                       periodic, iout, want, passes, ncol, res)
     !f2py threadsafe
-    integer, intent(in) :: nds, nr, nl, np, ng, nd, ns, nld, nt, nscan, periodic, want, ncol
-    real(dp), intent(in) :: prm(nds, nr)
+    integer, intent(in) :: nds, nr, nl, np, ng, nd, ns, nld, nt, nscan, periodic, want, passes, ncol
+    real(dp), intent(in) :: prm(nr, nds)
     integer, intent(in) :: idrv(4), ipts(np), igd(ng), idy(nd, 6), ild(nld), ift(4), iout(2)
-    real(dp), intent(out) :: res(nds, ncol)
+    real(dp), intent(out) :: res(ncol, nds)
     real(dp) :: rpts(np, 2), rgd(ng, 3), rdrv(3), rdy(nd, 3), rl(nl, 4), grav(2), rld(nld, 2), rtq(nl), &
                 rft(3), tab(nt, 2), x0, span, cs, h
     real(dp), allocatable :: x(:), lk(:, :, :), pk(:, :, :), sk(:, :, :), qa(:, :), fk(:, :, :), fd(:, :), &
                              sh(:, :), y(:), dy(:), ddy(:), row(:), en(:)
     logical, allocatable :: okrow(:)
     real(dp), allocatable :: pose(:, :, :), att(:, :, :, :)
-    integer, allocatable :: st(:, :)
-    integer :: i, k, o, l, j, d, c, n, nok, wk, alink
-    logical :: whole
+    integer, allocatable :: st(:, :), flags(:, :)
+    integer :: i, k, o, l, j, d, c, n, nok, wk, asel, rsel
+    logical :: whole, do_out, do_q, do_pk, do_f
     n = max(nscan, 2)
-    ! the outputs the summary reads: the output link's angle only, the links' rates, the
-    ! transmission and pressure angles, the slides (no points)
-    wk = ior(iand(want, want_continuity + want_forces), want_angles + want_link_rates + want_quality + want_slides)
-    alink = -1
-    if (iout(1) == 1) alink = iout(2)
+    ! the outputs the passes read (never the points): the output's angle and rates (a link) or
+    ! its slide; the transmission and pressure angles; every link's rates and the slides; forces
+    do_out = iand(passes, pass_output) /= 0
+    do_q = iand(passes, pass_quality) /= 0
+    do_pk = iand(passes, pass_peaks) /= 0
+    do_f = iand(passes, pass_forces) /= 0 .and. iand(want, want_forces) /= 0
+    wk = iand(want, want_continuity)
+    if (do_f) wk = ior(wk, want_forces)
+    if (do_q) wk = ior(wk, want_quality)
+    if (do_pk) wk = ior(wk, want_link_rates + want_slides)
+    asel = -1
+    rsel = -1
+    if (do_out .and. iout(1) == 1) then
+      wk = ior(wk, want_angles + want_link_rates)
+      asel = iout(2)
+      rsel = iout(2)
+    else if (do_out) then
+      wk = ior(wk, want_slides)
+    end if
+    if (do_pk) rsel = 0
     allocate (x(n), lk(n, 3, nl), pk(n, 6, np), sk(n, 3, max(ns, 1)), qa(n, nd), fk(n, 9, nd), fd(n, 4), &
-              sh(n, 3), st(n, nd), y(n), dy(n), ddy(n), row(ncol), en(nenergy), okrow(n))
+              sh(n, 3), st(n, nd), y(n), dy(n), ddy(n), row(ncol), en(nenergy), okrow(n), flags(n, 3))
     allocate (pose(nb, npose, nl), att(nb, natt, 2, nd))   ! the blocks' work arrays, once for all designs
     sk = 0.0_dp   ! a mechanism without slides is given one inert slide, never written by analyse
     do i = 1, nds
@@ -1531,9 +1560,9 @@ contains
       call take(rtq, nl)
       call take(rft, 3)
       call take(tab, 2*nt)
-      x0 = prm(i, o + 1)
-      span = prm(i, o + 2)
-      cs = prm(i, o + 3)
+      x0 = prm(o + 1, i)
+      span = prm(o + 2, i)
+      cs = prm(o + 3, i)
       if (periodic == 1) then
         h = span/real(n, dp)
       else
@@ -1543,18 +1572,36 @@ contains
         x(k) = x0 + h*real(k - 1, dp)
       end do
       call analyse_core(n, nl, np, ng, nd, max(ns, 1), nld, nt, n, x, idrv, rdrv, ipts, rpts, igd, rgd, idy, &
-                        rdy, rl, grav, ild, rld, rtq, ift, tab, rft, wk, alink, lk, pk, sk, qa, st, fk, fd, sh, &
-                        pose, att)
+                        rdy, rl, grav, ild, rld, rtq, ift, tab, rft, wk, asel, rsel, lk, pk, sk, qa, st, fk, fd, &
+                        sh, pose, att, i == 1)
       row = 0.0_dp
-      do k = 1, n
-        okrow(k) = all(st(k, :) == st_ok)
+      ! per row: some group not ok, not placed (neither ok nor a toggle), at a toggle
+      flags = 0
+      do d = 1, nd
+        do k = 1, n
+          flags(k, 1) = ior(flags(k, 1), merge(1, 0, st(k, d) /= st_ok))
+          flags(k, 2) = ior(flags(k, 2), merge(1, 0, st(k, d) /= st_ok .and. st(k, d) /= st_toggle))
+          flags(k, 3) = ior(flags(k, 3), merge(1, 0, st(k, d) == st_toggle))
+        end do
       end do
-      nok = count(okrow)
+      okrow = flags(:, 1) == 0
+      nok = n - sum(flags(:, 1))
       row(1) = real(nok, dp)/real(n, dp)
-      row(2) = real(count(any(st /= st_ok .and. st /= st_toggle, dim=2)), dp)
-      row(3) = real(count(any(st == st_toggle, dim=2)), dp)
+      row(2) = real(sum(flags(:, 2)), dp)
+      row(3) = real(sum(flags(:, 3)), dp)
       whole = nok == n
-      ! the output element: position y and its derivative over the input dy
+      if (do_out) call output_pass()
+      if (do_q) call quality_pass()
+      if (do_pk) call peaks_pass()
+      if (do_f .and. nok > 0) call forces_pass()
+      res(:, i) = row
+    end do
+
+  contains
+
+    !> The output element: position y and its derivatives over the input; its extremes, stroke
+    !> and time ratio (the whole cycle assembled).
+    subroutine output_pass()
       if (iout(1) == 1) then
         call unwrap(n, lk(:, 1, iout(2)), y)
         dy = lk(:, 2, iout(2))
@@ -1576,7 +1623,11 @@ contains
         ddy = 0.0_dp
       end if
       if (whole) call output_extremes()
-      ! transmission and pressure angles
+    end subroutine output_pass
+
+    !> The transmission and pressure angles: each group's range, the RRR groups' extremes with
+    !> their inputs, the sliding groups' largest.
+    subroutine quality_pass()
       row(10) = 0.0_dp
       row(11) = 0.0_dp
       c = 0
@@ -1590,7 +1641,10 @@ contains
           row(12) = max(row(12), row(nsum_head + nsum_link*(nl - 1) + nsum_slide*ns + nsum_dyad*(d - 1) + 2))
         end if
       end do
-      ! link and slide peaks
+    end subroutine quality_pass
+
+    !> Each link's peak omega and alpha, each slide's range and peak rate and acceleration.
+    subroutine peaks_pass()
       do l = 2, nl
         j = nsum_head + nsum_link*(l - 2)
         row(j + 1) = peak(n, lk(:, 2, l), okrow, periodic == 1)
@@ -1605,33 +1659,32 @@ contains
         row(j + 3) = peak(n, sk(:, 2, l), okrow, periodic == 1)
         row(j + 4) = peak(n, sk(:, 3, l), okrow, periodic == 1)
       end do
-      ! forces
-      if (iand(want, want_forces) /= 0 .and. nok > 0) then
-        call peak_at(n, fd(:, 4), okrow, periodic == 1, h, x0, row(13), row(14))
-        row(17) = maxval(hypot(sh(:, 1), sh(:, 2)))
-        row(18) = maxval(abs(sh(:, 3)))
-        if (whole) then
-          if (periodic == 1) then
-            row(15) = sum(fd(:, 4))/real(n, dp)
-            row(16) = sqrt(sum(fd(:, 4)**2)/real(n, dp))
-            call energy_of(n, x, fd(:, 4), .true., cs, rdrv(2), en)
-            row(19) = en(2)
-            row(20) = en(3)
-          else
-            row(15) = (0.5_dp*(fd(1, 4) + fd(n, 4)) + sum(fd(2:n - 1, 4)))/real(n - 1, dp)
-            row(16) = sqrt((0.5_dp*(fd(1, 4)**2 + fd(n, 4)**2) + sum(fd(2:n - 1, 4)**2))/real(n - 1, dp))
-          end if
+    end subroutine peaks_pass
+
+    !> The driving torque's peak, mean and RMS, the shaking force's and moment's peaks, the
+    !> energy fluctuation and the flywheel.
+    subroutine forces_pass()
+      call peak_at(n, fd(:, 4), okrow, periodic == 1, h, x0, row(13), row(14))
+      row(17) = maxval(hypot(sh(:, 1), sh(:, 2)))
+      row(18) = maxval(abs(sh(:, 3)))
+      if (whole) then
+        if (periodic == 1) then
+          row(15) = sum(fd(:, 4))/real(n, dp)
+          row(16) = sqrt(sum(fd(:, 4)**2)/real(n, dp))
+          call energy_of(n, x, fd(:, 4), .true., cs, rdrv(2), en)
+          row(19) = en(2)
+          row(20) = en(3)
+        else
+          row(15) = (0.5_dp*(fd(1, 4) + fd(n, 4)) + sum(fd(2:n - 1, 4)))/real(n - 1, dp)
+          row(16) = sqrt((0.5_dp*(fd(1, 4)**2 + fd(n, 4)**2) + sum(fd(2:n - 1, 4)**2))/real(n - 1, dp))
         end if
       end if
-      res(i, :) = row
-    end do
-
-  contains
+    end subroutine forces_pass
 
     subroutine take(a, cnt)
       integer, intent(in) :: cnt
       real(dp), intent(out) :: a(*)
-      if (cnt > 0) a(1:cnt) = prm(i, o + 1:o + cnt)
+      if (cnt > 0) a(1:cnt) = prm(o + 1:o + cnt, i)
       o = o + cnt
     end subroutine take
 
@@ -1774,10 +1827,15 @@ contains
     integer, intent(in) :: n
     real(dp), intent(in) :: a(n)
     real(dp), intent(out) :: y(n)
+    real(dp) :: turns(n)
     integer :: k
+    ! the whole turns to take off each step, then the running sum (in the same order of operations)
+    do k = 2, n
+      turns(k) = 2*pi*anint((a(k) - a(k - 1))/(2*pi))
+    end do
     y(1) = a(1)
     do k = 2, n
-      y(k) = y(k - 1) + (a(k) - a(k - 1)) - 2*pi*anint((a(k) - a(k - 1))/(2*pi))
+      y(k) = y(k - 1) + (a(k) - a(k - 1)) - turns(k)
     end do
   end subroutine unwrap
 

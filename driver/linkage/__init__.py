@@ -33,6 +33,8 @@ from driver.linkage._batch import (
     BATCH_IGNORED,
     BATCH_INDEPENDENT,
     BATCH_KEYS,
+    BATCH_PASSES,
+    PASS_NAMES,
     refusal,
     summarise,
     summarise_batch,
@@ -46,10 +48,11 @@ else:
     from driver.linkage._report import run
 
 __all__ = ["SPEC", "STUDY", "run", "estimate", "summarise", "summarise_batch", "compile_deck", "solve",
-           "table_flywheel", "animation_frames", "BATCH_KEYS", "LABELS", "kernel"]
+           "table_flywheel", "animation_frames", "BATCH_KEYS", "BATCH_PASSES", "LABELS", "kernel"]
 
 STUDY = Study(name="linkage", package=__name__, spec=SPEC, run=run, estimate=estimate, summarise=summarise,
               batch=BatchSummary(summarise_batch, keys=BATCH_KEYS, ignored=BATCH_IGNORED,
-                                 independent=BATCH_INDEPENDENT, elements=BATCH_ELEMENTS, refusal=refusal),
+                                 independent=BATCH_INDEPENDENT, elements=BATCH_ELEMENTS, refusal=refusal,
+                                 passes=BATCH_PASSES, pass_names=tuple(PASS_NAMES)),
               labels=LABELS, sweep_plot=SWEEP_PLOT, sweep_best=SWEEP_BEST, summary_settings=SUMMARY_SETTINGS,
               published=published.compare, animation=animation_frames, figures=f"{__name__}._figures", kernel=kernel)

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Collection, Mapping
+from collections.abc import Callable, Collection, Mapping
 from typing import Any
 
 import numpy as np
@@ -22,7 +22,8 @@ from driver.linkage._kernel import NSUM_DYAD, NSUM_LINK, NSUM_SLIDE, SummaryCol
 from driver.linkage._kernel_program import Mechanism
 from driver.linkage._spec_model import compile_deck
 
-__all__ = ["BATCH_KEYS", "BATCH_IGNORED", "BATCH_INDEPENDENT", "BATCH_ELEMENTS", "summarise_batch", "summarise",
+__all__ = ["BATCH_KEYS", "BATCH_IGNORED", "BATCH_INDEPENDENT", "BATCH_ELEMENTS", "BATCH_PASSES", "ELEMENT_PASSES",
+           "PASS_NAMES", "passes_for", "summarise_batch", "summarise",
            "summary_of", "summary_frame", "scan_of", "refusal"]
 
 #: deck keys a batch may vary (numbers of the mechanism, its loads and the scan)
@@ -34,8 +35,11 @@ BATCH_ELEMENTS = ("pivot_xy", "guide_xy", "guide_deg", "dyad_dims", "dyad_modes"
                   "inertia", "gravity", "load_xy", "torques", "guide_force", "turning_moment")
 #: keys accepted in a batch that leave the summary unchanged
 BATCH_IGNORED = ("title", "step")
-#: keys whose deck checks involve no other key
-BATCH_INDEPENDENT = ("omega", "alpha", "speed_fluctuation", "title", "step")
+#: keys whose deck checks involve no other key that a batch may vary (a sweep validates each of
+#: their values once): every number of the mechanism is checked on its own (its sign, its pairs;
+#: the topology, which fixes the list lengths and which sign a group's numbers need, is the base
+#: deck's); only start and stop are checked together (the range, the position count)
+BATCH_INDEPENDENT = tuple(k for k in BATCH_KEYS if k not in ("start", "stop")) + ("title", "step")
 _ELEMENT = re.compile(r"([a-z_]+)\((\d+)\)")
 
 
@@ -134,13 +138,16 @@ def _numbers(base: Params, mech: Mechanism, columns: Mapping[str, Any], n: int) 
                     if msg:
                         i = int(np.argmax(inverse == u))
                         raise base.error(key, f"design {i}: {msg}")
-                rows += (nlo - b)[None, :] + slope[None, :] * (uniq[inverse] - lo)[:, None]
+                # only the kernel numbers the key moves (one or two of the design's)
+                moved = np.flatnonzero((nlo != b) | (slope != 0.0))
+                rows[:, moved] += (nlo - b)[moved] + slope[moved] * (uniq[inverse] - lo)[:, None]
                 continue
         delta = np.empty((len(uniq), len(b)))
         for u, v in enumerate(uniq):
             delta[u] = _design(base, key, index, v.item() if hasattr(v, "item") else v, b, u, inverse) - b
-        rows += delta[inverse]
-    return np.asfortranarray(rows)
+        moved = np.flatnonzero(np.any(delta != 0.0, axis=0))
+        rows[:, moved] += delta[:, moved][inverse]
+    return rows   # C order: each design's numbers contiguous, as the kernel reads them
 
 
 @contract_doc
@@ -156,7 +163,8 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
         {key or 'key(i)': n values} for keys in ``BATCH_KEYS`` (elements of ``BATCH_ELEMENTS``),
         in the deck's units; ``'linkage.key'`` is accepted for ``'key'``; scalars broadcast.
     wanted : collection of str, optional
-        Only these summary columns (all are computed; the kernel's row is one pass).
+        Only these summary columns; the kernel runs only the passes they need (:data:`BATCH_PASSES`,
+        the per-element columns by their prefix), each giving the same values as in a full summary.
 
     Returns
     -------
@@ -183,72 +191,112 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
         raise base.error(None, f"batch columns have different lengths {sorted(sizes)}")
     n = sizes.pop() if sizes else 1
     mech = compile_deck(base)
-    rows = kernel.summaries(mech, _numbers(base, mech, columns, n), base["scan_points"], mech.driver == "crank")
-    frame = summary_frame(base, mech, rows)
-    if wanted is not None:
-        frame = frame[[c for c in frame.columns if c in set(wanted)]]
-    return frame
+    rows = kernel.summaries(mech, _numbers(base, mech, columns, n), base["scan_points"], mech.driver == "crank",
+                            passes=passes_for(wanted))
+    return summary_frame(base, mech, rows, wanted)
 
 
-def summary_frame(p: Mapping[str, Any], mech: Mechanism, res: np.ndarray) -> pd.DataFrame:
-    """Kernel rows -> the summary columns (the one place both paths go through)."""
+#: the summary's columns -> the kernel passes they need (fortran/linkage.f90 summaries; the
+#: study's part of "compute only what the deck asks for").  Columns with no pass are always
+#: computed (the assembly counts); the per-element columns (one per link, slide or group, named
+#: after it) take their pass from their prefix (:data:`ELEMENT_PASSES`).
+BATCH_PASSES: dict[str, tuple[str, ...]] = {
+    "assembled_fraction": (), "assemblable": (), "toggle_in_range": (),
+    **{c: ("output",) for c in ("output_min", "output_min_at", "output_max", "output_max_at", "stroke", "time_ratio")},
+    **{c: ("quality",) for c in ("mu_min_deg", "mu_min_at", "mu_max_deg", "mu_max_at", "pressure_max_deg")},
+    **{c: ("forces",) for c in ("torque_peak", "torque_peak_at", "torque_mean", "torque_rms", "shaking_force_peak_N",
+                                 "shaking_moment_peak_Nm", "energy_fluctuation_J", "flywheel_inertia_kgm2")},
+}
+#: prefixes of the per-element columns -> their pass
+ELEMENT_PASSES = {"omega_peak_": "peaks", "alpha_peak_": "peaks", "slide_min_": "peaks", "slide_max_": "peaks",
+                  "slide_rate_peak_": "peaks", "slide_accel_peak_": "peaks", "mu_min_deg_": "quality",
+                  "mu_max_deg_": "quality", "pressure_min_deg_": "quality", "pressure_max_deg_": "quality"}
+#: the kernel's passes by name (the pass names of the study's batch summary)
+PASS_NAMES = {"output": kernel.Pass.OUTPUT, "quality": kernel.Pass.QUALITY, "peaks": kernel.Pass.PEAKS,
+              "forces": kernel.Pass.FORCES}
+
+
+def passes_for(wanted: Collection[str] | None) -> kernel.Pass:
+    """The kernel passes summary columns ``wanted`` need (None: every pass)."""
+    if wanted is None:
+        return kernel.Pass.ALL
+    bits = kernel.Pass(0)
+    for c in wanted:
+        names = BATCH_PASSES.get(c)
+        if names is None:
+            names = tuple(ps for pre, ps in ELEMENT_PASSES.items() if c.startswith(pre))[:1]
+        for name in names:
+            bits |= PASS_NAMES[name]
+    return bits
+
+
+def summary_frame(p: Mapping[str, Any], mech: Mechanism, res: np.ndarray,
+                  wanted: Collection[str] | None = None) -> pd.DataFrame:
+    """Kernel rows -> the summary columns (the one place both paths go through); only the
+    columns ``wanted`` (None: all), in the summary's order."""
     c = SummaryCol
     crank = mech.driver == "crank"
     xin = np.degrees if crank else (lambda v: v)
     whole = res[:, c.ASSEMBLED_FRACTION] >= 1.0
+    some = res[:, c.ASSEMBLED_FRACTION] > 0
     has = lambda v, m: np.where(m, v, np.nan)
     out_is_link = mech.output[0] == 1
     ou = np.degrees if out_is_link else (lambda v: v)
-    full_turn = out_is_link & whole & (res[:, c.STROKE] == 0.0) & (res[:, c.OUTPUT_MAX] == 0.0)
-    rrr = any(d.kind == "rrr" for d in mech.dyads)
-    sliding = any(d.kind != "rrr" for d in mech.dyads)
-    cols: dict[str, Any] = {
-        "assembled_fraction": res[:, c.ASSEMBLED_FRACTION],
-        "assemblable": whole,
-        "toggle_in_range": res[:, c.TOGGLES] > 0,
-        "output_min": has(ou(res[:, c.OUTPUT_MIN]), whole & ~full_turn),
-        "output_min_at": has(xin(res[:, c.OUTPUT_MIN_AT]), whole & ~full_turn),
-        "output_max": has(ou(res[:, c.OUTPUT_MAX]), whole & ~full_turn),
-        "output_max_at": has(xin(res[:, c.OUTPUT_MAX_AT]), whole & ~full_turn),
-        "stroke": has(ou(res[:, c.STROKE]), whole & ~full_turn),
-        "time_ratio": has(res[:, c.TIME_RATIO], whole & (res[:, c.TIME_RATIO] > 0)),
-        "mu_min_deg": has(np.degrees(res[:, c.MU_MIN]), np.full(len(res), rrr) & (res[:, c.ASSEMBLED_FRACTION] > 0)),
-        "mu_min_at": has(xin(res[:, c.MU_MIN_AT]), np.full(len(res), rrr) & (res[:, c.ASSEMBLED_FRACTION] > 0)),
-        "mu_max_deg": has(np.degrees(res[:, c.MU_MAX]), np.full(len(res), rrr) & (res[:, c.ASSEMBLED_FRACTION] > 0)),
-        "mu_max_at": has(xin(res[:, c.MU_MAX_AT]), np.full(len(res), rrr) & (res[:, c.ASSEMBLED_FRACTION] > 0)),
-        "pressure_max_deg": has(np.degrees(res[:, c.PRESSURE_MAX]),
-                                np.full(len(res), sliding) & (res[:, c.ASSEMBLED_FRACTION] > 0)),
+    rrr = any(d.kind == "rrr" for d in mech.dyads) & some
+    sliding = any(d.kind != "rrr" for d in mech.dyads) & some
+
+    def output(col: int, unit: Callable[[np.ndarray], np.ndarray]) -> Callable[[], np.ndarray]:
+        # an output link that turns fully has no extremes (the kernel leaves them 0)
+        full_turn = out_is_link & whole & (res[:, c.STROKE] == 0.0) & (res[:, c.OUTPUT_MAX] == 0.0)
+        return lambda: has(unit(res[:, col]), whole & ~full_turn)
+
+    # each column made only when asked for (a design search asks for a few of many)
+    cols: dict[str, Callable[[], Any]] = {
+        "assembled_fraction": lambda: res[:, c.ASSEMBLED_FRACTION],
+        "assemblable": lambda: whole,
+        "toggle_in_range": lambda: res[:, c.TOGGLES] > 0,
+        "output_min": output(c.OUTPUT_MIN, ou), "output_min_at": output(c.OUTPUT_MIN_AT, xin),
+        "output_max": output(c.OUTPUT_MAX, ou), "output_max_at": output(c.OUTPUT_MAX_AT, xin),
+        "stroke": output(c.STROKE, ou),
+        "time_ratio": lambda: has(res[:, c.TIME_RATIO], whole & (res[:, c.TIME_RATIO] > 0)),
+        "mu_min_deg": lambda: has(np.degrees(res[:, c.MU_MIN]), rrr),
+        "mu_min_at": lambda: has(xin(res[:, c.MU_MIN_AT]), rrr),
+        "mu_max_deg": lambda: has(np.degrees(res[:, c.MU_MAX]), rrr),
+        "mu_max_at": lambda: has(xin(res[:, c.MU_MAX_AT]), rrr),
+        "pressure_max_deg": lambda: has(np.degrees(res[:, c.PRESSURE_MAX]), sliding),
     }
-    if mech.forces:
-        f = res[:, c.ASSEMBLED_FRACTION] > 0
-        cols |= {"torque_peak": has(res[:, c.TORQUE_PEAK], f), "torque_peak_at": has(xin(res[:, c.TORQUE_PEAK_AT]), f),
-                 "torque_mean": has(res[:, c.TORQUE_MEAN], whole), "torque_rms": has(res[:, c.TORQUE_RMS], whole),
-                 "shaking_force_peak_N": has(res[:, c.SHAKING_FORCE_PEAK], f),
-                 "shaking_moment_peak_Nm": has(res[:, c.SHAKING_MOMENT_PEAK], f)}
-        if crank:
-            cols |= {"energy_fluctuation_J": has(res[:, c.ENERGY_FLUCTUATION], whole),
-                     "flywheel_inertia_kgm2": has(res[:, c.FLYWHEEL_INERTIA],
-                                                  whole & (res[:, c.FLYWHEEL_INERTIA] > 0))}
+    # the force columns are always there (a stable schema for sweeps): NaN without bodies, the
+    # energy and flywheel NaN for an input slider too
+    forced, cranked = some & mech.forces, whole & (mech.forces and crank)
+    cols |= {"torque_peak": lambda: has(res[:, c.TORQUE_PEAK], forced),
+             "torque_peak_at": lambda: has(xin(res[:, c.TORQUE_PEAK_AT]), forced),
+             "torque_mean": lambda: has(res[:, c.TORQUE_MEAN], whole & mech.forces),
+             "torque_rms": lambda: has(res[:, c.TORQUE_RMS], whole & mech.forces),
+             "shaking_force_peak_N": lambda: has(res[:, c.SHAKING_FORCE_PEAK], forced),
+             "shaking_moment_peak_Nm": lambda: has(res[:, c.SHAKING_MOMENT_PEAK], forced),
+             "energy_fluctuation_J": lambda: has(res[:, c.ENERGY_FLUCTUATION], cranked),
+             "flywheel_inertia_kgm2": lambda: has(res[:, c.FLYWHEEL_INERTIA], cranked & (res[:, c.FLYWHEEL_INERTIA] > 0))}
+    column = lambda j, m, unit=(lambda v: v): (lambda: has(unit(res[:, j]), m))
     base = len(SummaryCol)
-    f = res[:, c.ASSEMBLED_FRACTION] > 0
     for i, name in enumerate(mech.links[1:]):
         j = base + NSUM_LINK * i
-        cols[f"omega_peak_{name}_rad_s"] = has(res[:, j], f)
-        cols[f"alpha_peak_{name}_rad_s2"] = has(res[:, j + 1], f)
+        cols[f"omega_peak_{name}_rad_s"] = column(j, some)
+        cols[f"alpha_peak_{name}_rad_s2"] = column(j + 1, some)
     base += NSUM_LINK * (len(mech.links) - 1)
     for i, (name, _, _) in enumerate(mech.slides):
         j = base + NSUM_SLIDE * i
-        cols[f"slide_min_{name}"] = has(res[:, j], whole)
-        cols[f"slide_max_{name}"] = has(res[:, j + 1], whole)
-        cols[f"slide_rate_peak_{name}"] = has(res[:, j + 2], f)
-        cols[f"slide_accel_peak_{name}"] = has(res[:, j + 3], f)
+        cols[f"slide_min_{name}"] = column(j, whole)
+        cols[f"slide_max_{name}"] = column(j + 1, whole)
+        cols[f"slide_rate_peak_{name}"] = column(j + 2, some)
+        cols[f"slide_accel_peak_{name}"] = column(j + 3, some)
     base += NSUM_SLIDE * mech.nslides
     for i, d in enumerate(mech.dyads):
         j = base + NSUM_DYAD * i
         word = "mu" if d.kind == "rrr" else "pressure"
-        cols[f"{word}_min_deg_{d.joints[2]}"] = has(np.degrees(res[:, j]), f)
-        cols[f"{word}_max_deg_{d.joints[2]}"] = has(np.degrees(res[:, j + 1]), f)
-    return pd.DataFrame(cols, index=pd.RangeIndex(len(res)))
+        cols[f"{word}_min_deg_{d.joints[2]}"] = column(j, some, np.degrees)
+        cols[f"{word}_max_deg_{d.joints[2]}"] = column(j + 1, some, np.degrees)
+    names = list(cols) if wanted is None else [k for k in cols if k in set(wanted)]
+    return pd.DataFrame({k: cols[k]() for k in names}, index=pd.RangeIndex(len(res)))
 
 
 def refusal(row: Mapping[str, Any]) -> str | None:

@@ -23,7 +23,7 @@ else:
     from driver._fortran import _kernels
 
 __all__ = ["reusable_call", "LinkageStatus", "LinkCol", "PointCol", "SlideCol", "JointCol", "DriverCol", "ShakeCol", "EnergyCol",
-           "SummaryCol", "Want", "Analysis", "analyse", "table_energy", "summaries", "summary_width",
+           "SummaryCol", "Want", "Pass", "buffers", "Analysis", "analyse", "table_energy", "summaries", "summary_width",
            "NSUM_LINK", "NSUM_SLIDE", "NSUM_DYAD"]
 
 _K = _kernels.linkage
@@ -380,7 +380,20 @@ def summary_width(mech: Mechanism) -> int:
     return NSUM_HEAD + NSUM_LINK * (len(mech.links) - 1) + NSUM_SLIDE * mech.nslides + NSUM_DYAD * len(mech.dyads)
 
 
-def summaries(mech: Mechanism, numbers: np.ndarray, nscan: int, periodic: bool, forces: bool | None = None) -> np.ndarray:
+class Pass(IntFlag):
+    """The passes of :func:`summaries` (fortran/linkage.f90 ``pass_*``): the output's extremes
+    (stroke, time ratio), the transmission and pressure angles, the links' and slides' peaks,
+    the forces.  A pass not run leaves its columns 0; the others are the same whichever run."""
+
+    OUTPUT = int(_K.pass_output)
+    QUALITY = int(_K.pass_quality)
+    PEAKS = int(_K.pass_peaks)
+    FORCES = int(_K.pass_forces)
+    ALL = int(_K.pass_output) | int(_K.pass_quality) | int(_K.pass_peaks) | int(_K.pass_forces)
+
+
+def summaries(mech: Mechanism, numbers: np.ndarray, nscan: int, periodic: bool, forces: bool | None = None,
+              passes: Pass = Pass.ALL) -> np.ndarray:
     """Summarise many designs of one mechanism in one kernel call.
 
     Parameters
@@ -389,13 +402,16 @@ def summaries(mech: Mechanism, numbers: np.ndarray, nscan: int, periodic: bool, 
         The mechanism (its integer program is shared by every design).
     numbers : numpy.ndarray
         (designs, numbers + 3): each design's :meth:`Mechanism.numbers`, then the scan's first
-        input, span [rad or length] and the coefficient of speed fluctuation.
+        input, span [rad or length] and the coefficient of speed fluctuation (C order: a
+        design's numbers contiguous, as the kernel reads them).
     nscan : int
         Scan points of the cycle.
     periodic : bool
         A crank's cycle (no end point) or a slider's range (both ends).
     forces : bool, optional
         Include the kinetostatic figures (default: when the mechanism has bodies).
+    passes : Pass, default Pass.ALL
+        The passes to run (:class:`Pass`).
 
     Returns
     -------
@@ -404,6 +420,8 @@ def summaries(mech: Mechanism, numbers: np.ndarray, nscan: int, periodic: bool, 
     """
     i = mech.integers()
     want = int(Want.CONTINUITY) | (int(Want.FORCES) if (mech.forces if forces is None else forces) else 0)
-    return _K.summaries(farray(numbers, 2), len(mech.links), mech.nslides, mech.reals()["tab"].shape[0], i["idrv"],
-                        i["ipts"], i["igd"], i["idy"], i["ild"], i["ift"], int(nscan), int(bool(periodic)),
-                        np.array(mech.output, dtype=np.int32), want, summary_width(mech))
+    prm = farray(np.ascontiguousarray(numbers, dtype=np.float64).T, 2)   # (numbers, designs), no copy
+    res = _K.summaries(prm, len(mech.links), mech.nslides, mech.reals()["tab"].shape[0], i["idrv"],
+                       i["ipts"], i["igd"], i["idy"], i["ild"], i["ift"], int(nscan), int(bool(periodic)),
+                       np.array(mech.output, dtype=np.int32), want, int(passes), summary_width(mech))
+    return res.T

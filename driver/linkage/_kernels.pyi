@@ -57,6 +57,10 @@ class _linkage:
     nsum_head: NDArray[np.int32]
     nsum_link: NDArray[np.int32]
     nsum_slide: NDArray[np.int32]
+    pass_forces: NDArray[np.int32]
+    pass_output: NDArray[np.int32]
+    pass_peaks: NDArray[np.int32]
+    pass_quality: NDArray[np.int32]
     st_indeterminate: NDArray[np.int32]
     st_no_assembly: NDArray[np.int32]
     st_ok: NDArray[np.int32]
@@ -78,6 +82,7 @@ class _linkage:
         periodic: int,
         iout: NDArray[np.int32],
         want: int,
+        passes: int,
         ncol: int,
         nds: int = ...,
         nr: int = ...,
@@ -86,7 +91,7 @@ class _linkage:
         nd: int = ...,
         nld: int = ...,
     ) -> NDArray[np.float64]:
-        """``res = summaries(prm,nl,ns,nt,idrv,ipts,igd,idy,ild,ift,nscan,periodic,iout,want,ncol,[nds,nr,np,ng,nd,nld])``; shapes res(nds,ncol)"""
+        """``res = summaries(prm,nl,ns,nt,idrv,ipts,igd,idy,ild,ift,nscan,periodic,iout,want,passes,ncol,[nds,nr,np,ng,nd,nld])``; shapes res(ncol,nds)"""
         ...
     @staticmethod
     def table_energy(
