@@ -81,6 +81,8 @@ module linkage
 
   integer, parameter, public :: st_ok = 0, st_no_assembly = 1, st_toggle = 2, st_indeterminate = 3, &
                                 st_unplaced = 4
+  !> status of a call of analyse: done, or refused (its arrays do not agree: a wrapper's mistake)
+  integer, parameter, public :: call_ok = 0, call_bad_args = 1
   integer, parameter, public :: dy_rrr = 1, dy_rrp = 2, dy_rpr = 3, dy_prp = 4
   integer, parameter, public :: drv_crank = 1, drv_slider = 2
   !> want bits of analyse: what it computes besides the kinematics, and which outputs it writes
@@ -119,25 +121,52 @@ contains
   ! ======================================================================== analysis
 
   !> Positions, velocities, accelerations (and forces with want bit 2) at the inputs x(1:n)
-  !> (crank angle [rad] or slide [length], in order).  See the module header.
-  subroutine analyse(n, nl, np, ng, nd, ns, nld, nt, nf, x, idrv, rdrv, ipts, rpts, igd, rgd, idy, rdy, &
-                     rl, grav, ild, rld, rtq, ift, tab, rft, want, lk, pk, sk, qa, st, fk, fd, sh)
+  !> (crank angle [rad] or slide [length], in order).  See the module header.  The mechanism's
+  !> program comes packed (two arrays, so a call passes few arguments):
+  !>   iprog: ng, nld, nt, then idrv(4), ipts(np), igd(ng), idy(nd, 6), ild(nld), ift(4)
+  !>   rprog: rpts(np, 2), rgd(ng, 3), rdrv(3), rdy(nd, 3), rl(nl, 4), grav(2), rld(nld, 2),
+  !>          rtq(nl), rft(3), tab(nt, 2) (column-major; the numbers of summaries' designs)
+  !> info: 0, or call_bad_args when the arrays do not agree (sizes, force rows): nothing written.
+  subroutine analyse(n, nl, np, nd, ns, nf, ni, nr, x, iprog, rprog, want, lk, pk, sk, qa, st, fk, fd, sh, info)
     !f2py threadsafe
-    integer, intent(in) :: n, nl, np, ng, nd, ns, nld, nt, nf   ! nf: rows of the force outputs (n, or 1 unused)
-    real(dp), intent(in) :: x(n), rdrv(3), rpts(np, 2), rgd(ng, 3), rdy(nd, 3), rl(nl, 4), grav(2)
-    integer, intent(in) :: idrv(4), ipts(np), igd(ng), idy(nd, 6), ild(nld), ift(4), want
-    real(dp), intent(in) :: rld(nld, 2), rtq(nl), tab(nt, 2), rft(3)
+    integer, intent(in) :: n, nl, np, nd, ns, nf, ni, nr, want   ! nf: rows of the force outputs (n, or 1 unused)
+    real(dp), intent(in) :: x(n), rprog(nr)
+    integer, intent(in) :: iprog(ni)
     ! outputs: overwritten (intent inout so that callers can reuse their buffers)
     real(dp), intent(inout) :: lk(n, 3, nl), pk(n, 6, np), sk(n, 3, ns), qa(n, nd), fk(nf, 9, nd), fd(nf, 4), &
                                sh(nf, 3)
     !f2py intent(in,out) :: lk, pk, sk, qa, fk, fd, sh
     integer, intent(inout) :: st(n, nd)
     !f2py intent(in,out) :: st
+    integer, intent(out) :: info
     real(dp), allocatable :: pose(:, :, :), att(:, :, :, :)
+    integer :: ng, nld, nt, i0(6), r0(10)
+    info = call_bad_args
+    if (ni < 3) return
+    ng = iprog(1)
+    nld = iprog(2)
+    nt = iprog(3)
+    if (ng < 1 .or. nld < 1 .or. nt < 1 .or. ni /= 3 + 4 + np + ng + 6*nd + nld + 4 .or. &
+        nr /= 2*np + 3*ng + 3 + 3*nd + 4*nl + 2 + 2*nld + nl + 3 + 2*nt) return
+    if (iand(want, want_forces) /= 0 .and. nf < n) return
+    ! where each array starts in the packed program: passed in place (sequence association, no copy)
+    i0 = [4, 8, 8 + np, 8 + np + ng, 8 + np + ng + 6*nd, 8 + np + ng + 6*nd + nld]
+    r0(1) = 1
+    r0(2) = r0(1) + 2*np      ! rgd
+    r0(3) = r0(2) + 3*ng      ! rdrv
+    r0(4) = r0(3) + 3         ! rdy
+    r0(5) = r0(4) + 3*nd      ! rl
+    r0(6) = r0(5) + 4*nl      ! grav
+    r0(7) = r0(6) + 2         ! rld
+    r0(8) = r0(7) + 2*nld     ! rtq
+    r0(9) = r0(8) + nl        ! rft
+    r0(10) = r0(9) + 3        ! tab
+    info = call_ok
     allocate (pose(nb, npose, nl), att(nb, natt, 2, nd))
-    call analyse_core(n, nl, np, ng, nd, ns, nld, nt, nf, x, idrv, rdrv, ipts, rpts, igd, rgd, idy, rdy, &
-                      rl, grav, ild, rld, rtq, ift, tab, rft, want, 0, 0, lk, pk, sk, qa, st, fk, fd, sh, pose, att, &
-                      .true.)
+    call analyse_core(n, nl, np, ng, nd, ns, nld, nt, nf, x, iprog(i0(1)), rprog(r0(3)), iprog(i0(2)), rprog(r0(1)), &
+                      iprog(i0(3)), rprog(r0(2)), iprog(i0(4)), rprog(r0(4)), rprog(r0(5)), rprog(r0(6)), &
+                      iprog(i0(5)), rprog(r0(7)), rprog(r0(8)), iprog(i0(6)), rprog(r0(10)), rprog(r0(9)), want, 0, 0, &
+                      lk, pk, sk, qa, st, fk, fd, sh, pose, att, .true.)
   end subroutine analyse
 
   !> analyse's work, with the block work arrays of the caller (summaries makes them once for
@@ -170,7 +199,6 @@ contains
       modes(:, d) = merge(1.0_dp, -1.0_dp, rdy(d, 3) >= 0.0_dp)
     end do
     cont = iand(want, want_continuity) /= 0 .and. n >= 4
-    if (iand(want, want_forces) /= 0 .and. nf < n) error stop "linkage analyse: force outputs need n rows"
     ! first pass: each block checks in cache whether any group might change assembly (the
     ! continuity test below without a flip so far); only then are the new joints stored and scanned
     store = .false.

@@ -10,11 +10,11 @@ from __future__ import annotations
 import weakref
 from collections.abc import Callable
 from enum import IntEnum, IntFlag
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
-from driver._fortran import KernelStatus, farray
+from driver._fortran import KernelStatus, farray, kernel_status
 from driver.linkage._kernel_program import Mechanism
 
 if TYPE_CHECKING:   # the study's modules of the extension, typed (generated: tools/gen_kernel_stub.py)
@@ -22,7 +22,8 @@ if TYPE_CHECKING:   # the study's modules of the extension, typed (generated: to
 else:
     from driver._fortran import _kernels
 
-__all__ = ["reusable_call", "LinkageStatus", "LinkCol", "PointCol", "SlideCol", "JointCol", "DriverCol", "ShakeCol", "EnergyCol",
+__all__ = ["reusable_call", "LinkageStatus", "CallStatus", "LinkCol", "PointCol", "SlideCol", "JointCol", "DriverCol",
+           "ShakeCol", "EnergyCol",
            "SummaryCol", "Want", "Pass", "buffers", "Analysis", "analyse", "table_energy", "summaries", "summary_width",
            "NSUM_LINK", "NSUM_SLIDE", "NSUM_DYAD"]
 
@@ -44,10 +45,19 @@ class LinkageStatus(KernelStatus):
     unplaced = int(_K.st_unplaced), "not placed", "a link the group attaches to is not placed"
 
 
+class CallStatus(KernelStatus):
+    """Status of a call of analyse (fortran/linkage.f90 ``call_*``)."""
+
+    ok = int(_K.call_ok), "ok"
+    bad_args = (int(_K.call_bad_args), "bad arguments",
+                "the packed program and the output arrays do not agree (a wrapper's mistake)", True)
+
+
 class Want(IntFlag):
-    """What analyse computes besides the kinematics, and which of its outputs it writes (bits;
-    fortran/linkage.f90 ``want_*``).  An output not asked for is not written (zero in the arrays
-    the wrapper makes); the status of each group is always written.
+    """What analyse computes and writes besides the kinematics (bits).
+
+    Bits of fortran/linkage.f90 ``want_*``.  An output not asked for is not written (zero in the
+    arrays the wrapper makes); the status of each group is always written.
 
     ``KINEMATICS`` every kinematic output; ``JOINTS`` the points' positions, velocities and
     accelerations (what pylinkage's kinematics step gives); ``POINTS`` their positions only.
@@ -264,7 +274,7 @@ def analyse(mech: Mechanism, x: np.ndarray, forces: bool | None = None, continui
     x = farray(x if type(x) is np.ndarray and x.ndim == 1 else np.atleast_1d(x), 1)
     do_forces = mech.forces if forces is None else forces
     want = (_CONTINUITY if continuity else 0) | (_FORCES if do_forces else 0) | (int(outputs) & _KINEMATICS)
-    i, r = mech.integers(), mech.reals()
+    iprog, rprog = mech.program()
     n = x.shape[0]
     bufs = buffers(mech, n, do_forces) if out is None else out
     if bufs[0].shape[0] != n or (do_forces and bufs[5].shape[0] != n):
@@ -272,10 +282,10 @@ def analyse(mech: Mechanism, x: np.ndarray, forces: bool | None = None, continui
                          f", called with {n}{' and forces' if do_forces else ''}")
     if out is not None:
         _fill_ground(mech, bufs[0], bufs[1])
-    lk, pk, sk, qa, st, fk, fd, sh = _K.analyse(x, i["idrv"], r["rdrv"], i["ipts"], r["rpts"], i["igd"], r["rgd"],
-                                                i["idy"], r["rdy"], r["rl"], r["grav"], i["ild"], r["rld"], r["rtq"],
-                                                i["ift"], r["tab"], r["rft"], want, bufs[0], bufs[1], bufs[2],
-                                                bufs[3], bufs[4], bufs[5], bufs[6], bufs[7])
+    lk, pk, sk, qa, st, fk, fd, sh, info = _K.analyse(x, iprog, rprog, want, bufs[0], bufs[1], bufs[2], bufs[3], bufs[4],
+                                                      bufs[5], bufs[6], bufs[7])
+    if info:
+        kernel_status(CallStatus, info, "linkage.analyse")
     if not do_forces:   # no force analysis: zero-size force arrays, not an unused row
         fk, fd, sh = fk[:0], fd[:0], sh[:0]
     return Analysis(lk, pk, sk if mech.slides else sk[:, :, :0], qa, st, fk, fd, sh)
@@ -293,7 +303,7 @@ def _fill_ground(mech: Mechanism, lk: np.ndarray, pk: np.ndarray) -> None:
     """Write the ground's columns of the output buffers (the kernel leaves them: constant), unless
     the buffer is the very array an earlier call filled with exactly these (the weak reference
     proves it is the same living object, whose ground columns nothing else writes)."""
-    ground = tuple((j, u, v) for j, (_, link, u, v) in enumerate(mech.points) if link == 1)
+    ground = mech.ground_points()
     for buf, contents in ((lk, ("links",)), (pk, ground)):
         held = _GROUND.get(id(buf))
         if held is not None and held[0]() is buf and held[1] == contents:
@@ -311,11 +321,13 @@ def _fill_ground(mech: Mechanism, lk: np.ndarray, pk: np.ndarray) -> None:
 
 
 def reusable_call(mech: Mechanism, x: np.ndarray, forces: bool | None = None, continuity: bool = True,
-                  outputs: Want = Want.KINEMATICS) -> Callable[[], Analysis]:
-    """Make a call of :func:`analyse` on fixed inputs and output arrays made once.
+                  outputs: Want = Want.KINEMATICS) -> Callable[[], tuple[np.ndarray, ...]]:
+    """Make a call of the kernel on fixed inputs, its arguments prepared once.
 
-    For benchmarks: the kernel through its wrapper, its outputs reused as the four-bar's
-    ``out=`` buffers are.
+    For benchmarks and callers that call again and again: the arguments :func:`analyse` would
+    pass (the packed program, the want bits, output arrays made once by :func:`buffers`) bound
+    once, as the four-bar's ``out=`` buffers are; each call is the Fortran call and its status
+    check, nothing else.
 
     Parameters
     ----------
@@ -333,11 +345,24 @@ def reusable_call(mech: Mechanism, x: np.ndarray, forces: bool | None = None, co
     Returns
     -------
     callable
-        ``call()`` runs the kernel and returns its :class:`Analysis`.
+        ``call()`` runs the kernel and returns its output arrays (those of :class:`Analysis`,
+        the force arrays with one unused row without forces).
     """
     x = farray(np.atleast_1d(x), 1)
-    bufs = buffers(mech, x.shape[0], forces)
-    return lambda: analyse(mech, x, forces, continuity, outputs, bufs)
+    do_forces = mech.forces if forces is None else forces
+    bufs = buffers(mech, x.shape[0], do_forces)
+    iprog, rprog = mech.program()
+    want = (_CONTINUITY if continuity else 0) | (_FORCES if do_forces else 0) | (int(outputs) & _KINEMATICS)
+    args: tuple[Any, ...] = (x, iprog, rprog, want, *bufs)
+    kernel: Callable[..., tuple[Any, ...]] = _K.analyse
+
+    def call() -> tuple[np.ndarray, ...]:
+        res = kernel(*args)
+        if res[8]:
+            kernel_status(CallStatus, int(res[8]), "linkage.analyse")
+        return tuple(res[:8])
+
+    return call
 
 
 def table_energy(theta: np.ndarray, torque: np.ndarray, cs: float, omega: float) -> np.ndarray:
@@ -381,9 +406,12 @@ def summary_width(mech: Mechanism) -> int:
 
 
 class Pass(IntFlag):
-    """The passes of :func:`summaries` (fortran/linkage.f90 ``pass_*``): the output's extremes
-    (stroke, time ratio), the transmission and pressure angles, the links' and slides' peaks,
-    the forces.  A pass not run leaves its columns 0; the others are the same whichever run."""
+    """The passes of :func:`summaries` (fortran/linkage.f90 ``pass_*``).
+
+    The output's extremes (stroke, time ratio), the transmission and pressure angles, the links'
+    and slides' peaks, the forces.  A pass not run leaves its columns 0; the others are the same
+    whichever run.
+    """
 
     OUTPUT = int(_K.pass_output)
     QUALITY = int(_K.pass_quality)

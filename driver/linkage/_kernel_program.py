@@ -158,6 +158,24 @@ class Mechanism:
         return {"rpts": rpts, "rgd": rgd, "rdrv": rdrv, "rdy": rdy, "rl": rl, "grav": grav, "rld": rld,
                 "rtq": rtq, "rft": rft, "tab": tab}
 
+    def program(self) -> tuple[np.ndarray, np.ndarray]:
+        """The program packed as fortran/linkage.f90 analyse reads it: (integers: ng, nld, nt and
+        the integer arrays in order; reals: :meth:`numbers`).  Made once: read it, do not change it."""
+        if "program" not in self._arrays:
+            i, r = self.integers(), self.reals()
+            head = np.array([len(i["igd"]), len(i["ild"]), r["tab"].shape[0]], dtype=np.int32)
+            iprog = np.concatenate([head] + [i[k].ravel(order="F") for k in ("idrv", "ipts", "igd", "idy", "ild",
+                                                                              "ift")]).astype(np.int32)
+            self._arrays["program"] = {"i": iprog, "r": self.numbers()}
+        return self._arrays["program"]["i"], self._arrays["program"]["r"]
+
+    def ground_points(self) -> tuple[tuple[int, float, float], ...]:
+        """(index from 0, x, y) of each point on the ground (made once)."""
+        if "ground" not in self._arrays:
+            self._arrays["ground"] = tuple((j, u, v) for j, (_, link, u, v) in enumerate(self.points)
+                                           if link == 1)   # type: ignore[assignment]
+        return self._arrays["ground"]   # type: ignore[return-value]
+
     def numbers(self) -> np.ndarray:
         """This design's numbers as the batch kernel reads them (fortran/linkage.f90 summaries),
         without the scan's three (x0, span, C_s)."""

@@ -9,22 +9,8 @@ class _linkage:
     @staticmethod
     def analyse(
         x: NDArray[np.float64],
-        idrv: NDArray[np.int32],
-        rdrv: NDArray[np.float64],
-        ipts: NDArray[np.int32],
-        rpts: NDArray[np.float64],
-        igd: NDArray[np.int32],
-        rgd: NDArray[np.float64],
-        idy: NDArray[np.int32],
-        rdy: NDArray[np.float64],
-        rl: NDArray[np.float64],
-        grav: NDArray[np.float64],
-        ild: NDArray[np.int32],
-        rld: NDArray[np.float64],
-        rtq: NDArray[np.float64],
-        ift: NDArray[np.int32],
-        tab: NDArray[np.float64],
-        rft: NDArray[np.float64],
+        iprog: NDArray[np.int32],
+        rprog: NDArray[np.float64],
         want: int,
         lk: NDArray[np.float64],
         pk: NDArray[np.float64],
@@ -37,15 +23,16 @@ class _linkage:
         n: int = ...,
         nl: int = ...,
         np: int = ...,
-        ng: int = ...,
         nd: int = ...,
         ns: int = ...,
-        nld: int = ...,
-        nt: int = ...,
         nf: int = ...,
-    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.int32], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-        """``lk,pk,sk,qa,st,fk,fd,sh = analyse(x,idrv,rdrv,ipts,rpts,igd,rgd,idy,rdy,rl,grav,ild,rld,rtq,ift,tab,rft,want,lk,pk,sk,qa,st,fk,fd,sh,[n,nl,np,ng,nd,ns,nld,nt,nf])``; shapes lk(n,3,nl), pk(n,6,np), sk(n,3,ns), qa(n,nd), st(n,nd), fk(nf,9,nd), fd(nf,4), sh(nf,3)"""
+        ni: int = ...,
+        nr: int = ...,
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.int32], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], int]:
+        """``lk,pk,sk,qa,st,fk,fd,sh,info = analyse(x,iprog,rprog,want,lk,pk,sk,qa,st,fk,fd,sh,[n,nl,np,nd,ns,nf,ni,nr])``; shapes lk(n,3,nl), pk(n,6,np), sk(n,3,ns), qa(n,nd), st(n,nd), fk(nf,9,nd), fd(nf,4), sh(nf,3)"""
         ...
+    call_bad_args: NDArray[np.int32]
+    call_ok: NDArray[np.int32]
     drv_crank: NDArray[np.int32]
     drv_slider: NDArray[np.int32]
     dy_prp: NDArray[np.int32]
