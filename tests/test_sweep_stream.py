@@ -79,15 +79,31 @@ STOP = "key{j} = 'fourbar.stop_deg', values{j} = 200, 360, 350"
 CRANK = "key{k} = 'fourbar.crank', start{k} = 1, stop{k} = 7, count{k} = 700"
 
 
-@pytest.mark.parametrize("order, streamed", [((1, 2, 3), False), ((2, 3, 1), None)])
-def test_bad_input_rows(tmp_path, monkeypatch, order, streamed):
-    """A bad interior combination (start_deg 300, stop_deg 200: the range is refused) gives
-    bad-input rows.  Only in some chunks (their summary columns are objects, the others' floats):
-    not streamed, the rows read into memory; spread over every chunk: streamed when the parts'
-    columns agree (a column that is blank in a whole part does not).  The same files either way."""
+def _bad_text(order: tuple[int, int, int]) -> str:
     i, j, k = order
     axes = "\n  ".join(sorted([START.format(i=i), STOP.format(j=j), CRANK.format(k=k)], key=lambda a: a[3]))
-    text = BAD_BASE.format(axes=axes)
+    return BAD_BASE.format(axes=axes)
+
+
+def test_bad_interior_combination_is_refused_before_anything_runs(tmp_path, monkeypatch, capsys):
+    """The 2 100-case grid's interior combination start_deg 300, stop_deg 200 is found by the
+    sweep's validation of its coupled axes: exit 2 naming the line and key, nothing written."""
+    status, out = _run(tmp_path, "b", _bad_text((1, 2, 3)), 10, monkeypatch)
+    err = capsys.readouterr().err
+    assert status == 2 and not out.exists()
+    assert "b.dat:3: key 'values1'" in err and "start_deg = 300, fourbar.stop_deg = 200 is bad input" in err
+
+
+@pytest.mark.parametrize("order, streamed", [((1, 2, 3), False), ((2, 3, 1), None)])
+def test_bad_input_rows(tmp_path, monkeypatch, order, streamed):
+    """Should a bad case pass the sweep's validation (here switched off), the batch path's own
+    check gives bad-input rows.  Only in some chunks (their summary columns are objects, the
+    others' floats): not streamed, the rows read into memory; spread over every chunk: streamed
+    when the parts' columns agree (a column that is blank in a whole part does not).  The same
+    files either way."""
+    from driver.sweep import _plan
+    monkeypatch.setattr(_plan, "validate_sweep", lambda *a, **k: {})
+    text = _bad_text(order)
     calls = []
     real = stream.write_streamed
     monkeypatch.setattr(stream, "write_streamed", lambda *a, **k: calls.append(real(*a, **k)) or calls[-1])
