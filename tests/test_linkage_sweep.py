@@ -79,3 +79,28 @@ def test_bad_element_refused_before_anything_runs(key, words, tmp_path, capsys):
     err = capsys.readouterr().err
     assert words in err and "bad.dat:" in err, err
     assert not out.exists() or not any(out.iterdir())
+
+
+def test_shipped_sweep_rows_are_their_own_decks():
+    """The committed summary of inputs/linkage_watt2_sweep.dat (outputs/, equal to a fresh run by
+    test_outputs_fresh): a corner, an inner and a refused design each equal the base deck with
+    driver_length and link5 replaced by hand, summarised as a single run (masses, gravity and the
+    output torque included, so the force columns are checked too); the keep rule holds row by row."""
+    import pandas as pd
+
+    from conftest import INPUTS, ROOT
+    text = (INPUTS / "linkage_watt2_sweep.dat").read_text()
+    body = text.split("&linkage", 1)[1].split("\n/", 1)[0]
+    table = pd.read_csv(ROOT / "outputs" / "linkage_watt2_sweep_summary.csv")
+    assert len(table) == 121 and (table["status"] == "ok").all()
+    assert list(table["kept"]) == [bool(f == 1.0 and m >= 35) for f, m in
+                                   zip(table["assembled_fraction"], table["mu_min_deg"])]
+    assert table["kept"].any() and not table["kept"].all()
+    refused = int(np.argmax(~table["kept"].to_numpy(bool)))
+    for i in (0, 60, refused, 120):
+        row = table.iloc[i]
+        length, link5 = float(row["linkage.driver_length"]), float(row["linkage.dyad_dims(3)"])
+        own = summarise(params_of(body.replace("driver_length = 0.10", f"driver_length = {length!r}")
+                                  .replace("0.35, 0.30,   0.214, 0.189", f"0.35, 0.30,   {link5!r}, 0.189")))
+        for c in ("stroke", "time_ratio", "mu_min_deg", "torque_peak", "shaking_force_peak_N", "flywheel_inertia_kgm2"):
+            assert row[c] == pytest.approx(own[c], rel=1e-12, abs=1e-12), (i, c)
