@@ -81,16 +81,45 @@ def _dist_to_line(p: np.ndarray, a: np.ndarray, u: np.ndarray) -> float:
     return float(u[0] * (p[1] - a[1]) - u[1] * (p[0] - a[0]))
 
 
+def _drawn_params(deck, summary: Path, browser):
+    """The parameters the page draws: the deck's; for a sweep, its marked case's (the case the
+    page names, its swept values -- elements of lists too -- read from the summary table the
+    sweep wrote and put into the deck's group by hand)."""
+    if "sweep" not in deck.groups:
+        return study_of(deck)[1]
+    import re
+
+    import pandas as pd
+
+    from driver._deck import validate
+    from driver.linkage import SPEC
+    case = int(re.search(r"Case (\d+),", browser.eval("document.body.textContent")).group(1))
+    row = pd.read_csv(summary).set_index("case").loc[case]
+    raw = deck.groups["linkage"]
+    values = dict(raw.values)
+    for col, value in row.items():
+        m = re.fullmatch(r"linkage\.(\w+)(?:\((\d+)\))?", str(col))
+        if m is None:
+            continue
+        if m.group(2) is None:
+            values[m.group(1)] = float(value)
+        else:
+            items = list(values[m.group(1)])
+            items[int(m.group(2)) - 1] = float(value)
+            values[m.group(1)] = items
+    return validate(type(raw)(raw.name, values, raw.lines, raw.line), SPEC, deck.path)
+
+
 @pytest.mark.parametrize("stem", DECKS)
 def test_page_animates_the_deck_mechanism(pages, browser, stem):
     path = INPUTS / f"{stem}.dat"
-    _, params = study_of(read_deck(path))
-    mech = compile_deck(params)
-    fr = animation_frames(params, None)          # the parts' names and which points each joins
-    parts = {link.name: [fr.names[i] for i in link.points] for link in fr.links}
     browser.events.clear()
     browser.open(pages / f"{stem}.html")
     assert browser.errors() == []
+    params = _drawn_params(read_deck(path), pages / f"{stem}_summary.csv", browser)
+    mech = compile_deck(params)
+    fr = animation_frames(params, None)          # the parts' names and which points each joins
+    parts = {link.name: [fr.names[i] for i in link.points] for link in fr.links}
     assert browser.eval("document.querySelectorAll('svg.mech').length") == 1
     n = int(browser.eval("document.querySelector('.anim input[type=range]').max")) + 1
     assert n == fr.n_frames
