@@ -23,14 +23,16 @@ from driver.slidercrank._spec import Model
 @styled
 def slidercrank_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray]], title: str,
                               ylabel: str = "axial strain [microstrain]", above: dict[str, float] | None = None,
-                              missing: Sequence[str] = (), ax=None) -> Figure:
+                              missing: Sequence[str] = (), ax=None,
+                              yield_strain: tuple[float, str] | None = None) -> Figure:
     """A quantity against crank angle [deg], one line per case (label, angle, value): Figure 10.
 
     ``above`` maps the labels of cases whose rod compression exceeds the Euler load to that
     ratio N/P_E: their curves are dashed and flagged in the legend (a linear model draws
     them although the rod would buckle).  ``missing`` are one-line texts of cases not drawn (e.g. a speed that
     buckled): they are listed in the legend, so no speed silently disappears.  ``ax``: an axes
-    to draw into (its figure is returned).
+    to draw into (its figure is returned).  ``yield_strain``: (sigma_y / E [microstrain], what the
+    yield strength is), marked on a strain figure.
     """
     from matplotlib.lines import Line2D
     above = above or {}
@@ -44,6 +46,7 @@ def slidercrank_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray
                 lw=1.2, ls="--" if flagged else "-")
     for text in missing:
         ax.add_line(Line2D([], [], ls="none", marker="x", color="C3", label=text))
+    _yield_lines(ax, [y for _, _, y in series], yield_strain)
     ax.axhline(0.0, color="k", lw=0.6)
     ax.set_xlim(0, 360)
     ax.set_xticks(np.arange(0, 361, 45))
@@ -172,6 +175,23 @@ def slidercrank_history_figure(time: np.ndarray, series: dict[str, np.ndarray], 
     return fig
 
 
+def _yield_lines(ax, values: Sequence[np.ndarray], yield_strain: tuple[float, str] | None) -> None:
+    """The rod's yield strain +-sigma_y / E [microstrain] with its words: drawn as two dotted lines
+    where the curves come within a quarter of it, else named in the legend as off the scale (a
+    strain beyond it is not physical: the rod would have yielded)."""
+    if yield_strain is None:
+        return
+    from matplotlib.lines import Line2D
+    eps, words = yield_strain
+    top = max((float(np.nanmax(np.abs(v))) for v in values if np.size(v)), default=0.0)
+    label = f"yield strain $\\pm${eps:.0f} microstrain ({words})"
+    if top >= 0.25 * eps:
+        for sign in (1.0, -1.0):
+            ax.axhline(sign * eps, color="C3", lw=0.9, ls=":", label=label if sign > 0 else None)
+    else:
+        ax.add_line(Line2D([], [], ls="none", label=f"{label}: off the scale"))
+
+
 def _own_axes(ax, figsize: tuple[float, float]):
     """(figure, axes): the given axes and its figure, or a new house-style figure."""
     if ax is not None:
@@ -182,13 +202,15 @@ def _own_axes(ax, figsize: tuple[float, float]):
 
 @styled
 def slidercrank_nl_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray, np.ndarray]], title: str,
-                                 ax=None) -> Figure:
+                                 ax=None, yield_strain: tuple[float, str] | None = None) -> Figure:
     """Crank-end axial strain [microstrain] against crank angle [deg]: per speed (label, angle,
-    linear, nonlinear), the linear model dashed and the nonlinear rod solid in one colour."""
+    linear, nonlinear), the linear model dashed and the nonlinear rod solid in one colour;
+    ``yield_strain`` (sigma_y / E [microstrain], its words) marked."""
     fig, ax = _own_axes(ax, (7.4, 4.4))
     for k, (label, x, lin, nl) in enumerate(series):
         ax.plot(x, nl, color=f"C{k % 10}", lw=1.2, label=label)
         ax.plot(x, lin, color=f"C{k % 10}", lw=0.9, ls="--")
+    _yield_lines(ax, [v for _, _, lin, nl in series for v in (lin, nl)], yield_strain)
     ax.axhline(0.0, color="k", lw=0.6)
     ax.set_xlim(0, 360)
     ax.set_xticks(np.arange(0, 361, 45))
