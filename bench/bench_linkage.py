@@ -248,7 +248,7 @@ def versus_pylinkage(n: int, repeat: int) -> dict[str, float] | str:
         return g
 
     joints1 = linkage_kernel.reusable_call(mech, theta, forces=False, outputs=Want.JOINTS)
-    theirs1 = lambda: link.step_fast_with_kinematics(iterations=n, dt=1.0)  # noqa: E731
+    theirs1 = lambda: link.step_fast_with_kinematics(iterations=n, dt=1.0)
     joints = many(joints1)
     points = many(linkage_kernel.reusable_call(mech, theta, forces=False, outputs=Want.POINTS))
     tj, tk = interleaved(joints, many(theirs1), repeat)
