@@ -89,9 +89,11 @@ def interleaved(kernel: Callable[[], object], baseline: Callable[[], object], re
 
 
 def keep_freed_memory() -> str:
-    """Have glibc keep freed memory for reuse: blocks up to 32 MiB from the heap, and the heap
-    never trimmed (the C int's largest value), so arrays made and freed call after call land on pages already mapped (as
-    ``out=`` buffers do).  Returns what was done, or why not (another C library)."""
+    """Have glibc keep freed memory for reuse, for the rest of the process (called by the
+    pylinkage rows only, after their own out= buffers are made): blocks up to 32 MiB from the
+    heap, and the heap never trimmed (the C int's largest threshold), so arrays made and freed
+    call after call land on pages already mapped (as ``out=`` buffers do).  Returns what was
+    done, or why not (another C library)."""
     import ctypes
     import ctypes.util
     try:
@@ -223,6 +225,7 @@ def versus_pylinkage(n: int, repeat: int) -> dict[str, float] | str:
     if built is None:
         return why
     link, crank, mech = built
+    memory = keep_freed_memory()   # pylinkage's per-call arrays on mapped pages, as our out= buffers
     dt = 2 * math.pi / n
     crank.angular_velocity = dt
     link.set_input_velocity(crank, 10.0, 0.0)
@@ -256,7 +259,7 @@ def versus_pylinkage(n: int, repeat: int) -> dict[str, float] | str:
     per = n * r
     return {"joints": tj / per, "pylinkage": tk / per, "positions": tp / per, "pylinkage_positions": tq / per,
             "floor": store_floor(n, 24, repeat), "faults": minor_faults(joints1),
-            "pylinkage_faults": minor_faults(theirs1)}
+            "pylinkage_faults": minor_faults(theirs1), "memory": memory}
 
 
 def batch_summary(nd: int, scan: int, repeat: int) -> dict[str, float]:
@@ -320,7 +323,7 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--sweep", action="store_true", help="also the 10^6-design sweep through the command line")
     args = ap.parse_args(argv)
     print(f"bench_linkage: {os.cpu_count()} cpus, load {os.getloadavg()[0]:.2f}; CPU time, medians of "
-          f"{args.repeat} interleaved; {keep_freed_memory()}")
+          f"{args.repeat} interleaved")
     for n in SIZES:
         f = versus_fourbar(n, args.repeat)
         print(f"  n = {n}: four-bar kernel {f['fourbar'] * 1e9:6.1f} ns/position; as a group, like outputs "
@@ -336,7 +339,8 @@ def main(argv: list[str] | None = None) -> None:
               f"{r['pylinkage'] * 1e9:7.1f} ns ({r['pylinkage'] / r['joints']:5.1f}x, target >= 20); positions "
               f"{r['positions'] * 1e9:6.1f} ns, pylinkage positions {r['pylinkage_positions'] * 1e9:7.1f} ns "
               f"({r['pylinkage_positions'] / r['positions']:5.1f}x, target > 1); store floor {r['floor'] * 1e9:5.1f} ns; "
-              f"page faults per call {r['faults']:.0f} (ours), {r['pylinkage_faults']:.0f} (pylinkage's kinematics)")
+              f"page faults per call {r['faults']:.0f} (ours), {r['pylinkage_faults']:.0f} (pylinkage's kinematics); "
+              f"{r['memory']}")
     s = batch_summary(20000, 72, 3)
     print(f"  Watt II batch summary, 72-point scan: output pass {s['output'] * 1e6:6.2f} us/design, every pass "
           f"{s['all'] * 1e6:6.2f} us/design")

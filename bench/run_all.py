@@ -287,10 +287,7 @@ def linkage(sizes: tuple[int, ...], repeat: int) -> list[Row]:
     numba kinematics step (each point's position, velocity and acceleration) and positions-only
     step (rows skipped, with the reason, when pylinkage or numba is not installed: they are not
     project dependencies); at each size of ``sizes`` (one turn at 0.1 deg: in cache; a long run:
-    streamed to memory, where the store floor bounds the kernel).  Memory alike: freed memory is
-    kept for reuse (bench_linkage.keep_freed_memory), so pylinkage's per-call arrays are not
-    fresh pages while the linkage's out= buffers are reused."""
-    print(f"linkage rows: {bench_linkage.keep_freed_memory()}")
+    streamed to memory, where the store floor bounds the kernel)."""
     rows = []
     for n in sizes:
         f = bench_linkage.versus_fourbar(n, repeat)
