@@ -33,7 +33,8 @@ import matplotlib.colors  # noqa: E402 (after require above)
 import matplotlib.ticker  # noqa: E402 (after require above)
 from matplotlib.figure import Figure  # noqa: E402 (after require above)
 
-__all__ = ["STYLE", "style", "styled", "new_figure", "save_figure", "line_panels", "plain_text"]
+__all__ = ["STYLE", "style", "styled", "new_figure", "save_figure", "line_panels", "plain_text", "break_wraps",
+           "unwrap_angle"]
 
 #: the house style, applied only inside :func:`style` (never written to the global rcParams)
 STYLE: dict[str, Any] = {"figure.dpi": 150, "savefig.dpi": 150, "axes.grid": True, "grid.alpha": 0.3,
@@ -151,6 +152,108 @@ def line_panels(x: np.ndarray, panels: Sequence[tuple[str, dict[str, np.ndarray]
     if title:
         fig.suptitle(plain_text(title))
     return fig
+
+
+# ----------------------------------------------------------------------------- drawings of mechanisms
+
+def keep_texts_inside(ax, texts: Sequence[Any], pad: float = 3.0, rounds: int = 5) -> None:
+    """Grow the data limits of ``ax`` until each of ``texts`` (labels placed beside points of the
+    drawing, offset in points) lies inside the axes box, ``pad`` pixels in: a label pushed out
+    of a drawing must not sit on the tick labels or leave the canvas.  Lays the figure out
+    (``draw_without_rendering``) a few times; equal aspect is kept."""
+    fig = ax.figure
+    for _ in range(rounds):
+        fig.draw_without_rendering()
+        r = fig._get_renderer()
+        box = ax.get_window_extent(r)
+        left = bottom = right = top = 0.0
+        for t in texts:
+            bb = t.get_window_extent(r)
+            left, bottom = max(left, box.x0 + pad - bb.x0), max(bottom, box.y0 + pad - bb.y0)
+            right, top = max(right, bb.x1 - (box.x1 - pad)), max(top, bb.y1 - (box.y1 - pad))
+        if max(left, bottom, right, top) <= 0.5:
+            return
+        (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+        sx, sy = (x1 - x0) / max(box.width, 1.0), (y1 - y0) / max(box.height, 1.0)
+        grow = 1.3   # the limits grow, the scale shrinks: overshoot a little to converge
+        ax.set_xlim(x0 - grow * left * sx, x1 + grow * right * sx)
+        ax.set_ylim(y0 - grow * bottom * sy, y1 + grow * top * sy)
+
+
+def drawing_figure(figsize: tuple[float, float] = (9.6, 5.4), legend_width: float = 3.2) -> tuple[Figure, Any]:
+    """A figure for a drawing of a mechanism at equal scales: the drawing's axes and, beside it,
+    a panel of ``legend_width`` inches that holds its legend (:func:`drawing_legend`).  The
+    legend has a place of its own in the layout, so equal scales never push it (or the axis
+    labels) off the canvas.  Returns (figure, drawing axes)."""
+    fig = Figure(figsize=figsize, layout="constrained")
+    ax, side = fig.subplots(1, 2, width_ratios=[max(figsize[0] - legend_width, 1.0), legend_width])
+    side.set_axis_off()
+    side.set_label("legend")
+    ax._drawing_legend_panel = side   # where drawing_legend puts the legend
+    return fig, ax
+
+
+def drawing_legend(ax, **kw: Any) -> Any:
+    """The legend of a drawing: in its panel beside it (a figure of :func:`drawing_figure`), or
+    beside the axes outside the drawing (axes of the caller's own figure).  ``order=`` (words)
+    sorts the entries by the first of the words each label contains (the rest keep their order)."""
+    side = getattr(ax, "_drawing_legend_panel", None)
+    handles, labels = ax.get_legend_handles_labels()
+    order = kw.pop("order", ())
+    if order:   # entries in the order of the first word of ``order`` each label contains
+        rank = [next((i for i, w in enumerate(order) if w in lab), len(order)) for lab in labels]
+        pairs = sorted(zip(rank, range(len(labels)), handles, labels))
+        handles, labels = [h for _, _, h, _ in pairs], [lab for _, _, _, lab in pairs]
+    opts = dict(frameon=False, borderaxespad=0.0, **kw)
+    if side is not None:
+        return side.legend(handles, labels, loc="upper left", **opts)
+    return ax.legend(handles, labels, loc="upper left", bbox_to_anchor=(1.02, 1.0), **opts)
+
+
+def length_label(axis: str, units: str) -> str:
+    """A drawing's axis label: ``'x [m]'``, or ``'x [length units]'`` when the deck's length unit is free."""
+    return f"{axis} [{units or 'length units'}]"
+
+
+# ----------------------------------------------------------------------------- angles
+
+def break_wraps(x: np.ndarray, y: np.ndarray, period: float = 360.0) -> tuple[np.ndarray, np.ndarray]:
+    """``x``, ``y`` with a NaN inserted wherever ``y`` (an angle wrapped into one ``period``) jumps
+    by more than half a period between neighbours, so the drawn line breaks at the wrap instead
+    of running vertically across the panel.  For angles drawn on a fixed 0-period axis."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    jumps = np.flatnonzero(np.abs(np.diff(y)) > 0.5 * period) + 1
+    return np.insert(x, jumps, np.nan), np.insert(y, jumps, np.nan)
+
+
+def unwrap_angle(y: Any, period: float = 360.0) -> np.ndarray:
+    """An angle defined modulo ``period`` (deg) made continuous along its order (``numpy.unwrap``
+    with that period; NaN gaps kept, each finite run unwrapped from where it starts, the first
+    value kept): ``phi = 90, 120, 150, 0`` (mod 180) becomes ``90, 120, 150, 180``."""
+    v = np.asarray(y, dtype=float).copy()
+    ok = np.isfinite(v)
+    if ok.sum() > 1:
+        v[ok] = np.unwrap(v[ok], period=period)
+    return v
+
+
+def angle_period(values: Any, unit: str = "deg") -> float | None:
+    """The period of a swept angle inferred from its searched values: equally spaced values
+    ``a, a + h, ..., a + (n - 1) h`` with ``n h`` = 180 or 360 deg cover one period (a phase
+    swept over a half or a whole turn); None otherwise (or when ``unit`` is not 'deg')."""
+    if unit != "deg":
+        return None
+    v = np.unique(np.asarray(values, dtype=float)[np.isfinite(np.asarray(values, dtype=float))])
+    if len(v) < 3:
+        return None
+    h = np.diff(v)
+    if not np.allclose(h, h[0], rtol=1e-6, atol=1e-9):
+        return None
+    span = len(v) * h[0]
+    for period in (180.0, 360.0):
+        if math.isclose(span, period, rel_tol=1e-6):
+            return period
+    return None
 
 
 # ----------------------------------------------------------------------------- sweep

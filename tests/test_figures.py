@@ -23,7 +23,6 @@ from driver._output import column_label
 from driver._result import plot_format
 from driver._runner import compute, study_of
 from driver._study import load_study
-from driver.fourbar import _figures as fourbar_figures
 from driver.ujoint import _figures as ujoint_figures
 
 
@@ -202,7 +201,7 @@ def test_cli_plot_format_svg_and_repeatable(tmp_path):
 def test_break_wraps_breaks_only_at_the_wrap():
     x = np.arange(6.0)
     y = np.array([350.0, 355.0, 2.0, 8.0, 10.0, 12.0])
-    bx, by = fourbar_figures.break_wraps(x, y)
+    bx, by = plotting.break_wraps(x, y)
     assert np.isnan(by[2]) and np.count_nonzero(np.isnan(by)) == 1
     assert np.allclose(by[~np.isnan(by)], y)
 
@@ -227,10 +226,11 @@ def test_fourbar_wrapped_angle_curves_have_no_vertical_jump():
 
 def test_fourbar_linkage_labelled_with_the_legend_off_the_mechanism():
     fig = figures_of("crank5.dat")["linkage"]
-    (ax,) = fig.axes
+    ax, panel = fig.axes   # the drawing, and the legend's own panel beside it
     assert ax.get_xlabel() == "x [length units]" and ax.get_ylabel() == "y [length units]"
+    assert ax.get_aspect() == 1.0
     r = _renderer(fig)
-    legend = ax.get_legend()
+    legend = panel.get_legend()
     assert not legend.get_window_extent(r).overlaps(ax.get_window_extent(r))
     assert _inside_figure(fig, legend)
     assert_no_overlapping_text(fig)

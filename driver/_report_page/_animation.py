@@ -13,15 +13,12 @@ from typing import Any
 
 import numpy as np
 
-from driver._mechanism import MechanismFrames
+from driver._mechanism import LINK_COLOURS, PATH_COLOURS, MechanismFrames
 
 __all__ = ["ANIMATION_FRAMES", "AnimationView", "LinkView", "animation_view"]
 
 #: frames asked of a study's animation hook (a crank turn in 2 degree steps)
 ANIMATION_FRAMES = 180
-#: colours of the links, in drawing order (cycled), and of the traced paths
-LINK_COLOURS = ("#2c3e50", "#2980b9", "#e67e22", "#16a085", "#8e44ad", "#c0392b", "#7f8c8d")
-PATH_COLOURS = ("#999999", "#c0392b", "#8e44ad", "#27ae60", "#d35400")
 
 
 @dataclass

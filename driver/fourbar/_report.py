@@ -31,11 +31,12 @@ from driver.fourbar._analysis import (
     summary_rows,
     tidy_frame,
 )
+from driver.fourbar._analysis_forces import counterweights as berkof_lowen
 from driver.fourbar._batch import summary_of
 from driver.fourbar._kernel import Listing, Point, State
 from driver.fourbar._report_forces import figures as force_figures
 from driver.fourbar._report_forces import force_section
-from driver.fourbar._spec import SPEC, band_of, forces_active
+from driver.fourbar._spec import SPEC, band_of, force_value, forces_active
 
 __all__ = ["run", "listing_text", "exact_table", "summary_lines", "audit", "deck_figures", "output_name", "animation_frames"]
 
@@ -251,6 +252,22 @@ def output_name(p: Params) -> str:
     return "output crank" if g.name.startswith("double-crank") else "rocker"
 
 
+def length_units(p: Params) -> str:
+    """The deck's length unit in words: metres when it gives masses (the force analysis is in SI
+    units), else '' (any consistent unit)."""
+    return "m" if forces_active(p) else ""
+
+
+def counterweight_view(p: Params) -> dict[str, tuple[float, float]] | None:
+    """The Berkof-Lowen counterweights a ``balance = 'force'`` deck adds, as drawings show them:
+    ``radius`` [m], ``angle_deg`` off the link line and ``mass`` [kg] of (crank, output link);
+    None for a deck that does not balance."""
+    if not forces_active(p) or force_value(p, "balance") != "force":
+        return None
+    cw = berkof_lowen(p)
+    return {"radius": cw.radius, "angle_deg": cw.angle_deg, "mass": cw.mass}
+
+
 def deck_figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> list[Figure]:
     """The figures of a run (drawn on demand): the curves and the linkage at its limit positions."""
     def curves():
@@ -275,7 +292,8 @@ def deck_figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> li
                 drawn.append({"lo": m.lo, "hi": m.hi, "theta": m.theta, "out": m.out, "stroke": m.stroke,
                               "branch": m.branch, "point": None if mp is None else mp[:, :2]})
             return figures.fourbar_linkage(p.fixed_link, theta, out, st == ST["ok"], None, stem_title,
-                                           output=output_name(p), motions=drawn)
+                                           output=output_name(p), motions=drawn, units=length_units(p),
+                                           counterweights=counterweight_view(p))
         limits = []
         for a in limit_angles(p.fixed_link, p.crank, p.coupler, p.rocker):
             if theta[0] - 1e-9 <= a <= theta[-1] + 1e-9 or hi - lo >= 360.0:
@@ -284,7 +302,7 @@ def deck_figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> li
                     limits.append((a, row[0]))
         return figures.fourbar_linkage(p.fixed_link, theta, out, st == ST["ok"], listing, stem_title,
                                        point=None if cp is None else cp[:, :2], output=output_name(p),
-                                       limits=limits)
+                                       limits=limits, units=length_units(p), counterweights=counterweight_view(p))
 
     return [Figure("curves", curves), Figure("linkage", linkage)]
 
