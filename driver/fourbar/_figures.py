@@ -384,11 +384,24 @@ def _rocking_drawing(fig, ax, ground: float, motions: Sequence[dict], title: str
 
 # ----------------------------------------------------------------------------- the force analysis
 
-def plot_torque(theta: np.ndarray, fa: ForceAnalysis, p: Mapping[str, Any], ax: Any) -> Any:
+#: one style per meaning in every force figure: the linkage analysed (with its counterweights
+#: when the deck balances) solid blue, the same linkage without counterweights dashed red
+AS_ANALYSED = dict(color="C0", lw=1.5, ls="-")
+WITHOUT_COUNTERWEIGHTS = dict(color="C3", lw=1.2, ls="--")
+#: crank angles marked on the pin-force loci [deg]
+MARKED_ANGLES = (0.0, 90.0, 180.0, 270.0)
+
+
+def _analysed_label(fa: ForceAnalysis) -> str:
+    return "with counterweights (Berkof-Lowen)" if fa.unbalanced is not None else "as given"
+
+
+def plot_torque(theta: np.ndarray, fa: ForceAnalysis, p: Mapping[str, Any], ax: Any, legend: bool = True) -> Any:
     """Plot the input torque against crank angle, its mean, and the energy fluctuation dE.
 
     dE is shaded between the torque curve and the mean; with balancing the torque of the
-    linkage without counterweights is dashed.
+    linkage without counterweights is dashed (the same style as in the pin-force and shaking
+    figures).
 
     Parameters
     ----------
@@ -400,6 +413,8 @@ def plot_torque(theta: np.ndarray, fa: ForceAnalysis, p: Mapping[str, Any], ax: 
         The ``&fourbar`` keys.
     ax : matplotlib.axes.Axes
         The axes to draw into (crank angle in deg, torque in N m, dE in J in the legend).
+    legend : bool, default True
+        Give ``ax`` its legend (beside it); False leaves it to the caller (a figure legend).
 
     Returns
     -------
@@ -407,27 +422,48 @@ def plot_torque(theta: np.ndarray, fa: ForceAnalysis, p: Mapping[str, Any], ax: 
         ``ax``.
     """
     t = np.where(fa.ok, fa.forces[:, Force.INPUT_TORQUE], np.nan)
-    ax.plot(theta, t, color="C0", label="input torque")
+    ax.plot(theta, t, **AS_ANALYSED, label=f"input torque, {_analysed_label(fa)}")
     if fa.ok.all() and len(theta) > 1:
         mean = np.trapezoid(t, theta) / (theta[-1] - theta[0])
         e = np.concatenate([[0.0], np.cumsum(0.5 * (t[1:] + t[:-1] - 2 * mean) * np.diff(np.radians(theta)))])
-        ax.axhline(mean, color="C1", lw=1, label=f"mean {mean:.3f} N m")
+        shown = 0.0 if abs(mean) < 5e-4 else mean   # the .out's 3 decimals; no '-0.000'
+        ax.axhline(mean, color="0.35", lw=0.9, ls=":", label=f"mean {shown:.3f} N m")
         ax.fill_between(theta, t, mean, color="C0", alpha=0.15,
-                        label=f"dE = {e.max() - e.min():.4g} J (max - min of the area)")
+                        label=f"energy fluctuation dE = {e.max() - e.min():.4g} J (largest minus smallest area)")
     if fa.unbalanced is not None:
-        ax.plot(theta, np.where(fa.ok, fa.unbalanced[:, Force.INPUT_TORQUE], np.nan), "--", color="C3",
-                label="without counterweights")
-    ax.set_xlabel("crank angle [deg]")
+        ax.plot(theta, np.where(fa.ok, fa.unbalanced[:, Force.INPUT_TORQUE], np.nan), **WITHOUT_COUNTERWEIGHTS,
+                label="input torque, without counterweights")
+    ax.set_xlim(float(np.min(theta)), float(np.max(theta)))
+    ax.set_xlabel("crank angle \u03b8\u2082 [deg]")
     ax.set_ylabel("input torque [N m]")
-    ax.legend(fontsize=7, loc="best")
+    if legend:
+        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     return ax
 
 
-def plot_pin_polars(fa: ForceAnalysis, axes: Any) -> Any:
+def _empty_sector(curves: list[tuple[np.ndarray, np.ndarray]]) -> float:
+    """The direction [deg] of the 45-deg sector where the drawn loci reach least far: the radial
+    tick labels go there, off the curves."""
+    best, where = np.inf, 22.5
+    for centre in np.arange(22.5, 360.0, 45.0):
+        reach = 0.0
+        for ang, rad in curves:
+            d = np.abs((np.degrees(ang) - centre + 180.0) % 360.0 - 180.0)
+            near = (d < 22.5) & np.isfinite(rad)
+            if near.any():
+                reach = max(reach, float(np.max(rad[near])))
+        if reach < best - 1e-12:
+            best, where = reach, float(centre)
+    return where
+
+
+def plot_pin_polars(fa: ForceAnalysis, axes: Any, theta: np.ndarray | None = None) -> Any:
     """Plot the force at each pin over the cycle on polar axes.
 
-    Angle = direction of the force, radius = its magnitude in N; with balancing, the
-    unbalanced linkage's dashed.
+    Angle = direction of the force, radius = its magnitude in N; with balancing, the linkage
+    without counterweights dashed (the same style as in the torque and shaking figures).  The
+    crank angles of :data:`MARKED_ANGLES` are marked on each locus (with ``theta``), the radial
+    labels sit in the emptiest sector, off the curves.
 
     Parameters
     ----------
@@ -435,31 +471,46 @@ def plot_pin_polars(fa: ForceAnalysis, axes: Any) -> Any:
         The forces (``driver.fourbar.forces.analyse``).
     axes : sequence of matplotlib.axes.Axes
         Four polar axes: O2, A, B, O4.
+    theta : numpy.ndarray, optional
+        The crank angles of the forces, deg (to mark the loci).
 
     Returns
     -------
     sequence of matplotlib.axes.Axes
         ``axes``.
     """
-    names = ("O2 (ground on crank)", "A (crank on coupler)", "B (coupler on rocker)", "O4 (ground on rocker)")
+    names = ("$O_2$: ground on crank", "A: crank on coupler", "B: coupler on rocker", "$O_4$: ground on rocker")
     pins = ((Force.F_O2_X, Force.F_O2_Y), (Force.F_A_X, Force.F_A_Y), (Force.F_B_X, Force.F_B_Y),
             (Force.F_O4_X, Force.F_O4_Y))
     for j, ax in enumerate(np.ravel(axes)[:4]):
         fx = np.where(fa.ok, fa.forces[:, pins[j][0]], np.nan)
         fy = np.where(fa.ok, fa.forces[:, pins[j][1]], np.nan)
-        ax.plot(np.arctan2(fy, fx), np.hypot(fx, fy), color="C0", lw=1,
-                label="balanced" if fa.unbalanced is not None else "as given")
+        ang, rad = np.arctan2(fy, fx), np.hypot(fx, fy)
+        ax.plot(ang, rad, **AS_ANALYSED, label=_analysed_label(fa))
+        curves = [(ang, rad)]
         if fa.unbalanced is not None:
             bx = np.where(fa.ok, fa.unbalanced[:, pins[j][0]], np.nan)
             by = np.where(fa.ok, fa.unbalanced[:, pins[j][1]], np.nan)
-            ax.plot(np.arctan2(by, bx), np.hypot(bx, by), color="C3", lw=1, ls="--", label="unbalanced")
-        ax.set_title(f"F at {names[j]} [N]", fontsize=8)
-    np.ravel(axes)[0].legend(fontsize=6, loc="lower left")
+            ax.plot(np.arctan2(by, bx), np.hypot(bx, by), **WITHOUT_COUNTERWEIGHTS, label="without counterweights")
+            curves.append((np.arctan2(by, bx), np.hypot(bx, by)))
+        if theta is not None:   # where the crank is at 0, 90, 180, 270 deg, on the analysed locus
+            for a in MARKED_ANGLES:
+                k = int(np.argmin(np.abs((np.asarray(theta) - a + 180.0) % 360.0 - 180.0)))
+                if fa.ok[k] and abs((theta[k] - a + 180.0) % 360.0 - 180.0) < 1.0:
+                    ax.plot([ang[k]], [rad[k]], "o", ms=4, color="k", zorder=5,
+                            label="crank angle \u03b8\u2082 = 0, 90, 180, 270°" if a == 0.0 else None)
+                    ax.annotate(f"{a:.0f}", (ang[k], rad[k]), xytext=(3, 3), textcoords="offset points", fontsize=7,
+                                zorder=6, bbox=dict(boxstyle="round,pad=0.1", fc="white", ec="none", alpha=0.8))
+        ax.set_rlabel_position(_empty_sector(curves))
+        ax.tick_params(axis="y", labelsize=7)
+        ax.tick_params(axis="x", labelsize=7, pad=1)
+        ax.set_title(f"force on pin {names[j]} [N]", fontsize=8.5)
     return axes
 
 
 def plot_shaking(theta: np.ndarray, fa: ForceAnalysis, ax: Any, polar_ax: Any | None = None) -> Any:
-    """Plot the shaking force magnitude against crank angle, and its locus, before and after balancing.
+    """Plot the shaking force magnitude against crank angle, and its locus, with and without
+    counterweights (the same styles as in the torque and pin-force figures).
 
     Parameters
     ----------
@@ -477,22 +528,24 @@ def plot_shaking(theta: np.ndarray, fa: ForceAnalysis, ax: Any, polar_ax: Any | 
     matplotlib.axes.Axes
         ``ax``.
     """
-    before = fa.unbalanced if fa.unbalanced is not None else fa.forces
     shaking = [Force.SHAKING_X, Force.SHAKING_Y]
-    s = np.where(fa.ok[:, None], before[:, shaking], np.nan)
-    ax.plot(theta, np.hypot(*s.T), color="C0", label="unbalanced")
+    s = np.where(fa.ok[:, None], fa.forces[:, shaking], np.nan)
+    ax.plot(theta, np.hypot(*s.T), **AS_ANALYSED, label=_analysed_label(fa))
     if polar_ax is not None:
-        polar_ax.plot(s[:, 0], s[:, 1], color="C0", label="unbalanced")
+        polar_ax.plot(s[:, 0], s[:, 1], **AS_ANALYSED, label=_analysed_label(fa))
+        if fa.unbalanced is not None and np.nanmax(np.hypot(*s.T)) < 1e-9 * max(1.0, float(np.nanmax(np.abs(fa.forces)))):
+            polar_ax.plot([0.0], [0.0], "o", ms=5, color=AS_ANALYSED["color"], zorder=5)   # a locus that is a point
     if fa.unbalanced is not None:
-        b = np.where(fa.ok[:, None], fa.forces[:, shaking], np.nan)
-        ax.plot(theta, np.hypot(*b.T), "--", color="C3", label="balanced (Berkof-Lowen)")
+        b = np.where(fa.ok[:, None], fa.unbalanced[:, shaking], np.nan)
+        ax.plot(theta, np.hypot(*b.T), **WITHOUT_COUNTERWEIGHTS, label="without counterweights")
         if polar_ax is not None:
-            polar_ax.plot(b[:, 0], b[:, 1], "o", ms=3, color="C3", label="balanced (Berkof-Lowen)")
-    ax.set_xlabel("crank angle [deg]")
+            polar_ax.plot(b[:, 0], b[:, 1], **WITHOUT_COUNTERWEIGHTS, label="without counterweights")
+    ax.set_xlim(float(np.min(theta)), float(np.max(theta)))
+    ax.set_xlabel("crank angle \u03b8\u2082 [deg]")
     ax.set_ylabel("|shaking force| [N]")
-    ax.legend(fontsize=7)
     if polar_ax is not None:
         polar_ax.set_xlabel("shaking force x [N]")
         polar_ax.set_ylabel("shaking force y [N]")
         polar_ax.set_aspect("equal", adjustable="datalim")
+        polar_ax.set_title("locus of the shaking force", fontsize=9)
     return ax
