@@ -287,7 +287,7 @@ def test_slidercrank_linear_model_flags_cases_above_the_euler_load(write_deck):
 def test_manipulator_design_space_draws_the_iso_ri2_ellipses():
     fig = figures_of("manipulator_case1_report.dat")["design_space"]
     left = fig.axes[0]
-    assert "iso-RI2 ellipses" in left.get_title()
+    assert "iso-$RI_2$ ellipses" in left.get_title()
     ellipses = [ln for ln in left.get_lines() if (ln.get_gid() or "").startswith("iso-RI2 ellipse")]
     levels = sorted({float(ln.get_gid().split()[-1]) for ln in ellipses})
     assert len(ellipses) == 2 * len(levels) and len(levels) >= 3 and 2.0 in levels   # the deck's Table 4.1 level
