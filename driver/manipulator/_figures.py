@@ -96,7 +96,7 @@ def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, 
             cs = ax.contour(L1, L2, ri2, levels=bounds[1:-1], colors="k", linewidths=0.5)
             # one label per contour, where it crosses the ray at 65 deg from the l1 axis (the contours
             # converge at the ends of C_rob: labels there would collide)
-            spots = []
+            spots: list[tuple[float, float]] = []
             for segs in cs.allsegs:
                 pts = np.vstack([seg for seg in segs if len(seg)]) if any(len(seg) for seg in segs) else None
                 if pts is not None:
@@ -128,7 +128,7 @@ def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, 
     bar = fig.colorbar(matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap), ax=list(axes), shrink=0.85, pad=0.02,
                        spacing="uniform")
     bar.set_label("robustness index $RI_2$ [-]")
-    bar.set_ticks(bounds)
+    bar.set_ticks(list(bounds))
     bar.set_ticklabels([f"{v:.3g}" for v in bounds])
     words = (f"$RI_2$: the largest singular value of the sensitivity of the {n} workspace positions to "
              f"($l_1$, $l_2$), smallest ($\\sqrt{{n}}$ = {math.sqrt(n):.3g}) on $C_{{rob}}$: "
