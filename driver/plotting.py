@@ -501,81 +501,117 @@ def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, 
 
 @styled
 def convergence_plot(history, evals, objective: str, sense: str = "minimize", title: str = "",
-                     axes=None) -> Figure:
+                     axes=None, tolerance: float | None = None, tolerance_words: str = "") -> Figure:
     """How an optimisation converged, as an engineer reads it: three panels against the number
-    of designs evaluated.
+    of designs evaluated, judged against the tolerance the deck states.
 
-    Left: the best feasible objective so far (a step line), every feasible design as a grey
-    dot; the axis shows plain numbers (no offset).  Middle: the gap between the best so far
-    and the final best on a log axis (zero gaps left out), so the last digits gained are
-    visible without a 1e-7 change looking like a big step.  Right: the constraint violation
-    of every design on a log axis (feasible designs, violation 0, are not drawn) and its
-    running minimum.  ``history`` has columns evals, feasible, objective; ``evals`` eval,
-    feasible, objective, violation.  ``objective`` is the axis label (words and unit);
-    ``sense`` 'minimize' or 'maximize'.  ``axes``: three axes to draw into.
+    Left: the best feasible objective so far (a step line) over every feasible design (grey
+    dots), the band within ``tolerance`` of the final best shaded; the window shows the descent
+    and at least that band, plain numbers (no offset).  Middle: the gap between the best so far
+    and the final best in units of ``tolerance`` on a log axis, drawn until it first falls within
+    the tolerance (the line at 1) and no further: what changes below the stated tolerance is not
+    convergence (a lattice's last bits).  Right: the constraint violation of every design on a
+    log axis (feasible designs, violation 0, are not drawn) and its running minimum.
+
+    ``history`` has columns evals, feasible, objective; ``evals`` eval, feasible, objective,
+    violation.  ``objective`` is the axis label (words and unit); ``sense`` 'minimize' or
+    'maximize'; ``tolerance`` the stated tolerance in the objective's unit (None: the gap is drawn
+    in the objective's unit, down to its last change) and ``tolerance_words`` how it was stated
+    (``'tol x |best| + atol'``).  ``axes``: three axes to draw into.
     """
     import pandas as pd
     if axes is None:
-        fig, axes = new_figure(1, 3, sharex=True, figsize=(11.0, 3.8))
+        fig, axes = new_figure(1, 3, sharex=True, figsize=(11.5, 4.4))
     else:
         fig = axes[0].figure
     a1, a2, a3 = axes
     objective = wrap(objective, 40)
+    unit = re.search(r"\[([^\[\]]+)\]\s*$", objective)   # the objective's unit, when its label has one
+    unit_text = f" {unit.group(1)}" if unit and unit.group(1) not in ("-", "1") else ""
     ev = evals.sort_values("eval")
     feas = ev[ev["feasible"].astype(bool)]
     sign = -1.0 if sense.startswith("max") else 1.0
     obj = pd.to_numeric(feas["objective"], errors="coerce").to_numpy(dtype=float)
+    tol = tolerance if tolerance is not None and tolerance > 0 else None
     a1.plot(feas["eval"], obj, ".", ms=2.5, color="0.65", label="feasible designs", rasterized=len(obj) > 2000)
     if len(obj):
         best = sign * np.minimum.accumulate(sign * obj)
-        x = np.concatenate([feas["eval"].to_numpy(dtype=float), [float(ev["eval"].max())]])
+        at = feas["eval"].to_numpy(dtype=float)
+        x = np.concatenate([at, [float(ev["eval"].max())]])
         y = np.concatenate([best, best[-1:]])
-        a1.step(x, y, where="post", color="C3", lw=1.8, label="best so far")
+        a1.step(x, y, where="post", color="C3", lw=1.8, label="best feasible so far")
         final = best[-1]
+        if tol is not None:
+            a1.axhspan(final - tol, final + tol, color="C2", alpha=0.15, lw=0,
+                       label=f"within the stated tolerance of the final best (\u00b1{tol:.3g}{unit_text})")
         gap = np.abs(best - final)
-        pos = gap > 0
-        if pos.any():
-            a2.step(x[:-1][pos], gap[pos], where="post", color="C3", lw=1.6)
-            a2.set_yscale("log")
+        scale = tol if tol is not None else 1.0
+        rel = gap / scale
+        if tol is not None:
+            inside = np.flatnonzero(rel <= 1.0)
+            first_in = int(inside[0])   # the final best is within its own tolerance: always found
+            if first_in == 0:
+                a2.text(0.5, 0.72, f"the first feasible design (design {at[0]:.0f})\nwas within the stated "
+                                   f"tolerance\nof the final best", transform=a2.transAxes, ha="center", va="center",
+                        bbox=dict(boxstyle="round,pad=0.3", fc="white", ec="0.8"))
+            else:
+                a2.step(at[:first_in + 1], np.maximum(rel[:first_in + 1], 1e-3), where="post", color="C3", lw=1.6,
+                        label="gap of the best so far")
+                a2.plot([at[first_in]], [max(rel[first_in], 1e-3)], "o", color="C2", ms=6, zorder=5,
+                        label=f"within the tolerance from design {at[first_in]:.0f}")
+                a2.set_yscale("log")
+            a2.axhline(1.0, color="C2", lw=1.2, ls="--", label="the stated tolerance")
+            a2.set_ylim(bottom=min(0.3, float(np.min(np.maximum(rel[:first_in + 1], 1e-3)))) * 0.8)
+            a2.set_ylabel("|best so far - final best| / tolerance")
+            a2.set_title("gap to the final best, in tolerances")
+            if a2.get_yscale() == "linear":
+                a2.set_ylim(0.0, 2.0)
         else:
-            a2.text(0.5, 0.5, "the first feasible design\nwas already the best", transform=a2.transAxes,
-                    ha="center", va="center")
-        a2.axvline(float(feas["eval"].iloc[int(np.argmax(best == final))]), color="0.4", ls=":", lw=1,
-                   label="final best found")
-        a2.legend(loc="upper right")
-        lo, hi = np.nanmin(obj), np.nanmax(obj)
-        # at least 1e-4 of the objective's size: a change in the 7th digit reads as converged here
-        # (a flat line), and the gap panel beside it shows how small it is
-        span = max(hi - lo, 1e-4 * max(abs(final), 1e-12))
+            pos = gap > 0
+            if pos.any():
+                a2.step(at[pos], gap[pos], where="post", color="C3", lw=1.6, label="gap of the best so far")
+                a2.set_yscale("log")
+            else:
+                a2.text(0.5, 0.5, "the first feasible design\nwas already the best", transform=a2.transAxes,
+                        ha="center", va="center")
+            a2.set_ylabel("|best so far - final best|" + (f" [{unit.group(1)}]" if unit else ""))
+            a2.set_title("gap to the final best")
+        lo, hi = float(np.min(best)), float(np.max(best))
+        span = max(hi - lo, 4.0 * tol if tol is not None else 1e-4 * max(abs(final), 1e-12))
         mid = 0.5 * (lo + hi)
-        a1.set_ylim(mid - 0.55 * span, mid + 0.55 * span)
+        a1.set_ylim(mid - 0.6 * span, mid + 0.6 * span)
     else:
         a1.text(0.5, 0.5, "no feasible design", transform=a1.transAxes, ha="center", va="center")
+        a2.text(0.5, 0.5, "no feasible design", transform=a2.transAxes, ha="center", va="center")
+        a2.set_title("gap to the final best")
     a1.set_ylabel(objective)
-    a1.set_title(f"best feasible ({'largest' if sign < 0 else 'smallest'})")
-    a1.legend(loc="best")
-    unit = re.search(r"\[([^\[\]]+)\]\s*$", objective)   # the objective's unit, when its label has one
-    a2.set_ylabel("|best so far - final best|" + (f" [{unit.group(1)}]" if unit else ""))
-    a2.set_title("gap to the final best")
+    a1.set_title(f"best feasible objective ({'largest' if sign < 0 else 'smallest'} so far)")
     viol = pd.to_numeric(ev["violation"], errors="coerce").to_numpy(dtype=float) if "violation" in ev else np.array([])
     if viol.size and np.nanmax(viol) > 0:
         pos = viol > 0
         a3.plot(ev["eval"].to_numpy()[pos], viol[pos], ".", ms=2.5, color="C0", alpha=0.6,
-                label="violation of each design", rasterized=pos.sum() > 2000)
+                label="constraint violation of each design", rasterized=pos.sum() > 2000)
         run = np.minimum.accumulate(np.where(np.isfinite(viol), viol, np.inf))
         shown = run > 0
         a3.step(ev["eval"].to_numpy()[shown], run[shown], where="post", color="k", lw=1.4,
-                label="smallest so far (0 once feasible)")
+                label="smallest violation so far (0 once feasible)")
         a3.set_yscale("log")
-        a3.legend(loc="best")
     else:
         a3.text(0.5, 0.5, "every design feasible", transform=a3.transAxes, ha="center", va="center")
-    a3.set_ylabel("constraint violation")
+    a3.set_ylabel("constraint violation [constraint units]")
     a3.set_title("constraint violation")
     for a in axes:
         a.set_xlabel("designs evaluated")
     plain_numbers(a1)
     plain_numbers(a3) if a3.get_yscale() == "linear" else None
+    handles, labels = [], []
+    for a in axes:
+        h, lab = a.get_legend_handles_labels()
+        handles += h
+        labels += lab
+    if handles:
+        fig.legend(handles, labels, loc="outside lower center", ncol=3, frameon=False,
+                   title=f"tolerance: {tolerance_words}" if tolerance_words else None, title_fontsize=8.5)
     if title:
         fig.suptitle(title)   # composed by the caller: deck parts through plain_text
     return fig

@@ -66,8 +66,10 @@ def _convergence():
     history = pd.read_csv(ROOT / "outputs" / "optimize_manipulator_torque_history.csv")
     evals = pd.read_parquet(ROOT / "outputs" / "optimize_manipulator_torque_evals.parquet")
     from driver._output import expression_label  # the label the optimiser gives it (mathtext symbols)
+    best = float(history["objective"].min())
     return plotting.convergence_plot(history, evals, expression_label(driver.manipulator.STUDY, "design_torque_demand_Nm"),
-                                     "minimize", title="convergence")
+                                     "minimize", title="convergence", tolerance=1e-3 * best,
+                                     tolerance_words=f"tol x max(1, |best|) = 0.001 x {best:.6g}")
 
 
 def _manipulator_search():

@@ -349,4 +349,13 @@ def test_optimisation_convergence_figure_names_its_objective_with_units(tmp_path
     assert designs.get_xlabel().startswith("coupler") and designs.get_ylabel() == "rocker swing [deg]"
     star = next(line for line in designs.get_lines() if line.get_label() == "optimum")
     assert star.get_xdata()[0] == pytest.approx(oc.x["fourbar.coupler"]) and star.get_ydata()[0] == pytest.approx(oc.fun)
-    assert fig.axes[1].get_ylabel() == "|best so far - final best| [deg]"   # the gap in the objective's unit
+    # the gap in units of the stated tolerance (tol x max(1, |best|) for a local method), drawn
+    # until it is within it; the title names the objective in words
+    assert fig.axes[1].get_ylabel() == "|best so far - final best| / tolerance"
+    assert fig.get_suptitle() == "opt: maximize rocker swing [deg]"
+    tol, how = report.stated_tolerance(oc.problem, oc.fun)
+    assert tol == pytest.approx(1e-3 * abs(oc.fun)) and how.startswith("tol x max(1, |best|)")
+    gap = [ln for ln in fig.axes[1].get_lines() if ln.get_label() == "gap of the best so far"]
+    if gap:   # it stops at the first design within the tolerance
+        y = np.asarray(gap[0].get_ydata(), dtype=float)
+        assert y[-1] <= 1.0 and (y[:-1] > 1.0).all()

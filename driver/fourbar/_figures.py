@@ -113,7 +113,7 @@ def _runs(ok: np.ndarray) -> list[np.ndarray]:
 #: the drawing's colours: the page's animation draws the crank, coupler and output link in the same
 CRANK_COLOUR, COUPLER_COLOUR, OUTPUT_COLOUR = LINK_COLOURS[:3]
 #: the positions other than the one drawn solid: light ghosts
-GHOST = dict(color="0.8", lw=0.9, zorder=1)
+GHOST: dict[str, Any] = dict(color="0.8", lw=0.9, zorder=1)
 
 
 def _pose(ax, ground: float, row: np.ndarray, p: np.ndarray | None, output: str, label: bool = True) -> None:
@@ -386,8 +386,8 @@ def _rocking_drawing(fig, ax, ground: float, motions: Sequence[dict], title: str
 
 #: one style per meaning in every force figure: the linkage analysed (with its counterweights
 #: when the deck balances) solid blue, the same linkage without counterweights dashed red
-AS_ANALYSED = dict(color="C0", lw=1.5, ls="-")
-WITHOUT_COUNTERWEIGHTS = dict(color="C3", lw=1.2, ls="--")
+AS_ANALYSED: dict[str, Any] = dict(color="C0", lw=1.5, ls="-")
+WITHOUT_COUNTERWEIGHTS: dict[str, Any] = dict(color="C3", lw=1.2, ls="--")
 #: crank angles marked on the pin-force loci [deg]
 MARKED_ANGLES = (0.0, 90.0, 180.0, 270.0)
 

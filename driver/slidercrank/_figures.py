@@ -180,22 +180,60 @@ def _own_axes(ax, figsize: tuple[float, float]):
     return fig, axes[0]
 
 
+#: the two models in the nonlinear deck's figures: one style each, a key says which is which
+NONLINEAR: dict[str, Any] = dict(lw=1.3, ls="-")
+LINEAR: dict[str, Any] = dict(lw=1.0, ls="--", color="0.25")
+BUCKLED = "#c0392b"
+
+
 @styled
 def slidercrank_nl_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray, np.ndarray]], title: str,
-                                 ax=None) -> Figure:
-    """Crank-end axial strain [microstrain] against crank angle [deg]: per speed (label, angle,
-    linear, nonlinear), the linear model dashed and the nonlinear rod solid in one colour."""
-    fig, ax = _own_axes(ax, (7.4, 4.4))
-    for k, (label, x, lin, nl) in enumerate(series):
-        ax.plot(x, nl, color=f"C{k % 10}", lw=1.2, label=label)
-        ax.plot(x, lin, color=f"C{k % 10}", lw=0.9, ls="--")
-    ax.axhline(0.0, color="k", lw=0.6)
-    ax.set_xlim(0, 360)
-    ax.set_xticks(np.arange(0, 361, 45))
-    ax.set_xlabel("crank angle theta2 [deg]")
-    ax.set_ylabel("axial strain [microstrain]")
-    ax.legend(fontsize=7, title="crank speed", title_fontsize=7)
-    ax.set_title(title)
+                                 buckled: dict[str, str] | None = None, axes=None) -> Figure:
+    """Crank-end axial strain [microstrain] against crank angle [deg], one panel per crank speed
+    (label, angle, linear, nonlinear), each on its own scale: the nonlinear rod solid in the
+    speed's colour, the linear model dashed dark grey (a key below says so).  A buckled rod's
+    spike of thousands of microstrain cannot flatten the sub-buckling speeds.  ``buckled`` maps
+    the labels of the speeds at which the nonlinear rod buckled to why (their panels are framed
+    and titled in red).  ``axes``: one axes per speed to draw into."""
+    from matplotlib.lines import Line2D
+    buckled = buckled or {}
+    n = len(series)
+    ncols = 1 if n == 1 else 2
+    nrows = int(np.ceil(n / ncols))
+    if axes is None:
+        fig, axes = new_figure(nrows, ncols, sharex=True, figsize=(10.0 if ncols == 2 else 7.4, 2.3 * nrows + 1.3))
+        for extra in list(axes)[n:]:
+            extra.set_visible(False)
+    else:
+        fig = axes[0].figure
+    for k, (ax, (label, x, lin, nl)) in enumerate(zip(axes, series)):
+        ax.plot(x, nl, color=f"C{k % 10}", **NONLINEAR)
+        ax.plot(x, lin, **LINEAR)
+        ax.axhline(0.0, color="k", lw=0.5)
+        ax.set_xlim(0, 360)
+        ax.set_xticks(np.arange(0, 361, 90))
+        if label in buckled:
+            ax.set_title(f"{label}: buckled ({buckled[label]})", fontsize=8.5, color=BUCKLED)
+            for spine in ax.spines.values():
+                spine.set_visible(True)
+                spine.set_color(BUCKLED)
+                spine.set_linewidth(1.4)
+        else:
+            ax.set_title(label, fontsize=9)
+    shown = list(axes)[:n]
+    for ax in shown:
+        spec = ax.get_subplotspec()
+        if spec is None or spec.is_last_row() or ax is shown[-1] or (ncols == 2 and ax is shown[-2] and n % 2 == 1):
+            ax.set_xlabel("crank angle \u03b8\u2082 [deg]")
+            ax.tick_params(labelbottom=True)
+    fig.supylabel("crank-end axial strain [microstrain]", fontsize=9)
+    key = [Line2D([], [], color="C0", **NONLINEAR), Line2D([], [], **LINEAR)]
+    names = ["nonlinear rod (co-rotational), colour per speed", "linear model (the paper's)"]
+    if buckled:
+        key.append(Line2D([], [], color=BUCKLED, lw=1.4))
+        names.append("frame: the nonlinear rod buckled at this speed")
+    fig.legend(key, names, loc="outside lower center", ncol=len(key), frameon=False)
+    fig.suptitle(plain_text(title))
     return fig
 
 
@@ -205,31 +243,35 @@ def slidercrank_nl_shapes_figure(series: Sequence[tuple[str, tuple[float, float]
     """Lateral deflection [mm] along the rod [m] at the step of largest deflection (solid) and of
     largest crank-end compression (dotted), one colour per speed; true scale in mm (the axis
     is stretched, not the shape)."""
-    fig, ax = _own_axes(ax, (7.4, 4.4))
+    from matplotlib.lines import Line2D
+    fig, ax = _own_axes(ax, (8.6, 4.6))
     for k, (label, (a1, _a2), shapes) in enumerate(series):   # the dotted line's angle is not labelled
         s = np.linspace(0.0, length, shapes.shape[0])
         ax.plot(s, shapes[:, Shape.LARGEST_DEFLECTION] * 1e3, color=f"C{k % 10}", lw=1.2,
-                label=f"{label}, theta2 = {a1:.0f} deg")
+                label=f"{label}, \u03b8\u2082 = {a1:.0f}°")
         ax.plot(s, shapes[:, Shape.LARGEST_COMPRESSION] * 1e3, color=f"C{k % 10}", lw=0.8, ls=":")
     ax.axhline(0.0, color="k", lw=0.6)
     ax.set_xlabel("position along the rod from the crank pin [m]")
     ax.set_ylabel("lateral deflection from the chord [mm]")
-    ax.legend(fontsize=7)
-    ax.set_title(title)
+    handles, labels = ax.get_legend_handles_labels()
+    handles += [Line2D([], [], color="0.3", lw=1.2), Line2D([], [], color="0.3", lw=0.8, ls=":")]
+    labels += ["solid: at the largest deflection", "dotted: at the largest crank-end compression"]
+    ax.legend(handles, labels, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    ax.set_title(plain_text(title))
     return fig
 
 
 @styled
 def slidercrank_nl_revolutions_figure(series: Sequence[tuple[str, np.ndarray]], title: str, ax=None) -> Figure:
     """Peak lateral deflection [mm] in each revolution, one line per speed (log scale)."""
-    fig, ax = _own_axes(ax, (7.0, 4.0))
+    fig, ax = _own_axes(ax, (8.0, 4.2))
     for label, d in series:
         ax.plot(np.arange(1, len(d) + 1), d, "o-", ms=3, label=label)
     ax.set_yscale("log")
     ax.set_xlabel("revolution")
     ax.set_ylabel("peak lateral deflection [mm]")
-    ax.legend(fontsize=7)
-    ax.set_title(title)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False, title="crank speed")
+    ax.set_title(plain_text(title))
     return fig
 
 

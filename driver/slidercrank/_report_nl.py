@@ -159,6 +159,13 @@ def _tidy(material: str, pairs: list[tuple[Case, NLCase]]) -> pd.DataFrame:
     return with_units(pd.concat(frames, ignore_index=True), {"n_elements": "1"})
 
 
+def _buckled_words(nl: NLCase, tol: float, limit: float) -> str:
+    """Why the nonlinear rod counts as buckled at this speed, in a few words for a figure."""
+    if nl.grows(tol):
+        return f"grows {100 * nl.growth:.0f} % per revolution"
+    return f"lateral deflection {nl.peak_lateral * 1e3:.3g} mm > {limit * 1e3:.3g} mm"
+
+
 def _summary(pairs: list[tuple[Case, NLCase]], tol: float, limit: float,
              onset: dict[str, tuple[float, float] | None] | None) -> dict[str, Any]:
     out: dict[str, Any] = {}
@@ -247,9 +254,11 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
     figures = []
     good = [(lin, nl) for lin, nl in pairs if nl.ok and lin.ok]
     if good:
+        buckled = {f"{nl.omega:g} rad/s": _buckled_words(nl, tol, limit) for _, nl in good if nl.buckled(tol, limit)}
         figures.append(Figure("strain_linear_nonlinear", lambda: figures_module().slidercrank_nl_strain_figure(
             [(f"{nl.omega:g} rad/s", lin.angle_deg, lin.eps_1 * 1e6, nl.eps_ax[0] * 1e6) for lin, nl in good],
-            f"{params.material}: crank-end axial strain, linear (dashed) and nonlinear (solid)")))
+            f"{params.material}: crank-end axial strain, linear model and nonlinear rod, per crank speed",
+            buckled=buckled)))
     okn = [nl for nl in nls if nl.ok]
     if okn:
         figures.append(Figure("shapes", lambda: figures_module().slidercrank_nl_shapes_figure(
