@@ -278,14 +278,20 @@ def _trivial(y, x, chosen, unit: str = "") -> bool:
 
 @styled
 def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (), title: str = "",
-                  labels: dict[str, str] | None = None, preferred: Sequence[str] = ()) -> Figure:
+                  labels: dict[str, str] | None = None, preferred: Sequence[str] = (),
+                  searched: Mapping[str, Any] | None = None, n_cases: int | None = None) -> Figure:
     """Summary of a sweep: chosen (or the study's headline) figures against a swept key.
 
     ``labels`` maps column names to axis labels with units (driver._output.column_label);
     ``preferred`` are the study's headline columns, plotted when ``ys`` is empty.  Panels
     chosen automatically never repeat x, a constant or another panel.  With one numeric x
     the figures are drawn as lines over the cases, one line per value of the other keys;
-    when some cases are not kept, kept cases are circled.
+    when some cases are not kept, kept cases are circled.  When every headline figure is
+    constant over the rows (a table of the kept designs only), the kept designs' keys are drawn
+    against each other as points over the searched grid (``searched``: the values each key was
+    searched over; ``n_cases`` how many cases that made): a swept angle whose searched values
+    cover one period (a phase over a half turn) is drawn continuous along the kept points, not
+    wrapped back to 0 (:func:`unwrap_angle`).
     """
     import pandas as pd
     labels = labels or {}
@@ -310,6 +316,9 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
             ys = [k for k in keys if k != x and pd.api.types.is_numeric_dtype(frame[k])] or ordered[:1]
             keys = [k for k in keys if k not in ys]
             only_points = True   # a key against a key: points, no line (angles may wrap between them)
+    searched = {k: _numeric_axis(v) for k, v in (searched or {}).items()}
+    if only_points:
+        return _kept_keys(frame, x, list(ys), title, label, searched, n_cases)
     fig, axes = new_figure(len(ys), 1, sharex=True, figsize=(7.0, 1.9 * len(ys) + 0.9))
     kept = frame["kept"].astype(bool) if "kept" in frame else pd.Series(True, index=frame.index)
     others = [k for k in keys if k != x]
@@ -326,8 +335,8 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
             continue
         for key, g in groups:
             g = g.sort_values(x)
-            style = "-" if len(frame) <= 2000 and not only_points else ""
-            ax.plot(g[x], g[y], style, marker="o" if len(frame) <= 200 else ".", ms=3, lw=1,
+            style = "-" if len(frame) <= 2000 else "none"
+            ax.plot(g[x], g[y], ls=style, marker="o" if len(frame) <= 200 else ".", ms=3, lw=1,
                     label=", ".join(f"{labels.get(k, k).split(' [')[0]} = {plain_text(v)}"
                                     for k, v in zip(others, key if isinstance(key, tuple) else (key,))) or None)
         if not kept.all():
@@ -341,6 +350,42 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
     return fig
 
 
+def _kept_keys(frame, x: str, ys: list[str], title: str, label: Callable[[str], str],
+               searched: Mapping[str, np.ndarray], n_cases: int | None) -> Figure:
+    """The kept designs' swept keys against ``x`` as points, over the searched grid (grey dots),
+    on axes spanning the searched values; an angle key that covers one period unwrapped along x
+    (its label says modulo what)."""
+    import pandas as pd
+    fig, axes = new_figure(len(ys), 1, sharex=True, figsize=(7.0, 2.6 * len(ys) + 1.0))
+    kept = frame[frame["kept"].astype(bool)] if "kept" in frame else frame
+    order = kept.sort_values(x)
+    xv = pd.to_numeric(order[x], errors="coerce").to_numpy(dtype=float)
+    for ax, y in zip(axes, ys):
+        yv = pd.to_numeric(order[y], errors="coerce").to_numpy(dtype=float)
+        unit = label(y).rpartition("[")[2].rstrip("]")
+        period = angle_period(searched[y], unit) if y in searched else None
+        words = label(y)
+        if period is not None:
+            yv = unwrap_angle(yv, period)
+            words = f"{words}\n(mod {period:g}\u00b0, drawn continuous)"
+        if x in searched and y in searched:   # the searched grid behind the kept designs
+            gx, gy = np.meshgrid(searched[x], searched[y])
+            ax.plot(gx.ravel(), gy.ravel(), ".", ms=1.5, color="0.75", zorder=1, rasterized=gx.size > 2000,
+                    label=f"searched ({gx.size} designs)")
+            if period is not None and len(yv) and np.nanmax(yv) > searched[y][-1]:   # the next period, as far as drawn
+                top = gy.ravel() + period <= np.nanmax(yv) + 1e-9
+                ax.plot(gx.ravel()[top], gy.ravel()[top] + period, ".", ms=1.5, color="0.88", zorder=1,
+                        rasterized=gx.size > 2000)
+        ax.plot(xv, yv, "o", ms=6, color="C3", mec="k", zorder=3, label=f"kept ({len(order)})")
+        ax.set_ylabel(words)
+        plain_numbers(ax)
+    axes[0].legend(loc="lower left", bbox_to_anchor=(0.0, 1.02), ncol=2, frameon=False)
+    axes[-1].set_xlabel(label(x))
+    counted = f"{len(order)} kept of {n_cases} cases" if n_cases else f"{len(order)} kept designs"
+    fig.suptitle(f"{plain_text(title)}: the kept designs ({counted})" if title else f"the kept designs ({counted})")
+    return fig
+
+
 # ----------------------------------------------------------------------------- design spaces and convergence
 
 def _numeric_axis(values) -> np.ndarray:
@@ -350,15 +395,22 @@ def _numeric_axis(values) -> np.ndarray:
     return np.unique(v[np.isfinite(v)])
 
 
-def _grid_of(frame, kx: str, ky: str, col: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Values of ``col`` on the (kx, ky) grid of the rows of ``frame`` (NaN where no row)."""
+def _grid_of(frame, kx: str, ky: str, col: str, xs: np.ndarray | None = None,
+             ys: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Values of ``col`` on the (kx, ky) grid of the rows of ``frame`` (NaN where no row); the
+    grid's values ``xs``, ``ys`` (the searched ones), default the rows' own."""
     import pandas as pd
-    xs, ys = _numeric_axis(frame[kx]), _numeric_axis(frame[ky])
+    xs = _numeric_axis(frame[kx]) if xs is None else np.asarray(xs, dtype=float)
+    ys = _numeric_axis(frame[ky]) if ys is None else np.asarray(ys, dtype=float)
     z = np.full((len(ys), len(xs)), np.nan)
-    ix = np.searchsorted(xs, pd.to_numeric(frame[kx], errors="coerce").to_numpy(dtype=float))
-    iy = np.searchsorted(ys, pd.to_numeric(frame[ky], errors="coerce").to_numpy(dtype=float))
+    if not (len(xs) and len(ys)):
+        return xs, ys, z
+    fx = pd.to_numeric(frame[kx], errors="coerce").to_numpy(dtype=float)
+    fy = pd.to_numeric(frame[ky], errors="coerce").to_numpy(dtype=float)
+    ix = np.clip(np.searchsorted(xs, fx), 0, len(xs) - 1)
+    iy = np.clip(np.searchsorted(ys, fy), 0, len(ys) - 1)
     vals = pd.to_numeric(frame[col], errors="coerce").to_numpy(dtype=float)
-    ok = (ix < len(xs)) & (iy < len(ys))
+    ok = np.isclose(xs[ix], fx, rtol=1e-9, atol=1e-12) & np.isclose(ys[iy], fy, rtol=1e-9, atol=1e-12)
     z[iy[ok], ix[ok]] = vals[ok]
     return xs, ys, z
 
@@ -369,6 +421,24 @@ def _edges(v: np.ndarray) -> np.ndarray:
         return np.array([v[0] - 0.5, v[0] + 0.5])
     mid = 0.5 * (v[1:] + v[:-1])
     return np.concatenate([[2 * v[0] - mid[0]], mid, [2 * v[-1] - mid[-1]]])
+
+
+def outline_cells(ax, xe: np.ndarray, ye: np.ndarray, mask: np.ndarray, **kw: Any) -> None:
+    """Outline the cells of a map where ``mask`` ((ny, nx) bool) holds, along the cell edges
+    ``xe`` (nx + 1), ``ye`` (ny + 1): a line on every edge between a marked cell and an unmarked
+    one (or the map's border), so a single kept cell is a square, not a contour's sliver."""
+    from matplotlib.collections import LineCollection
+    m = np.pad(np.asarray(mask, dtype=bool), 1)
+    segs = []
+    vert = m[1:-1, 1:] != m[1:-1, :-1]       # (ny, nx + 1): edge left of column j
+    for i, j in zip(*np.nonzero(vert)):
+        segs.append([(xe[j], ye[i]), (xe[j], ye[i + 1])])
+    horiz = m[1:, 1:-1] != m[:-1, 1:-1]      # (ny + 1, nx): edge below row i
+    for i, j in zip(*np.nonzero(horiz)):
+        segs.append([(xe[j], ye[i]), (xe[j + 1], ye[i])])
+    if segs:
+        ax.add_collection(LineCollection(segs, colors=kw.get("color", "k"), linewidths=kw.get("lw", 1.2),
+                                         zorder=kw.get("zorder", 4)), autolim=False)
 
 
 def plain_numbers(ax) -> None:
@@ -383,7 +453,9 @@ def plain_numbers(ax) -> None:
 @styled
 def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, str] | None = None,
                      best: int | None = None, best_text: str = "", title: str = "", panels: int = 6,
-                     cmap: str = "viridis", only_kept: bool = False, ax=None) -> Figure:
+                     cmap: str = "viridis", only_kept: bool = False, ax=None,
+                     searched: Mapping[str, Any] | None = None, slices: Sequence[float] | None = None,
+                     slice_note: str = "") -> Figure:
     """A metric over the design space of a sweep, as a textbook prints it.
 
     ``frame`` has one row per case (the sweep summary: swept keys, ``kept``, the metric);
@@ -395,6 +467,10 @@ def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, 
     cells are designs not kept, not missing ones).  ``best`` is the frame index of the design to mark (a
     star labelled ``best_text``); ``labels`` maps columns to axis words with units.  With
     ``ax`` (one key or two) the map is drawn into that axes and its figure returned.
+    ``searched``: the values each key was searched over (the sweep's grid): the axes span them
+    and the cells sit on them, so a map of the kept designs shows where they lie in the searched
+    space.  ``slices``: the values of the third key to draw (the same in every map of one sweep,
+    :func:`sweep_maps`), ``slice_note`` the words that say how they were chosen.
     """
     import pandas as pd
     labels = labels or {}
@@ -432,19 +508,17 @@ def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, 
         return fig
 
     kx, ky = keys[0], keys[1]
+    searched = {k: _numeric_axis(v) for k, v in (searched or {}).items() if k in keys and len(_numeric_axis(v))}
+    parts: list[tuple[float | None, Any]]
     if len(keys) == 3:
         kz = keys[2]
-        zs = _numeric_axis(frame[kz])
-        pick = np.unique(np.linspace(0, len(zs) - 1, min(panels, len(zs))).round().astype(int))
-        if brow is not None:
-            bz = int(np.argmin(np.abs(zs - float(brow[kz]))))
-            if bz not in pick:
-                pick[np.argmin(np.abs(pick - bz))] = bz
-            pick = np.unique(pick)
-        slices = [(zs[i], frame[np.isclose(pd.to_numeric(frame[kz], errors="coerce"), zs[i])]) for i in pick]
+        if slices is None:
+            slices = pick_slices(frame, kz, panels, brow[kz] if brow is not None else None)
+        zcol = pd.to_numeric(frame[kz], errors="coerce")
+        parts = [(float(z), frame[np.isclose(zcol, z)]) for z in slices]
     else:
-        kz, slices = "", [(None, frame)]
-    n = len(slices)
+        kz, parts = "", [(None, frame)]
+    n = len(parts)
     if ax is not None and n == 1:
         fig, axes = ax.figure, [ax]
     else:
@@ -455,24 +529,22 @@ def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, 
         axes = list(grid)
         for extra in axes[n:]:
             extra.set_visible(False)
-    xs_all, ys_all = _numeric_axis(frame[kx]), _numeric_axis(frame[ky])
+    xs_all = searched.get(kx, _numeric_axis(frame[kx]))
+    ys_all = searched.get(ky, _numeric_axis(frame[ky]))
     image = None
-    for a, (zval, part) in zip(axes, slices):
-        xs, ys, z = _grid_of(part, kx, ky, metric)
-        _, _, keep = _grid_of(part.assign(_kept=kept[part.index].astype(float)), kx, ky, "_kept")
+    for a, (zval, part) in zip(axes, parts):
+        xs, ys, z = _grid_of(part, kx, ky, metric, xs_all if kx in searched else None,
+                             ys_all if ky in searched else None)
+        _, _, keep = _grid_of(part.assign(_kept=kept[part.index].astype(float)), kx, ky, "_kept",
+                              xs_all if kx in searched else None, ys_all if ky in searched else None)
         a.grid(False)
         a.set_facecolor("0.93")
         image = a.pcolormesh(_edges(xs), _edges(ys), np.ma.masked_invalid(z), cmap=cmap, norm=norm,
                              shading="flat", rasterized=True)
         if np.nansum(keep) and not np.all(keep[np.isfinite(keep)] == 1):
-            k = np.nan_to_num(keep, nan=0.0)
-            a.contour(xs, ys, k, levels=[0.5], colors="k", linewidths=1.2)
+            outline_cells(a, _edges(xs), _edges(ys), np.nan_to_num(keep, nan=0.0) > 0.5)
         if brow is not None and (zval is None or np.isclose(float(brow[kz]), zval)):
             a.plot([brow[kx]], [brow[ky]], "*", ms=15, color="C3", mec="k", mew=0.8, zorder=5)
-            right = float(brow[kx]) > 0.5 * (xs_all[0] + xs_all[-1])
-            a.annotate("best", (brow[kx], brow[ky]), xytext=(-9 if right else 9, 7), textcoords="offset points",
-                       ha="right" if right else "left", fontsize=9, fontweight="bold", color="k",
-                       bbox=dict(boxstyle="round,pad=0.15", fc="w", ec="none", alpha=0.8))
         a.set_xlim(_edges(xs_all)[[0, -1]])
         a.set_ylim(_edges(ys_all)[[0, -1]])
         if zval is not None:
@@ -483,8 +555,13 @@ def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, 
             a.set_xlabel(lab(kx))
         if a.get_subplotspec() is None or a.get_subplotspec().is_first_col() or n == 1:
             a.set_ylabel(lab(ky))
-    if brow is not None and best_text:   # the best design's values, under the panels
-        fig.supxlabel("\u2605 " + wrap(best_text, 110), fontsize=8.5, color="0.15")
+    if (brow is not None and best_text) or slice_note:   # the best design's values and the slices, under the panels
+        hidden = brow is not None and kz and not any(z is not None and np.isclose(float(brow[kz]), z) for z, _ in parts)
+        words = ("\u2605 " + wrap(best_text + ("; its slice is not among those drawn" if hidden else ""), 110)
+                 if brow is not None and best_text else "")
+        if slice_note:
+            words = f"{words}\n{wrap(slice_note, 110)}" if words else wrap(slice_note, 110)
+        fig.supxlabel(words, fontsize=8.5, color="0.15")
     if image is None:   # no panel (an empty frame)
         raise ValueError("design_space_map: no design to draw")
     cb = fig.colorbar(image, ax=list(axes[:n]), shrink=0.9, pad=0.02)
@@ -655,12 +732,45 @@ def _words_value(label: str, value: float, name: bool = True) -> str:
     return f"{words} {text}" if name else text
 
 
+def pick_slices(frame, kz: str, panels: int = 6, must: Any = None) -> list[float]:
+    """Up to ``panels`` values of the third swept key ``kz`` for a map's small multiples: evenly
+    over the values whose rows hold a kept design (all values when none is kept), with ``must``
+    (the best design's value) among them."""
+    import pandas as pd
+    col = pd.to_numeric(frame[kz], errors="coerce")
+    kept = frame["kept"].astype(bool) if "kept" in frame else pd.Series(True, index=frame.index)
+    zs = _numeric_axis(col[kept]) if kept.any() else _numeric_axis(col)
+    if not len(zs):
+        zs = _numeric_axis(col)
+    pick = np.unique(np.linspace(0, len(zs) - 1, min(panels, len(zs))).round().astype(int))
+    if must is not None and np.isfinite(float(must)):
+        bz = int(np.argmin(np.abs(zs - float(must))))
+        if bz not in pick:
+            pick[np.argmin(np.abs(pick - bz))] = bz
+        pick = np.unique(pick)
+    return [float(zs[i]) for i in pick]
+
+
 def sweep_maps(frame, keys: Sequence[str], ys: Sequence[str], labels: dict[str, str], senses: Mapping[str, str],
-               title: str = "", only_kept: bool = False) -> list[Figure]:
+               title: str = "", only_kept: bool = False, searched: Mapping[str, Any] | None = None) -> list[Figure]:
     """Design-space maps of a 2-3-key grid sweep, one per plotted column ``ys``: the best kept
     design (by ``senses[y]``, 'min' or 'max', when the study knows which is better) starred and
-    labelled with its key values."""
+    labelled with its key values.  ``searched``: the values each key was searched over (the axes
+    span them).  Over three keys every map shows the same values of the third (chosen once, by
+    the first column's best design, and stated under the panels)."""
     figs = []
+    slices, note = None, ""
+    keys = list(keys)
+    if len(keys) == 3 and ys:
+        kz = keys[2]
+        first = best_index(frame, ys[0], senses.get(ys[0]))
+        slices = pick_slices(frame, kz, 6, frame.loc[first, kz] if first is not None else None)
+        every = _numeric_axis((searched or {}).get(kz, frame[kz]))
+        word = labels.get(kz, kz).split(" [")[0]
+        shown = ", ".join(f"{z:.4g}" for z in slices)
+        note = (f"{word} = {shown}: {len(slices)} of the {len(every)} searched values"
+                + (f" ({every[0]:.4g} to {every[-1]:.4g})" if len(every) > 1 else "")
+                + ", evenly over those with kept designs; the same in every map of this sweep")
     for y in ys:
         best = best_index(frame, y, senses.get(y))
         text = ""
@@ -671,7 +781,7 @@ def sweep_maps(frame, keys: Sequence[str], ys: Sequence[str], labels: dict[str, 
                 f"; {labels.get(y, y).split(' [')[0]} {_words_value(labels.get(y, y), frame.loc[best, y], name=False)}"
         figs.append(design_space_map(frame, keys, y, labels, best=best, best_text=text,
                                      title=f"{plain_text(title)}: {labels.get(y, y)}" if title else labels.get(y, y),
-                                     only_kept=only_kept))
+                                     only_kept=only_kept, searched=searched, slices=slices, slice_note=note))
     return figs
 
 

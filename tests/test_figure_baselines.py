@@ -58,7 +58,7 @@ def _design_map(keys: int):
         return plotting.design_space_map(frame, names, "mu_min_deg", labels, best=best, best_text="best",
                                          title="one swept key")
     return plotting.sweep_maps(frame, names, ["mu_min_deg"], labels, driver.fourbar.SWEEP_BEST,
-                               title=f"{keys} swept keys")[0]
+                               title=f"{keys} swept keys", searched={f"fourbar.{k}": v for k, v in grid.items()})[0]
 
 
 def _convergence():
