@@ -12,11 +12,13 @@ if TYPE_CHECKING:   # annotations only: keeps `python -m driver --help` light
     import matplotlib.figure
     import pandas as pd
 
-__all__ = ["Figure", "PLOT_FORMATS", "Result", "plot_format"]
+__all__ = ["Figure", "PLOT_FORMATS", "ANIMATION_FORMATS", "Result", "plot_format"]
 
 
 #: file formats of ``--plot`` figures (``--plot-format``); the first is the default
 PLOT_FORMATS = ("png", "svg", "pdf")
+#: file formats of the mechanism's animation (``--animation``): GIF through Pillow, MP4 through ffmpeg
+ANIMATION_FORMATS = ("gif", "mp4")
 
 
 def plot_format(plot: bool | str | None) -> str | None:
@@ -81,6 +83,10 @@ class Result:
         Namelist group of the study (set by the runner).
     params : Params or None
         The validated deck keys the run was made from (set by the runner).
+    data : dict of str to object
+        Arrays of the run that no table holds, for its study's figures and the report page's
+        animation (the slider-crank's nonlinear rod: ``'rod'``, its nodes' lateral deflection
+        over the recorded revolution); never written to a file.
     """
 
     text: str
@@ -95,6 +101,8 @@ class Result:
     #: the validated deck keys the run was made from (set by the runner; the report page's
     #: animation and comparison use them)
     params: Any = field(default=None, repr=False, compare=False)
+    #: arrays no table holds, for the study's figures and the page's animation (not written)
+    data: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
 
     @property
     def out(self) -> str:

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 import f90nml
 
+from driver._mechanism import Mark, MechanismFrames
 from driver._outcome import OptimizeOutcome, Outcome, RunOutcome, SweepOutcome, SynthesisOutcome
 from driver._report_page._animation import study_animation
 from driver._report_page._blocks import (
@@ -37,7 +38,7 @@ if TYPE_CHECKING:
     from driver._deck import Deck, Params
     from driver._result import Result
 
-__all__ = ["page_of", "result_sections", "deck_text"]
+__all__ = ["page_of", "result_sections", "deck_text", "outcome_frames"]
 
 #: what the animation's caption adds to the study's
 HINT = "Drag the slider or press play."
@@ -71,11 +72,13 @@ def _anim_id(name: str) -> str:
     return "anim-" + (re.sub(r"[^A-Za-z0-9]", "", name) or "x")
 
 
-def _run_blocks(result: Result, params: Params | None, what: str) -> tuple[list[Block], list[str]]:
-    """A run's animation, figures and headline figures, as blocks (the parts of a design a
-    sweep, an optimisation or a synthesis draws); and the figures that could not be drawn."""
+def _run_blocks(result: Result, params: Params | None, what: str,
+                marks: tuple[Mark, ...] = ()) -> tuple[list[Block], list[str]]:
+    """A run's animation (``marks`` added: a synthesis's targets), figures and headline figures,
+    as blocks (the parts of a design a sweep, an optimisation or a synthesis draws); and the
+    figures that could not be drawn."""
     blocks: list[Block] = []
-    view = study_animation(params, result, _anim_id(result.name), f"{what} {HINT}")
+    view = study_animation(params, result, _anim_id(result.name), f"{what} {HINT}", marks)
     if view is not None:
         blocks.append(Animation(view))
     figs, failed = figure_blocks(result.figures, result.name)
@@ -207,13 +210,22 @@ def _optimize_page(oc: OptimizeOutcome, deck: Deck | None) -> Page:
     return Page(f"{oc.name}: optimisation", sub, sections, run_metadata())
 
 
+def _targets(oc: SynthesisOutcome) -> tuple[Mark, ...]:
+    """A path synthesis's target points, in its linkage's frame, for the animation."""
+    syn = oc.value
+    if syn is None or getattr(syn.params, "task", "") != "path" or syn.design is None:
+        return ()
+    from driver.synthesis import path_targets
+    return (Mark(path_targets(syn), "target points"),)
+
+
 def _synthesis_page(oc: SynthesisOutcome, deck: Deck | None) -> Page:
     notes: list[str] = []
     blocks: list[Block] = []
     figs, failed = figure_blocks(oc.figures, oc.name)
     notes += failed
     if oc.result is not None:
-        blocks, failed = _run_blocks(oc.result, oc.params, "The synthesised linkage.")
+        blocks, failed = _run_blocks(oc.result, oc.params, "The synthesised linkage.", _targets(oc))
         notes += failed
         if oc.linkage_deck:
             blocks.append(Details(f"{oc.name}.linkage.dat", [Pre(oc.linkage_deck)]))
@@ -226,6 +238,23 @@ def _synthesis_page(oc: SynthesisOutcome, deck: Deck | None) -> Page:
                                       "deck it writes (--compare).")
     linkage = f" of a &{oc.result.study} linkage" if oc.result is not None else ""
     return Page(f"{oc.name}: synthesis", f"synthesis ({oc.task}){linkage}", sections, run_metadata())
+
+
+def outcome_frames(outcome: Outcome) -> tuple[MechanismFrames | None, str]:
+    """The mechanism the page of ``outcome`` animates, as frames, and whose it is: a run's, a
+    sweep's best case's, an optimisation's optimum's, the synthesised linkage's (its targets
+    added); (None, '') when there is none (no such run, or a study without an animation)."""
+    from driver._report_page._animation import study_frames
+    if isinstance(outcome, RunOutcome):
+        r = outcome.result
+        return study_frames(r.params, r), r.name
+    if isinstance(outcome, SweepOutcome) and outcome.best is not None:
+        return study_frames(outcome.best.params, outcome.best), f"{outcome.name}, case {outcome.best_case}"
+    if isinstance(outcome, OptimizeOutcome) and outcome.optimum is not None:
+        return study_frames(outcome.optimum.params, outcome.optimum.result), f"{outcome.name}, the optimum"
+    if isinstance(outcome, SynthesisOutcome) and outcome.result is not None:
+        return study_frames(outcome.params, outcome.result, _targets(outcome)), f"{outcome.name}, the linkage"
+    return None, ""
 
 
 def page_of(outcome: Outcome, deck: Deck | None = None) -> Page:

@@ -349,11 +349,33 @@ def animation_frames(params: Params, result: Result | None = None, n: int = 180)
     if cp is not None:
         pts[ok, 4] = cp[ok, :2]
     coupler = Link("coupler", (1, 2, 4), body=True) if cp is not None else Link("coupler", (1, 2))
+    links = [Link("crank", (0, 1)), coupler, Link(output_name(params), (3, 2))]
+    masses: tuple[int, ...] = ()
+    cw = counterweight_view(params)
+    if cw is not None:   # the Berkof-Lowen counterweights ride on crank and output link, off their lines
+        crank_dir = np.arctan2(pts[:, 1, 1], pts[:, 1, 0])
+        out_dir = np.arctan2(pts[:, 2, 1], pts[:, 2, 0] - g)
+        extra = []
+        for k, (pivot, direction, name) in enumerate(((0, crank_dir, "crank counterweight"),
+                                                      (3, out_dir, f"{output_name(params)} counterweight"))):
+            radius, off, mass = cw["radius"][k], np.radians(cw["angle_deg"][k]), cw["mass"][k]
+            if mass > 0 and radius > 0:
+                at = pts[:, pivot] + radius * np.column_stack([np.cos(direction + off), np.sin(direction + off)])
+                extra.append((f"{name} {mass:.3g} kg", at, pivot, k))
+        if extra:
+            pts = np.concatenate([pts, np.stack([e[1] for e in extra], axis=1)], axis=1)
+            base = len(names)
+            names = names + tuple(e[0] for e in extra)
+            links += [Link(f"arm of the {e[0].rpartition(' ')[0].rpartition(' ')[0]}", (e[2], base + j),
+                           colour=(0, 2)[e[3]]) for j, e in enumerate(extra)]
+            masses = tuple(range(base, base + len(extra)))
     return MechanismFrames(
-        names=names, points=pts, links=(Link("crank", (0, 1)), coupler, Link(output_name(params), (3, 2))),
+        names=names, points=pts, links=tuple(links), masses=masses,
         labels=tuple(f"{t:.0f}\u00b0" + (phase[k] if phase else "") for k, t in enumerate(np.round(theta, 6))),
+        units=length_units(params),
         ground=(0, 3), joints=(1, 2), markers=(4,) if cp is not None else (), guides=tuple(guides),
         paths=(1, 2, 4) if cp is not None else (1, 2), segments=tuple(segments), frame_name="crank angle",
         caption="The linkage over " + ("its rocking motions between the limit positions (dashed)" if motions
-                                       else "one crank turn") + ", positions from the kernel's closed loop.",
+                                       else "one crank turn") + ", positions from the kernel's closed loop."
+        + (" Discs: the Berkof-Lowen counterweights of the force balance." if masses else ""),
         invalid_note="the linkage cannot be assembled at this crank angle")

@@ -268,7 +268,21 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
         [(f"{c.omega:g} rad/s", c.rev_lat[:max(c.steps_done - 1, 0) // c.steps_per_rev + 1] * 1e3)
          for c in nls if c.steps_done], f"{params.material}: peak lateral deflection per revolution")))
     return Result(text="\n".join(text) + "\n", tidy=_tidy(params.material, pairs),
-                  summary=_summary(pairs, tol, limit, onset), warnings=warnings, failure=failure, figures=figures)
+                  summary=_summary(pairs, tol, limit, onset), warnings=warnings, failure=failure, figures=figures,
+                  data=_rod_data(okn))
+
+
+def _rod_data(okn: list[NLCase]) -> dict[str, Any]:
+    """The deflected rod the report page animates: the fastest speed whose nonlinear run
+    finished, its nodes' lateral deflection [m] over the recorded revolution (``lateral``:
+    (nodes, frames) at crank angles ``angle_deg``)."""
+    if not okn:
+        return {}
+    c = max(okn, key=lambda nl: nl.omega)
+    if not c.frames.size:
+        return {}
+    return {"rod": {"omega_rad_s": c.omega, "n_elements": c.n_elements, "angle_deg": np.asarray(c.frame_deg),
+                    "lateral_m": np.asarray(c.frames)}}
 
 
 @study_run(SPEC)
