@@ -25,7 +25,7 @@ import numpy as np
 
 from driver._atomic import atomic_open
 from driver._extras import require
-from driver._result import PLOT_FORMATS, plot_format
+from driver._result import ANIMATION_FORMATS, PLOT_FORMATS, plot_format
 
 require("plot")   # a clear message naming the [plot] extra when matplotlib is missing; then import it:
 import matplotlib  # noqa: E402 (after require above)
@@ -785,3 +785,121 @@ def sweep_maps(frame, keys: Sequence[str], ys: Sequence[str], labels: dict[str, 
     return figs
 
 
+
+
+# ----------------------------------------------------------------------------- the mechanism's animation
+
+def mechanism_animation(frames: Any, title: str = "", figsize: tuple[float, float] = (6.4, 4.8),
+                        max_frames: int = 120) -> Any:
+    """The motion of a mechanism (a :class:`driver._mechanism.MechanismFrames`, what the report
+    page animates) as a matplotlib ``FuncAnimation``: the same parts in the same colours (links,
+    rigid bodies, pins, coupler points, counterweights, ground marks, guides, traced paths and
+    target points), equal scales, the frame's label as the title.  Points that do not exist at
+    a frame hide the parts through them; at most ``max_frames`` frames (every k-th).  Drawn in
+    the house style; no pyplot state."""
+    from matplotlib.animation import FuncAnimation
+    from matplotlib.patches import Polygon
+
+    from driver._mechanism import LINK_COLOURS, MARK_COLOUR, MASS_COLOUR, PATH_COLOURS
+    step = max(1, -(-frames.n_frames // max_frames))
+    with style():
+        fig, (ax,) = new_figure(1, 1, figsize=figsize)
+        ax.set_aspect("equal")
+        ax.grid(False)
+        x0, y0, w, h = frames.extent()
+        pad = 0.08 * max(w, h, 1e-9)
+        ax.set_xlim(x0 - pad, x0 + w + pad)
+        ax.set_ylim(y0 - pad, y0 + h + pad)
+        ax.set_axis_off()   # a drawing for slides: no ticks (and a frame draws in a fraction of the time)
+        pts = frames.points
+        for g in frames.guides:
+            xy = np.vstack([g.xy, g.xy[:1]]) if g.closed else g.xy
+            ax.plot(xy[:, 0], xy[:, 1], color="0.35", lw=0.8, ls="--" if g.dashed else "-", zorder=1)
+        for j, i in enumerate(frames.paths):
+            for a, b in frames.runs():
+                seg = pts[a:b, i]
+                if frames.closed_paths():
+                    seg = np.vstack([seg, seg[:1]])
+                ax.plot(seg[:, 0], seg[:, 1], color=PATH_COLOURS[j % len(PATH_COLOURS)], lw=0.9, ls="--", zorder=2)
+        artists: list[tuple[Any, tuple[int, ...], str]] = []
+        for k, link in enumerate(frames.links):
+            colour = LINK_COLOURS[(k if link.colour is None else link.colour) % len(LINK_COLOURS)]
+            if link.body:
+                patch = Polygon(np.zeros((len(link.points), 2)), closed=True, fc=matplotlib.colors.to_rgba(colour, 0.25),
+                                ec=colour, lw=2.6, joinstyle="round", zorder=3)
+                ax.add_patch(patch)
+                artists.append((patch, link.points, "body"))
+            else:
+                (line,) = ax.plot([], [], color=colour, lw=3.0, solid_capstyle="round", solid_joinstyle="round",
+                                  zorder=3)
+                artists.append((line, link.points, "line"))
+        dots = []
+        for idx, kw in ((frames.joints, dict(marker="o", ms=7, mfc="white", mec="k", mew=1.0, zorder=6)),
+                        (frames.markers, dict(marker="o", ms=6, color="#8e44ad", zorder=6)),
+                        (frames.masses, dict(marker="o", ms=12, color=MASS_COLOUR, mec="k", zorder=5))):
+            for i in idx:
+                (dot,) = ax.plot([], [], ls="none", **kw)
+                dots.append((dot, i))
+        for i in frames.ground:
+            ax.plot(*pts[0, i], "^", color="0.3", ms=11, zorder=4)
+        for m in frames.marks:
+            ax.plot(m.xy[:, 0], m.xy[:, 1], "s", mfc="none", mec=MARK_COLOUR, mew=1.4, ms=8, zorder=7)
+        label = ax.set_title("")
+
+        def show(k: int) -> list[Any]:
+            for artist, idx, kind in artists:
+                xy = pts[k, list(idx)]
+                ok = bool(np.isfinite(xy).all())
+                artist.set_visible(ok)
+                if ok and kind == "body":
+                    artist.set_xy(xy)
+                elif ok:
+                    artist.set_data(xy[:, 0], xy[:, 1])
+            for dot, i in dots:
+                ok = bool(np.isfinite(pts[k, i]).all())
+                dot.set_visible(ok)
+                if ok:
+                    dot.set_data([pts[k, i, 0]], [pts[k, i, 1]])
+            words = f"{frames.frame_name} {frames.labels[k]}"
+            if frames.units:
+                words += f"   (lengths in {frames.units})"
+            if not frames.valid[k]:
+                words += f"  ({frames.invalid_note})"
+            label.set_text(f"{plain_text(title)}\n{words}" if title else words)
+            return [a for a, _, _ in artists] + [d for d, _ in dots] + [label]
+
+        show(0)
+        # lay the figure out once (room for a two-line title), then keep it: every frame moves the
+        # parts only, and a layout per frame would cost more than the drawing
+        label.set_text(f"{plain_text(title)}\nX" if title else "X")
+        fig.draw_without_rendering()
+        fig.set_layout_engine("none")
+        show(0)
+    return FuncAnimation(fig, show, frames=range(0, frames.n_frames, step), interval=1000 // 25, blit=False)
+
+
+def save_animation(frames: Any, path: str | Path, fmt: str = "gif", title: str = "", fps: int = 25,
+                   dpi: int = 90) -> Path:
+    """Write the motion of a mechanism (:func:`mechanism_animation`) as ``path`` with the suffix
+    of ``fmt``: 'gif' through matplotlib's Pillow writer, 'mp4' (H.264) through its ffmpeg writer
+    (ffmpeg must be on PATH).  Encoded in a scratch folder, then written atomically (as every
+    output: an interrupted export never leaves half a file).  Returns the path written."""
+    import tempfile
+
+    from matplotlib.animation import FFMpegWriter, PillowWriter, writers
+    fmt = str(fmt).lower().lstrip(".")
+    if fmt not in ANIMATION_FORMATS:
+        raise ValueError(f"animation format {fmt!r} is not one of {', '.join(ANIMATION_FORMATS)}")
+    if fmt == "mp4" and not writers.is_available("ffmpeg"):
+        raise RuntimeError("an MP4 animation needs ffmpeg on PATH (apt-get install ffmpeg); GIF needs nothing more")
+    path = Path(path).with_suffix(f".{fmt}")
+    anim = mechanism_animation(frames, title)
+    writer = PillowWriter(fps=fps) if fmt == "gif" else FFMpegWriter(fps=fps, codec="h264",
+                                                                       extra_args=["-pix_fmt", "yuv420p"])
+    with tempfile.TemporaryDirectory(prefix="driver_animation_") as scratch:
+        tmp = Path(scratch) / f"animation.{fmt}"
+        with style():
+            anim.save(str(tmp), writer=writer, dpi=dpi)
+        with atomic_open(path, "wb") as fh:
+            fh.write(tmp.read_bytes())
+    return path

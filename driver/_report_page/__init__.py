@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 from driver._report_page._animation import ANIMATION_FRAMES, animation_view
 from driver._report_page._figures import figure_svg, plain
 from driver._report_page._render import render_fragment, render_page, run_metadata
-from driver._report_page._sections import page_of, result_sections
+from driver._report_page._sections import outcome_frames, page_of, result_sections
 
 if TYPE_CHECKING:
     from driver._deck import Deck
@@ -31,7 +31,7 @@ if TYPE_CHECKING:
     from driver._result import Result
 
 __all__ = ["MAX_PAGE_BYTES", "ANIMATION_FRAMES", "page", "fragment", "write_report", "figure_svg", "plain",
-           "run_metadata", "animation_view"]
+           "run_metadata", "animation_view", "outcome_frames", "write_animation"]
 
 #: the page size the browser test holds every shipped report to [bytes] (the SVG figures are most of it)
 MAX_PAGE_BYTES = 6_000_000
@@ -61,6 +61,17 @@ def fragment(result: Result) -> str:
     page around them (for a notebook's rich display), made by the page's own templates."""
     sections, _ = result_sections(result, result.params, None, "")
     return render_fragment(sections)
+
+
+def write_animation(stem: Path, outcome: Outcome, fmt: str) -> Path | None:
+    """Write the animation the report page plays as ``<stem>_animation.<fmt>`` ('gif' or 'mp4':
+    :func:`driver.plotting.save_animation`, from the same frames); None when the outcome has no
+    mechanism to animate."""
+    frames, whose = outcome_frames(outcome)
+    if frames is None:
+        return None
+    from driver.plotting import save_animation
+    return save_animation(frames, stem.with_name(f"{stem.name}_animation.{fmt}"), fmt, title=whose)
 
 
 def write_report(path: Path, text: str) -> Path:
