@@ -43,6 +43,10 @@ STYLE: dict[str, Any] = {"figure.dpi": 150, "savefig.dpi": 150, "axes.grid": Tru
 
 _F = TypeVar("_F", bound=Callable[..., Any])
 
+#: a scatter of more points than this is drawn as an image inside a vector figure (SVG, PDF):
+#: each point as a vector marker would make a report page of megabytes that scrolls slowly
+RASTER_POINTS = 400
+
 
 def plain_text(text: Any) -> str:
     """Text from a deck (a title, a design name, the deck's file name, a value, an expression)
@@ -370,12 +374,12 @@ def _kept_keys(frame, x: str, ys: list[str], title: str, label: Callable[[str], 
             words = f"{words}\n(mod {period:g}\u00b0, drawn continuous)"
         if x in searched and y in searched:   # the searched grid behind the kept designs
             gx, gy = np.meshgrid(searched[x], searched[y])
-            ax.plot(gx.ravel(), gy.ravel(), ".", ms=1.5, color="0.75", zorder=1, rasterized=gx.size > 2000,
+            ax.plot(gx.ravel(), gy.ravel(), ".", ms=1.5, color="0.75", zorder=1, rasterized=gx.size > RASTER_POINTS,
                     label=f"searched ({gx.size} designs)")
             if period is not None and len(yv) and np.nanmax(yv) > searched[y][-1]:   # the next period, as far as drawn
                 top = gy.ravel() + period <= np.nanmax(yv) + 1e-9
                 ax.plot(gx.ravel()[top], gy.ravel()[top] + period, ".", ms=1.5, color="0.88", zorder=1,
-                        rasterized=gx.size > 2000)
+                        rasterized=gx.size > RASTER_POINTS)
         ax.plot(xv, yv, "o", ms=6, color="C3", mec="k", zorder=3, label=f"kept ({len(order)})")
         ax.set_ylabel(words)
         plain_numbers(ax)
@@ -610,7 +614,7 @@ def convergence_plot(history, evals, objective: str, sense: str = "minimize", ti
     sign = -1.0 if sense.startswith("max") else 1.0
     obj = pd.to_numeric(feas["objective"], errors="coerce").to_numpy(dtype=float)
     tol = tolerance if tolerance is not None and tolerance > 0 else None
-    a1.plot(feas["eval"], obj, ".", ms=2.5, color="0.65", label="feasible designs", rasterized=len(obj) > 2000)
+    a1.plot(feas["eval"], obj, ".", ms=2.5, color="0.65", label="feasible designs", rasterized=len(obj) > RASTER_POINTS)
     if len(obj):
         best = sign * np.minimum.accumulate(sign * obj)
         at = feas["eval"].to_numpy(dtype=float)
@@ -667,7 +671,7 @@ def convergence_plot(history, evals, objective: str, sense: str = "minimize", ti
     if viol.size and np.nanmax(viol) > 0:
         pos = viol > 0
         a3.plot(ev["eval"].to_numpy()[pos], viol[pos], ".", ms=2.5, color="C0", alpha=0.6,
-                label="constraint violation of each design", rasterized=pos.sum() > 2000)
+                label="constraint violation of each design", rasterized=pos.sum() > RASTER_POINTS)
         run = np.minimum.accumulate(np.where(np.isfinite(viol), viol, np.inf))
         shown = run > 0
         a3.step(ev["eval"].to_numpy()[shown], run[shown], where="post", color="k", lw=1.4,

@@ -311,9 +311,10 @@ def test_manipulator_torque_curves_mark_rows_violating_the_reach_conditions():
     result = compute(module, params)
     fig = next(f.draw() for f in result.figures if f.name == "torque_crob")
     (ax,) = fig.axes
-    curves = {ln.get_label(): ln for ln in ax.get_lines() if ln.get_label().startswith("tau")}
-    l1 = np.asarray(curves["tau1"].get_xdata(), dtype=float)
-    drawn = np.isfinite(np.asarray(curves["tau1"].get_ydata(), dtype=float))
+    curves = {ln.get_label(): ln for ln in ax.get_lines() if ln.get_label().startswith("$\\tau")}
+    shoulder = curves["$\\tau_1$ (shoulder)"]
+    l1 = np.asarray(shoulder.get_xdata(), dtype=float)
+    drawn = np.isfinite(np.asarray(shoulder.get_ydata(), dtype=float))
     c = 51.5                                        # C_rob: l1^2 + l2^2 [m^2] of this deck
     l2 = np.sqrt(c - l1 ** 2)
     r, R = result.summary["r_m"], result.summary["R_m"]

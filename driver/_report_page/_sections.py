@@ -9,6 +9,7 @@ run again and no file the engine wrote is read back; the deck is echoed as its f
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -32,6 +33,7 @@ from driver._report_page._blocks import (
     warnings_section,
 )
 from driver._report_page._figures import figure_blocks, figure_svg, plain
+from driver._report_page._numbers import Printed, summary_texts
 from driver._report_page._render import run_metadata
 
 if TYPE_CHECKING:
@@ -60,12 +62,44 @@ def deck_text(deck: Deck | None, params: Params | None = None) -> str:
     return ""
 
 
-def _labels(study: str, names: Any) -> dict[str, str]:
-    """Each summary column's name in words with its unit (the column name is its tooltip)."""
+def _labels(study: str, names: Any, units: Mapping[str, str] | None = None) -> dict[str, str]:
+    """Each column's name in words with its unit (the column name is its tooltip): the study's
+    labels, else ``units`` (a tidy table's ``attrs['units']``) for a name that does not say its
+    unit."""
     from driver._output import column_label
     from driver._study import load_study
     module = load_study(study) if study else None
-    return {n: plain(column_label(module, n)) for n in names} if module is not None else {}
+    out = {}
+    for n in names:
+        words = plain(column_label(module, str(n)))
+        unit = (units or {}).get(n)
+        if "[" not in words and unit not in (None, "", "1"):
+            words = f"{words} [{'length units' if unit == 'length' else unit}]"
+        out[n] = words
+    return out
+
+
+def _unit(label: str) -> str:
+    """The unit in a label's brackets ('' when none)."""
+    m = re.search(r"\[([^\[\]]*)\]\s*$", label)
+    return m.group(1) if m else ""
+
+
+def _summary_block(result: Result) -> Block:
+    """The headline figures: names in words with units (the column name as tooltip), numbers as
+    the run's .out prints them, zeros as zeros."""
+    labels = _labels(result.study, result.summary)
+    printed = Printed(result.text + "\n" + "\n".join(result.extra.values()))
+    texts = summary_texts(result.summary, printed, {k: _unit(v) for k, v in labels.items()})
+    return key_values(result.summary, labels, texts)
+
+
+def _tidy_table(result: Result) -> Block:
+    """The tidy table: names in words, numbers to the .out's decimals (or six significant
+    digits of their column)."""
+    tidy = result.tidy
+    labels = _labels(result.study, tidy.columns, tidy.attrs.get("units"))
+    return frame_table(tidy, labels=labels, printed=Printed(result.text))
 
 
 def _anim_id(name: str) -> str:
@@ -84,7 +118,7 @@ def _run_blocks(result: Result, params: Params | None, what: str,
     figs, failed = figure_blocks(result.figures, result.name)
     blocks += figs
     if result.summary:
-        blocks.append(key_values(result.summary, _labels(result.study, result.summary)))
+        blocks.append(_summary_block(result))
     return blocks, failed
 
 
@@ -100,15 +134,14 @@ def result_sections(result: Result, params: Params | None, comparison: Any,
     if figs:
         sections.append(Section("figures", "figures", list(figs)))
     if result.summary:
-        sections.append(Section("summary", "headline figures",
-                                [key_values(result.summary, _labels(result.study, result.summary))]))
+        sections.append(Section("summary", "headline figures", [_summary_block(result)]))
     sections.append(Section("published", "comparison with the published tables",
                             comparison_blocks(comparison, comparison_note)))
     tables: list[Block] = [Pre(result.text)]
     tables += [Details(result.name + suffix, [Pre(text)]) for suffix, text in result.extra.items()]
     sections.append(Section("tables", "tables (.out)", tables))
     if result.tidy is not None and len(result.tidy):
-        sections.append(Section("tidy", "tidy table", [frame_table(result.tidy)]))
+        sections.append(Section("tidy", "tidy table", [_tidy_table(result)]))
     return sections, failed
 
 
@@ -178,7 +211,9 @@ def _sweep_page(oc: SweepOutcome, deck: Deck | None) -> Page:
     sections.append(Section("tables", "sweep summary (.out)",
                             [Pre(oc.text)] if oc.text else [Text(f"See {oc.name}.out.", "note")]))
     if summary is not None:
-        sections.append(Section("summary-table", "summary table", [frame_table(summary)]))
+        sections.append(Section("summary-table", "summary table",
+                                [frame_table(summary, labels=_labels(oc.study, summary.columns),
+                                             printed=Printed(oc.text or ""))]))
     _close(sections, oc, deck, notes, "A sweep runs a study over many cases; the published tables belong to "
                                       "single-case decks.")
     rows = len(summary) if summary is not None else oc.n_cases
@@ -202,7 +237,7 @@ def _optimize_page(oc: OptimizeOutcome, deck: Deck | None) -> Page:
         sections.append(Section("optimum", "the optimum" if opt.converged else "the best design", blocks))
     sections.append(Section("tables", "report (.out)", [Pre(oc.text)]))
     if oc.history_table is not None:
-        sections.append(Section("history", "history", [frame_table(oc.history_table)]))
+        sections.append(Section("history", "history", [frame_table(oc.history_table, printed=Printed(oc.text))]))
     _close(sections, oc, deck, notes, "An optimisation has no published table of its own; compare the optimum "
                                       "deck it writes (--compare).")
     sense = "minimize" if p.sense > 0 else "maximize"

@@ -150,7 +150,7 @@ def manipulator_torque_crob(l1: np.ndarray, tau1: np.ndarray, tau2: np.ndarray, 
     |l1 - l2| <= r, l1 + l2 >= R fail): their points are crossed and named in the legend."""
     fig, (ax,) = new_figure(1, 1, figsize=(7.4, 3.8))
     total = tau1 + tau2
-    for label, y in (("tau1", tau1), ("tau2", tau2), ("tau1 + tau2", total)):
+    for label, y in (("$\\tau_1$ (shoulder)", tau1), ("$\\tau_2$ (elbow)", tau2), ("$\\tau_1 + \\tau_2$", total)):
         ax.plot(l1, y, "-o", ms=2.5, lw=1.2, label=label)
     if violates is not None and np.any(violates):
         bad = np.asarray(violates, dtype=bool)
@@ -158,9 +158,10 @@ def manipulator_torque_crob(l1: np.ndarray, tau1: np.ndarray, tau2: np.ndarray, 
             ax.plot(l1[bad], y[bad], "x", color="C3", ms=7, mew=1.5,
                     label="violates the workspace reach conditions" if k == 0 else None)
     ax.set_ylabel("motor torque [N m]")
-    ax.set_xlabel(f"l1 [m]  (l2 = sqrt({c:g} - l1^2) [m])")
+    ax.set_xlabel(f"$l_1$ [m]  (on $C_{{rob}}$: $l_2 = \\sqrt{{{c:g} - l_1^2}}$ m)")
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
-    fig.suptitle(f"{plain_text(title)}: motor torques along C_rob" if title else "Motor torques along C_rob")
+    fig.suptitle(f"{plain_text(title)}: motor torques along the robust circle" if title
+                 else "Motor torques along the robust circle")
     return fig
 
 

@@ -274,9 +274,10 @@ def designs_figure(p: Problem, evals: pd.DataFrame, title: str, x: dict[str, flo
     feas, bad = evals[ok], evals[~ok]
     with plotting.style():
         fig, (ax,) = plotting.new_figure(1, 1, figsize=(6.4, 4.4))
-        ax.plot(bad[vx], bad[vy], "x", ms=3, color="0.6", label="infeasible designs", rasterized=len(bad) > 2000)
+        ax.plot(bad[vx], bad[vy], "x", ms=3, color="0.6", label="infeasible designs",
+                rasterized=len(bad) > plotting.RASTER_POINTS)
         sc = ax.scatter(feas[vx], feas[vy], c=feas["objective"], s=10, cmap="viridis", label="feasible designs",
-                        rasterized=len(feas) > 2000)
+                        rasterized=len(feas) > plotting.RASTER_POINTS)
         if len(feas):
             cb = fig.colorbar(sc, ax=ax)
             cb.set_label(plotting.wrap(objective, 40))
