@@ -24,8 +24,8 @@ from driver import __version__
 from driver import _limits as limits
 from driver._export import FORMATS
 from driver._extras import MissingExtra, require
+from driver._formats import ANIMATION_FORMATS, PLOT_FORMATS
 from driver._outcome import ExitCode, Outcome, RunOutcome, SweepOutcome
-from driver._result import ANIMATION_FORMATS, PLOT_FORMATS
 from driver._study import study_names
 
 __all__ = ["main", "run_deck", "say", "ExitCode"]

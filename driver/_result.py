@@ -8,28 +8,13 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+from driver._formats import ANIMATION_FORMATS, PLOT_FORMATS, plot_format
+
 if TYPE_CHECKING:   # annotations only: keeps `python -m driver --help` light
     import matplotlib.figure
     import pandas as pd
 
 __all__ = ["Figure", "PLOT_FORMATS", "ANIMATION_FORMATS", "Result", "plot_format"]
-
-
-#: file formats of ``--plot`` figures (``--plot-format``); the first is the default
-PLOT_FORMATS = ("png", "svg", "pdf")
-#: file formats of the mechanism's animation (``--animation``): GIF through Pillow, MP4 through ffmpeg
-ANIMATION_FORMATS = ("gif", "mp4")
-
-
-def plot_format(plot: bool | str | None) -> str | None:
-    """The figure format a ``plot`` argument asks for: None (no figures), or one of
-    :data:`PLOT_FORMATS` (``True`` means PNG).  Raises ValueError for any other format."""
-    if not plot:
-        return None
-    fmt = PLOT_FORMATS[0] if plot is True else str(plot).lower().lstrip(".")
-    if fmt not in PLOT_FORMATS:
-        raise ValueError(f"figure format {plot!r} is not one of {', '.join(PLOT_FORMATS)}")
-    return fmt
 
 
 @dataclass
@@ -154,6 +139,12 @@ class Result:
             if f.name == name:
                 return f.draw()
         raise LookupError(f"no figure {name!r}; this result draws {', '.join(self.figure_names)}")
+
+    def _repr_html_(self) -> str:
+        """The run as its report page shows it (animation, figures, headline figures, tables),
+        for a notebook's rich display (made by :func:`driver._report_page.fragment`)."""
+        from driver._report_page._fragment import fragment
+        return fragment(self)
 
     def __repr__(self) -> str:
         state = "ok" if self.ok else f"failed: {self.failure}"

@@ -25,11 +25,12 @@ import numpy as np
 
 from driver._atomic import atomic_open
 from driver._extras import require
-from driver._result import ANIMATION_FORMATS, PLOT_FORMATS, plot_format
+from driver._formats import ANIMATION_FORMATS, PLOT_FORMATS, plot_format
 
 require("plot")   # a clear message naming the [plot] extra when matplotlib is missing; then import it:
 import matplotlib  # noqa: E402 (after require above)
 import matplotlib.colors  # noqa: E402 (after require above)
+import matplotlib.font_manager  # noqa: E402 (after require above)
 import matplotlib.ticker  # noqa: E402 (after require above)
 from matplotlib.figure import Figure  # noqa: E402 (after require above)
 
@@ -77,6 +78,14 @@ def wrap(text: str, width: int) -> str:
     if line:
         lines.append(line)
     return "\n".join(lines)
+
+
+def suptitle(fig: Figure, text: str, **kw: Any) -> Any:
+    """Give ``fig`` its title, each line wrapped to the figure's width (a deck's long title
+    never runs off the canvas); mathtext spans are kept whole (:func:`wrap`)."""
+    size = matplotlib.font_manager.FontProperties(size=kw.get("fontsize", matplotlib.rcParams["figure.titlesize"]))
+    chars = max(20, int(fig.get_figwidth() * 72.0 / (0.58 * size.get_size_in_points())))
+    return fig.suptitle("\n".join(wrap(line, chars) for line in str(text).split("\n")), **kw)
 
 
 @contextlib.contextmanager
@@ -154,7 +163,7 @@ def line_panels(x: np.ndarray, panels: Sequence[tuple[str, dict[str, np.ndarray]
             ax.legend(loc="best")
     axes[-1].set_xlabel(xlabel)
     if title:
-        fig.suptitle(plain_text(title))
+        suptitle(fig, plain_text(title))
     return fig
 
 
@@ -350,7 +359,7 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
         axes[0].legend(ncol=min(3, max(1, len(frame.groupby(others)) if others else 1)),
                        loc="lower left", bbox_to_anchor=(0.0, 1.02), frameon=False)
     axes[-1].set_xlabel(label(x))
-    fig.suptitle(f"{plain_text(title)}: sweep summary" if title else "sweep summary")
+    suptitle(fig, f"{plain_text(title)}: sweep summary" if title else "sweep summary")
     return fig
 
 
@@ -386,7 +395,7 @@ def _kept_keys(frame, x: str, ys: list[str], title: str, label: Callable[[str], 
     axes[0].legend(loc="lower left", bbox_to_anchor=(0.0, 1.02), ncol=2, frameon=False)
     axes[-1].set_xlabel(label(x))
     counted = f"{len(order)} kept of {n_cases} cases" if n_cases else f"{len(order)} kept designs"
-    fig.suptitle(f"{plain_text(title)}: the kept designs ({counted})" if title else f"the kept designs ({counted})")
+    suptitle(fig, f"{plain_text(title)}: the kept designs ({counted})" if title else f"the kept designs ({counted})")
     return fig
 
 
@@ -574,7 +583,7 @@ def design_space_map(frame, keys: Sequence[str], metric: str, labels: dict[str, 
     note = ("kept designs outlined in black" if not kept.all() else
             "only kept designs tabulated (blank: not kept)" if only_kept else "every design kept")
     if title:
-        fig.suptitle(f"{title}\n{note}" if (n > 1 or not kept.all() or only_kept) else title)
+        suptitle(fig, f"{title}\n{note}" if (n > 1 or not kept.all() or only_kept) else title)
     elif not kept.all() or only_kept:
         axes[0].set_title(note, fontsize=8)
     return fig
@@ -694,7 +703,7 @@ def convergence_plot(history, evals, objective: str, sense: str = "minimize", ti
         fig.legend(handles, labels, loc="outside lower center", ncol=3, frameon=False,
                    title=f"tolerance: {tolerance_words}" if tolerance_words else None, title_fontsize=8.5)
     if title:
-        fig.suptitle(title)   # composed by the caller: deck parts through plain_text
+        suptitle(fig, title)   # composed by the caller: deck parts through plain_text
     return fig
 
 

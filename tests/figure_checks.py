@@ -40,6 +40,8 @@ def _tick_labels(fig: Figure) -> tuple[set[int], set[int]]:
         for axis in ax._axis_map.values():
             for tick in [*axis.majorTicks, *axis.minorTicks]:
                 every |= {id(tick.label1), id(tick.label2)}
+            if not (ax.axison and axis.get_visible()):
+                continue   # an axis that is not drawn draws no tick label
             for tick in axis._update_ticks():
                 drawn |= {id(t) for t in (tick.label1, tick.label2) if tick.get_visible() and t.get_visible()}
     return every, drawn

@@ -1,25 +1,25 @@
-"""The report page (``--report``) loaded in a real browser: headless Chromium over the DevTools
-protocol (tests/headless.py).
+"""The report page (``--report``) loaded in a real browser: headless Chromium driven by Selenium
+and Debian's chromium-driver (tests/browser.py, one browser per session).
 
-One deck of each study, a sweep, an optimisation and a synthesis are run once with --report;
+One deck of each study, a sweep, an optimisation and a synthesis are run once with --report
+(tests/report_runs.py: the shipped decks' runs are shared with tests/test_shipped_pages.py);
 every page is then opened from disk and must: raise no console error or exception, ask for
-nothing outside itself, render every figure with a non-empty box, be under the stated size,
-print to PDF, and give a screenshot that is not blank.  The animations are checked against
-geometry the page cannot fake: at every crank angle the slider selects, the drawn crank pin
-lies on the crank circle at that angle (the closed form r(cos t, sin t)), and the drawn coupler
-and rocker keep their deck lengths (loop closure); the slider-crank's slider stays on its guide
-at the rod's length from the crank pin.
+nothing outside itself, render every figure with a non-empty box, print to PDF, and give a
+screenshot that is not blank.  The animations are checked against geometry the page cannot
+fake: at every crank angle the slider selects, the drawn crank pin lies on the crank circle at
+that angle (the closed form r(cos t, sin t)), and the drawn coupler and rocker keep their deck
+lengths (loop closure); the slider-crank's slider stays on its guide at the rod's length from
+the crank pin, its rod bowed by the run's deflection; a balancing four-bar's counterweights
+ride at their radius and angle; a path synthesis's targets lie on the coupler point's path.
 
-Chromium is Debian's ``chromium`` (.ci/setup installs it); without it these tests are skipped
-on a developer machine and fail in CI (CI set), where the page must be tested.
+Without selenium, chromium or chromedriver these tests are skipped on a developer machine and
+fail in CI (CI set), where the page must be tested.
 """
 from __future__ import annotations
 
 import io
 import math
-import os
 import re
-import subprocess
 import sys
 from pathlib import Path
 
@@ -27,16 +27,10 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
-from conftest import INPUTS, ROOT
-from headless import Browser, chromium_path
+from conftest import INPUTS
 
 pytest.importorskip("matplotlib")
 pytest.importorskip("pyarrow")
-
-if chromium_path() is None:
-    if os.environ.get("CI"):
-        pytest.fail("CI must test the report page in Chromium: .ci/setup installs Debian's chromium", pytrace=False)
-    pytest.skip("no chromium on PATH (bash .ci/setup installs it)", allow_module_level=True)
 
 from driver._report_page import MAX_PAGE_BYTES
 
@@ -71,23 +65,11 @@ WRITTEN = {"slidercrank_small": SLIDERCRANK, "ujoint_one": UJOINT_ONE}
 
 
 @pytest.fixture(scope="module")
-def pages(tmp_path_factory):
-    out = tmp_path_factory.mktemp("report")
-    for name, text in WRITTEN.items():
-        (out / f"{name}.dat").write_text(text)
-    decks = [str(INPUTS / f"{n}.dat") for n in PAGES if n not in WRITTEN] + [str(out / f"{n}.dat") for n in WRITTEN]
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    proc = subprocess.run([sys.executable, "-m", "driver", *decks, "--report", "-q", "-o", str(out / "out")],
-                          capture_output=True, text=True, env=env, timeout=900)
-    assert proc.returncode in (0, 1), proc.stderr   # 1: crank5's listing audit is a warning, not a failure
-    assert "report page could not be written" not in proc.stderr, proc.stderr
-    return out / "out"
-
-
-@pytest.fixture(scope="module")
-def browser():
-    with Browser(width=1200, height=900) as b:
-        yield b
+def pages(report_runs):
+    """Every page of PAGES written (the session's runs), and the folder holding them."""
+    for name in PAGES:
+        report_runs.get(name, WRITTEN.get(name))
+    return report_runs.root / "out"
 
 
 def _png_pixels(png: bytes) -> np.ndarray:
@@ -104,7 +86,6 @@ def test_page_renders_offline(pages, browser, stem):
     text = path.read_text()
     assert "<link" not in text and not re.search(r"""\b(src|href)\s*=\s*["'](?!#|data:)""", text), \
         "the page must not load anything from outside itself"
-    browser.events.clear()
     browser.open(path)
     assert browser.errors() == []
     # every figure and animation has a box on the page
@@ -172,7 +153,6 @@ def test_animation_follows_the_slider(pages, browser, stem, lengths):
         mid = fast["midpoint_deflection_mm"].to_numpy() * 1e-3
         order = np.argsort(ang)
         lengths = dict(lengths, mid=(ang[order], mid[order]), scale=0.06 * 0.505 / np.abs(mid).max())
-    browser.events.clear()
     browser.open(pages / f"{stem}.html")
     n = _frames(browser)
     seen = []
@@ -245,7 +225,6 @@ def test_animation_follows_the_slider(pages, browser, stem, lengths):
 def test_ujoint_animation_turns_the_output_as_the_closed_form(pages, browser):
     """One Hooke joint at 30 deg: the page's output deviation at every frame is the closed form
     atan(cos(beta) tan(theta)) - theta (about its mean, zero over a turn); the shafts keep their length."""
-    browser.events.clear()
     browser.open(pages / "ujoint_one.html")
     n = _frames(browser)
     beta = math.radians(30.0)
@@ -267,7 +246,6 @@ def test_manipulator_animation_reaches_each_workspace_point(pages, browser):
     """The deck's designs (l1, l2) = (5.61, 3.97) and (4.86, 4.86): at each frame that says 'at Pi' the
     drawn tip is the workspace point and the links keep their lengths (inverse kinematics checked
     by forward kinematics on the page)."""
-    browser.events.clear()
     browser.open(pages / "manipulator_case1_report.html")
     points = {1: (1, 5), 2: (2, 7), 3: (3, 7), 4: (4, 6)}
     reached = set()
@@ -299,11 +277,10 @@ def test_every_mechanism_moves_by_the_same_script(pages):
 
 
 def test_play_button_moves_the_mechanism(pages, browser):
-    browser.events.clear()
     browser.open(pages / "crank5.html")
     before = _parts(browser)["dots"]["A"]
     browser.eval("document.querySelector('.anim button').click()")
-    browser.eval("new Promise(r => setTimeout(r, 400))")
+    browser.wait(400)
     after = _parts(browser)
     browser.eval("document.querySelector('.anim button').click()")
     assert after["dots"]["A"] != before and after["label"] != "0\u00b0"
@@ -314,7 +291,6 @@ def test_published_comparison_on_the_page(pages, browser):
     """crank5 reproduces the paper's Lampiran 3: the page lists its cells and counts them."""
     from driver._compare import compare
     expected = compare(INPUTS / "crank5.dat")
-    browser.events.clear()
     browser.open(pages / "crank5.html")
     text = browser.eval("document.getElementById('published').textContent")
     assert f"{len(expected)} published cells compared" in text
@@ -329,7 +305,6 @@ def test_result_write_report(tmp_path, browser):
     written = driver.write(r, tmp_path, report=True)
     page = tmp_path / "crank2.html"
     assert page in written
-    browser.events.clear()
     browser.open(page)
     assert browser.errors() == []
     assert browser.eval("document.querySelectorAll('svg.mech').length") == 1

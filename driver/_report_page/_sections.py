@@ -8,18 +8,14 @@ run again and no file the engine wrote is read back; the deck is echoed as its f
 """
 from __future__ import annotations
 
-import re
-from collections.abc import Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import f90nml
 
 from driver._mechanism import Mark, MechanismFrames
 from driver._outcome import OptimizeOutcome, Outcome, RunOutcome, SweepOutcome, SynthesisOutcome
-from driver._report_page._animation import study_animation
 from driver._report_page._blocks import (
-    Animation,
     Block,
     Details,
     FigureBlock,
@@ -27,24 +23,18 @@ from driver._report_page._blocks import (
     Pre,
     Section,
     Text,
-    comparison_blocks,
     frame_table,
-    key_values,
     warnings_section,
 )
 from driver._report_page._figures import figure_blocks, figure_svg, plain
-from driver._report_page._numbers import Printed, summary_texts
+from driver._report_page._fragment import labels_of, result_sections, run_blocks
+from driver._report_page._numbers import Printed
 from driver._report_page._render import run_metadata
 
 if TYPE_CHECKING:
     from driver._deck import Deck, Params
-    from driver._result import Result
 
 __all__ = ["page_of", "result_sections", "deck_text", "outcome_frames"]
-
-#: what the animation's caption adds to the study's
-HINT = "Drag the slider or press play."
-
 
 def deck_text(deck: Deck | None, params: Params | None = None) -> str:
     """The deck as its file says it; a deck given in Python (no file) as the namelists of its
@@ -60,89 +50,6 @@ def deck_text(deck: Deck | None, params: Params | None = None) -> str:
     if params is not None:
         return str(f90nml.Namelist({params.group: {k: params[k] for k in params.given}}))
     return ""
-
-
-def _labels(study: str, names: Any, units: Mapping[str, str] | None = None) -> dict[str, str]:
-    """Each column's name in words with its unit (the column name is its tooltip): the study's
-    labels, else ``units`` (a tidy table's ``attrs['units']``) for a name that does not say its
-    unit."""
-    from driver._output import column_label
-    from driver._study import load_study
-    module = load_study(study) if study else None
-    out = {}
-    for n in names:
-        words = plain(column_label(module, str(n)))
-        unit = (units or {}).get(n)
-        if "[" not in words and unit not in (None, "", "1"):
-            words = f"{words} [{'length units' if unit == 'length' else unit}]"
-        out[n] = words
-    return out
-
-
-def _unit(label: str) -> str:
-    """The unit in a label's brackets ('' when none)."""
-    m = re.search(r"\[([^\[\]]*)\]\s*$", label)
-    return m.group(1) if m else ""
-
-
-def _summary_block(result: Result) -> Block:
-    """The headline figures: names in words with units (the column name as tooltip), numbers as
-    the run's .out prints them, zeros as zeros."""
-    labels = _labels(result.study, result.summary)
-    printed = Printed(result.text + "\n" + "\n".join(result.extra.values()))
-    texts = summary_texts(result.summary, printed, {k: _unit(v) for k, v in labels.items()})
-    return key_values(result.summary, labels, texts)
-
-
-def _tidy_table(result: Result) -> Block:
-    """The tidy table: names in words, numbers to the .out's decimals (or six significant
-    digits of their column)."""
-    tidy = result.tidy
-    labels = _labels(result.study, tidy.columns, tidy.attrs.get("units"))
-    return frame_table(tidy, labels=labels, printed=Printed(result.text))
-
-
-def _anim_id(name: str) -> str:
-    return "anim-" + (re.sub(r"[^A-Za-z0-9]", "", name) or "x")
-
-
-def _run_blocks(result: Result, params: Params | None, what: str,
-                marks: tuple[Mark, ...] = ()) -> tuple[list[Block], list[str]]:
-    """A run's animation (``marks`` added: a synthesis's targets), figures and headline figures,
-    as blocks (the parts of a design a sweep, an optimisation or a synthesis draws); and the
-    figures that could not be drawn."""
-    blocks: list[Block] = []
-    view = study_animation(params, result, _anim_id(result.name), f"{what} {HINT}", marks)
-    if view is not None:
-        blocks.append(Animation(view))
-    figs, failed = figure_blocks(result.figures, result.name)
-    blocks += figs
-    if result.summary:
-        blocks.append(_summary_block(result))
-    return blocks, failed
-
-
-def result_sections(result: Result, params: Params | None, comparison: Any,
-                    comparison_note: str = "") -> tuple[list[Section], list[str]]:
-    """The sections of one run: animation, figures, headline figures, the comparison with the
-    published cells, the tables (.out and extra files) and the tidy table."""
-    sections = []
-    view = study_animation(params, result, _anim_id(result.name), HINT)
-    if view is not None:
-        sections.append(Section("animation", "animation", [Animation(view)]))
-    figs, failed = figure_blocks(result.figures, result.name)
-    if figs:
-        sections.append(Section("figures", "figures", list(figs)))
-    if result.summary:
-        sections.append(Section("summary", "headline figures", [_summary_block(result)]))
-    sections.append(Section("published", "comparison with the published tables",
-                            comparison_blocks(comparison, comparison_note)))
-    tables: list[Block] = [Pre(result.text)]
-    tables += [Details(result.name + suffix, [Pre(text)]) for suffix, text in result.extra.items()]
-    sections.append(Section("tables", "tables (.out)", tables))
-    if result.tidy is not None and len(result.tidy):
-        sections.append(Section("tidy", "tidy table", [_tidy_table(result)]))
-    return sections, failed
 
 
 def _subtitle(study: str, params: Params | None) -> str:
@@ -203,7 +110,7 @@ def _sweep_page(oc: SweepOutcome, deck: Deck | None) -> Page:
     if oc.best is not None:
         values = ", ".join(f"{k} = {oc.best.params[k.partition('.')[2]]:.6g}" for k in keys
                            if isinstance(oc.best.params[k.partition(".")[2]], (int, float)))
-        blocks, failed = _run_blocks(oc.best, oc.best.params, "The marked design.")
+        blocks, failed = run_blocks(oc.best, oc.best.params, "The marked design.")
         notes += failed
         sections.append(Section("best", "the marked design",
                                 [Text(f"Case {oc.best_case}, {plain(oc.best_by)}" + (f": {values}." if values else "."))]
@@ -212,7 +119,7 @@ def _sweep_page(oc: SweepOutcome, deck: Deck | None) -> Page:
                             [Pre(oc.text)] if oc.text else [Text(f"See {oc.name}.out.", "note")]))
     if summary is not None:
         sections.append(Section("summary-table", "summary table",
-                                [frame_table(summary, labels=_labels(oc.study, summary.columns),
+                                [frame_table(summary, labels=labels_of(oc.study, summary.columns),
                                              printed=Printed(oc.text or ""))]))
     _close(sections, oc, deck, notes, "A sweep runs a study over many cases; the published tables belong to "
                                       "single-case decks.")
@@ -231,7 +138,7 @@ def _optimize_page(oc: OptimizeOutcome, deck: Deck | None) -> Page:
     opt = oc.optimum
     if opt is not None:
         word = "The optimum." if opt.converged else "The best design found (the method did not converge)."
-        blocks, failed = _run_blocks(opt.result, opt.params, word)
+        blocks, failed = run_blocks(opt.result, opt.params, word)
         notes += failed
         blocks.append(Details(f"{oc.name}.optimum.dat", [Pre(opt.deck)]))
         sections.append(Section("optimum", "the optimum" if opt.converged else "the best design", blocks))
@@ -260,7 +167,7 @@ def _synthesis_page(oc: SynthesisOutcome, deck: Deck | None) -> Page:
     figs, failed = figure_blocks(oc.figures, oc.name)
     notes += failed
     if oc.result is not None:
-        blocks, failed = _run_blocks(oc.result, oc.params, "The synthesised linkage.", _targets(oc))
+        blocks, failed = run_blocks(oc.result, oc.params, "The synthesised linkage.", _targets(oc))
         notes += failed
         if oc.linkage_deck:
             blocks.append(Details(f"{oc.name}.linkage.dat", [Pre(oc.linkage_deck)]))

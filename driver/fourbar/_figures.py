@@ -26,6 +26,7 @@ from driver.plotting import (
     new_figure,
     plain_text,
     styled,
+    suptitle,
 )
 
 if TYPE_CHECKING:
@@ -99,7 +100,7 @@ def fourbar_curves(exact, listing, title: str, band: Sequence[float] = (40.0, 12
         ax.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
     axes[-1].set_xlabel(r"crank angle $\theta_2$ [deg]")
     if title:
-        fig.suptitle(f"{plain_text(title)}: four-bar kinematics")
+        suptitle(fig, f"{plain_text(title)}: four-bar kinematics")
     return fig
 
 
@@ -276,7 +277,7 @@ def fourbar_linkage(ground: float, theta: np.ndarray, out: np.ndarray, ok: np.nd
     if len(runs) > 1:
         spans = ", ".join(f"{theta[r[0]]:.0f}-{theta[r[-1]]:.0f}°" for r in runs)
         what += f"\nassembles over {len(runs)} separate crank intervals ({spans}): separate motions"
-    fig.suptitle(f"{plain_text(title)}: {what}" if title else what)
+    suptitle(fig, f"{plain_text(title)}: {what}" if title else what)
     _finish(fig, ax, units, texts)
     return fig
 
@@ -375,7 +376,7 @@ def _rocking_drawing(fig, ax, ground: float, motions: Sequence[dict], title: str
                  f"\neach out on the {out_word} assembly, back on the {back_word}")
     if solid_words:
         what += f"\ndrawn at {solid_words}"
-    fig.suptitle(f"{plain_text(title)}: {what}" if title else what)
+    suptitle(fig, f"{plain_text(title)}: {what}" if title else what)
     _finish(fig, ax, units, texts)
 
 
@@ -509,8 +510,9 @@ def plot_pin_polars(fa: ForceAnalysis, axes: Any, theta: np.ndarray | None = Non
 
 
 def plot_shaking(theta: np.ndarray, fa: ForceAnalysis, ax: Any, polar_ax: Any | None = None) -> Any:
-    """Plot the shaking force magnitude against crank angle, and its locus, with and without
-    counterweights (the same styles as in the torque and pin-force figures).
+    """Plot the shaking force magnitude against crank angle, and its locus.
+
+    With and without counterweights, in the same styles as the torque and pin-force figures.
 
     Parameters
     ----------

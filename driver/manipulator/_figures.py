@@ -19,7 +19,7 @@ from matplotlib.figure import Figure
 from driver._deck import Params
 from driver.manipulator import _kernel as kernel
 from driver.manipulator._analysis import Conv, Workspace, optima
-from driver.plotting import new_figure, plain_text, styled
+from driver.plotting import new_figure, plain_text, styled, suptitle
 
 
 def _ellipse_levels(levels: Sequence[float], n: int) -> list[float]:
@@ -136,7 +136,7 @@ def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, 
     fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncol=3, frameon=False,
                title=words, title_fontsize=8.5)
     if title:
-        fig.suptitle(plain_text(title))
+        suptitle(fig, plain_text(title))
     return fig
 
 
@@ -160,7 +160,7 @@ def manipulator_torque_crob(l1: np.ndarray, tau1: np.ndarray, tau2: np.ndarray, 
     ax.set_ylabel("motor torque [N m]")
     ax.set_xlabel(f"$l_1$ [m]  (on $C_{{rob}}$: $l_2 = \\sqrt{{{c:g} - l_1^2}}$ m)")
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
-    fig.suptitle(f"{plain_text(title)}: motor torques along the robust circle" if title
+    suptitle(fig, f"{plain_text(title)}: motor torques along the robust circle" if title
                  else "Motor torques along the robust circle")
     return fig
 

@@ -14,7 +14,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from driver._deck import Params
-from driver.plotting import new_figure, plain_text, styled
+from driver.plotting import new_figure, plain_text, styled, suptitle
 from driver.slidercrank._analysis import Case, history
 from driver.slidercrank._kernel import Shape
 from driver.slidercrank._spec import Model
@@ -131,7 +131,7 @@ def slidercrank_convergence_figure(series: dict[str, Any], title: str, axes=None
     fig.legend(handles, names, loc="outside lower center", ncol=1 if max(map(len, names)) > 60 else 2,
                frameon=False)
     if title:
-        fig.suptitle(plain_text(title))
+        suptitle(fig, plain_text(title))
     return fig
 
 
@@ -168,7 +168,7 @@ def slidercrank_history_figure(time: np.ndarray, series: dict[str, np.ndarray], 
     handles, names = axes[0].get_legend_handles_labels()
     fig.legend(handles, names, loc="outside lower center", ncol=2, frameon=False)
     if title:
-        fig.suptitle(plain_text(title))
+        suptitle(fig, plain_text(title))
     return fig
 
 
@@ -233,7 +233,7 @@ def slidercrank_nl_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndar
         key.append(Line2D([], [], color=BUCKLED, lw=1.4))
         names.append("frame: the nonlinear rod buckled at this speed")
     fig.legend(key, names, loc="outside lower center", ncol=len(key), frameon=False)
-    fig.suptitle(plain_text(title))
+    suptitle(fig, plain_text(title))
     return fig
 
 

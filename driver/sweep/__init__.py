@@ -53,7 +53,7 @@ from driver import _expr as expr
 from driver._atomic import refuse_link, remove_stale_temporaries
 from driver._deck import Deck, Params, RawGroup, validate
 from driver._extras import require
-from driver._outcome import ExitCode, SweepOutcome
+from driver._outcome import HTML, ExitCode, SweepOutcome
 from driver._runner import compute, output_stem, study_of
 from driver.sweep import _batch as batch_path
 from driver.sweep import _engine as engine
@@ -521,3 +521,12 @@ class _Run:
                        *(self.outdir / f"{self.stem}_summary.{fmt}" for fmt in ("csv", "parquet"))]
         return oc
 
+
+def _notebook_html(outcome: SweepOutcome) -> str:
+    """The outcome in a notebook: its report page's sections (driver._report_page, which stands
+    above this engine: registered here, called when a notebook shows the outcome)."""
+    from driver._report_page import outcome_fragment
+    return outcome_fragment(outcome)
+
+
+HTML[SweepOutcome] = _notebook_html
