@@ -30,7 +30,8 @@ def test_a_result_shows_its_page_content(tmp_path):
     html = r._repr_html_()
     assert html.lstrip().startswith('<div class="mechanism-driver">')
     assert "<html" not in html and "<body" not in html and 'id="deck"' not in html
-    assert len(re.findall(r'<svg[^>]*class="fig"', html)) == len(r.figures) and len(re.findall(r'<svg[^>]*class="mech"', html)) == 1
+    assert len(re.findall(r'<svg[^>]*class="fig"', html)) == len(r.figures)
+    assert len(re.findall(r'<svg[^>]*class="mech"', html)) == 1
     assert html.count("<script>") == 1   # the animation's script travels with it
     # the same headline table as the page's, made by the same code: words, units, .out decimals
     page = (driver.write(r, tmp_path, report=True)[-1]).read_text()
