@@ -46,7 +46,7 @@ _F = TypeVar("_F", bound=Callable[..., Any])
 
 #: a scatter of more points than this is drawn as an image inside a vector figure (SVG, PDF):
 #: each point as a vector marker would make a report page of megabytes that scrolls slowly
-RASTER_POINTS = 400
+RASTER_POINTS = 150
 
 
 def plain_text(text: Any) -> str:
@@ -84,7 +84,7 @@ def suptitle(fig: Figure, text: str, **kw: Any) -> Any:
     """Give ``fig`` its title, each line wrapped to the figure's width (a deck's long title
     never runs off the canvas); mathtext spans are kept whole (:func:`wrap`)."""
     size = matplotlib.font_manager.FontProperties(size=kw.get("fontsize", matplotlib.rcParams["figure.titlesize"]))
-    chars = max(20, int(fig.get_figwidth() * 72.0 / (0.58 * size.get_size_in_points())))
+    chars = max(20, int(fig.get_figwidth() * 72.0 / (0.53 * size.get_size_in_points())))
     return fig.suptitle("\n".join(wrap(line, chars) for line in str(text).split("\n")), **kw)
 
 
@@ -356,8 +356,10 @@ def sweep_summary(frame, keys: Sequence[str], x: str = "", ys: Sequence[str] = (
             ax.plot(frame.loc[kept, x], frame.loc[kept, y], "o", ms=4, mfc="none", color="k", label="kept")
         ax.set_ylabel(label(y))
     if others or not kept.all():
-        axes[0].legend(ncol=min(3, max(1, len(frame.groupby(others)) if others else 1)),
-                       loc="lower left", bbox_to_anchor=(0.0, 1.02), frameon=False)
+        handles, names = axes[0].get_legend_handles_labels()
+        # as many columns as fit the figure's width (about 7 pt a character at 8.5 pt)
+        fits = max(1, int(fig.get_figwidth() * 72.0 / (0.6 * 8.5 * (max(map(len, names), default=10) + 6))))
+        fig.legend(handles, names, ncol=min(3, fits, max(1, len(names))), loc="outside lower center", frameon=False)
     axes[-1].set_xlabel(label(x))
     suptitle(fig, f"{plain_text(title)}: sweep summary" if title else "sweep summary")
     return fig

@@ -102,7 +102,7 @@ def test_sweep_summary_labels_and_no_trivial_panels():
     assert ylabels == ["peak tensile strain [microstrain]", "peak compression / Euler load [-]"]
     assert fig.axes[-1].get_xlabel() == "crank speed [rad/s]"
     assert all("_" not in y for y in ylabels)
-    legend = fig.axes[0].get_legend()
+    legend = fig.legends[0]   # the figure's legend, under the panels
     assert [t.get_text() for t in legend.get_texts()] == ["material = aluminium", "material = steel"]
     assert _inside_figure(fig, legend)
     assert_no_overlapping_text(fig)

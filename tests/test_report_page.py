@@ -53,6 +53,18 @@ UJOINT_ONE = """! one Hooke joint at 30 deg
 /
 """
 
+#: a small nonlinear rod (the paper's aluminium, 8 elements): buckled at 29.32 rad/s in seconds
+SLIDERCRANK_NL = """! aluminium rod of the paper, nonlinear, coarse mesh for a quick report
+&slidercrank
+  material = 'aluminium'
+  speeds = 11.52, 29.32
+  n_elements = 8
+  steps_per_rev = 720, revolutions = 4
+  damping_ratio = 0.02
+  model = 'nonlinear'
+/
+"""
+
 #: deck stem -> what the page must hold (an animation, design-space maps)
 PAGES = {"crank5": {"anim": "fourbar"}, "nongrashof": {"anim": "fourbar"},
          "crank5_coupler_point": {"anim": "fourbar"}, "slidercrank_small": {"anim": "slidercrank"},
@@ -60,8 +72,9 @@ PAGES = {"crank5": {"anim": "fourbar"}, "nongrashof": {"anim": "fourbar"},
          "manipulator_case1_report": {"anim": "manipulator"}, "robust_example": {},
          "fourbar_paper_sweep": {"anim": "fourbar", "section": "best"},
          "optimize_crank_rocker": {"anim": "fourbar", "section": "optimum"},
-         "synthesis_path": {"anim": "fourbar", "section": "linkage"}}
-WRITTEN = {"slidercrank_small": SLIDERCRANK, "ujoint_one": UJOINT_ONE}
+         "synthesis_path": {"anim": "fourbar", "section": "linkage"}, "slidercrank_nl_small": {"anim": "slidercrank"},
+         "fourbar_forces_balanced": {"anim": "fourbar"}}
+WRITTEN = {"slidercrank_small": SLIDERCRANK, "ujoint_one": UJOINT_ONE, "slidercrank_nl_small": SLIDERCRANK_NL}
 
 
 @pytest.fixture(scope="module")
@@ -309,3 +322,94 @@ def test_result_write_report(tmp_path, browser):
     assert browser.errors() == []
     assert browser.eval("document.querySelectorAll('svg.mech').length") == 1
     assert browser.eval("document.querySelectorAll('svg.fig').length") == len(r.figures)
+
+
+def test_nonlinear_rod_is_drawn_through_its_nodes_as_the_run_left_them(pages, browser):
+    """The nonlinear deck's rod is no rigid bar: at each frame its middle node (the midspan node
+    of the 8-element mesh) lies off the chord by the midspan deflection the run's tidy table
+    records at that crank angle (a separate record of the kernel's), at the scale the caption
+    states, to the left of A->B; the rod runs from A to B through its interior nodes."""
+    import driver
+    tidy = driver.run(SLIDERCRANK_NL, name="slidercrank_nl_small").tidy
+    fast = tidy[tidy["omega_rad_s"] == tidy["omega_rad_s"].max()]
+    ang = np.mod(fast["crank_angle_deg"].to_numpy(), 360.0)
+    mid = fast["midspan_nonlinear_mm"].to_numpy() * 1e-3
+    order = np.argsort(ang)
+    browser.open(pages / "slidercrank_nl_small.html")
+    caption = browser.eval("document.querySelector('.anim p.caption').textContent")
+    m = re.search(r"magnified ([0-9.e+]+) times", caption)
+    scale = float(m.group(1)) if m else 1.0
+    assert m or "drawn at true scale" in caption, caption
+    n = _frames(browser)
+    bows = []
+    for k in range(0, n, 9):
+        _move(browser, k)
+        p = _parts(browser)
+        a, b = np.array(p["dots"]["A"]), np.array(p["dots"]["B"])
+        rod = np.array(p["links"]["connecting rod"]["points"])
+        assert len(rod) == 9 and np.allclose(rod[0], a) and np.allclose(rod[-1], b)
+        chord = (b - a) / np.hypot(*(b - a))
+        off = rod[4] - 0.5 * (a + b)
+        bow = float(chord[0] * off[1] - chord[1] * off[0])
+        want = scale * np.interp(360.0 * k / n, ang[order], mid[order], period=360.0)
+        assert bow == pytest.approx(want, abs=2e-3 * scale * np.abs(mid).max() + 1e-7)
+        bows.append(bow)
+    assert np.ptp(bows) > 0.05 * 0.505   # a visibly bending rod, not a rigid bar
+    assert browser.errors() == []
+
+
+def test_balancing_linkage_keeps_its_centre_of_mass_with_the_drawn_counterweights(pages, browser):
+    """fourbar_forces_balanced: the Berkof-Lowen counterweights drawn on the page are where the
+    force balance puts them: the centre of mass of the three links (deck masses at their deck
+    centre-of-mass offsets, from the drawn pins) and the two drawn counterweights does not move
+    over the turn (a shaking force of zero), and each counterweight keeps its radius from its
+    pivot."""
+    from driver.fourbar.forces import counterweights
+
+    import driver
+    params = driver.run(str(INPUTS / "fourbar_forces_balanced.dat")).params
+    cw = counterweights(params)
+    m, d, off = [0.5, 1.2, 0.9], [0.05, 0.175, 0.125], np.radians([0.0, 10.0, 0.0])
+    g = 0.30
+    browser.open(pages / "fourbar_forces_balanced.html")
+    n = _frames(browser)
+
+    def at(p0, p1, dist, angle):
+        u = (p1 - p0) / np.hypot(*(p1 - p0))
+        rot = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
+        return p0 + dist * rot @ u
+
+    coms = []
+    for k in range(0, n, 10):
+        _move(browser, k)
+        p = _parts(browser)
+        a, b = np.array(p["dots"]["A"]), np.array(p["dots"]["B"])
+        o2, o4 = np.zeros(2), np.array([g, 0.0])
+        c2 = np.array(next(v for name, v in p["dots"].items() if name.startswith("crank counterweight")))
+        c4 = np.array(next(v for name, v in p["dots"].items() if name.startswith("rocker counterweight")))
+        assert np.hypot(*c2) == pytest.approx(cw.radius[0], rel=1e-5)
+        assert np.hypot(*(c4 - o4)) == pytest.approx(cw.radius[1], rel=1e-5)
+        links = [at(o2, a, d[0], off[0]), at(a, b, d[1], off[1]), at(o4, b, d[2], off[2])]
+        total = sum(mi * ri for mi, ri in zip(m, links)) + cw.mass[0] * c2 + cw.mass[1] * c4
+        coms.append(total / (sum(m) + sum(cw.mass)))
+    coms = np.array(coms)
+    assert np.ptp(coms, axis=0).max() < 1e-5 * g   # the drawing's 7 digits; unbalanced it moves ~1e-2 g
+    assert browser.errors() == []
+
+
+def test_synthesis_targets_lie_on_the_drawn_coupler_path(pages, browser):
+    """synthesis_path: the page draws the task's target points (squares) in the linkage's frame,
+    and each lies on the coupler point's drawn path within the synthesis's structural error."""
+    browser.open(pages / "synthesis_path.html")
+    marks = browser.eval("""Array.from(document.querySelectorAll(".anim [data-role='mark']")).map(r =>
+        [+r.getAttribute('x') + r.getAttribute('width') / 2, +r.getAttribute('y') + r.getAttribute('height') / 2])""")
+    assert len(marks) == 5
+    path = browser.eval("""Array.from(document.querySelectorAll(".anim [data-role='path']"))
+        .filter(e => e.querySelector('title').textContent === 'path of P')
+        .map(e => e.getAttribute('points').trim().split(/\\s+/).map(q => q.split(',').map(Number)))""")
+    pts = np.vstack([np.array(seg) for seg in path])
+    size = np.ptp(pts, axis=0).max()
+    for x, y in marks:
+        gap = np.min(np.hypot(pts[:, 0] - x, pts[:, 1] - y))
+        assert gap < 0.02 * size, (x, y, gap, size)
+    assert browser.errors() == []

@@ -80,7 +80,8 @@ def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, 
     cmap, norm, bounds = _ri2_scale(n)
     for k, ax in enumerate(axes):
         if k == 0:
-            ax.contourf(G1, G2, ok.astype(float), levels=[0.5, 1.5], colors=["#dce9f5"])
+            # filled regions as images inside the vector figure (their outlines are the lines drawn on top)
+            ax.contourf(G1, G2, ok.astype(float), levels=[0.5, 1.5], colors=["#dce9f5"]).set_rasterized(True)
             ax.fill([], [], color="#dce9f5", label="reaches the whole workspace")
             ax.plot(g, g - r, "-", color="C0", lw=0.9, label="$|l_1 - l_2| = r$")
             ax.plot(g, g + r, "-", color="C0", lw=0.9)
@@ -92,7 +93,7 @@ def manipulator_design_space(r: float, R: float, radius: float, L1: np.ndarray, 
                             else None)
         else:
             field = np.clip(ri2, bounds[0], bounds[-1])
-            ax.contourf(L1, L2, field, levels=bounds, cmap=cmap, norm=norm, alpha=0.9)
+            ax.contourf(L1, L2, field, levels=bounds, cmap=cmap, norm=norm, alpha=0.9).set_rasterized(True)
             cs = ax.contour(L1, L2, ri2, levels=bounds[1:-1], colors="k", linewidths=0.5)
             # one label per contour, where it crosses the ray at 65 deg from the l1 axis (the contours
             # converge at the ends of C_rob: labels there would collide)
