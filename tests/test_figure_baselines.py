@@ -112,6 +112,20 @@ def _function_error():
                                     ("error", {"error": 1e-3 * np.sin(9 * x)})], "x", title="line panels")
 
 
+def _nonlinear_strain():
+    deck = ("&slidercrank\n material = 'aluminium'\n speeds = 11.52, 29.32\n n_elements = 8\n"
+            " steps_per_rev = 720, revolutions = 4\n damping_ratio = 0.02\n model = 'nonlinear'\n/\n")
+    return driver.run(deck, name="nonlinear_small").figure("strain_linear_nonlinear")
+
+
+def _phasing_map():
+    """The shipped phasing sweep's map: the ratio over the searched (rho, phi) plane."""
+    from driver.sweep._report import summary_figures
+    s = driver.run_sweep(str(INPUTS / "ujoint_phasing_sweep.dat"), jobs=1)
+    return summary_figures(s.summary, s.sweep, ["ujoint.rho", "ujoint.phi"], driver.ujoint.STUDY,
+                           "ujoint_phasing_sweep")[0]
+
+
 #: figure kind -> how to draw it (real runs of shipped decks where they are quick)
 KINDS = {
     "fourbar_curves": lambda: _fourbar("crank5.dat", "curves"),
@@ -138,6 +152,12 @@ KINDS = {
         " steps_per_rev = 360, revolutions = 2\n/\n", name="convergence_small").figure("convergence"),
     "slidercrank_simeon_history": lambda: _result_figure("slidercrank_simeon1996.dat", "history"),
     "line_panels": _function_error,
+    "fourbar_linkage_balanced": lambda: _fourbar("fourbar_forces_balanced.dat", "linkage"),
+    "fourbar_torque": lambda: _fourbar("fourbar_forces_balanced.dat", "torque"),
+    "fourbar_pin_forces": lambda: _fourbar("fourbar_forces_balanced.dat", "pin_forces"),
+    "fourbar_shaking": lambda: _fourbar("fourbar_forces_balanced.dat", "shaking"),
+    "slidercrank_nonlinear_strain": _nonlinear_strain,
+    "ujoint_phasing_map": _phasing_map,
 }
 
 
