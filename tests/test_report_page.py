@@ -364,7 +364,7 @@ def test_balancing_linkage_keeps_its_centre_of_mass_with_the_drawn_counterweight
     centre-of-mass offsets, from the drawn pins) and the two drawn counterweights does not move
     over the turn (a shaking force of zero), and each counterweight keeps its radius from its
     pivot."""
-    from driver.fourbar.forces import counterweights
+    from driver.fourbar._analysis_forces import counterweights
 
     import driver
     params = driver.run(str(INPUTS / "fourbar_forces_balanced.dat")).params
