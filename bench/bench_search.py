@@ -87,8 +87,8 @@ from driver import sweep
 from driver.fourbar import kernel as fourbar_kernel
 from driver._deck import read_deck
 if sys.argv[4] == "pool":    # the worker pool even for a small sweep (the measurement before the small-sweep rule)
-    from driver.sweep import _batch as sweep_batch
-    sweep_batch.POOL_MIN_SECONDS = 0.0
+    from driver.sweep import _executor as sweep_executor
+    sweep_executor.POOL_MIN_SECONDS = 0.0
 if sys.argv[4] == "dense":   # the previous peak search, in this process and in the forked workers
     real = fourbar_kernel.fourbar_summaries
     fourbar_kernel.fourbar_summaries = lambda params, passes=7: real(params, passes | (fourbar_kernel.FOURBAR_PASSES["dense_scan"]
@@ -125,7 +125,7 @@ def dask_estimate(tmp: Path, linkages: int) -> None:
     """The driver's CPU per phase on a loopback Dask cluster, and the 10^9 estimate."""
     sys.path.insert(0, str(ROOT / "bench"))
     import bench_dask_cluster as bdc
-    from driver.sweep import _batch as sweep_batch
+    from driver.sweep import chunk_size
     cranks = -(-linkages // PER_CRANK)
     n = cranks * PER_CRANK
     deck = tmp / "dask.dat"
@@ -148,13 +148,13 @@ def dask_estimate(tmp: Path, linkages: int) -> None:
     per_part = ph["run_cpu"] / ph["chunks"]           # receiving and merging a chunk (its part: the worker's)
     per_row = ph["finish_cpu"] / max(ph["rows"], 1)   # the tables and the .out, per kept row
     big = 10**9
-    parts_big, rows_big = -(-big // sweep_batch.chunk_size(big)), ph["rows"] * big / n
+    parts_big, rows_big = -(-big // chunk_size(big, "batch")), ph["rows"] * big / n
     est = ph["prepare_cpu"] + per_part * parts_big + per_row * rows_big
     print(f"  loopback Dask, 2 workers: {n:,d} linkages, wall {r['wall']:.1f} s, driver CPU {r['cpu']:.2f} s: "
           f"prepare {ph['prepare_cpu']:.2f} s, {ph['chunks']} chunks merged in {ph['run_cpu']:.2f} s "
           f"({per_part * 1e3:.2f} ms each), tables of {ph['rows']:,d} kept rows in {ph['finish_cpu']:.2f} s "
           f"({per_row * 1e6:.1f} us each); driver RSS {r['rss']:.0f} MiB   [{load()}]")
-    print(f"  10^9 linkages: {parts_big} chunks of {sweep_batch.chunk_size(big):,d} and ~{rows_big:,.0f} kept rows -> "
+    print(f"  10^9 linkages: {parts_big} chunks of {chunk_size(big, 'batch'):,d} and ~{rows_big:,.0f} kept rows -> "
           f"driver CPU about {est:.0f} s = {est / 60:.1f} min (target < 5 min); the workers' time divides by their number")
 
 

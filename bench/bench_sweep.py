@@ -178,7 +178,7 @@ def main() -> None:
               f"sweep / kernel CPU time {c1 / k:4.2f} (target <= 2)")
         print(f"  1 worker, wall time : {t1:7.2f} s  {n / t1:9.0f} linkages/s (best of 2)")
         print(f"  -j 2, wall time     : {t2:7.2f} s  {n / t2:9.0f} linkages/s (best of 2; a search this small runs "
-              "in the driver when the worker pool would not pay, see driver.sweep._batch.POOL_MIN_SECONDS)")
+              "in the driver when the worker pool would not pay, see driver.sweep._executor.POOL_MIN_SECONDS)")
         print(f"  targets: >= 100 000 linkages/s on 2 cores: wall {'met' if n / t2 >= 1e5 else 'NOT met'}, "
               f"from CPU time (2 idle cores) {'met' if 2 * n / c1 >= 1e5 else 'NOT met'}; "
               f"sweep within 2x of the kernel: {'met' if c1 <= 2 * k else 'NOT met'}")

@@ -216,7 +216,7 @@ def keys(group: str) -> pd.DataFrame:
 
 # ----------------------------------------------------------------------------- sweeps
 
-#: what :func:`run_sweep` returns (the sweep engine's outcome, with its tables read back):
+#: what :func:`run_sweep` returns (the sweep engine's outcome, which carries its tables):
 #: :class:`driver._outcome.SweepOutcome`, documented there
 SweepResult = SweepOutcome
 
@@ -248,7 +248,8 @@ def run_sweep(source: DeckSource, grid: Mapping[str, Sequence[Any]] | None = Non
     Either ``source`` is a deck with a ``&sweep`` group, or ``grid`` gives the keys to vary in
     Python with the ``&sweep`` options as keywords.  Files are written to ``outdir`` exactly as
     ``python -m driver DECK -o OUTDIR`` writes them; without ``outdir`` they go to a temporary
-    folder that is removed after the tables are read back.
+    folder that is removed once the sweep is done.  The result carries the tables as the
+    engine built them (nothing is read back from the folder).
 
     Parameters
     ----------
@@ -290,9 +291,10 @@ def run_sweep(source: DeckSource, grid: Mapping[str, Sequence[Any]] | None = Non
     -------
     SweepResult
         ``summary`` (one row per case: the swept keys, status, kept, the study's headline
-        figures with units in their names), ``kept``, ``cases``, ``out``, ``status`` (the
-        command line's exit status) and the counts ``n_cases``, ``n_ok``, ``n_kept``,
-        ``n_failed``; ``seconds`` the cases' wall time in s.
+        figures with units in their names; with ``outdir``, a batch sweep too large to hold
+        gives a lazy :class:`~driver._outcome.StreamedSummary`), ``kept``, ``cases``, ``out``,
+        ``best_case``, ``status`` (the command line's exit status) and the counts ``n_cases``,
+        ``n_ok``, ``n_kept``, ``n_failed``; ``seconds`` the cases' wall time in s.
 
     Raises
     ------
@@ -345,18 +347,13 @@ def run_sweep(source: DeckSource, grid: Mapping[str, Sequence[Any]] | None = Non
         raise ValueError(f"unknown table format {bad[0]!r} (choose {', '.join(FORMATS)})")
     from driver import sweep
 
-    stem = Path(deck.path).stem
     with contextlib.ExitStack() as stack:
-        if outdir is None:
+        if outdir is None:   # the tables in memory: the files go with the temporary folder
             where = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="driver_sweep_")))
         else:
             where = Path(outdir)
         outcome = sweep.run_sweep_deck(deck, where, list(formats), plot, progress, jobs=jobs, scheduler=scheduler,
-                                       resume=resume)
-        outcome.summary = pd.read_parquet(where / f"{stem}_summary.parquet")
-        cases_path = where / f"{stem}_cases.parquet"
-        outcome.cases = pd.read_parquet(cases_path) if cases_path.exists() else None
-        outcome.text = (where / f"{stem}.out").read_text()
+                                       resume=resume, stream=outdir is not None)
     if outdir is None:   # the files were in a temporary folder, now gone
         outcome.outdir, outcome.written = None, []
     return outcome

@@ -8,12 +8,19 @@ The files of one deck form a set (:func:`output_set`): every file is first writt
 to its temporary, and only when all are complete are they renamed into place; a
 failure or interrupt (Ctrl-C, SIGTERM, a full disk) removes all the temporaries, so a
 new ``.out`` never stands beside an old ``.csv``.  Every path written inside a set is
-checked to lie inside the set's output folder, and every name to fit NAME_MAX (255 bytes:
-:class:`NameTooLong` before the file is opened).  Temporaries are named
+checked to lie inside the set's output folder, every name to fit NAME_MAX (255 bytes:
+:class:`NameTooLong` before the file is opened), and no path to hold a control or bidi
+character (:class:`UnsafeName`, :mod:`driver._names`).  Temporaries are named
 ``.<first 40 characters of the file name>.<pid>.<random>.tmp`` (at most 62 bytes, whatever the
 output's name); a process killed by SIGKILL cannot remove its
 own, so :func:`remove_stale_temporaries` removes those of processes no longer alive
 (the next run of the same deck calls it).
+
+Nothing is written through a symbolic link.  A temporary is created with ``O_EXCL``
+(``mkstemp``, which never follows a link) and renamed over the final name, so a link planted
+there is replaced, its target untouched; the folders the tool makes inside an output set are
+never links (:func:`own_folder`); the tool's own append-only and resume files are opened with
+``O_NOFOLLOW`` (:func:`open_append` replaces a link at the name, :func:`read_own` reads none).
 """
 from __future__ import annotations
 
@@ -29,7 +36,8 @@ from typing import IO
 from driver._errors import DriverError
 
 __all__ = ["atomic_open", "write_text", "output_set", "OutputSet", "inside", "remove_stale_temporaries",
-           "file_digest", "DIGEST_CHARS", "own_folder", "refuse_link", "LinkRefused", "NAME_MAX", "NameTooLong"]
+           "file_digest", "DIGEST_CHARS", "own_folder", "refuse_link", "LinkRefused", "NAME_MAX", "NameTooLong",
+           "open_append", "read_own", "UnsafeName"]
 
 #: the longest file name the file systems we write to take [bytes]
 NAME_MAX = 255
@@ -48,6 +56,22 @@ class NameTooLong(DriverError, OSError):
     def __reduce__(self) -> tuple[type[NameTooLong], tuple[str]]:
         """Pickle by the path (the message is made from it)."""
         return (type(self), (str(self.filename),))
+
+
+class UnsafeName(DriverError, OSError):
+    """An output's path holds a control or bidi character (:mod:`driver._names`): refused before its
+    file is opened, the path shown escaped."""
+
+    def __init__(self, path: str | Path, why: str):
+        import errno
+
+        from driver._names import shown
+        self.path = str(path)
+        super().__init__(errno.EINVAL, why, shown(path))
+
+    def __reduce__(self) -> tuple[type[UnsafeName], tuple[str, str]]:
+        """Pickle by the path and the reason (the message is made from them)."""
+        return (type(self), (self.path, str(self.strerror)))
 
 
 class OutputSet:
@@ -83,6 +107,7 @@ def atomic_open(path: str | Path, mode: str = "w") -> Iterator[IO]:
     path = Path(path)
     if len(os.fsencode(path.name)) > NAME_MAX:
         raise NameTooLong(path)
+    _check_name(path)
     current = _CURRENT.get()
     if current is not None and not inside(current.root, path):
         raise PermissionError(1, f"refusing to write outside the output folder {current.root}", str(path))
@@ -118,6 +143,14 @@ def atomic_open(path: str | Path, mode: str = "w") -> Iterator[IO]:
         raise
 
 
+def _check_name(path: Path) -> None:
+    """Refuse (:class:`UnsafeName`) a path holding a character that must not reach a terminal or a page."""
+    from driver._names import name_problem
+    why = name_problem(path, "the output's path")
+    if why:
+        raise UnsafeName(path, why)
+
+
 #: characters of the final name kept in a temporary's name (a 255-byte deck name still fits)
 TEMP_NAME = 40
 
@@ -137,7 +170,16 @@ def write_text(path: str | Path, text: str) -> Path:
 
 @contextlib.contextmanager
 def output_set(root: str | Path) -> Iterator[OutputSet]:
-    """Write a set of files inside folder ``root`` all or nothing (see the module docstring)."""
+    """Write a set of files inside folder ``root`` all or nothing (see the module docstring).
+
+    A set opened while another is being written, for a folder inside that one's (an engine's
+    outputs that include a study run's), joins it: its files are renamed into place with the
+    outer set's, or not at all.  Before anything is renamed every target is checked: a folder
+    where a file is to go fails the whole set, with nothing of it in place."""
+    outer = _CURRENT.get()
+    if outer is not None and (inside(outer.root, root) or os.path.abspath(root) == os.path.abspath(outer.root)):
+        yield outer
+        return
     s = OutputSet(Path(root))
     token = _CURRENT.set(s)
     current = True   # this set is the current one until reset
@@ -147,6 +189,10 @@ def output_set(root: str | Path) -> Iterator[OutputSet]:
         current = False
         done = 0
         try:
+            for _, path in s.pending:   # what would fail a rename fails the set before the first one
+                if os.path.isdir(path) and not os.path.islink(path):
+                    raise IsADirectoryError(21, "exists and is a folder; nothing of this run's outputs was put in "
+                                                "place", str(path))
             for tmp, path in s.pending:
                 try:
                     os.replace(tmp, path)
@@ -278,3 +324,66 @@ def own_folder(path: str | Path, base: str | Path) -> Path:
         if not current.is_dir():
             raise NotADirectoryError(20, "exists and is not a folder", str(current))
     return path
+
+
+_NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
+_CLOEXEC = getattr(os, "O_CLOEXEC", 0)
+
+
+def open_append(path: str | Path) -> IO[str]:
+    """Open the tool's own log file ``path`` (an optimisation's journal) for appending, never
+    through a symbolic link: a link planted at its name is removed and a new file made in its
+    place (``O_NOFOLLOW``; ``O_EXCL`` for the new one), so nothing is written outside the folder
+    and the file a link points to is untouched.  Anything but a regular file there is refused."""
+    import errno
+    import stat as _stat
+    path = Path(path)
+    if len(os.fsencode(path.name)) > NAME_MAX:
+        raise NameTooLong(path)
+    _check_name(path)
+    flags = os.O_WRONLY | os.O_APPEND | _CLOEXEC
+    for _ in range(3):
+        try:
+            fd = os.open(path, flags | _NOFOLLOW)
+        except FileNotFoundError:
+            try:
+                fd = os.open(path, flags | os.O_CREAT | os.O_EXCL | _NOFOLLOW, 0o644)
+            except FileExistsError:   # made (or planted) meanwhile: look again
+                continue
+        except OSError as exc:
+            if exc.errno == errno.ELOOP or os.path.islink(path):   # a link in its place: replaced, not followed
+                with contextlib.suppress(FileNotFoundError):
+                    os.unlink(path)
+                continue
+            raise _fault(exc, path) from None
+        if not _stat.S_ISREG(os.fstat(fd).st_mode):
+            os.close(fd)
+            raise IsADirectoryError(errno.EISDIR, "exists and is not a regular file", str(path))
+        return os.fdopen(fd, "a", encoding="utf-8")
+    raise PermissionError(errno.EPERM, "a link keeps reappearing in place of the file", str(path))
+
+
+def read_own(path: str | Path, limit: int | None = None) -> bytes | None:
+    """The bytes of the tool's own file ``path`` (a resume record), or None when it is missing,
+    is a symbolic link (never followed: a record is not read from elsewhere), is not a regular
+    file, or has more than ``limit`` bytes."""
+    import stat as _stat
+    try:
+        fd = os.open(path, os.O_RDONLY | _NOFOLLOW | _CLOEXEC)
+    except OSError:
+        return None
+    try:
+        st = os.fstat(fd)
+        if not _stat.S_ISREG(st.st_mode) or (limit is not None and st.st_size > limit):
+            return None
+        chunks = []
+        while True:
+            block = os.read(fd, 1 << 20)
+            if not block:
+                break
+            chunks.append(block)
+        return b"".join(chunks)
+    except OSError:
+        return None
+    finally:
+        os.close(fd)

@@ -1,4 +1,4 @@
-"""The one deck reader: Fortran namelist decks (f90nml) with validation.
+"""The one deck reader: Fortran namelist decks with validation.
 
 A deck is a text file of namelist groups with ``!`` comments::
 
@@ -12,6 +12,12 @@ defaults, choices and checks); :func:`validate` turns the raw group into
 :class:`Params`.  Every problem is a :class:`DeckError` that names the file,
 the line and the key.  The four-bar listing's own terminal input (three lines
 ``p q r s`` / ``omq`` / ``incr``) is accepted as a legacy deck.
+
+Values are read as Fortran list-directed input reads them (the pre-scan's
+:func:`_list_values`, compared with gfortran's own namelist reader by
+tests/test_fortran_reader.py); f90nml reads the same text as a second reader, and a deck on
+which the two disagree is refused.  Null values, and the separators Fortran readers disagree
+on, are refused: a deck states every value.
 """
 from __future__ import annotations
 
@@ -23,14 +29,14 @@ import re
 import stat
 import unicodedata
 import warnings
-from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import f90nml
 
 from driver._groupspec import DeckError, GroupSpec, Key, Params
+from driver._names import name_problem, shown
 from driver._study import group_spec
 
 __all__ = ["DeckError", "Key", "GroupSpec", "Params", "RawGroup", "Deck", "read_deck", "validate"]
@@ -112,6 +118,13 @@ class _Item:
     line: int
     text: str          # the value text (strings kept), possibly over several lines
     count: int = 0     # number of values after repeat-count expansion
+    value: Any = None  # the value(s) read: one value, or a list of them
+    #: the value text line by line: (line, text, whether a '!' comment follows it on its line)
+    segments: list[tuple[int, str, bool]] = field(default_factory=list)
+
+    def add(self, line: int, text: str, comment: bool) -> None:
+        self.text += text + " "
+        self.segments.append((line, text, comment))
 
 
 def _code_mask(path: Path, n: int, line: str) -> tuple[str, str]:
@@ -166,71 +179,192 @@ def is_number(text: str) -> bool:
     return bool(_NUMBER_RE.fullmatch(t)) and sum(c.isdigit() for c in t) <= MAX_DIGITS
 
 
-def _value_tokens(text: str) -> Iterator[str]:
-    """The values of a value text, separated by commas and blanks; quoted strings (with their
-    doubled-quote escapes and a repeat count glued in front) kept whole."""
-    i, n = 0, len(text)
-    while i < n:
-        ch = text[i]
-        if ch in " \t\n,":
-            i += 1
-            continue
-        j = i
-        while j < n and text[j] not in " \t\n,'\"":
+def _token_end(text: str, i: int) -> int:
+    """Where the value token starting at ``text[i]`` ends: at a blank, a comma or the end; a
+    quoted string (its doubled-quote escapes, a repeat count glued in front) kept whole."""
+    j, n = i, len(text)
+    while j < n and text[j] not in " \t\n,'\"":
+        j += 1
+    if j < n and text[j] in "'\"" and (j == i or text[j - 1] == "*"):
+        q = text[j]
+        j += 1
+        while j < n:
+            if text[j] == q:
+                if j + 1 < n and text[j + 1] == q:
+                    j += 2
+                    continue
+                break
             j += 1
-        if j < n and text[j] in "'\"" and (j == i or text[j - 1] == "*"):
-            q = text[j]
-            j += 1
-            while j < n:
-                if text[j] == q:
-                    if j + 1 < n and text[j + 1] == q:
-                        j += 2
-                        continue
-                    break
-                j += 1
-            j += 1
-        yield text[i:j]
-        i = j
+        j += 1
+    return j
 
 
-def _check_values(path: Path, it: _Item) -> None:
+@dataclass
+class _Value:
+    """One value of a key's list as Fortran list-directed input reads it."""
+
+    text: str          # as written, with its repeat count
+    line: int
+
+
+#: how to write a list so that it means the same to every Fortran reader (in null-value messages)
+_NULL_HELP = "a deck states every value (a null value would leave the key's default in a Fortran program)"
+
+
+def _null(path: Path, it: _Item, line: int, what: str) -> DeckError:
+    return DeckError(path, line, it.key, f"{what}: Fortran reads a null value (an empty entry) there; {_NULL_HELP}")
+
+
+def _list_values(path: Path, it: _Item) -> list[_Value]:
+    """The values of ``it``'s list, read as Fortran list-directed input reads them.
+
+    Values are separated by a comma (blanks around it allowed), by blanks, or by a line end.
+    A null value is refused: ``r*`` followed by a blank, a comma or a line end (``2* 5`` is two
+    null values and then 5, not ``2*5``), a comma before the first value, two commas with only
+    blanks between, an empty list.  So are the separators Fortran readers disagree on, where
+    gfortran reads a null value and the Fortran standard reads none: a ``!`` comment right
+    after a comma, or after the ``=``, with the list going on below, and a line that starts
+    with a comma after a value.  A comma followed by a comment at the end of a list (before the
+    next key or the ``/``) is no value to anyone and is fine.
+    """
+    out: list[_Value] = []
+    last = "start"                        # what came last: 'start' (the '='), 'value' or 'comma'
+    pending: tuple[int, str] | None = None   # a separator read differently, if a value follows it
+    for index, (line, text, comment) in enumerate(it.segments):
+        first = True                      # no token yet on this line
+        i, n = 0, len(text)
+        while i < n:
+            ch = text[i]
+            if ch in " \t":
+                i += 1
+                continue
+            if ch == ",":
+                if last == "start":
+                    raise _null(path, it, line, "a comma before the first value")
+                if last == "comma":
+                    raise _null(path, it, line, "two commas with nothing between")
+                if first and index > 0:
+                    pending = (line, "a line that starts with a comma after a value, with the list going on: "
+                                     "gfortran reads a null value before the comma and the Fortran standard "
+                                     "reads none; end the line before with the comma instead")
+                last, first = "comma", False
+                i += 1
+                continue
+            if pending is not None:
+                raise DeckError(path, pending[0], it.key, pending[1])
+            j = _token_end(text, i)
+            tok = text[i:j]
+            m = _COUNT_RE.fullmatch(tok)
+            if m and not m.group(2):
+                nxt = text[j:].lstrip(" \t")
+                follows = f" and then {nxt.split()[0].rstrip(',')!r}" if nxt and nxt[0] != "," else ""
+                raise _null(path, it, line, f"{tok!r} followed by a {'comma' if nxt[:1] == ',' else 'blank or a line end'} "
+                            f"is {m.group(1)} null value(s){follows}, not a repeated value (write {tok}VALUE without "
+                            "a blank)")
+            out.append(_Value(tok, line))
+            last, first = "value", False
+            i = j
+        # the comma (or the '=') on this very line: a comment on a line of its own is no separator
+        if comment and ((last == "comma" and not first) or (last == "start" and index == 0)):
+            where = ("the '=', with the values on the lines below: gfortran reads a null value first and the "
+                     "Fortran standard reads none; put the first value on the line of the key"
+                     if last == "start" else
+                     "a comma, with the list going on below: gfortran reads a null value there and the Fortran "
+                     "standard reads none; drop the comma before the comment")
+            pending = (line, f"a comment right after {where} (a comment after a value, without a comma, means "
+                             "the same to every reader)")
+    if not out:
+        raise _null(path, it, it.line, "no value after the '=' (an empty list)")
+    return out
+
+
+def _check_values(path: Path, it: _Item) -> list[_Value]:
     """Every value of ``it`` is a number, a logical or a quoted string as Fortran list-directed
-    input reads them, with at most one repeat count; anything else is a DeckError naming the
-    token (f90nml would read ``5.0_8`` as 5.08, ``4+1`` as 40 and ``2*1*4.0`` as 1, 1, 4)."""
-    for tok in _value_tokens(it.text):
+    input reads them, with at most one repeat count, and no value is null (:func:`_list_values`);
+    anything else is a DeckError naming the token (f90nml would read ``5.0_8`` as 5.08, ``4+1``
+    as 40, ``2*1*4.0`` as 1, 1, 4 and ``2* 5`` as 5, 5).  Returns the values."""
+    values = _list_values(path, it)
+    for v in values:
+        tok = v.text
         value = tok
         m = _COUNT_RE.fullmatch(tok)
         if m:
             if int(m.group(1)[:7]) == 0:
-                raise DeckError(path, it.line, it.key, f"repeat count 0 in {tok[:40]!r}: a count is at least 1")
+                raise DeckError(path, v.line, it.key, f"repeat count 0 in {tok[:40]!r}: a count is at least 1")
             value = m.group(2)
-            if not value:
-                continue                      # r* : r empty entries
         if value[:1] in "'\"":
             if len(value) < 2 or value[-1] != value[0]:
-                raise DeckError(path, it.line, it.key, f"text after a quoted string in {tok[:40]!r}")
+                raise DeckError(path, v.line, it.key, f"text after a quoted string in {tok[:40]!r}")
             continue
         if _VALUE_RE.fullmatch(value):
             digits = sum(c.isdigit() for c in value)
             if digits > MAX_DIGITS:
-                raise DeckError(path, it.line, it.key, f"number with {digits} digits: not a value any study "
+                raise DeckError(path, v.line, it.key, f"number with {digits} digits: not a value any study "
                                 f"takes (at most {MAX_DIGITS} digits)")
             continue
-        if "*" in value and _COUNT_RE.fullmatch(value):
-            why = "a repeat count applied to a repeat count"
-        elif "_" in value:
-            why = "a kind suffix or '_' inside a number (write the number itself: 5.0, 15)"
-        elif re.fullmatch(r"[+-]?[0-9.]+[eEdD]?[0-9]*[+-][0-9.]+", value):
-            why = "arithmetic is not read in a deck (write the number itself; '4+1' would be read as 4e+1)"
-        elif value[:1] == "(":
-            why = "complex numbers and parentheses are not read"
-        elif re.fullmatch(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)[eEdD][+-]?", value):
-            why = "an exponent without digits"
-        elif re.fullmatch(r"[A-Za-z_]\w*", value):
-            why = "not a number, a logical (.true./.false.) or a 'quoted string' (quote text values)"
-        else:
-            why = "not a number as Fortran reads one (digits, '.', an E or D exponent), a logical or a 'quoted string'"
-        raise DeckError(path, it.line, it.key, f"not a number: {tok[:40]!r}: {why}")
+        raise DeckError(path, v.line, it.key, _why_not(tok, value))
+    return values
+
+
+class QuotedText(str):
+    """A value written in quotes in a deck: text, never a number (Fortran reads no number from
+    ``'5'``), whatever it spells; :func:`validate` gives string keys a plain ``str``."""
+
+    __slots__ = ()
+
+
+def _value_of(tok: str) -> list[Any]:
+    """The values a checked token stands for (:func:`_check_values`): its repeat count expanded;
+    a quoted string as :class:`QuotedText` without its quotes, a logical as bool, an integer as
+    int (``-0`` as the float -0.0: a real read from it keeps its sign), any other number as float."""
+    count, value = 1, tok
+    m = _COUNT_RE.fullmatch(tok)
+    if m:
+        count, value = int(m.group(1)), m.group(2)
+    v: Any
+    if value[:1] in "'\"":
+        q = value[0]
+        v = QuotedText(value[1:-1].replace(q + q, q))
+    elif re.fullmatch(_LOGICAL, value, re.IGNORECASE | re.ASCII):
+        v = value.lstrip(".")[:1].lower() == "t"
+    elif re.fullmatch(_INTEGER, value, re.ASCII):
+        v = int(value)
+        if v == 0 and value.startswith("-"):
+            v = -0.0
+    else:
+        v = float(value.replace("d", "e").replace("D", "e"))
+    return [v] * count
+
+
+def _why_not(tok: str, value: str) -> str:
+    """Why ``value`` (token ``tok``) is no value of a deck."""
+    shown = repr(tok[:40])
+    if "*" in value and _COUNT_RE.fullmatch(value):
+        return f"not a number: {shown}: a repeat count applied to a repeat count"
+    if "_" in value:
+        return f"not a number: {shown}: a kind suffix or '_' inside a number (write the number itself: 5.0, 15)"
+    if ";" in value:
+        return (f"not a number: {shown}: a semicolon separates values only in DECIMAL='COMMA' input; separate "
+                "values with commas or blanks")
+    if re.fullmatch(r"[+-]?[0-9.]+[eEdD]?[0-9]*[+-][0-9.]+", value):
+        return (f"not a number: {shown}: arithmetic is not read in a deck (write the number itself; '4+1' "
+                "would be read as 4e+1)")
+    if re.fullmatch(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)[qQ][+-]?[0-9]+", value):
+        return f"not a number: {shown}: a Q exponent is a gfortran extension; write E or D (1.0e3, 1.0d3)"
+    if re.fullmatch(r"[+-]?(?:inf|infinity|nan(?:\(.*\))?)", value, re.IGNORECASE):
+        return f"not a number: {shown}: infinity and NaN are not deck values (every value is a finite number)"
+    if value[:1] == "(":
+        return f"not a number: {shown}: complex numbers and parentheses are not read"
+    if re.fullmatch(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)[eEdD][+-]?", value):
+        return f"not a number: {shown}: an exponent without digits"
+    if re.fullmatch(r"\.?[tTfF]\w*\.?", value):
+        return (f"not a value: {shown}: Fortran would read a logical from its first letter alone (.t, .tomato, "
+                "tx); write .true. or .false. (or quote text)")
+    if re.fullmatch(r"[A-Za-z_]\w*", value):
+        return (f"not a number: {shown}: not a number, a logical (.true./.false.) or a 'quoted string' (text is "
+                "written in quotes in a deck)")
+    return (f"not a number: {shown}: not a number as Fortran reads one (digits, '.', an E or D exponent), a "
+            "logical or a 'quoted string'")
 
 
 _DASHES = "\u2212\u2010\u2011\u2012\u2013\u2014\ufe63\uff0d"
@@ -324,7 +458,7 @@ def _prescan(path: Path, text: str) -> tuple[list[tuple[str, int]], list[_Item]]
                                 f"column {pos + stray.start() + 1}: '=' without a key name before it")
             for km in keys:
                 if item is not None:
-                    item.text += raw[pos + cut:pos + km.start()] + " "
+                    item.add(n, raw[pos + cut:pos + km.start()], False)
                 elif segment[cut:km.start()].strip(" \t,"):
                     raise DeckError(path, n, None, f"column {pos + cut + 1}: value without a key: "
                                     f"{raw[pos + cut:pos + km.start()].strip()!r}")
@@ -349,7 +483,7 @@ def _prescan(path: Path, text: str) -> tuple[list[tuple[str, int]], list[_Item]]
                 cut = km.end()
             tail = raw[pos + cut:stop]
             if item is not None:
-                item.text += tail + " "
+                item.add(n, tail, end is None and len(raw) < len(raw_line))
             elif segment[cut:].strip(" \t,"):
                 raise DeckError(path, n, None, f"column {pos + cut + 1}: value without a key: "
                                 f"{segment[cut:].strip()!r}")
@@ -366,7 +500,7 @@ def _prescan(path: Path, text: str) -> tuple[list[tuple[str, int]], list[_Item]]
     if current is not None:
         raise DeckError(path, group_line, None, f"group &{current} is not closed (end it with '/')")
     for it in items:
-        _check_values(path, it)
+        tokens = _check_values(path, it)
         blank, _ = _code_mask(path, it.line, it.text)
         big = [m.group(1) for m in _REPEAT.finditer(blank) if len(m.group(1)) > 6 or int(m.group(1)) > MAX_VALUES]
         if big:
@@ -375,6 +509,8 @@ def _prescan(path: Path, text: str) -> tuple[list[tuple[str, int]], list[_Item]]
         it.count = _count_values(blank)
         if it.count > MAX_VALUES:
             raise DeckError(path, it.line, it.key, f"{it.count} values; at most {MAX_VALUES} are read per key")
+        values = [v for t in tokens for v in _value_of(t.text)]
+        it.value = values[0] if len(values) == 1 else values
     return groups, items
 
 
@@ -441,6 +577,17 @@ def _plain(value: Any) -> Any:
     return value
 
 
+def _same(a: Any, b: Any) -> bool:
+    """Whether two readings of a value agree: equal numbers (-0.0 and 0 alike), logicals and
+    texts, item by item; a value and a list of that one value alike."""
+    a = a if isinstance(a, list) else [a]
+    b = b if isinstance(b, list) else [b]
+    return len(a) == len(b) and all(type(x) is type(y) or (isinstance(x, str) and isinstance(y, str)) or
+                                    (isinstance(x, (int, float)) and isinstance(y, (int, float)) and
+                                     not isinstance(x, bool) and not isinstance(y, bool))
+                                    for x, y in zip(a, b)) and a == b
+
+
 def _f90nml_reads(text: str) -> tuple[Any, list[str]]:
     """f90nml's parse of ``text`` with its warnings captured (never printed)."""
     with warnings.catch_warnings(record=True) as caught, contextlib.redirect_stdout(io.StringIO()):
@@ -490,9 +637,13 @@ def read_deck(path: str | Path, text: str | None = None) -> Deck:
     ------
     DeckError
         An unreadable or malformed deck (what f90nml would misread, a repeat count too large),
-        with file, line and key.
+        with file, line and key; a file name holding control or bidi characters
+        (:mod:`driver._names`).
     """
     path = Path(path)
+    why = name_problem(path, "the deck's file name")
+    if why:   # printed in every message and naming every output: refused, and shown escaped
+        raise DeckError(shown(path), None, None, why)
     if text is None:
         text = _read_text(path)
     text = _normalise(text)
@@ -509,22 +660,34 @@ def read_deck(path: str | Path, text: str | None = None) -> Deck:
         if name in seen:
             raise DeckError(path, line, None, f"group &{name} given twice (first on line {seen[name]})")
         seen[name] = line
+    # f90nml reads the same text without its comments (it reads '2!note' as text: f90nml issue
+    # 182) as a second reader: the values are the pre-scan's (Fortran's reading, compared with
+    # gfortran's own reader in tests/test_fortran_reader.py); where the two disagree the deck is
+    # refused rather than one of them believed
+    code = "\n".join(_code_mask(path, n, text_line)[1] for n, text_line in enumerate(text.split("\n"), start=1))
     try:
-        nml, warned = _f90nml_reads(text)
+        nml, warned = _f90nml_reads(code)
     except Exception as exc:  # f90nml raises ValueError, StopIteration, IndexError, AssertionError...
         raise _locate(path, items, exc) from None
     if warned:
         raise _locate(path, items, None)
     key_lines: dict[str, dict[str, int]] = {}
+    mine: dict[str, dict[str, Any]] = {}
     for it in items:
         key_lines.setdefault(it.group, {})[it.key] = it.line
+        mine.setdefault(it.group, {})[it.key] = it.value
     groups: dict[str, RawGroup] = {}
     for name, line in order:
         raw = nml.get(name, {}) or {}
-        values = {k.lower(): _plain(v) for k, v in raw.items()}
-        if set(values) != set(key_lines.get(name, {})):   # f90nml read keys the pre-scan did not see
+        theirs = {k.lower(): _plain(v) for k, v in raw.items()}
+        values = mine.get(name, {})
+        if set(theirs) != set(values):   # f90nml read keys the pre-scan did not see
             raise DeckError(path, line, None, f"cannot read &{name}: its keys are "
-                            f"{sorted(key_lines.get(name, {}))} but the namelist reader found {sorted(values)}")
+                            f"{sorted(values)} but the namelist reader found {sorted(theirs)}")
+        for key, v in values.items():
+            if not _same(v, theirs[key]):
+                raise DeckError(path, key_lines[name][key], key, f"cannot read the value: two namelist readers "
+                                f"disagree ({shown_value(v)} and {shown_value(theirs[key])})")
         groups[name] = RawGroup(name, values, key_lines.get(name, {}), line)
     return Deck(path, groups)
 
@@ -544,6 +707,8 @@ def _as_float(v: Any) -> float | None:
             return math.inf if v > 0 else -math.inf
     if isinstance(v, float):
         return v
+    if isinstance(v, QuotedText):   # '5' in a deck is text, as Fortran reads it
+        return None
     if isinstance(v, str):
         if not is_number(v):
             return None
@@ -583,6 +748,9 @@ def _coerce(kind: str, v: Any) -> tuple[Any, str | None]:
         return None, f"expected one value, got a list of {len(v)}"
     if kind in ("float", "int"):
         f = _as_float(v)
+        if f is None and isinstance(v, QuotedText) and is_number(v):
+            return None, (f"not a number: {shown_value(v)} is in quotes, and a quoted value is text (Fortran "
+                          f"reads no number from it); write {v.strip()} without the quotes")
         if f is None:
             return None, f"not a number: {shown_value(v)}"
         if not math.isfinite(f):
@@ -605,8 +773,8 @@ def _coerce(kind: str, v: Any) -> tuple[Any, str | None]:
             if bad is not None:   # ESC, NUL, line breaks: text from a deck is printed in tables
                 return None, (f"text holds the control character U+{ord(bad):04X} "
                               f"({unicodedata.name(bad, 'control')}); text is printable characters only")
-            return v, None
-        return None, f"not a quoted string: {v!r}"
+            return str(v), None
+        return None, f"not a quoted string: {shown_value(v)} (text is written in quotes in a deck)"
     raise AssertionError(kind)
 
 

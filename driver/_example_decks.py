@@ -8,8 +8,10 @@ the checkout's ``inputs/``.
 """
 from __future__ import annotations
 
-import shutil
+import os
 from pathlib import Path
+
+from driver._atomic import atomic_open
 
 __all__ = ["examples_dir", "list_examples", "example_path", "describe", "copy_example"]
 
@@ -52,13 +54,15 @@ def describe(name: str) -> str:
 def copy_example(name: str, dest: Path | str = ".", overwrite: bool = False) -> Path:
     """Copy example ``name`` into folder ``dest`` (created when missing); returns the new path.
 
-    Refuses (FileExistsError) to overwrite a deck the user may have edited unless ``overwrite``.
+    Refuses (FileExistsError) to overwrite a deck the user may have edited unless ``overwrite``;
+    a symbolic link at the name counts as a file there, and is replaced, never written through.
     """
     src = example_path(name)
     dest = Path(dest)
     dest.mkdir(parents=True, exist_ok=True)
     target = dest / src.name
-    if target.exists() and not overwrite:
+    if os.path.lexists(target) and not overwrite:   # a symbolic link there (even a dangling one) counts
         raise FileExistsError(f"{target} exists; not overwritten (delete it or copy to another folder with -o)")
-    shutil.copyfile(src, target)
+    with atomic_open(target, "wb") as fh:   # a link at the name is replaced, never written through
+        fh.write(src.read_bytes())
     return target

@@ -27,8 +27,8 @@ if TYPE_CHECKING:   # annotations only
     from driver.optimize._methods import HistoryRow, MethodResult
     from driver.optimize._problem import Problem
 
-__all__ = ["ExitCode", "Message", "Outcome", "RunOutcome", "FilesOutcome", "SweepOutcome", "OptimizeOutcome",
-           "Optimum", "SynthesisOutcome"]
+__all__ = ["ExitCode", "Message", "Outcome", "RunOutcome", "FilesOutcome", "SweepOutcome", "StreamedSummary",
+           "OptimizeOutcome", "Optimum", "SynthesisOutcome"]
 
 
 class ExitCode(enum.IntEnum):
@@ -171,6 +171,96 @@ class FilesOutcome(Outcome):
         return ExitCode.FAILED if self.failure else super().exit_code
 
 
+class StreamedSummary:
+    """The summary of a sweep too large to hold, read from its record's parts when asked.
+
+    A lazy handle over the parts of the sweep's resume record that hold its rows (one part at
+    a time where it can).  Valid while the sweep's output folder is; :func:`driver.run_sweep` without an output
+    folder gives a DataFrame instead.
+
+    Parameters
+    ----------
+    paths : list of pathlib.Path
+        The record's parts that hold rows, in case order.
+    metadata : dict of bytes to bytes
+        The summary table's schema metadata (the pandas columns and ``attrs``), as written to
+        ``<stem>_summary.parquet``.
+    num_rows : int
+        Rows of the summary.
+    """
+
+    def __init__(self, paths: list[Path], metadata: dict[bytes, bytes], num_rows: int):
+        self.paths, self.metadata, self.num_rows = list(paths), dict(metadata), int(num_rows)
+
+    def __len__(self) -> int:
+        return self.num_rows
+
+    def __repr__(self) -> str:
+        return f"<StreamedSummary: {self.num_rows} rows in {len(self.paths)} parts>"
+
+    @property
+    def columns(self) -> list[str]:
+        """The summary's column names, in order."""
+        import pyarrow.parquet as pq
+        return list(pq.read_schema(self.paths[0]).names) if self.paths else []
+
+    def _table(self, path: Path, columns: list[str] | None = None) -> Any:
+        import pyarrow.parquet as pq
+        t = pq.read_table(path, columns=columns)
+        return t.replace_schema_metadata(self.metadata)
+
+    def to_pandas(self, columns: list[str] | None = None) -> pd.DataFrame:
+        """Read the summary into one DataFrame, as pandas reads ``<stem>_summary.parquet``.
+
+        Parameters
+        ----------
+        columns : list of str, optional
+            The columns to read; default all.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Every row, in case order, with the summary's ``attrs``.
+        """
+        import json
+
+        import pandas as pd
+        import pyarrow as pa
+        if not self.paths:
+            return pd.DataFrame()
+        frame = pa.concat_tables([self._table(p, columns) for p in self.paths]).to_pandas()
+        attrs = self.metadata.get(b"PANDAS_ATTRS")
+        if attrs:
+            frame.attrs = json.loads(attrs)
+        return frame
+
+    def kept(self, columns: list[str] | None = None) -> pd.DataFrame:
+        """Read the rows the deck's ``keep`` filter kept, one part at a time.
+
+        Parameters
+        ----------
+        columns : list of str, optional
+            The columns to read; default all.
+
+        Returns
+        -------
+        pandas.DataFrame
+            The kept rows, in case order.
+        """
+        import pandas as pd
+        import pyarrow as pa
+        import pyarrow.compute as pc
+        read = None if columns is None else list(dict.fromkeys([*columns, "kept"]))
+        pieces = []
+        for p in self.paths:
+            t = self._table(p, read)
+            pieces.append(t.filter(pc.fill_null(t.column("kept"), False)))
+        if not pieces:
+            return pd.DataFrame()
+        frame = pa.concat_tables(pieces).to_pandas()
+        return frame if columns is None or "kept" in columns else frame.drop(columns=["kept"])
+
+
 @dataclass(kw_only=True)
 class SynthesisOutcome(FilesOutcome):
     """What a synthesis did (:func:`driver.synthesis.run_synthesis_deck`).
@@ -237,13 +327,11 @@ class SynthesisOutcome(FilesOutcome):
         return None if self.result is None else self.result.params
 
 
-
 @dataclass(kw_only=True)
 class SweepOutcome(Outcome):
-    """What a sweep did (:func:`driver.sweep.run_sweep_deck`, :func:`driver.run_sweep`).
+    """What a sweep did (:func:`driver.sweep.run_sweep_deck`, :func:`driver.run_sweep`), with its data.
 
-    ``driver.SweepResult`` is this class.  ``summary``, ``cases`` and ``text`` are filled by
-    :func:`driver.run_sweep`, which reads the tables back.
+    ``driver.SweepResult`` is this class.
 
     Attributes
     ----------
@@ -276,31 +364,39 @@ class SweepOutcome(Outcome):
     workers : str
         Where the cases ran (``"2 worker(s)"``, ``"dask ADDRESS"``).
     chunk : int
-        Cases per task.
+        Cases per chunk (a function of the number of cases only: the resume record's parts).
     seconds : float
         Wall time of the cases, s.
     phases : dict of str to float
         The driver's CPU time per phase (``prepare_cpu``, ``run_cpu``, ``finish_cpu`` ...), s.
-    summary : pandas.DataFrame, a lazy handle or None
-        One row per case: case number, the swept keys, status, kept, the study's headline
-        figures (units in their names), error; the summary table the sweep wrote.  A sweep
-        that streamed its rows holds a handle on them (its ``to_pandas()`` reads them).
+    summary : pandas.DataFrame or StreamedSummary or None
+        The ``<stem>_summary`` table: one row per case (with ``summary_rows = 'kept'`` the kept
+        and failed ones), exactly the columns of ``<stem>_summary.parquet``: case number, the
+        swept keys, status, kept, the study's headline figures (units in their names), error;
+        its ``attrs`` hold the base deck's settings the columns depend on.  For a batch sweep
+        whose rows were too many to hold, a :class:`StreamedSummary` (``to_pandas()``,
+        ``num_rows``, ``kept()``).
     cases : pandas.DataFrame or None
-        The tidy rows of every case that wrote its outputs, a column per swept key; None
-        when no case did.
-    text : str
-        The fixed-format summary ``.out``.
+        The ``<stem>_cases`` table: the tidy rows of every case that wrote its outputs, a
+        column per swept key; None when no case did, or too many for one table.
+    text : str or None
+        The fixed-format summary ``.out``; None when the tables were streamed (read
+        :attr:`out`).
     study : str
         The study group swept.
     sweep : Params or None
         The validated ``&sweep`` group (its plotted columns, keep filter, rows).
-    best : Result or None
-        The full run of the best case (the case the report page draws), when the engine was
-        asked for it (``best=True``, as ``--report`` asks); None otherwise or without a kept case.
     best_case : int or None
-        Its case number.
-    best_by : str
-        Why it is the best, in words (``'largest minimum transmission angle'``).
+        The best kept case: the largest or smallest value of the first plotted summary
+        column (``plot_y``, else the study's first ``sweep_plot`` column) where the study says
+        which end is better (``sweep_best``), else the first kept case; None when no case was
+        kept.  The design-space maps mark the same case.
+    best_metric : str or None
+        The column (or plotted expression) ``best_case`` is best by; None when it is the first
+        kept case.
+    best : Result or None
+        The run of ``best_case`` (its tables, figures, summary and ``params``: the case the
+        report page draws), when asked for (``best=True``; the command line's ``--report``).
     """
 
     deck: str = ""
@@ -319,14 +415,14 @@ class SweepOutcome(Outcome):
     chunk: int = 0
     seconds: float = 0.0
     phases: dict[str, float] = field(default_factory=dict)
-    summary: Any = None
+    summary: pd.DataFrame | StreamedSummary | None = None
     cases: pd.DataFrame | None = None
-    text: str = ""
+    text: str | None = ""
     study: str = ""
     sweep: Params | None = None
-    best: Result | None = None
     best_case: int | None = None
-    best_by: str = ""
+    best_metric: str | None = None
+    best: Result | None = None
 
     @property
     def exit_code(self) -> ExitCode:
@@ -346,13 +442,17 @@ class SweepOutcome(Outcome):
 
     @property
     def out(self) -> str:
-        """The fixed-format summary ``.out`` text."""
-        return self.text
+        """The fixed-format summary ``.out`` text (of a streamed sweep: read from its file)."""
+        if self.text is None and self.outdir is not None:
+            return (self.outdir / f"{self.name}.out").read_text()
+        return self.text or ""
 
     @property
     def kept(self) -> pd.DataFrame:
         """The summary rows of the cases the deck's ``keep`` filter kept (all ok cases without one)."""
-        assert self.summary is not None, "the summary is read back by driver.run_sweep"
+        if isinstance(self.summary, StreamedSummary):
+            return self.summary.kept()
+        assert self.summary is not None, "a sweep outcome carries its summary"
         return self.summary[self.summary["kept"].astype(bool)]
 
     def __repr__(self) -> str:
@@ -445,6 +545,9 @@ class OptimizeOutcome(Outcome):
         The reported design with its full run; None when no design is feasible.
     figures : list of Figure
         The convergence plot and the map of the designs evaluated, drawn on demand.
+    check_agrees : bool
+        The full study's re-run of ``x`` agrees with its evaluation (True without a re-run); when
+        it does not, the run failed (exit 1): the evaluation did not compute what the study does.
     """
 
     problem: Problem
@@ -465,6 +568,7 @@ class OptimizeOutcome(Outcome):
     text: str = ""
     optimum: Optimum | None = None
     figures: list[Figure] = field(default_factory=list)
+    check_agrees: bool = True
 
     @property
     def status(self) -> int:
@@ -473,9 +577,13 @@ class OptimizeOutcome(Outcome):
 
     @property
     def exit_code(self) -> ExitCode:
-        """1 when the method did not converge or the optimum's full run failed, else 0."""
-        failed = not self.success or (self.check is not None and self.study_result is not None
-                                      and bool(self.study_result.failure))
+        """1 when the method failed or the optimum's re-run failed or differs, else 0.
+
+        Failed: the method did not converge, or the optimum's full run by the study failed or
+        differs from its evaluation (:attr:`check_agrees`).
+        """
+        failed = not self.success or not self.check_agrees or (
+            self.check is not None and self.study_result is not None and bool(self.study_result.failure))
         return ExitCode.FAILED if failed else super().exit_code
 
     @property

@@ -1,20 +1,22 @@
-"""The code digest that signs resume records, and the axis labels of summary columns.
+"""The code digest that signs resume records, summary columns' axis labels, a summary's best design.
 
 What a study *is* (the :class:`~driver._study.Study` every study package declares as ``STUDY``)
 and the registry of studies are in :mod:`driver._study`; what a run returns (``Result`` and its
 ``Figure`` s) in :mod:`driver._result`.  This module holds the code digest of a study (resume
-records carry it) and the axis labels of summary columns and objectives from a study's
-``labels``.
+records carry it), the axis labels of summary columns and objectives from a study's
+``labels``, and the one rule for a summary's best design (:func:`best_index`: the case a
+sweep reports as its best and its design-space maps mark).
 """
 from __future__ import annotations
 
 import re
 from pathlib import Path
 from types import ModuleType
+from typing import Any
 
 from driver._study import Study
 
-__all__ = ["code_digest", "column_label", "expression_label"]
+__all__ = ["code_digest", "source_digest", "column_label", "expression_label", "best_index"]
 
 
 def code_digest(module: Study | ModuleType | None, *others: ModuleType | None) -> bytes:
@@ -47,6 +49,46 @@ def code_digest(module: Study | ModuleType | None, *others: ModuleType | None) -
             except OSError:
                 h.update(b"<unreadable>")
     return h.digest()
+
+
+def source_digest(module: Study | ModuleType | None, *others: ModuleType | Path | None) -> str:
+    """Hex SHA-256 of the Python source of study ``module`` (every ``.py`` of its package), of
+    the modules ``others`` (a package's ``__init__.py`` path stands for the whole package, read
+    without importing it) and of the kernels' Fortran sources (``fortran/*.f90`` of a source
+    tree; an installed package's version instead).
+
+    Unlike :func:`code_digest` it does not read the compiled kernel, whose bytes differ between
+    machines and builds that compute the same numbers: a record that outputs/ keeps (an
+    optimisation's ``_evals`` table) carries it and stays the same on every machine, while an
+    edit to the code that computes the values changes it."""
+    import hashlib
+
+    import driver
+
+    def files(mod: ModuleType | Path | None) -> list[Path]:
+        path = mod if isinstance(mod, Path) else getattr(mod, "__file__", None)
+        if not path:
+            return []
+        p = Path(path)
+        return sorted(p.parent.rglob("*.py")) if p.name == "__init__.py" else [p]
+
+    if isinstance(module, Study):
+        module = module.module
+    h = hashlib.sha256()
+    for mod in (module, *others):
+        for f in files(mod):
+            h.update(f.name.encode())
+            try:
+                h.update(f.read_bytes())
+            except OSError:
+                h.update(b"<unreadable>")
+    fortran = Path(driver.__file__).resolve().parents[1] / "fortran"
+    sources = sorted(fortran.glob("*.f90")) if fortran.is_dir() else []
+    for f in sources:
+        h.update(f.name.encode() + f.read_bytes())
+    if not sources:
+        h.update(str(getattr(driver, "__version__", "")).encode())
+    return h.hexdigest()
 
 
 def column_label(study: Study | None, name: str) -> str:
@@ -108,3 +150,35 @@ def expression_label(study: Study | None, text: str) -> str:
         if entry:
             words = re.sub(rf"\b{re.escape(n)}\b", entry[0], words)
     return f"{words} [{units.pop()}]" if len(units) == 1 and "" not in units else words
+
+
+def best_index(frame: Any, metric: str, sense: str | None) -> Any:
+    """The frame index of the kept, ok design with the best ``metric``.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        Summary rows (``status`` and ``kept`` columns, where present, select the kept, ok ones).
+    metric : str
+        The column to judge by (non-numbers count as missing).
+    sense : str or None
+        ``'max'`` or ``'min'``: which end is better (the study's ``sweep_best``).
+
+    Returns
+    -------
+    index label or None
+        The row of the largest (``'max'``) or smallest (``'min'``) value, the first of equal
+        ones; None when the sense is not known or no kept, ok row has a number there.
+    """
+    import pandas as pd
+    if sense not in ("min", "max") or metric not in frame:
+        return None
+    ok = frame
+    if "status" in ok:
+        ok = ok[ok["status"] == "ok"]
+    if "kept" in ok:
+        ok = ok[ok["kept"].astype(bool)]
+    m = pd.to_numeric(ok[metric], errors="coerce")
+    if not m.notna().any():
+        return None
+    return m.idxmax() if sense == "max" else m.idxmin()

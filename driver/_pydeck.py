@@ -11,7 +11,7 @@ from __future__ import annotations
 import os
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, TypeAlias
+from typing import Any, TypeAlias, cast
 
 import numpy as np
 
@@ -23,19 +23,51 @@ __all__ = ["DeckSource", "deck_of", "group_from_dict", "is_text", "plain_value"]
 DeckSource: TypeAlias = str | os.PathLike | Mapping[str, Mapping[str, Any]]
 
 
+def _scalar(value: np.generic, where: str, key: str | None) -> Any:
+    """A numpy scalar as a plain Python value: a float of any precision (``longdouble`` too) as
+    the nearest double, as a deck's number is read; complex numbers, bytes, dates and records
+    are refused naming the key (``.item()`` of a ``longdouble`` is a ``longdouble`` again: it
+    is converted here, never by recursion)."""
+    if isinstance(value, np.bool_):
+        return bool(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.floating):
+        with np.errstate(over="ignore"):   # beyond a double: inf, refused as not finite by the reader
+            return float(np.float64(value))
+    if isinstance(value, np.str_):
+        return str(value)
+    what = {"c": "a complex number", "S": "bytes", "M": "a date", "m": "a time span", "V": "a record"}
+    raise DeckError(where, None, key, f"value {shown_value(value)} of numpy type {type(value).__name__} is "
+                                      f"{what.get(value.dtype.kind, 'not a deck value')}: a deck value is a number, "
+                                      "a string, a logical or a flat list of them")
+
+
 def plain_value(value: Any, where: str, key: str | None = None, depth: int = 0) -> Any:
     """A Python/numpy value as the deck reader's plain types (lists for sequences).
 
     Sizes are checked from ``len()`` and ``shape`` before anything is converted (a
     ``range(10**9)`` is refused, not materialised); a list of lists is one level deep at most
-    (a deck value is a number, a string, a logical or a list of them)."""
+    (a deck value is a number, a string, a logical or a list of them).  numpy scalars and arrays
+    of every dtype are converted (``longdouble`` to the nearest double, an object array element
+    by element) or refused with a DeckError naming the key (complex, bytes, dates, records)."""
     if isinstance(value, np.ndarray):
-        if value.ndim == 0:
-            return plain_value(value.item(), where, key, depth)
         if value.size > MAX_VALUES or value.ndim > 1:
             raise DeckError(where, None, key, f"array of shape {value.shape}: a deck value is at most a flat "
                             f"list of {MAX_VALUES} values")
-        value = value.tolist()
+        if value.dtype.kind == "O":   # element by element (tolist() would recurse into nested arrays)
+            items = list(value.flat)
+            if value.ndim == 0:
+                return plain_value(items[0], where, key, depth)
+            value = items
+        elif value.ndim == 0:
+            return _scalar(cast(np.generic, value[()]), where, key)
+        else:
+            value = [_scalar(v, where, key) for v in value]   # every element a numpy scalar of the dtype
+            if depth >= 1:
+                raise DeckError(where, None, key, "a list inside a list: a deck value is a number, a string, "
+                                "a logical or a flat list of them")
+            return value
     if isinstance(value, (list, tuple, range)):
         if len(value) > MAX_VALUES:
             raise DeckError(where, None, key, f"{len(value)} values; at most {MAX_VALUES} are read per key "
@@ -45,7 +77,7 @@ def plain_value(value: Any, where: str, key: str | None = None, depth: int = 0) 
                             "a logical or a flat list of them")
         return [plain_value(v, where, key, depth + 1) for v in value]
     if isinstance(value, np.generic):
-        return plain_value(value.item(), where, key, depth)
+        return _scalar(value, where, key)
     if isinstance(value, Path):
         return str(value)
     if isinstance(value, str) and len(value) > MAX_DECK_BYTES:

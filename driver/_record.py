@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from driver._export import json_safe
-from driver._outcome import OptimizeOutcome, Outcome, RunOutcome, SweepOutcome, SynthesisOutcome
+from driver._outcome import OptimizeOutcome, Outcome, RunOutcome, StreamedSummary, SweepOutcome, SynthesisOutcome
 from driver._result import Result
 
 __all__ = ["SCHEMA", "ENGINES", "record", "result_record", "compare_record", "record_text", "write_record"]
@@ -66,23 +66,18 @@ def _messages(outcome: Outcome) -> list[dict[str, str]]:
     return [{"level": m.level, "text": m.text} for m in outcome.messages]
 
 
-def _summary_frame(outcome: SweepOutcome) -> Any:
-    """The sweep's summary as a DataFrame (a lazy handle is read), or None."""
-    s = outcome.summary
-    return s.to_pandas() if s is not None and hasattr(s, "to_pandas") else s
-
-
 def _sweep(outcome: SweepOutcome, files: list[str]) -> dict[str, Any]:
-    frame = _summary_frame(outcome)
+    s = outcome.summary   # a frame, or a lazy handle on streamed rows (only its status column is read)
     section: dict[str, Any] = {"cases": outcome.n_cases, "batch": outcome.batch,
                                "summary_table": next((f for f in files if f.endswith("_summary.parquet")), None),
                                "failed": [{"case": c, "values": v, "error": e} for c, v, e in outcome.failed]}
     study = outcome.study
-    if frame is not None:
-        columns = [str(c) for c in frame.columns]
-        section.update(rows=len(frame), columns=columns, swept_keys=[c for c in columns if "." in c])
-        if "status" in frame:
-            section["status_counts"] = {str(k): int(v) for k, v in frame["status"].value_counts().sort_index().items()}
+    if s is not None:
+        columns = [str(c) for c in s.columns]
+        section.update(rows=len(s), columns=columns, swept_keys=[c for c in columns if "." in c])
+        if "status" in columns:
+            status = s.to_pandas(["status"])["status"] if isinstance(s, StreamedSummary) else s["status"]
+            section["status_counts"] = {str(k): int(v) for k, v in status.value_counts().sort_index().items()}
         study = study or next((c.partition(".")[0] for c in columns if "." in c), "")
     summary = {"cases": outcome.n_cases, "ok": outcome.n_ok, "kept": outcome.n_kept, "failed": outcome.n_failed,
                "resumed": outcome.n_resumed, "redone": outcome.n_redone}

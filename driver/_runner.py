@@ -9,7 +9,7 @@ from __future__ import annotations
 import functools
 import os
 import re
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -18,10 +18,11 @@ import numpy as np
 from driver import _blas as blas
 from driver import _limits as limits
 from driver._atomic import NAME_MAX, inside, output_set, remove_stale_temporaries, write_text
-from driver._deck import Deck, DeckError, GroupSpec, Params, validate
+from driver._deck import Deck, DeckError, GroupSpec, Params, shown_value, validate
 from driver._export import FORMATS, write_tidy
+from driver._names import name_problem, shown
 from driver._outcome import RunOutcome
-from driver._pydeck import deck_of
+from driver._pydeck import deck_of, is_text
 from driver._result import Result
 from driver._signatures import sign
 from driver._study import ENGINES, Study, load_study, registered, study_names
@@ -68,11 +69,15 @@ def output_stem(outdir: str | Path, deck_path: str | Path, suffixes: Iterable[st
     is opened (:class:`driver._atomic.NameTooLong`, before anything is renamed into place).
 
     A deck named ``..dat`` has the stem ``.``, ``...dat`` the stem ``..``: their outputs would
-    land beside or above OUTDIR.
+    land beside or above OUTDIR.  A name or folder holding control or bidi characters is refused
+    (:mod:`driver._names`).
     """
     name = Path(deck_path).name
     stem = name[: -len(Path(name).suffix)] if Path(name).suffix else name
     candidate = Path(outdir) / stem
+    why = name_problem(candidate, "the outputs' name (the output folder and the deck's stem)")
+    if why:   # every output's name is printed and written: control and bidi characters are refused
+        raise DeckError(shown(deck_path), None, None, why)
     if not stem or stem.strip(".") == "" or "/" in stem or "\\" in stem or not inside(outdir, candidate):
         raise DeckError(deck_path, None, None, f"outputs are named after the deck file, and {name!r} would name "
                         f"them outside the output folder {outdir}: rename the deck (e.g. case.dat)")
@@ -162,7 +167,12 @@ def numerical_error(params: Params, exc: BaseException) -> CaseFailure:
     """
     study = load_study(params.group)
     blamed = study.blame(params, exc) if study is not None and study.blame is not None else None
-    if blamed:
+    if blamed and blamed[0] is not None and blamed[0] not in params.given:
+        # the deck does not have the key: the error is placed at the group, the default named
+        key, words = blamed
+        e = params.error(None, f"{words} (key '{key}' is not in the deck: its default, "
+                               f"{shown_value(params.get(key))}, applies)")
+    elif blamed:
         e = params.error(*blamed)
     else:
         words = next(w for cls, w in _WORDS if isinstance(exc, cls))
@@ -180,8 +190,10 @@ def check_finite(result: Result, params: Params) -> Result:
         m = _NON_FINITE.search(text)
         if m:
             line = text.count("\n", 0, m.start()) + 1
-            raise numerical_error(params, TableValueError(
-                f"'{m.group(0)}' would be written on line {line} of {what}"))
+            found = m.group(0)
+            kind = ("a field of asterisks (a number too wide for its column)" if found.startswith("*") else
+                    "a NaN (not a number)" if "nan" in found.lower() else "an infinity")
+            raise numerical_error(params, TableValueError(f"{kind} would be written on line {line} of {what}"))
     num = result.tidy.select_dtypes("number") if result.tidy is not None else None
     if num is not None and num.size and not np.isfinite(num.to_numpy(dtype=float, na_value=0.0)).all():
         bad = [c for c in num.columns if not np.isfinite(num[c].to_numpy(dtype=float, na_value=0.0)).all()]
@@ -244,10 +256,44 @@ def study_run(spec: GroupSpec) -> Callable[[Callable[..., Result]], Callable[...
             if params is not None:
                 if keys:
                     raise TypeError(f"{spec.name}.run() takes validated params or deck keys, not both")
-                return run(params, progress=progress)
+                if isinstance(params, Params):
+                    return run(params, progress=progress)
+                return _positional_run(spec.name, params, progress)
             return run_study(deck_of({spec.name: keys}, None), None, [], False, progress=progress).result
 
         sign(wrapper, spec)
         return wrapper
 
     return decorate
+
+
+def _positional_run(group: str, source: Any, progress: bool) -> Result:
+    """A study's ``run`` given one positional argument other than Params: a dict of its keys
+    (``{'crank': 5, ...}``), or a deck as :func:`driver.run` takes one (a dict of groups, a
+    deck's text, a deck file) whose study group is ``group``; anything else is a TypeError that
+    says what to pass."""
+    what = (f"{group}.run() takes the deck's keys as keyword arguments ({group}.run(crank=5, ...)), a dict of "
+            f"them, a &{group} deck (its text, its file, or {{'{group}': {{...}}}}), or validated Params")
+    if isinstance(source, Mapping):
+        nested = [isinstance(v, Mapping) for v in source.values()]
+        if source and not any(nested):          # the keys of this study
+            return run_study(deck_of({group: dict(source)}, None), None, [], False, progress=progress).result
+        if not all(nested):
+            raise TypeError(f"{what}; this dict mixes groups ({{'{group}': {{...}}}}) and keys")
+    elif not isinstance(source, (str, os.PathLike)):
+        raise TypeError(f"{what}, not {type(source).__name__}")
+    deck = deck_of(source, None)
+    control = [g for g in ("synthesis", "optimize", "sweep") if g in deck.groups]
+    if control:
+        raise DeckError(deck.path, deck.groups[control[0]].line or None, None,
+                        f"this deck has a &{control[0]} group: {group}.run() runs one &{group} deck (run the deck "
+                        "with driver.run_sweep(), driver.optimize.optimize() or driver.synthesis.synthesise())")
+    others = sorted(g for g in deck.groups if g != group)
+    if others:
+        raise DeckError(deck.path, deck.groups[others[0]].line or None, None,
+                        f"a &{others[0]} group in a deck given to {group}.run(), which runs a &{group} deck "
+                        f"(driver.run() runs a deck of any study)")
+    result = run_study(deck, None, [], False, progress=progress).result
+    if isinstance(source, str) and is_text(source):   # a deck's text has no file name: named after the study
+        result.name = group
+    return result

@@ -64,8 +64,10 @@ def fortran_f(value: float, w: int | None, d: int, style: str = "modern") -> str
     when the value does not fit (callers widen the column; never ``****``).
     """
     x = float(value)
-    if not math.isfinite(x):
-        raise TableValueError(f"non-finite value {x!r} cannot be written in F{w}.{d}")
+    if not math.isfinite(x):   # in words: no 'nan' or 'FNone.3' in a message
+        what = "a NaN (not a number)" if math.isnan(x) else ("+infinity" if x > 0 else "-infinity")
+        column = f"an F{w}.{d} column" if w is not None else f"a column of {d} decimals"
+        raise TableValueError(f"{what} cannot be written in {column}")
     text = _round_half_up(x, d)
     if text.startswith("-") and float(text) == 0.0:
         text = text[1:]  # no sign on a value that rounds to zero

@@ -26,6 +26,7 @@ import numpy as np
 from driver._atomic import atomic_open
 from driver._extras import require
 from driver._formats import ANIMATION_FORMATS, PLOT_FORMATS, plot_format
+from driver._output import best_index  # one rule for the maps' star and the sweep's best case
 
 require("plot")   # a clear message naming the [plot] extra when matplotlib is missing; then import it:
 import matplotlib  # noqa: E402 (after require above)
@@ -707,23 +708,6 @@ def convergence_plot(history, evals, objective: str, sense: str = "minimize", ti
     if title:
         suptitle(fig, title)   # composed by the caller: deck parts through plain_text
     return fig
-
-
-def best_index(frame, metric: str, sense: str | None):
-    """The frame index of the kept, ok design with the best ``metric`` (``sense`` 'min' or 'max'),
-    or None (no sense known, or no such design)."""
-    import pandas as pd
-    if sense not in ("min", "max") or metric not in frame:
-        return None
-    ok = frame
-    if "status" in ok:
-        ok = ok[ok["status"] == "ok"]
-    if "kept" in ok:
-        ok = ok[ok["kept"].astype(bool)]
-    m = pd.to_numeric(ok[metric], errors="coerce")
-    if not m.notna().any():
-        return None
-    return m.idxmax() if sense == "max" else m.idxmin()
 
 
 def is_grid(frame, keys: Sequence[str]) -> bool:

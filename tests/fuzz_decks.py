@@ -229,7 +229,9 @@ def grammar_deck(rng: random.Random) -> tuple[str, set[str], bool]:
         tok = number_token(rng)
         keys[k] = tok
         vals = fortran_values(tok)
-        if tok.strip() and (vals is None or len(vals) != 1):   # an empty value is Fortran's null
+        # an empty value is Fortran's null value, which a deck may not give (a deck states every
+        # value): refused naming its key too
+        if not tok.strip() or vals is None or len(vals) != 1:
             must.add(k)
     text = "&fourbar\n" + "\n".join(f"  {key} = {v}" for key, v in keys.items())
     if rng.random() < 0.3:
@@ -239,8 +241,11 @@ def grammar_deck(rng: random.Random) -> tuple[str, set[str], bool]:
         toks = [rng.choice(["2", "3", "4.5", "2*3.0"]) if rng.random() < 0.6 else number_token(rng)
                 for _ in range(rng.randrange(1, 4))]
         lines = ["  key1 = 'fourbar.crank'", f"  values1 = {', '.join(toks)}"]
-        # an empty token is Fortran's null value (a trailing separator, or ", ,"), not a bad number
+        # an empty token is Fortran's null value: refused as such (", ,"), or no value at all (a
+        # trailing separator); either way only a bad number requires a refusal
         if any(t.strip() and fortran_values(t) is None for t in toks):
+            must.add("values1")
+        if any(not t.strip() for t in toks[:-1]):   # ", ," within the list: a null value, refused
             must.add("values1")
         if rng.random() < 0.6:
             lines.append(f"  keep = \"{expression(rng)}\"")

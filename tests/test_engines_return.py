@@ -11,7 +11,6 @@
 from __future__ import annotations
 
 import ast
-import subprocess
 from pathlib import Path
 
 import pytest
@@ -150,31 +149,6 @@ def test_cli_prints_the_outcome_stdout_and_stderr_apart(write_deck, capsys):
 
 # ----------------------------------------------------------------------------- Ctrl-C notices
 
-def test_interrupt_notice_reaches_the_callback_before_the_running_task_finishes(tmp_path, capsys):
-    """run_pool: Ctrl-C while one task still runs (a 3 s shell sleep, then a marker file): the
-    callback hears the notice before that task ends; run_pool waits for it, then re-raises."""
-    from driver.sweep._pool import run_pool
-    marker = tmp_path / "done"
-    queue = iter(["slow", "quick"])
-    heard: list[tuple[str, bool]] = []
-
-    def submit(pool, task):
-        if task == "slow":
-            return pool.submit(subprocess.run, ["sh", "-c", f"sleep 3; touch {marker}"])
-        return pool.submit(abs, -1)
-
-    def on_result(task, result, in_flight):
-        assert task == "quick"
-        raise KeyboardInterrupt   # Ctrl-C as the quick task's result comes in
-
-    with pytest.raises(KeyboardInterrupt):
-        run_pool(lambda: next(queue, None), submit, lambda task: None, on_result, 2, 2, "chunks",
-                 notify=lambda line: heard.append((line, marker.exists())))
-    assert heard == [("interrupt: cancelling queued chunks, finishing the running ones", False)]
-    assert marker.exists()   # the running task finished before the interrupt went on
-    assert capsys.readouterr() == ("", "")
-
-
 SWEEP = """&fourbar
   fixed_link = 12.0, crank = 2.0, coupler = 15.0, rocker = 9.0
   omega = 5.0, step_deg = 20, method = 'exact'
@@ -188,15 +162,15 @@ SWEEP = """&fourbar
 def interrupted_sweep(tmp_path, monkeypatch):
     """A 15-case per-case sweep whose 6th case raises KeyboardInterrupt in its worker (the workers
     are forked after the patch); the driver gets it from the case's future."""
-    from driver.sweep import _engine as engine
-    real = engine._compute
+    from driver.sweep import _chunks as chunks
+    real = chunks.compute_case
 
     def compute(task, case, module):
         if case.index == 6:
             raise KeyboardInterrupt
         return real(task, case, module)
 
-    monkeypatch.setattr(engine, "_compute", compute)
+    monkeypatch.setattr(chunks, "compute_case", compute)
     path = tmp_path / "sw.dat"
     path.write_text(SWEEP)
     return path

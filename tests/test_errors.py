@@ -46,7 +46,7 @@ def test_every_exception_of_the_driver_derives_from_driver_error_and_keeps_its_b
     builtins = {"DeckError": ValueError, "CaseFailure": ValueError, "ExprError": ValueError,
                 "TableValueError": ValueError, "PublishedError": ValueError, "FitError": ValueError,
                 "MissingExtra": ImportError, "NameTooLong": OSError, "LinkRefused": PermissionError,
-                "SweepBusy": OSError, "KernelError": RuntimeError}
+                "SweepBusy": OSError, "KernelError": RuntimeError, "UnsafeName": OSError}
     for name, cls in classes.items():
         if name in OUTSIDE:
             assert not issubclass(cls, DriverError) and not issubclass(cls, Exception), name
@@ -62,18 +62,20 @@ def test_every_exception_of_the_driver_derives_from_driver_error_and_keeps_its_b
 
 
 def _instances() -> list[BaseException]:
-    from driver._atomic import LinkRefused, NameTooLong
+    from driver._atomic import LinkRefused, NameTooLong, UnsafeName
     from driver._expr import ExprError
     from driver._extras import MissingExtra
     from driver._published import PublishedError
     from driver._runner import CaseFailure
     from driver._table import TableValueError
     from driver.robust_example._analysis import FitError
-    from driver.sweep._store import SweepBusy
+    from driver.sweep._resume import SweepBusy
     return [driver.DeckError("a.dat", 3, "crank", "must be positive"), CaseFailure("b.dat", 4, None, "diverged"),
             ExprError("not allowed", "__import__"), TableValueError("nan"), PublishedError("missing"),
             FitError("singular"), MissingExtra("parquet", ImportError("No module named 'pyarrow'")),
-            NameTooLong("/tmp/" + "x" * 300 + ".out"), LinkRefused("/tmp/link"), SweepBusy(Path("/tmp/s.sweep")),
+            NameTooLong("/tmp/" + "x" * 300 + ".out"), LinkRefused("/tmp/link"),
+            UnsafeName("/tmp/a\x1b[31m.out", "the name holds a control character"),
+            SweepBusy(Path("/tmp/s.sweep")),
             KernelError("slidercrank_nl.column_static", 4, "BAD ARGUMENTS: the kernel refused its arguments")]
 
 

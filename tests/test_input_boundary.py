@@ -292,7 +292,7 @@ def test_a_symlinked_outdir_given_by_the_user_works(tmp_path, capsys):
 # ----------------------------------------------------------------------------- 5. the rest
 
 def test_concurrent_run_of_one_sweep_is_refused_with_one_line(tmp_path, capsys):
-    from driver.sweep import _store as store
+    from driver.sweep import _resume as store
     deck = tmp_path / "sw.dat"
     deck.write_text(SWEEP_DECK)
     out = tmp_path / "out"

@@ -174,3 +174,162 @@ def test_a_cut_table_is_redone_and_said(deck, tmp_path, capsys):
     assert "opt_evals.parquet cannot be read" in said
     assert computed == N_DESIGNS
     _same(fresh, out)
+
+
+# ----------------------------------------------------------------------------- round three (issue 36)
+# A resume record is bound to the whole problem and to the code: replayed only into the same one.
+
+SWAP = """&fourbar fixed_link = 10, crank = 2, coupler = 9, rocker = 6, omega = 5, step_deg = 10 /
+&optimize
+  var1 = 'fourbar.rocker', lower1 = 2, upper1 = 8
+  var2 = 'fourbar.crank', lower2 = 2, upper2 = 8
+  maximize = 'mu_min_deg'
+  constraint1 = 'grashof_class == "crank-rocker"'
+  method = 'grid', grid_count = 4
+/
+"""
+SWAPPED = SWAP.replace("var1 = 'fourbar.rocker'", "var1 = 'fourbar.CRANK'").replace(
+    "var2 = 'fourbar.crank'", "var2 = 'fourbar.rocker'").replace("CRANK", "crank")
+
+
+def _fresh(tmp_path, text: str):
+    """The truth: an uninterrupted run of the deck (the same file as the resumed one's, written first)."""
+    path = tmp_path / "opt.dat"
+    path.write_text(text)
+    fresh = tmp_path / "fresh"
+    assert main([str(path), "-o", str(fresh), "-q", "-j", "1"]) == 0
+    return fresh
+
+
+def _interrupt(path, out, monkeypatch) -> None:
+    def stop(*_a, **_k):
+        raise KeyboardInterrupt
+    with monkeypatch.context() as m:
+        m.setattr(opt, "_write", stop)
+        with pytest.raises(KeyboardInterrupt):
+            opt.optimize(path, out, jobs=1)
+    assert (out / "opt.journal.jsonl").is_file()
+
+
+def _same_as(fresh, out):
+    import pandas as pd
+    for name in COMPARED:
+        assert (out / name).read_bytes() == (fresh / name).read_bytes(), name
+    # the evaluations table too, its columns in the same order as a fresh run's
+    pd.testing.assert_frame_equal(pd.read_parquet(out / "opt_evals.parquet"),
+                                  pd.read_parquet(fresh / "opt_evals.parquet"), check_exact=True)
+
+
+def test_a_journal_of_swapped_variables_is_not_replayed(tmp_path, monkeypatch, capsys):
+    """Issue 36 item 1: var1/var2 swapped after an interrupt; the old records were replayed in the
+    wrong order (an optimum that cannot be assembled, CONVERGED, exit 0)."""
+    fresh = _fresh(tmp_path, SWAPPED)
+    path = tmp_path / "opt.dat"
+    path.write_text(SWAP)
+    out = tmp_path / "out"
+    _interrupt(path, out, monkeypatch)
+    path.write_text(SWAPPED)
+    said, computed = _resume(path, out, capsys)
+    assert "16 evaluation record(s) not replayed" in said and "written for another problem" in said, said
+    assert computed == 16
+    _same_as(fresh, out)
+
+
+@pytest.mark.parametrize("change", [
+    ("upper1 = 8", "upper1 = 8.5"),                                  # a bound
+    ("maximize = 'mu_min_deg'", "minimize = 'mu_min_deg'"),          # the objective's sense
+    ("constraint1 = 'grashof_class == \"crank-rocker\"'", "constraint1 = 'mu_min_deg > 1'"),
+    ("method = 'grid', grid_count = 4", "method = 'grid', grid_count = 4, constraint_tol = 1e-3"),   # a setting
+    ("coupler = 9", "coupler = 9.5"),                                # the study group
+])
+def test_a_journal_of_another_problem_is_not_replayed(tmp_path, monkeypatch, capsys, change):
+    changed = SWAP.replace(*change)
+    assert changed != SWAP
+    fresh = _fresh(tmp_path, changed)
+    path = tmp_path / "opt.dat"
+    path.write_text(SWAP)
+    out = tmp_path / "out"
+    _interrupt(path, out, monkeypatch)
+    path.write_text(changed)
+    said, computed = _resume(path, out, capsys)
+    assert "written for another problem" in said, said
+    _same_as(fresh, out)
+
+
+def test_jobs_do_not_change_the_problem(tmp_path, monkeypatch, capsys):
+    path = tmp_path / "opt.dat"
+    path.write_text(SWAP)
+    out = tmp_path / "out"
+    _interrupt(path, out, monkeypatch)
+    path.write_text(SWAP.replace("grid_count = 4", "grid_count = 4, jobs = 2"))
+    said, computed = _resume(path, out, capsys)
+    assert computed == 0 and "not replayed" not in said
+
+
+def test_a_journal_of_other_code_is_not_replayed(tmp_path, monkeypatch, capsys):
+    fresh = _fresh(tmp_path, SWAP)
+    path = tmp_path / "opt.dat"
+    path.write_text(SWAP)
+    out = tmp_path / "out"
+    _interrupt(path, out, monkeypatch)
+    from driver.optimize._problem import Problem
+    monkeypatch.setattr(Problem, "code_digest", lambda self: "0" * 16)   # as if the tool had changed since
+    said, computed = _resume(path, out, capsys)
+    assert "16 because it was computed by other code" in said, said
+    assert computed == 16
+    monkeypatch.undo()
+    _same_as(fresh, out)
+
+
+def _forge(lines: list[str], i: int, change) -> list[str]:
+    """Line i's record changed by ``change`` and checksummed again (anyone can: sha256 has no key)."""
+    from driver.optimize import _journal
+    rec = json.loads(lines[i])["record"]
+    change(rec)
+    return lines[:i] + [_journal.line(rec)] + lines[i + 1:]
+
+
+@pytest.mark.parametrize("change, why", [
+    (lambda r: r.update(summary="mu_min_deg"), "its summary is not a table"),       # was: run failed: AttributeError
+    (lambda r: r.update(summary={"mu_min_deg": [1, 2]}), "its summary is not a table"),
+    (lambda r: r.update(x=[1.0]), "its design is not 2 finite number(s)"),
+    (lambda r: r.update(x=[None, 3.0]), "its design is not 2 finite number(s)"),
+    (lambda r: r.update(status="excellent"), "its status is not one of"),
+    (lambda r: r.pop("code"), "its fields are not those of a record"),
+])
+def test_a_checksummed_record_of_the_wrong_shape_is_redone(deck, tmp_path, monkeypatch, capsys, change, why):
+    path, fresh = deck
+    out = tmp_path / "out"
+    lines = _interrupted(path, out, monkeypatch)
+    (out / "opt.journal.jsonl").write_text("".join(_forge(lines, 3, change)))
+    said, computed = _resume(path, out, capsys)
+    assert "1 because a journal record is not of the shape this tool writes" in said and why in said, said
+    assert computed == 1
+    _same(fresh, out)
+
+
+def test_a_forged_record_that_wins_fails_the_run(deck, tmp_path, monkeypatch, capsys):
+    """A record with a valid checksum but a forged figure is replayed (its shape is right): the
+    optimum's re-run by the full study then DIFFERS from its evaluation, which is a failure
+    (exit 1, stated), never a success (it printed DIFFERS and exited 0)."""
+    path, _ = deck
+    out = tmp_path / "out"
+    lines = _interrupted(path, out, monkeypatch)
+    worst = min(range(len(lines)), key=lambda i: json.loads(lines[i])["record"]["summary"]["mu_min_deg"] or 99)
+    (out / "opt.journal.jsonl").write_text(
+        "".join(_forge(lines, worst, lambda r: r["summary"].update(mu_min_deg=89.0))))
+    capsys.readouterr()
+    assert main([str(path), "-o", str(out), "-j", "1", "--resume"]) == 1
+    err = capsys.readouterr().err
+    assert "DIFFERS from its evaluation" in err and "no optimum is claimed" in err, err
+    assert "DIFFERS from the evaluation" in (out / "opt.out").read_text()
+
+
+def test_a_resumed_runs_evaluations_table_equals_a_fresh_ones(deck, tmp_path, monkeypatch, capsys):
+    """Its columns came in another order (the journal's summaries have sorted keys)."""
+    path, fresh = deck
+    out = tmp_path / "out"
+    lines = _interrupted(path, out, monkeypatch)
+    (out / "opt.journal.jsonl").write_text("".join(lines[: len(lines) // 2]))
+    _resume(path, out, capsys)
+    _same_as(fresh, out)

@@ -364,9 +364,8 @@ def test_balancing_linkage_keeps_its_centre_of_mass_with_the_drawn_counterweight
     centre-of-mass offsets, from the drawn pins) and the two drawn counterweights does not move
     over the turn (a shaking force of zero), and each counterweight keeps its radius from its
     pivot."""
-    from driver.fourbar._analysis_forces import counterweights
-
     import driver
+    from driver.fourbar._analysis_forces import counterweights
     params = driver.run(str(INPUTS / "fourbar_forces_balanced.dat")).params
     cw = counterweights(params)
     m, d, off = [0.5, 1.2, 0.9], [0.05, 0.175, 0.125], np.radians([0.0, 10.0, 0.0])

@@ -2,23 +2,26 @@
 to *any* module of a study package, not only its ``__init__.py`` (an edit to a study's report
 module changes what the tables say, so a record made before it must be redone).
 
-Both kinds carry the one signature :func:`driver.sweep._store.signature`; checked on the
+Both kinds carry the one signature :func:`driver.sweep._resume.signature`; checked on the
 functions (a synthetic study package edited on disk) and end to end (a Hooke-joint sweep run
 on the batch path and case by case, resumed before and after an edit of
 ``driver/ujoint/_report.py`` as the digest reads it)."""
 from __future__ import annotations
 
 import importlib.util
+import json
 import sys
 from pathlib import Path
 
+import pyarrow.parquet as pq
 import pytest
 
 from driver._cli import main
 from driver._deck import RawGroup
 from driver._output import code_digest
-from driver.sweep import _batch as sweep_batch
-from driver.sweep import _store as store
+from driver.sweep import _plan as plan
+from driver.sweep import _resume as store
+from driver.sweep._spec import Grid
 
 
 @pytest.fixture
@@ -45,8 +48,8 @@ def fake_study(tmp_path: Path):
 def _both(mod) -> tuple[str, str]:
     raw = RawGroup("fakestudy", {"a": 1.0, "b": 2.0}, {"a": 2, "b": 3}, 1)
     per_case = store.case_signature(raw, ["fakestudy.a"], "deck.dat", "", "none", [], False, mod)
-    grid = sweep_batch.Grid(["fakestudy.a"], [[1.0, 2.0]], False)
-    batch = sweep_batch._signature(raw, grid, "", "all", mod)
+    grid = Grid(["fakestudy.a"], [[1.0, 2.0]], False)
+    batch = plan.batch_signature(raw, grid, "", "all", mod)
     return per_case, batch
 
 
@@ -97,8 +100,8 @@ def test_an_edit_of_the_report_module_redoes_a_resumed_sweep(tmp_path, capsys, m
     deck.write_text(DECK.format(outputs=outputs))
     out = tmp_path / "out"
     assert main([str(deck), "-o", str(out), "-q", "-j", "1"]) == 0
-    parts = [p.name for p in (out / "usw.sweep").glob("part-*.parquet")]
-    assert parts and all(n.startswith("part-r") == (engine == "case") for n in parts), parts
+    kinds = {json.loads(pq.read_schema(p).metadata[b"sweep"])["kind"] for p in (out / "usw.sweep").glob("part-*")}
+    assert kinds == {"batch" if engine == "batch" else "cases"}, kinds
     assert _resumed(capsys, deck, out) == "resume: 6 of 6 cases complete, 0 to run"
     target = Path(report.__file__).resolve()
     real = Path.read_bytes

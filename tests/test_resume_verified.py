@@ -114,3 +114,34 @@ def test_damaged_batch_part_is_redone(tmp_path, capsys):
     assert "100 cases redone" in capsys.readouterr().err
     for name in ("b.out", "b_summary.csv"):
         assert (out / name).read_bytes() == (fresh / name).read_bytes(), name
+
+
+BIG = DECK.replace("values1 = 2, 3, 4, 5", "start1 = 2, stop1 = 5, count1 = 200\n  key2 = 'fourbar.rocker', values2 = 8, 9")
+
+
+@pytest.mark.parametrize("outputs, per_part", [("none", 64), ("all", 4)])
+def test_a_part_cut_in_half_is_redone_counted_and_said(tmp_path, capsys, outputs, per_part):
+    """A record part cut in half (a crash while copying the folder, a full disk) cannot even
+    be read: its chunk runs again, and the warning counts its cases with the reason, for both
+    kinds of record (batch: 400 cases in parts of 64; per case: 100 parts of 4).  The
+    tables equal a fresh run's."""
+    deck = tmp_path / "c.dat"
+    deck.write_text(BIG.replace("&sweep\n", f"&sweep\n  case_outputs = '{outputs}'\n"))
+    fresh, out = tmp_path / "fresh", tmp_path / "out"
+    assert main([str(deck), "-o", str(fresh), "-q", "-j", "1"]) == 0
+    assert main([str(deck), "-o", str(out), "-q", "-j", "1"]) == 0
+    parts = sorted((out / "c.sweep").glob("part-*.parquet"))
+    assert len(parts) == -(-400 // per_part)
+    cut = parts[3]   # the chunk of cases 3 * per_part + 1 ...
+    cut.write_bytes(cut.read_bytes()[: cut.stat().st_size // 2])
+    with pytest.raises(pa.ArrowInvalid):
+        pq.read_schema(cut)   # unreadable: only its name tells which chunk it was
+    capsys.readouterr()
+    assert main([str(deck), "-o", str(out), "-j", "1", "--resume"]) == 0
+    said = capsys.readouterr()
+    assert f"resume: {400 - per_part} of 400 cases complete, {per_part} to run" in said.out
+    assert (f"resume: {per_part} cases redone ({per_part} because a record part was cut short or cannot be read)"
+            in said.err), said.err
+    for name in ("c.out", "c_summary.csv"):
+        assert (out / name).read_bytes() == (fresh / name).read_bytes(), name
+    assert len(list((out / "c.sweep").glob("part-*.parquet"))) == -(-400 // per_part)

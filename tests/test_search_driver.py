@@ -7,7 +7,7 @@
 * the driver merges the rows the workers return (kept and failed ones) and reads back only
   the parts of resumed chunks: a resumed run gives the same tables;
 * the chunk layout depends on the number of cases only and is capped at MAX_CHUNKS chunks
-  (10^9 cases: 4096 parts); a small sweep (the shipped search) runs in the driver when the
+  (10^9 cases: 4096 parts), for batch and per-case chunks alike; a small sweep (the shipped search) runs in the driver when the
   worker pool would cost more than it saves.
 """
 from __future__ import annotations
@@ -20,7 +20,10 @@ import pyarrow.parquet as pq
 import pytest
 
 from driver._cli import main
-from driver.sweep import _batch as sweep_batch
+from driver.sweep import _chunks as chunks
+from driver.sweep import _executor as executor
+from driver.sweep import _plan as plan
+from driver.sweep import _resume as resume
 
 SWEEP = """&fourbar fixed_link = 12.0, crank = 3.0, coupler = 15.0, rocker = 9.0, omega = 5.0, step_deg = 10 /
 &sweep
@@ -37,25 +40,26 @@ SWEEP = """&fourbar fixed_link = 12.0, crank = 3.0, coupler = 15.0, rocker = 9.0
 def writers(tmp_path, monkeypatch):
     """A file listing the pid of every write_part call (workers fork from this process)."""
     log = tmp_path / "writers.log"
-    real = sweep_batch.write_part
+    real = resume.write_part
 
-    def spy(folder, res, signature):
+    def spy(folder, rows, meta):
         with open(log, "a") as fh:
-            fh.write(f"{os.getpid()} {res.start}\n")
-        return real(folder, res, signature)
+            fh.write(f"{os.getpid()} {meta['start']}\n")
+        return real(folder, rows, meta)
 
-    monkeypatch.setattr(sweep_batch, "write_part", spy)
+    monkeypatch.setattr(chunks, "write_part", spy)     # where a worker writes its chunk's part
+    monkeypatch.setattr(resume, "write_part", spy)     # where the driver writes one
     return log
 
 
 def test_workers_write_their_parts_and_the_driver_merges(tmp_path, writers, monkeypatch):
-    monkeypatch.setattr(sweep_batch, "POOL_MIN_SECONDS", 0.0)   # the pool even for this small sweep
+    monkeypatch.setattr(executor, "POOL_MIN_SECONDS", 0.0)   # the pool even for this small sweep
     deck = tmp_path / "s.dat"
     deck.write_text(SWEEP)
     assert main([str(deck), "-o", str(tmp_path / "two"), "-q", "-j", "2"]) == 0
     lines = [line.split() for line in writers.read_text().splitlines()]
     n = 21 * 40 * 40
-    size = sweep_batch.chunk_size(n)
+    size = plan.chunk_size(n, "batch")
     assert sorted(int(s) for _, s in lines) == list(range(0, n, size))
     assert all(int(pid) != os.getpid() for pid, _ in lines)   # not one part from the driver
     parts = sorted((tmp_path / "two" / "s.sweep").glob("part-*.parquet"))
@@ -83,7 +87,7 @@ def test_a_small_sweep_runs_in_the_driver_when_the_pool_would_not_pay(tmp_path, 
     deck.write_text(SWEEP)
     assert main([str(deck), "-o", str(tmp_path / "two"), "-q", "-j", "2"]) == 0
     pids = {int(line.split()[0]) for line in writers.read_text().splitlines()}
-    assert pids == {os.getpid()} and len(writers.read_text().splitlines()) == sweep_batch.MIN_CHUNKS
+    assert pids == {os.getpid()} and len(writers.read_text().splitlines()) == plan.MIN_CHUNKS
     writers.unlink()
     assert main([str(deck), "-o", str(tmp_path / "one"), "-q", "-j", "1"]) == 0
     assert (tmp_path / "two" / "s.out").read_text() == (tmp_path / "one" / "s.out").read_text()
@@ -94,11 +98,15 @@ def test_a_small_sweep_runs_in_the_driver_when_the_pool_would_not_pay(tmp_path, 
 
 
 def test_chunk_layout_depends_on_the_case_count_only_and_is_capped():
-    assert sweep_batch.chunk_size(102400) == 12800         # the shipped search: 8 chunks
-    assert sweep_batch.chunk_size(10**7) == sweep_batch.CHUNK
+    assert plan.chunk_size(102400, "batch") == 12800         # the shipped search: 8 chunks
+    assert plan.chunk_size(10**7, "batch") == plan.CHUNK
     for n in (10**8, 10**9, 10**10):
-        size = sweep_batch.chunk_size(n)
-        assert -(-n // size) <= sweep_batch.MAX_CHUNKS and size >= sweep_batch.CHUNK
+        size = plan.chunk_size(n, "batch")
+        assert -(-n // size) <= plan.MAX_CHUNKS and size >= plan.CHUNK
+    # case by case: small chunks (whole decks per case), as many as MAX_CHUNKS at most
+    assert [plan.chunk_size(n, "cases") for n in (1, 18, 128, 129, 900, 8192, 10**6)] == [1, 1, 1, 2, 8, 64, 245]
+    assert -(-10**6 // plan.chunk_size(10**6, "cases")) <= plan.MAX_CHUNKS
+    assert plan.chunk_size(10**6, "cases", given=7) == 7   # the deck's chunk
 
 
 def _decimal_half_up(value: float, decimals: int) -> str:

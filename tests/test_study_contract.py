@@ -31,7 +31,7 @@ from driver._limits import Estimate
 from driver._runner import CONTROL_GROUPS, compute, study_of
 from driver._signatures import render_stub
 from driver._study import REGISTRY, REQUIRED_LAYERS, BatchSummary, Study, load_study, study_names
-from driver.sweep import _batch as sweep_batch
+from driver.sweep import _plan as sweep_batch
 
 ROOT = Path(__file__).resolve().parents[1]
 INPUTS = ROOT / "inputs"

@@ -165,21 +165,21 @@ def test_resume_runs_only_missing_cases(tmp_path, capsys):
 def test_interrupt_keeps_finished_cases_and_leaves_no_partial_file(tmp_path, monkeypatch):
     path = deck(tmp_path, SWEEP_GRID)
     out = tmp_path / "o"
-    from driver.sweep import _engine as engine
-    real = engine._compute
+    from driver.sweep import _chunks as chunks
+    real = chunks.compute_case
 
     def interrupted(task, case, module):
         if case.index == 6:
             raise KeyboardInterrupt
         return real(task, case, module)
 
-    monkeypatch.setattr(engine, "_compute", interrupted)
+    monkeypatch.setattr(chunks, "compute_case", interrupted)
     assert main([str(path), "-o", str(out), "-q", "-j", "1"]) == 130
     names = sorted(p.name for p in (out / "sw").iterdir())
     assert [n for n in names if n.endswith(".json")] == [f"case_{k:04d}.json" for k in range(1, 6)]
     assert not any(n.startswith(".") or n.endswith(".tmp") for n in names)
     assert not (out / "sw.out").exists() and not (out / "sw_summary.csv").exists()
-    monkeypatch.setattr(engine, "_compute", real)
+    monkeypatch.setattr(chunks, "compute_case", real)
     assert main([str(path), "-o", str(out), "-q", "-j", "1", "--resume"]) == 0
     assert len(pd.read_csv(out / "sw_summary.csv")) == 15
 
@@ -197,36 +197,90 @@ def test_design_search_filter_and_kept_rows(tmp_path):
     assert sorted(p.name for p in (out / "sw").glob("*.out")) == ["case_0002.out"]
 
 
+#: the driver of the Ctrl-C test: the command line, its workers forked after a gate is put in
+#: front of every case (``gate/slot-<k>`` claims one of the first 20 places; every later case
+#: says so in ``gate/waiting-<case>`` and waits for ``gate/go``).  So the sweep cannot finish
+#: before the test's SIGINT, which arrives while both workers wait and the driver is idle.
+GATED = """
+import os, sys, time
+from pathlib import Path
+from driver.sweep import _chunks
+gate, real = Path(sys.argv[1]), _chunks.compute_case
+
+def gated(task, case, module):
+    for k in range(20):
+        try:
+            os.close(os.open(gate / f"slot-{k}", os.O_CREAT | os.O_EXCL))
+            return real(task, case, module)
+        except FileExistsError:
+            pass
+    (gate / f"waiting-{case.index}").touch()
+    while not (gate / "go").exists():
+        time.sleep(0.01)
+    return real(task, case, module)
+
+_chunks.compute_case = gated
+from driver._cli import main
+sys.exit(main(sys.argv[2:]))
+"""
+
+
 def test_ctrl_c_on_worker_processes(tmp_path):
-    """Real SIGINT to the whole process group of a 2-worker sweep: prompt exit 130, every
-    started case complete (.json marker <=> .out), no temporary file, then --resume finishes."""
+    """Real SIGINT to the whole process group of a 2-worker sweep: the driver says at once that
+    it cancels the queued cases, lets the running ones finish, exits 130; every started case is
+    complete (.json marker <=> .out), no temporary file is left, then --resume finishes.
+
+    No sleeps decide anything: the signal is sent once 20 cases are complete and a worker
+    waits at the gate (the sweep cannot have finished), and the waiting cases are released
+    only once the driver has announced the interrupt on stderr."""
     import os
+    import select
     import signal
     import subprocess
     import sys
     import time
     path = deck(tmp_path, "&sweep key1 = 'fourbar.crank', start1 = 1, stop1 = 5, count1 = 30\n"
-                          "       key2 = 'fourbar.rocker', start2 = 6, stop2 = 12, count2 = 30 /\n",
+                          "       key2 = 'fourbar.rocker', start2 = 6, stop2 = 12, count2 = 10 /\n",
                 base=BASE.replace("method = 'listing'", "method = 'exact'"))
-    out = tmp_path / "o"
-    cmd = [sys.executable, "-m", "driver", str(path), "-o", str(out), "-q", "-j", "2"]
-    proc = subprocess.Popen(cmd, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    out, gate = tmp_path / "o", tmp_path / "gate"
+    gate.mkdir()
+    cmd = [str(path), "-o", str(out), "-q", "-j", "2"]
+    proc = subprocess.Popen([sys.executable, "-c", GATED, str(gate), *cmd], start_new_session=True,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     case_dir = out / "sw"
-    deadline = time.time() + 60
-    while time.time() < deadline and (not case_dir.exists() or len(list(case_dir.glob("*.json"))) < 20):
-        time.sleep(0.05)
-    os.killpg(proc.pid, signal.SIGINT)
-    proc.communicate(timeout=60)
-    assert proc.returncode == 130
+    try:
+        deadline = time.monotonic() + 300   # a bound for a broken tool only: nothing below waits on time
+        while not (list(gate.glob("waiting-*")) and case_dir.is_dir()
+                   and len(list(case_dir.glob("*.json"))) >= 20):
+            assert proc.poll() is None and time.monotonic() < deadline, "the sweep ended before its cases waited"
+            time.sleep(0.02)
+        os.killpg(proc.pid, signal.SIGINT)
+        heard = ""
+        while "interrupt: cancelling queued cases" not in heard:   # the driver's own notice
+            assert select.select([proc.stderr], [], [], max(0.0, deadline - time.monotonic()))[0], heard
+            line = proc.stderr.readline()
+            assert line, f"stderr closed before the notice: {heard!r}"
+            heard += line
+        (gate / "go").touch()   # the running cases may finish now
+        _, err = proc.communicate(timeout=300)
+    finally:
+        (gate / "go").touch()
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+    assert proc.returncode == 130, heard + err
+    assert "interrupted: finished outputs are complete" in err
     names = [p.name for p in case_dir.iterdir()]
     assert not [n for n in names if n.startswith(".") or n.endswith(".tmp")]
     done = {n[:-5] for n in names if n.endswith(".json")}
-    assert 20 <= len(done) < 900
+    assert 20 <= len(done) < 300
     assert done == {n[:-4] for n in names if n.endswith(".out")}
     assert not (out / "sw_summary.csv").exists()
-    res = subprocess.run(cmd + ["--resume"], capture_output=True, text=True)
-    assert res.returncode == 0
-    assert len(pd.read_csv(out / "sw_summary.csv")) == 900
+    # the running chunks finished in their workers, which wrote their record parts: all resumed
+    res = subprocess.run([sys.executable, "-m", "driver", *cmd[:-3], "-j", "2", "--resume"], capture_output=True,
+                         text=True)
+    assert res.returncode == 0, res.stderr
+    assert f"resume: {len(done)} of 300 cases complete, {300 - len(done)} to run" in res.stdout
+    assert len(pd.read_csv(out / "sw_summary.csv")) == 300
 
 
 def test_keep_filter_is_never_code(tmp_path, capsys):
@@ -239,3 +293,92 @@ def test_keep_filter_is_never_code(tmp_path, capsys):
         assert main([str(deck), "-o", str(tmp_path / "out"), "-q", "-j", "1"]) == 2
         assert "key 'keep'" in capsys.readouterr().err
     assert not canary.exists() and not (tmp_path / "out" / "inject.out").exists()
+
+
+def test_the_outcome_carries_the_tables_it_wrote_and_the_best_case(tmp_path):
+    """run_sweep_deck's outcome holds the _summary and _cases tables and the .out exactly as
+    written (what pandas reads back from the files); with best=True the run of the best kept
+    case.  The paper's sweep: crank 2 keeps the largest minimum transmission angle (the
+    paper's conclusion), and its run reproduces the published table and the case's own file."""
+    from driver._deck import read_deck
+    out = tmp_path / "o"
+    oc = sweep.run_sweep_deck(read_deck(INPUTS / "fourbar_paper_sweep.dat"), out, [], False, jobs=2, best=True)
+    stem = out / "fourbar_paper_sweep"
+    written = pd.read_parquet(f"{stem}_summary.parquet")
+    pd.testing.assert_frame_equal(oc.summary, written)
+    assert oc.summary.attrs == written.attrs == {"summary_settings": {"transmission_band_deg": [40.0, 120.0]}}
+    pd.testing.assert_frame_equal(oc.cases, pd.read_parquet(f"{stem}_cases.parquet"))
+    assert oc.text == oc.out == (out / "fourbar_paper_sweep.out").read_text()
+    assert (oc.best_case, oc.best_metric) == (1, "mu_min_deg")
+    assert oc.best is not None and oc.best.params["crank"] == 2.0 and oc.best.name == "fourbar_paper_sweep_case1"
+    assert table_rows(oc.best.out) == published(2)
+    assert oc.best.out == (stem / "case_0001.out").read_text()
+    assert sweep.run_sweep_deck(read_deck(INPUTS / "fourbar_paper_sweep.dat"), tmp_path / "n", [], False,
+                                jobs=1).best is None   # the run only when asked
+
+
+def test_the_best_case_of_a_batch_search_and_of_its_streamed_tables(tmp_path, monkeypatch):
+    """The shipped design search (batch path, kept rows only): the best kept design by its first
+    plotted column (rocker_swing_deg, larger is better) is found by a plain scan of the summary
+    file; the same when the tables are streamed (a lazy summary), and its run gives that swing."""
+    from driver._deck import read_deck
+    from driver._outcome import StreamedSummary
+    from driver.sweep import _executor as executor
+    deck = read_deck(INPUTS / "fourbar_design_search.dat")
+    held = sweep.run_sweep_deck(deck, tmp_path / "held", [], False, jobs=1)
+    written = pd.read_parquet(tmp_path / "held" / "fourbar_design_search_summary.parquet")
+    pd.testing.assert_frame_equal(held.summary, written)
+    best_row, best_swing = None, -1.0
+    for case, status, kept, swing in zip(written["case"], written["status"], written["kept"],
+                                         written["rocker_swing_deg"]):
+        if status == "ok" and kept and swing > best_swing:
+            best_row, best_swing = int(case), float(swing)
+    assert (held.best_case, held.best_metric) == (best_row, "rocker_swing_deg") and held.best is None
+    monkeypatch.setattr(executor, "STREAM_ROWS", 50)
+    streamed = sweep.run_sweep_deck(deck, tmp_path / "streamed", [], False, jobs=1, best=True)
+    assert isinstance(streamed.summary, StreamedSummary) and streamed.best_case == best_row
+    assert streamed.best.summary["rocker_swing_deg"] == pytest.approx(best_swing, rel=1e-12)
+
+
+def test_the_best_case_is_the_one_the_maps_mark_and_the_page_names(tmp_path):
+    """One rule for the best case, the design-space maps' star and the report page: the first
+    plotted column (here plot_y = rocker_swing_deg, larger is better; not the study's first
+    sweep_plot column, mu_min_deg, which picks another case) over the kept, ok cases, found again
+    by a plain scan of the summary file; the page names that case and why.  A plotted expression
+    has no better end: the best case is then the first kept case (no metric)."""
+    from driver import _report_page as report_page
+    from driver._deck import read_deck
+    from driver._output import best_index
+    grid = ("key1 = 'fourbar.crank', values1 = 2, 2.5, 3, 3.5\n key2 = 'fourbar.rocker', values2 = 8, 9, 10\n"
+            " keep = 'rocker_swing_deg > 40'\n")
+    path = deck(tmp_path, f"&sweep\n {grid} plot_y = 'rocker_swing_deg' /\n")
+    oc = sweep.run_sweep_deck(read_deck(path), tmp_path / "o", [], False, jobs=1, best=True)
+    written = pd.read_parquet(tmp_path / "o" / "sw_summary.parquet")
+    best, best_value = None, -1.0
+    for case, status, kept, value in zip(written["case"], written["status"], written["kept"],
+                                         written["rocker_swing_deg"]):
+        if status == "ok" and kept and value > best_value:
+            best, best_value = int(case), float(value)
+    kept = written[(written["status"] == "ok") & written["kept"].astype(bool)]
+    assert 0 < len(kept) < len(written)   # the filter keeps some, not all
+    assert best not in (int(kept["case"].iloc[0]), int(kept.loc[kept["mu_min_deg"].idxmax(), "case"]))
+    assert (oc.best_case, oc.best_metric) == (best, "rocker_swing_deg")
+    assert int(written.loc[best_index(written, "rocker_swing_deg", "max"), "case"]) == best   # the maps' star
+    assert oc.best is not None and oc.best.summary["rocker_swing_deg"] == pytest.approx(best_value, rel=1e-12)
+    assert f"Case {best}, largest rocker swing" in report_page.page(oc, read_deck(path))
+    path = deck(tmp_path, f"&sweep\n {grid} plot_y = 'rocker_swing_deg - mu_min_deg' /\n", name="expr.dat")
+    oc = sweep.run_sweep_deck(read_deck(path), tmp_path / "e", [], False, jobs=1)
+    assert (oc.best_case, oc.best_metric) == (int(kept["case"].iloc[0]), None)
+
+
+def test_run_sweep_reads_nothing_back(tmp_path, monkeypatch):
+    """driver.run_sweep builds its result from the engine's outcome: with the Parquet and text
+    readers of pandas and pathlib made to fail, the tables are there all the same."""
+    import driver
+    monkeypatch.setattr(pd, "read_parquet", lambda *a, **k: pytest.fail("read back a Parquet file"))
+    monkeypatch.setattr(pd, "read_csv", lambda *a, **k: pytest.fail("read back a CSV file"))
+    s = driver.run_sweep({"fourbar": {"fixed_link": 12, "crank": 2, "coupler": 15, "rocker": 9, "step_deg": 20}},
+                         grid={"crank": [2, 3, 4, 5]}, jobs=1)
+    assert s.outdir is None and s.summary["fourbar.crank"].tolist() == [2, 3, 4, 5]
+    assert [int(v) for v in s.summary["mu_min_deg"]] == [40, 33, 26, 17]   # the paper's closed-loop minima
+    assert len(s.cases) == 4 * 19 and "fourbar.crank" in s.cases and s.out.startswith("  sweep over &fourbar")

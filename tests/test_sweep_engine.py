@@ -1,13 +1,17 @@
-"""The streaming batch sweep engine (driver/sweep/_batch.py): same tables as case by case, on one
-process, two workers and Dask; exact resume after SIGKILL; a dying worker costs its chunk only;
-workers never outlive the driver; bad values found without validating every case."""
+"""The sweep engine (driver/sweep/: plan, executor, chunks, record): the batch path gives the same
+tables as case by case, on one process, two workers and Dask; exact resume after SIGKILL; a
+dying worker costs its one crashing case only, for both kinds of chunk; chunk sizes depend on
+the number of cases only; workers never outlive the driver; bad values found without
+validating every case; the one Ctrl-C rule of the pool and of Dask."""
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import subprocess
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -15,7 +19,11 @@ import pandas as pd
 import pytest
 
 from driver._cli import main
-from driver.sweep import _batch as sweep_batch
+from driver.sweep import _chunks as chunks
+from driver.sweep import _executor as executor
+from driver.sweep import _plan as plan_mod
+from driver.sweep._chunks import Span
+from driver.sweep._spec import Grid
 
 BASE = """&fourbar
   fixed_link = 12.0, crank = 3.0, coupler = 15.0, rocker = 9.0, omega = 5.0, step_deg = 10
@@ -95,10 +103,10 @@ def test_interior_bad_combination_of_a_large_grid_is_a_failed_case(tmp_path):
     d = read_deck(path)
     sw = validate(d.groups["sweep"], sweep.SPEC, d.path)
     axes = swept_axes(sw, "fourbar", fourbar.SPEC)
-    grid = sweep_batch.Grid([a[0] for a in axes], [a[1] for a in axes], False)
-    p = sweep_batch.plan(fourbar.STUDY, d.groups["fourbar"], str(path), grid, "", "all")
-    res = sweep_batch.chunk_rows(p, 0, grid.n)
-    f = res.frame
+    grid = Grid([a[0] for a in axes], [a[1] for a in axes], False)
+    p = plan_mod.batch_plan(fourbar.STUDY, d.groups["fourbar"], str(path), grid, "", "all")
+    res = chunks.batch_rows(p, Span(0, grid.n, range(1, grid.n + 1)))
+    f = res.rows
     bad = (f["fourbar.start_deg"] == 300) & (f["fourbar.stop_deg"] == 200)
     assert res.n_failed == bad.sum() == 700
     assert (f.loc[bad, "status"] == "bad input").all() and f.loc[bad, "error"].str.contains("key 'step_deg'").all()
@@ -152,38 +160,71 @@ def test_resume_skips_complete_chunks(tmp_path, capsys):
     assert not list((out / "sw.sweep").glob("*.tmp"))
 
 
-def _dies(p, start, stop, folder="", _real=sweep_batch.chunk_rows):
-    """A chunk function whose worker is SIGKILLed on the chunk starting at case 30 (always, or
-    once when DIE_ONCE names a marker file)."""
+def _dies(p, span, _real=chunks.batch_rows):
+    """A batch chunk function whose worker is SIGKILLed whenever its cases include case 35
+    (always, or once when DIE_ONCE names a marker file)."""
     marker = os.environ.get("DIE_ONCE")
-    if start == 30 and (not marker or not os.path.exists(marker)):
+    if 35 in span.cases and (not marker or not os.path.exists(marker)):
         if marker:
             Path(marker).write_text("died")
         os.kill(os.getpid(), signal.SIGKILL)
-    return _real(p, start, stop, folder)
+    return _real(p, span)
 
 
 @pytest.mark.parametrize("once", [True, False])
-def test_dying_worker_costs_at_most_its_chunk(tmp_path, monkeypatch, capsys, once):
+def test_dying_worker_costs_at_most_its_case(tmp_path, monkeypatch, capsys, once):
+    """A batch chunk (cases 31-40) whose worker dies: retried once alone; when that dies too,
+    bisected down to the one case that kills its worker (35): only that case is failed."""
     path = deck(tmp_path, extra=", chunk = 10")
     ref = tmp_path / "ref"
     assert main([str(path), "-o", str(ref), "-q", "-j", "1"]) == 0
     if once:
         monkeypatch.setenv("DIE_ONCE", str(tmp_path / "marker"))
-    monkeypatch.setattr(sweep_batch, "chunk_rows", _dies)   # inherited by the forked workers
+    monkeypatch.setitem(chunks.CHUNK_FUNCTIONS, "batch", _dies)   # inherited by the forked workers
     out = tmp_path / "o"
     rc = main([str(path), "-o", str(out), "-q", "-j", "2"])
     s, r = summary(out), summary(ref)
     if once:   # retried once, alone: identical results
         assert rc == 0
         pd.testing.assert_frame_equal(s, r)
-    else:      # reported as failed cases with the reason; every other case completes
+    else:      # reported as one failed case with the reason; every other case completes
         assert rc == 1
         bad = s["status"] != "ok"
-        assert list(s.loc[bad, "case"]) == list(range(31, 41))
+        assert list(s.loc[bad, "case"]) == [35]
         assert s.loc[bad, "error"].str.contains("worker process died").all()
         pd.testing.assert_frame_equal(s[~bad].reset_index(drop=True), r[~bad].reset_index(drop=True), check_dtype=False)
-        assert "case 31" in capsys.readouterr().err
+        assert "case 35 (" in capsys.readouterr().err
+        # the chunk's part was assembled by the driver: --resume takes it as it is
+        assert main([str(path), "-o", str(out), "-q", "-j", "1", "--resume"]) == 1
+        pd.testing.assert_frame_equal(summary(out), s)
+
+
+def _raises_on(case: int):
+    def rows(p, span, _real=chunks.batch_rows):
+        if case in span.cases:
+            os._exit(3)   # a crash in a kernel: the process is gone, no exception travels
+        return _real(p, span)
+    return rows
+
+
+def test_a_crash_in_a_batch_chunk_of_the_default_size_is_bisected_to_its_case(tmp_path, monkeypatch, capsys):
+    """The default layout (chunks of 64 cases, a function of the case count): case 77 ends its
+    worker with os._exit, so the chunk of cases 65-120 is retried alone, then bisected down to
+    case 77 (6 rounds); only case 77 is reported failed, the 55 others of its chunk complete."""
+    path = deck(tmp_path)
+    ref = tmp_path / "ref"
+    assert main([str(path), "-o", str(ref), "-q", "-j", "1"]) == 0
+    monkeypatch.setattr(executor, "POOL_MIN_SECONDS", 0.0)   # the pool even for this small sweep
+    monkeypatch.setitem(chunks.CHUNK_FUNCTIONS, "batch", _raises_on(77))
+    out = tmp_path / "o"
+    assert main([str(path), "-o", str(out), "-q", "-j", "2"]) == 1
+    s, r = summary(out), summary(ref)
+    assert plan_mod.chunk_size(120, "batch") == 64 and s["case"].tolist() == list(range(1, 121))
+    bad = s["status"] != "ok"
+    assert s.loc[bad, "case"].tolist() == [77] and "worker process died" in s.loc[bad, "error"].iloc[0]
+    pd.testing.assert_frame_equal(s[~bad].reset_index(drop=True), r[~bad].reset_index(drop=True), check_dtype=False)
+    err = capsys.readouterr().err
+    assert "case 77 (" in err and "case 76 (" not in err and "case 78 (" not in err
 
 
 def test_workers_exit_when_the_driver_is_killed(tmp_path):
@@ -195,13 +236,14 @@ def test_workers_exit_when_the_driver_is_killed(tmp_path):
 
 def test_grid_columns_follow_product_order():
     import itertools
-    g = sweep_batch.Grid(["a.x", "a.y", "a.z"], [[1.0, 2.0], [3.0, 4.0, 5.0], ["u", "v"]], False)
+    g = Grid(["a.x", "a.y", "a.z"], [[1.0, 2.0], [3.0, 4.0, 5.0], ["u", "v"]], False)
     combos = list(itertools.product(*g.values))
     cols = g.columns(0, g.n)
     assert g.n == 12 and list(zip(*cols.values())) == combos
     part = g.columns(5, 9)
     assert list(zip(*part.values())) == combos[5:9]
-    z = sweep_batch.Grid(["a.x", "a.y"], [[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]], True)
+    assert list(zip(*g.columns_at(np.array([11, 0, 5])).values())) == [combos[11], combos[0], combos[5]]
+    z = Grid(["a.x", "a.y"], [[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]], True)
     assert list(zip(*z.columns(1, 3).values())) == [(2.0, 5.0), (3.0, 6.0)]
     assert np.asarray(z.columns(0, 3)["a.x"]).dtype == np.float64
 
@@ -292,8 +334,34 @@ def test_shrunken_grid_removes_the_old_cases_files(tmp_path):
     assert sorted(p.name for p in (out / "pc").iterdir()) == ["notes.txt"]
 
 
+def test_a_grown_grid_resumes_its_unchanged_cases_across_a_new_chunk_layout(tmp_path, capsys):
+    """Per case, the record's rows count case by case: 129 cases (chunks of 2) grown to 258
+    (chunks of 3) by appending crank values keeps cases 1-129's numbers and values, so only
+    the 129 new ones run; the record then holds the new layout's parts only, and the tables
+    equal a fresh run of the larger grid."""
+    def grown(k: int, name: str) -> Path:
+        cranks = ", ".join(f"{1.5 + 0.05 * i:.2f}" for i in range(k))
+        path = tmp_path / name
+        path.write_text(BASE + f"&sweep key1 = 'fourbar.crank', values1 = {cranks}\n"
+                               "       key2 = 'fourbar.rocker', values2 = 8, 9, 10\n"
+                               "       key3 = 'fourbar.method', values3 = 'exact'\n"
+                               "       case_outputs = 'all' /\n")
+        return path
+    out, fresh = tmp_path / "o", tmp_path / "fresh"
+    assert main([str(grown(43, "g.dat")), "-o", str(out), "-q", "-j", "1"]) == 0
+    assert _record_spans(out, "g") == [(s, min(s + 2, 129)) for s in range(0, 129, 2)]
+    assert main([str(grown(86, "g.dat")), "-o", str(fresh), "-q", "-j", "1"]) == 0
+    capsys.readouterr()
+    assert main([str(grown(86, "g.dat")), "-o", str(out), "-j", "2", "--resume"]) == 0
+    said = capsys.readouterr()
+    assert "resume: 129 of 258 cases complete, 129 to run" in said.out and "redone" not in said.err
+    assert _record_spans(out, "g") == [(s, min(s + 3, 258)) for s in range(0, 258, 3)]
+    pd.testing.assert_frame_equal(summary(out, "g"), summary(fresh, "g"))
+    assert (out / "g.out").read_text() == (fresh / "g.out").read_text()
+
+
 def test_large_sweeps_shard_their_case_files(tmp_path, monkeypatch):
-    from driver.sweep import _store as store
+    from driver.sweep import _resume as store
     path = per_case_deck(tmp_path, a=3)                       # 9 cases
     flat = tmp_path / "flat"
     assert main([str(path), "-o", str(flat), "-q", "-j", "1"]) == 0
@@ -311,27 +379,24 @@ def test_large_sweeps_shard_their_case_files(tmp_path, monkeypatch):
     assert sorted(p.name for p in (out / "pc").iterdir()) == sorted(p.name for p in (flat / "pc").iterdir())
 
 
-def _die_on_case(task, case, module, _real=None):
+def _die_on_case(task, case, module, _real=chunks.compute_case):
     """A case computation whose worker is SIGKILLed on case 7 (always, or once with DIE_ONCE)."""
-    from driver.sweep import _engine as engine
     marker = os.environ.get("DIE_ONCE")
     if case.index == 7 and (not marker or not os.path.exists(marker)):
         if marker:
             Path(marker).write_text("died")
         os.kill(os.getpid(), signal.SIGKILL)
-    return engine._real_compute(task, case, module)
+    return _real(task, case, module)
 
 
 @pytest.mark.parametrize("once", [True, False])
 def test_per_case_dying_worker_is_retried_then_isolated(tmp_path, monkeypatch, capsys, once):
-    from driver.sweep import _engine as engine
     path = per_case_deck(tmp_path, a=4, extra=", chunk = 4")   # 12 cases; case 7 in chunk 5-8
     ref = tmp_path / "ref"
     assert main([str(path), "-o", str(ref), "-q", "-j", "1"]) == 0
     if once:
         monkeypatch.setenv("DIE_ONCE", str(tmp_path / "marker"))
-    monkeypatch.setattr(engine, "_real_compute", engine._compute, raising=False)
-    monkeypatch.setattr(engine, "_compute", _die_on_case)   # inherited by the forked workers
+    monkeypatch.setattr(chunks, "compute_case", _die_on_case)   # inherited by the forked workers
     out = tmp_path / "o"
     rc = main([str(path), "-o", str(out), "-q", "-j", "2"])
     s, r = summary(out, "pc"), summary(ref, "pc")
@@ -350,28 +415,46 @@ def test_per_case_dying_worker_is_retried_then_isolated(tmp_path, monkeypatch, c
         assert not (out / "pc" / "case_0007.out").exists() and (out / "pc" / "case_0008.out").exists()
 
 
-def test_chunk_size_comes_from_a_warm_case(tmp_path, monkeypatch, capsys):
-    """A worker's first case pays its cold imports: the chunk is sized from a later one."""
-    from driver.sweep import _engine as engine
-    real, calls = engine._compute, []
+def _record_spans(out: Path, stem: str) -> list[tuple[int, int]]:
+    import json
 
-    def cold_first(task, case, module):
-        calls.append(case.index)
-        if len(calls) == 1:
-            time.sleep(0.5)   # 'cold imports'
-        return real(task, case, module)
+    import pyarrow.parquet as pq
+    metas = [json.loads(pq.read_schema(p).metadata[b"sweep"]) for p in (out / f"{stem}.sweep").glob("part-*.parquet")]
+    return sorted((m["start"], m["stop"]) for m in metas)
 
-    monkeypatch.setattr(engine, "_compute", cold_first)
-    path = per_case_deck(tmp_path, a=6)   # 18 cases
-    assert main([str(path), "-o", str(tmp_path / "o"), "-j", "1"]) == 0
-    chunk = int(capsys.readouterr().out.split("chunk ")[1].split(")")[0])
-    assert chunk > 1      # from the first case alone it would be 1
+
+@pytest.mark.parametrize("kind", ["batch", "cases"])
+def test_chunk_sizes_depend_on_the_case_count_only(tmp_path, kind):
+    """The chunks are the resume record's parts: one layout for a given number of cases, on one
+    process, two workers and a Dask cluster, for both kinds of chunk; the rule in code
+    (driver.sweep._plan.chunk_size) is the one the sweep used."""
+    from driver import sweep
+    from driver._deck import read_deck
+    path = deck(tmp_path, 4, 5, 6) if kind == "batch" else per_case_deck(tmp_path, a=50)   # 120 / 150 cases
+    stem = path.stem
+    d = read_deck(path)
+    outs = {}
+    for label, options in [("one", {"jobs": 1}), ("two", {"jobs": 2})]:
+        outs[label] = sweep.run_sweep_deck(d, tmp_path / label, [], False, **options)
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=3, processes=False, dashboard_address=None) \
+            as cluster, distributed.Client(cluster) as client:
+        outs["dask"] = sweep.run_sweep_deck(d, tmp_path / "dask", [], False, scheduler=client)
+    n = outs["one"].n_cases
+    size = sweep.chunk_size(n, kind)
+    assert size == (64 if kind == "batch" else 2) and outs["one"].batch == (kind == "batch")
+    assert {o.chunk for o in outs.values()} == {size}
+    want = [(s, min(s + size, n)) for s in range(0, n, size)]
+    for label in outs:
+        assert _record_spans(tmp_path / label, stem) == want, label
+    for label in ("two", "dask"):   # and the same answers
+        pd.testing.assert_frame_equal(outs[label].summary, outs["one"].summary)
+        assert outs[label].text == outs["one"].text
 
 
 def test_dask_sizes_by_the_cluster_and_probes_its_file_system(tmp_path):
-    """The first single-case batch is sized by the cluster's threads (not this machine's
-    cores); workers that cannot see the output folder are found before anything runs."""
-    from driver.sweep import _engine as engine
+    """Chunks in flight follow the cluster's threads (not this machine's cores); workers that
+    cannot see the output folder are found before anything runs."""
 
     class Client:   # the parts of a dask.distributed.Client the engine uses
         def __init__(self, root: Path | None = None):
@@ -385,13 +468,14 @@ def test_dask_sizes_by_the_cluster_and_probes_its_file_system(tmp_path):
                 folder = str(self.root / Path(folder).relative_to("/"))
             return {w: fn(folder, token) for w in self.scheduler_info()["workers"]}
 
-    assert engine.cluster_workers(Client()) == 12
-    feed = engine._Feed(iter(range(1, 101)), 100, engine.cluster_workers(Client()), 0)
-    assert len(feed.probes) == 24
-    engine.check_shared_folder(Client(), tmp_path / "shared")   # same file system: fine
+    assert executor.cluster_workers(Client()) == 12
+    assert executor.Workers(2, Client()).threads == 12
+    executor.check_shared_folder(Client(), tmp_path / "shared")   # same file system: fine
     assert not list((tmp_path / "shared").iterdir())             # probes removed
+    assert executor.Workers(2, Client()).shares(tmp_path / "shared")
+    assert not executor.Workers(2, Client(tmp_path / "elsewhere")).shares(tmp_path / "o")
     with pytest.raises(OSError) as err:
-        engine.check_shared_folder(Client(tmp_path / "elsewhere"), tmp_path / "o")
+        executor.check_shared_folder(Client(tmp_path / "elsewhere"), tmp_path / "o")
     msg = str(err.value)
     assert "do not share this output folder" in msg and "tcp://10.0.0.7:4000" in msg and "1 more" in msg
 
@@ -424,7 +508,7 @@ def test_dask_is_imported_only_when_configured(tmp_path):
 
 
 def test_cases_table_is_bounded_in_the_drivers_memory(tmp_path, monkeypatch):
-    import driver.sweep as sweep_pkg
+    from driver.sweep import _report as sweep_pkg
     path = per_case_deck(tmp_path, a=1)   # 3 cases
     out = tmp_path / "o"
     assert main([str(path), "-o", str(out), "-q", "-j", "1"]) == 0
@@ -471,3 +555,51 @@ def _kill_driver_and_check_workers(psutil, path: Path, out: Path) -> None:
     proc.wait()
     gone, alive = psutil.wait_procs(kids, timeout=20)
     assert not alive, f"workers still running after the driver died: {alive}"
+
+
+# ----------------------------------------------------------------------------- the one Ctrl-C rule
+
+@dataclass
+class _Sleepy:
+    """The work of a chunk function whose chunk 0 runs 3 s (a shell sleep, then a marker file)."""
+
+    marker: str
+    kind = "sleepy"
+
+
+def _sleepy(work: _Sleepy, span: Span) -> chunks.ChunkResult:
+    if span.start == 0:
+        subprocess.run(["sh", "-c", f"sleep 3; touch {work.marker}"], check=True)
+    return chunks.ChunkResult(span.start, span.stop, None)
+
+
+@pytest.mark.parametrize("where", ["pool", "dask"])
+def test_one_ctrl_c_rule_for_the_pool_and_dask(tmp_path, monkeypatch, where):
+    """Ctrl-C while a chunk still runs (here: as another chunk's result comes in): the pool and
+    Dask both tell ``notify`` at once, in the same words, before that chunk ends, cancel what
+    is queued and re-raise; the pool lets the running chunk finish first."""
+    monkeypatch.setitem(chunks.CHUNK_FUNCTIONS, "sleepy", _sleepy)   # forked workers inherit it
+    marker = tmp_path / "done"
+    heard: list[tuple[str, bool]] = []
+    spans = [Span(0, 1, range(1, 2)), Span(1, 2, range(2, 3)), Span(2, 3, range(3, 4))]
+
+    def on_result(res):
+        assert res.start != 0
+        raise KeyboardInterrupt   # Ctrl-C as the quick chunk's result comes in
+
+    def notify(line: str) -> None:
+        heard.append((line, marker.exists()))
+
+    with contextlib.ExitStack() as stack:
+        scheduler = None
+        if where == "dask":
+            distributed = pytest.importorskip("distributed")
+            cluster = stack.enter_context(distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
+                                                                   dashboard_address=None))
+            scheduler = stack.enter_context(distributed.Client(cluster))
+        workers = stack.enter_context(executor.open_workers(2, scheduler, notify))
+        with pytest.raises(KeyboardInterrupt):
+            executor.execute(_Sleepy(str(marker)), spans, on_result, workers, in_flight=2)
+        assert heard == [("interrupt: cancelling queued chunks, finishing the running ones", False)]
+        if where == "pool":
+            assert marker.exists()   # the running chunk finished before the interrupt went on

@@ -1,5 +1,6 @@
 """A batch sweep whose rows exceed STREAM_ROWS writes its tables part by part from the resume
-record (driver memory flat, issue 27): the files must be those the in-memory path writes.
+record (driver memory flat, issue 27): the files must be those the in-memory path writes, and
+its outcome's summary is a lazy handle over the parts that reads as the summary file does.
 
 The reference is the same deck run with streaming off (every row held, one ``to_parquet`` /
 ``write_tidy`` / ``render_table`` call): the ``.out`` and the ``_summary.csv`` byte for byte, the
@@ -16,8 +17,8 @@ import pandas as pd
 import pytest
 
 from driver._cli import main
-from driver.sweep import _batch as sweep_batch
-from driver.sweep import _stream as stream
+from driver.sweep import _assemble as stream
+from driver.sweep import _executor as executor
 
 ROOT = Path(__file__).resolve().parents[1]
 SHIPPED = (ROOT / "inputs" / "fourbar_design_search.dat").read_text()
@@ -26,7 +27,7 @@ REVERSED = SHIPPED.replace("start1 = 1.0,  stop1 = 7.0,  count1 = 25", "start1 =
 
 
 def _run(tmp_path: Path, name: str, text: str, stream_rows: int, monkeypatch, jobs: str = "2") -> tuple[int, Path]:
-    monkeypatch.setattr(stream, "STREAM_ROWS", stream_rows)
+    monkeypatch.setattr(executor, "STREAM_ROWS", stream_rows)
     deck = tmp_path / f"{name}.dat"
     deck.write_text(text)
     out = tmp_path / f"out_{stream_rows}_{jobs}"
@@ -78,15 +79,31 @@ STOP = "key{j} = 'fourbar.stop_deg', values{j} = 200, 360, 350"
 CRANK = "key{k} = 'fourbar.crank', start{k} = 1, stop{k} = 7, count{k} = 700"
 
 
-@pytest.mark.parametrize("order, streamed", [((1, 2, 3), False), ((2, 3, 1), None)])
-def test_bad_input_rows(tmp_path, monkeypatch, order, streamed):
-    """A bad interior combination (start_deg 300, stop_deg 200: the range is refused) gives
-    bad-input rows.  Only in some chunks (their summary columns are objects, the others' floats):
-    not streamed, the rows read into memory; spread over every chunk: streamed when the parts'
-    columns agree (a column that is blank in a whole part does not).  The same files either way."""
+def _bad_text(order: tuple[int, int, int]) -> str:
     i, j, k = order
     axes = "\n  ".join(sorted([START.format(i=i), STOP.format(j=j), CRANK.format(k=k)], key=lambda a: a[3]))
-    text = BAD_BASE.format(axes=axes)
+    return BAD_BASE.format(axes=axes)
+
+
+def test_bad_interior_combination_is_refused_before_anything_runs(tmp_path, monkeypatch, capsys):
+    """The 2 100-case grid's interior combination start_deg 300, stop_deg 200 is found by the
+    sweep's validation of its coupled axes: exit 2 naming the line and key, nothing written."""
+    status, out = _run(tmp_path, "b", _bad_text((1, 2, 3)), 10, monkeypatch)
+    err = capsys.readouterr().err
+    assert status == 2 and not out.exists()
+    assert "b.dat:3: key 'values1'" in err and "start_deg = 300, fourbar.stop_deg = 200 is bad input" in err
+
+
+@pytest.mark.parametrize("order, streamed", [((1, 2, 3), False), ((2, 3, 1), None)])
+def test_bad_input_rows(tmp_path, monkeypatch, order, streamed):
+    """Should a bad case pass the sweep's validation (here switched off), the batch path's own
+    check gives bad-input rows.  Only in some chunks (their summary columns are objects, the
+    others' floats): not streamed, the rows read into memory; spread over every chunk: streamed
+    when the parts' columns agree (a column that is blank in a whole part does not).  The same
+    files either way."""
+    from driver.sweep import _plan
+    monkeypatch.setattr(_plan, "validate_sweep", lambda *a, **k: {})
+    text = _bad_text(order)
     calls = []
     real = stream.write_streamed
     monkeypatch.setattr(stream, "write_streamed", lambda *a, **k: calls.append(real(*a, **k)) or calls[-1])
@@ -100,23 +117,41 @@ def test_bad_input_rows(tmp_path, monkeypatch, order, streamed):
     assert "    failed                       700" in out
 
 
-def test_run_stops_holding_rows_above_the_threshold(tmp_path):
-    from driver._deck import read_deck, validate
-    from driver._study import load_study
-    from driver.sweep._spec import SPEC, grid_of
+def test_run_stops_holding_rows_above_the_threshold(tmp_path, monkeypatch):
+    from driver._deck import read_deck
+    from driver._outcome import StreamedSummary
+    from driver.sweep import run_sweep_deck
+    from driver.sweep._plan import plan_sweep
+    from driver.sweep._report import read_columns
     deck = tmp_path / "s.dat"
     deck.write_text(SHIPPED.replace("count1 = 25", "count1 = 4"))
     d = read_deck(deck)
-    module = load_study("fourbar")
-    sw = validate(d.groups["sweep"], SPEC, deck)
-    grid = grid_of(sw, "fourbar", module.spec)
-    p = sweep_batch.plan(module, d.groups["fourbar"], str(deck), grid, sw.keep, sw.summary_rows)
-    rows, counts, _ = sweep_batch.run(p, tmp_path / "rec", 1, None, False, False, stream_rows=10)
-    assert isinstance(rows, sweep_batch.StreamedRows) and len(rows) == counts["kept"] > 10
-    assert sum(len(pd.read_parquet(q)) for q in rows.paths) == counts["kept"]
-    held, counts2, _ = sweep_batch.run(p, tmp_path / "rec2", 1, None, False, False)
-    assert isinstance(held, pd.DataFrame) and counts2 == counts
-    pd.testing.assert_frame_equal(stream.read_columns(rows.paths), held)
+    monkeypatch.setattr(executor, "STREAM_ROWS", 10)
+    plan = plan_sweep(d, tmp_path / "rec", [], False)
+    with executor.open_workers(1) as workers:
+        streamed = executor.run_chunks(plan, workers).main
+    assert streamed.rows is None and streamed.n_rows == streamed.counts["n_kept"] > 10
+    paths = streamed.record.paths(with_rows=True)
+    assert sum(len(pd.read_parquet(q)) for q in paths) == streamed.counts["n_kept"]
+    held_plan = plan_sweep(d, tmp_path / "rec2", [], False, stream=False)
+    with executor.open_workers(1) as workers:
+        held = executor.run_chunks(held_plan, workers).main
+    assert held.rows is not None and held.counts == streamed.counts
+    pd.testing.assert_frame_equal(read_columns(paths), held.frame())
+    # the outcome: a lazy summary over the parts, equal to the file it wrote
+    oc = run_sweep_deck(d, tmp_path / "o", [], False, jobs=1)
+    assert isinstance(oc.summary, StreamedSummary) and oc.text is None
+    written = pd.read_parquet(tmp_path / "o" / "s_summary.parquet")
+    assert oc.summary.num_rows == len(oc.summary) == len(written) == oc.n_kept
+    pd.testing.assert_frame_equal(oc.summary.to_pandas(), written)
+    assert oc.summary.to_pandas().attrs == written.attrs
+    pd.testing.assert_frame_equal(oc.summary.to_pandas(["case", "mu_min_deg"]), written[["case", "mu_min_deg"]])
+    pd.testing.assert_frame_equal(oc.kept.reset_index(drop=True),
+                                  written[written["kept"]].reset_index(drop=True))
+    assert oc.out == (tmp_path / "o" / "s.out").read_text()
+    held_oc = run_sweep_deck(d, tmp_path / "h", [], False, jobs=1, stream=False)
+    pd.testing.assert_frame_equal(held_oc.summary, written)
+    assert held_oc.text == oc.out
 
 
 def test_a_cell_wider_than_its_column_redoes_the_table(tmp_path, monkeypatch):

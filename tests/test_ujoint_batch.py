@@ -186,11 +186,14 @@ def _sweep(tmp_path: Path, outputs: str, option: int = 0) -> Path:
 
 
 def _path_taken(out: Path, stem: str = "usw") -> str:
-    """'batch' or 'case': the parts of the resume record <stem>.sweep/ say which engine ran
-    (driver.sweep._batch: part-<first case>.parquet; driver.sweep: part-r<run>-<seq>.parquet)."""
-    parts = [p.name for p in (out / f"{stem}.sweep").glob("part-*.parquet")]
-    assert parts
-    return "case" if all(n.startswith("part-r") for n in parts) else "batch"
+    """'batch' or 'case': the parts of the resume record <stem>.sweep/ say which kind of chunk
+    ran (their metadata's kind: driver.sweep._resume)."""
+    import json
+
+    import pyarrow.parquet as pq
+    kinds = {json.loads(pq.read_schema(p).metadata[b"sweep"])["kind"] for p in (out / f"{stem}.sweep").glob("part-*")}
+    assert len(kinds) == 1, kinds
+    return "case" if kinds == {"cases"} else "batch"
 
 
 def test_sweep_takes_the_batch_path_and_equals_case_by_case(tmp_path):

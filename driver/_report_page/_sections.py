@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 import f90nml
 
 from driver._mechanism import Mark, MechanismFrames
-from driver._outcome import OptimizeOutcome, Outcome, RunOutcome, SweepOutcome, SynthesisOutcome
+from driver._outcome import OptimizeOutcome, Outcome, RunOutcome, StreamedSummary, SweepOutcome, SynthesisOutcome
 from driver._report_page._blocks import (
     Block,
     Details,
@@ -93,8 +93,8 @@ def _close(sections: list[Section], oc: Outcome, deck: Deck | None, notes: list[
 
 def _sweep_page(oc: SweepOutcome, deck: Deck | None) -> Page:
     from driver._study import load_study
-    from driver.sweep._report import summary_figures
-    summary = oc.summary.to_pandas() if hasattr(oc.summary, "to_pandas") else oc.summary
+    from driver.sweep._report import best_words, summary_figures
+    summary = oc.summary.to_pandas() if isinstance(oc.summary, StreamedSummary) else oc.summary
     module = load_study(oc.study)
     keys = [c for c in summary.columns if c.partition(".")[0] == oc.study] if summary is not None else []
     notes: list[str] = []
@@ -112,9 +112,9 @@ def _sweep_page(oc: SweepOutcome, deck: Deck | None) -> Page:
                            if isinstance(oc.best.params[k.partition(".")[2]], (int, float)))
         blocks, failed = run_blocks(oc.best, oc.best.params, "The marked design.")
         notes += failed
+        why = plain(best_words(module, oc.best_metric))
         sections.append(Section("best", "the marked design",
-                                [Text(f"Case {oc.best_case}, {plain(oc.best_by)}" + (f": {values}." if values else "."))]
-                                + blocks))
+                                [Text(f"Case {oc.best_case}, {why}" + (f": {values}." if values else "."))] + blocks))
     sections.append(Section("tables", "sweep summary (.out)",
                             [Pre(oc.text)] if oc.text else [Text(f"See {oc.name}.out.", "note")]))
     if summary is not None:

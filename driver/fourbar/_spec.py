@@ -162,7 +162,7 @@ def force_check(p: Params) -> None:
     if p.com_distance is not None:
         for i, (d, L) in enumerate(zip(p.com_distance, lengths)):
             if d > MAX_COM_RATIO * L:
-                raise p.error("com_distance", f"{d:g} m for the {LINKS[i]} is {d / L:.0f} times its length "
+                raise p.error("com_distance", f"{d:g} m for the {LINKS[i]} is {d / L:.3g} times its length "
                                               f"{L:g} m: com_distance and the link lengths look like different "
                                               "units (metres are expected)")
     if p.inertia is not None:
@@ -180,7 +180,7 @@ def force_check(p: Params) -> None:
             raise p.error("counterweight_radius", "is used only with balance = 'force'")
         for i, (rc, L) in enumerate(zip(p.counterweight_radius, (lengths[0], lengths[2]))):
             if rc > MAX_COM_RATIO * L:
-                raise p.error("counterweight_radius", f"{rc:g} m is {rc / L:.0f} times the "
+                raise p.error("counterweight_radius", f"{rc:g} m is {rc / L:.3g} times the "
                                                       f"{('crank', 'rocker')[i]} length: a length unit mismatch?")
     fx, fy = force_value(p, "load_force_x"), force_value(p, "load_force_y")
     if (fx != 0.0 or fy != 0.0) and not p.coupler_point:

@@ -1,5 +1,5 @@
 """Design summaries of many &manipulator designs in one kernel call: the batch path of sweeps
-(driver.sweep._batch) and optimisations (driver.optimize._evaluate).
+(driver.sweep._chunks.batch_rows) and optimisations (driver.optimize._evaluate).
 
 :func:`summarise_batch` returns, one row per design deck, the columns of the single run's
 summary (``run(...).summary``) plus nothing else: the workspace and C_rob figures, the torques

@@ -24,6 +24,7 @@ fields ``x``, ``fun``, ``success``, ``message``, ``nfev``).
 """
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any
 
@@ -40,7 +41,7 @@ from driver._result import Figure
 from driver._runner import compute, output_stem, write_outputs
 from driver.optimize import _journal as journal_file
 from driver.optimize import _report as report
-from driver.optimize._evaluate import Evaluator, Record, design_params
+from driver.optimize._evaluate import Evaluator, Record, design_params, rerun_agrees
 from driver.optimize._methods import HistoryRow, run_method
 from driver.optimize._problem import SPEC, Problem, problem_of
 
@@ -166,8 +167,7 @@ def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[
     formats = list(formats or [])
     stem = None if outdir is None else output_stem(outdir, deck.path, _suffixes(formats, plot))
     journal = None if stem is None else journal_file.journal_path(stem)
-    found = journal_file.read(problem.fingerprint(), problem.names, stem) if (resume and stem is not None) \
-        else journal_file.Resumed()
+    found = journal_file.read(problem, stem) if (resume and stem is not None) else journal_file.Resumed()
     if journal is not None and journal.exists() and not resume:
         journal.unlink()
     njobs = jobs if jobs is not None else problem.opts.jobs
@@ -196,7 +196,7 @@ def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[
     outcome = OptimizeOutcome(problem, None if best is None else DesignVector(zip(problem.names, best.x)),
                               None if best is None else best.objective, bool(mres.converged and best is not None),
                               mres.message, len(ev.records), best, check, mres, history, ev, study_result=result,
-                              name=name)
+                              name=name, check_agrees=best is None or check is None or rerun_agrees(best, check))
     _tables(outcome, params, [] if stem is None else [f"{stem.name}.optimum.dat"])
     if stem is not None:
         with output_set(stem.parent):   # the run's files all together, or none
@@ -213,7 +213,7 @@ def _tables(oc: OptimizeOutcome, params: Params | None, files: list[str]) -> Non
     p, ev = oc.problem, oc.evaluator
     evals = ev.frame()
     evals.insert(1, "base", p.fingerprint())
-    evals.attrs[journal_file.DIGEST_KEY] = journal_file.table_digests(evals, p.names)   # verified on --resume
+    journal_file.stamp(evals, p)   # bound to the problem and the code, verified on --resume
     if report.settings_of(p):   # the band behind summary.meets_transmission_band, with the table
         evals.attrs["summary_settings"] = report.settings_of(p)
     hist = report.history_frame(p, oc.history)
@@ -320,6 +320,11 @@ def run_optimize_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool |
         oc.error(f"{deck.path}: optimisation did not converge: {oc.message}")
     elif oc.check is not None and oc.study_result is not None and oc.study_result.failure:
         oc.error(f"{deck.path}: the optimum's full run failed: {oc.study_result.failure}")
+    if oc.best is not None and oc.check is not None and not oc.check_agrees:
+        shown = [f"{v:.6g}" if math.isfinite(v) else "undefined" for v in (oc.check.objective, oc.best.objective)]
+        oc.error(f"{deck.path}: the optimum re-run as a complete deck DIFFERS from its evaluation (objective "
+                 f"{shown[0]} against {shown[1]}, feasible {oc.check.feasible} against {oc.best.feasible}): the "
+                 "evaluation did not compute what the study computes, so no optimum is claimed")
     return oc
 
 

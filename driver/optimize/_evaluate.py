@@ -19,6 +19,7 @@ import math
 import os
 import re
 import time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any
@@ -29,6 +30,7 @@ import pandas as pd
 from driver import _blas as blas
 from driver import _expr as expr
 from driver import _limits as limits
+from driver._atomic import open_append
 from driver._deck import DeckError, Params, RawGroup, validate
 from driver._runner import NUMERICAL, CaseFailure, compute, numerical_error
 from driver._study import load_study
@@ -38,7 +40,7 @@ from driver.optimize._problem import Problem
 if TYPE_CHECKING:   # pragma: no cover - dask is an optional dependency
     from dask.distributed import Client
 
-__all__ = ["Evaluator", "evaluate_cases", "FAILED_VIOLATION"]
+__all__ = ["Evaluator", "evaluate_cases", "FAILED_VIOLATION", "rerun_agrees"]
 
 #: constraint violation given to a design whose case failed (ranks below every evaluated design)
 FAILED_VIOLATION = 1e6
@@ -88,35 +90,39 @@ def evaluate_cases(group: str, deck_path: str, raw: RawGroup, keys: list[str], k
     if module is None:   # the problem was built from this study's deck
         raise ValueError(f"no study reads namelist group &{group}")
     out: list[tuple[str, str, dict]] = []
-    for x in xs:
-        try:
-            params = validate(_design_raw(raw, keys, kinds, np.asarray(x)), module.spec, deck_path)
-        except DeckError as exc:
-            out.append(("bad_input", _deck_reason(exc), {}))
-            continue
-        try:
-            limits.check(module, params, lim=budget)
-        except DeckError as exc:
-            out.append(("refused", _deck_reason(exc), {}))
-            continue
-        try:
-            if module.summarise is not None:
-                try:
-                    with np.errstate(all="ignore"):
-                        summary = dict(module.summarise(params))
-                except NUMERICAL as exc:
-                    raise numerical_error(params, exc) from None
-                out.append(("ok", "", summary))
-            else:
-                result = compute(module, params, budget=budget)
-                out.append(("failed", str(result.failure), dict(result.summary)) if result.failure
-                           else ("ok", "", dict(result.summary)))
-        except CaseFailure as exc:   # a numerical failure, or a non-finite number bound for a table
-            out.append(("failed", _deck_reason(exc), {}))
-        except DeckError as exc:     # the study refuses the design (e.g. an arm that cannot reach)
-            out.append(("bad_input", _deck_reason(exc), {}))
-        except Exception as exc:   # a failing design is infeasible, never the end of the run
-            out.append(("failed", f"{exc.__class__.__name__}: {exc}", {}))
+    # a library's warning about one design is not printed from a worker: the design is judged by its
+    # own checks (numerical failures in words, finite numbers), the same on every route
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for x in xs:
+            try:
+                params = validate(_design_raw(raw, keys, kinds, np.asarray(x)), module.spec, deck_path)
+            except DeckError as exc:
+                out.append(("bad_input", _deck_reason(exc), {}))
+                continue
+            try:
+                limits.check(module, params, lim=budget)
+            except DeckError as exc:
+                out.append(("refused", _deck_reason(exc), {}))
+                continue
+            try:
+                if module.summarise is not None:
+                    try:
+                        with np.errstate(all="ignore"):
+                            summary = dict(module.summarise(params))
+                    except NUMERICAL as exc:
+                        raise numerical_error(params, exc) from None
+                    out.append(("ok", "", summary))
+                else:
+                    result = compute(module, params, budget=budget)
+                    out.append(("failed", str(result.failure), dict(result.summary)) if result.failure
+                               else ("ok", "", dict(result.summary)))
+            except CaseFailure as exc:   # a numerical failure, or a non-finite number bound for a table
+                out.append(("failed", _deck_reason(exc), {}))
+            except DeckError as exc:     # the study refuses the design (e.g. an arm that cannot reach)
+                out.append(("bad_input", _deck_reason(exc), {}))
+            except Exception as exc:   # a failing design is infeasible, never the end of the run
+                out.append(("failed", f"{exc.__class__.__name__}: {exc}", {}))
     return out
 
 
@@ -288,13 +294,13 @@ class Evaluator:
             self.cache[r.x] = r.index
             self.records.append(r)
         if self.journal is not None and any(journal):
-            if self._journal_fh is None:
+            if self._journal_fh is None:   # never through a link planted at its name
                 self.journal.parent.mkdir(parents=True, exist_ok=True)
-                self._journal_fh = open(self.journal, "a")
-            fp = self.problem.fingerprint()
+                self._journal_fh = open_append(self.journal)
+            fp, code = self.problem.fingerprint(), self.problem.code_digest()
             for r, j in zip(recs, journal):
                 if j:   # one checksummed line per computed design (driver.optimize._journal)
-                    self._journal_fh.write(journal_file.line(journal_file.record(fp, r.x, r.status, r.reason,
+                    self._journal_fh.write(journal_file.line(journal_file.record(fp, code, r.x, r.status, r.reason,
                                                                                  r.summary)))
             self._journal_fh.flush()
 
@@ -402,9 +408,12 @@ class Evaluator:
         return dict(sorted(out.items(), key=lambda kv: (-kv[1], kv[0])))
 
     def frame(self) -> pd.DataFrame:
-        """Every evaluation as a tidy table: variables, status, objective, margins, summary columns."""
+        """Every evaluation as a tidy table: variables, status, objective, margins, summary columns
+        (in name order: the same whether a design was computed or replayed from a resume record,
+        whose summary has sorted keys)."""
         p = self.problem
         rows = []
+        names = sorted({k for r in self.records for k in r.summary})
         for r in self.records:
             row: dict[str, Any] = {"eval": r.index + 1, **dict(zip(p.names, r.x)), "status": r.status,
                                    "feasible": r.feasible, "infeasible_reason": r.why,
@@ -413,9 +422,21 @@ class Evaluator:
             for k, m in enumerate(r.margins):
                 row[f"margin{_constraint_number(p, k)}"] = m if math.isfinite(m) else np.nan
             row["case_error"] = r.reason
-            row.update({f"summary.{k}": v for k, v in r.summary.items()})
+            row.update({f"summary.{k}": r.summary[k] for k in names if k in r.summary})
             rows.append(row)
         return pd.DataFrame(rows)
+
+
+def rerun_agrees(best: Record, check: Record) -> bool:
+    """Whether the full study's re-run of a design (``check``) agrees with its evaluation
+    (``best``): the same feasibility and the objective within 1e-9 x max(1, |f|).  A re-run that
+    differs means the evaluation did not compute what the study computes (a resume record of
+    another problem, a batch path out of step with the study): the run fails, never succeeds."""
+    if check.feasible != best.feasible:
+        return False
+    if check.objective == best.objective:
+        return True
+    return abs(check.objective - best.objective) <= 1e-9 * max(1.0, abs(best.objective))
 
 
 def _slots(problem: Problem) -> list[str]:

@@ -148,6 +148,7 @@ class Problem:
     #: epigraph terms: 'maximize = min(a, b, ...)' / 'minimize = max(a, b, ...)' -> [a, b, ...]
     #: (gradient methods then solve min s subject to s >= sense x term, smooth at the optimum)
     terms: list[expr.Expr] = field(default_factory=list)
+    _code: str | None = field(default=None, repr=False, compare=False)
 
     @property
     def names(self) -> list[str]:
@@ -193,14 +194,37 @@ class Problem:
         return f"{'minimize' if self.sense > 0 else 'maximize'} {self.objective.text}"
 
     def fingerprint(self) -> str:
-        """Hash of everything that changes an evaluation's result (study group minus the variables)."""
-        whole = {v.key for v in self.variables if v.index is None}
-        fixed = {k: v for k, v in self.raw.values.items() if k not in whole}
-        parts: list[Any] = [self.raw.name, sorted(fixed.items(), key=lambda kv: kv[0])]
-        if self.opts.summary_columns:   # fewer columns recorded: another set of evaluations
-            parts.append(sorted(self.opts.summary_columns))
-        blob = json.dumps(parts, default=str)
+        """Hash of the whole problem, everything that decides which design gets which values:
+        the study group as written (the variables' own values included), the variables in
+        order with their bounds, the objective and its sense, the constraints, and every
+        setting of the method (all of &optimize but ``jobs``, which never changes a result).
+        A resume record is replayed only into a problem with the same fingerprint (and code:
+        :meth:`code_digest`)."""
+        values = sorted(((k, self.raw.values[k]) for k in self.raw.values), key=lambda kv: kv[0])
+        settings = {k: self.opts[k] for k in sorted(SPEC.keys) if k != "jobs"}
+        parts: dict[str, Any] = {
+            "study": self.raw.name, "deck": values,
+            "variables": [[v.name, v.lower, v.upper] for v in self.variables],
+            "objective": [self.sense, self.objective.text], "constraints": [c.text for c in self.constraints],
+            "settings": settings}
+        blob = json.dumps(parts, default=repr, sort_keys=True)
         return hashlib.sha256(blob.encode()).hexdigest()[:16]
+
+    def code_digest(self) -> str:
+        """Digest of the code that computes a design's values (the study, the evaluation, the
+        runner, the deck reader, the expression language; the kernels' Fortran sources): a
+        resume record computed by other code is not replayed.  The same on every machine
+        (:func:`driver._output.source_digest`), so a committed ``_evals`` table carries it."""
+        if self._code is None:
+            from pathlib import Path
+
+            import driver._deck
+            import driver._expr
+            import driver._runner
+            from driver._output import source_digest
+            engine = Path(__file__).with_name("__init__.py")   # the whole optimize package, not imported here
+            self._code = source_digest(self.study, engine, driver._runner, driver._deck, driver._expr)[:16]
+        return self._code
 
 
 def _sub(e: expr.Expr, node: ast.expr) -> expr.Expr:
@@ -262,7 +286,8 @@ def problem_of(deck: Deck) -> Problem:
     Raises
     ------
     DeckError
-        Bad input, naming the deck, line and key.
+        Bad input, naming the deck, line and key; the deck's own design beyond the budget of one
+        run (``--max-work``, ``--max-memory``).
     """
     from driver._runner import study_of
     study, base = study_of(deck)
@@ -337,6 +362,11 @@ def problem_of(deck: Deck) -> Problem:
         raise opts.error(key, f"this run may need {worst:.3g} design evaluations, more than max_evals = "
                               f"{min(opts.max_evals, MAX_EVALS)}; reduce it or raise max_evals (at most {MAX_EVALS})")
     sense = 1 if okey == "minimize" else -1
+    # every design is one run of the study under the budget (--max-work, --max-memory): the deck's
+    # own design is checked before anything starts (a design the search reaches beyond it is
+    # refused on its own and counted as infeasible, driver.optimize._evaluate)
+    from driver import _limits as limits
+    limits.check(study, base, "each design of this optimisation (the deck's own design) ")
     return Problem(deck, study, raw, base, opts, variables, objective, sense, constraints, _terms(objective, sense))
 
 

@@ -10,7 +10,7 @@ import pandas as pd
 
 from driver._deck import Params
 from driver._table import Column, render_table
-from driver.optimize._evaluate import Evaluator, Record
+from driver.optimize._evaluate import Evaluator, Record, rerun_agrees
 from driver.optimize._methods import HistoryRow, MethodResult
 from driver.optimize._problem import Problem
 
@@ -167,9 +167,7 @@ def report_text(p: Problem, ev: Evaluator, mres: MethodResult, history: list[His
                 Column("margin", "s", 16, 0, 2), Column("tolerance", "s", 10, 0, 2), Column("met", "s", 15, 0, 2)]
         L += render_table(cols, _constraint_rows(p, best)) + [""]
     if best is not None and check is not None:
-        same = (check.feasible == best.feasible and
-                (check.objective == best.objective or abs(check.objective - best.objective)
-                 <= 1e-9 * max(1.0, abs(best.objective))))
+        same = rerun_agrees(best, check)
         L += ["  Check: the design re-run as a complete deck by the full study",
               f"    {files[0] if files else ''}",
               f"    objective {_g(check.objective)}, feasible {_g(check.feasible)}, margins "

@@ -1,6 +1,6 @@
 """The sweep's ``keep`` filter, once: parsed once per text, checked against the base deck's
-summary before any case runs, and applied to rows by both engines (case by case,
-:mod:`driver.sweep._engine`; batch, :mod:`driver.sweep._batch`) with the same rule."""
+summary before any case runs, and applied to rows by both chunk functions (case by case and
+batch, :mod:`driver.sweep._chunks`) with the same rule."""
 from __future__ import annotations
 
 import functools

@@ -1,10 +1,29 @@
 """What a sweep reports: the summary frame (one row per case), the fixed-format ``.out``, the
-warnings many cases repeat (printed once), and the sweep's own files written as one set."""
+warnings many cases repeat (printed once), the ``_cases`` tables, and the sweep's own files
+written as one set, from rows in memory (:func:`write_sweep_files`) or streamed from the
+record's parts (:func:`write_streamed`).
+
+**Streamed tables.**  A batch sweep's rows (with ``summary_rows = 'kept'`` its kept and failed
+cases) are in the parts of its resume record, one Parquet file per chunk, in case order.  Above
+:data:`driver.sweep._executor.STREAM_ROWS` rows the driver stops holding them and
+:func:`write_streamed` writes the ``.out``, the ``_summary`` CSV and the ``_summary`` Parquet file
+reading one part at a time, so the driver's memory does not grow with the rows.  The files are
+those the in-memory path writes: the same ``.out`` and CSV bytes, the same Parquet table (in one
+row group per part); the ``.out`` table's column widths, which the widest cell decides, are
+taken in a first pass that writes the body to a scratch file (the case column at the width of
+the last case number) and only redone when a cell did not fit.  Parts whose columns differ in
+type (bad-input rows turn a chunk's summary columns into objects) cannot be streamed this way;
+:func:`write_streamed` then returns None and the caller reads the rows into memory.
+"""
 from __future__ import annotations
 
+import json
 import math
+import shutil
+import tempfile
+from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
@@ -18,8 +37,20 @@ from driver._output import column_label
 from driver._table import Column, render_table
 from driver.sweep._spec import CaseResult
 
-__all__ = ["summary_frame", "summary_settings", "sweep_text", "Warnings", "write_sweep_files", "summary_figures",
-           "plotted_columns", "with_plotted"]
+if TYPE_CHECKING:   # annotations only: pyarrow is imported where a table is read or written
+    import pyarrow as pa
+
+__all__ = ["summary_frame", "summary_settings", "sweep_text", "Warnings", "write_sweep_files", "write_streamed",
+           "read_columns", "Streamed", "CasesTable", "TABLE_ALL_MAX", "CASES_TABLE_MAX", "CASES_TABLE_BYTES",
+           "summary_figures", "plotted_columns", "with_plotted", "best_words"]
+
+#: the sweep's .out lists every case up to this many cases (above: the kept and failed ones)
+TABLE_ALL_MAX = 2000
+#: the combined ``<stem>_cases`` tables are written up to this many written cases (above, the
+#: cases' own Parquet files are the table: ``pyarrow.dataset.dataset(<stem>/, format="parquet")``)
+CASES_TABLE_MAX = 2000
+#: ... and up to this many bytes of them in the driver's memory
+CASES_TABLE_BYTES = 256 * 2**20
 
 
 def summary_settings(module: Any, base: Params, swept: set[str] | None = None) -> dict[str, Any]:
@@ -75,7 +106,7 @@ def summary_frame(results: list[CaseResult], names: list[str]) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def _summary_table(frame: pd.DataFrame, limit: int = 2000, n_cases: int | None = None,
+def _summary_table(frame: pd.DataFrame, limit: int = TABLE_ALL_MAX, n_cases: int | None = None,
                    rows: str = "all") -> list[str]:
     """Fixed-format rendering of the summary frame (kept and failed cases only above ``limit``
     cases; ``frame`` may hold only those already, then ``n_cases`` is the study's total)."""
@@ -202,6 +233,16 @@ def plotted_columns(shown: pd.DataFrame, sw: Params, module: Any) -> list[str]:
     return [y for y in sw.plot_y if y in shown] or [c for c in module.sweep_plot if c in shown][:1]
 
 
+def best_words(module: Any, metric: str | None) -> str:
+    """Why a sweep's best case (:attr:`~driver._outcome.SweepOutcome.best_case`) is the best, in
+    words: ``'largest minimum transmission angle'`` by its ``best_metric``, or ``'the first
+    kept case'`` (None)."""
+    if metric is None:
+        return "the first kept case"
+    sense = module.sweep_best.get(metric) if module is not None else None
+    return ("largest " if sense == "max" else "smallest ") + column_label(module, metric).split(" [")[0]
+
+
 def summary_figures(shown: pd.DataFrame, sw: Params, names: list[str], module: Any, stem: str) -> list[Any]:
     """The sweep's summary figure(s) of the rows ``shown`` (what ``--plot`` writes and the report
     page shows): maps of the plotted columns over a grid of 2-3 numeric keys, else the summary
@@ -282,3 +323,229 @@ def failed_lines(failed: list[tuple[int, dict, str]], n_failed: int) -> list[str
     if n_failed > FAILED_LISTED:
         lines.append(f"    ... and {n_failed - FAILED_LISTED} more (status column of the _summary table)")
     return lines
+
+
+# ----------------------------------------------------------------------------- tables streamed from the record
+
+class Streamed:
+    """What the caller needs after a streamed write: the failed cases (the first
+    :data:`FAILED_LISTED`, in case order), their count, and whether any was bad input."""
+
+    def __init__(self) -> None:
+        self.failed: list[tuple[int, dict, str]] = []
+        self.n_failed = 0
+        self.bad_input = False
+        self.n_kept = 0
+        self.n_rows = 0
+        #: the summary table's schema metadata (pandas columns, attrs), as written
+        self.metadata: dict[bytes, bytes] = {}
+
+
+def _origins(schema: pa.Schema) -> dict[str, str]:
+    """Column -> the pandas dtype it was written from (an object column of numbers is 'object')."""
+    meta = schema.pandas_metadata or {}
+    return {c["name"]: c["numpy_type"] for c in meta.get("columns", []) if c.get("name") is not None}
+
+
+def _uniform(paths: list[Path]) -> pa.Schema | None:
+    """The parts' common schema (without the record's metadata), or None when the parts' columns
+    differ in name, type or the dtype they were written from."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+    first = pq.read_schema(paths[0])
+    for p in paths[1:]:
+        s = pq.read_schema(p)
+        if not s.equals(first, check_metadata=False) or _origins(s) != _origins(first):
+            return None
+    origins = _origins(first)
+    for f in first:   # an object column of logicals with a short name: its width depends on every row
+        if origins.get(f.name) == "object" and pa.types.is_boolean(f.type) and len(f.name) < 6:
+            return None
+    meta = {k: v for k, v in (first.metadata or {}).items() if k != b"sweep"}
+    return first.with_metadata(meta)
+
+
+def _frame(table: pa.Table, origins: dict[str, str]) -> pd.DataFrame:
+    """A part as the DataFrame its worker returned: object columns as Python objects again."""
+    frame = table.to_pandas()
+    for name, kind in origins.items():
+        if kind == "object" and name in frame.columns:
+            frame[name] = pd.Series(table.column(name).to_pylist(), dtype=object)
+    return frame
+
+
+def write_streamed(outdir: Path, stem: str, paths: list[Path], deck: Deck, sw: Params, base: Params,
+                   axes: list[tuple[str, list]], names: list[str], n_cases: int, plot: bool | str = False,
+                   module: Any = None, settings: dict[str, Any] | None = None) -> Streamed | None:
+    """Write ``<stem>.out`` and ``<stem>_summary.{csv,parquet}`` from the record parts ``paths``
+    (case order; each with rows), one part at a time, and with ``plot`` the summary figure (its
+    rows are read back for it), all renamed into place together.  ``settings``
+    (:func:`summary_settings`) go into the Parquet metadata as pandas writes a frame's attrs.
+    Returns None, writing nothing, when the parts' columns differ in type (see the module)."""
+    schema = _uniform(paths)
+    if schema is None:
+        return None
+    if settings:   # as DataFrame.to_parquet records attrs (with_settings)
+        schema = schema.with_metadata({**(schema.metadata or {}),
+                                       b"PANDAS_ATTRS": json.dumps({"summary_settings": dict(settings)}).encode()})
+    result = Streamed()
+    result.metadata = dict(schema.metadata or {})
+    table = _StreamedTable(paths, _origins(schema), names, n_cases > TABLE_ALL_MAX)
+    with tempfile.TemporaryFile("w+", dir=outdir, prefix=f".{stem}.body.") as body, output_set(outdir):
+        with atomic_open(outdir / f"{stem}_summary.csv", "wb") as csv, \
+                atomic_open(outdir / f"{stem}_summary.parquet", "wb") as pfh:
+            table.first_pass(schema, csv, pfh, body, result)
+        with atomic_open(outdir / f"{stem}.out", "w") as out:
+            out.write("\n".join(head_lines(deck, sw, base, axes, n_cases, result.n_kept, result.n_failed)) + "\n")
+            table.write(out, body)
+            tail = ([not_listed_line(n_cases - table.shown, sw.summary_rows)] if table.shown < n_cases else []) \
+                + failed_lines(result.failed, result.n_failed)
+            if tail:
+                out.write("\n".join(tail) + "\n")
+        if plot:   # the figure needs its rows together: read back for it
+            write_sweep_plot(outdir, stem, plot, sw, names, module, read_columns(paths))
+    return result
+
+
+class _StreamedTable:
+    """The ``.out`` table of a streamed sweep: its rows written at the columns' default widths
+    in a first pass over the parts (which also writes the CSV and Parquet summaries and counts
+    the failed cases), and again at the widths found when a cell did not fit."""
+
+    def __init__(self, paths: list[Path], origins: dict[str, str], names: list[str], limit_rows: bool):
+        self.paths, self.origins, self.names, self.limit_rows = paths, origins, names, limit_rows
+        self.cols: list[Column] = []
+        self.keys: list[str] = []
+        self.widths: list[int] = []   # the columns' widths before any row (the case column's: its last number)
+        self.need: list[int] = []     # the widths the rows need
+        self.shown = 0
+
+    def _shown(self, frame: pd.DataFrame) -> pd.DataFrame:
+        """The rows the .out lists: all, or (above TABLE_ALL_MAX cases) the kept and failed ones."""
+        return frame[frame["kept"] | (frame["status"] != "ok")] if self.limit_rows else frame
+
+    def _start(self, frame: pd.DataFrame) -> None:
+        import pyarrow.parquet as pq
+        self.cols, self.keys = table_columns(frame)
+        self.widths = [max(c.width, len(c.header)) for c in self.cols]
+        if "case" in self.keys:   # case numbers grow row by row: the last part's last one is widest
+            last = pq.read_table(self.paths[-1], columns=["case"]).column("case")
+            j = self.keys.index("case")
+            self.widths[j] = max(self.widths[j], len(str(int(last[len(last) - 1].as_py()))))
+        self.need = list(self.widths)
+
+    def _lines(self, frame: pd.DataFrame, widths: list[int]) -> Iterator[tuple[list[str], str]]:
+        for row in table_values(self._shown(frame), self.cols, self.keys):
+            cells = [c.cell(v) for c, v in zip(self.cols, row)]
+            yield cells, "".join(" " * c.sep + v.rjust(w) for c, v, w in zip(self.cols, cells, widths)).rstrip() + "\n"
+
+    def first_pass(self, schema: pa.Schema, csv: Any, pfh: Any, body: Any, result: Streamed) -> None:
+        """Every part once: into the CSV and Parquet summaries, its rows into ``body``, its
+        failed cases and counts into ``result``."""
+        import pyarrow.parquet as pq
+
+        from driver._export import write_csv_arrow
+        writer = pq.ParquetWriter(pfh, schema)
+        try:
+            for k, path in enumerate(self.paths):
+                table = pq.read_table(path).replace_schema_metadata(schema.metadata)
+                writer.write_table(table)
+                write_csv_arrow(table, csv, header=k == 0)
+                frame = _frame(table, self.origins)
+                if k == 0:
+                    self._start(frame)
+                bad = frame["status"] != "ok"
+                result.n_rows += len(frame)
+                result.n_kept += int(frame["kept"].sum())
+                self.shown += len(self._shown(frame))
+                for cells, line in self._lines(frame, self.widths):
+                    self.need = [max(w, len(v)) for w, v in zip(self.need, cells)]
+                    body.write(line)
+                for _, r in frame[bad].iterrows():
+                    result.n_failed += 1
+                    result.bad_input |= r["status"] == "bad input"
+                    if len(result.failed) < FAILED_LISTED:
+                        result.failed.append((int(r["case"]), {k2: r[k2] for k2 in self.names}, r["error"]))
+        finally:
+            writer.close()
+
+    def write(self, out: Any, body: Any) -> None:
+        """The table's header and rows into the .out: the first pass's body, or every row again
+        at the widths found when a cell did not fit its column's width."""
+        import pyarrow.parquet as pq
+        out.write("".join(" " * c.sep + c.header.rjust(w) for c, w in zip(self.cols, self.need)).rstrip() + "\n")
+        if self.need == self.widths:
+            body.seek(0)
+            shutil.copyfileobj(body, out)
+            return
+        for path in self.paths:
+            for _, line in self._lines(_frame(pq.read_table(path), self.origins), self.need):
+                out.write(line)
+
+
+def read_columns(paths: list[Path], columns: list[str] | None = None) -> pd.DataFrame:
+    """The rows of ``paths`` (only ``columns``; None: all) as one frame, object columns as objects."""
+    import pyarrow.parquet as pq
+    frames = []
+    for p in paths:
+        t = pq.read_table(p, columns=columns)
+        frames.append(_frame(t, _origins(pq.read_schema(p))))
+    return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
+
+
+# ----------------------------------------------------------------------------- the _cases tables
+
+class CasesTable:
+    """The ``<stem>_cases`` tables, built from the written cases' Parquet files as the cases
+    arrive (while the workers compute, off the critical path): their Arrow tables and CSV rows,
+    up to :data:`CASES_TABLE_MAX` cases and :data:`CASES_TABLE_BYTES`."""
+
+    def __init__(self, layout: Any):
+        self.layout = layout
+        self.pieces: dict[int, tuple[Any, bytes | None]] = {}
+        self.nbytes = 0
+        self.full = False   # beyond CASES_TABLE_MAX cases or CASES_TABLE_BYTES: no combined table
+
+    def add_chunk(self, res: Any) -> None:
+        """Add the cases of a per-case chunk's result (its record rows) that wrote files."""
+        if self.full or not hasattr(res.rows, "column"):
+            return
+        files, cases = res.rows.column("files").to_pylist(), res.rows.column("case").to_pylist()
+        self.add([c for c, f in zip(cases, files) if f != "[]"])
+
+    def add(self, indices: list[int]) -> None:
+        import pyarrow.parquet as pq
+
+        from driver._export import csv_bytes
+        for k in indices:
+            if self.full:
+                return
+            t = pq.read_table(self.layout.stem(k).with_suffix(".parquet"))
+            try:
+                body = csv_bytes(t, header=False)
+            except TypeError:
+                body = None
+            self.pieces[k] = (t, body)
+            self.nbytes += t.nbytes + len(body or b"")
+            if len(self.pieces) > CASES_TABLE_MAX or self.nbytes > CASES_TABLE_BYTES:
+                self.full, self.pieces = True, {}   # the driver's memory stays bounded
+
+    def table(self, written: list[int]) -> Any:
+        """The combined table of cases ``written`` (in order): a DataFrame, or an (Arrow table, CSV
+        bytes) pair when every case has the same columns; None above CASES_TABLE_MAX cases or
+        CASES_TABLE_BYTES."""
+        if not written or len(written) > CASES_TABLE_MAX or self.full:
+            return None
+        self.add([k for k in written if k not in self.pieces])
+        if self.full:
+            return None
+        import pyarrow as pa
+
+        from driver._export import csv_bytes
+        parts = [self.pieces[k] for k in written]
+        first = parts[0][0].schema
+        bodies = [body for _, body in parts if body is not None]
+        if len(bodies) == len(parts) and all(t.schema.equals(first, check_metadata=False) for t, _ in parts):
+            table = pa.concat_tables([t for t, _ in parts])
+            return table, csv_bytes(table.slice(0, 0)) + b"".join(bodies)
+        return pd.concat([t.to_pandas() for t, _ in parts], ignore_index=True)

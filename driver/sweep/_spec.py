@@ -22,7 +22,7 @@ __all__ = ["SPEC", "Case", "CaseResult", "MAX_KEYS", "MAX_CASES", "FULL_VALIDATI
            "iter_cases", "case_count", "validate_sweep"]
 
 MAX_KEYS = 9
-#: most cases one per-case sweep deck may have (a batch sweep lists no case: driver.sweep._batch.MAX_CASES)
+#: most cases one per-case sweep deck may have (a batch sweep lists no case: driver.sweep._plan.BATCH_MAX_CASES)
 MAX_CASES = 1_000_000
 #: most values one start/stop/count axis may have (about 0.3 GB as Python floats)
 MAX_AXIS_VALUES = 10_000_000
@@ -85,9 +85,9 @@ def _spec() -> GroupSpec:
         "scheduler": Key("str", check=_no_scheduler_in_deck,
                          doc="refused: the scheduler comes from --scheduler or Dask's configuration"),
         "chunk": Key("int", default=0, check=lambda v: "must not be negative" if v < 0 else None,
-                     doc="cases per task; 0 = chosen by the tool (case by case: from the time of a warm case, "
-                         "not a worker's first; batch path: from the case count, and a small sweep runs in "
-                         "the driver when workers would not pay)"),
+                     doc="cases per chunk; 0 = chosen by the tool from the number of cases alone (each chunk "
+                         "is a part of the resume record, found again with any -j or scheduler; on the batch "
+                         "path a small sweep runs in the driver when workers would not pay)"),
         "case_plots": Key("bool", default=False,
                           doc="with --plot, also draw every written case's own figures (by default --plot "
                               "draws the sweep's summary only: per-case figures cost more than the sweep)"),
@@ -119,13 +119,22 @@ class Grid:
 
     def indices(self, start: int, stop: int) -> list[np.ndarray]:
         """Per axis, the value index of cases start..stop-1 (0-based; product order)."""
-        idx = np.arange(start, stop, dtype=np.int64)
+        return self.indices_at(np.arange(start, stop, dtype=np.int64))
+
+    def indices_at(self, positions: np.ndarray) -> list[np.ndarray]:
+        """Per axis, the value index of the cases at 0-based ``positions`` (case number - 1)."""
+        idx = np.asarray(positions, dtype=np.int64)
         if self.zipped:
             return [idx] * len(self.names)
         return list(np.unravel_index(idx, [len(v) for v in self.values]))
 
     def columns(self, start: int, stop: int) -> dict[str, np.ndarray]:
-        return {name: _array(vals)[ix] for name, vals, ix in zip(self.names, self.values, self.indices(start, stop))}
+        """The swept values of cases start..stop-1 (0-based), one array per swept key."""
+        return self.columns_at(np.arange(start, stop, dtype=np.int64))
+
+    def columns_at(self, positions: np.ndarray) -> dict[str, np.ndarray]:
+        """The swept values of the cases at 0-based ``positions``, one array per swept key."""
+        return {name: _array(vals)[ix] for name, vals, ix in zip(self.names, self.values, self.indices_at(positions))}
 
 
 def _array(vals: list) -> np.ndarray:
@@ -321,8 +330,13 @@ def _axis_line(sw: Params, name: str) -> tuple[str, int]:
 
 def validate_sweep(sw: Params, raw: RawGroup, module: Any, grid: Grid) -> dict[int, float]:
     """Refuse the whole sweep (DeckError naming the sweep line and key) before anything runs
-    when a case would be bad input: every value of every axis is validated in the base deck,
-    and every case too for sweeps up to FULL_VALIDATION cases (else the grid's corners).
+    when a case would be bad input.
+
+    Up to FULL_VALIDATION cases every case is validated.  Above, every value of every axis is
+    validated alone, and every combination of the values of the *coupled* axes (keys whose deck
+    checks involve other keys: all of them, unless the study's batch path names a key
+    ``independent``) is validated as a case would be: a check between two swept keys (a start
+    angle past a stop angle) is found in the inner cases too, not only at the grid's corners.
 
     Returns {case: estimated seconds of work} (driver._limits) when every case was validated
     and the study estimates its work (the engine runs the longest cases first), else {}."""
@@ -345,16 +359,44 @@ def validate_sweep(sw: Params, raw: RawGroup, module: Any, grid: Grid) -> dict[i
         return estimates
     axis_values: dict[str, list] = {}
     for n, vals in zip(grid.names, grid.values):
-        uniq: dict[str, Any] = {}
-        for v in vals:
-            uniq.setdefault(repr(v), v)
-        axis_values[n] = list(uniq.values())
+        axis_values[n] = _unique(vals)
         for v in axis_values[n]:
             check({n: v}, None)
-    corners = [[vals[0], vals[-1]] if len(vals) > 1 else vals for vals in axis_values.values()]
-    for combo in itertools.islice(itertools.product(*corners), 512):
-        check(dict(zip(grid.names, combo)), None)
+    for combo in _coupled_combinations(sw, module, grid, axis_values):
+        check(combo, None)
     return {}
+
+
+def _unique(values: Iterable[Any]) -> list[Any]:
+    """The distinct values of an axis, in their first order."""
+    uniq: dict[str, Any] = {}
+    for v in values:
+        uniq.setdefault(repr(v), v)
+    return list(uniq.values())
+
+
+def _coupled_combinations(sw: Params, module: Any, grid: Grid, axis_values: dict[str, list]) -> Iterator[dict[str, Any]]:
+    """Every distinct combination of the coupled axes' values a case of the grid holds (none
+    with fewer than two coupled axes: a value alone was validated).  Refused (DeckError) when
+    there are more than MAX_CASES of them: a sweep that cannot be validated is not run."""
+    independent = set(module.batch.independent) if module.batch is not None else set()
+    coupled = [i for i, n in enumerate(grid.names) if n.partition(".")[2] not in independent]
+    if len(coupled) < 2:
+        return
+    names = [grid.names[i] for i in coupled]
+    if grid.zipped:
+        seen: dict[str, dict[str, Any]] = {}
+        for combo in zip(*(grid.values[i] for i in coupled)):
+            seen.setdefault(repr(combo), dict(zip(names, combo)))
+        yield from seen.values()
+        return
+    count = math.prod(len(axis_values[n]) for n in names)
+    if count > MAX_CASES:
+        raise sw.error("key1", f"the swept keys {', '.join(n.partition('.')[2] for n in names)} are checked together "
+                       f"by the study, and their {count} combinations are beyond the {MAX_CASES} a sweep validates "
+                       "before it runs; coarsen the grid or split the sweep")
+    for combo in itertools.product(*(axis_values[n] for n in names)):
+        yield dict(zip(names, combo))
 
 
 def case_raw(raw: RawGroup, case: Case) -> RawGroup:

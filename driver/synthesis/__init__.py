@@ -40,6 +40,7 @@ from driver._outcome import SynthesisOutcome
 from driver._result import Figure
 from driver._runner import compute, output_stem, write_outputs
 from driver.fourbar import _kernel as fourbar_kernel
+from driver.synthesis import _budget
 from driver.synthesis import _crank_rocker as cr
 from driver.synthesis._function import FunctionDesign, chebyshev, freudenstein, links_from_k, wrap180
 
@@ -540,7 +541,8 @@ def synthesise(deck: Deck | str | Path) -> Synthesis:
     Raises
     ------
     DeckError
-        Bad input, or another group beside ``&synthesis``.
+        Bad input, another group beside ``&synthesis``, degenerate path targets, or work or
+        memory beyond the budget (``--max-work``, ``--max-memory``), before anything is computed.
     """
     if not isinstance(deck, Deck):
         deck = read_deck(deck)
@@ -550,6 +552,7 @@ def synthesise(deck: Deck | str | Path) -> Synthesis:
         raise DeckError(deck.path, raw.line, None, f"a &synthesis deck has no other group (found &{others[0]}); "
                                                    "it writes the &fourbar deck of its linkage")
     p = validate(deck.groups["synthesis"], SPEC, deck.path)
+    _budget.admit(p)   # over the budget, or degenerate targets: refused before anything is computed
     syn = {"function": _synthesise_function, "crank_rocker": _synthesise_crank_rocker, "path": _synthesise_path}[p.task](p)
     if syn.linkage is not None:
         fp = validate(RawGroup("fourbar", dict(syn.linkage, title=p.title or f"{Path(deck.path).stem} ({p.task} synthesis)"),

@@ -27,6 +27,11 @@ __all__ = ["PathProblem", "PathDesign", "solve", "evaluate"]
 
 ST_OK = fourbar_kernel.FOURBAR_STATUS["ok"]
 PENALTY = 1e3
+#: least-squares runs from the best distinct designs of the evolution
+POLISH_STARTS = 24
+#: steps of one least-squares run at most (the shipped decks' converge within 20; the bound keeps
+#: a run that cannot converge, and so the synthesis's work, finite and known in advance)
+POLISH_MAX_NFEV = 300
 #: weight of the pull towards the start in the least-squares stage (see polish)
 REG = 1e-6
 
@@ -148,7 +153,8 @@ def refine(pp: PathProblem, design: PathDesign) -> PathDesign:
                 return math.inf
             p = fourbar_kernel.fourbar_coupler_point(th, out, st, a, 1.0, 0.0, u, v)[0]
             return math.hypot(p[0] - tx, p[1] - ty)
-        r = minimize_scalar(dist, bounds=(t0 - step, t0 + step), method="bounded", options={"xatol": 1e-10})
+        with np.errstate(invalid="ignore", over="ignore"):   # dist is inf where the linkage cannot assemble
+            r = minimize_scalar(dist, bounds=(t0 - step, t0 + step), method="bounded", options={"xatol": 1e-10})
         if r.fun < e0:
             errs.append(float(r.fun))
             ats.append(float(r.x) % 360.0)
@@ -197,7 +203,7 @@ def polish(pp: PathProblem, design: PathDesign) -> PathDesign:
         return np.concatenate([residuals(z), REG * (z - z0)])
 
     try:
-        res = least_squares(padded, z0, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=3000)
+        res = least_squares(padded, z0, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=POLISH_MAX_NFEV)
     except ValueError:
         return design
     if not (np.all(res.x[:n9] >= lo) and np.all(res.x[:n9] <= hi)):
@@ -212,7 +218,7 @@ def polish(pp: PathProblem, design: PathDesign) -> PathDesign:
 
 
 def solve(pp: PathProblem, seed: int, maxiter: int, popsize: int,
-          polish_starts: int = 24) -> tuple[PathDesign, bool, str, int]:
+          polish_starts: int = POLISH_STARTS) -> tuple[PathDesign, bool, str, int]:
     """Differential evolution on RMS error + penalty x violation, then least squares from the
     best distinct designs it evaluated; (best design, DE converged, message, evaluations)."""
     seen: list[tuple[float, tuple]] = []
