@@ -54,9 +54,12 @@ def plain_text(text: Any) -> str:
     """Text from a deck (a title, a design name, the deck's file name, a value, an expression)
     as matplotlib draws it literally: never mathtext (every ``$`` escaped, so ``'$\\frac$'`` or
     nested braces cannot raise a parse error), control characters dropped.  Every figure
-    builder passes deck text through this one function."""
+    builder passes deck text through this one function.  Each line is bounded to
+    :data:`driver._names.NAME_CHARS` characters (a longer one cut in the middle, saying how many
+    characters were left out: :func:`driver._names.shown`)."""
+    from driver._names import NAME_CHARS, shown
     text = "".join(ch for ch in str(text) if ch.isprintable() or ch == "\n")
-    return text.replace("$", r"\$")
+    return "\n".join(shown(line, NAME_CHARS) for line in text.split("\n")).replace("$", r"\$")
 
 
 def wrap(text: str, width: int) -> str:

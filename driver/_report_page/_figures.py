@@ -14,6 +14,7 @@ from typing import Any
 
 from markupsafe import Markup
 
+from driver._names import shown
 from driver._report_page._blocks import FigureBlock
 
 __all__ = ["plain", "figure_svg", "figure_blocks"]
@@ -83,6 +84,6 @@ def figure_blocks(figures: Iterable[Any], prefix: str) -> tuple[list[FigureBlock
         except Exception as exc:
             failed.append(f"figure '{f.name}' could not be drawn: {exc.__class__.__name__}: {exc}")
             continue
-        caption = plain(f"{prefix}_{f.name}: {f.name.replace('_', ' ')}")
+        caption = plain(f"{shown(prefix)}_{f.name}: {f.name.replace('_', ' ')}")
         blocks.append(FigureBlock(figure_svg(fig, caption), caption))
     return blocks, failed

@@ -12,6 +12,7 @@ from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 from driver._mechanism import Mark
+from driver._names import shown
 from driver._report_page._animation import study_animation
 from driver._report_page._blocks import (
     Animation,
@@ -79,7 +80,13 @@ def tidy_table(result: Result) -> Block:
 
 
 def anim_id(name: str) -> str:
-    return "anim-" + (re.sub(r"[^A-Za-z0-9]", "", name) or "x")
+    """The HTML id of a run's animation: the name's letters and digits, at most 40 of them and
+    then a digest of the whole name (a long name is not repeated in every line of the script)."""
+    word = re.sub(r"[^A-Za-z0-9]", "", name) or "x"
+    if len(word) > 40:
+        import hashlib
+        word = word[:40] + hashlib.sha256(name.encode("utf-8", "surrogatepass")).hexdigest()[:8]
+    return "anim-" + word
 
 
 def run_blocks(result: Result, params: Params | None, what: str,
@@ -114,7 +121,7 @@ def result_sections(result: Result, params: Params | None, comparison: Any,
     sections.append(Section("published", "comparison with the published tables",
                             comparison_blocks(comparison, comparison_note)))
     tables: list[Block] = [Pre(result.text)]
-    tables += [Details(result.name + suffix, [Pre(text)]) for suffix, text in result.extra.items()]
+    tables += [Details(shown(result.name) + suffix, [Pre(text)]) for suffix, text in result.extra.items()]
     sections.append(Section("tables", "tables (.out)", tables))
     if result.tidy is not None and len(result.tidy):
         sections.append(Section("tidy", "tidy table", [tidy_table(result)]))

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 import f90nml
 
 from driver._mechanism import Mark, MechanismFrames
+from driver._names import shown
 from driver._outcome import OptimizeOutcome, Outcome, RunOutcome, StreamedSummary, SweepOutcome, SynthesisOutcome
 from driver._report_page._blocks import (
     Block,
@@ -57,7 +58,7 @@ def _subtitle(study: str, params: Params | None) -> str:
     module = load_study(study) if study else None
     doc = module.spec.doc if module is not None else ""
     title = params.get("title", "") if params is not None and hasattr(params, "get") else ""
-    return " \u2014 ".join(x for x in (doc, title) if x)
+    return " \u2014 ".join(x for x in (doc, shown(title)) if x)
 
 
 def _run_page(oc: RunOutcome, deck: Deck | None, compare: bool = True) -> Page:
@@ -77,7 +78,7 @@ def _run_page(oc: RunOutcome, deck: Deck | None, compare: bool = True) -> Page:
         warnings[warnings.index(result.failure)] = f"the run failed: {result.failure}"
     sections.insert(0, warnings_section(warnings))
     sections.append(Section("deck", "deck", [Pre(deck_text(deck, params))]))
-    return Page(f"{result.name}: {result.study}", _subtitle(result.study, params), sections, run_metadata())
+    return Page(f"{shown(result.name)}: {result.study}", _subtitle(result.study, params), sections, run_metadata())
 
 
 def _messages(oc: Outcome) -> list[str]:
@@ -102,7 +103,7 @@ def _sweep_page(oc: SweepOutcome, deck: Deck | None) -> Page:
     if summary is not None and module is not None and oc.sweep is not None and len(summary):
         try:
             for k, fig in enumerate(summary_figures(summary, oc.sweep, keys, module, oc.name)):
-                caption = f"{oc.name}_summary{'' if k == 0 else f'_{k + 1}'}: the summary over the swept keys"
+                caption = f"{shown(oc.name)}_summary{'' if k == 0 else f'_{k + 1}'}: the summary over the swept keys"
                 maps.append(FigureBlock(figure_svg(fig, caption), caption))
         except Exception as exc:
             notes.append(f"the design-space maps could not be drawn: {exc.__class__.__name__}: {exc}")
@@ -116,7 +117,7 @@ def _sweep_page(oc: SweepOutcome, deck: Deck | None) -> Page:
         sections.append(Section("best", "the marked design",
                                 [Text(f"Case {oc.best_case}, {why}" + (f": {values}." if values else "."))] + blocks))
     sections.append(Section("tables", "sweep summary (.out)",
-                            [Pre(oc.text)] if oc.text else [Text(f"See {oc.name}.out.", "note")]))
+                            [Pre(oc.text)] if oc.text else [Text(f"See {shown(oc.name)}.out.", "note")]))
     if summary is not None:
         sections.append(Section("summary-table", "summary table",
                                 [frame_table(summary, labels=labels_of(oc.study, summary.columns),
@@ -126,7 +127,7 @@ def _sweep_page(oc: SweepOutcome, deck: Deck | None) -> Page:
     rows = len(summary) if summary is not None else oc.n_cases
     sub = (f"sweep of &{oc.study} over {', '.join(keys)}: {rows} rows in the summary, {oc.n_kept} kept "
            f"of {oc.n_cases} cases")
-    return Page(f"{oc.name}: sweep", sub, sections, run_metadata())
+    return Page(f"{shown(oc.name)}: sweep", sub, sections, run_metadata())
 
 
 def _optimize_page(oc: OptimizeOutcome, deck: Deck | None) -> Page:
@@ -140,7 +141,7 @@ def _optimize_page(oc: OptimizeOutcome, deck: Deck | None) -> Page:
         word = "The optimum." if opt.converged else "The best design found (the method did not converge)."
         blocks, failed = run_blocks(opt.result, opt.params, word)
         notes += failed
-        blocks.append(Details(f"{oc.name}.optimum.dat", [Pre(opt.deck)]))
+        blocks.append(Details(f"{shown(oc.name)}.optimum.dat", [Pre(opt.deck)]))
         sections.append(Section("optimum", "the optimum" if opt.converged else "the best design", blocks))
     sections.append(Section("tables", "report (.out)", [Pre(oc.text)]))
     if oc.history_table is not None:
@@ -149,7 +150,7 @@ def _optimize_page(oc: OptimizeOutcome, deck: Deck | None) -> Page:
                                       "deck it writes (--compare).")
     sense = "minimize" if p.sense > 0 else "maximize"
     sub = f"{sense} {p.objective_text} over {', '.join(p.names)}; {oc.nfev} designs evaluated"
-    return Page(f"{oc.name}: optimisation", sub, sections, run_metadata())
+    return Page(f"{shown(oc.name)}: optimisation", sub, sections, run_metadata())
 
 
 def _targets(oc: SynthesisOutcome) -> tuple[Mark, ...]:
@@ -170,16 +171,16 @@ def _synthesis_page(oc: SynthesisOutcome, deck: Deck | None) -> Page:
         blocks, failed = run_blocks(oc.result, oc.params, "The synthesised linkage.", _targets(oc))
         notes += failed
         if oc.linkage_deck:
-            blocks.append(Details(f"{oc.name}.linkage.dat", [Pre(oc.linkage_deck)]))
+            blocks.append(Details(f"{shown(oc.name)}.linkage.dat", [Pre(oc.linkage_deck)]))
     sections = [Section("linkage", "the synthesised linkage", list(figs) + blocks
                         or [Text("No linkage was found.", "note")])]
     sections.append(Section("tables", "report (.out)", [Pre(oc.text)]))
     if len(oc.table):
-        sections.append(Section("task-table", f"{oc.name}{oc.table_name}.csv", [frame_table(oc.table)]))
+        sections.append(Section("task-table", f"{shown(oc.name)}{oc.table_name}.csv", [frame_table(oc.table)]))
     _close(sections, oc, deck, notes, "A synthesis has no published table of its own; compare the linkage "
                                       "deck it writes (--compare).")
     linkage = f" of a &{oc.result.study} linkage" if oc.result is not None else ""
-    return Page(f"{oc.name}: synthesis", f"synthesis ({oc.task}){linkage}", sections, run_metadata())
+    return Page(f"{shown(oc.name)}: synthesis", f"synthesis ({oc.task}){linkage}", sections, run_metadata())
 
 
 def outcome_frames(outcome: Outcome) -> tuple[MechanismFrames | None, str]:
@@ -189,13 +190,13 @@ def outcome_frames(outcome: Outcome) -> tuple[MechanismFrames | None, str]:
     from driver._report_page._animation import study_frames
     if isinstance(outcome, RunOutcome):
         r = outcome.result
-        return study_frames(r.params, r), r.name
+        return study_frames(r.params, r), shown(r.name)
     if isinstance(outcome, SweepOutcome) and outcome.best is not None:
-        return study_frames(outcome.best.params, outcome.best), f"{outcome.name}, case {outcome.best_case}"
+        return study_frames(outcome.best.params, outcome.best), f"{shown(outcome.name)}, case {outcome.best_case}"
     if isinstance(outcome, OptimizeOutcome) and outcome.optimum is not None:
-        return study_frames(outcome.optimum.params, outcome.optimum.result), f"{outcome.name}, the optimum"
+        return study_frames(outcome.optimum.params, outcome.optimum.result), f"{shown(outcome.name)}, the optimum"
     if isinstance(outcome, SynthesisOutcome) and outcome.result is not None:
-        return study_frames(outcome.params, outcome.result, _targets(outcome)), f"{outcome.name}, the linkage"
+        return study_frames(outcome.params, outcome.result, _targets(outcome)), f"{shown(outcome.name)}, the linkage"
     return None, ""
 
 
