@@ -50,6 +50,14 @@ def _fs_error(exc: OSError) -> str:
     return f"cannot write {where}: {reason}"
 
 
+def _plot_format(text: str) -> str:
+    """``--plot-format``'s value; an animation format is refused naming the option that writes it."""
+    if text.lower() in ANIMATION_FORMATS:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a figure format ({', '.join(PLOT_FORMATS)}): the "
+                                         f"mechanism's animation is written with --animation {text.lower()}")
+    return text
+
+
 def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool | str, progress: bool,
              quiet: bool = False, sweep_options: dict | None = None, summary_json: bool = False,
              report: bool = False, animation: str | None = None) -> int:
@@ -230,7 +238,7 @@ def build_parser() -> argparse.ArgumentParser:
                              "warnings, a sweep's cases, an optimisation's x, fun, constraints, a synthesis's "
                              "linkage and checks); with --compare, one record per deck on stdout (JSON Lines)")
     parser.add_argument("--plot", action="store_true", help="write figures <stem>_<name>.png (see --plot-format)")
-    parser.add_argument("--plot-format", choices=PLOT_FORMATS, default=None,
+    parser.add_argument("--plot-format", choices=PLOT_FORMATS, default=None, type=_plot_format,
                         help="figure file format (implies --plot; default png); the same inputs give "
                              "byte-identical files")
     parser.add_argument("--report", action="store_true",

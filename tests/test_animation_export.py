@@ -69,6 +69,20 @@ def test_write_an_animation_from_python(tmp_path):
         save_animation(animation_frames(r.params, r, 12), tmp_path / "x", "avi")
 
 
+@pytest.mark.parametrize("fmt", ["gif", "mp4", "GIF"])
+def test_plot_format_gif_names_the_animation_option(tmp_path, capsys, fmt):
+    """The issue's spelling, --plot-format gif, is exit 2 naming --animation (the figures' formats
+    are png, svg, pdf); nothing is written."""
+    deck = tmp_path / "four.dat"
+    deck.write_text(DECK)
+    with pytest.raises(SystemExit) as info:
+        main([str(deck), "-o", str(tmp_path / "out"), "--plot-format", fmt])
+    assert info.value.code == 2
+    err = capsys.readouterr().err
+    assert f"--animation {fmt.lower()}" in err and "png, svg, pdf" in err, err
+    assert not (tmp_path / "out").exists()
+
+
 def test_mp4_without_ffmpeg_is_a_clear_error(tmp_path, monkeypatch):
     import matplotlib.animation
     monkeypatch.setattr(matplotlib.animation.writers, "is_available", lambda name: False)
