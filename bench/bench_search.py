@@ -45,7 +45,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 DECK = ROOT / "inputs" / "fourbar_design_search.dat"
 PER_CRANK = 64 * 64              # linkages per crank value of the shipped grid
-PEAK_KEEP = "meets_transmission_band and rocker_swing_deg >= 60 and abs(omega3_peak_rad_s) <= 3"
+PEAK_KEEP = "meets_transmission_band and rocker_swing_deg >= 60 and abs(rocker_omega_peak_rad_s) <= 3"
 
 
 def load() -> str:

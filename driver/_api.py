@@ -61,7 +61,7 @@ def run(source: DeckSource, *, name: str | None = None, progress: bool = False) 
     -------
     Result
         The run's fixed-format text, tidy table, summary, figures and warnings; units are in
-        the tidy and summary column names (``omega3_rad_s``) or ``tidy.attrs["units"]``.
+        the tidy and summary column names (``rocker_omega_rad_s``) or ``tidy.attrs["units"]``.
 
     Raises
     ------

@@ -36,9 +36,10 @@ from typing import Any
 import pandas as pd
 
 from driver import _published as published
-from driver._deck import Params, read_deck
+from driver._deck import Params
 from driver._outcome import ExitCode, Outcome
 from driver._published import agrees_printed
+from driver._pydeck import DeckSource, source_deck
 from driver._result import Result
 from driver._runner import study_of
 from driver._study import load_study
@@ -84,10 +85,11 @@ class Comparison:
         return not (self.frame["status"] == "differs").any()
 
 
-def run_comparison(deck: str | Path) -> Comparison:
-    """Run ``deck`` in memory and compare it with its published tables (DeckError for bad input)."""
-    path = Path(deck)
-    d = read_deck(path)
+def run_comparison(deck: DeckSource) -> Comparison:
+    """Run ``deck`` (any :data:`~driver._pydeck.DeckSource`) in memory and compare it with its
+    published tables (DeckError for bad input, TypeError for a source of another type)."""
+    d = source_deck(deck)
+    path = Path(d.path)
     from driver._runner import CONTROL_GROUPS
     for control in CONTROL_GROUPS:
         if control in d.groups:
@@ -117,14 +119,15 @@ def compare_result(deck: str | Path, params: Params, result: Result) -> pd.DataF
     return frame
 
 
-def compare(deck: str | Path) -> pd.DataFrame:
+def compare(deck: DeckSource) -> pd.DataFrame:
     """Compare a deck's run with the published record, cell by cell.
 
     Parameters
     ----------
-    deck : str or pathlib.Path
-        Path of the deck to run (one of the shipped decks whose case is in ``published/``, or any
-        deck: a deck no published table belongs to gives an empty frame).
+    deck : str, path-like or dict
+        The deck to run, as every entry point takes one (``driver.DeckSource``): its file (one of
+        the shipped decks whose case is in ``published/``, or any deck: a deck no published
+        table belongs to gives an empty frame), its text, or a dict of groups.
 
     Returns
     -------
@@ -137,7 +140,9 @@ def compare(deck: str | Path) -> pd.DataFrame:
     Raises
     ------
     DeckError
-        The deck has bad input.
+        The deck has bad input (or its file cannot be read).
+    TypeError
+        ``deck`` is not a deck source.
 
     Examples
     --------

@@ -1,7 +1,7 @@
 """The one tidy-table exporter: a pandas frame to CSV or Parquet, atomically.
 
 Tidy means one row per output point (crank angle, time step, design, ...) and
-one column per quantity, with units in the column names (``omega3_rad_s``) or,
+one column per quantity, with units in the column names (``rocker_omega_rad_s``) or,
 where a name cannot say it (``xa`` is in the deck's length unit), in
 ``frame.attrs["units"]`` (:func:`with_units`; Parquet files keep it in their
 metadata).  CSV and Parquet read back with the same dtypes and values: floats
@@ -31,12 +31,12 @@ FORMATS = ("csv", "parquet")
 #: units read from a column name's suffix (longest suffix first)
 SUFFIX_UNITS = (("_rad_s2", "rad/s^2"), ("_rad_s", "rad/s"), ("_m_s2", "m/s^2"), ("_per_s2", "length/s^2"),
                 ("_per_s", "length/s"), ("_microstrain", "1e-6"), ("_deg", "deg"), ("_rpm", "rpm"),
-                ("_Nm", "N m"), ("_m2", "m^2"), ("_mm", "mm"), ("_um", "um"), ("_kg", "kg"), ("_m", "m"),
+                ("_Nm", "N m"), ("_MPa", "MPa"), ("_m2", "m^2"), ("_mm", "mm"), ("_um", "um"), ("_kg", "kg"), ("_m", "m"),
                 ("_N", "N"), ("_s", "s"))
 
 
 def unit_of(name: str, dtype: Any = None) -> str | None:
-    """The unit a column name says (``omega3_rad_s`` -> 'rad/s'); '' for text and logicals;
+    """The unit a column name says (``rocker_omega_rad_s`` -> 'rad/s'); '' for text and logicals;
     None when a numeric column's name does not say it."""
     for suffix, unit in SUFFIX_UNITS:
         if name.endswith(suffix):

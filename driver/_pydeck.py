@@ -17,7 +17,7 @@ import numpy as np
 
 from driver._deck import MAX_DECK_BYTES, MAX_VALUES, Deck, DeckError, RawGroup, read_deck, shown_value
 
-__all__ = ["DeckSource", "deck_of", "group_from_dict", "is_text", "plain_value"]
+__all__ = ["DeckSource", "deck_of", "source_deck", "group_from_dict", "is_text", "plain_value"]
 
 #: what :func:`driver.run` and :func:`driver.run_sweep` accept: a deck file, a deck's text, or {group: {key: value}}
 DeckSource: TypeAlias = str | os.PathLike | Mapping[str, Mapping[str, Any]]
@@ -122,3 +122,15 @@ def deck_of(source: DeckSource | Deck, name: str | None) -> Deck:
     if isinstance(source, (str, os.PathLike)):
         return read_deck(Path(source))
     raise TypeError(f"a deck is a path, a deck's text or a dict of groups, not {type(source).__name__}")
+
+
+def source_deck(source: DeckSource | Deck, name: str | None = None) -> Deck:
+    """The deck of any Python entry point's ``source`` (:data:`DeckSource`: a deck file, a deck's
+    text, a {group: {key: value}} dict; or a parsed Deck), named ``name``, else after its file,
+    else after its first study group (as :func:`driver.run` names a deck's text): the stem of the
+    files an engine writes for it.  DeckError for bad input, TypeError for a source of another type."""
+    deck = deck_of(source, name)
+    if name is None and isinstance(source, str) and is_text(source):
+        study = [g for g in deck.groups if g not in ("sweep", "optimize", "synthesis")] or list(deck.groups)
+        deck = Deck(Path(study[0] if study else "deck"), deck.groups)
+    return deck

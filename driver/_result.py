@@ -41,7 +41,7 @@ class Result:
 
     What :func:`driver.run` and ``driver.<study>.run`` return.  Units are those of the study's
     deck keys; tidy and summary columns carry them in their names (``theta_deg``,
-    ``omega3_rad_s``, ``tau1_Nm``) or in ``tidy.attrs["units"]``.
+    ``rocker_omega_rad_s``, ``tau1_Nm``) or in ``tidy.attrs["units"]``.
 
     Attributes
     ----------
@@ -58,6 +58,11 @@ class Result:
     failure : str or None
         Set when the run completed but did not succeed (e.g. an optimiser did not converge):
         outputs are written, the exit status is 1.
+    design_failure : bool
+        The failure is the design's own answer (a four-bar chain that cannot move, or that
+        assembles nowhere in its crank range), not a computation that failed: a single run
+        still fails (exit 1), but in a sweep, a design search, the case is a design its summary
+        classifies (status ok, on both the batch and the per-case path).
     figures : list of Figure
         Figures for ``--plot``, drawn only on demand (:meth:`figure`).
     extra : dict of str to str
@@ -88,6 +93,8 @@ class Result:
     params: Any = field(default=None, repr=False, compare=False)
     #: arrays no table holds, for the study's figures and the page's animation (not written)
     data: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
+    #: the failure is the design's answer (docs above): a sweep records the case as ok
+    design_failure: bool = False
 
     @property
     def out(self) -> str:

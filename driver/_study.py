@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import importlib
 import re
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType, ModuleType
 from typing import TYPE_CHECKING, Any
@@ -224,7 +224,9 @@ class Study:
     sweep_best   ``{column: 'max' | 'min'}``: which end of a column is the better design
     summary_settings  deck keys the summary columns depend on: a sweep's and an optimisation's .out
                  state their base values, their tables record them
-    renamed      ``{old column: new name}`` of summary columns that were renamed
+    renamed      ``{old column: new name}`` of summary and tidy columns that were renamed: an old
+                 name in a deck, a sweep filter or an &optimize expression is refused with the
+                 new one named (:meth:`renamed_in`)
     blame        ``blame(params, exc) -> (key, message) | None``: the key a numerical failure
                  is due to
     published    ``published(params, result) -> list[dict]``: the run compared cell by cell
@@ -299,6 +301,25 @@ class Study:
                  and c in self.batch.passes]
         if stale:
             raise ValueError(f"{self.name}: column {stale[0]!r} is renamed, yet the batch pass table names it")
+
+    def renamed_in(self, names: Iterable[str]) -> str | None:
+        """The refusal of the first of ``names`` that is a renamed column (:attr:`renamed`), in
+        words naming its new name; None when none is.
+
+        Parameters
+        ----------
+        names : iterable of str
+            Column names a deck, filter or expression reads.
+
+        Returns
+        -------
+        str or None
+            ``"column 'old' of &study is now new"``, or None.
+        """
+        for n in names:
+            if n in self.renamed:
+                return f"column '{n}' of &{self.name} is now {self.renamed[n]}"
+        return None
 
     @property
     def module(self) -> ModuleType:

@@ -19,8 +19,8 @@ def main(outdir: Path) -> driver.Result:
     r = driver.fourbar.run(fixed_link=12.0, crank=5.0, coupler=15.0, rocker=9.0, omega=5.0, step_deg=5.0)
     s = r.summary
     print(f"{s['grashof_class']}: transmission angle {s['mu_min_deg']:.2f} .. {s['mu_max_deg']:.2f} deg, "
-          f"peak rocker speed {s['omega3_peak_rad_s']:.4f} rad/s")
-    print(r.tidy[["theta_deg", "rocker_deg", "omega3_rad_s", "transmission_deg"]].head(4).to_string(index=False))
+          f"peak rocker speed {s['rocker_omega_peak_rad_s']:.4f} rad/s")
+    print(r.tidy[["theta_deg", "rocker_deg", "rocker_omega_rad_s", "transmission_deg"]].head(4).to_string(index=False))
     fig = r.figure("linkage")             # a matplotlib Figure; shows inline in Jupyter
     fig.axes[0].set_title("crank 5: linkage positions (from Python)")
     path = save_figure(fig, Path(outdir) / "fourbar_linkage.png")

@@ -25,7 +25,7 @@ module fourbar_forces
   use fourbar, only: exact_states, st_ok
   implicit none
   private
-  public :: joint_forces, berkof_lowen, force_summaries
+  public :: joint_forces, berkof_lowen, force_summaries, link_stresses
 
   !> props columns: masses, inertias, com distances, com angles [rad], gravity, loads, load point
   integer, parameter, public :: nprop = 18
@@ -161,6 +161,102 @@ contains
       shm(k) = -p*fo4yk - tqk
     end do
   end subroutine forces_block
+
+  !> Peak normal stress in each moving link at n positions, from the joint forces fout (joint_forces
+  !> with the same states, omega, alpha1 and props): each link a straight prismatic bar between
+  !> its pins with area section(i) [m^2] and elastic section modulus section(3 + i) [m^3] for
+  !> in-plane bending (i = 1 crank, 2 coupler, 3 rocker).  Its loads are those of the force
+  !> analysis's free bodies, where they act: the pin forces at the pins (crank: F_O2 at O2 and
+  !> -F_A at A; coupler: F_A at A, -F_B at B and the load force at P; rocker: F_O4 at O4 and
+  !> F_B at B), the driver torque T on the crank at O2 and the load torque on the rocker at O4,
+  !> and the link's inertia force and weight -R_i at its centre of mass G_i (R_i from the link's
+  !> force balance: R_1 = F_O2 - F_A, R_2 = F_A - F_B + F_load, R_3 = F_O4 + F_B) with the couple
+  !> -I_i alpha_i there.  Cut at a distance xi from the first pin along the pin line, the part
+  !> before the cut carries the axial force N and bending moment M; with the loads lumped at
+  !> points, N is constant and M linear between them, so |N|/A + |M|/Z peaks on one side of a
+  !> load point or at a pin: those cuts are evaluated (a load beyond the pins, projected off the
+  !> bar, counts as before or after every cut).  sout(k, i): the peak |N|/A + |M|/Z of link i
+  !> at position k [Pa]; 0 where status is not st_ok.
+  subroutine link_stresses(n, states, status, p, q, r, s, alpha1, props, fout, section, sout)
+    !f2py threadsafe
+    integer, intent(in) :: n
+    real(dp), intent(in) :: states(n, 11)
+    integer, intent(in) :: status(n)
+    real(dp), intent(in) :: p, q, r, s, alpha1, props(18), fout(n, 12), section(6)
+    real(dp), intent(out) :: sout(n, 3)
+    real(dp) :: xa, ya, xb, yb, ex, ey, kx, ky, gx, gy, ux, uy, lpx(4), lpy(4), lfx(4), lfy(4), lc(4)
+    real(dp) :: fo2x, fo2y, fax, fay, fbx, fby, fo4x, fo4y, flx, fly
+    integer :: k
+    flx = props(15)
+    fly = props(16)
+    sout = 0.0_dp
+    do k = 1, n
+      if (status(k) /= st_ok) cycle
+      xa = states(k, 4); ya = states(k, 5); xb = states(k, 6); yb = states(k, 7)
+      fo2x = fout(k, 2); fo2y = fout(k, 3); fax = fout(k, 4); fay = fout(k, 5)
+      fbx = fout(k, 6); fby = fout(k, 7); fo4x = fout(k, 8); fo4y = fout(k, 9)
+      ! crank O2 -> A: F_O2 and T at O2, -F_A at A, -R_1 and -I_1 alpha_1 at G_1
+      ex = xa/q; ey = ya/q
+      kx = props(7)*cos(props(10)); ky = props(7)*sin(props(10))
+      gx = kx*ex - ky*ey; gy = kx*ey + ky*ex
+      lpx(1:3) = [0.0_dp, xa, gx]; lpy(1:3) = [0.0_dp, ya, gy]
+      lfx(1:3) = [fo2x, -fax, -(fo2x - fax)]; lfy(1:3) = [fo2y, -fay, -(fo2y - fay)]
+      lc(1:3) = [fout(k, 1), 0.0_dp, -props(4)*alpha1]
+      sout(k, 1) = bar_stress(3, lpx, lpy, lfx, lfy, lc, 0.0_dp, 0.0_dp, ex, ey, q, section(1), section(4))
+      ! coupler A -> B: F_A at A, -F_B at B, -R_2 and -I_2 alpha_2 at G_2, the load force at P
+      ex = (xb - xa)/r; ey = (yb - ya)/r
+      kx = props(8)*cos(props(11)); ky = props(8)*sin(props(11))
+      gx = xa + kx*ex - ky*ey; gy = ya + kx*ey + ky*ex
+      ux = xa + props(17)*ex - props(18)*ey; uy = ya + props(17)*ey + props(18)*ex
+      lpx = [xa, xb, gx, ux]; lpy = [ya, yb, gy, uy]
+      lfx = [fax, -fbx, -(fax - fbx + flx), flx]; lfy = [fay, -fby, -(fay - fby + fly), fly]
+      lc = [0.0_dp, 0.0_dp, -props(5)*states(k, 10), 0.0_dp]
+      sout(k, 2) = bar_stress(4, lpx, lpy, lfx, lfy, lc, xa, ya, ex, ey, r, section(2), section(5))
+      ! rocker O4 -> B: F_O4 and the load torque at O4, F_B at B, -R_3 and -I_3 alpha_3 at G_3
+      ex = (xb - p)/s; ey = yb/s
+      kx = props(9)*cos(props(12)); ky = props(9)*sin(props(12))
+      gx = p + kx*ex - ky*ey; gy = kx*ey + ky*ex
+      lpx(1:3) = [p, xb, gx]; lpy(1:3) = [0.0_dp, yb, gy]
+      lfx(1:3) = [fo4x, fbx, -(fo4x + fbx)]; lfy(1:3) = [fo4y, fby, -(fo4y + fby)]
+      lc(1:3) = [props(14), 0.0_dp, -props(6)*states(k, 11)]
+      sout(k, 3) = bar_stress(3, lpx, lpy, lfx, lfy, lc, p, 0.0_dp, ex, ey, s, section(3), section(6))
+    end do
+  end subroutine link_stresses
+
+  !> The peak |N|/A + |M|/Z [Pa] along a bar from (x0, y0) in the unit direction (ex, ey) of length
+  !> len under nl point loads: forces (fx, fy) [N] at (px, py) [m] and couples c [N m].  Cuts on
+  !> both sides of every load's projection xi_j = (P_j - start) . e clamped to [0, len]; the part
+  !> before a cut holds the loads with xi_j below it (strictly, or up to it), and its resultant
+  !> force and moment about the cut point are the section's N (along e) and M.
+  pure real(dp) function bar_stress(nl, px, py, fx, fy, c, x0, y0, ex, ey, len, area, modulus) result(peak)
+    integer, intent(in) :: nl
+    real(dp), intent(in) :: px(nl), py(nl), fx(nl), fy(nl), c(nl), x0, y0, ex, ey, len, area, modulus
+    real(dp) :: xi(nl), cut, sx, sy, nx, ny, m, st
+    integer :: i, j, side
+    do j = 1, nl
+      xi(j) = (px(j) - x0)*ex + (py(j) - y0)*ey
+    end do
+    peak = 0.0_dp
+    do i = 1, nl
+      cut = min(max(xi(i), 0.0_dp), len)
+      sx = x0 + cut*ex
+      sy = y0 + cut*ey
+      do side = 0, 1
+        nx = 0.0_dp
+        ny = 0.0_dp
+        m = 0.0_dp
+        do j = 1, nl
+          if (xi(j) < cut .or. (side == 1 .and. xi(j) <= cut)) then
+            nx = nx + fx(j)
+            ny = ny + fy(j)
+            m = m + (px(j) - sx)*fy(j) - (py(j) - sy)*fx(j) + c(j)
+          end if
+        end do
+        st = abs(nx*ex + ny*ey)/area + abs(m)/modulus
+        peak = max(peak, st)
+      end do
+    end do
+  end function bar_stress
 
   !> Berkof-Lowen shaking-force balance by counterweights on the crank and the rocker.
   !> The total centre of mass is stationary when (complex link vectors, z_i = d_i e^(i phi_i))

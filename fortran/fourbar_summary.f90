@@ -2,7 +2,7 @@
 !>
 !> For each linkage (one row of params) the figures a design search filters on, over the
 !> crank range [lo, hi] of the deck (only one turn matters: the motion is 360 deg periodic):
-!> Grashof class, assemblability and the assembled fraction of the range, transmission-angle
+!> class (Grashof's, or a chain that cannot move), assemblability and the assembled fraction of the range, transmission-angle
 !> extremes, rocker extremes and swing, toggle (limit) positions in the range, and the peak
 !> coupler and rocker angular velocities with their crank angles.  Every state is computed by
 !> fourbar::exact_states (the one place the loop-closure physics lives); this module only
@@ -51,9 +51,15 @@ module fourbar_summary
   integer, parameter, public :: npar = 8
   !> result columns (see summaries)
   integer, parameter, public :: ncol = 19
-  !> Grashof class codes shared with driver/fourbar.py
+  !> Class codes shared with driver/fourbar/_batch.py (GRASHOF_NAMES): Grashof's classes by the
+  !> shortest link; the change-point (S + L = P + Q) classes the same way (the crank turns fully
+  !> when the ground or the crank is the shortest); and two chains that cannot move: the longest
+  !> link longer than the other three together (no position exists: gr_no_chain) or equal to them
+  !> (the chain lies flat, one position: gr_flat_chain)
   integer, parameter, public :: gr_double_crank = 0, gr_crank_rocker = 1, gr_rocker_crank = 2, &
-                                gr_double_rocker = 3, gr_change_point = 4, gr_triple_rocker = 5
+                                gr_double_rocker = 3, gr_cp_double_crank = 4, gr_triple_rocker = 5, &
+                                gr_cp_crank_rocker = 6, gr_cp_rocker_crank = 7, gr_cp_double_rocker = 8, &
+                                gr_no_chain = 9, gr_flat_chain = 10
   !> passes (bits of summaries' passes argument)
   integer, parameter, public :: pass_transmission = 1, pass_rocker = 2, pass_peaks = 4, pass_all = 7
   !> with pass_peaks: the previous peak search (every 1 deg grid point, no bisection below 1 deg),
@@ -106,11 +112,12 @@ contains
     end do
   end subroutine summaries
 
-  !> Grashof class from the link lengths (same rule and tolerance as driver/fourbar.py grashof()).
+  !> Class from the link lengths (same rule and tolerance as driver/fourbar/_analysis.py grashof()).
   pure integer function grashof_code(p, q, r, s) result(code)
     real(dp), intent(in) :: p, q, r, s
-    real(dp) :: l(4), lhs, rhs, tol
+    real(dp) :: l(4), lhs, rhs, tol, rest
     integer :: i, ishort
+    logical :: crank_turns, rocker_turns
     l = [p, q, s, r]                   ! tie order of the Python rule: ground, crank, rocker, coupler
     ishort = 1
     do i = 2, 4
@@ -119,11 +126,29 @@ contains
     call sort(l, 4)                    ! a sorted copy
     lhs = l(1) + l(4)
     rhs = l(2) + l(3)
+    rest = l(1) + l(2) + l(3)          ! the three shorter links together
     tol = 1.0e-12_dp*rhs
-    if (lhs > rhs + tol) then
+    if (l(4) > rest + 1.0e-12_dp*rest) then
+      code = gr_no_chain               ! the longest link spans more than the other three: no position
+    else if (l(4) >= rest - 1.0e-12_dp*rest) then
+      code = gr_flat_chain             ! only lying flat, stretched along the longest link: no motion
+    else if (lhs > rhs + tol) then
       code = gr_triple_rocker
     else if (abs(lhs - rhs) <= tol) then
-      code = gr_change_point
+      ! change point: a link among the shortest (ties counted: a parallelogram's crank and rocker)
+      ! turns fully; the crank turns when the ground or the crank is one, the rocker when the
+      ! ground or the rocker is
+      crank_turns = min(p, q) <= l(1) + 1.0e-12_dp*l(1)
+      rocker_turns = min(p, s) <= l(1) + 1.0e-12_dp*l(1)
+      if (crank_turns .and. rocker_turns) then
+        code = gr_cp_double_crank
+      else if (crank_turns) then
+        code = gr_cp_crank_rocker
+      else if (rocker_turns) then
+        code = gr_cp_rocker_crank
+      else
+        code = gr_cp_double_rocker
+      end if
     else
       select case (ishort)
       case (1)

@@ -33,7 +33,8 @@ module ujoint
   use vecmath, only: sincos_array, atan2_array
   implicit none
   private
-  public :: chain_speed, chain_objective, chain_equivalent, chain_geometry, chain_summaries
+  public :: chain_speed, chain_objective, chain_equivalent, chain_geometry, chain_summaries, chain_jet, &
+            chain_roots, chain_input_torque
 
   !> model codes
   integer, parameter, public :: model_eq13 = 0, model_cumulative = 1, model_exact = 2
@@ -42,9 +43,18 @@ module ujoint
   !> status codes of chain_equivalent (beta_res) and chain_geometry
   integer, parameter, public :: st_ok = 0, st_res_undefined = 1, st_zero_axis = 2, st_right_angle = 3
   !> result columns of chain_summaries
-  integer, parameter, public :: nsum = 7
+  integer, parameter, public :: nsum = 9
   !> passes of chain_summaries (bits)
   integer, parameter, public :: sum_objective = 1, sum_speed = 2, sum_equivalent = 4
+  !> what chain_roots finds the roots of: R - 1 (speed ratio one), d2R/dtheta2 (extremes of the
+  !> output acceleration), d T_in/d theta (extremes of the input torque of chain_input_torque)
+  integer, parameter, public :: root_ratio_one = 1, root_accel_extreme = 2, root_torque_extreme = 3
+  !> a chain whose ratio R stays within cv_tol of its range (max R - min R on the grid) turns its
+  !> output uniformly but for round-off: its peak-acceleration angle and R = 1 angle are undefined
+  real(dp), parameter, public :: cv_tol = 1.0e-13_dp
+  !> root finding: bracket width [rad] and iteration cap of the Illinois regula falsi
+  real(dp), parameter :: root_tol = 1.0e-12_dp
+  integer, parameter :: root_maxit = 200
 
   real(dp), parameter :: pi = 3.14159265358979323846264338327950288_dp
 
@@ -277,19 +287,30 @@ contains
   !> design alone: the same procedures on the same grid, so the same bits.
   !>   res(i, 1)  objective of kind (dimensionless; over the first m/2 angles for even m)
   !>   res(i, 2:3) min and max of R = omega_out/omega_in on the grid
-  !>   res(i, 4)  max |dR/dtheta| on the grid [1/rad] (times omega_in**2: peak output
-  !>              angular acceleration at constant input speed)
+  !>   res(i, 4)  max |dR/dtheta| over the turn [1/rad] (times omega_in**2: peak output angular
+  !>              acceleration at constant input speed): the grid's largest, refined where
+  !>              d2R/dtheta2 changes sign between its neighbours (root to 1e-12 rad)
   !>   res(i, 5)  beta_e [rad]; res(i, 6) beta_res [rad], 0 unless res(i, 7) = st_ok
   !>   res(i, 7)  status of beta_res (chain_equivalent with tolerance tol [rad])
+  !>   (a chain with max R - min R < cv_tol on the grid turns its output uniformly but for
+  !>   round-off: res(i, 4) is the grid's largest and res(i, 8:9) are -1, undefined)
+  !>   res(i, 8)  the input angle of res(i, 4) [rad, 0..2 pi, from the normal to joint 1's plane]:
+  !>              of the grid angles within 1e-9 of the largest |dR/dtheta| (the peak's mirror
+  !>              and half-turn images), the first from theta0 on
+  !>   res(i, 9)  the first input angle from theta0 on [rad, 0..2 pi) where R = 1 (R has period
+  !>              pi: the first sign change of R - 1 on theta0 + 2 pi j/m, j = 0..m/2, refined
+  !>              to 1e-12 rad); -1 where R - 1 keeps its sign
+  !> theta0 [rad] is the input angle the caller counts from (its angle origin).
   !> The sines and cosines of the grid are taken once for all designs.
   !> passes: sum of sum_* bits -- sum_objective (res(:, 1)), sum_speed (res(:, 2:4)),
-  !> sum_equivalent (res(:, 5:7)); the columns of a pass not asked for are 0 (not computed).
-  subroutine chain_summaries(model, kind, n, nd, x, m, tol, passes, res)
+  !> sum_equivalent (res(:, 5:7)); the columns of a pass not asked for are 0 (not computed);
+  !> res(:, 8:9) belong to sum_speed.
+  subroutine chain_summaries(model, kind, n, nd, x, m, tol, theta0, passes, res)
     integer, intent(in) :: model, kind, n, nd, m, passes
-    real(dp), intent(in) :: x(nd, 3*n - 2), tol
-    real(dp), intent(out) :: res(nd, 7)                ! nsum columns (literal for f2py)
+    real(dp), intent(in) :: x(nd, 3*n - 2), tol, theta0
+    real(dp), intent(out) :: res(nd, 9)                ! nsum columns (literal for f2py)
     real(dp), allocatable :: th(:), c(:), s(:), rat(:), ratf(:), dlth(:), dlp(:, :), thout(:), acc(:)
-    real(dp) :: beta(n), phi(n - 1), rho(n - 1), be, br
+    real(dp) :: beta(n), phi(n - 1), rho(n - 1), be, br, peak, at, one
     integer :: i, j, mh, st
     !f2py threadsafe
     mh = m
@@ -318,7 +339,17 @@ contains
         end do
         res(i, 2) = minval(ratf)
         res(i, 3) = maxval(ratf)
-        res(i, 4) = maxval(acc)
+        if (res(i, 3) - res(i, 2) < cv_tol) then   ! a constant-velocity chain: no peak, R = 1 throughout
+          res(i, 4) = maxval(acc)
+          res(i, 8) = -1.0_dp
+          res(i, 9) = -1.0_dp
+        else
+          call refine_peak(model, n, beta, phi, rho, m, th, acc, theta0, peak, at)
+          res(i, 4) = peak
+          res(i, 8) = at
+          call first_ratio_one(model, n, beta, phi, rho, m, theta0, one)
+          res(i, 9) = one
+        end if
       end if
       if (iand(passes, sum_equivalent) /= 0) then
         call chain_equivalent(model, n, beta, phi, rho, tol, be, br, st)
@@ -397,6 +428,260 @@ contains
       end if
     end do
   end subroutine propagate_nograd
+
+  !> R = omega_out/omega_in (r0), dR/dtheta (r1, 1/rad) and d2R/dtheta2 (r2, 1/rad**2) at
+  !> (cos, sin) = (c0, s0) of m input angles, in closed form: with theta_k the driving angle of
+  !> joint k, ln R = sum_k ln r_k(theta_k), r_k = cos b_k / (1 - sin(b_k)**2 sin(theta_k)**2),
+  !>   d ln r_k/d theta_k   = a_k = sin(b_k)**2 sin(2 theta_k) / d_k,  d_k = 1 - sin(b_k)**2 sin(theta_k)**2
+  !>   d2 ln r_k/d theta_k2 = b_k = (2 sin(b_k)**2 cos(2 theta_k) d_k + (sin(b_k)**2 sin(2 theta_k))**2) / d_k**2
+  !> and the driving angles' derivatives carried forward: the exact chain drives joint k+1 with
+  !> joint k's output, theta'_(k+1) = r_k theta'_k, theta''_(k+1) = r_k a_k theta'_k**2 + r_k theta''_k;
+  !> the paper's models with the input angle plus a phase (theta'_k = 1, theta''_k = 0).  Then
+  !> R' = R (ln R)', R'' = R ((ln R)'**2 + (ln R)'').
+  subroutine jet(model, n, beta, phi, rho, m, c0, s0, r0, r1, r2)
+    integer, intent(in) :: model, n, m
+    real(dp), intent(in) :: beta(n), phi(n - 1), rho(n - 1), c0(m), s0(m)
+    real(dp), intent(out) :: r0(m), r1(m), r2(m)
+    real(dp) :: c(m), s(m), t1(m), t2(m), l1(m), l2(m), cs(n), sn(n)
+    real(dp) :: cb, s2, d, r, a, b, sc, cc, isd, x, y
+    integer :: j, k
+    call shifts(model, n, phi, rho, cs, sn)
+    c = c0
+    s = s0
+    t1 = 1.0_dp
+    t2 = 0.0_dp
+    r0 = 1.0_dp
+    l1 = 0.0_dp
+    l2 = 0.0_dp
+    do k = 1, n
+      cb = cos(beta(k))
+      s2 = sin(beta(k))**2
+      do j = 1, m
+        d = 1.0_dp - s2*s(j)*s(j)
+        r = cb/d
+        sc = 2.0_dp*s(j)*c(j)
+        cc = c(j)*c(j) - s(j)*s(j)
+        a = s2*sc/d
+        b = (2.0_dp*s2*cc*d + (s2*sc)**2)/(d*d)
+        r0(j) = r0(j)*r
+        l1(j) = l1(j) + a*t1(j)
+        l2(j) = l2(j) + b*t1(j)*t1(j) + a*t2(j)
+        if (k == n) cycle
+        if (model == model_exact) then
+          t2(j) = r*a*t1(j)*t1(j) + r*t2(j)
+          t1(j) = r*t1(j)
+          isd = 1.0_dp/sqrt(d)
+          x = c(j)*isd
+          y = cb*s(j)*isd
+        else
+          x = c(j)
+          y = s(j)
+        end if
+        c(j) = x*cs(k) - y*sn(k)
+        s(j) = x*sn(k) + y*cs(k)
+      end do
+    end do
+    r1 = r0*l1
+    r2 = r0*(l1*l1 + l2)
+  end subroutine jet
+
+  !> R, dR/dtheta and d2R/dtheta2 (see jet) at input angles theta(1..m) [rad, from the normal to
+  !> joint 1's plane]: the output angular velocity per omega_in, and at constant input speed the
+  !> output acceleration per omega_in**2 and its rate per omega_in**3.
+  subroutine chain_jet(model, n, beta, phi, rho, m, theta, r0, r1, r2)
+    integer, intent(in) :: model, n, m
+    real(dp), intent(in) :: beta(n), phi(n - 1), rho(n - 1), theta(m)
+    real(dp), intent(out) :: r0(m), r1(m), r2(m)
+    real(dp) :: c(m), s(m)
+    !f2py threadsafe
+    call sincos_array(m, theta, s, c)
+    call jet(model, n, beta, phi, rho, m, c, s, r0, r1, r2)
+  end subroutine chain_jet
+
+  !> Input torque [N m] at constant input speed omega [rad/s] driving an output shaft of moment of
+  !> inertia inertia [kg m**2] against a constant load torque load [N m] (resisting the output's
+  !> rotation), the joints massless and frictionless: by power balance
+  !>   T_in omega_in = (J alpha_out + T_load) omega_out,  so  T_in = (J omega**2 R' + T_load) R,
+  !> at input angles theta(1..m) [rad]; dtorque = d T_in / d theta [N m/rad].
+  subroutine chain_input_torque(model, n, beta, phi, rho, m, theta, omega, inertia, load, torque, dtorque)
+    integer, intent(in) :: model, n, m
+    real(dp), intent(in) :: beta(n), phi(n - 1), rho(n - 1), theta(m), omega, inertia, load
+    real(dp), intent(out) :: torque(m), dtorque(m)
+    real(dp) :: r0(m), r1(m), r2(m), jw2
+    !f2py threadsafe
+    call chain_jet(model, n, beta, phi, rho, m, theta, r0, r1, r2)
+    jw2 = inertia*omega*omega
+    torque = (jw2*r1 + load)*r0
+    dtorque = jw2*(r2*r0 + r1*r1) + load*r1
+  end subroutine chain_input_torque
+
+  !> The function whose roots chain_roots finds, at (cos, sin) = (c0, s0) of m angles:
+  !> root_ratio_one R - 1, root_accel_extreme R'', root_torque_extreme
+  !> coef(1) (R'' R + R'**2) + coef(2) R' (coef = J omega**2 [kg m**2/s**2], T_load [N m]).
+  subroutine root_function(model, n, beta, phi, rho, what, coef, m, c0, s0, f)
+    integer, intent(in) :: model, n, what, m
+    real(dp), intent(in) :: beta(n), phi(n - 1), rho(n - 1), coef(2), c0(m), s0(m)
+    real(dp), intent(out) :: f(m)
+    real(dp) :: r0(m), r1(m), r2(m)
+    call jet(model, n, beta, phi, rho, m, c0, s0, r0, r1, r2)
+    select case (what)
+    case (root_ratio_one)
+      f = r0 - 1.0_dp
+    case (root_accel_extreme)
+      f = r2
+    case default
+      f = coef(1)*(r2*r0 + r1*r1) + coef(2)*r1
+    end select
+  end subroutine root_function
+
+  !> The root in [a, b] of the root function, whose values fa, fb at the ends differ in sign:
+  !> Illinois regula falsi (a bisection step when a step stalls) to a bracket of root_tol [rad].
+  real(dp) function bracketed_root(model, n, beta, phi, rho, what, coef, a, b, fa, fb) result(x)
+    integer, intent(in) :: model, n, what
+    real(dp), intent(in) :: beta(n), phi(n - 1), rho(n - 1), coef(2), a, b, fa, fb
+    real(dp) :: xa, xb, ya, yb, fx(1), w
+    integer :: it, side
+    xa = a
+    xb = b
+    ya = fa
+    yb = fb
+    side = 0
+    do it = 1, root_maxit
+      w = xb - xa
+      if (w <= root_tol) exit
+      x = xb - yb*(xb - xa)/(yb - ya)
+      if (.not. (x > xa .and. x < xb) .or. mod(it, 8) == 0) x = 0.5_dp*(xa + xb)
+      call root_function(model, n, beta, phi, rho, what, coef, 1, [cos(x)], [sin(x)], fx)
+      if (fx(1) == 0.0_dp) then
+        xa = x
+        xb = x
+        exit
+      end if
+      if ((fx(1) > 0.0_dp) .eqv. (yb > 0.0_dp)) then
+        xb = x
+        yb = fx(1)
+        if (side == 1) ya = 0.5_dp*ya
+        side = 1
+      else
+        xa = x
+        ya = fx(1)
+        if (side == -1) yb = 0.5_dp*yb
+        side = -1
+      end if
+    end do
+    x = 0.5_dp*(xa + xb)
+  end function bracketed_root
+
+  !> Every root in [0, 2 pi) of the root function ``what`` (root_ratio_one, root_accel_extreme or
+  !> root_torque_extreme; coef as root_function): each sign change between neighbours of the
+  !> grid theta_j = 2 pi (j-1)/m (the last interval wrapping to 2 pi), refined to root_tol [rad]
+  !> by bracketed_root, and each grid angle where the function is exactly 0; ascending, the
+  !> first nroots entries of roots [rad] (two roots inside one grid interval are not seen).
+  subroutine chain_roots(model, n, beta, phi, rho, what, coef, m, roots, nroots)
+    integer, intent(in) :: model, n, what, m
+    real(dp), intent(in) :: beta(n), phi(n - 1), rho(n - 1), coef(2)
+    real(dp), intent(out) :: roots(m)
+    integer, intent(out) :: nroots
+    real(dp) :: th(m), c(m), s(m), f(m), a, b, fb, x
+    integer :: j
+    !f2py threadsafe
+    do j = 1, m
+      th(j) = (2.0_dp*pi/real(m, dp))*real(j - 1, dp)
+    end do
+    call sincos_array(m, th, s, c)
+    call root_function(model, n, beta, phi, rho, what, coef, m, c, s, f)
+    nroots = 0
+    roots = 0.0_dp
+    do j = 1, m
+      a = th(j)
+      if (j < m) then
+        b = th(j + 1)
+        fb = f(j + 1)
+      else
+        b = 2.0_dp*pi
+        fb = f(1)
+      end if
+      if (f(j) == 0.0_dp) then
+        x = a
+      else if ((f(j) > 0.0_dp .and. fb < 0.0_dp) .or. (f(j) < 0.0_dp .and. fb > 0.0_dp)) then
+        x = bracketed_root(model, n, beta, phi, rho, what, coef, a, b, f(j), fb)
+        if (x >= 2.0_dp*pi) x = x - 2.0_dp*pi
+      else
+        cycle
+      end if
+      nroots = nroots + 1
+      roots(nroots) = x
+    end do
+  end subroutine chain_roots
+
+  !> The peak of |dR/dtheta| over the turn from its values acc(1..m) on the grid th: of the grid
+  !> angles within 1e-9 of the largest (a peak's mirror and half-turn images), the first from
+  !> theta0 on, refined where d2R/dtheta2 changes sign between its neighbours (bracketed_root);
+  !> peak [1/rad] and its angle at [rad, 0..2 pi).
+  subroutine refine_peak(model, n, beta, phi, rho, m, th, acc, theta0, peak, at)
+    integer, intent(in) :: model, n, m
+    real(dp), intent(in) :: beta(n), phi(n - 1), rho(n - 1), th(m), acc(m), theta0
+    real(dp), intent(out) :: peak, at
+    real(dp) :: h, a, b, f(2), x, r0(1), r1(1), r2(1), top, dist, best
+    real(dp), parameter :: none(2) = 0.0_dp
+    integer :: j, i
+    top = maxval(acc)
+    j = maxloc(acc, 1)
+    best = 4.0_dp*pi
+    do i = 1, m
+      if (acc(i) < top*(1.0_dp - 1.0e-9_dp)) cycle
+      dist = modulo(th(i) - theta0, 2.0_dp*pi)
+      if (dist < best) then
+        best = dist
+        j = i
+      end if
+    end do
+    peak = acc(j)
+    at = th(j)
+    if (m < 3 .or. peak == 0.0_dp) return
+    h = 2.0_dp*pi/real(m, dp)
+    a = th(j) - h
+    b = th(j) + h
+    call root_function(model, n, beta, phi, rho, root_accel_extreme, none, 2, [cos(a), cos(b)], &
+                       [sin(a), sin(b)], f)
+    if (.not. ((f(1) > 0.0_dp .and. f(2) < 0.0_dp) .or. (f(1) < 0.0_dp .and. f(2) > 0.0_dp))) return
+    x = bracketed_root(model, n, beta, phi, rho, root_accel_extreme, none, a, b, f(1), f(2))
+    call jet(model, n, beta, phi, rho, 1, [cos(x)], [sin(x)], r0, r1, r2)
+    if (abs(r1(1)) >= peak) then
+      peak = abs(r1(1))
+      at = modulo(x, 2.0_dp*pi)
+    end if
+  end subroutine refine_peak
+
+  !> The first input angle from theta0 on [rad, 0..2 pi) where R = 1: R has period pi, so the
+  !> first sign change of R - 1 on the half-turn grid theta0 + 2 pi j/m (j = 0..ceiling(m/2)),
+  !> refined by bracketed_root; -1 when there is none.
+  subroutine first_ratio_one(model, n, beta, phi, rho, m, theta0, one)
+    integer, intent(in) :: model, n, m
+    real(dp), intent(in) :: beta(n), phi(n - 1), rho(n - 1), theta0
+    real(dp), intent(out) :: one
+    real(dp) :: t(m/2 + 2), c(m/2 + 2), s(m/2 + 2), f(m/2 + 2)
+    real(dp), parameter :: none(2) = 0.0_dp
+    integer :: j, mh
+    mh = m/2 + 2
+    do j = 1, mh
+      t(j) = theta0 + (2.0_dp*pi/real(m, dp))*real(j - 1, dp)
+    end do
+    call sincos_array(mh, t, s, c)
+    call root_function(model, n, beta, phi, rho, root_ratio_one, none, mh, c, s, f)
+    one = -1.0_dp
+    do j = 1, mh - 1
+      if (f(j) == 0.0_dp) then
+        one = modulo(t(j), 2.0_dp*pi)
+        return
+      end if
+      if ((f(j) > 0.0_dp .and. f(j + 1) < 0.0_dp) .or. (f(j) < 0.0_dp .and. f(j + 1) > 0.0_dp)) then
+        one = modulo(bracketed_root(model, n, beta, phi, rho, root_ratio_one, none, t(j), t(j + 1), &
+                                    f(j), f(j + 1)), 2.0_dp*pi)
+        return
+      end if
+    end do
+  end subroutine first_ratio_one
 
   !> Closed-form equivalent angles [rad].
   !> beta_e: first-order residual angle, beta_e**2 = |sum_k beta_k**2 exp(2i gamma_k)| with

@@ -79,6 +79,9 @@ def _batch_and_auxiliary_kernels(rng: np.random.Generator, theta: np.ndarray) ->
                       9.81, 1.5, 3.0, -2.0, 0.07, 0.02])
     states, st = fourbar_kernel.fourbar_exact(theta, p, q, r, s, 5.0, 0.7, 1)
     out["fourbar_joint_forces"] = _h(fourbar_kernel.fourbar_joint_forces(states, st, p, q, r, s, 5.0, 0.7, props))
+    forces = fourbar_kernel.fourbar_joint_forces(states, st, p, q, r, s, 5.0, 0.7, props)
+    out["fourbar_link_stresses"] = _h(fourbar_kernel.fourbar_link_stresses(
+        states, st, p, q, r, s, 0.7, props, forces, np.array([2e-5, 3e-5, 2.5e-5, 5e-8, 8e-8, 6e-8])))
     balanced, cw = fourbar_kernel.fourbar_berkof_lowen(q, r, s, props, (0.03, 0.04))
     out["fourbar_berkof_lowen"] = _h(balanced, cw)
     nf = 200
@@ -104,6 +107,12 @@ def _batch_and_auxiliary_kernels(rng: np.random.Generator, theta: np.ndarray) ->
           for code in ujoint_kernel.UJOINT_MODELS.values() for i in range(50)]
     eq += [ujoint_kernel.ujoint_equivalent(ujoint_kernel.UJOINT_MODELS["exact"], beta[0], [np.pi / 2, 0.0], [0.0, 0.0])]
     out["ujoint_equivalent"] = _h([be for be, _ in eq], [np.nan if br is None else br for _, br in eq])
+    exact = ujoint_kernel.UJOINT_MODELS["exact"]
+    out["ujoint_jet"] = _h(*ujoint_kernel.ujoint_jet(exact, beta[0], phi[0], rho[0], theta))
+    out["ujoint_roots"] = _h(*(ujoint_kernel.ujoint_roots(exact, what, beta[i], phi[i], rho[i], 360, (0.4, 1.5))
+                               for what in ujoint_kernel.UJOINT_ROOTS for i in range(5)))
+    out["ujoint_input_torque"] = _h(*ujoint_kernel.ujoint_input_torque(exact, beta[0], phi[0], rho[0], theta,
+                                                                       60.0, 0.4, 1.5))
     axes = rng.normal(0, 1, (5, 3)) * 0.2 + np.array([1.0, 0.0, 0.0])
     g_beta, g_rho, g_status = ujoint_kernel.ujoint_geometry(np.cumsum(axes, axis=0))
     out["ujoint_geometry"] = _h(g_beta, g_rho, g_status)

@@ -105,7 +105,7 @@ def test_transmission_and_rocker_extremes_in_closed_form(q, write_deck):
     ((8, 6, 2, 7), "Grashof double-rocker", False),
     ((8, 7, 6, 2), "rocker-crank", False),
     ((10, 6, 7, 8), "non-Grashof triple-rocker", False),
-    ((4, 2, 4, 2), "change-point (special Grashof)", True),
+    ((4, 2, 4, 2), "change-point double-crank (special Grashof)", True),   # a parallelogram
 ])
 def test_grashof_classes(lengths, name, full):
     g = grashof(*lengths)

@@ -161,7 +161,7 @@ def test_summarise_batch_wanted_columns(shipped):
     cols = {"crank": shipped[:3000, 1], "coupler": shipped[:3000, 2], "rocker": shipped[:3000, 3]}
     full = fourbar.summarise_batch(base, cols, detail=True)
     assert set(full.columns) == {c for c, p in fourbar.BATCH_PASSES.items() if p != ("forces",)}
-    for wanted in (["mu_min_deg"], ["rocker_swing_deg", "meets_transmission_band"], ["omega2_peak_at_deg"], []):
+    for wanted in (["mu_min_deg"], ["rocker_swing_deg", "meets_transmission_band"], ["coupler_omega_peak_at_deg"], []):
         part = fourbar.summarise_batch(base, cols, wanted=wanted)
         assert list(part.columns) == [c for c in full.columns if c in wanted] and len(part) == 3000
         for c in wanted:

@@ -60,7 +60,7 @@ def oracle(p, q, r, s, lo=0.0, hi=360.0, branch=1, omega=1.0, step=0.01):
     res["rocker_max_deg"] = math.degrees(u.max()) % 360.0
     ok = stt == OK
     if ok.all():
-        for name, col in (("omega3_peak_rad_s", 8), ("omega2_peak_rad_s", 7)):
+        for name, col in (("rocker_omega_peak_rad_s", 8), ("coupler_omega_peak_rad_s", 7)):
             k = np.argmax(np.abs(out[:, col]))
             res[name] = out[k, col]
         if hi - lo == 360.0 and res["rocker_swing_deg"] < 359.0:
@@ -103,14 +103,14 @@ def test_batch_against_brute_force(lengths, branch):
         assert circ(f["rocker_max_deg"], o["rocker_max_deg"]) < 1e-4
     if f["rocker_turns_fully"]:
         assert o["rocker_swing_deg"] >= 360.0 - 1e-6
-    if "omega3_peak_rad_s" in o:
+    if "rocker_omega_peak_rad_s" in o:
         assert not f["toggle_in_range"]
-        for name in ("omega3_peak_rad_s", "omega2_peak_rad_s"):
+        for name in ("rocker_omega_peak_rad_s", "coupler_omega_peak_rad_s"):
             # the grid maximum is below the true peak by at most ~curvature * (0.005 deg)^2
             assert f[name] == pytest.approx(o[name], rel=1e-6, abs=1e-9)
             assert abs(f[name]) >= abs(o[name]) * (1 - 1e-12)
     else:
-        assert f["toggle_in_range"] and math.isnan(f["omega3_peak_rad_s"])
+        assert f["toggle_in_range"] and math.isnan(f["rocker_omega_peak_rad_s"])
     if "time_ratio" in o:   # a full turn with the rocker oscillating: strokes of 180 +- alpha
         assert f["time_ratio"] >= 1.0
         assert f["time_ratio"] == pytest.approx(o["time_ratio"], abs=2e-4)
@@ -144,26 +144,26 @@ def test_partial_ranges_and_long_ranges():
         row = f.iloc[i]
         if o is None:   # one crank angle: every extreme at it
             one, _ = fourbar_kernel.fourbar_exact(np.radians([lo]), 12.0, 5.0, 15.0, 9.0, 5.0)
-            assert row["omega3_peak_rad_s"] == pytest.approx(one[0, 8], rel=1e-12)
-            assert row["rocker_swing_deg"] == 0.0 and row["omega3_peak_at_deg"] == lo
+            assert row["rocker_omega_peak_rad_s"] == pytest.approx(one[0, 8], rel=1e-12)
+            assert row["rocker_swing_deg"] == 0.0 and row["rocker_omega_peak_at_deg"] == lo
             continue
-        assert lo <= row["omega3_peak_at_deg"] <= hi and lo <= row["rocker_min_at_deg"] <= hi
+        assert lo <= row["rocker_omega_peak_at_deg"] <= hi and lo <= row["rocker_min_at_deg"] <= hi
         for name in ("mu_min_deg", "mu_max_deg", "rocker_swing_deg"):
             assert row[name] == pytest.approx(o[name], abs=1e-4), (lo, hi, name)
-        for name in ("omega3_peak_rad_s", "omega2_peak_rad_s"):
+        for name in ("rocker_omega_peak_rad_s", "coupler_omega_peak_rad_s"):
             assert row[name] == pytest.approx(o[name], rel=1e-6), (lo, hi, name)
 
 
 def test_not_assemblable_and_toggles():
     f = summarise_batch(params(fixed_link=1.0, crank=10.0, coupler=1.0, rocker=1.0), detail=True).iloc[0]
     assert not f["assemblable"] and f["assembled_fraction"] == 0.0
-    assert all(math.isnan(f[k]) for k in ("mu_min_deg", "rocker_swing_deg", "omega3_peak_rad_s"))
+    assert all(math.isnan(f[k]) for k in ("mu_min_deg", "rocker_swing_deg", "rocker_omega_peak_rad_s"))
     # a triple-rocker: two toggles, peaks unbounded (missing), fraction between the limits
     f = summarise_batch(params(fixed_link=10.0, crank=6.0, coupler=7.0, rocker=8.0), detail=True).iloc[0]
     a = limit_angles(10.0, 6.0, 7.0, 8.0)
     assert f["toggle_in_range"] and f["toggles_in_range"] == len(a) == 2
     assert f["assembled_fraction"] == pytest.approx(1 - (a[1] - a[0]) / 360.0, abs=1e-12)
-    assert math.isnan(f["omega2_peak_rad_s"])
+    assert math.isnan(f["coupler_omega_peak_rad_s"])
     # the rocker's travel runs to the toggle positions (the old sampled summary missed this)
     assert f["rocker_swing_deg"] == pytest.approx(oracle(10.0, 6.0, 7.0, 8.0)["rocker_swing_deg"], abs=1e-4)
     assert f["rocker_swing_deg"] > 100.0
@@ -222,4 +222,4 @@ def test_a_run_calls_the_summary_kernel_once_and_reports_its_row(monkeypatch):
     s = res.summary
     assert f"min {s['mu_min_deg']:.2f} deg" in res.text and f"max {s['mu_max_deg']:.2f} deg" in res.text
     assert f"swing {s['rocker_swing_deg']:.3f} deg" in res.text
-    assert f"peak rocker speed .... {s['omega3_peak_rad_s']:.4f} rad/s" in res.text
+    assert f"peak rocker speed .... {s['rocker_omega_peak_rad_s']:.4f} rad/s" in res.text

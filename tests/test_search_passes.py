@@ -84,7 +84,7 @@ def test_summary_columns_narrow_the_tables_with_the_same_values(tmp_path, spy, r
     # nobody asked for a peak speed: only the base deck's one summary (naming the columns) has them
     assert spy[0] == (1, 7) and all(not bits & P["peaks"] for _, bits in spy[1:])
     text = (part / "b.out").read_text()
-    assert "mu_min_deg" in text and "omega3_peak" not in text
+    assert "mu_min_deg" in text and "rocker_omega_peak" not in text
 
 
 def test_summary_columns_refuses_an_unknown_column(tmp_path, capsys):

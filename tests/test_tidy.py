@@ -47,10 +47,10 @@ def test_every_tidy_column_has_a_unit(results, tmp_path):
         write_tidy(r.tidy, tmp_path / name, "parquet")
         assert pd.read_parquet(tmp_path / f"{name}.parquet").attrs["units"] == units   # kept in the file
     fb = results["crank5"].tidy.attrs["units"]
-    assert (fb["xa"], fb["yb"], fb["theta_deg"], fb["omega3_rad_s"], fb["ab_error"]) == \
+    assert (fb["xa"], fb["yb"], fb["theta_deg"], fb["rocker_omega_rad_s"], fb["ab_error"]) == \
         ("length", "length", "deg", "rad/s", "length")
     assert results["crank5_coupler_point"].tidy.attrs["units"]["vxp_per_s"] == "length/s"
-    assert unit_of("alpha3_rad_s2") == "rad/s^2" and unit_of("tau1_Nm") == "N m" and unit_of("xa", float) is None
+    assert unit_of("rocker_alpha_rad_s2") == "rad/s^2" and unit_of("tau1_Nm") == "N m" and unit_of("xa", float) is None
 
 
 def test_csv_and_parquet_read_back_with_the_same_dtypes(results, tmp_path):

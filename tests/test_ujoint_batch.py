@@ -118,19 +118,23 @@ def test_three_d_chain_from_axes():
 
 
 def test_closed_forms():
-    """A single joint: R runs from cos(beta) to 1/cos(beta) (grid through 0 and 90 deg), peak
-    acceleration omega^2 sin^2(beta) cos(beta)... checked against the grid maximum of the
-    closed-form derivative; two equal joints with yokes in phase cancel exactly (exact chain)."""
+    """A single joint: R runs from cos(beta) to 1/cos(beta) (grid through 0 and 90 deg), the peak
+    acceleration at the root of d2R/dtheta2 = 0 in closed form (not the grid's maximum, which lies
+    below it); two equal joints with yokes in phase cancel exactly (exact chain)."""
     beta = np.array([5.0, 15.0, 30.0, 45.0])
     f = ujoint.summarise_batch(base(beta=[0.0], rpm=60.0, n_grid=360), {"beta": beta})
     c = np.cos(np.radians(beta))
     np.testing.assert_allclose(f["omega_out_min_rpm"], 60.0 * c, rtol=1e-14)
     np.testing.assert_allclose(f["omega_out_max_rpm"], 60.0 / c, rtol=1e-14)
     np.testing.assert_allclose(f["pp_ratio"], 1 / c - c, rtol=1e-13)
-    th = np.radians(np.arange(360.0))
-    s2 = np.sin(np.radians(beta))[:, None] ** 2
-    dr = c[:, None] * s2 * np.sin(2 * th) / (1 - s2 * np.sin(th) ** 2) ** 2   # d/dtheta of cos b/(1 - s2 sin^2)
-    np.testing.assert_allclose(f["peak_accel_rad_s2"], (2 * math.pi) ** 2 * np.abs(dr).max(axis=1), rtol=1e-12)
+    # R' = c s2 sin 2t / d^2 (d = 1 - s2 sin^2 t) peaks where cos 2t (1 - s2 sin^2 t) + s2 sin^2 2t = 0,
+    # a quadratic in x = cos 2t: x^2 - (2/s2 - 1) x - 2 = 0
+    s2 = np.sin(np.radians(beta)) ** 2
+    q = 2 / s2 - 1
+    x = (q - np.sqrt(q * q + 8)) / 2
+    peak = c * s2 * np.sqrt(1 - x * x) / (1 - s2 * (1 - x) / 2) ** 2
+    np.testing.assert_allclose(f["peak_accel_rad_s2"], (2 * math.pi) ** 2 * peak, rtol=1e-12)
+    np.testing.assert_allclose(f["peak_accel_at_deg"], np.degrees(np.arccos(x)) / 2, atol=1e-9)
     np.testing.assert_allclose(f["beta_e_deg"], beta, rtol=1e-14)   # one joint: beta_e = beta_res = beta
     np.testing.assert_allclose(f["beta_res_deg"], beta, rtol=1e-12)
     # two equal joints, yokes in phase on the intermediate shaft (phi = 90): constant velocity

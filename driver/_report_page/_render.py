@@ -22,7 +22,8 @@ TEMPLATES = Path(__file__).with_name("templates")
 #: the longest line of text the page shows whole: a longer one (a deck's 75 kB title echoed in
 #: the deck and the .out) is cut in the middle, saying how many characters were left out.  The
 #: names the page prints (a run's, a design's, a deck's title) are bounded where they are
-#: composed, to :data:`driver._names.NAME_CHARS`; this bound holds for every other text.
+#: composed, to :data:`driver._names.NAME_CHARS`; this bound holds for every text a block
+#: shows (the templates' ``bounded`` filter; not the drawing's coordinates).
 LINE_CHARS = 2000
 
 
@@ -38,9 +39,11 @@ def bounded(value: object) -> object:
 @functools.cache
 def environment() -> jinja2.Environment:
     """The templates' environment: every value escaped unless it is Markup (the figures' SVG),
-    an undefined name an error, not an empty string, every line of text bounded (:func:`bounded`)."""
-    return jinja2.Environment(loader=jinja2.FileSystemLoader(TEMPLATES), autoescape=True,
-                              undefined=jinja2.StrictUndefined, keep_trailing_newline=True, finalize=bounded)
+    an undefined name an error, not an empty string; the filter ``bounded`` (:func:`bounded`)."""
+    env = jinja2.Environment(loader=jinja2.FileSystemLoader(TEMPLATES), autoescape=True,
+                             undefined=jinja2.StrictUndefined, keep_trailing_newline=True)
+    env.filters["bounded"] = bounded
+    return env
 
 
 def render_page(page: Page) -> str:

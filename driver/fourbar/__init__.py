@@ -47,12 +47,14 @@ from driver.fourbar._batch import (
     BATCH_INDEPENDENT,
     BATCH_KEYS,
     BATCH_PASSES,
+    batch_applies,
+    batch_refusal,
     summarise,
     summarise_batch,
 )
 from driver.fourbar._published import LISTING_DEFECT, LISTING_PRECISION, exact_as_listed
 from driver.fourbar._report import animation_frames
-from driver.fourbar._spec import LABELS, SPEC, SUMMARY_SETTINGS, SWEEP_BEST, SWEEP_PLOT, estimate
+from driver.fourbar._spec import LABELS, RENAMED, SPEC, SUMMARY_SETTINGS, SWEEP_BEST, SWEEP_PLOT, estimate
 
 if TYPE_CHECKING:   # run's keys as typed keywords: generated from SPEC (tools/gen_keyword_signatures.py)
     from driver.fourbar._keywords import run
@@ -68,7 +70,9 @@ __all__ = ["SPEC", "STUDY", "run", "estimate", "summarise", "summarise_batch", "
 STUDY = Study(name="fourbar", package=__name__, spec=SPEC, run=run, estimate=estimate, summarise=summarise,
               batch=BatchSummary(summarise_batch, keys=BATCH_KEYS, ignored=BATCH_IGNORED,
                                  independent=BATCH_INDEPENDENT, passes=BATCH_PASSES,
-                                 pass_names=(*PASS_BITS, "forces")),
+                                 pass_names=(*PASS_BITS, "forces"), refusal=batch_refusal,
+                                 applies=batch_applies),
               labels=LABELS, sweep_plot=SWEEP_PLOT, sweep_best=SWEEP_BEST, summary_settings=SUMMARY_SETTINGS,
+              renamed=RENAMED,
               blame=blame, published=published.compare, animation=animation_frames, figures=f"{__name__}._figures",
               kernel=kernel)

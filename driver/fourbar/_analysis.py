@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -16,38 +16,84 @@ from driver._study import batch_error
 from driver.fourbar import _kernel as kernel
 from driver.fourbar._kernel import Point, State, Summary, SummaryParam
 
-__all__ = ['ST', 'Grashof', 'grashof', 'limit_angles', 'assembly_intervals', 'Motion', 'rocking_motions',
-           'crank_angles', 'exact_grid', 'coupler_point', 'listing_grid', 'deg360', 'Extremes', 'toggles_in_range',
-           'extremes', 'TIDY_UNITS', 'tidy_frame', 'exact_columns', 'blame', 'SUMMARY_KEYS', 'PASS_BITS', 'param_matrix',
-           'summary_rows']
+__all__ = ['ST', 'CLASSES', 'LinkageClass', 'Grashof', 'grashof', 'limit_angles', 'assembly_intervals', 'Motion',
+           'rocking_motions', 'crank_angles', 'exact_grid', 'coupler_point', 'listing_grid', 'deg360', 'Extremes',
+           'toggles_in_range', 'extremes', 'TIDY_UNITS', 'tidy_frame', 'exact_columns', 'blame', 'SUMMARY_KEYS',
+           'PASS_BITS', 'param_matrix', 'summary_rows']
 
 
 ST = kernel.FOURBAR_STATUS
 
 
+class LinkageClass(NamedTuple):
+    """One class of :func:`grashof`: its name, whether the crank turns fully, whether the chain moves."""
+
+    name: str
+    full_crank_rotation: bool
+    movable: bool = True
+
+
+#: the classes by the summary kernel's code name (fortran/fourbar_summary.f90 gr_*): Grashof's four by
+#: the shortest link, the non-Grashof triple-rocker, the change-point ones (S + L = P + Q) by the
+#: shortest link the same way, and the two chains that cannot move
+CLASSES: dict[str, LinkageClass] = {
+    "double_crank": LinkageClass("double-crank (drag link)", True),
+    "crank_rocker": LinkageClass("crank-rocker", True),
+    "rocker_crank": LinkageClass("rocker-crank", False),
+    "double_rocker": LinkageClass("Grashof double-rocker", False),
+    "triple_rocker": LinkageClass("non-Grashof triple-rocker", False),
+    "cp_double_crank": LinkageClass("change-point double-crank (special Grashof)", True),
+    "cp_crank_rocker": LinkageClass("change-point crank-rocker (special Grashof)", True),
+    "cp_rocker_crank": LinkageClass("change-point rocker-crank (special Grashof)", False),
+    "cp_double_rocker": LinkageClass("change-point double-rocker (special Grashof)", False),
+    "no_chain": LinkageClass("impossible chain", False, False),
+    "flat_chain": LinkageClass("flat chain", False, False),
+}
+
+
 @dataclass
 class Grashof:
-    """Grashof classification of a four-bar (Norton's classes).
+    """Class of a four-bar from its link lengths: Grashof's, or a chain that cannot move.
+
+    Grashof's classes are Norton's; a change-point linkage is named the same way by which of
+    crank and rocker turn fully.
 
     Attributes
     ----------
     name : str
         The class: ``'crank-rocker'``, ``'double-crank (drag link)'``, ``'rocker-crank'``,
-        ``'Grashof double-rocker'``, ``'change-point (special Grashof)'`` or
-        ``'non-Grashof triple-rocker'``.
+        ``'Grashof double-rocker'``, ``'non-Grashof triple-rocker'``, a change-point class
+        (S + L = P + Q, named by its shortest link the same way: ``'change-point crank-rocker
+        (special Grashof)'``, ...), ``'impossible chain'`` (the longest link is longer than the
+        other three together: no position exists) or ``'flat chain'`` (it equals them: the
+        chain lies flat in one position).
     condition : str
-        The Grashof inequality with the lengths, ``'S + L = ... < P + Q = ...'``.
+        The inequality that decides the class, with the lengths (``'S + L = ... < P + Q = ...'``;
+        ``'L = ... > S + P + Q = ...'`` for a chain that cannot move).
     full_crank_rotation : bool
         The crank turns fully.
+    movable : bool, default True
+        The chain has a motion (False for an impossible or a flat chain).
+    reason : str or None, default None
+        Why a chain that cannot move has no motion, in words naming the longest link; None when
+        it moves.
     """
 
     name: str
     condition: str
     full_crank_rotation: bool
+    movable: bool = True
+    reason: str | None = None
 
 
 def grashof(p: float, q: float, r: float, s: float) -> Grashof:
     """Classify a four-bar by Grashof's condition from its link lengths.
+
+    The same rule and tolerance as the summary kernel (fortran/fourbar_summary.f90
+    ``grashof_code``): first whether the chain closes at all (the longest link no longer than the
+    other three together), then S + L against P + Q (S shortest, L longest), the class named by
+    the shortest link; a change-point linkage (S + L = P + Q) by which of crank and rocker turn
+    fully, a link among the shortest (ties counted) being one that does.
 
     Parameters
     ----------
@@ -57,30 +103,51 @@ def grashof(p: float, q: float, r: float, s: float) -> Grashof:
     Returns
     -------
     Grashof
-        The class, the condition with the lengths, and whether the crank turns fully.
+        The class, the condition with the lengths, whether the crank turns fully and whether
+        the chain moves at all.
 
     Examples
     --------
     >>> from driver.fourbar import grashof
     >>> grashof(12, 5, 15, 9).name
     'crank-rocker'
+    >>> g = grashof(12, 5, 150, 9)
+    >>> g.name, g.full_crank_rotation, g.movable
+    ('impossible chain', False, False)
     """
     links = {"ground": p, "crank": q, "coupler": r, "rocker": s}
     srt = sorted(links.values())
     short, long_ = srt[0], srt[-1]
     lhs, rhs = short + long_, srt[1] + srt[2]
+    rest = srt[0] + srt[1] + srt[2]
+    longest = max(links, key=lambda k: (links[k], -["ground", "crank", "coupler", "rocker"].index(k)))
+    others = " + ".join(f"{v:g}" for k, v in links.items() if k != longest)
+    word = {"ground": "fixed link"}.get(longest, longest)
+    if long_ > rest + 1e-12 * rest:
+        return Grashof(CLASSES["no_chain"].name, f"L = {long_:g} > S + P + Q = {rest:g}", False, False,
+                       f"the longest link, the {word} ({long_:g}), is longer than the other three together "
+                       f"({others} = {rest:g}): no position exists, at any crank angle")
+    if long_ >= rest - 1e-12 * rest:
+        return Grashof(CLASSES["flat_chain"].name, f"L = {long_:g} = S + P + Q = {rest:g}", False, False,
+                       f"the longest link, the {word} ({long_:g}), is as long as the other three together "
+                       f"({others} = {rest:g}): the chain closes only lying flat, in one position, and cannot move")
     tol = 1e-12 * rhs
     rel = "<" if lhs < rhs - tol else ("=" if abs(lhs - rhs) <= tol else ">")
     cond = f"S + L = {short:g} + {long_:g} = {lhs:g} {rel} P + Q = {rhs:g}"
     if lhs > rhs + tol:
-        return Grashof("non-Grashof triple-rocker", cond, False)
+        return Grashof(CLASSES["triple_rocker"].name, cond, False)
     if abs(lhs - rhs) <= tol:
-        return Grashof("change-point (special Grashof)", cond, True)
+        # change point: a link among the shortest (ties counted: a parallelogram's crank and rocker)
+        # turns fully, so the crank turns when the ground or the crank is one, the rocker when the
+        # ground or the rocker is
+        tied = {k for k, v in links.items() if v <= short + 1e-12 * short}
+        crank, rocker = bool(tied & {"ground", "crank"}), bool(tied & {"ground", "rocker"})
+        code = "cp_" + {(True, True): "double_crank", (True, False): "crank_rocker", (False, True): "rocker_crank",
+                        (False, False): "double_rocker"}[(crank, rocker)]
+        return Grashof(CLASSES[code].name, cond, CLASSES[code].full_crank_rotation)
     shortest = min(links, key=lambda k: (links[k], ["ground", "crank", "rocker", "coupler"].index(k)))
-    names = {"ground": ("double-crank (drag link)", True), "crank": ("crank-rocker", True),
-             "rocker": ("rocker-crank", False), "coupler": ("Grashof double-rocker", False)}
-    name, full = names[shortest]
-    return Grashof(name, cond, full)
+    code = {"ground": "double_crank", "crank": "crank_rocker", "rocker": "rocker_crank", "coupler": "double_rocker"}[shortest]
+    return Grashof(CLASSES[code].name, cond, CLASSES[code].full_crank_rotation)
 
 
 def limit_angles(p: float, q: float, r: float, s: float) -> list[float]:
@@ -371,9 +438,9 @@ class Extremes:
         Extreme rocker angles, deg.
     rocker_min_at, rocker_max_at : float
         Crank angles where they occur, deg.
-    w3_peak, w2_peak : float
+    rocker_omega_peak, coupler_omega_peak : float
         Peak rocker and coupler angular velocity (signed), rad/s.
-    w3_peak_at, w2_peak_at : float
+    rocker_omega_peak_at, coupler_omega_peak_at : float
         Crank angles where they occur, deg.
     assembled_fraction : float
         Fraction of the range where the linkage assembles, dimensionless.
@@ -393,10 +460,10 @@ class Extremes:
     rocker_min_at: float
     rocker_max: float
     rocker_max_at: float
-    w3_peak: float
-    w3_peak_at: float
-    w2_peak: float
-    w2_peak_at: float
+    rocker_omega_peak: float
+    rocker_omega_peak_at: float
+    coupler_omega_peak: float
+    coupler_omega_peak_at: float
     assembled_fraction: float
     rocker_turns: bool = False
     toggles: tuple[float, ...] = ()
@@ -442,8 +509,8 @@ def extremes(p: Params, row: np.ndarray | None = None) -> Extremes | None:
     c = Summary
     return Extremes(row[c.MU_MIN_DEG], row[c.MU_MIN_AT_DEG], row[c.MU_MAX_DEG], row[c.MU_MAX_AT_DEG],
                     row[c.ROCKER_MIN_DEG], row[c.ROCKER_MIN_AT_DEG], row[c.ROCKER_MAX_DEG], row[c.ROCKER_MAX_AT_DEG],
-                    row[c.OMEGA3_PEAK_RAD_S], row[c.OMEGA3_PEAK_AT_DEG], row[c.OMEGA2_PEAK_RAD_S],
-                    row[c.OMEGA2_PEAK_AT_DEG], row[c.ASSEMBLED_FRACTION], bool(row[c.ROCKER_TURNS]), toggles,
+                    row[c.ROCKER_OMEGA_PEAK_RAD_S], row[c.ROCKER_OMEGA_PEAK_AT_DEG], row[c.COUPLER_OMEGA_PEAK_RAD_S],
+                    row[c.COUPLER_OMEGA_PEAK_AT_DEG], row[c.ASSEMBLED_FRACTION], bool(row[c.ROCKER_TURNS]), toggles,
                     row[c.ROCKER_SWING_DEG])
 
 
@@ -453,7 +520,7 @@ TIDY_UNITS = {"xa": "length", "ya": "length", "xb": "length", "yb": "length", "x
 
 
 def tidy_frame(method: str, theta: np.ndarray, cols: dict[str, np.ndarray], status: np.ndarray,
-               not_closed: np.ndarray | None = None) -> pd.DataFrame:
+               not_closed: np.ndarray | None = None, chain: str | None = None) -> pd.DataFrame:
     """Build the tidy table of a run: one row per crank angle.
 
     Parameters
@@ -468,6 +535,9 @@ def tidy_frame(method: str, theta: np.ndarray, cols: dict[str, np.ndarray], stat
         Kernel status per row (0 ok, 1 cannot assemble, 2 toggle, 3 indeterminate).
     not_closed : numpy.ndarray, optional
         True for a listing row whose |AB| is not the coupler length (``loop_not_closed``).
+    chain : str, optional
+        The status word of the rows without a position of a chain that cannot move
+        (``'impossible_chain'``, ``'flat_chain'``) instead of ``'cannot_assemble'``.
 
     Returns
     -------
@@ -475,7 +545,7 @@ def tidy_frame(method: str, theta: np.ndarray, cols: dict[str, np.ndarray], stat
         The table, status in words; unassemblable cells left empty (NaN); units in
         ``attrs["units"]``.
     """
-    words = np.array(["ok", "cannot_assemble", "toggle", "indeterminate", "loop_not_closed"])[
+    words = np.array(["ok", chain or "cannot_assemble", "toggle", "indeterminate", "loop_not_closed"])[
         np.where(not_closed, 4, status) if not_closed is not None else status]
     frame = pd.DataFrame({"method": method, "theta_deg": theta, **cols, "status": words})
     return with_units(frame, TIDY_UNITS)
@@ -486,8 +556,9 @@ def exact_columns(out: np.ndarray, status: np.ndarray, cp: np.ndarray | None = N
     s = State
     vals = {"coupler_deg": deg360(out[:, s.COUPLER_ANGLE]), "rocker_deg": deg360(out[:, s.ROCKER_ANGLE]),
             "transmission_deg": np.degrees(out[:, s.TRANSMISSION_ANGLE]), "xa": out[:, s.XA], "ya": out[:, s.YA],
-            "xb": out[:, s.XB], "yb": out[:, s.YB], "omega2_rad_s": out[:, s.OMEGA2], "omega3_rad_s": out[:, s.OMEGA3],
-            "alpha2_rad_s2": out[:, s.ALPHA2], "alpha3_rad_s2": out[:, s.ALPHA3]}
+            "xb": out[:, s.XB], "yb": out[:, s.YB], "coupler_omega_rad_s": out[:, s.COUPLER_OMEGA],
+            "rocker_omega_rad_s": out[:, s.ROCKER_OMEGA], "coupler_alpha_rad_s2": out[:, s.COUPLER_ALPHA],
+            "rocker_alpha_rad_s2": out[:, s.ROCKER_ALPHA]}
     if coupler is not None:   # loop closure of the solution: |AB| - coupler (round-off only)
         vals["ab_error"] = np.hypot(out[:, s.XB] - out[:, s.XA], out[:, s.YB] - out[:, s.YA]) - coupler
     if cp is not None:

@@ -8,6 +8,7 @@ unknowns and balances the linkage.
 """
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -17,10 +18,10 @@ import numpy as np
 from driver._deck import Params
 from driver.fourbar import _kernel as kernel
 from driver.fourbar._kernel import Counterweight
-from driver.fourbar._spec import force_value, moving_lengths
+from driver.fourbar._spec import LINKS, force_value, moving_lengths, sections_of
 
-__all__ = ["props", "cw_radii", "Counterweights", "counterweights", "COLUMNS", "ForceAnalysis", "forces_at",
-           "analyse", "tidy_columns"]
+__all__ = ["props", "cw_radii", "Counterweights", "counterweights", "COLUMNS", "STRESS_COLUMNS", "ForceAnalysis",
+           "forces_at", "stresses_at", "scan_angles", "analyse", "tidy_columns"]
 
 ST_OK = kernel.FOURBAR_STATUS["ok"]
 
@@ -101,18 +102,48 @@ class ForceAnalysis:
         carries the counterweights).
     cw : Counterweights or None
         The Berkof-Lowen counterweights, with ``balance = 'force'``.
+    stresses : numpy.ndarray or None
+        With ``section_area`` and ``section_modulus``: (n, 3) peak normal stress in crank,
+        coupler and rocker [Pa] (of the analysed linkage), zero where not defined.
     """
 
     forces: np.ndarray
     ok: np.ndarray
     unbalanced: np.ndarray | None = None
     cw: Counterweights | None = None
+    stresses: np.ndarray | None = None
+
+
+#: tidy column names of the link stresses (decks with sections)
+STRESS_COLUMNS = tuple(f"{link}_stress_MPa" for link in LINKS)
 
 
 def forces_at(p: Mapping[str, Any], out: np.ndarray, status: np.ndarray, pr: np.ndarray) -> np.ndarray:
     """Kernel forces for states ``out``/``status`` (from the deck's exact grid) and props ``pr``."""
     return kernel.fourbar_joint_forces(out, status, p["fixed_link"], p["crank"], p["coupler"], p["rocker"],
                                         p["omega"], p["alpha"], pr)
+
+
+def stresses_at(p: Mapping[str, Any], out: np.ndarray, status: np.ndarray, pr: np.ndarray,
+                forces: np.ndarray) -> np.ndarray | None:
+    """Peak normal stress in each link [Pa] (kernel link_stresses) for states ``out``/``status``,
+    props ``pr`` and their joint ``forces``; None when the deck gives no sections."""
+    section = sections_of(p)
+    if section is None:
+        return None
+    return kernel.fourbar_link_stresses(out, status, p["fixed_link"], p["crank"], p["coupler"], p["rocker"],
+                                        p["alpha"], pr, forces, np.array(section))
+
+
+def scan_angles(p: Mapping[str, Any]) -> np.ndarray:
+    """The crank angles [deg] of the force summary's scan of the deck's range: at most 0.1 deg
+    apart, at most 36001 (fortran/fourbar_forces.f90 force_summaries)."""
+    lo, hi = float(p["start_deg"]), float(p["stop_deg"])
+    span = abs(hi - lo)
+    if span == 0.0:
+        return np.array([lo])
+    n = min(36001, max(2, math.ceil(span / 0.1 - 1e-9) + 1))
+    return lo + (hi - lo) / (n - 1) * np.arange(n)
 
 
 def analyse(p: Params, out: np.ndarray, status: np.ndarray) -> ForceAnalysis:
@@ -130,11 +161,13 @@ def analyse(p: Params, out: np.ndarray, status: np.ndarray) -> ForceAnalysis:
     ForceAnalysis
         Forces in N, torques and moments in N m, per crank angle.
     """
-    given = forces_at(p, out, status, props(p))
+    pr = props(p)
+    given = forces_at(p, out, status, pr)
     if force_value(p, "balance") != "force":
-        return ForceAnalysis(given, status == ST_OK)
+        return ForceAnalysis(given, status == ST_OK, stresses=stresses_at(p, out, status, pr, given))
     cw = counterweights(p)
-    return ForceAnalysis(forces_at(p, out, status, cw.props), status == ST_OK, given, cw)
+    balanced = forces_at(p, out, status, cw.props)
+    return ForceAnalysis(balanced, status == ST_OK, given, cw, stresses_at(p, out, status, cw.props, balanced))
 
 
 def tidy_columns(fa: ForceAnalysis) -> dict[str, np.ndarray]:
@@ -148,11 +181,14 @@ def tidy_columns(fa: ForceAnalysis) -> dict[str, np.ndarray]:
     Returns
     -------
     dict of str to numpy.ndarray
-        Tidy column (units in the name: ``input_torque_Nm``, ``F_O2_x_N``) -> values, NaN
-        where the forces are not defined (no assembly or toggle); with balancing, the
-        linkage as given follows in columns prefixed ``unbalanced_``.
+        Tidy column (units in the name: ``input_torque_Nm``, ``F_O2_x_N``; with sections the
+        link stresses ``crank_stress_MPa`` ...) -> values, NaN where the forces are not defined
+        (no assembly or toggle); with balancing, the linkage as given follows in columns
+        prefixed ``unbalanced_``.
     """
     cols = {c: np.where(fa.ok, fa.forces[:, j], np.nan) for j, c in enumerate(COLUMNS)}
+    if fa.stresses is not None:
+        cols |= {c: np.where(fa.ok, fa.stresses[:, j] / 1e6, np.nan) for j, c in enumerate(STRESS_COLUMNS)}
     if fa.unbalanced is not None:
         cols |= {"unbalanced_" + c: np.where(fa.ok, fa.unbalanced[:, j], np.nan) for j, c in enumerate(COLUMNS)}
     return cols

@@ -14,14 +14,25 @@ import pandas as pd
 from driver._deck import Params
 from driver._study import batch_error, contract_doc
 from driver.fourbar import _kernel as kernel
-from driver.fourbar._analysis import PASS_BITS, SUMMARY_KEYS, param_matrix, summary_rows
-from driver.fourbar._analysis_forces import cw_radii, props
+from driver.fourbar._analysis import CLASSES, PASS_BITS, SUMMARY_KEYS, param_matrix, summary_rows
+from driver.fourbar._analysis_forces import counterweights, cw_radii, forces_at, props, scan_angles, stresses_at
 from driver.fourbar._kernel import ForceParam
-from driver.fourbar._spec import BAND, FORCE_SUMMARY_DOC, band_of, force_value, forces_active
+from driver.fourbar._spec import (
+    BAND,
+    FORCE_SUMMARY_DOC,
+    LINKS,
+    STRESS_SUMMARY_DOC,
+    band_of,
+    force_value,
+    forces_active,
+    sections_of,
+    yields_of,
+)
 
-__all__ = ['BATCH_KEYS', 'BATCH_IGNORED', 'BATCH_INDEPENDENT', 'BATCH_PASSES', 'DETAIL', 'summarise_batch',
+__all__ = ['BATCH_KEYS', 'BATCH_IGNORED', 'BATCH_INDEPENDENT', 'BATCH_PASSES', 'DETAIL', 'summarise_batch', 'batch_refusal',
            'summary_frame', 'summarise', 'summary_of',
-           'FORCE_BATCH_KEYS', 'force_frame', 'force_summary', 'summarise_force_batch']
+           'FORCE_BATCH_KEYS', 'force_frame', 'force_summary', 'summarise_force_batch', 'batch_applies',
+           'stress_summary']
 
 
 #: deck keys a batch may vary (one value per design: the summary kernel's parameters); every
@@ -47,13 +58,15 @@ BATCH_PASSES: dict[str, tuple[str, ...]] = {
     "grashof_class": (), "full_crank_rotation": (), "assemblable": (),
     "mu_min_deg": ("transmission",), "mu_max_deg": ("transmission",), "meets_transmission_band": ("transmission",),
     "rocker_turns_fully": ("rocker",), "rocker_swing_deg": ("rocker",), "toggle_in_range": (),
-    "omega3_peak_rad_s": ("peaks",), "omega2_peak_rad_s": ("peaks",), "assembled_fraction": (),
+    "rocker_omega_peak_rad_s": ("peaks",), "coupler_omega_peak_rad_s": ("peaks",), "assembled_fraction": (),
     "time_ratio": ("rocker",),
     "mu_min_at_deg": ("transmission",), "mu_max_at_deg": ("transmission",), "rocker_min_deg": ("rocker",),
     "rocker_min_at_deg": ("rocker",), "rocker_max_deg": ("rocker",), "rocker_max_at_deg": ("rocker",),
-    "omega3_peak_at_deg": ("peaks",), "omega2_peak_at_deg": ("peaks",), "toggles_in_range": (),
+    "rocker_omega_peak_at_deg": ("peaks",), "coupler_omega_peak_at_deg": ("peaks",), "toggles_in_range": (),
     # decks that give masses: the force summary (summarise_force_batch), a pass of its own
     **{f"{pre}{c}": ("forces",) for pre in ("", "unbalanced_") for c in FORCE_SUMMARY_DOC},
+    # decks that give link sections too: the link stresses (stress_summary, design by design)
+    **{c: ("forces",) for c in STRESS_SUMMARY_DOC},
 }
 
 
@@ -64,11 +77,8 @@ def _pass_mask(wanted: Collection[str] | None) -> int:
     return sum({PASS_BITS[p] for c in wanted for p in BATCH_PASSES.get(c, ()) if p in PASS_BITS})
 
 
-#: kernel Grashof codes -> (class name as grashof() prints it, full crank rotation)
-GRASHOF_NAMES = {"double_crank": ("double-crank (drag link)", True), "crank_rocker": ("crank-rocker", True),
-                 "rocker_crank": ("rocker-crank", False), "double_rocker": ("Grashof double-rocker", False),
-                 "change_point": ("change-point (special Grashof)", True),
-                 "triple_rocker": ("non-Grashof triple-rocker", False)}
+#: kernel class codes -> (class name as grashof() prints it, full crank rotation)
+GRASHOF_NAMES = {k: (CLASSES[k].name, CLASSES[k].full_crank_rotation) for k in CLASSES}
 
 
 @contract_doc
@@ -84,7 +94,7 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     (missing figures as NaN): grashof_class, full_crank_rotation, assemblable, mu_min_deg,
     mu_max_deg, meets_transmission_band (mu within the base deck's ``transmission_band_deg``),
     rocker_turns_fully, rocker_swing_deg, toggle_in_range,
-    omega3_peak_rad_s, omega2_peak_rad_s, assembled_fraction, time_ratio (crank angle of the
+    rocker_omega_peak_rad_s, coupler_omega_peak_rad_s, assembled_fraction, time_ratio (crank angle of the
     rocker's slower stroke over its quicker one, >= 1; missing unless the range holds a full
     turn, assembled throughout, without a toggle, with the rocker oscillating); with ``detail`` also the crank
     angles [deg] of those extremes, the rocker extreme positions [deg] and the number of
@@ -136,15 +146,68 @@ def _assemble(base: Mapping[str, Any], res: np.ndarray, detail: bool, wanted: Co
     if forces_active(base) and (wanted is None or any(BATCH_PASSES.get(c) == ("forces",) for c in wanted)):
         # force columns when the deck gives masses, and someone reads one
         more = summarise_force_batch(base, force_columns)
+        if sections_of(base) is not None:   # the link stresses, design by design
+            n = len(res)
+            designs = [{**dict(base), **{k: (v[i] if np.ndim(v) > 0 else v) for k, v in force_columns.items()}}
+                       for i in range(n)]
+            more = pd.concat([more, pd.DataFrame([stress_summary(d) for d in designs])], axis=1)
         if wanted is not None:
             more = more[[c for c in more.columns if c in set(wanted)]]
         frame = pd.concat([frame, more], axis=1)
     return frame
 
 
+def batch_applies(base: Mapping[str, Any]) -> bool:
+    """Tell whether designs on ``base`` take the batch path: not with link sections (their
+    stresses are summarised design by design, case by case in a sweep)."""
+    return sections_of(base) is None
+
+
+def stress_summary(p: Mapping[str, Any]) -> dict[str, Any]:
+    """The link stresses of one deck with sections over the force summary's scan of its range:
+    the peak normal stress in each link [MPa] and its crank angle [deg], and with
+    ``yield_strength`` the largest ratio of a peak to its link's yield strength and whether a
+    link yields (:data:`STRESS_SUMMARY_DOC`; None where no position is defined).
+
+    Parameters
+    ----------
+    p : mapping
+        ``&fourbar`` keys with ``mass``, ``section_area`` and ``section_modulus`` (SI).
+
+    Returns
+    -------
+    dict of str to float, bool or None
+        The columns of ``STRESS_SUMMARY_DOC``.
+    """
+    theta = scan_angles(p)
+    out, status = kernel.fourbar_exact(np.radians(theta), p["fixed_link"], p["crank"], p["coupler"], p["rocker"],
+                                       p["omega"], p.get("alpha", 0.0), 1 if p.get("branch", "open") == "open" else -1)
+    pr = counterweights(p).props if force_value(p, "balance") == "force" else props(p)
+    stress = stresses_at(p, out, status, pr, forces_at(p, out, status, pr))
+    ok = status == kernel.FOURBAR_STATUS["ok"]
+    row: dict[str, Any] = {}
+    peaks: list[float | None] = []
+    for j, link in enumerate(LINKS):
+        if stress is None or not ok.any():
+            row[f"{link}_stress_peak_MPa"], row[f"{link}_stress_peak_at_deg"] = None, None
+            peaks.append(None)
+            continue
+        k = int(np.argmax(np.where(ok, stress[:, j], -1.0)))
+        row[f"{link}_stress_peak_MPa"], row[f"{link}_stress_peak_at_deg"] = float(stress[k, j] / 1e6), float(theta[k])
+        peaks.append(float(stress[k, j]))
+    ys = yields_of(p)
+    if ys is None or any(v is None for v in peaks):
+        row["yield_ratio_max"], row["yields"] = None, None
+    else:
+        ratio = max(float(v) / y for v, y in zip(peaks, ys) if v is not None)
+        row["yield_ratio_max"], row["yields"] = ratio, bool(ratio >= 1.0)
+    order = [f"{link}_stress_peak_MPa" for link in LINKS] + [f"{link}_stress_peak_at_deg" for link in LINKS]
+    return {k: row[k] for k in (*order, "yield_ratio_max", "yields")}
+
+
 #: the columns of summarise_batch(detail=True) only
 DETAIL = ("mu_min_at_deg", "mu_max_at_deg", "rocker_min_deg", "rocker_min_at_deg", "rocker_max_deg",
-           "rocker_max_at_deg", "omega3_peak_at_deg", "omega2_peak_at_deg", "toggles_in_range")
+           "rocker_max_at_deg", "rocker_omega_peak_at_deg", "coupler_omega_peak_at_deg", "toggles_in_range")
 
 
 def summary_frame(res: np.ndarray, detail: bool = False, band: tuple[float, float] = BAND,
@@ -153,7 +216,7 @@ def summary_frame(res: np.ndarray, detail: bool = False, band: tuple[float, floa
     with ``wanted``, only those columns are built."""
     c = dict(zip(kernel.FOURBAR_SUMMARY_COLUMNS, res.T))
     ok = c["assemblable"] > 0
-    lut = [GRASHOF_NAMES[kernel.FOURBAR_GRASHOF[k]] for k in range(len(GRASHOF_NAMES))]
+    lut = [GRASHOF_NAMES[kernel.FOURBAR_GRASHOF[k]] for k in range(len(kernel.FOURBAR_GRASHOF))]
     tog = lambda: ok & (c["toggles_in_range"] > 0)
     has = lambda v, m=None: np.where(ok if m is None else m, v, np.nan)
     lo, hi = band
@@ -166,8 +229,8 @@ def summary_frame(res: np.ndarray, detail: bool = False, band: tuple[float, floa
         "rocker_turns_fully": lambda: ok & (c["rocker_turns"] > 0),
         "rocker_swing_deg": lambda: has(c["rocker_swing_deg"]),
         "toggle_in_range": tog,
-        "omega3_peak_rad_s": lambda: has(c["omega3_peak_rad_s"], ok & ~tog()),
-        "omega2_peak_rad_s": lambda: has(c["omega2_peak_rad_s"], ok & ~tog()),
+        "rocker_omega_peak_rad_s": lambda: has(c["rocker_omega_peak_rad_s"], ok & ~tog()),
+        "coupler_omega_peak_rad_s": lambda: has(c["coupler_omega_peak_rad_s"], ok & ~tog()),
         "assembled_fraction": lambda: np.where(ok, c["assembled_fraction"], 0.0),
         "time_ratio": lambda: np.where(ok & (c["time_ratio"] > 0), c["time_ratio"], np.nan)}
     if detail:
@@ -176,11 +239,21 @@ def summary_frame(res: np.ndarray, detail: bool = False, band: tuple[float, floa
                   "rocker_min_at_deg": lambda: has(c["rocker_min_at_deg"]),
                   "rocker_max_deg": lambda: has(c["rocker_max_deg"]),
                   "rocker_max_at_deg": lambda: has(c["rocker_max_at_deg"]),
-                  "omega3_peak_at_deg": lambda: has(c["omega3_peak_at_deg"], ok & ~tog()),
-                  "omega2_peak_at_deg": lambda: has(c["omega2_peak_at_deg"], ok & ~tog()),
+                  "rocker_omega_peak_at_deg": lambda: has(c["rocker_omega_peak_at_deg"], ok & ~tog()),
+                  "coupler_omega_peak_at_deg": lambda: has(c["coupler_omega_peak_at_deg"], ok & ~tog()),
                   "toggles_in_range": lambda: c["toggles_in_range"].astype(int)}
     keys = build if wanted is None else [k for k in build if k in set(wanted)]
     return pd.DataFrame({k: build[k]() for k in keys}, index=pd.RangeIndex(len(res)))
+
+
+def batch_refusal(row: Mapping[str, Any]) -> str | None:
+    """Why the study's own run fails the design of a batch row, or None: a chain that cannot move
+    (an impossible or a flat chain) has no position, so its run fails (exit 1); an &optimize design
+    counts as infeasible with that reason on the batch path as it does case by case."""
+    name = row.get("grashof_class")
+    if name in (CLASSES["no_chain"].name, CLASSES["flat_chain"].name):
+        return f"{name}: the chain cannot move (no position over the crank range)"
+    return None
 
 
 @contract_doc

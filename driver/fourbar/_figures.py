@@ -8,6 +8,7 @@ Drawn in the house style (:mod:`driver.plotting`); this module imports matplotli
 from __future__ import annotations
 
 import math
+import textwrap
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -47,18 +48,19 @@ def _unassembled_spans(theta: np.ndarray, ok: np.ndarray) -> list[tuple[float, f
     return spans
 
 
-#: legend words of the four-bar curves: words first, textbook link numbers (2 crank, 3 coupler,
-#: 4 output link) as symbols; the tidy columns keep the paper's names (omega2 = coupler)
+#: legend words of the four-bar curves: the link's name first (as in every column name:
+#: coupler_omega_rad_s), then its symbol in the one documented numbering (docs/fourbar.md, "Names":
+#: 1 ground, 2 crank, 3 coupler, 4 output link; the pivots O2, O4)
 def _fourbar_names(output: str = "rocker") -> dict[str, str]:
     return {"coupler_deg": r"coupler angle $\theta_3$", "rocker_deg": rf"{output} angle $\theta_4$",
             "transmission_deg": r"transmission angle $\mu$",
-            "omega2_rad_s": r"coupler angular velocity $\omega_3$",
-            "omega3_rad_s": rf"{output} angular velocity $\omega_4$"}
+            "coupler_omega_rad_s": r"coupler angular velocity $\omega_3$",
+            "rocker_omega_rad_s": rf"{output} angular velocity $\omega_4$"}
 
 
 @styled
 def fourbar_curves(exact, listing, title: str, band: Sequence[float] = (40.0, 120.0), output: str = "rocker",
-                   axes=None) -> Figure:
+                   axes=None, chain: str | None = None) -> Figure:
     """Angles, angular velocities and transmission angle against crank angle.
 
     ``exact`` and ``listing`` are tidy frames from driver.fourbar; listing rows are
@@ -66,23 +68,25 @@ def fourbar_curves(exact, listing, title: str, band: Sequence[float] = (40.0, 12
     wrapped into 0-360 deg break at the wrap (no vertical line); crank angles where the
     linkage cannot be assembled are shaded and said so; the transmission-angle ``band``
     [deg] is shaded.  ``output`` names the output link ('rocker', 'output crank').
-    ``axes``: three axes to draw into.
+    ``axes``: three axes to draw into.  ``chain``: the class and reason of a chain that cannot
+    move, written on the panels (which then hold no curve) and in the title.
     """
     names = _fourbar_names(output)
     panels = [("link angle [deg]", ["coupler_deg", "rocker_deg"]),
               ("transmission angle [deg]", ["transmission_deg"]),
-              ("angular velocity [rad/s]", ["omega2_rad_s", "omega3_rad_s"])]
+              ("angular velocity [rad/s]", ["coupler_omega_rad_s", "rocker_omega_rad_s"])]
     if axes is None:
         fig, axes = new_figure(3, 1, sharex=True, figsize=(7.4, 7.6))
     else:
         fig = axes[0].figure
     colors = {"coupler_deg": "C0", "rocker_deg": "C1", "transmission_deg": "C2",
-              "omega2_rad_s": "C0", "omega3_rad_s": "C1"}
+              "coupler_omega_rad_s": "C0", "rocker_omega_rad_s": "C1"}
     theta = exact["theta_deg"].to_numpy(dtype=float)
     spans = _unassembled_spans(theta, np.isfinite(exact["transmission_deg"].to_numpy(dtype=float)))
     for ax, (label, keys) in zip(axes, panels):
         for j, (lo, hi) in enumerate(spans):
-            ax.axvspan(lo, hi, color="0.85", alpha=0.6, lw=0, label="cannot be assembled" if j == 0 else None)
+            ax.axvspan(lo, hi, color="0.85", alpha=0.6, lw=0,
+                       label=("cannot be assembled" if not chain else chain.split(":")[0]) if j == 0 else None)
         for k in keys:
             wrap = k.endswith("_deg")
             ax.plot(*(break_wraps(theta, exact[k]) if wrap else (theta, exact[k])), color=colors[k],
@@ -99,8 +103,51 @@ def fourbar_curves(exact, listing, title: str, band: Sequence[float] = (40.0, 12
     for ax in axes:
         ax.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
     axes[-1].set_xlabel(r"crank angle $\theta_2$ [deg]")
-    if title:
+    if chain:
+        for ax in axes:
+            ax.text(0.5, 0.5, "no position: " + chain.split(":")[0], transform=ax.transAxes, ha="center",
+                    va="center", color="C3")
+        suptitle(fig, (f"{plain_text(title)}: four-bar kinematics" if title else "four-bar kinematics")
+                 + f"\n{plain_text(chain)}", fontsize="small")
+    elif title:
         suptitle(fig, f"{plain_text(title)}: four-bar kinematics")
+    return fig
+
+
+@styled
+def fourbar_chain(lengths: Mapping[str, float], name: str, reason: str, title: str, units: str = "",
+                  ax=None) -> Figure:
+    """A chain that cannot move (an impossible or a flat chain, :func:`driver.fourbar.grashof`):
+    its longest link drawn as one bar and the other three laid end to end beside it, so the gap
+    (or the exact match) is seen; the class and its reason in the title.
+
+    ``lengths``: {'fixed link', 'crank', 'coupler', 'rocker': length} in ``units`` (the deck's
+    length unit, '' when it is free).  ``ax``: the axes to draw into.
+    """
+    if ax is None:
+        fig, (ax,) = new_figure(1, 1, figsize=(8.6, 3.2))
+    else:
+        fig = ax.figure
+    longest = max(lengths, key=lambda k: lengths[k])
+    others = [k for k in lengths if k != longest]
+    ax.plot([0.0, lengths[longest]], [1.0, 1.0], "-o", color="k", lw=3, ms=5,
+            label=f"longest link: {longest} {lengths[longest]:g}")
+    x = 0.0
+    for j, k in enumerate(others):
+        ax.plot([x, x + lengths[k]], [0.0, 0.0], "-o", color=f"C{j}", lw=3, ms=5, label=f"{k} {lengths[k]:g}")
+        x += lengths[k]
+    gap = lengths[longest] - x
+    if gap > 0:
+        ax.annotate("", xy=(lengths[longest], 0.0), xytext=(x, 0.0),
+                    arrowprops={"arrowstyle": "<->", "color": "C3", "lw": 1.2})
+        ax.text(0.5 * (x + lengths[longest]), 0.12, f"short by {gap:g}", color="C3", ha="center", va="bottom")
+    ax.set_ylim(-0.8, 1.8)
+    ax.set_yticks([])
+    ax.set_xlabel(length_label("length", units))
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
+    what = f"{name}: no position exists" if gap > 0 else f"{name}: it closes only lying flat"
+    ax.set_title((f"{plain_text(title)}: " if title else "") + what + "\n" + textwrap.fill(plain_text(reason), 90),
+                 fontsize="small")
     return fig
 
 

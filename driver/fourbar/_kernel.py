@@ -24,7 +24,8 @@ else:
 __all__ = ['FourbarStatus', 'State', 'Listing', 'Point', 'Force', 'Prop', 'Counterweight', 'ForceParam', 'Summary',
            'SummaryParam', 'FOURBAR_PASSES', 'fourbar_listing', 'fourbar_exact', 'fourbar_coupler_point',
            'fourbar_summaries', 'fourbar_joint_forces', 'fourbar_berkof_lowen', 'fourbar_force_summaries',
-           'FOURBAR_FORCE_SUMMARY_COLUMNS', 'FOURBAR_SUMMARY_COLUMNS', 'FOURBAR_GRASHOF', 'FOURBAR_STATUS']
+           'FOURBAR_FORCE_SUMMARY_COLUMNS', 'FOURBAR_SUMMARY_COLUMNS', 'FOURBAR_GRASHOF', 'FOURBAR_STATUS',
+           'fourbar_link_stresses']
 
 
 class FourbarStatus(KernelStatus):
@@ -36,7 +37,7 @@ class FourbarStatus(KernelStatus):
     ok = int(_kernels.fourbar.st_ok), "ok"
     no_assembly = int(_kernels.fourbar.st_no_assembly), "cannot assemble", "the loop does not close at this crank angle"
     toggle = int(_kernels.fourbar.st_toggle), "toggle", "coupler and rocker in line: the velocities are unbounded"
-    indeterminate = int(_kernels.fourbar.st_indeterminate), "indeterminate", "the crank pin A lies on the rocker pivot O_B"
+    indeterminate = int(_kernels.fourbar.st_indeterminate), "indeterminate", "the crank pin A lies on the rocker pivot O4"
 
 
 #: the four-bar kernels' status codes by name (``FOURBAR_STATUS["no_assembly"]``): :class:`FourbarStatus`
@@ -50,7 +51,7 @@ class State(IntEnum):
     """Columns of :func:`fourbar_exact`'s states.
 
     Angles [rad], pin positions [length], angular velocities [rad/s] and accelerations [rad/s^2] of
-    coupler (2) and rocker (3).
+    the coupler and the rocker, each named after its link (docs/fourbar.md, "Names").
     """
 
     COUPLER_ANGLE = 0
@@ -60,10 +61,10 @@ class State(IntEnum):
     YA = 4
     XB = 5
     YB = 6
-    OMEGA2 = 7
-    OMEGA3 = 8
-    ALPHA2 = 9
-    ALPHA3 = 10
+    COUPLER_OMEGA = 7
+    ROCKER_OMEGA = 8
+    COUPLER_ALPHA = 9
+    ROCKER_ALPHA = 10
 
 
 class Listing(IntEnum):
@@ -209,10 +210,10 @@ class Summary(IntEnum):
     ROCKER_SWING_DEG = 11
     ROCKER_TURNS = 12
     TOGGLES_IN_RANGE = 13
-    OMEGA3_PEAK_RAD_S = 14
-    OMEGA3_PEAK_AT_DEG = 15
-    OMEGA2_PEAK_RAD_S = 16
-    OMEGA2_PEAK_AT_DEG = 17
+    ROCKER_OMEGA_PEAK_RAD_S = 14
+    ROCKER_OMEGA_PEAK_AT_DEG = 15
+    COUPLER_OMEGA_PEAK_RAD_S = 16
+    COUPLER_OMEGA_PEAK_AT_DEG = 17
     TIME_RATIO = 18
 
 
@@ -289,7 +290,7 @@ def fourbar_exact(theta: np.ndarray, p: float, q: float, r: float, s: float, ome
         acceleration [rad/s^2].
     status : numpy.ndarray
         (n,): 0 ok, 1 cannot be assembled, 2 toggle (velocities unbounded, returned as 0),
-        3 indeterminate (A on O_B).
+        3 indeterminate (A on O4).
 
     Raises
     ------
@@ -312,10 +313,13 @@ def fourbar_exact(theta: np.ndarray, p: float, q: float, r: float, s: float, ome
 
 #: columns of fourbar_summaries by name (fortran/fourbar_summary.f90): :class:`Summary`
 FOURBAR_SUMMARY_COLUMNS = tuple(c.name.lower() for c in Summary)
-#: Grashof class codes of fourbar_summaries
+#: class codes of fourbar_summaries (fortran/fourbar_summary.f90 gr_*): Grashof's classes, the
+#: change-point ones (cp_), and the chains that cannot move (no_chain: no position exists;
+#: flat_chain: the longest link equals the other three together)
 FOURBAR_GRASHOF = {int(getattr(_kernels.fourbar_summary, f"gr_{k}")): k for k in
-                   ("double_crank", "crank_rocker", "rocker_crank", "double_rocker", "change_point",
-                    "triple_rocker")}
+                   ("double_crank", "crank_rocker", "rocker_crank", "double_rocker", "triple_rocker",
+                    "cp_double_crank", "cp_crank_rocker", "cp_rocker_crank", "cp_double_rocker",
+                    "no_chain", "flat_chain")}
 
 
 #: pass bits of fourbar_summaries (fortran/fourbar_summary.f90 pass_*); 'dense_scan' with
@@ -445,6 +449,50 @@ def fourbar_berkof_lowen(q: float, r: float, s: float, props: np.ndarray,
     """
     return _kernels.fourbar_forces.berkof_lowen(q, r, s, np.asarray(props, dtype=np.float64),
                                                 np.asarray(radii, dtype=np.float64))
+
+
+def fourbar_link_stresses(states: np.ndarray, status: np.ndarray, p: float, q: float, r: float, s: float,
+                          alpha: float, props: np.ndarray, forces: np.ndarray, section: np.ndarray) -> np.ndarray:
+    """Compute the peak normal stress in each moving link from the joint forces.
+
+    Each link is a straight prismatic bar between its pins carrying the loads of the force
+    analysis's free body where they act (pin forces, driver and load torques, its inertia force
+    and weight at its centre of mass, the load force at the coupler point); the peak of
+    |N|/A + |M|/Z along it (fortran/fourbar_forces.f90 ``link_stresses``).
+
+    Parameters
+    ----------
+    states, status : numpy.ndarray
+        The ``fourbar_exact`` results.
+    p, q, r, s : float
+        Ground, crank, coupler and rocker length, m.
+    alpha : float
+        Crank angular acceleration, rad/s^2.
+    props : numpy.ndarray
+        (18,) link and load properties, as for ``fourbar_joint_forces``.
+    forces : numpy.ndarray
+        (n, 12) ``fourbar_joint_forces`` of the same states and props.
+    section : numpy.ndarray
+        (6,): the section areas of crank, coupler, rocker [m^2], then their elastic section
+        moduli for in-plane bending [m^3].
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, 3): the peak normal stress in crank, coupler and rocker [Pa]; zero where the status
+        is not ok.
+
+    Raises
+    ------
+    ValueError
+        ``section`` does not have 6 positive values.
+    """
+    section = np.ascontiguousarray(section, dtype=np.float64)
+    if section.shape != (6,) or not np.all(section > 0):
+        raise ValueError(f"section must be 6 positive values (areas, moduli), got {section!r}")
+    return _kernels.fourbar_forces.link_stresses(farray(states, 2), np.asarray(status, dtype=np.int32), p, q, r, s,
+                                                 alpha, np.asarray(props, dtype=np.float64), farray(forces, 2),
+                                                 section)
 
 
 #: columns of fourbar_force_summaries (fortran/fourbar_forces.f90 force_summaries)

@@ -86,6 +86,22 @@ class _fourbar_forces:
     ) -> NDArray[np.float64]:
         """``fout = joint_forces(states,status,p,q,r,s,omega,alpha1,props,[n])``; shapes fout(n,12)"""
         ...
+    @staticmethod
+    def link_stresses(
+        states: NDArray[np.float64],
+        status: NDArray[np.int32],
+        p: float,
+        q: float,
+        r: float,
+        s: float,
+        alpha1: float,
+        props: NDArray[np.float64],
+        fout: NDArray[np.float64],
+        section: NDArray[np.float64],
+        n: int = ...,
+    ) -> NDArray[np.float64]:
+        """``sout = link_stresses(states,status,p,q,r,s,alpha1,props,fout,section,[n])``; shapes sout(n,3)"""
+        ...
     nbpar: NDArray[np.int32]
     nbres: NDArray[np.int32]
     nforce: NDArray[np.int32]
@@ -94,10 +110,15 @@ class _fourbar_forces:
 
 class _fourbar_summary:
     """Fortran module ``fourbar_summary`` (fortran/*.f90)."""
-    gr_change_point: NDArray[np.int32]
+    gr_cp_crank_rocker: NDArray[np.int32]
+    gr_cp_double_crank: NDArray[np.int32]
+    gr_cp_double_rocker: NDArray[np.int32]
+    gr_cp_rocker_crank: NDArray[np.int32]
     gr_crank_rocker: NDArray[np.int32]
     gr_double_crank: NDArray[np.int32]
     gr_double_rocker: NDArray[np.int32]
+    gr_flat_chain: NDArray[np.int32]
+    gr_no_chain: NDArray[np.int32]
     gr_rocker_crank: NDArray[np.int32]
     gr_triple_rocker: NDArray[np.int32]
     ncol: NDArray[np.int32]

@@ -41,5 +41,8 @@ def run(
     load_force_y: float = ...,
     speed_fluctuation: float = ...,
     balance: Literal["none", "force"] = ...,
+    section_area: float | Sequence[float] | NDArray[Any] = ...,
+    section_modulus: float | Sequence[float] | NDArray[Any] = ...,
+    yield_strength: float | Sequence[float] | NDArray[Any] = ...,
     counterweight_radius: float | Sequence[float] | NDArray[Any] = ...,
 ) -> Result: ...

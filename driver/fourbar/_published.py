@@ -48,7 +48,7 @@ def exact_as_listed(p: Params, theta_deg: np.ndarray) -> dict[tuple[int, str], s
     out, status = exact_grid(p, theta_deg)
     cols = exact_columns(out, status)
     names = {"epsl": "coupler_deg", "phi": "rocker_deg", "beta": "transmission_deg", "xa": "xa", "ya": "ya",
-             "xb": "xb", "yb": "yb", "omr": "omega2_rad_s", "oms": "omega3_rad_s"}
+             "xb": "xb", "yb": "yb", "omr": "coupler_omega_rad_s", "oms": "rocker_omega_rad_s"}
     res: dict[tuple[int, str], str] = {}
     for k, i in enumerate(np.asarray(theta_deg).astype(int)):
         res[(int(i), "i")] = str(int(i))

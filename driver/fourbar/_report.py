@@ -35,7 +35,7 @@ from driver.fourbar._analysis_forces import counterweights as berkof_lowen
 from driver.fourbar._batch import summary_of
 from driver.fourbar._kernel import Listing, Point, State
 from driver.fourbar._report_forces import figures as force_figures
-from driver.fourbar._report_forces import force_section
+from driver.fourbar._report_forces import force_section, yield_warnings
 from driver.fourbar._spec import SPEC, band_of, force_value, forces_active
 
 __all__ = ["run", "listing_text", "exact_table", "summary_lines", "audit", "deck_figures", "output_name", "animation_frames"]
@@ -43,8 +43,8 @@ __all__ = ["run", "listing_text", "exact_table", "summary_lines", "audit", "deck
 
 def _echo(p: Params) -> list[str]:
     """Deck inputs echoed in the English header of exact runs."""
-    rows = [("fixed link O_A-O_B", p.fixed_link, ""), ("crank (driver) O_A-A", p.crank, ""),
-            ("coupler A-B", p.coupler, ""), ("rocker (output) O_B-B", p.rocker, ""),
+    rows = [("fixed link O2-O4", p.fixed_link, ""), ("crank (driver) O2-A", p.crank, ""),
+            ("coupler A-B", p.coupler, ""), ("rocker (output) O4-B", p.rocker, ""),
             ("crank speed", p.omega, "rad/s"), ("crank acceleration", p.alpha, "rad/s^2")]
     return [f"  {name:<24}{fortran_f(v, 12, 4)} {u}".rstrip() for name, v, u in rows]
 
@@ -79,15 +79,18 @@ def listing_text(p: Params, table: np.ndarray, status: np.ndarray) -> tuple[list
 
 
 def exact_table(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarray,
-                cp: np.ndarray | None = None) -> list[str]:
+                cp: np.ndarray | None = None, chain: Grashof | None = None) -> list[str]:
     """Fixed-format exact table: the listing's ten columns (angles rounded) plus accelerations,
     and the coupler point's position and speed when the deck defines one (``cp`` from
-    kernel.fourbar_coupler_point)."""
+    kernel.fourbar_coupler_point).  ``chain``: the linkage's class (:func:`grashof`); the rows of
+    a chain that cannot move say its class instead of the distance that fails."""
     whole = np.all(np.isclose(theta, np.round(theta)))
     tcol = Column("theta", "i", 5, 0, 2) if whole else Column("theta", "f", 8, 3, 2)
-    cols = [tcol, Column("coupler", "f", 7, 1), Column("rocker", "f", 7, 1), Column("transm", "f", 7, 1)]
+    # headers: the tidy columns' names without their unit (on the line below)
+    cols = [tcol, Column("coupler", "f", 7, 1), Column("rocker", "f", 7, 1), Column("transmission", "f", 7, 1)]
     cols += [Column(h, "f", 9, 4) for h in ("xa", "ya", "xb", "yb")]
-    cols += [Column(h, "f", 10, 4) for h in ("omega2", "omega3")] + [Column(h, "f", 11, 4) for h in ("alpha2", "alpha3")]
+    cols += ([Column(h, "f", 10, 4) for h in ("coupler_omega", "rocker_omega")]
+             + [Column(h, "f", 11, 4) for h in ("coupler_alpha", "rocker_alpha")])
     units = ["[deg]", "[deg]", "[deg]", "[deg]", "", "", "", "", "[rad/s]", "[rad/s]", "[rad/s2]", "[rad/s2]"]
     if cp is not None:
         cols += [Column("xp", "f", 9, 4), Column("yp", "f", 9, 4), Column("vp", "f", 10, 4)]
@@ -97,15 +100,17 @@ def exact_table(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarra
                            np.degrees(out[:, State.TRANSMISSION_ANGLE])])
     rows, trailers = [], []
     d = np.hypot(p.fixed_link - out[:, State.XA], out[:, State.YA])
-    pins, rates = slice(State.XA, State.YB + 1), slice(State.XA, State.ALPHA3 + 1)
+    pins, rates = slice(State.XA, State.YB + 1), slice(State.XA, State.ROCKER_ALPHA + 1)
     for k in range(len(theta)):
         t = int(round(theta[k])) if whole else theta[k]
         if status[k] == ST["indeterminate"]:
             rows.append([t, None, None, None, out[k, State.XA], out[k, State.YA]] + [None] * 6)
-            trailers.append("indeterminate: crank pin A on the rocker pivot O_B, B free on a circle")
+            trailers.append("indeterminate: crank pin A on the rocker pivot O4, B free on a circle")
         elif status[k] == ST["no_assembly"]:
             rows.append([t, None, None, None, out[k, State.XA], out[k, State.YA]] + [None] * 6)
-            trailers.append(f"cannot be assembled: |A O_B| = {d[k]:.4f} outside "
+            trailers.append(f"{chain.name}: {'no position exists' if chain.name == 'impossible chain' else 'no motion'}"
+                            if chain is not None and not chain.movable else
+                            f"cannot be assembled: |A O4| = {d[k]:.4f} outside "
                             f"[{abs(p.coupler - p.rocker):g}, {p.coupler + p.rocker:g}]")
         elif status[k] == ST["toggle"]:
             rows.append([t, *ang[k], *out[k, pins]] + [None] * 4)
@@ -122,14 +127,25 @@ def exact_table(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarra
     return [lines[0], unit_line] + lines[1:]
 
 
+def _rotation(p: Params, g: Grashof) -> str:
+    """The crank's rotation in words: none (a chain that cannot move), a full turn (through the
+    change points of a change-point linkage, where the links lie in line), or limited by the
+    limit (toggle) crank angles."""
+    lim = limit_angles(p.fixed_link, p.crank, p.coupler, p.rocker)
+    angles = ", ".join(f"{a:.3f}" for a in lim) + " deg"
+    if not g.movable:
+        return "none: " + ("the chain cannot be assembled at any crank angle" if g.name == "impossible chain"
+                           else "the chain lies flat in one position")
+    if g.full_crank_rotation:
+        return "full turn" + (f", through the change point(s) at {angles} (the links in line)" if lim else "")
+    return "limited: limit (toggle) crank angles " + angles
+
+
 def summary_lines(p: Params, g: Grashof, ex: Extremes | None) -> list[str]:
     """Words and numbers after an exact table."""
-    lim = limit_angles(p.fixed_link, p.crank, p.coupler, p.rocker)
     out = ["", "  Summary (closed-loop solution, branch = " + p.branch + ")",
            f"    Grashof class ........ {g.name}  ({g.condition})",
-           "    crank rotation ....... " + ("full turn" if not lim else
-                                           "limited: limit (toggle) crank angles " +
-                                           ", ".join(f"{a:.3f}" for a in lim) + " deg")]
+           "    crank rotation ....... " + _rotation(p, g)]
     if ex is None:
         out.append("    the linkage cannot be assembled anywhere in the requested range")
         return out
@@ -146,8 +162,8 @@ def summary_lines(p: Params, g: Grashof, ex: Extremes | None) -> list[str]:
         out.append("    peak speeds .......... unbounded at the toggle positions (theta = "
                    + ", ".join(f"{a:.3f}" for a in ex.toggles) + " deg)")
     else:
-        out += [f"    peak rocker speed .... {ex.w3_peak:.4f} rad/s at theta = {ex.w3_peak_at:.2f} deg",
-                f"    peak coupler speed ... {ex.w2_peak:.4f} rad/s at theta = {ex.w2_peak_at:.2f} deg"]
+        out += [f"    peak rocker speed .... {ex.rocker_omega_peak:.4f} rad/s at theta = {ex.rocker_omega_peak_at:.2f} deg",
+                f"    peak coupler speed ... {ex.coupler_omega_peak:.4f} rad/s at theta = {ex.coupler_omega_peak_at:.2f} deg"]
     if ex.assembled_fraction < 1.0:
         out.append(f"    assemblable .......... about {100 * ex.assembled_fraction:.1f} % of the requested range")
     return out
@@ -168,9 +184,9 @@ def audit(p: Params, theta: np.ndarray, table: np.ndarray, lst_status: np.ndarra
     worst = int(np.argmax(np.where(bad, np.abs(dev), -1)))
     cols = [Column("i", "i", 5, 0), Column("|AB|", "f", 9, 4), Column("dev", "f", 9, 4),
             Column("xb lst", "f", 8, 3), Column("yb lst", "f", 8, 3), Column("xb", "f", 8, 3),
-            Column("yb", "f", 8, 3), Column("oms lst", "f", 9, 4), Column("omega3", "f", 9, 4)]
+            Column("yb", "f", 8, 3), Column("oms lst", "f", 9, 4), Column("rocker_omega", "f", 12, 4)]
     rows = [[int(theta[k]), ab[k], dev[k], table[k, Listing.XB], table[k, Listing.YB], out[k, State.XB],
-             out[k, State.YB], table[k, Listing.OMS], out[k, State.OMEGA3]] for k in np.flatnonzero(bad)]
+             out[k, State.YB], table[k, Listing.OMS], out[k, State.ROCKER_OMEGA]] for k in np.flatnonzero(bad)]
     lines += [f"    {int(bad.sum())} of {len(theta)} rows have a coupler length |AB| different from "
               f"the deck's {p.coupler:g}; largest deviation {dev[worst]:+.4f} at i = {int(theta[worst])}:"]
     lines += ["  " + l for l in render_table(cols, rows)]
@@ -178,7 +194,7 @@ def audit(p: Params, theta: np.ndarray, table: np.ndarray, lst_status: np.ndarra
               "    sigy > 0, sigx > 0 to 'sigma = 2 pi - |atan|' (meant: |atan|), so those rows",
               "    repeat the positions of 360 - i (mirror image) and their velocities are",
               "    wrong; the transmission angle column is still right (it depends on |A O_B| only).",
-              "    Use method = 'exact' for correct values (columns 'xb', 'yb', 'omega3' above)."]
+              "    Use method = 'exact' for correct values (columns 'xb', 'yb', 'rocker_omega' above)."]
     warn = (f"listing rows violate loop closure at {int(bad.sum())} crank angles "
             f"(largest |AB| deviation {dev[worst]:+.4f} at {int(theta[worst])} deg); see the audit in the .out")
     return lines, warn, frame
@@ -211,8 +227,10 @@ def run(params: Params, progress: bool = False) -> Result:
     cp = coupler_point(p, theta, out, status)
     rows = summary_rows(p)   # the summary kernel, once: the .out's headline figures and the summary
     ex = extremes(p, rows[0])
-    exact_frame = tidy_frame("exact", theta, exact_columns(out, status, cp, p.coupler), status)
+    chain = None if g.movable else g.name.replace(" ", "_")   # the tidy rows' status of a chain that cannot move
+    exact_frame = tidy_frame("exact", theta, exact_columns(out, status, cp, p.coupler), status, chain=chain)
     warnings: list[str] = []
+    failure = run_failure(p, g, ex)
     title = p.title or f"{p.path.stem}"
     if p.method == "listing":
         table, lst_status = listing_grid(p)
@@ -222,34 +240,55 @@ def run(params: Params, progress: bool = False) -> Result:
         if warn:
             warnings.append(warn)
         lst_cols = dict(zip(["coupler_deg", "rocker_deg", "transmission_deg", "xa", "ya", "xb", "yb",
-                             "omega2_rad_s", "omega3_rad_s"], table[:, Listing.EPSL:].T))
+                             "coupler_omega_rad_s", "rocker_omega_rad_s"], table[:, Listing.EPSL:].T))
         lst_cols["ab_error"] = np.where(lst_status == ST["ok"], closure["ab_deviation"].to_numpy(), np.nan)
-        listing_frame = tidy_frame("listing", theta, lst_cols, lst_status, closure["loop_not_closed"].to_numpy())
+        listing_frame = tidy_frame("listing", theta, lst_cols, lst_status, closure["loop_not_closed"].to_numpy(),
+                                   chain=chain)
         tidy = with_units(pd.concat([listing_frame, exact_frame], ignore_index=True), TIDY_UNITS)
     else:
         listing_frame = None
         lines = [f"  four-bar linkage: closed-loop analysis (method = exact, branch = {p.branch})",
                  f"  deck: {p.path}" + (f" -- {p.title}" if p.title else ""), ""] + _echo(p) + [""]
-        lines += exact_table(p, theta, out, status, cp) + summary_lines(p, g, ex)
+        lines += exact_table(p, theta, out, status, cp, g) + summary_lines(p, g, ex)
         if cp is not None:
             lines += [f"    coupler point P ...... u = {p.coupler_point[0]:g} along A->B, v = {p.coupler_point[1]:g} "
                       "to its left; xp, yp its position, vp its speed [length/s]"]
         if forces_active(p):
-            lines += force_section(p, theta, out, status, exact_frame)
-        for k in np.flatnonzero(status == ST["no_assembly"])[:1]:
+            lines += force_section(p, theta, out, status, exact_frame, None if g.movable else g.name)
+        for k in np.flatnonzero(status == ST["no_assembly"])[:1 if failure is None else 0]:
             warnings.append(f"the linkage cannot be assembled at {int((status == ST['no_assembly']).sum())} "
                             f"of {len(theta)} crank angles (first at {theta[k]:g} deg)")
         tidy = exact_frame
+    if failure:
+        lines += ["", f"  FAILED: {failure}"]
     summary = summary_of(p, rows)
+    if forces_active(p):   # a link past its yield strength: said in the .out (force_section) and warned
+        warnings += yield_warnings(p, summary)
     figs = deck_figures(p, title, listing_frame) + (force_figures(p, title, exact_grid) if forces_active(p) else [])
-    return Result(text="\n".join(lines) + "\n", tidy=tidy, summary=summary, warnings=warnings, figures=figs)
+    return Result(text="\n".join(lines) + "\n", tidy=tidy, summary=summary, warnings=warnings, failure=failure,
+                  figures=figs, design_failure=failure is not None)
+
+
+def run_failure(p: Params, g: Grashof, ex: Extremes | None) -> str | None:
+    """Why a run produced no motion, or None: a chain that cannot move (its class's reason), or a
+    linkage that assembles nowhere in the deck's crank range (with where it does assemble).  The
+    run then exits 1 (docs/fourbar.md, "Chains that cannot close")."""
+    if not g.movable:
+        return f"{g.name}: {g.reason}"
+    if ex is None:
+        spans = assembly_intervals(p.fixed_link, p.crank, p.coupler, p.rocker)
+        where = "" if not spans else " (it assembles for crank angles " + ", ".join(
+            f"{lo:.3f} to {hi:.3f}" for lo, hi in spans) + " deg)"
+        lo, hi = sorted((p.start_deg, p.stop_deg))
+        return f"the linkage cannot be assembled anywhere in the requested crank range {lo:g} to {hi:g} deg{where}"
+    return None
 
 
 def output_name(p: Params) -> str:
     """What the output link is called in figures: 'output crank' when it turns fully (a
     double-crank, a drag link), 'rocker' otherwise."""
     g = grashof(p.fixed_link, p.crank, p.coupler, p.rocker)
-    return "output crank" if g.name.startswith("double-crank") else "rocker"
+    return "output crank" if "double-crank" in g.name else "rocker"
 
 
 def length_units(p: Params) -> str:
@@ -269,16 +308,25 @@ def counterweight_view(p: Params) -> dict[str, tuple[float, float]] | None:
 
 
 def deck_figures(p: Params, stem_title: str, listing: pd.DataFrame | None) -> list[Figure]:
-    """The figures of a run (drawn on demand): the curves and the linkage at its limit positions."""
+    """The figures of a run (drawn on demand): the curves and the linkage at its limit positions;
+    for a chain that cannot move, its links laid out beside its longest (the gap seen)."""
+    g = grashof(p.fixed_link, p.crank, p.coupler, p.rocker)
+    chain = None if g.movable else f"{g.name}: {g.reason}"
+
     def curves():
         from driver.fourbar import _figures as figures  # matplotlib is the optional [plot] extra: imported when drawn
         theta = np.linspace(p.start_deg, p.stop_deg, 721)
         out, st = exact_grid(p, theta)
         exact = tidy_frame("exact", theta, exact_columns(out, st), st)
-        return figures.fourbar_curves(exact, listing, stem_title, band=band_of(p), output=output_name(p))
+        return figures.fourbar_curves(exact, listing, stem_title, band=band_of(p), output=output_name(p),
+                                      chain=chain)
 
     def linkage():
         from driver.fourbar import _figures as figures
+        if not g.movable:
+            return figures.fourbar_chain({"fixed link": p.fixed_link, "crank": p.crank, "coupler": p.coupler,
+                                          "rocker": p.rocker}, g.name, str(g.reason), stem_title,
+                                          units=length_units(p))
         lo, hi = sorted((p.start_deg, p.stop_deg))
         # the deck's crank range when it is less than a turn (a function generator's design range)
         theta = np.linspace(lo, hi, 721) if hi - lo < 360.0 else np.linspace(0.0, 360.0, 721)
@@ -316,6 +364,7 @@ def animation_frames(params: Params, result: Result | None = None, n: int = 180)
     motions = rocking_motions(params, max(8, n // 2 // max(
         1, len(assembly_intervals(params.fixed_link, params.crank, params.coupler, params.rocker) or [1]))))
     g = params.fixed_link
+    chain = grashof(params.fixed_link, params.crank, params.coupler, params.rocker)
     phase: list[str] = []
     segments: list[tuple[int, int]] = []
     guides = [Guide(np.array([[0.0, 0.0], [g, 0.0]]), "fixed link")]
@@ -378,4 +427,5 @@ def animation_frames(params: Params, result: Result | None = None, n: int = 180)
         caption="The linkage over " + ("its rocking motions between the limit positions (dashed)" if motions
                                        else "one crank turn") + ", positions from the kernel's closed loop."
         + (" Discs: the Berkof-Lowen counterweights of the force balance." if masses else ""),
-        invalid_note="the linkage cannot be assembled at this crank angle")
+        invalid_note=("the linkage cannot be assembled at this crank angle" if chain.movable
+                      else f"{chain.name}: {chain.reason}"))

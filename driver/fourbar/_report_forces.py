@@ -17,24 +17,77 @@ from driver._result import Figure
 from driver._table import Column, fortran_f, render_table
 from driver.fourbar._analysis import ST, TIDY_UNITS
 from driver.fourbar._analysis_forces import ForceAnalysis, analyse, props, tidy_columns
-from driver.fourbar._batch import force_summary
+from driver.fourbar._batch import force_summary, stress_summary
 from driver.fourbar._kernel import Force, Prop
-from driver.fourbar._spec import LINKS, force_value
+from driver.fourbar._spec import LINKS, force_value, sections_of, yields_of
 
-__all__ = ["force_section", "echo_lines", "table_lines", "summary_lines", "figures"]
+__all__ = ["force_section", "echo_lines", "table_lines", "summary_lines", "stress_lines", "yield_warnings", "figures"]
 
 
 def force_section(p: Params, theta: np.ndarray, out: np.ndarray, status: np.ndarray,
-                  frame: pd.DataFrame) -> list[str]:
-    """The force analysis's lines of the .out; its columns are added to ``frame`` (in place)."""
+                  frame: pd.DataFrame, chain: str | None = None) -> list[str]:
+    """The force analysis's lines of the .out; its columns are added to ``frame`` (in place).
+    ``chain``: the class of a chain that cannot move, said on its rows instead of 'not placed'."""
     fa = analyse(p, out, status)
     for name, values in tidy_columns(fa).items():
         frame[name] = values
     with_units(frame, TIDY_UNITS)
-    words = ["toggle: forces unbounded" if s == ST["toggle"] else "not placed" for s in status]
+    words = ["toggle: forces unbounded" if s == ST["toggle"] else (f"{chain}: no position" if chain else "not placed")
+             for s in status]
     title = ("Force analysis (Newton-Euler, closed form; " +
              ("with the Berkof-Lowen counterweights" if fa.cw is not None else "links as given") + ")")
-    return echo_lines(p) + table_lines(theta, fa.forces, fa.ok, words, title) + summary_lines(p, force_summary(p), fa)
+    lines = echo_lines(p) + table_lines(theta, fa.forces, fa.ok, words, title) + summary_lines(p, force_summary(p), fa)
+    if sections_of(p) is not None:
+        lines += stress_lines(p, stress_summary(p))
+    return lines
+
+
+def stress_lines(p: Params, s: dict[str, Any]) -> list[str]:
+    """The link-stress lines of the .out: the sections, each link's peak |N|/A + |M|/Z and its crank
+    angle, and with ``yield_strength`` each link's ratio to it and a verdict naming a link that
+    yields (its elastic answer beyond that point is not physical).
+
+    Parameters
+    ----------
+    p : Params
+        Validated ``&fourbar`` keys with the sections (SI).
+    s : dict
+        The link-stress summary (``driver.fourbar._batch.stress_summary``).
+
+    Returns
+    -------
+    list of str
+        The lines (stresses in MPa).
+    """
+    sec = sections_of(p) or []
+    out = ["", "  Link stresses (peak |N|/A + |M|/Z along each link: the force analysis's loads where they act,"
+               " the scan above)",
+           "    sections ............. " + "; ".join(f"{link} A = {sec[j]:g} m^2, Z = {sec[3 + j]:g} m^3"
+                                                  for j, link in enumerate(LINKS))]
+    if s[f"{LINKS[0]}_stress_peak_MPa"] is None:
+        return out + ["    the stresses are not defined anywhere in the range"]
+    out.append("    peak stress .......... " + ", ".join(
+        f"{link} {s[f'{link}_stress_peak_MPa']:.4f} MPa at theta = {s[f'{link}_stress_peak_at_deg']:.2f} deg"
+        for link in LINKS))
+    ys = yields_of(p)
+    if ys is not None:
+        out.append("    yield strength ....... " + ", ".join(
+            f"{link} {y / 1e6:g} MPa (peak {s[f'{link}_stress_peak_MPa'] * 1e6 / y:.3f} of it)"
+            for link, y in zip(LINKS, ys)))
+        out += [f"    PASSES YIELD: {w}" for w in yield_warnings(p, s)] or ["    every link stays below its yield strength"]
+    return out
+
+
+def yield_warnings(p: Params, s: dict[str, Any]) -> list[str]:
+    """One line per link whose peak stress reaches its yield strength (none without
+    ``yield_strength``): what the .out says and the run warns."""
+    ys = yields_of(p)
+    if ys is None or not s.get("yields"):
+        return []
+    return [f"the {link} passes yield: its peak stress {s[f'{link}_stress_peak_MPa']:.4g} MPa at theta = "
+            f"{s[f'{link}_stress_peak_at_deg']:.2f} deg exceeds its yield strength {y / 1e6:g} MPa; the elastic "
+            "answer beyond that point is not physical"
+            for link, y in zip(LINKS, ys) if s[f"{link}_stress_peak_MPa"] * 1e6 >= y]
 
 
 def table_lines(theta: np.ndarray, f: np.ndarray, ok: np.ndarray, status_words: list[str], title: str) -> list[str]:

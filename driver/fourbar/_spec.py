@@ -15,9 +15,9 @@ from driver._deck import GroupSpec, Key, Params, non_negative, positive
 from driver._limits import Estimate
 from driver._study import contract_doc
 
-__all__ = ['SPEC', 'LABELS', 'SWEEP_BEST', 'SWEEP_PLOT', 'SUMMARY_SETTINGS', 'BAND', 'MAX_ANGLE', 'band_of', 'estimate',
-           'FORCE_KEYS', 'FORCE_DEFAULTS', 'FORCE_SUMMARY_DOC', 'LINKS', 'force_value', 'forces_active', 'force_check',
-           'moving_lengths']
+__all__ = ['SPEC', 'LABELS', 'RENAMED', 'SWEEP_BEST', 'SWEEP_PLOT', 'SUMMARY_SETTINGS', 'BAND', 'MAX_ANGLE', 'band_of',
+           'estimate', 'FORCE_KEYS', 'FORCE_DEFAULTS', 'FORCE_SUMMARY_DOC', 'STRESS_SUMMARY_DOC', 'LINKS',
+           'force_value', 'forces_active', 'force_check', 'moving_lengths', 'sections_of', 'yields_of']
 
 
 MAX_ANGLE = 1.0e6   # |crank angle| [deg] a deck may give (ulp of 1e6 is 1.2e-10 deg)
@@ -66,6 +66,26 @@ def _three_non_negative(v: Any) -> str | None:
     return _three(v) or _finite(v) or non_negative(v)
 
 
+def _positive(v: Any) -> str | None:
+    return None if all(math.isfinite(x) and x > 0 for x in v) else "must be positive and finite"
+
+
+#: a yield strength below this [Pa] is taken for a unit mistake (MPa given for Pa)
+MIN_YIELD_PA = 1.0e5
+
+
+def _yield_check(v: Any) -> str | None:
+    if len(v) not in (1, 3):
+        return f"give one value for every link, or three: crank, coupler, rocker (got {len(v)})"
+    bad = _positive(v)
+    if bad:
+        return bad
+    if min(v) < MIN_YIELD_PA:
+        return (f"{min(v):g} Pa is below {MIN_YIELD_PA:g} Pa: yield strengths are in Pa (250 MPa is 2.5e8); "
+                "this looks like MPa")
+    return None
+
+
 FORCE_KEYS: dict[str, Key] = {
     "mass": Key("floats", default=None, units="kg", check=_three_non_negative,
                 doc="masses of crank, coupler, rocker; giving them runs the force analysis (lengths in metres)"),
@@ -91,6 +111,14 @@ FORCE_KEYS: dict[str, Key] = {
     "balance": Key("str", default=None, choices=("none", "force"),
                    doc="'force': Berkof-Lowen counterweights on crank and rocker, balanced analysis reported too "
                        "(default 'none')"),
+    "section_area": Key("floats", default=None, units="m^2", check=lambda v: _three(v) or _positive(v),
+                        doc="cross-section area of crank, coupler, rocker; with section_modulus each link's peak "
+                            "normal stress |N|/A + |M|/Z over the range (the force analysis's loads)"),
+    "section_modulus": Key("floats", default=None, units="m^3", check=lambda v: _three(v) or _positive(v),
+                           doc="elastic section modulus I/c of crank, coupler, rocker for in-plane bending"),
+    "yield_strength": Key("floats", default=None, units="Pa", check=_yield_check,
+                          doc="yield strength of the links' material (one value, or crank, coupler, rocker); "
+                              "with the sections a link whose peak stress reaches it is reported as yielding"),
     "counterweight_radius": Key("floats", default=None, units="m",
                                 check=lambda v: (None if len(v) == 2 else f"give two values: crank, rocker (got {len(v)})")
                                 or (None if all(x > 0 for x in v) else "must be positive"),
@@ -182,6 +210,12 @@ def force_check(p: Params) -> None:
             if rc > MAX_COM_RATIO * L:
                 raise p.error("counterweight_radius", f"{rc:g} m is {rc / L:.3g} times the "
                                                       f"{('crank', 'rocker')[i]} length: a length unit mismatch?")
+    if (p.section_area is None) != (p.section_modulus is None):
+        key = "section_area" if p.section_area is not None else "section_modulus"
+        raise p.error(key, "the link stresses need both section_area (m^2) and section_modulus (m^3)")
+    if p.yield_strength is not None and p.section_area is None:
+        raise p.error("yield_strength", "is compared with the link stresses, which need section_area and "
+                                        "section_modulus")
     fx, fy = force_value(p, "load_force_x"), force_value(p, "load_force_y")
     if (fx != 0.0 or fy != 0.0) and not p.coupler_point:
         key = "load_force_x" if fx != 0.0 else "load_force_y"
@@ -201,13 +235,37 @@ FORCE_SUMMARY_DOC = {
     "flywheel_inertia_kgm2": "flywheel inertia dE / (C_s omega^2) [kg m^2]",
 }
 
+#: the link-stress summary's columns (decks with section_area and section_modulus) and what they are
+STRESS_SUMMARY_DOC = {
+    **{f"{link}_stress_peak_MPa": f"peak normal stress |N|/A + |M|/Z in the {link} [MPa]" for link in LINKS},
+    **{f"{link}_stress_peak_at_deg": f"crank angle of the {link}'s peak stress [deg]" for link in LINKS},
+    "yield_ratio_max": "largest peak stress over the link's yield strength [1]",
+    "yields": "a link's peak stress reaches its yield strength []",
+}
+
 
 #: axis labels of the force summary columns: name -> (words, units)
 FORCE_LABELS = {name: (doc.rsplit(" [", 1)[0], doc.rsplit(" [", 1)[1].rstrip("]"))
-                for name, doc in FORCE_SUMMARY_DOC.items()}
+                for name, doc in (FORCE_SUMMARY_DOC | STRESS_SUMMARY_DOC).items()}
 #: ... and of the same columns of the linkage without its counterweights (balance = 'force')
 FORCE_LABELS |= {f"unbalanced_{name}": (f"{words}, without counterweights", unit)
                  for name, (words, unit) in list(FORCE_LABELS.items())}
+
+
+def sections_of(p: Mapping[str, Any]) -> list[float] | None:
+    """The link sections of the deck for the kernel's link_stresses: the areas of crank, coupler,
+    rocker [m^2], then their section moduli [m^3]; None without section_area."""
+    if p.get("section_area") is None or p.get("section_modulus") is None:
+        return None
+    return [float(x) for x in (*p["section_area"], *p["section_modulus"])]
+
+
+def yields_of(p: Mapping[str, Any]) -> list[float] | None:
+    """The yield strength of crank, coupler and rocker [Pa] (one deck value for all), or None."""
+    v = p.get("yield_strength")
+    if v is None:
+        return None
+    return [float(v[0])] * 3 if len(v) == 1 else [float(x) for x in v]
 
 
 # ----------------------------------------------------------------------------- the group
@@ -242,15 +300,24 @@ LABELS = {"crank": ("crank length", "length units"), "coupler": ("coupler length
           "fixed_link": ("ground link length", "length units"), "omega": ("crank speed", ""),
           "mu_min_deg": ("minimum transmission angle", "deg"), "mu_max_deg": ("maximum transmission angle", "deg"),
           "rocker_swing_deg": ("rocker swing", "deg"),
-          "omega3_peak_rad_s": ("peak rocker speed (signed: the largest in size)", "rad/s"),
-          "omega2_peak_rad_s": ("peak coupler speed (signed: the largest in size)", "rad/s"),
+          "rocker_omega_peak_rad_s": ("peak rocker speed (signed: the largest in size)", "rad/s"),
+          "coupler_omega_peak_rad_s": ("peak coupler speed (signed: the largest in size)", "rad/s"),
           "assembled_fraction": ("fraction of the turn assembled", "-"),
           "time_ratio": ("time ratio (slow / quick stroke)", "-"), **FORCE_LABELS}
 
 
+#: columns renamed (old -> new) when every name came to say its link in words (issue 35; the
+#: paper's listing numbered the coupler 2 and the rocker 3, textbooks 3 and 4): an old name in a
+#: deck, a sweep filter or an &optimize expression is refused with the new one named
+RENAMED = {"omega3_peak_rad_s": "rocker_omega_peak_rad_s", "omega2_peak_rad_s": "coupler_omega_peak_rad_s",
+           "omega3_peak_at_deg": "rocker_omega_peak_at_deg", "omega2_peak_at_deg": "coupler_omega_peak_at_deg",
+           "omega2_rad_s": "coupler_omega_rad_s", "omega3_rad_s": "rocker_omega_rad_s",
+           "alpha2_rad_s2": "coupler_alpha_rad_s2", "alpha3_rad_s2": "rocker_alpha_rad_s2"}
+
+
 #: which way a summary column is better (the design-space maps star the best kept design)
-SWEEP_BEST = {"mu_min_deg": "max", "mu_max_deg": "min", "rocker_swing_deg": "max", "omega3_peak_rad_s": "min",
-              "omega2_peak_rad_s": "min"}
+SWEEP_BEST = {"mu_min_deg": "max", "mu_max_deg": "min", "rocker_swing_deg": "max", "rocker_omega_peak_rad_s": "min",
+              "coupler_omega_peak_rad_s": "min"}
 
 
 #: keys of the base deck the summary columns depend on (transmission_band_deg: meets_transmission_band):
@@ -259,7 +326,7 @@ SUMMARY_SETTINGS = ("transmission_band_deg",)
 
 
 #: what a sweep summary plots when its deck names no plot_y
-SWEEP_PLOT = ("mu_min_deg", "mu_max_deg", "rocker_swing_deg", "omega3_peak_rad_s", "omega2_peak_rad_s",
+SWEEP_PLOT = ("mu_min_deg", "mu_max_deg", "rocker_swing_deg", "rocker_omega_peak_rad_s", "coupler_omega_peak_rad_s",
               "assembled_fraction")
 
 
@@ -267,10 +334,10 @@ SPEC = GroupSpec(
     name="fourbar",
     doc="planar four-bar linkage driven by its crank at constant speed",
     keys={
-        "fixed_link": Key("float", required=True, check=positive, units="length", doc="ground link O_A-O_B"),
-        "crank": Key("float", required=True, check=positive, units="length", doc="input link O_A-A"),
+        "fixed_link": Key("float", required=True, check=positive, units="length", doc="ground link O2-O4 (the paper's O_A-O_B)"),
+        "crank": Key("float", required=True, check=positive, units="length", doc="input link O2-A"),
         "coupler": Key("float", required=True, check=positive, units="length", doc="coupler A-B"),
-        "rocker": Key("float", required=True, check=positive, units="length", doc="output link O_B-B"),
+        "rocker": Key("float", required=True, check=positive, units="length", doc="output link O4-B"),
         "omega": Key("float", default=1.0, units="rad/s", doc="crank angular velocity (ccw positive)"),
         "alpha": Key("float", default=0.0, units="rad/s^2", doc="crank angular acceleration (exact method)"),
         "step_deg": Key("float", required=True, units="deg", doc="crank-angle step"),
@@ -279,7 +346,7 @@ SPEC = GroupSpec(
         "method": Key("str", default="exact", choices=("exact", "listing"),
                       doc="'listing' = published program cell for cell; 'exact' = closed loop"),
         "branch": Key("str", default="open", choices=("open", "crossed"),
-                      doc="'open': B left of the line A->O_B; 'crossed': mirror assembly"),
+                      doc="'open': B left of the line A->O4; 'crossed': mirror assembly"),
         "transmission_band_deg": Key("floats", default=list(BAND), units="deg", check=_band_check,
                                      doc="the transmission-angle band a design should keep to (min, max): the "
                                          "summary's meets_transmission_band, the .out and the figures use it; "

@@ -25,6 +25,7 @@ fields ``x``, ``fun``, ``success``, ``message``, ``nfev``).
 from __future__ import annotations
 
 import math
+import os
 from pathlib import Path
 from typing import Any
 
@@ -33,10 +34,11 @@ import pandas as pd
 
 from driver import _blas as blas
 from driver._atomic import output_set, write_text
-from driver._deck import Deck, Params, read_deck
+from driver._deck import Deck, DeckError, Params
 from driver._export import write_tidy
 from driver._extras import require
 from driver._outcome import HTML, OptimizeOutcome, Optimum
+from driver._pydeck import DeckSource, source_deck
 from driver._result import Figure
 from driver._runner import compute, output_stem, write_outputs
 from driver.optimize import _journal as journal_file
@@ -74,6 +76,17 @@ def _probe(problem: Problem) -> None:
     Only a clean run (no failure, no warning) proves a column does not exist; otherwise (a buckled
     rod has no strain peaks) a design whose summary lacks a column is infeasible, with that reason.
     """
+    o = problem.opts
+    for key, names in [("summary_columns", o.summary_columns),
+                       ("minimize" if problem.sense > 0 else "maximize", sorted(problem.objective.names))]:
+        refusal = problem.study.renamed_in(names)
+        if refusal:
+            raise o.error(key, refusal)
+    nums = [n for n in range(1, 10) if o[f"constraint{n}"] is not None]
+    for n, c in zip(nums, problem.constraints):
+        refusal = problem.study.renamed_in(sorted(c.whole.names))
+        if refusal:
+            raise o.error(f"constraint{n}", refusal)
     x = [base_value(problem, v) for v in problem.variables]
     try:
         params = design_params(problem, np.array(x))
@@ -88,7 +101,6 @@ def _probe(problem: Problem) -> None:
         return
     from driver import _expr as expr
     frame = pd.DataFrame([summary])
-    o = problem.opts
     exprs = [("minimize" if problem.sense > 0 else "maximize", problem.objective)]
     nums = [n for n in range(1, 10) if o[f"constraint{n}"] is not None]
     exprs += [(f"constraint{n}", c.whole) for n, c in zip(nums, problem.constraints)]
@@ -98,10 +110,6 @@ def _probe(problem: Problem) -> None:
                                          f"(columns: {', '.join(frame.columns)})")
     for key, e in exprs:
         missing = [name for name in sorted(e.names) if name not in frame]
-        renamed = problem.study.renamed
-        if missing and missing[0] in renamed:
-            raise o.error(key, f"summary column '{missing[0]}' of &{problem.raw.name} is now "
-                               f"{renamed[missing[0]]}")
         if missing and clean:   # a clean run of the deck's design has every column its study writes
             raise o.error(key, f"unknown summary column '{missing[0]}' of &{problem.raw.name} "
                                f"(columns: {', '.join(frame.columns)})")
@@ -124,15 +132,17 @@ def base_value(problem: Problem, v) -> float:
 
 
 @blas.one_thread()
-def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[str] | None = None,
+def optimize(deck: DeckSource | Deck, outdir: str | os.PathLike | None = None, formats: list[str] | None = None,
              plot: bool | str = False, jobs: int | None = None, resume: bool = False,
-             scheduler: Any = None) -> OptimizeOutcome:
+             scheduler: Any = None, name: str | None = None) -> OptimizeOutcome:
     """Run an optimisation deck: a study group and an ``&optimize`` group.
 
     Parameters
     ----------
-    deck : Deck, str or path-like
-        The deck, or its file.
+    deck : str, path-like, dict or Deck
+        The deck, as every entry point takes one (``driver.DeckSource``): its file, its text
+        (``"&fourbar ... / &optimize ... /"``), a dict of groups ``{"fourbar": {...},
+        "optimize": {...}}`` (keys in the deck's units), or a parsed Deck.
     outdir : path-like, optional
         Where to write the outputs (``<stem>.out``, the optimum's deck and run, the history);
         None writes nothing.
@@ -147,6 +157,9 @@ def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[
     scheduler : str or dask.distributed.Client, optional
         A Dask scheduler address or client (from the command line or Dask's configuration,
         never from the deck): each batch of designs is spread over its workers.
+    name : str, optional
+        Output stem; default the deck's file stem, or for a deck's text or a dict its study
+        group.
 
     Returns
     -------
@@ -158,14 +171,21 @@ def optimize(deck: Deck | str | Path, outdir: Path | None = None, formats: list[
     Raises
     ------
     DeckError
-        Bad input, before anything is computed or written.
+        Bad input (an unreadable file, a bad key or value, no ``&optimize`` group), before
+        anything is computed or written.
+    TypeError
+        ``deck`` is not a deck source (a number, bytes, ...).
     """
-    if not isinstance(deck, Deck):
-        deck = read_deck(deck)
+    deck = source_deck(deck, name)
+    if "optimize" not in deck.groups or "synthesis" in deck.groups:
+        raise DeckError(deck.path, None, None, "an optimisation deck has a study group and an &optimize group"
+                        + (" and no &synthesis group" if "synthesis" in deck.groups else
+                           f" (found {', '.join('&' + g for g in deck.groups) or 'none'}); run a study deck "
+                           "with driver.run"))
     problem = problem_of(deck)
     _probe(problem)
     formats = list(formats or [])
-    stem = None if outdir is None else output_stem(outdir, deck.path, _suffixes(formats, plot))
+    stem = None if outdir is None else output_stem(Path(outdir), deck.path, _suffixes(formats, plot))
     journal = None if stem is None else journal_file.journal_path(stem)
     found = journal_file.read(problem, stem) if (resume and stem is not None) else journal_file.Resumed()
     if journal is not None and journal.exists() and not resume:

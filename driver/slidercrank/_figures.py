@@ -23,14 +23,16 @@ from driver.slidercrank._spec import Model
 @styled
 def slidercrank_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray]], title: str,
                               ylabel: str = "axial strain [microstrain]", above: dict[str, float] | None = None,
-                              missing: Sequence[str] = (), ax=None) -> Figure:
+                              missing: Sequence[str] = (), ax=None,
+                              yield_strain: tuple[float, str] | None = None) -> Figure:
     """A quantity against crank angle [deg], one line per case (label, angle, value): Figure 10.
 
     ``above`` maps the labels of cases whose rod compression exceeds the Euler load to that
     ratio N/P_E: their curves are dashed and flagged in the legend (a linear model draws
     them although the rod would buckle).  ``missing`` are one-line texts of cases not drawn (e.g. a speed that
     buckled): they are listed in the legend, so no speed silently disappears.  ``ax``: an axes
-    to draw into (its figure is returned).
+    to draw into (its figure is returned).  ``yield_strain``: (sigma_y / E [microstrain], what the
+    yield strength is), marked on a strain figure.
     """
     from matplotlib.lines import Line2D
     above = above or {}
@@ -44,13 +46,16 @@ def slidercrank_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray
                 lw=1.2, ls="--" if flagged else "-")
     for text in missing:
         ax.add_line(Line2D([], [], ls="none", marker="x", color="C3", label=text))
+    _yield_lines(ax, [y for _, _, y in series], yield_strain)
     ax.axhline(0.0, color="k", lw=0.6)
     ax.set_xlim(0, 360)
     ax.set_xticks(np.arange(0, 361, 45))
     ax.set_xlabel(r"crank angle $\theta_2$ [deg]")
     ax.set_ylabel(ylabel)
-    fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center",
-               ncol=3 if len(series) + len(missing) > 4 else 2, frameon=False, title="crank speed")
+    handles, labels = ax.get_legend_handles_labels()
+    # a long entry (a speed not drawn and why, the yield strain) gets the legend's whole width
+    ncol = 1 if _longest_line(labels) > 48 else (3 if len(labels) > 4 else 2)
+    fig.legend(handles, labels, loc="outside lower center", ncol=ncol, frameon=False, title="crank speed")
     ax.set_title(plain_text(title))
     return fig
 
@@ -172,6 +177,28 @@ def slidercrank_history_figure(time: np.ndarray, series: dict[str, np.ndarray], 
     return fig
 
 
+def _yield_lines(ax, values: Sequence[np.ndarray], yield_strain: tuple[float, str] | None) -> None:
+    """The rod's yield strain +-sigma_y / E [microstrain] with its words: drawn as two dotted lines
+    where the curves come within a quarter of it, else named in the legend as off the scale (a
+    strain beyond it is not physical: the rod would have yielded)."""
+    if yield_strain is None:
+        return
+    from matplotlib.lines import Line2D
+    eps, words = yield_strain
+    top = max((float(np.nanmax(np.abs(v))) for v in values if np.size(v)), default=0.0)
+    label = f"yield strain $\\pm${eps:.0f} microstrain\n({words})"   # its source on a line of its own
+    if top >= 0.25 * eps:
+        for sign in (1.0, -1.0):
+            ax.axhline(sign * eps, color="C3", lw=0.9, ls=":", label=label if sign > 0 else None)
+    else:
+        ax.add_line(Line2D([], [], ls="none", label=f"{label}: off the scale"))
+
+
+def _longest_line(labels: Sequence[str]) -> int:
+    """The characters of the longest line of legend entries ``labels`` (an entry may have two)."""
+    return max((len(line) for label in labels for line in label.split("\n")), default=0)
+
+
 def _own_axes(ax, figsize: tuple[float, float]):
     """(figure, axes): the given axes and its figure, or a new house-style figure."""
     if ax is not None:
@@ -184,17 +211,22 @@ def _own_axes(ax, figsize: tuple[float, float]):
 NONLINEAR: dict[str, Any] = dict(lw=1.3, ls="-")
 LINEAR: dict[str, Any] = dict(lw=1.0, ls="--", color="0.25")
 BUCKLED = "#c0392b"
+#: the rod's yield strain +-sigma_y / E (as :func:`_yield_lines` draws it)
+YIELD: dict[str, Any] = dict(color="C3", lw=0.9, ls=":")
 
 
 @styled
 def slidercrank_nl_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray, np.ndarray]], title: str,
-                                 buckled: dict[str, str] | None = None, axes=None) -> Figure:
+                                 buckled: dict[str, str] | None = None, axes=None,
+                                 yield_strain: tuple[float, str] | None = None) -> Figure:
     """Crank-end axial strain [microstrain] against crank angle [deg], one panel per crank speed
     (label, angle, linear, nonlinear), each on its own scale: the nonlinear rod solid in the
     speed's colour, the linear model dashed dark grey (a key below says so).  A buckled rod's
     spike of thousands of microstrain cannot flatten the sub-buckling speeds.  ``buckled`` maps
     the labels of the speeds at which the nonlinear rod buckled to why (their panels are framed
-    and titled in red).  ``axes``: one axes per speed to draw into."""
+    and titled in red).  ``axes``: one axes per speed to draw into.  ``yield_strain``
+    (sigma_y / E [microstrain], its words) marked dotted on the panels whose curves come within a
+    quarter of it, and named in the key (off the scale where no panel reaches it)."""
     from matplotlib.lines import Line2D
     buckled = buckled or {}
     n = len(series)
@@ -206,9 +238,16 @@ def slidercrank_nl_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndar
             extra.set_visible(False)
     else:
         fig = axes[0].figure
+    near_yield = False
+    yield_words = (f"yield strain $\\pm${yield_strain[0]:.0f} microstrain\n({yield_strain[1]})"
+                   if yield_strain is not None else "")
     for k, (ax, (label, x, lin, nl)) in enumerate(zip(axes, series)):
         ax.plot(x, nl, color=f"C{k % 10}", **NONLINEAR)
         ax.plot(x, lin, **LINEAR)
+        if yield_strain is not None and max(float(np.nanmax(np.abs(v))) for v in (lin, nl)) >= 0.25 * yield_strain[0]:
+            near_yield = True
+            for sign in (1.0, -1.0):
+                ax.axhline(sign * yield_strain[0], **YIELD, label=yield_words if sign > 0 else None)
         ax.axhline(0.0, color="k", lw=0.5)
         ax.set_xlim(0, 360)
         ax.set_xticks(np.arange(0, 361, 90))
@@ -232,7 +271,11 @@ def slidercrank_nl_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndar
     if buckled:
         key.append(Line2D([], [], color=BUCKLED, lw=1.4))
         names.append("frame: the nonlinear rod buckled at this speed")
-    fig.legend(key, names, loc="outside lower center", ncol=len(key), frameon=False)
+    if yield_strain is not None:
+        key.append(Line2D([], [], **YIELD) if near_yield else Line2D([], [], ls="none"))
+        names.append(yield_words + ("" if near_yield else ": off the scale"))
+    # two columns of short entries; a long one (the yield strain and its source) one a line
+    fig.legend(key, names, loc="outside lower center", ncol=1 if _longest_line(names) > 60 else 2, frameon=False)
     suptitle(fig, plain_text(title))
     return fig
 

@@ -27,6 +27,7 @@ def run(
     section_depth: float = ...,
     section_width: float = ...,
     section_diameter: float = ...,
+    yield_strength: float = ...,
     slider_mass: float = 0.9,
     bearing_mass_crank: float = 0.05,
     bearing_mass_slider: float = 0.05,

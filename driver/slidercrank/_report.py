@@ -60,6 +60,8 @@ def header_lines(params: Params, model: Model, derived: Derived) -> list[str]:
         ("density rho", "kg/m^3", f"{model.density:g}   ({src['density']})"),
         ("Young's modulus E", "Pa", f"{model.modulus:.5g}   ({src['youngs_modulus']})"),
         ("section depth (outer fibre at depth/2)", "m", f"{model.depth:g}   ({src['section_depth']})"),
+        ("yield strength", "Pa", f"{model.yield_strength:.4g}   ({model.yield_source})" if model.yield_strength
+         else "not known (a custom rod: give yield_strength to check the stresses against it)"),
         ("slider mass M", "kg", f"{model.slider_mass:g}"),
         ("bearing masses m_B (crank pin), m_C (slider)", "kg",
          f"{model.bearing_crank:g}, {model.bearing_slider:g}"),
@@ -144,6 +146,67 @@ def _peak_table(cases: list[Case], tol: float) -> list[str]:
         + render_table(cols, rows, trailers)
 
 
+def peak_stress(model: Model, outer_strain: float) -> float:
+    """The rod's peak stress [Pa] from its peak outer-fibre strain |eps| + c |kappa| [-], elastic
+    (sigma = E eps): what it would carry if it stayed elastic."""
+    return model.modulus * outer_strain
+
+
+def yield_table(model: Model, rows: list[tuple[str, float, float | None]]) -> list[str]:
+    """The .out's check of every model's peak stress against the rod's yield strength: one row per
+    (model, crank speed [rad/s], peak outer-fibre stress [Pa] or None where the case failed)."""
+    ys = model.yield_strength
+    head = ["Table Y  Peak stress against the yield strength",
+            "         stress = E x peak outer-fibre strain (|eps| + c|kappa|) [MPa], elastic; "
+            + (f"yield strength {ys / 1e6:g} MPa ({model.yield_source})" if ys else
+               "yield strength not known (give yield_strength)"),
+            "         ratio = stress / yield strength; YIELDS: the rod would yield, and the elastic answer beyond",
+            "         that point is not physical", ""]
+    cols = [Column("model", "s", 9), Column("omega", "f", 7, 2), Column("stress", "f", 10, 2),
+            Column("ratio", "s", 7)]
+    table: list[list[Cell]] = []
+    trailers: list[str] = []
+    for name, w, st in rows:
+        if st is None:
+            table.append([name, w, "-", "-"])
+            trailers.append("no stress (the case failed)")
+            continue
+        ratio = None if not ys else st / ys
+        table.append([name, w, st / 1e6, "-" if ratio is None else f"{ratio:.3f}"])
+        trailers.append("" if ratio is None else ("YIELDS" if ratio >= 1.0 else ""))
+    return head + render_table(cols, table, trailers)
+
+
+def yield_warnings(model: Model, rows: list[tuple[str, float, float | None]]) -> list[str]:
+    """One warning per (model, speed) whose peak stress reaches the yield strength."""
+    ys = model.yield_strength
+    if not ys:
+        return []
+    return [f"{name} model, crank speed {w:g} rad/s: the rod passes yield: its peak outer-fibre stress "
+            f"{st / 1e6:.4g} MPa (E x {st / model.modulus * 1e6:.0f} microstrain, if it stayed elastic) exceeds "
+            f"the yield strength {ys / 1e6:g} MPa; the elastic answer beyond that point is not physical"
+            for name, w, st in rows if st is not None and st >= ys]
+
+
+def yield_strain(model: Model) -> tuple[float, str] | None:
+    """The rod's yield strain sigma_y / E [microstrain] and what its yield strength is, for the
+    figures; None without a yield strength."""
+    if not model.yield_strength:
+        return None
+    return model.yield_strength / model.modulus * 1e6, f"{model.yield_strength / 1e6:g} MPa, {model.yield_source}"
+
+
+def yield_summary(model: Model, stresses: list[float | None], prefix: str = "") -> dict[str, Any]:
+    """The summary's stress columns of one model: the peak over the speeds [MPa], its ratio to the
+    yield strength and whether it yields (None without a yield strength)."""
+    known = [s for s in stresses if s is not None]
+    peak = max(known) if known else None
+    ys = model.yield_strength
+    ratio = None if peak is None or not ys else peak / ys
+    return {f"{prefix}peak_stress_MPa": None if peak is None else peak / 1e6,
+            f"{prefix}yield_ratio": ratio, f"{prefix}yields": None if ratio is None else bool(ratio >= 1.0)}
+
+
 def _crank_end_table(cases: list[Case], every_deg: float = 10.0) -> list[str]:
     grid = np.arange(0.0, 360.0 + 1e-9, every_deg)
     cols = [Column("theta2", "f", 7, 1)] + [Column(f"w={c.omega:g}", "f", 9, 2) for c in cases]
@@ -223,7 +286,7 @@ def _tidy(model_name: str, cases: list[Case]) -> pd.DataFrame:
     return with_units(pd.concat(frames, ignore_index=True), {"n_elements": "1"})
 
 
-def _summary(cases: list[Case], model: Model | None = None) -> dict[str, Any]:
+def _summary(cases: list[Case], model: Model, section: bool = False) -> dict[str, Any]:
     out: dict[str, Any] = {}
     for i, c in enumerate(cases, start=1):
         out[f"omega_{i}_rad_s"] = c.omega
@@ -233,7 +296,8 @@ def _summary(cases: list[Case], model: Model | None = None) -> dict[str, Any]:
             t, ta, _ = c.peak(+1)
             p, pa, _ = c.peak(-1)
             out.update({f"peak_tensile_{i}_microstrain": t * 1e6, f"peak_tensile_{i}_deg": ta,
-                        f"peak_compressive_{i}_microstrain": p * 1e6, f"peak_compressive_{i}_deg": pa})
+                        f"peak_compressive_{i}_microstrain": p * 1e6, f"peak_compressive_{i}_deg": pa,
+                        f"peak_stress_{i}_MPa": peak_stress(model, c.outer_peak()) / 1e6})
     good = [c for c in cases if c.ok]
     if good:
         best = max(good, key=lambda c: c.peak(+1)[0])
@@ -242,7 +306,9 @@ def _summary(cases: list[Case], model: Model | None = None) -> dict[str, Any]:
                     "peak_compressive_microstrain": worst.peak(-1)[0] * 1e6,
                     "peak_compressive_deg": worst.peak(-1)[1]})
     out["euler_ratio_max"] = max(c.euler_ratio for c in cases)
-    if model is not None:   # a section given by its shape (what a section optimisation varies)
+    out["yield_strength_MPa"] = None if not model.yield_strength else model.yield_strength / 1e6
+    out.update(yield_summary(model, [peak_stress(model, c.outer_peak()) if c.ok else None for c in cases]))
+    if section:   # a section given by its shape (what a section optimisation varies)
         out["rod_mass_kg"] = model.rho_a * model.length
         out["section_area_m2"] = model.area
     out["buckled"] = any(not c.ok for c in cases)
@@ -327,6 +393,10 @@ def run_linear(params: Params, progress: bool = False) -> Result:
     conv = {w: [done[(w, n)] for n in counts] for w in params.speeds} if params.element_counts else {}
     if conv:
         text += _convergence_table(conv, model.length) + [""]
+    stress_rows = [("linear", c.omega, peak_stress(model, c.outer_peak()) if c.ok else None) for c in cases]
+    if params.end_time <= 0:
+        text += yield_table(model, stress_rows) + [""]
+        warnings += yield_warnings(model, stress_rows)
     for c in cases:
         if c.euler_ratio > EULER_WARN:
             msg = (f"crank speed {c.omega:g} rad/s: peak rod compression {c.peak_compression:.1f} N is "
@@ -391,7 +461,8 @@ def run_linear(params: Params, progress: bool = False) -> Result:
         stiffness = "K + K_G" if params.geometric_stiffness else "linear model"
         figures.append(Figure("strain", lambda: figures_module().slidercrank_strain_figure(
             [(f"{c.omega:g} rad/s", c.angle_deg, c.eps_1 * 1e6) for c in good],
-            f"{params.material}: crank-end element axial strain ({stiffness})", above=above, missing=missing)))
+            f"{params.material}: crank-end element axial strain ({stiffness})", above=above, missing=missing,
+            yield_strain=yield_strain(model))))
         figures.append(Figure("deflection", lambda: figures_module().slidercrank_strain_figure(
             [(f"{c.omega:g} rad/s", c.angle_deg, c.mid * 1e3) for c in good],
             f"{params.material}: midpoint deflection ({stiffness})", ylabel="midpoint deflection [mm]",
@@ -408,7 +479,7 @@ def run_linear(params: Params, progress: bool = False) -> Result:
         figures.append(Figure("convergence", lambda: figures_module().slidercrank_convergence_figure(
             series, f"{params.material} rod at {speeds}: convergence of the peak tensile strain with the mesh")))
     return Result(text="\n".join(text) + "\n", tidy=_tidy(params.material, list(done.values())),
-                  summary=_summary(cases, model if section_shape(params)[1] else None), warnings=warnings, failure=failure,
+                  summary=_summary(cases, model, bool(section_shape(params)[1])), warnings=warnings, failure=failure,
                   figures=figures)
 
 

@@ -21,8 +21,19 @@ from driver._table import Cell, Column, render_table
 from driver.slidercrank._analysis import Case, run_case, static_onset
 from driver.slidercrank._analysis_nl import IRREGULAR, NLCase, onset_search, run_nl_case
 from driver.slidercrank._kernel import NonlinearStatus
-from driver.slidercrank._report import Derived, figures_module, header_lines, run_linear, status_text
-from driver.slidercrank._spec import SPEC, model_of, rayleigh
+from driver.slidercrank._report import (
+    Derived,
+    figures_module,
+    header_lines,
+    peak_stress,
+    run_linear,
+    status_text,
+    yield_strain,
+    yield_summary,
+    yield_table,
+    yield_warnings,
+)
+from driver.slidercrank._spec import SPEC, Model, model_of, rayleigh
 
 
 def nl_status_text(c: NLCase) -> str:
@@ -167,7 +178,7 @@ def _buckled_words(nl: NLCase, tol: float, limit: float) -> str:
 
 
 def _summary(pairs: list[tuple[Case, NLCase]], tol: float, limit: float,
-             onset: dict[str, tuple[float, float] | None] | None) -> dict[str, Any]:
+             onset: dict[str, tuple[float, float] | None] | None, model: Model) -> dict[str, Any]:
     out: dict[str, Any] = {}
     for i, (lin, nl) in enumerate(pairs, start=1):
         out[f"omega_{i}_rad_s"] = nl.omega
@@ -185,6 +196,10 @@ def _summary(pairs: list[tuple[Case, NLCase]], tol: float, limit: float,
         out["nl_peak_outer_microstrain"] = max(float(c.eps_of.max()) for c in good) * 1e6
     out["n_buckled"] = sum(nl.buckled(tol, limit) for _, nl in pairs)
     out["buckled"] = out["n_buckled"] > 0
+    out["yield_strength_MPa"] = None if not model.yield_strength else model.yield_strength / 1e6
+    rows = _stress_rows(model, pairs)
+    out.update(yield_summary(model, [s for m, _, s in rows if m == "linear"]))
+    out.update(yield_summary(model, [s for m, _, s in rows if m == "nonlinear"], "nl_"))
     if onset:
         for what, br in onset.items():
             if br is not None:
@@ -223,7 +238,9 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
         [""] + _strain_curves(pairs) + [""]
     if onset is not None:
         text += _onset_lines(onset, params, static, limit) + [""]
-    warnings: list[str] = []
+    rows = _stress_rows(model, pairs)
+    text += yield_table(model, rows) + [""]
+    warnings: list[str] = yield_warnings(model, rows)
     failure = None
     for lin, nl in pairs:
         if nl.status in ("no_convergence", "not_spd"):
@@ -258,7 +275,7 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
         figures.append(Figure("strain_linear_nonlinear", lambda: figures_module().slidercrank_nl_strain_figure(
             [(f"{nl.omega:g} rad/s", lin.angle_deg, lin.eps_1 * 1e6, nl.eps_ax[0] * 1e6) for lin, nl in good],
             f"{params.material}: crank-end axial strain, linear model and nonlinear rod, per crank speed",
-            buckled=buckled)))
+            buckled=buckled, yield_strain=yield_strain(model))))
     okn = [nl for nl in nls if nl.ok]
     if okn:
         figures.append(Figure("shapes", lambda: figures_module().slidercrank_nl_shapes_figure(
@@ -268,8 +285,8 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
         [(f"{c.omega:g} rad/s", c.rev_lat[:max(c.steps_done - 1, 0) // c.steps_per_rev + 1] * 1e3)
          for c in nls if c.steps_done], f"{params.material}: peak lateral deflection per revolution")))
     return Result(text="\n".join(text) + "\n", tidy=_tidy(params.material, pairs),
-                  summary=_summary(pairs, tol, limit, onset), warnings=warnings, failure=failure, figures=figures,
-                  data=_rod_data(okn))
+                  summary=_summary(pairs, tol, limit, onset, model), warnings=warnings, failure=failure,
+                  figures=figures, data=_rod_data(okn))
 
 
 def _rod_data(okn: list[NLCase]) -> dict[str, Any]:
@@ -283,6 +300,16 @@ def _rod_data(okn: list[NLCase]) -> dict[str, Any]:
         return {}
     return {"rod": {"omega_rad_s": c.omega, "n_elements": c.n_elements, "angle_deg": np.asarray(c.frame_deg),
                     "lateral_m": np.asarray(c.frames)}}
+
+
+def _stress_rows(model: Model, pairs: list[tuple[Case, NLCase]]) -> list[tuple[str, float, float | None]]:
+    """(model, crank speed [rad/s], peak outer-fibre stress E eps [Pa] or None) of both models at
+    every speed, for the yield check."""
+    rows: list[tuple[str, float, float | None]] = []
+    for lin, nl in pairs:
+        rows.append(("linear", lin.omega, peak_stress(model, lin.outer_peak()) if lin.ok else None))
+        rows.append(("nonlinear", nl.omega, peak_stress(model, float(nl.eps_of.max())) if nl.ok else None))
+    return rows
 
 
 @study_run(SPEC)

@@ -16,16 +16,26 @@ from driver.slidercrank import _kernel as kernel
 
 #: Table 1a of the paper (columns re-ordered, docs/slidercrank.md); the depth is the
 #: in-plane section depth used for the outer-fibre strain (weak axis in plane).
+#: ``yield_strength`` [Pa] and ``grade``: the paper names no grade, so the tool assumes a common one
+#: for each and says so (docs/bibliography.md): aluminium alloy 6061-T6, typical tensile yield
+#: 276 MPa [ASM Vol. 2]; medium-carbon steel AISI 1045 and low-carbon steel AISI 1020, hot rolled,
+#: minimum yield 310 and 210 MPa (SAE J1397, as tabulated by [Shigley], Table A-20).
 MATERIALS: dict[str, dict[str, Any]] = {
     "aluminium": dict(area=27e-6, second_moment=2.025e-11, density=2660.0, youngs_modulus=7.17e10,
-                      section_depth=3.0e-3, section="rectangle 9 x 3 mm, weak axis in plane"),
+                      section_depth=3.0e-3, section="rectangle 9 x 3 mm, weak axis in plane",
+                      yield_strength=276e6, grade="aluminium alloy 6061-T6 assumed, typical yield [ASM Vol. 2]"),
     "medium_carbon_steel": dict(area=22.5e-6, second_moment=1.1718e-11, density=7800.0,
                                 youngs_modulus=20.68e10, section_depth=2.5e-3,
-                                section="rectangle 9 x 2.5 mm, weak axis in plane"),
+                                section="rectangle 9 x 2.5 mm, weak axis in plane",
+                                yield_strength=310e6,
+                                grade="AISI 1045 hot rolled assumed, minimum yield [Shigley] Table A-20"),
     "low_carbon_steel": dict(area=7.8965e-5, second_moment=4.9620e-10, density=7800.0,
                              youngs_modulus=18.96e10, section_depth=10.03e-3,
-                             section="round bar D = 10.03 mm"),
+                             section="round bar D = 10.03 mm", yield_strength=210e6,
+                             grade="AISI 1020 hot rolled assumed, minimum yield [Shigley] Table A-20"),
 }
+#: a yield strength below this [Pa] is taken for a unit mistake (MPa given for Pa)
+MIN_YIELD_PA = 1.0e5
 SECTION_KEYS = ("area", "second_moment", "density", "youngs_modulus", "section_depth")
 #: the paper's six crank speeds [rad/s]
 PAPER_SPEEDS = (11.52, 14.66, 18.85, 21.99, 25.13, 29.32)
@@ -118,6 +128,14 @@ _KEYS: dict[str, Key] = {
     "section_diameter": Key("float", check=positive, units="m",
                             doc="round rod: diameter d gives area = pi d^2/4, second_moment = pi d^4/64, "
                                 "depth d (instead of area, second_moment and section_depth)"),
+    "yield_strength": Key("float", units="Pa",
+                          check=lambda v: positive(v) or (f"{v:g} Pa is below {MIN_YIELD_PA:g} Pa: yield strengths "
+                                                          "are in Pa (276 MPa is 2.76e8); this looks like MPa"
+                                                          if v < MIN_YIELD_PA else None),
+                          doc="the rod's yield strength; its peak outer-fibre stress E eps is checked against it in "
+                              "every model (default: the named material's assumed grade, docs/slidercrank.md: "
+                              "aluminium 6061-T6 276 MPa, AISI 1045 310 MPa, AISI 1020 210 MPa; custom: none, no "
+                              "check)"),
     "slider_mass": Key("float", default=0.9, check=positive, units="kg", doc="M (Table 1b)"),
     "bearing_mass_crank": Key("float", default=0.05, check=non_negative, units="kg",
                               doc="m_B at the crank pin (prescribed motion: does not load the rod)"),
@@ -204,6 +222,10 @@ class Model:
         Bearing masses at the crank pin and the slider, kg.
     sources : dict of str to str
         Where each value came from (the deck, a named material, a section shape).
+    yield_strength : float or None
+        The rod's yield strength, Pa; None: not known (a custom rod without ``yield_strength``).
+    yield_source : str
+        Where it came from (the deck, or the grade assumed for a named material).
     """
 
     r2: float
@@ -217,6 +239,8 @@ class Model:
     bearing_crank: float
     bearing_slider: float
     sources: dict[str, str] = field(default_factory=dict)
+    yield_strength: float | None = None
+    yield_source: str = ""
 
     @property
     def rho_a(self) -> float:
@@ -286,9 +310,14 @@ def model_of(params: Params) -> Model:
         else:
             raise params.error(key, f"missing: give {key} or name a material "
                                     f"({', '.join(repr(m) for m in MATERIALS)})")
+    ys: float | None
+    if params.yield_strength is not None:
+        ys, ysrc = float(params.yield_strength), "deck"
+    else:
+        ys, ysrc = table.get("yield_strength"), table.get("grade", "")
     return Model(params.crank_radius, params.rod_length, values["area"], values["second_moment"],
                  values["density"], values["youngs_modulus"], values["section_depth"], params.slider_mass,
-                 params.bearing_mass_crank, params.bearing_mass_slider, sources)
+                 params.bearing_mass_crank, params.bearing_mass_slider, sources, ys, ysrc)
 
 
 def rayleigh(zeta: float, w1: float, w2: float) -> tuple[float, float]:

@@ -132,7 +132,7 @@ def compute_case(task: CaseTask, case: Case, module: Any) -> tuple[CaseResult, A
         if full or module.summarise is None:
             result = compute(module, params)
             res.summary = dict(result.summary)
-            if result.failure:
+            if result.failure and not result.design_failure:   # a design's own answer is no failed case
                 res.status, res.error = ExitCode.FAILED, result.failure
         else:
             res.summary = dict(module.summarise(params))
@@ -150,7 +150,7 @@ def _write_case(task: CaseTask, case: Case, res: CaseResult, result: Any, params
     try:
         if result is None:
             result = compute(module, params)
-            if result.failure:
+            if result.failure and not result.design_failure:
                 res.status, res.error = ExitCode.FAILED, result.failure
         res.warnings = list(result.warnings)
         stem = task.layout.stem(case.index)

@@ -190,6 +190,12 @@ def _check_columns(sw: Params, module: Any, base: Params, grid: Grid, plotted: l
     kinds = {**expr.kinds_of({n: v[0] for n, v in zip(grid.names, grid.values) if len(v)}), **expr.kinds_of(probe),
              "case": "number"}
     for key, text in named:
+        try:   # an old column name is answered with its new one (Study.renamed)
+            refusal = module.renamed_in(sorted(expr.parse(text).names))
+        except expr.ExprError:
+            refusal = None
+        if refusal:
+            raise sw.error(key, refusal)
         try:
             if key == "keep":
                 check_keep(text, columns, kinds)   # one number or logical per case, before any case runs
@@ -204,6 +210,9 @@ def _check_columns(sw: Params, module: Any, base: Params, grid: Grid, plotted: l
                            + ("" if key == "keep" else f"; summary columns: {', '.join(columns)}")) from None
     if not sw.summary_columns:
         return None
+    refusal = module.renamed_in(sw.summary_columns)
+    if refusal:
+        raise sw.error("summary_columns", refusal)
     unknown = [c for c in sw.summary_columns if c not in probe]
     if unknown:
         raise sw.error("summary_columns", f"'{unknown[0]}' is not a summary column of &{base.group} "

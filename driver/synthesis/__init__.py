@@ -34,9 +34,10 @@ from driver import _blas as blas
 from driver import _expr as expr
 from driver import fourbar
 from driver._atomic import output_set, write_text
-from driver._deck import Deck, DeckError, GroupSpec, Key, Params, RawGroup, positive, read_deck, validate
+from driver._deck import Deck, DeckError, GroupSpec, Key, Params, RawGroup, positive, validate
 from driver._export import write_tidy
 from driver._outcome import SynthesisOutcome
+from driver._pydeck import DeckSource, source_deck
 from driver._result import Figure
 from driver._runner import compute, output_stem, write_outputs
 from driver.fourbar import _kernel as fourbar_kernel
@@ -330,7 +331,12 @@ def _synthesise_function(p: Params) -> Synthesis:
         lines += ["    precision point   rocker error, this branch [deg]   other branch [deg]"]
         lines += [f"    {xx:15.6f}   {e1:31.3e}   {e2:18.3e}".replace("nan", "  -")
                   for xx, e1, e2 in zip(xs, fd.point_error_deg, fd.other_branch_point_error_deg)]
-        if len(bad):
+        chain = fourbar.grashof(d, fd.crank, fd.coupler, fd.rocker)
+        lines += [f"    class of the linkage:  {chain.name} ({chain.condition}); the crank "
+                  + ("turns fully" if chain.full_crank_rotation else "does not turn fully")]
+        if not chain.movable:   # Freudenstein's K solve gives lengths, not a chain that closes
+            failure = f"the linkage cannot move ({chain.name}): {chain.reason}"
+        elif len(bad):
             failure = (f"the linkage cannot run the x range on the {p.branch} branch: "
                        f"{len(bad)} of {len(x)} points cannot be assembled or are at a toggle "
                        f"(first at x = {x[bad[0]]:.6g})")
@@ -505,6 +511,9 @@ def _synthesise_path(p: Params) -> Synthesis:
     fp = validate(RawGroup("fourbar", dict(linkage), {}, p.line), fourbar.SPEC, p.path)
     g = fourbar.grashof(fp.fixed_link, fp.crank, fp.coupler, fp.rocker)
     ex = fourbar.extremes(fp)
+    if not g.movable:
+        lines += [f"  Check over a full turn: {g.name} ({g.condition})"]
+        failure = failure or f"the linkage cannot move ({g.name}): {g.reason}"
     if ex is not None:
         lines += [f"  Check over a full turn: {g.name}; assembled {100 * ex.assembled_fraction:.1f} % of the turn; "
                   f"transmission angle {ex.mu_min:.4f} .. {ex.mu_max:.4f} deg"]
@@ -524,13 +533,17 @@ def _synthesise_path(p: Params) -> Synthesis:
 # ----------------------------------------------------------------------------- run
 
 @blas.one_thread()
-def synthesise(deck: Deck | str | Path) -> Synthesis:
+def synthesise(deck: DeckSource | Deck, name: str | None = None) -> Synthesis:
     """Run a &synthesis deck: design the linkage, check it, and run its &fourbar deck.
 
     Parameters
     ----------
-    deck : Deck, str or path-like
-        The deck (a ``&synthesis`` group only), or its file.
+    deck : str, path-like, dict or Deck
+        The deck (a ``&synthesis`` group only), as every entry point takes one
+        (``driver.DeckSource``): its file, its text, a dict ``{"synthesis": {...}}`` (keys in
+        the deck's units), or a parsed Deck.
+    name : str, optional
+        The deck's name in messages and titles; default its file stem, or ``synthesis``.
 
     Returns
     -------
@@ -541,11 +554,13 @@ def synthesise(deck: Deck | str | Path) -> Synthesis:
     Raises
     ------
     DeckError
-        Bad input, another group beside ``&synthesis``, degenerate path targets, or work or
-        memory beyond the budget (``--max-work``, ``--max-memory``), before anything is computed.
+        Bad input (an unreadable file, a bad key or value), another group beside
+        ``&synthesis``, degenerate path targets, or work or memory beyond the budget
+        (``--max-work``, ``--max-memory``), before anything is computed.
+    TypeError
+        ``deck`` is not a deck source (a number, bytes, ...).
     """
-    if not isinstance(deck, Deck):
-        deck = read_deck(deck)
+    deck = source_deck(deck, name)
     others = [g for g in deck.groups if g != "synthesis"]
     if others:
         raw = deck.groups[others[0]]

@@ -13,8 +13,21 @@ from scipy.optimize import minimize
 from tqdm import tqdm
 
 from driver._deck import Params
-from driver.ujoint._kernel import UJOINT_MODELS, UJOINT_OBJECTIVES, ujoint_equivalent, ujoint_objective, ujoint_speed
-from driver.ujoint._spec import DEG
+from driver.ujoint._kernel import (
+    UJOINT_CV_TOL,
+    UJOINT_MODELS,
+    UJOINT_OBJECTIVES,
+    UJOINT_PASSES,
+    UJOINT_SUMMARY_COLUMNS,
+    ujoint_equivalent,
+    ujoint_input_torque,
+    ujoint_jet,
+    ujoint_objective,
+    ujoint_roots,
+    ujoint_speed,
+    ujoint_summaries,
+)
+from driver.ujoint._spec import DEG, loads, origin_deg
 
 #: phases within this of a symmetric assembly count as sitting on it [rad]
 SYM_TOL = 1e-7
@@ -50,6 +63,11 @@ class Chain:
         Input angles per revolution of the grid.
     rpm : float
         Input shaft speed, rpm.
+    origin : float, default 0.0
+        The kernel's input angle at the deck's theta = 0, deg (0: angle_origin 'normal', the
+        kernel's own; 90: 'plane').
+    load : tuple of float or None, default None
+        The output shaft's moment of inertia [kg m^2] and load torque [N m]; None: no load given.
     """
 
     model: int
@@ -57,11 +75,46 @@ class Chain:
     rho: np.ndarray          # (n-1,) rad
     m: int                   # grid points per revolution
     rpm: float
+    origin: float = 0.0      # deg
+    load: tuple[float, float] | None = None
 
     @property
     def omega(self) -> float:
         """Input speed [rad/s]."""
         return self.rpm * 2.0 * math.pi / 60.0
+
+    def kernel_rad(self, theta_deg) -> np.ndarray:
+        """Convert the deck's input angles to the kernel's.
+
+        Parameters
+        ----------
+        theta_deg : array_like
+            Input angles from the deck's ``angle_origin``, deg.
+
+        Returns
+        -------
+        numpy.ndarray
+            The same angles from the normal to joint 1's plane (the kernel's origin), rad.
+        """
+        return (np.asarray(theta_deg, float) + self.origin) * DEG
+
+    def deck_deg(self, theta_rad, period: float = 360.0) -> np.ndarray:
+        """Convert the kernel's input angles to the deck's.
+
+        Parameters
+        ----------
+        theta_rad : array_like
+            Input angles from the normal to joint 1's plane (the kernel's origin), rad.
+        period : float, default 360.0
+            The period to reduce them to, deg (180: the speed ratio's period).
+
+        Returns
+        -------
+        numpy.ndarray
+            The same angles from the deck's ``angle_origin``, deg in [0, period).
+        """
+        d = np.mod(np.asarray(theta_rad, float) / DEG - self.origin, period)
+        return np.where(d >= period - 1e-9, 0.0, d)
 
 
 @dataclass
@@ -91,9 +144,16 @@ class Design:
     beta_res : float or None
         Resultant angle, deg; None where undefined.
     peak_acc : float
-        Peak output angular acceleration at constant input speed, rad/s^2.
+        Peak output angular acceleration at constant input speed, rad/s^2 (its magnitude,
+        found to 1e-12 rad by the kernel's root finding on the closed form).
     mean_ratio : float
         Mean of R over the revolution (1 for a closed chain), dimensionless.
+    peak_acc_at : float or None
+        The input angle of ``peak_acc`` (the first where it peaks), deg from the deck's origin;
+        None for a constant-velocity chain.
+    ratio_one_at : float or None
+        The first input angle in [0, 180) deg (R has period 180 deg) where R = 1, deg from the
+        deck's origin; None when R - 1 keeps its sign (a constant-velocity chain).
     extra : dict
         Further figures of the design.
     """
@@ -110,6 +170,8 @@ class Design:
     beta_res: float | None = None
     peak_acc: float = 0.0
     mean_ratio: float = 1.0
+    peak_acc_at: float | None = None
+    ratio_one_at: float | None = None
     extra: dict = field(default_factory=dict)
 
 
@@ -184,11 +246,18 @@ def evaluate(chain: Chain, label: str, beta_deg, phi_deg, model: int | None = No
     theta = np.arange(chain.m) * (2.0 * math.pi / chain.m)
     ratio, dratio, _ = ujoint_speed(model, b, ph, chain.rho, theta)
     be, br = ujoint_equivalent(model, b, ph, chain.rho)
+    # the peak acceleration and the first angle of R = 1 by the summary kernel's root finding
+    # (the same bits as a sweep's batch row)
+    row = dict(zip(UJOINT_SUMMARY_COLUMNS, ujoint_summaries(
+        model, chain.kind, b[None, :], ph[None, :], None if b.size < 2 else np.asarray(chain.rho)[None, :],
+        chain.m, passes=UJOINT_PASSES["speed"], theta0=chain.origin * DEG)[0]))
     return Design(label, np.asarray(beta_deg, float), np.asarray(phi_deg, float), float(f),
                   float(ms * chain.rpm ** 2), float(ratio.max() - ratio.min()),
                   float(chain.rpm * ratio.min()), float(chain.rpm * ratio.max()), be / DEG,
-                  None if br is None else br / DEG, float(chain.omega ** 2 * np.abs(dratio).max()),
-                  float(ratio.mean()))
+                  None if br is None else br / DEG, float(chain.omega ** 2 * row["dratio_abs_max"]),
+                  float(ratio.mean()),
+                  None if row["dratio_abs_max_at"] < 0 else float(chain.deck_deg(row["dratio_abs_max_at"])),
+                  None if row["ratio_one_at"] < 0 else float(chain.deck_deg(row["ratio_one_at"], 180.0)))
 
 
 @dataclass
@@ -379,7 +448,8 @@ def free_index(option: int, n: int) -> np.ndarray:
 def chain_of(params: Params, rho_deg: np.ndarray | None, n: int, model: str | None = None) -> Chain:
     model = model or (params.model if params.model == "exact" else params.phasing)
     rho = np.zeros(n - 1) if rho_deg is None else np.asarray(rho_deg, float) * DEG
-    return Chain(UJOINT_MODELS[model], UJOINT_OBJECTIVES[params.objective], rho, params.n_grid, params.rpm)
+    return Chain(UJOINT_MODELS[model], UJOINT_OBJECTIVES[params.objective], rho, params.n_grid, params.rpm,
+                 origin_deg(params), loads(params))
 
 
 def start_points(params: Params, option: int, beta: np.ndarray, phi: np.ndarray, lb: np.ndarray,
@@ -412,6 +482,90 @@ def start_points(params: Params, option: int, beta: np.ndarray, phi: np.ndarray,
 
 
 def output_speed(chain: Chain, d: Design, theta_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(omega_out [rpm], alpha_out [rad/s^2], theta_out [deg]) of design d at theta_deg."""
-    r, dr, to = ujoint_speed(chain.model, d.beta * DEG, d.phi * DEG, chain.rho, theta_deg * DEG)
-    return chain.rpm * r, chain.omega ** 2 * dr, to / DEG
+    """(omega_out [rpm], alpha_out [rad/s^2], theta_out [deg]) of design d at the deck's input
+    angles theta_deg (from its angle_origin; theta_out from the same origin)."""
+    r, dr, to = ujoint_speed(chain.model, d.beta * DEG, d.phi * DEG, chain.rho, chain.kernel_rad(theta_deg))
+    return chain.rpm * r, chain.omega ** 2 * dr, to / DEG - chain.origin
+
+
+def input_torque(chain: Chain, d: Design, theta_deg: np.ndarray) -> np.ndarray:
+    """Input torque [N m] of design d at the deck's input angles theta_deg [deg] that drives the
+    output shaft's load (``chain.load``) at constant input speed (zeros without a load)."""
+    if chain.load is None:
+        return np.zeros(np.shape(theta_deg))
+    t, _ = ujoint_input_torque(chain.model, d.beta * DEG, d.phi * DEG, chain.rho, chain.kernel_rad(theta_deg),
+                               chain.omega, *chain.load)
+    return t
+
+
+@dataclass
+class Textbook:
+    """The figures a textbook asks of a Hooke-joint chain, each found by root finding on the
+    kernel's closed form (1e-12 rad): angles in deg from the deck's origin, in [0, 360).
+
+    Attributes
+    ----------
+    ratio_one : numpy.ndarray
+        The input angles where omega_out = omega_in (R = 1), deg.
+    accel_peak : float
+        The peak magnitude of the output angular acceleration at constant input speed, rad/s^2.
+    accel_peak_at : numpy.ndarray
+        The input angles where it is reached (within 1e-9 of it), deg.
+    accel_peak_signed : numpy.ndarray
+        The signed output acceleration there, rad/s^2.
+    torque_peak, torque_mean : float or None
+        With a load: the peak magnitude and the mean of the input torque over a turn, N m.
+    torque_peak_at : numpy.ndarray
+        The input angles of the torque peak, deg.
+    torque_peak_signed : numpy.ndarray
+        The signed input torque there, N m.
+    """
+
+    ratio_one: np.ndarray
+    accel_peak: float
+    accel_peak_at: np.ndarray
+    accel_peak_signed: np.ndarray
+    torque_peak: float | None = None
+    torque_mean: float | None = None
+    torque_peak_at: np.ndarray = field(default_factory=lambda: np.empty(0))
+    torque_peak_signed: np.ndarray = field(default_factory=lambda: np.empty(0))
+
+
+#: extremes within this relative difference of the largest count as the same peak (the mirror and
+#: half-turn images of one peak, equal but for round-off)
+PEAK_RTOL = 1e-9
+
+
+def textbook(chain: Chain, d: Design) -> Textbook:
+    """Where design d's speed ratio is one, where and how high its output acceleration peaks,
+    and with a load the peak and mean input torque over a turn (:class:`Textbook`)."""
+    b, ph = d.beta * DEG, d.phi * DEG
+    uniform = d.pp < UJOINT_CV_TOL   # a constant-velocity chain: R = 1 throughout, no peak (round-off only)
+    one = np.empty(0) if uniform else np.sort(chain.deck_deg(ujoint_roots(chain.model, "ratio_one", b, ph,
+                                                                          chain.rho, chain.m)))
+    ext = np.empty(0) if uniform else ujoint_roots(chain.model, "accel_extreme", b, ph, chain.rho, chain.m)
+    _, r1, _ = ujoint_jet(chain.model, b, ph, chain.rho, ext)
+    acc = chain.omega ** 2 * r1
+    top = float(np.abs(acc).max()) if acc.size else 0.0
+    at = np.abs(acc) >= top * (1.0 - PEAK_RTOL) if top > 0 else np.zeros(acc.size, bool)
+    order = np.argsort(chain.deck_deg(ext[at]))
+    tb = Textbook(one, top, chain.deck_deg(ext[at])[order], acc[at][order])
+    if chain.load is not None:
+        inertia, load = chain.load
+        coef = (inertia * chain.omega ** 2, load)
+        tx = ujoint_roots(chain.model, "torque_extreme", b, ph, chain.rho, chain.m, coef)
+        grid = np.arange(chain.m) * (2.0 * math.pi / chain.m)
+        t_ext, _ = ujoint_input_torque(chain.model, b, ph, chain.rho, tx, chain.omega, inertia, load)
+        t_grid, _ = ujoint_input_torque(chain.model, b, ph, chain.rho, grid, chain.omega, inertia, load)
+        tb.torque_mean = float(t_grid.mean())   # the trapezoid rule of a periodic function
+        if t_ext.size and np.abs(t_ext).max() >= np.abs(t_grid).max():
+            peak = float(np.abs(t_ext).max())
+            hit = np.abs(t_ext) >= peak * (1.0 - PEAK_RTOL)
+            angles, signed = chain.deck_deg(tx[hit]), t_ext[hit]
+        else:   # a torque constant over the turn (no load inertia, no fluctuation): the grid's
+            peak = float(np.abs(t_grid).max())
+            hit = np.abs(t_grid) >= peak * (1.0 - PEAK_RTOL)
+            angles, signed = chain.deck_deg(grid[hit]), t_grid[hit]
+        order = np.argsort(angles)
+        tb.torque_peak, tb.torque_peak_at, tb.torque_peak_signed = peak, angles[order], signed[order]
+    return tb

@@ -21,15 +21,15 @@ from driver.ujoint._kernel import (
     ujoint_geometry,
     ujoint_summaries,
 )
-from driver.ujoint._spec import DEG, KEYS
+from driver.ujoint._spec import DEG, KEYS, loads, origin_deg
 
 #: deck keys a batch may vary (one value per design); list keys as one value per design (a
 #: single-element list, as a sweep sets them), a (designs, k) array of whole lists, or element
 #: columns 'key(i)' (:data:`BATCH_ELEMENTS`)
 BATCH_KEYS = ("beta", "phi", "delta", "rho", "rpm", "model", "phasing", "objective", "n_grid")
 #: keys the summary of an option-0 run does not depend on (accepted, ignored)
-BATCH_IGNORED = ("table_step", "n_starts", "seed", "maxiter", "ftol", "beta_lower", "beta_upper", "phi_lower",
-                 "phi_upper", "paper_beta", "paper_phi", "paper_u", "paper_nit", "paper_nfev", "paper_band")
+BATCH_IGNORED = ("table_step", "tidy_grid", "n_starts", "seed", "maxiter", "ftol", "beta_lower", "beta_upper",
+                 "phi_lower", "phi_upper", "paper_beta", "paper_phi", "paper_u", "paper_nit", "paper_nfev", "paper_band")
 #: keys whose deck checks do not involve other keys (a sweep validates each of their values once)
 BATCH_INDEPENDENT = ("rpm", "objective", "n_grid", "table_step", "n_starts", "seed", "maxiter", "ftol",
                      "paper_u", "paper_nit", "paper_nfev")
@@ -40,13 +40,21 @@ BATCH_INDEPENDENT = ("rpm", "objective", "n_grid", "table_step", "n_starts", "se
 BATCH_PASSES: dict[str, tuple[str, ...]] = {
     "objective": ("objective",), "objective_trial": ("objective",), "pp_ratio": ("speed",),
     "omega_out_min_rpm": ("speed",), "omega_out_max_rpm": ("speed",), "beta_e_deg": ("equivalent",),
-    "beta_res_deg": ("equivalent",), "peak_accel_rad_s2": ("speed",), "converged": (), "iterations": (),
+    "beta_res_deg": ("equivalent",), "peak_accel_rad_s2": ("speed",), "peak_accel_at_deg": ("speed",),
+    "ratio_one_at_deg": ("speed",), "converged": (), "iterations": (),
     "evaluations": (),
 }
 
 #: list keys a batch column may set one element of, as 'phi(2)' (1-based; the optimiser's variables)
 BATCH_ELEMENTS = ("beta", "phi", "delta", "rho")
 _ELEMENT = re.compile(r"([a-z_]+)\((\d+)\)")
+
+
+def _deck_deg(theta_rad: np.ndarray, origin: float, period: float) -> np.ndarray:
+    """Kernel input angles [rad, from the normal] as the deck's [deg from its origin, in [0, period)]
+    (the association of driver.ujoint._analysis.Chain.deck_deg: the same bits)."""
+    d = np.mod(np.asarray(theta_rad, float) / DEG - origin, period)
+    return np.where(d >= period - 1e-9, 0.0, d)
 
 
 def batch_applies(base: Mapping[str, Any]) -> bool:
@@ -60,9 +68,10 @@ def batch_applies(base: Mapping[str, Any]) -> bool:
     Returns
     -------
     bool
-        True for option 0 (options 1-3 run an optimisation per case, which the batch does not).
+        True for option 0 without a load on the output shaft (options 1-3 run an optimisation
+        per case, and the input torque of ``load_inertia``/``load_torque`` is found case by case).
     """
-    return int(base["option"]) == 0
+    return int(base["option"]) == 0 and loads(base) is None
 
 
 def _design_count(base: Mapping[str, Any], columns: dict[str, Any]) -> int:
@@ -250,6 +259,7 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
     code = _codes(np.where(exact, "exact", phasing), UJOINT_MODELS)
     kind = _codes(_choice_column(base, "objective", cols, nd), UJOINT_OBJECTIVES)
     rpm = _number_column(base, "rpm", cols, nd)
+    origin = origin_deg(base)
     grid = _number_column(base, "n_grid", cols, nd).astype(np.int64)
     res = np.empty((nd, len(UJOINT_SUMMARY_COLUMNS)))
     rho_rad = None if rho is None else rho * DEG
@@ -267,7 +277,8 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
               sum({UJOINT_PASSES[p] for c in names for p in BATCH_PASSES.get(c, ())}))
     for (c, k, m), rows in groups:
         res[rows] = ujoint_summaries(int(c), int(k), beta[rows] * DEG, phi[rows] * DEG,
-                                     None if rho_rad is None else rho_rad[rows], int(m), passes=passes)
+                                     None if rho_rad is None else rho_rad[rows], int(m), passes=passes,
+                                     theta0=origin * DEG)
     r = dict(zip(UJOINT_SUMMARY_COLUMNS, res.T))
     omega = rpm * 2.0 * math.pi / 60.0      # the association of Chain.omega (same bits)
     defined = r["beta_res_status"] == 0
@@ -277,6 +288,9 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
            "beta_e_deg": r["beta_e"] / DEG,
            "beta_res_deg": np.where(defined, r["beta_res"] / DEG, np.nan),
            "peak_accel_rad_s2": omega ** 2 * r["dratio_abs_max"],
+           "peak_accel_at_deg": np.where(r["dratio_abs_max_at"] < 0, np.nan,
+                                         _deck_deg(r["dratio_abs_max_at"], origin, 360.0)),
+           "ratio_one_at_deg": np.where(r["ratio_one_at"] < 0, np.nan, _deck_deg(r["ratio_one_at"], origin, 180.0)),
            "converged": np.ones(nd, bool), "iterations": np.zeros(nd, np.int64),
            "evaluations": np.zeros(nd, np.int64)}
     out.update({f"beta_{k + 1}_deg": beta[:, k] for k in range(n)})

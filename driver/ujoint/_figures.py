@@ -15,7 +15,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from driver.plotting import new_figure, plain_text, styled, suptitle
-from driver.ujoint._analysis import Chain, Design, output_speed
+from driver.ujoint._analysis import Chain, Design, output_speed, textbook
 
 #: line styles of the Hooke-joint designs, by the label driver.ujoint gives them
 _UJOINT_STYLES = {"trial": dict(color="C1", lw=1.4), "design": dict(color="C1", lw=1.4),
@@ -26,14 +26,17 @@ _UJOINT_STYLES = {"trial": dict(color="C1", lw=1.4), "design": dict(color="C1", 
 @styled
 def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.ndarray],
                         polar: bool = False, band: Sequence[float] | None = None, title: str = "",
-                        ax=None) -> Figure:
+                        ax=None, origin: str = "theta from the normal to joint 1's plane",
+                        ratio_one: dict[str, np.ndarray] | None = None) -> Figure:
     """Input and output shaft speed [rpm] against the input angle [deg], every design (trial,
     optimum, the paper's printed optimum) overlaid on one panel as in the paper's Figures 6-11,
     with the paper's trial band ``band`` = (min, max) [rpm] shaded when given.
 
     Cartesian or polar (angle = input angle, radius = speed); the polar radius starts near
     the slowest speed, not at 0, so a fluctuation of a fraction of an rpm stays visible (the
-    empty centre says the radius does not start at 0)."""
+    empty centre says the radius does not start at 0).  ``origin`` says where the input angle is
+    0 (the deck's angle_origin), in the axis label; ``ratio_one``: per design the input angles
+    [deg] where its output speed equals the input's, marked on the input-speed line."""
     if ax is not None:   # the caller's axes (a polar one for polar = True)
         fig = ax.figure
     elif polar:
@@ -57,6 +60,10 @@ def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.
         ax.plot(x, w, label=f"{label}: output {np.min(w):.2f}-{np.max(w):.2f} rpm", **style)
     # the input speed last and on top: an optimum close to it must not hide it
     ax.plot(x, np.full_like(theta_deg, rpm, dtype=float), "k--", lw=1.1, zorder=5, label=f"input shaft {rpm:g} rpm")
+    marks = np.concatenate([np.asarray(v, float) for v in (ratio_one or {}).values()] or [np.empty(0)])
+    if marks.size:
+        ax.plot(np.radians(marks) if polar else marks, np.full(marks.size, rpm), "o", ms=4, mfc="none", mec="k",
+                zorder=4.5, label="output speed = input speed")   # under the input line (on top, zorder 5)
     if polar:
         ax.set_rlim(low - pad, top + pad)
         ax.set_rorigin(low - pad - 0.6 * (top - low + 2 * pad))
@@ -67,12 +74,12 @@ def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.
         for t in ticks:   # radial labels cross the curves: drawn on a white patch, above them
             ax.text(np.radians(112.5), t, f"{t:g} rpm", fontsize=7.5, ha="center", va="center", zorder=6,
                     bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.85))
-        ax.set_xlabel("input angle [deg]; radius: shaft speed [rpm], not starting at 0", fontsize=8)
+        ax.set_xlabel(f"input angle [deg, {origin}]; radius: shaft speed [rpm], not starting at 0", fontsize=8)
         fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncol=2, frameon=False)
     else:
         ax.set_ylim(low - pad, top + pad)
         ax.set_ylabel("shaft speed [rpm]")
-        ax.set_xlabel("input angle [deg]")
+        ax.set_xlabel(f"input angle [deg, {origin}]")
         ax.set_xlim(0.0, 360.0)
         ax.set_xticks(np.arange(0, 361, 45))
         fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncol=2, frameon=False)
@@ -82,8 +89,13 @@ def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.
 
 
 # ----------------------------------------------------------------------------- figures of a run
-def speed_figure(chain: Chain, designs: list[Design], polar: bool, band: list[float] | None = None, title: str = ""):
-    """The speed figure: every design overlaid, the paper's trial band (``paper_band``) shaded."""
+def speed_figure(chain: Chain, designs: list[Design], polar: bool, band: list[float] | None = None, title: str = "",
+                 origin: str = "theta from the normal to joint 1's plane"):
+    """The speed figure: every design overlaid, the paper's trial band (``paper_band``) shaded,
+    the input angles where an output speed equals the input's marked; ``origin`` names the input
+    angle's origin."""
     theta = np.arange(0.0, 360.0 + 1e-9, 1.0)
     curves = {d.label: output_speed(chain, d, theta)[0] for d in designs}
-    return ujoint_speed_figure(theta, chain.rpm, curves, polar=polar, band=band, title=title)
+    ones = {d.label: textbook(chain, d).ratio_one for d in designs if d.label != "paper printed"}
+    return ujoint_speed_figure(theta, chain.rpm, curves, polar=polar, band=band, title=title, origin=origin,
+                               ratio_one=ones)

@@ -20,8 +20,9 @@ if TYPE_CHECKING:   # the study's modules of the extension, typed (generated: to
 else:
     from driver._fortran import _kernels
 
-__all__ = ['UjointStatus', 'UJOINT_PASSES', 'UJOINT_MODELS', 'UJOINT_OBJECTIVES', 'ujoint_speed', 'ujoint_objective',
-           'ujoint_equivalent', 'ujoint_geometry', 'ujoint_summaries', 'UJOINT_SUMMARY_COLUMNS']
+__all__ = ['UjointStatus', 'UJOINT_PASSES', 'UJOINT_MODELS', 'UJOINT_OBJECTIVES', 'UJOINT_ROOTS', 'ujoint_speed',
+           'ujoint_objective', 'ujoint_equivalent', 'ujoint_geometry', 'ujoint_summaries', 'UJOINT_SUMMARY_COLUMNS',
+           'ujoint_jet', 'ujoint_roots', 'ujoint_input_torque', 'UJOINT_CV_TOL']
 
 
 class UjointStatus(KernelStatus):
@@ -163,24 +164,131 @@ def ujoint_equivalent(model: int, beta, phi, rho, tol: float = 1e-7) -> tuple[fl
 
 #: columns of ujoint_summaries (fortran/ujoint.f90 chain_summaries)
 UJOINT_SUMMARY_COLUMNS = ("objective", "ratio_min", "ratio_max", "dratio_abs_max", "beta_e", "beta_res",
-                          "beta_res_status")
+                          "beta_res_status", "dratio_abs_max_at", "ratio_one_at")
+
+#: a chain whose speed ratio stays within this of its range on the grid turns its output uniformly
+#: but for round-off (fortran/ujoint.f90 cv_tol): no peak-acceleration angle, R = 1 throughout
+UJOINT_CV_TOL = float(_kernels.ujoint.cv_tol)
+
+#: what :func:`ujoint_roots` finds the roots of (fortran/ujoint.f90 root_*): R - 1, d2R/dtheta2
+#: (the extremes of the output acceleration), d T_in/d theta (the extremes of the input torque)
+UJOINT_ROOTS = {k: int(getattr(_kernels.ujoint, f"root_{k}")) for k in ("ratio_one", "accel_extreme",
+                                                                        "torque_extreme")}
+
+
+@_doc
+def ujoint_jet(model: int, beta, phi, rho, theta) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Compute the chain's speed ratio and its first two derivatives in closed form.
+
+    Parameters
+    ----------
+    model : int
+        Model code (``UJOINT_MODELS``).
+    %(chain)s
+    theta : array_like
+        Input shaft angles, rad (from the normal to joint 1's plane).
+
+    Returns
+    -------
+    ratio : numpy.ndarray
+        R = omega_out/omega_in, dimensionless.
+    dratio : numpy.ndarray
+        The derivative dR/dtheta, 1/rad (times omega_in**2: the output angular acceleration,
+        rad/s**2).
+    d2ratio : numpy.ndarray
+        The second derivative d2R/dtheta2, 1/rad**2 (times omega_in**3: the rate of the output
+        acceleration, rad/s**3).
+    """
+    b, ph, rh = _ujoint_chain(beta, phi, rho)
+    return _kernels.ujoint.chain_jet(int(model), b, ph, rh, farray(np.atleast_1d(theta), 1))
+
+
+@_doc
+def ujoint_roots(model: int, what: str, beta, phi, rho, m: int,
+                 coef: tuple[float, float] = (0.0, 0.0)) -> np.ndarray:
+    """Find every root in one turn of R - 1, of d2R/dtheta2 or of the input torque's derivative.
+
+    Each sign change between neighbours of the grid of ``m`` input angles is refined to 1e-12
+    rad (Illinois regula falsi on the closed form of :func:`ujoint_jet`); two roots closer than
+    one grid step are not told apart.
+
+    Parameters
+    ----------
+    model : int
+        Model code (``UJOINT_MODELS``).
+    what : {'ratio_one', 'accel_extreme', 'torque_extreme'}
+        R = 1, the extremes of dR/dtheta, or the extremes of the input torque
+        (:func:`ujoint_input_torque`, with ``coef``).
+    %(chain)s
+    m : int
+        Grid points per revolution.
+    coef : tuple of float, default (0.0, 0.0)
+        For ``'torque_extreme'``: J omega**2 [kg m**2/s**2] and the load torque [N m].
+
+    Returns
+    -------
+    numpy.ndarray
+        The roots, rad in [0, 2 pi) from the normal to joint 1's plane, ascending.
+    """
+    b, ph, rh = _ujoint_chain(beta, phi, rho)
+    roots, count = _kernels.ujoint.chain_roots(int(model), b, ph, rh, int(UJOINT_ROOTS[what]),
+                                               np.asarray(coef, dtype=np.float64), int(m))
+    return np.array(roots[:count])
+
+
+@_doc
+def ujoint_input_torque(model: int, beta, phi, rho, theta, omega: float, inertia: float,
+                        load: float) -> tuple[np.ndarray, np.ndarray]:
+    """Compute the input torque that drives the output shaft's inertia and load at constant speed.
+
+    By power balance through massless, frictionless joints, T_in omega_in = (J alpha_out +
+    T_load) omega_out, so T_in = (J omega**2 dR/dtheta + T_load) R.
+
+    Parameters
+    ----------
+    model : int
+        Model code (``UJOINT_MODELS``).
+    %(chain)s
+    theta : array_like
+        Input shaft angles, rad.
+    omega : float
+        Input shaft speed, rad/s.
+    inertia : float
+        Moment of inertia of the output shaft and its load, kg m**2.
+    load : float
+        Constant load torque on the output shaft, resisting its rotation, N m.
+
+    Returns
+    -------
+    torque : numpy.ndarray
+        Input torque, N m (positive drives the input shaft).
+    dtorque : numpy.ndarray
+        Its derivative dT_in/dtheta, N m/rad.
+    """
+    b, ph, rh = _ujoint_chain(beta, phi, rho)
+    return _kernels.ujoint.chain_input_torque(int(model), b, ph, rh, farray(np.atleast_1d(theta), 1),
+                                              float(omega), float(inertia), float(load))
 
 
 #: pass bits of ujoint_summaries (fortran/ujoint.f90 sum_*)
 UJOINT_PASSES = {k: int(getattr(_kernels.ujoint, f"sum_{k}")) for k in ("objective", "speed", "equivalent")}
 
 
-def ujoint_summaries(model: int, kind: int, beta, phi, rho, m: int, tol: float = 1e-7, passes: int = 7) -> np.ndarray:
+def ujoint_summaries(model: int, kind: int, beta, phi, rho, m: int, tol: float = 1e-7, passes: int = 7,
+                     theta0: float = 0.0) -> np.ndarray:
     """Compute the headline figures of many designs of one chain layout in one kernel call.
 
     Every design shares ``model``, the objective ``kind`` and the grid of ``m`` input angles
     per revolution.  Columns
     (UJOINT_SUMMARY_COLUMNS): the objective (as :func:`ujoint_objective` without gradient),
-    min and max of R = omega_out/omega_in and max |dR/dtheta| [1/rad] on the grid
-    theta_j = 2 pi j/m (as :func:`ujoint_speed` there), beta_e and beta_res [rad] and the
-    status of beta_res (0: defined; as :func:`ujoint_equivalent` with ``tol`` [rad]).
+    min and max of R = omega_out/omega_in on the grid theta_j = 2 pi j/m (as
+    :func:`ujoint_speed` there), max |dR/dtheta| [1/rad] over the turn (the grid's largest,
+    refined to 1e-12 rad where d2R/dtheta2 changes sign beside it), beta_e and beta_res [rad],
+    the status of beta_res (0: defined; as :func:`ujoint_equivalent` with ``tol`` [rad]), the
+    input angle of the peak |dR/dtheta| and the first input angle where R = 1 [rad, from the
+    normal to joint 1's plane; -1 when R - 1 keeps its sign].
     Each row has the same bits as those single-design calls.  ``passes``: sum of
-    UJOINT_PASSES bits (objective: column 0, speed: 1-3, equivalent: 4-6); the columns of a
+    UJOINT_PASSES bits (objective: column 0, speed: 1-3 and 7-8, equivalent: 4-6); the columns of a
     pass not asked for are 0 (not computed).
 
     Parameters
@@ -201,11 +309,15 @@ def ujoint_summaries(model: int, kind: int, beta, phi, rho, m: int, tol: float =
         Tolerance of beta_res's condition, rad.
     passes : int, default 7
         Sum of ``UJOINT_PASSES`` bits.
+    theta0 : float, default 0.0
+        The input angle the caller counts from, rad (from the normal to joint 1's plane): the
+        peak's angle is the first of its images from it on, the angle of R = 1 the first root
+        from it on.
 
     Returns
     -------
     numpy.ndarray
-        (nd, 7), columns ``UJOINT_SUMMARY_COLUMNS`` (objective and R dimensionless,
+        (nd, 9), columns ``UJOINT_SUMMARY_COLUMNS`` (objective and R dimensionless,
         dR/dtheta 1/rad, angles rad).
 
     Raises
@@ -224,7 +336,7 @@ def ujoint_summaries(model: int, kind: int, beta, phi, rho, m: int, tol: float =
     x[:, n:2 * n - 1] = phi
     x[:, 2 * n - 1:] = 0.0 if rho is None else rho
     return _kernels.ujoint.chain_summaries(model=int(model), kind=int(kind), n=n, nd=nd, x=x, m=int(m),
-                                           tol=float(tol), passes=int(passes))
+                                           tol=float(tol), theta0=float(theta0), passes=int(passes))
 
 
 def ujoint_geometry(axes) -> tuple[np.ndarray, np.ndarray, UjointStatus]:

@@ -22,6 +22,33 @@ class _ujoint:
         """``beta,rho,status = chain_geometry(axes,[n])``; shapes beta(n), rho(-1 + n)"""
         ...
     @staticmethod
+    def chain_input_torque(
+        model: int,
+        beta: NDArray[np.float64],
+        phi: NDArray[np.float64],
+        rho: NDArray[np.float64],
+        theta: NDArray[np.float64],
+        omega: float,
+        inertia: float,
+        load: float,
+        n: int = ...,
+        m: int = ...,
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """``torque,dtorque = chain_input_torque(model,beta,phi,rho,theta,omega,inertia,load,[n,m])``; shapes torque(m), dtorque(m)"""
+        ...
+    @staticmethod
+    def chain_jet(
+        model: int,
+        beta: NDArray[np.float64],
+        phi: NDArray[np.float64],
+        rho: NDArray[np.float64],
+        theta: NDArray[np.float64],
+        n: int = ...,
+        m: int = ...,
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+        """``r0,r1,r2 = chain_jet(model,beta,phi,rho,theta,[n,m])``; shapes r0(m), r1(m), r2(m)"""
+        ...
+    @staticmethod
     def chain_objective(
         model: int,
         kind: int,
@@ -33,6 +60,19 @@ class _ujoint:
         n: int = ...,
     ) -> tuple[float, NDArray[np.float64]]:
         """``f,grad = chain_objective(model,kind,beta,phi,rho,m,want_grad,[n])``; shapes grad(-1 + 2 * n)"""
+        ...
+    @staticmethod
+    def chain_roots(
+        model: int,
+        beta: NDArray[np.float64],
+        phi: NDArray[np.float64],
+        rho: NDArray[np.float64],
+        what: int,
+        coef: NDArray[np.float64],
+        m: int,
+        n: int = ...,
+    ) -> tuple[NDArray[np.float64], int]:
+        """``roots,nroots = chain_roots(model,beta,phi,rho,what,coef,m,[n])``; shapes roots(m)"""
         ...
     @staticmethod
     def chain_speed(
@@ -53,12 +93,14 @@ class _ujoint:
         x: NDArray[np.float64],
         m: int,
         tol: float,
+        theta0: float,
         passes: int,
         n: int = ...,
         nd: int = ...,
     ) -> NDArray[np.float64]:
-        """``res = chain_summaries(model,kind,x,m,tol,passes,[n,nd])``; shapes res(nd,7)"""
+        """``res = chain_summaries(model,kind,x,m,tol,theta0,passes,[n,nd])``; shapes res(nd,9)"""
         ...
+    cv_tol: NDArray[np.float64]
     model_cumulative: NDArray[np.int32]
     model_eq13: NDArray[np.int32]
     model_exact: NDArray[np.int32]
@@ -66,6 +108,9 @@ class _ujoint:
     obj_mean_square: NDArray[np.int32]
     obj_peak_to_peak: NDArray[np.int32]
     obj_rms: NDArray[np.int32]
+    root_accel_extreme: NDArray[np.int32]
+    root_ratio_one: NDArray[np.int32]
+    root_torque_extreme: NDArray[np.int32]
     st_ok: NDArray[np.int32]
     st_res_undefined: NDArray[np.int32]
     st_right_angle: NDArray[np.int32]

@@ -25,16 +25,18 @@ from driver.ujoint._analysis import (
     chain_of,
     evaluate,
     free_index,
+    input_torque,
     objective_scale,
     optimise,
     output_speed,
     phases_for,
     pick_best,
     start_points,
+    textbook,
     yoke_shifts,
 )
-from driver.ujoint._kernel import UJOINT_MODELS, ujoint_speed
-from driver.ujoint._spec import BAND_TOL, CONVENTIONS, DEG, OPTIONS, SPEC, joint_geometry, per_joint, phases_deg
+from driver.ujoint._kernel import UJOINT_CV_TOL, UJOINT_MODELS, ujoint_speed
+from driver.ujoint._spec import BAND_TOL, CONVENTIONS, DEG, OPTIONS, ORIGINS, SPEC, joint_geometry, per_joint, phases_deg
 
 
 def _model_text(params: Params) -> str:
@@ -89,10 +91,20 @@ def _render(params: Params, chain: Chain, beta, rho, designs: list[Design], runs
                                          "R = omega_out/omega_in [-]",
                           "rms": "rms: sqrt(mean (R - 1)^2) [-]",
                           "peak_to_peak": "peak_to_peak: max R - min R on the grid [-]"}[params.objective]),
-           ("grid", f"{params.n_grid} input angles per revolution (theta from the normal to joint 1's plane)"),
+           ("angle origin", f"{params.angle_origin}: theta = 0 with {ORIGINS[params.angle_origin][0]}"),
+           ("grid", f"{params.n_grid} input angles per revolution ({ORIGINS[params.angle_origin][1]}): objective, "
+                    "band, and the brackets of the root finding"),
+           ("tables", f"speed table every {fortran_f(params.table_step, None, 4)} deg (table_step); tidy table "
+                      + (f"(CSV, Parquet) at the {params.n_grid} grid angles (tidy_grid = 'n_grid')"
+                         if params.tidy_grid == "n_grid" else "(CSV, Parquet) at the speed table's angles "
+                                                              "(tidy_grid = 'table_step')")),
            ("phases", "phi (the paper's convention): 90 deg = yokes on the shaft in phase; "
                       + ("yoke phase delta_k = phi_k - phi_(k-1) - 90 (eq. 13: phi_k is absolute)"
                          if chain.model == UJOINT_MODELS["eq13"] else "yoke phase delta = phi - 90"))]
+    if chain.load is not None:
+        hdr.append(("output load", f"J = {params.load_inertia or 0.0:g} kg m^2, T_load = {params.load_torque or 0.0:g} N m "
+                                   "(resisting); T_in = (J alpha_out + T_load) omega_out/omega_in (power balance, "
+                                   "massless frictionless joints, constant input speed)"))
     if params.axes is not None:
         a = np.asarray(params.axes, float).reshape(-1, 3)
         for k, v in enumerate(a):
@@ -147,6 +159,7 @@ def _render(params: Params, chain: Chain, beta, rho, designs: list[Design], runs
     if runs:
         out += _render_runs(runs, designs[1], _free_names(option, n))
     out += _render_compare(params, chain, designs)
+    out += _render_textbook(params, chain, designs)
     out += _render_speed_table(params, chain, designs, exact)
     out.append(" NOTES")
     all_notes = list(notes)
@@ -268,11 +281,40 @@ def _render_compare(params: Params, chain: Chain, designs: list[Design]) -> list
     return out
 
 
+def _angles(values: np.ndarray) -> str:
+    """Input angles [deg] for the .out: 9 decimals (the roots are found to 1e-12 rad, 6e-11 deg)."""
+    return ", ".join(f"{v:.9f}" for v in values) if len(values) else "none"
+
+
+def _render_textbook(params: Params, chain: Chain, designs: list[Design]) -> list[str]:
+    """Where each design's speed ratio is one, where its output acceleration peaks and how high,
+    and with a load its input torque: by root finding on the closed form (1e-12 rad)."""
+    origin = ORIGINS[params.angle_origin][1]
+    out = [f" TEXTBOOK FIGURES over one input turn (input angles in deg, {origin}; roots of the kernel's "
+           "closed form to 1e-12 rad)"]
+    for d in designs:
+        if d.label == "paper printed":
+            continue
+        tb = textbook(chain, d)
+        out.append(f"   {d.label}:")
+        out.append("     omega_out = omega_in (ratio one) " + (f"at theta = {_angles(tb.ratio_one)}" if d.pp >= UJOINT_CV_TOL
+                                                             else "throughout: a constant-velocity chain"))
+        out.append(f"     peak output acceleration |alpha_out| = {tb.accel_peak:.10f} rad/s^2 at theta = "
+                   f"{_angles(tb.accel_peak_at)}" + ("" if not len(tb.accel_peak_signed) else
+                                                    " (signed: " + ", ".join(f"{a:+.10f}" for a in tb.accel_peak_signed)
+                                                    + ")"))
+        if tb.torque_peak is not None:
+            out.append(f"     input torque: peak |T_in| = {tb.torque_peak:.10f} N m at theta = {_angles(tb.torque_peak_at)}"
+                       f"; mean over the turn {tb.torque_mean:.10f} N m")
+    return out + [""]
+
+
 def _render_speed_table(params: Params, chain: Chain, designs: list[Design], exact: bool) -> list[str]:
     th = _table_theta(params)
     shown = [d for d in designs if d.label != "paper printed"]
     out = [" SPEED TABLE over the input angle (omega_in = "
-           f"{fortran_f(params.rpm, None, 4)} rpm constant; acc = d omega_out/dt)"]
+           f"{fortran_f(params.rpm, None, 4)} rpm constant; acc = d omega_out/dt; "
+           f"{ORIGINS[params.angle_origin][1]})"]
     cols = [Column("theta_in", "f", 9, 2)]
     data = []
     for d in shown:
@@ -284,33 +326,48 @@ def _render_speed_table(params: Params, chain: Chain, designs: list[Design], exa
         if exact:
             cols.append(Column(f"{tag} th_out", "f", 11, 4))
             data.append(to)
+        if chain.load is not None:
+            cols.append(Column(f"{tag} T_in", "f", 12, 6))
+            data.append(input_torque(chain, d, th))
     rows = [[t, *(c[i] for c in data)] for i, t in enumerate(th)]
     out += render_table(cols, rows)
-    out.append("   units: theta_in, th_out [deg]; w_out [rpm]; ratio [-]; acc [rad/s^2]")
+    out.append(f"   units: theta_in, th_out [deg, {ORIGINS[params.angle_origin][1]}]; w_out [rpm]; ratio [-]; "
+               "acc [rad/s^2]" + ("; T_in [N m]" if chain.load is not None else ""))
     out.append("")
     return out
 
 
-def _tidy(chain: Chain, designs: list[Design]) -> pd.DataFrame:
-    theta = np.arange(chain.m) * (360.0 / chain.m)
+def _tidy(params: Params, chain: Chain, designs: list[Design]) -> pd.DataFrame:
+    """One row per design and input angle: the n_grid angles or the speed table's (tidy_grid),
+    from the deck's angle origin (said in every row's angle_origin)."""
+    theta = np.arange(chain.m) * (360.0 / chain.m) if params.tidy_grid == "n_grid" else _table_theta(params)
     frames = []
     for d in designs:
         w, a, to = output_speed(chain, d, theta)
-        frame = pd.DataFrame({"design": d.label, "theta_in_deg": theta, "omega_in_rpm": chain.rpm,
-                              "omega_out_rpm": w, "ratio": w / chain.rpm, "alpha_out_rad_s2": a})
+        frame = pd.DataFrame({"design": d.label, "theta_in_deg": theta, "angle_origin": params.angle_origin,
+                              "omega_in_rpm": chain.rpm, "omega_out_rpm": w, "ratio": w / chain.rpm,
+                              "alpha_out_rad_s2": a})
         if chain.model == UJOINT_MODELS["exact"]:
             frame["theta_out_deg"] = to
+        if chain.load is not None:
+            frame["input_torque_Nm"] = input_torque(chain, d, theta)
         frames.append(frame)
     return with_units(pd.concat(frames, ignore_index=True), {"ratio": "1"})
 
 
-def _summary(trial: Design, best: Design | None, runs: list[StartRun], failure: str | None) -> dict:
+def _summary(chain: Chain, trial: Design, best: Design | None, runs: list[StartRun], failure: str | None) -> dict:
     d = best if best is not None else trial
     s = {"objective": d.objective, "objective_trial": trial.objective, "pp_ratio": d.pp,
          "omega_out_min_rpm": d.w_min, "omega_out_max_rpm": d.w_max, "beta_e_deg": d.beta_e,
          "beta_res_deg": d.beta_res,   # None when the closed form does not apply
-         "peak_accel_rad_s2": d.peak_acc, "converged": failure is None,
+         "peak_accel_rad_s2": d.peak_acc, "peak_accel_at_deg": d.peak_acc_at, "ratio_one_at_deg": d.ratio_one_at,
+         "converged": failure is None,
          "iterations": sum(r.nit for r in runs), "evaluations": sum(r.nfev for r in runs)}
+    if chain.load is not None:
+        tb = textbook(chain, d)
+        s.update({"input_torque_peak_Nm": tb.torque_peak,
+                  "input_torque_peak_at_deg": float(tb.torque_peak_at[0]) if len(tb.torque_peak_at) else None,
+                  "input_torque_mean_Nm": tb.torque_mean})
     s.update({f"beta_{k + 1}_deg": float(v) for k, v in enumerate(d.beta)})
     s.update({f"phi_{k + 1}_deg": float(v) for k, v in enumerate(d.phi)})
     return s
@@ -334,6 +391,7 @@ def _result_dat(params: Params, chain: Chain, designs: list[Design], best: Desig
              f"funccount  = {1 if fixed else pick.nfev}",
              *(["% FIXED DESIGN: equal bounds fix every free variable; evaluated, not optimised"] if fixed
                else [] if pick.success else ["% NOT CONVERGED: x is the last iterate, not an optimum"]),
+             f"% angle origin {params.angle_origin}: {ORIGINS[params.angle_origin][1]}",
              "% theta_in_deg  omega_in_rpm  omega_out_trial_rpm  omega_out_optimum_rpm"]
     th = np.arange(0.0, 360.0 + 1e-9, 1.0)
     w0 = output_speed(chain, designs[0], th)[0]
@@ -412,12 +470,13 @@ def run(params: Params, progress: bool = False) -> Result:
         printed = evaluate(chain, "paper printed", pb, pp)
         designs.append(printed)
     text = _render(params, chain, beta, rho, designs, runs, notes, warnings, failure)
-    tidy = _tidy(chain, designs)
-    summary = _summary(trial, best, runs, failure)
+    tidy = _tidy(params, chain, designs)
+    summary = _summary(chain, trial, best, runs, failure)
     extra = {".result.dat": _result_dat(params, chain, designs, best, runs)} if best is not None else {}
     title = params.path.stem if getattr(params, "path", None) else ""
-    figures = [Figure("speed", lambda: _figures().speed_figure(chain, designs, False, params.paper_band, title)),
-               Figure("polar", lambda: _figures().speed_figure(chain, designs, True, params.paper_band, title))]
+    origin = ORIGINS[params.angle_origin][1]
+    figures = [Figure("speed", lambda: _figures().speed_figure(chain, designs, False, params.paper_band, title, origin)),
+               Figure("polar", lambda: _figures().speed_figure(chain, designs, True, params.paper_band, title, origin))]
     return Result(text=text, tidy=tidy, summary=summary, warnings=warnings, failure=failure,
                   figures=figures, extra=extra)
 

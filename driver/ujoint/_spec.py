@@ -26,11 +26,21 @@ BAND_TOL = 1.0
 #: how the θ, ρ and output angles are measured (printed in --keys and every .out)
 CONVENTIONS = (
     "theta (the input angle) and every shaft angle turn right-handed about their shaft's "
-    "direction (input towards output; the 'axes' vectors); theta = 0 when joint 1's input yoke "
-    "lies along the normal to the plane of joint 1. rho_k > 0 when the plane of joint k+1 is "
-    "turned right-handed about shaft k from the plane of joint k. th_out is the last joint's "
-    "output yoke angle from the normal to the plane of the last joint, in the sense of theta; "
-    "it includes the phases (in phase: th_out = theta + 90 (n-1) deg + the joints' error)")
+    "direction (input towards output; the 'axes' vectors); theta = 0 where angle_origin says: "
+    "'normal' (default, the paper's) when joint 1's input yoke lies along the normal to the plane "
+    "of joint 1, 'plane' (textbooks') when it lies in that plane, 90 deg on. rho_k > 0 when the "
+    "plane of joint k+1 is turned right-handed about shaft k from the plane of joint k. th_out is "
+    "the last joint's output yoke angle from the normal to (with 'plane': from) the plane of the "
+    "last joint, in the sense of theta; it includes the phases (in phase: th_out = theta + 90 "
+    "(n-1) deg + the joints' error)")
+
+#: the input angle's origin, by angle_origin: (what theta = 0 means, short words for tables and
+#: figures, the kernel's angle at theta = 0 [deg]: the kernel measures from the normal)
+ORIGINS = {"normal": ("joint 1's input yoke along the normal to the plane of its shafts (the paper's eq. 5/8; "
+                      "a single joint's slowest output, omega_out = omega_in cos beta)",
+                      "theta from the normal to joint 1's plane", 0.0),
+           "plane": ("joint 1's input yoke in the plane of its shafts (textbooks'; a single joint's fastest "
+                     "output, omega_out = omega_in / cos beta)", "theta from joint 1's plane", 90.0)}
 
 #: why the paper's printed results are not reproducible (published quantity -> why)
 NOT_REPRODUCIBLE = {
@@ -50,6 +60,14 @@ def _open_angles(v) -> str | None:
     bad = [x for x in v if not -90.0 < x < 90.0]
     return (f"a joint angle must lie strictly between -90 and 90 deg (got {bad[0]})"
             if bad else None)
+
+
+def _finite(v) -> str | None:
+    return None if math.isfinite(v) else "must be finite"
+
+
+def _non_negative_finite(v) -> str | None:
+    return None if math.isfinite(v) and v >= 0.0 else f"must be a finite value of at least 0 (got {v})"
 
 
 KEYS = dict(
@@ -94,9 +112,26 @@ KEYS = dict(
                  doc="multi-start: the trial point plus n_starts-1 seeded random starts"),
     seed=Key("int", default=0, doc="random seed of the multi-start (deterministic)"),
     n_grid=Key("int", default=360, check=lambda v: None if v >= 8 else "must be at least 8",
-               doc="input angles per revolution for objective, band and peaks"),
+               doc="input angles per revolution for objective and band, and the brackets of the root "
+               "finding of the peaks and of the angles where the speed ratio is one"),
     table_step=Key("float", default=10.0, check=positive, units="deg",
-                   doc="input-angle step of the speed table"),
+                   doc="input-angle step of the .out's speed table"),
+    tidy_grid=Key("str", default="n_grid", choices=("n_grid", "table_step"),
+                  doc="the input angles of the tidy table (CSV, Parquet): the n_grid angles of the "
+                  "objective and summary (360 / n_grid deg apart), or the speed table's (table_step)"),
+    angle_origin=Key("str", default="normal", choices=("normal", "plane"),
+                     doc="where the input angle theta is 0: 'normal', the paper's (kept as the default so "
+                     "its figures reproduce): joint 1's input yoke along the normal to the plane of its "
+                     "shafts, a single joint's slowest output; 'plane', textbooks': the yoke in that "
+                     "plane, its fastest output (theta_plane = theta_normal - 90 deg). Every table, "
+                     "figure and angle column says which"),
+    load_inertia=Key("float", units="kg m^2", check=_non_negative_finite,
+                     doc="moment of inertia of the driven (output) shaft and what it carries; with it "
+                     "(and load_torque) the input torque over a turn at constant input speed, "
+                     "T_in = (J alpha_out + T_load) omega_out/omega_in (default 0)"),
+    load_torque=Key("float", units="N m", check=_finite,
+                    doc="constant torque of the load on the output shaft, resisting its rotation "
+                    "(default 0); see load_inertia"),
     maxiter=Key("int", default=200, check=positive, doc="SLSQP iteration limit per start"),
     ftol=Key("float", default=1e-12, check=positive,
              doc="SLSQP tolerance on the objective divided by its scale, the larger of the "
@@ -109,6 +144,20 @@ KEYS = dict(
     paper_nfev=Key("int", doc="the paper's printed function evaluations"),
     paper_band=Key("floats", units="rpm", doc="the paper's trial band read off its plot: min, max"),
 )
+
+
+def loads(params) -> tuple[float, float] | None:
+    """The output shaft's load: (moment of inertia [kg m^2], load torque [N m]), or None when the
+    deck gives neither ``load_inertia`` nor ``load_torque`` (no input-torque analysis)."""
+    j, t = params.get("load_inertia"), params.get("load_torque")
+    if j is None and t is None:
+        return None
+    return (0.0 if j is None else float(j), 0.0 if t is None else float(t))
+
+
+def origin_deg(params) -> float:
+    """The kernel's input angle [deg, from the normal to joint 1's plane] at the deck's theta = 0."""
+    return ORIGINS[params.get("angle_origin") or "normal"][2]
 
 
 def per_joint(params: Params, key: str, count: int, what: str) -> np.ndarray:
@@ -240,7 +289,14 @@ LABELS = {"rpm": ("input shaft speed", "rpm"), "objective": ("objective (optimum
           "objective_trial": ("objective (trial)", "-"), "pp_ratio": ("peak-to-peak speed ratio", "-"),
           "omega_out_min_rpm": ("minimum output speed", "rpm"), "omega_out_max_rpm": ("maximum output speed", "rpm"),
           "beta_e_deg": ("equivalent joint angle", "deg"), "beta_res_deg": ("resultant joint angle", "deg"),
-          "peak_accel_rad_s2": ("peak output acceleration", "rad/s^2"), "iterations": ("iterations", "-"),
+          "peak_accel_rad_s2": ("peak output acceleration", "rad/s^2"),
+          "peak_accel_at_deg": ("input angle of the peak output acceleration", "deg"),
+          "ratio_one_at_deg": ("first input angle where the output speed equals the input's", "deg"),
+          "input_torque_peak_Nm": ("peak input torque", "N m"),
+          "input_torque_peak_at_deg": ("input angle of the peak input torque", "deg"),
+          "input_torque_mean_Nm": ("mean input torque", "N m"),
+          "load_inertia": ("output-shaft moment of inertia", "kg m^2"), "load_torque": ("load torque", "N m"),
+          "iterations": ("iterations", "-"),
           "evaluations": ("objective evaluations", "-"),
           "phi_{i}_deg": ("phase angle $\\varphi_{{i}}$", "deg"), "beta_{i}_deg": ("joint angle $\\beta_{{i}}$", "deg"),
           "beta": ("joint angle $\\beta$", "deg"), "phi": ("phase angle $\\varphi$", "deg"),
