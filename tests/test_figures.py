@@ -389,6 +389,32 @@ def test_linkage_drawing_one_solid_position_ghosts_counterweights_units():
     assert text_outside(fig) == []
 
 
+@pytest.mark.parametrize("links, extra, unit", [
+    (dict(fixed_link=12, crank=5, coupler=150, rocker=9), {}, "length units"),
+    (dict(fixed_link=12, crank=5, coupler=26, rocker=9), {}, "length units"),
+    (dict(fixed_link=0.3, crank=0.05, coupler=3.0, rocker=0.1),
+     dict(mass=[1, 1, 1], inertia=[0.01, 0.01, 0.01], omega=10), "m"),
+])
+def test_the_chain_that_cannot_move_is_drawn_in_the_decks_unit_inside_the_canvas(links, extra, unit):
+    """An impossible (or flat) chain's drawing: its longest link beside the other three laid end to
+    end, short by exactly the longest minus their sum, the axis in the deck's length unit (metres
+    for a deck with masses), every text on the canvas and in words."""
+    import driver
+    from figure_checks import figure_problems
+    r = driver.fourbar.run(step_deg=30, **links, **extra)
+    assert r.failure
+    fig = r.figure("linkage")
+    ax = fig.axes[0]
+    assert ax.get_xlabel() == f"length [{unit}]"
+    longest = max(links.values())
+    bars = [ln for ln in ax.get_lines() if len(ln.get_xdata()) == 2]
+    assert max(ln.get_xdata()[1] for ln in bars) == pytest.approx(longest)
+    laid = [ln for ln in bars if ln.get_ydata()[0] == 0.0]
+    assert laid[-1].get_xdata()[1] == pytest.approx(sum(links.values()) - longest)
+    assert figure_problems(fig, r.summary) == []
+    assert figure_problems(r.figure("curves"), r.summary) == []
+
+
 def test_synthesis_targets_drawn_on_top_of_the_linkage(tmp_path):
     from driver._deck import read_deck
     from driver.synthesis import synthesis_figures, synthesise
