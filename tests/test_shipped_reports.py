@@ -6,6 +6,8 @@ Each deck in inputs/ is run once per session with --report (tests/report_runs.py
   matplotlib's own renderer as ``savefig`` lays it out (tick labels, legends, annotations,
   colour-bar labels), and no title, axis label, legend entry or colour-bar label shows a column
   or key name instead of words (``mu_min_deg``, ``fourbar.crank``: tests/figure_checks.py);
+* no cell of its page's tables prints round-off or a negative zero (``6.35529e-14``, ``-0``)
+  where the ``.out`` prints 0.000;
 * its page keeps the size docs/report.md promises (PAGE_BYTES), loads nothing from outside
   itself (no external reference in the file; the browser's network log holds the page alone),
   raises no console error, gives every figure and the animation a box, draws every figure's text
@@ -54,6 +56,23 @@ def test_shipped_figures_keep_their_text_inside_and_in_words(report_runs, stem):
         fig = draw()
         problems += [f"{name}: {p}" for p in figure_problems(fig, names)]
     assert not problems, "\n".join(problems)
+
+
+#: a table cell that prints round-off or a negative zero instead of the .out's zero
+ROUND_OFF = re.compile(r"^-?\d(?:\.\d+)?e-(?:1[2-9]|[2-9]\d|\d{3})$|^-0(?:\.0*)?$")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("stem", SHIPPED)
+def test_shipped_page_tables_print_no_round_off(report_runs, stem):
+    """Every cell of the page's tables (headline figures, summary, history, tidy table) prints a
+    number to the precision its table states: round-off such as 6.35529e-14 N of a balanced
+    linkage's shaking force, or -0, is the .out's 0.0000 on the page too."""
+    run = report_runs.get(stem)
+    html = re.sub(r"<(svg|script)\b.*?</\1>", "", run.page.read_text(), flags=re.S)
+    cells = re.findall(r"<td>([^<]*)</td>", html)
+    bad = [c for c in cells if ROUND_OFF.match(c.strip())]
+    assert not bad, f"{run.page.name}: {bad[:10]}"
 
 
 def _png_pixels(png: bytes) -> np.ndarray:
