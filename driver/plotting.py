@@ -65,11 +65,17 @@ def plain_text(text: Any) -> str:
 def wrap(text: str, width: int) -> str:
     """``text`` filled to lines of about ``width`` characters like :func:`textwrap.fill`, but a
     mathtext span (``$|\\tau_1| + |\\tau_2|$``) is never broken across lines: matplotlib
-    parses each line on its own, and half a span would be drawn as its raw source."""
+    parses each line on its own, and half a span would be drawn as its raw source.  A word
+    longer than ``width`` (a name without blanks) is cut into lines of ``width``."""
     tokens = re.findall(r"(?:[^\s$\\]|\\.|(?<!\\)\$(?:[^$\\]|\\.)*\$)+", text)
     if re.sub(r"\s+", "", "".join(tokens)) != re.sub(r"\s+", "", text):   # an unpaired $: no span to keep whole
         import textwrap
         return textwrap.fill(text, width)
+    # a word longer than a line (a long name without blanks) is cut into lines of ``width``; one
+    # with a mathtext span or an escape stays whole (a cut could split a '\\$')
+    tokens = [part for tok in tokens
+              for part in ([tok[i:i + width] for i in range(0, len(tok), width)]
+                           if len(tok) > width and not re.search(r"[$\\]", tok) else [tok])]
     lines: list[str] = []
     line = ""
     for tok in tokens:

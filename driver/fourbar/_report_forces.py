@@ -251,7 +251,7 @@ def figures(p: Params, title: str, theta_grid: Any) -> list[Figure]:
         fig, ax = plotting.new_figure(1, 1, figsize=(8.0, 4.2))
         with plotting.style():
             draw.plot_torque(theta, fa, p, ax=ax[0], legend=False)
-            plotting.suptitle(fig, f"{title}: input torque")
+            plotting.suptitle(fig, f"{plotting.plain_text(title)}: input torque")
             fig.legend(*ax[0].get_legend_handles_labels(), loc="outside lower center", ncol=2, frameon=False)
         return fig
 
@@ -262,7 +262,7 @@ def figures(p: Params, title: str, theta_grid: Any) -> list[Figure]:
         with plotting.style():
             fig, axes = plotting.new_figure(2, 2, figsize=(7.4, 7.8), subplot_kw={"projection": "polar"})
             draw.plot_pin_polars(fa, axes=axes, theta=theta)
-            plotting.suptitle(fig, f"{title}: pin forces\nangle: the force's direction, radius: its magnitude [N]")
+            plotting.suptitle(fig, f"{plotting.plain_text(title)}: pin forces\nangle: the force's direction, radius: its magnitude [N]")
             fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncol=3, frameon=False)
         return fig
 
@@ -273,7 +273,7 @@ def figures(p: Params, title: str, theta_grid: Any) -> list[Figure]:
         with plotting.style():
             fig, axes = plotting.new_figure(1, 2, figsize=(9.0, 4.3))
             draw.plot_shaking(theta, fa, ax=axes[0], polar_ax=axes[1])
-            plotting.suptitle(fig, f"{title}: shaking force on the frame")
+            plotting.suptitle(fig, f"{plotting.plain_text(title)}: shaking force on the frame")
             fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncol=2, frameon=False)
         return fig
 
