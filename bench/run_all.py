@@ -31,6 +31,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import bench_fourbar
 import bench_fourbar_forces
+import bench_linkage
 import bench_manipulator
 import bench_slidercrank
 import bench_slidercrank_nl
@@ -279,6 +280,35 @@ SCALE = {"ns/position": 1e9, "ns/sample": 1e9, "us/config": 1e6, "us/objective":
          "ms/revolution": 1e3}
 
 
+def linkage(sizes: tuple[int, ...], repeat: int) -> list[Row]:
+    """The linkage kernel (issue 38), like with like (bench/bench_linkage.py): per group-position
+    against the four-bar kernel (the same four-bar as a crank and one RRR group writing what the
+    four-bar kernel writes; the Watt II six-bar per group), and the Watt II against pylinkage's
+    numba kinematics step (each point's position, velocity and acceleration) and positions-only
+    step (rows skipped, with the reason, when pylinkage or numba is not installed: they are not
+    project dependencies); at each size of ``sizes`` (one turn at 0.1 deg: in cache; a long run:
+    streamed to memory, where the store floor bounds the kernel)."""
+    rows = []
+    for n in sizes:
+        f = bench_linkage.versus_fourbar(n, repeat)
+        rows.append(Row(f"linkage: four-bar as a group, n = {n} (baseline: four-bar kernel)", "ns/position",
+                        f["group"], f["fourbar"], None, 0.5, "target: at most 2x the four-bar kernel per "
+                        "group-position (the same outputs, with branch continuity)", f["floor"]))
+        rows.append(Row(f"linkage: Watt II per group, n = {n} (baseline: four-bar kernel)", "ns/position",
+                        f["watt2_per_group"], f["fourbar"], None, 0.5, "target: at most 2x the four-bar kernel "
+                        "per group-position (two groups, the same kinds of output)"))
+        r = bench_linkage.versus_pylinkage(n, max(3, repeat // 2))
+        if isinstance(r, str):
+            print(f"linkage vs pylinkage skipped: {r}")
+            continue
+        rows.append(Row(f"linkage: Watt II, n = {n} (baseline: pylinkage numba kinematics)", "ns/position",
+                        r["joints"], r["pylinkage"], None, 20.0, "each point's position, velocity and acceleration, "
+                        "as pylinkage's step gives them", r["floor"]))
+        rows.append(Row(f"linkage: Watt II, n = {n} (baseline: pylinkage positions only)", "ns/position",
+                        r["positions"], r["pylinkage_positions"], None, 1.0, "each point's position"))
+    return rows
+
+
 def print_table(rows: list[Row]) -> None:
     print(f"{'benchmark':<46}{'unit':>14}{'kernel':>10}{'numpy':>12}{'ratio':>10}   target")
     for r in rows:
@@ -303,10 +333,10 @@ def main(argv: list[str] | None = None) -> list[Row]:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smaller sizes, fewer repeats")
     ap.add_argument("--smoke", action="store_true", help="tiny sizes (the test suite's check that this runs)")
-    ap.add_argument("--only", choices=["fourbar", "manipulator", "ujoint", "slidercrank", "slidercrank_nl"],
+    ap.add_argument("--only", choices=["fourbar", "manipulator", "ujoint", "slidercrank", "slidercrank_nl", "linkage"],
                     action="append", help="run only these studies (repeatable)")
     args = ap.parse_args(argv)
-    only = set(args.only or ["fourbar", "manipulator", "ujoint", "slidercrank", "slidercrank_nl"])
+    only = set(args.only or ["fourbar", "manipulator", "ujoint", "slidercrank", "slidercrank_nl", "linkage"])
     if args.smoke:
         sizes = dict(n=2048, samples=4096, n_el=20, spr=72, base_steps=4, repeat=2, nl_el=20, nl_revs=1)
     elif args.quick:
@@ -327,6 +357,8 @@ def main(argv: list[str] | None = None) -> list[Row]:
         rows += slidercrank(sizes["n_el"], sizes["spr"], sizes["base_steps"], max(3, sizes["repeat"] // 3))
     if "slidercrank_nl" in only:
         rows += slidercrank_nl(sizes["nl_el"], sizes["nl_revs"], max(3, sizes["repeat"] // 3))
+    if "linkage" in only:
+        rows += linkage((sizes["n"],) if args.smoke else bench_linkage.SIZES, sizes["repeat"])
     print_table(rows)
     return rows
 

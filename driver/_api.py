@@ -172,7 +172,7 @@ def studies() -> dict[str, str]:
     --------
     >>> import driver
     >>> sorted(driver.studies())
-    ['fourbar', 'manipulator', 'robust_example', 'slidercrank', 'ujoint']
+    ['fourbar', 'linkage', 'manipulator', 'robust_example', 'slidercrank', 'ujoint']
     """
     return {g: m.spec.doc for g, m in sorted(available_studies().items())}
 

@@ -43,6 +43,7 @@ __all__ = ["Study", "BatchSummary", "REGISTRY", "ENGINES", "LAYERS", "REQUIRED_L
 #: when a deck (or a caller) names the group, so ``python -m driver --help`` stays light.
 REGISTRY: dict[str, str] = {
     "fourbar": "driver.fourbar",
+    "linkage": "driver.linkage",
     "manipulator": "driver.manipulator",
     "robust_example": "driver.robust_example",
     "slidercrank": "driver.slidercrank",

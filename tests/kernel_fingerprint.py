@@ -12,6 +12,7 @@ import json
 import numpy as np
 
 from driver.fourbar import _kernel as fourbar_kernel
+from driver.linkage import _kernel as linkage_kernel
 from driver.manipulator import _kernel as manipulator_kernel
 from driver.slidercrank import _kernel as slidercrank_kernel
 from driver.ujoint import _kernel as ujoint_kernel
@@ -134,6 +135,33 @@ def _batch_and_auxiliary_kernels(rng: np.random.Generator, theta: np.ndarray) ->
     pe = rng.normal(0, 1e-3, 6)
     out["slidercrank_corot_element"] = _h(*slidercrank_kernel.slidercrank_corot_element(0.05, 2e11 * 64e-6,
                                                                                         2e11 * 3.413333333e-10, pe))
+    # the linkage kernel: every group type (RRR, RRP, PRR, RPR, PRP), forces, a guide-force table
+    import pathlib
+
+    from driver._deck import read_deck, validate
+    from driver.linkage import SPEC as LINKAGE_SPEC
+    from driver.linkage import compile_deck
+    from driver.linkage._batch import _numbers
+    root = pathlib.Path(__file__).resolve().parents[1] / "inputs"
+    decks = [validate(read_deck(root / f"{d}.dat").groups["linkage"], LINKAGE_SPEC, d)
+             for d in ("linkage_engine", "linkage_whitworth", "linkage_watt2", "linkage_inverted_slider_crank")]
+    prp = read_deck("prp.dat", "&linkage\npivots='O2', pivot_xy=0,0, guides='slot','ways', guide_on='crank','ground', "
+                    "guide_xy=0,0, 0.3,0.1, guide_deg=60,10\ndriver_joints='O2','A', driver_length=1, step=1\n"
+                    "dyads='PRP','PRR', dyad_joints='slot','ways','P', 'ways','P','Q', dyad_links='b1','b2','b3','rod', "
+                    "dyad_dims=0.1,-0.05, 0.2,0.8\nbodies='crank','b1','b2','rod', mass=1,0.5,0.5,0.7, "
+                    "inertia=0.1,0.01,0.01,0.05, com_uv=0.2,0,0,0,0,0,0.3,0.05\n/\n")
+    decks.append(validate(prp.groups["linkage"], LINKAGE_SPEC, "prp.dat"))
+    xs = np.linspace(0.0, 2 * np.pi, 1500)
+    for i, p in enumerate(decks):
+        mech = compile_deck(p)
+        a = linkage_kernel.analyse(mech, xs)
+        out[f"linkage_analyse{i}"] = _h(*[np.asarray(v, float) for v in a])
+        out[f"linkage_reusable_call{i}"] = _h(*linkage_kernel.reusable_call(mech, xs, continuity=False)())
+        rows = np.asfortranarray(np.tile(_numbers(p, mech, {}, 1), (3, 1)))
+        out[f"linkage_summaries{i}"] = _h(linkage_kernel.summaries(mech, rows, 90, mech.driver == "crank"),
+                                          [linkage_kernel.summary_width(mech)])
+    out["linkage_table_energy"] = _h(linkage_kernel.table_energy(np.radians([0.0, 90, 135, 180, 360]),
+                                                                 np.array([0.0, 0, 1000, 0, 0]), 0.02, 50.0))
     return out
 
 

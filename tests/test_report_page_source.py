@@ -162,7 +162,7 @@ def test_the_animation_hook_is_declared_by_the_studies_with_a_mechanism():
     from driver._mechanism import MechanismFrames
     from driver._study import registered
     have = {name for name, s in registered().items() if s.animation is not None}
-    assert have == {"fourbar", "slidercrank", "ujoint", "manipulator"}
+    assert have == {"fourbar", "slidercrank", "ujoint", "manipulator", "linkage"}
     import driver
     r = driver.run(str(ROOT / "inputs" / "crank5.dat"))
     frames = registered()["fourbar"].animation(r.params, r, 36)

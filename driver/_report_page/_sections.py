@@ -9,7 +9,7 @@ run again and no file the engine wrote is read back; the deck is echoed as its f
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import f90nml
 
@@ -92,6 +92,12 @@ def _close(sections: list[Section], oc: Outcome, deck: Deck | None, notes: list[
     sections.append(Section("deck", "deck", [Pre(deck_text(deck))]))
 
 
+def _swept_value(params: Any, key: str, element: int | None) -> Any:
+    """A swept key's value in a case's parameters: the key's, or its element (from 1)."""
+    value = params[key]
+    return value if element is None else value[element - 1]
+
+
 def _sweep_page(oc: SweepOutcome, deck: Deck | None) -> Page:
     from driver._study import load_study
     from driver.sweep._report import best_words, summary_figures
@@ -109,8 +115,9 @@ def _sweep_page(oc: SweepOutcome, deck: Deck | None) -> Page:
             notes.append(f"the design-space maps could not be drawn: {exc.__class__.__name__}: {exc}")
     sections = [Section("design-space", "design space", maps or [Text("No summary to map.", "note")])]
     if oc.best is not None:
-        values = ", ".join(f"{k} = {oc.best.params[k.partition('.')[2]]:.6g}" for k in keys
-                           if isinstance(oc.best.params[k.partition(".")[2]], (int, float)))
+        from driver.sweep._spec import split_key
+        best = {k: _swept_value(oc.best.params, *split_key(k)) for k in keys}   # 'key' or 'key(i)'
+        values = ", ".join(f"{k} = {v:.6g}" for k, v in best.items() if isinstance(v, (int, float)))
         blocks, failed = run_blocks(oc.best, oc.best.params, "The marked design.")
         notes += failed
         why = plain(best_words(module, oc.best_metric))

@@ -262,7 +262,8 @@ def figures(p: Params, title: str, theta_grid: Any) -> list[Figure]:
         with plotting.style():
             fig, axes = plotting.new_figure(2, 2, figsize=(7.4, 7.8), subplot_kw={"projection": "polar"})
             draw.plot_pin_polars(fa, axes=axes, theta=theta)
-            plotting.suptitle(fig, f"{plotting.plain_text(title)}: pin forces\nangle: the force's direction, radius: its magnitude [N]")
+            plotting.suptitle(fig, f"{plotting.plain_text(title)}: pin forces\n"
+                                   "angle: the force's direction, radius: its magnitude [N]")
             fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncol=3, frameon=False)
         return fig
 

@@ -35,7 +35,7 @@ from driver.sweep._chunks import BatchPlan, CaseTask
 from driver.sweep._keep import check_keep, keep_columns
 from driver.sweep._report import summary_settings
 from driver.sweep._resume import Layout, case_signature, layout_for, signature
-from driver.sweep._spec import MAX_CASES, SPEC, Grid, grid_of, validate_sweep
+from driver.sweep._spec import MAX_CASES, SPEC, Grid, deck_key, grid_of, set_swept, split_key, validate_sweep
 
 __all__ = ["SweepPlan", "plan_sweep", "chunk_size", "batchable", "batch_plan", "batch_signature", "wanted_columns",
            "BATCH_MAX_CASES", "MAX_CHUNKS", "SMALL_SWEEP", "CHUNK", "MIN_CHUNKS"]
@@ -230,10 +230,13 @@ def _base_hash(raw: RawGroup) -> str:
 # ----------------------------------------------------------------------------- the batch path
 
 def batchable(module: Any, names: list[str], keep: str, case_outputs: str) -> bool:
-    """Whether a sweep over ``names`` ('group.key') can take the study's batch path."""
+    """Whether a sweep over ``names`` ('group.key', or 'group.key(i)': one element) can take the
+    study's batch path: every key one the batch accepts, every element one of a key it names in
+    ``elements``."""
     if module.batch is None or case_outputs == "all" or (case_outputs == "kept" and not keep):
         return False
-    return all(n.partition(".")[2] in module.batch.accepted for n in names)
+    return all(split_key(n)[0] in module.batch.accepted
+               and (split_key(n)[1] is None or split_key(n)[0] in module.batch.elements) for n in names)
 
 
 def batch_signature(raw: RawGroup, grid: Grid, keep: str, rows: str, module: Any,
@@ -266,7 +269,7 @@ def wanted_columns(module: Any, keep: str, plotted: list[str], shown: list[str] 
 def _swap(raw: RawGroup, values: dict[str, Any]) -> RawGroup:
     v = dict(raw.values)
     for name, x in values.items():
-        v[name.partition(".")[2]] = x.item() if hasattr(x, "item") else x
+        set_swept(v, name, x.item() if hasattr(x, "item") else x)
     return RawGroup(raw.name, v, raw.lines, raw.line)
 
 
@@ -277,7 +280,7 @@ def batch_plan(module: Any, raw: RawGroup, deck_path: str, grid: Grid, keep: str
     applies = module.batch.applies   # e.g. not for a base deck that optimises per case
     if applies is not None and not applies(validate(raw, module.spec, deck_path)):
         return None
-    keys = [n.partition(".")[2] for n in grid.names]
+    keys = [deck_key(n) for n in grid.names]
     independent = set(module.batch.independent)
     single: dict[str, dict[int, str]] = {}
     coupled = [i for i, k in enumerate(keys) if k not in independent]

@@ -5,6 +5,7 @@ from __future__ import annotations
 import itertools
 import math
 import os
+import re
 import sys
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
@@ -19,7 +20,7 @@ from driver._deck import DeckError, GroupSpec, Key, Params, RawGroup, shown_valu
 from driver._outcome import ExitCode
 
 __all__ = ["SPEC", "Case", "CaseResult", "MAX_KEYS", "MAX_CASES", "FULL_VALIDATION", "build_cases", "grid_of", "case_at",
-           "iter_cases", "case_count", "validate_sweep"]
+           "iter_cases", "case_count", "validate_sweep", "split_key", "deck_key", "set_swept"]
 
 MAX_KEYS = 9
 #: most cases one per-case sweep deck may have (a batch sweep lists no case: driver.sweep._plan.BATCH_MAX_CASES)
@@ -69,7 +70,8 @@ def configured_scheduler() -> str:
 def _spec() -> GroupSpec:
     keys: dict[str, Key] = {}
     for k in range(1, MAX_KEYS + 1):
-        keys[f"key{k}"] = Key("str", doc=f"deck key to vary, 'group.key' (axis {k})")
+        keys[f"key{k}"] = Key("str", doc=f"deck key to vary (axis {k}): 'group.key', or one element of a list "
+                                          "key 'group.key(i)'")
         keys[f"values{k}"] = Key("list", doc="values of that key (numbers or strings)")
         keys[f"start{k}"] = Key("float", doc="first value (with stop and count)")
         keys[f"stop{k}"] = Key("float", doc="last value (inclusive)")
@@ -177,6 +179,40 @@ class Case:
 
 
 
+#: a swept element of a list key: 'key(i)', i from 1
+_ELEMENT = re.compile(r"([a-z_][a-z0-9_]*)\((\d+)\)")
+_LIST_KINDS = ("floats", "ints", "strs", "list")
+
+
+def split_key(swept: str) -> tuple[str, int | None]:
+    """The study key and the element index (from 1; None for the whole key) of a swept name
+    ``'group.key'`` or ``'group.key(i)'`` (the group may be left out)."""
+    name = swept.partition(".")[2] if "." in swept else swept
+    m = _ELEMENT.fullmatch(name)
+    return (m.group(1), int(m.group(2))) if m else (name, None)
+
+
+def deck_key(swept: str) -> str:
+    """The study key a swept name varies (``'linkage.dyad_dims(3)'`` -> ``'dyad_dims'``)."""
+    return split_key(swept)[0]
+
+
+def set_swept(values: dict[str, Any], swept: str, value: Any) -> None:
+    """Set swept ``'group.key'`` (or one element, ``'group.key(i)'``) in a group's ``values``;
+    DeckError (no path) when the element does not exist in the list the deck gives."""
+    key, index = split_key(swept)
+    if index is None:
+        values[key] = value
+        return
+    cur = values.get(key)
+    items = list(cur) if isinstance(cur, (list, tuple)) else ([] if cur is None else [cur])
+    if not 1 <= index <= len(items):
+        raise DeckError("", None, key, f"element {index} does not exist: the deck gives {key} "
+                                       f"{len(items)} value{'s' * (len(items) != 1)}")
+    items[index - 1] = value
+    values[key] = items
+
+
 def swept_axes(sw: Params, study_group: str, study_spec: GroupSpec) -> list[tuple[str, list]]:
     """The swept axes [(‘group.key’, values)], checked against the study's keys."""
     axes = []
@@ -189,13 +225,19 @@ def swept_axes(sw: Params, study_group: str, study_spec: GroupSpec) -> list[tupl
                 if sw[f"{w}{k}"] is not None:
                     raise sw.error(f"{w}{k}", f"given without key{k}")
             continue
-        group, _, key = name.lower().partition(".")
+        group, _, key = name.lower().replace(" ", "").partition(".")
         if not key:
             raise sw.error(f"key{k}", f"write the key as 'group.key' (e.g. '{study_group}.{name}')")
         if group != study_group:
             raise sw.error(f"key{k}", f"group '{group}' is not this deck's study group &{study_group}")
-        if key not in study_spec.keys:
-            raise sw.error(f"key{k}", f"&{study_group} has no key '{key}'")
+        base_key, index = split_key(key)
+        if base_key not in study_spec.keys:
+            raise sw.error(f"key{k}", f"&{study_group} has no key '{base_key}'")
+        if "(" in key and index is None:
+            raise sw.error(f"key{k}", f"write one element of a list key as '{study_group}.key(i)', i from 1")
+        if index is not None and (index < 1 or study_spec.keys[base_key].kind not in _LIST_KINDS):
+            raise sw.error(f"key{k}", f"'{base_key}' is not a list key: sweep it whole, '{study_group}.{base_key}'"
+                           if index >= 1 else "elements count from 1")
         if has_values and has_range:
             raise sw.error(f"values{k}", f"give values{k} or start{k}/stop{k}/count{k}, not both")
         if has_values:
@@ -322,7 +364,7 @@ def build_cases(sw: Params, study_group: str, study_spec: GroupSpec) -> list[Cas
 def _axis_line(sw: Params, name: str) -> tuple[str, int]:
     """The sweep key (values<k> or start<k>) and line that produced swept key ``name``."""
     for k in range(1, MAX_KEYS + 1):
-        if sw[f"key{k}"] is not None and sw[f"key{k}"].lower() == name:
+        if sw[f"key{k}"] is not None and sw[f"key{k}"].lower().replace(" ", "") == name:
             key = f"values{k}" if sw[f"values{k}"] is not None else f"start{k}"
             return key, sw.line_of(key)
     return "key1", sw.line_of("key1")
@@ -344,7 +386,7 @@ def validate_sweep(sw: Params, raw: RawGroup, module: Any, grid: Grid) -> dict[i
         try:
             return limits.check(module, validate(case_raw(raw, Case(0, values)), module.spec, sw.path), "each case ")
         except DeckError as exc:
-            name = next((n for n in values if n.partition(".")[2] == exc.key), next(iter(values)))
+            name = next((n for n in values if deck_key(n) == exc.key), next(iter(values)))
             key, line = _axis_line(sw, name)
             where = f"case {case_no} (" if case_no else "the value "
             vals = ", ".join(f"{k} = {shown_value(v)}" for k, v in values.items())
@@ -380,7 +422,7 @@ def _coupled_combinations(sw: Params, module: Any, grid: Grid, axis_values: dict
     with fewer than two coupled axes: a value alone was validated).  Refused (DeckError) when
     there are more than MAX_CASES of them: a sweep that cannot be validated is not run."""
     independent = set(module.batch.independent) if module.batch is not None else set()
-    coupled = [i for i, n in enumerate(grid.names) if n.partition(".")[2] not in independent]
+    coupled = [i for i, n in enumerate(grid.names) if deck_key(n) not in independent]
     if len(coupled) < 2:
         return
     names = [grid.names[i] for i in coupled]
@@ -392,7 +434,7 @@ def _coupled_combinations(sw: Params, module: Any, grid: Grid, axis_values: dict
         return
     count = math.prod(len(axis_values[n]) for n in names)
     if count > MAX_CASES:
-        raise sw.error("key1", f"the swept keys {', '.join(n.partition('.')[2] for n in names)} are checked together "
+        raise sw.error("key1", f"the swept keys {', '.join(deck_key(n) for n in names)} are checked together "
                        f"by the study, and their {count} combinations are beyond the {MAX_CASES} a sweep validates "
                        "before it runs; coarsen the grid or split the sweep")
     for combo in itertools.product(*(axis_values[n] for n in names)):
@@ -400,9 +442,11 @@ def _coupled_combinations(sw: Params, module: Any, grid: Grid, axis_values: dict
 
 
 def case_raw(raw: RawGroup, case: Case) -> RawGroup:
+    """The study group of a case: the base deck's with the case's swept values (whole keys or
+    single elements of list keys) in place."""
     values = dict(raw.values)
     for name, v in case.values.items():
-        values[name.partition(".")[2]] = v
+        set_swept(values, name, v)
     return RawGroup(raw.name, values, raw.lines, raw.line)
 
 
