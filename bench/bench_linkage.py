@@ -19,6 +19,16 @@ Ratios are measured in one process, kernel and baseline interleaved, medians of 
 * a 10^6-design Watt II summary sweep through the command line (``--sweep``: wall clock, two
   workers).  Target: under 10 s.
 
+Memory is treated alike: the linkage and the four-bar kernel write into ``out=`` buffers made
+once; pylinkage makes its three output arrays (``np.empty``) in every call, and glibc hands
+blocks that large back to the operating system when they are freed, so at 200 000 inputs each
+of its calls first-touched 67 MB of fresh pages (about 11 000 page faults, 100-200 ns a
+position of system time zeroing them) that the linkage never paid.  :func:`keep_freed_memory`
+tells glibc to keep freed memory for reuse (``mallopt``), so pylinkage's arrays land on pages
+already mapped, as the linkage's buffers do; the rows print both sides' page faults per call
+(0 when alike).  pylinkage writes every component (the three ground pivots too: 42 float64 a
+position against the linkage's 24), in its own layout (positions, then components, C order).
+
 Two sizes: one crank turn at 0.1 deg (3600 inputs: every output stays in the core's cache) and
 200 000 inputs (the outputs stream to memory).  The store floor is numpy writing the same
 output bytes in the same run: at 200 000 inputs it is what bounds a kernel that writes 200
@@ -76,6 +86,35 @@ def interleaved(kernel: Callable[[], object], baseline: Callable[[], object], re
             baseline()
         tb.append((time.process_time() - t0) / rounds)
     return statistics.median(tk), statistics.median(tb)
+
+
+def keep_freed_memory() -> str:
+    """Have glibc keep freed memory for reuse, for the rest of the process (called by the
+    pylinkage rows only, after their own out= buffers are made): blocks up to 32 MiB from the
+    heap, and the heap never trimmed (the C int's largest threshold), so arrays made and freed
+    call after call land on pages already mapped (as ``out=`` buffers do).  Returns what was
+    done, or why not (another C library)."""
+    import ctypes
+    import ctypes.util
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
+        mallopt = libc.mallopt
+    except (OSError, AttributeError) as exc:
+        return f"freed memory not kept ({exc}): pylinkage's rows include its page faults"
+    m_trim_threshold, m_mmap_threshold = -1, -3
+    if mallopt(m_mmap_threshold, 32 << 20) != 1 or mallopt(m_trim_threshold, (1 << 31) - 1) != 1:
+        return "mallopt refused: pylinkage's rows include its page faults"
+    return "freed memory kept for reuse (mallopt): both sides write into mapped pages"
+
+
+def minor_faults(f: Callable[[], object], calls: int = 3) -> float:
+    """Minor page faults per call of f (first touches of fresh memory; after a warm-up call)."""
+    import resource
+    f()
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+    for _ in range(calls):
+        f()
+    return (resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before) / calls
 
 
 def rounds_for(n: int) -> int:
@@ -186,6 +225,7 @@ def versus_pylinkage(n: int, repeat: int) -> dict[str, float] | str:
     if built is None:
         return why
     link, crank, mech = built
+    memory = keep_freed_memory()   # pylinkage's per-call arrays on mapped pages, as our out= buffers
     dt = 2 * math.pi / n
     crank.angular_velocity = dt
     link.set_input_velocity(crank, 10.0, 0.0)
@@ -210,13 +250,16 @@ def versus_pylinkage(n: int, repeat: int) -> dict[str, float] | str:
                 f()
         return g
 
-    joints = many(linkage_kernel.reusable_call(mech, theta, forces=False, outputs=Want.JOINTS))
+    joints1 = linkage_kernel.reusable_call(mech, theta, forces=False, outputs=Want.JOINTS)
+    theirs1 = lambda: link.step_fast_with_kinematics(iterations=n, dt=1.0)
+    joints = many(joints1)
     points = many(linkage_kernel.reusable_call(mech, theta, forces=False, outputs=Want.POINTS))
-    tj, tk = interleaved(joints, many(lambda: link.step_fast_with_kinematics(iterations=n, dt=1.0)), repeat)
+    tj, tk = interleaved(joints, many(theirs1), repeat)
     tp, tq = interleaved(points, many(lambda: link.step_fast(iterations=n, dt=1.0)), repeat)
     per = n * r
     return {"joints": tj / per, "pylinkage": tk / per, "positions": tp / per, "pylinkage_positions": tq / per,
-            "floor": store_floor(n, 24, repeat)}
+            "floor": store_floor(n, 24, repeat), "faults": minor_faults(joints1),
+            "pylinkage_faults": minor_faults(theirs1), "memory": memory}
 
 
 def batch_summary(nd: int, scan: int, repeat: int) -> dict[str, float]:
@@ -295,7 +338,9 @@ def main(argv: list[str] | None = None) -> None:
         print(f"  n = {n}: Watt II joints {r['joints'] * 1e9:6.1f} ns/position, pylinkage kinematics "
               f"{r['pylinkage'] * 1e9:7.1f} ns ({r['pylinkage'] / r['joints']:5.1f}x, target >= 20); positions "
               f"{r['positions'] * 1e9:6.1f} ns, pylinkage positions {r['pylinkage_positions'] * 1e9:7.1f} ns "
-              f"({r['pylinkage_positions'] / r['positions']:5.1f}x, target > 1); store floor {r['floor'] * 1e9:5.1f} ns")
+              f"({r['pylinkage_positions'] / r['positions']:5.1f}x, target > 1); store floor {r['floor'] * 1e9:5.1f} ns; "
+              f"page faults per call {r['faults']:.0f} (ours), {r['pylinkage_faults']:.0f} (pylinkage's kinematics); "
+              f"{r['memory']}")
     s = batch_summary(20000, 72, 3)
     print(f"  Watt II batch summary, 72-point scan: output pass {s['output'] * 1e6:6.2f} us/design, every pass "
           f"{s['all'] * 1e6:6.2f} us/design")

@@ -195,9 +195,11 @@ contains
     integer :: d, first, k0, m, flagk, mb
     logical :: cont, store
 
-    allocate (modes(n, nd))
+    ! each group's assembly: one row (constant over the inputs) until the continuity scan flips
+    ! one somewhere; only then one row per input (no n-long pass, no n-long read, in the common case)
+    allocate (modes(1, nd))
     do d = 1, nd
-      modes(:, d) = merge(1.0_dp, -1.0_dp, rdy(d, 3) >= 0.0_dp)
+      modes(1, d) = merge(1.0_dp, -1.0_dp, rdy(d, 3) >= 0.0_dp)
     end do
     cont = iand(want, want_continuity) /= 0 .and. n >= 4
     ! first pass: each block checks in cache whether any group might change assembly (the
@@ -246,6 +248,7 @@ contains
     allocate (chr(n, 4, nd))
     store = .true.
     call solve_rows(1)
+    call expand_modes()
     do d = 1, nd
       if (idy(d, 1) == dy_prp) cycle
       first = 0
@@ -254,6 +257,17 @@ contains
     end do
 
   contains
+
+    !> modes as one row per input (the continuity scan flips them from a row on).
+    subroutine expand_modes()
+      real(dp) :: m1(nd)
+      m1 = modes(1, :)
+      deallocate (modes)
+      allocate (modes(n, nd))
+      do d = 1, nd
+        modes(:, d) = m1(d)
+      end do
+    end subroutine expand_modes
 
     !> Rows k1..n in blocks of nb.
     subroutine solve_rows(k1)
@@ -378,7 +392,9 @@ contains
     integer, intent(in) :: m, k0, n, nl, np, ng, nd, ns, nld, nt, nf, asel, rsel
     real(dp), intent(in) :: x(n), rdrv(3), rpts(np, 2), rgd(ng, 3), rdy(nd, 3), rl(nl, 4), grav(2)
     integer, intent(in) :: idrv(4), ipts(np), igd(ng), idy(nd, 6), ild(nld), ift(4), want
-    real(dp), intent(in) :: rld(nld, 2), rtq(nl), tab(nt, 2), rft(3), modes(n, nd)
+    real(dp), intent(in) :: rld(nld, 2), rtq(nl), tab(nt, 2), rft(3)
+    !> each group's assembly: (n, nd) one per input, or (1, nd) the same at every input
+    real(dp), intent(in) :: modes(:, :)
     logical, intent(in) :: cont, store
     real(dp), intent(inout) :: chr(:, :, :), ring(3, 4, nd)
     integer, intent(inout) :: flagk
@@ -386,7 +402,7 @@ contains
     real(dp), intent(inout) :: lk(n, 3, nl), pk(n, 6, np), sk(n, 3, ns), qa(n, nd), fk(nf, 9, nd), fd(nf, 4), &
                                sh(nf, 3)
     integer, intent(inout) :: st(n, nd)
-    real(dp) :: a1(nb, natt), ex(nb, nex)
+    real(dp) :: a1(nb, natt), ex(nb, nex), mode(nb)
     real(dp) :: wk(nb, 3, nl), rx(nb, 9), tmp(nb), drf(nb, 4), fx(nb), fy(nb), q(nb), okr(nb)
     integer :: l, p, dd, kind, k1, s0, c
     logical :: forces, slides
@@ -424,15 +440,20 @@ contains
         l = ipts(idy(dd, 3))
         if (l /= 1) call point_of(m, l, rpts(idy(dd, 3), :), pose(:, :, l), att(:, :, 2, dd))
       end if
+      if (size(modes, 1) == 1) then
+        mode(1:m) = modes(1, dd)
+      else
+        mode(1:m) = modes(k0:k1, dd)
+      end if
       select case (kind)
       case (dy_rrr)
-        call dyad_rrr(m, rdy(dd, 1), rdy(dd, 2), modes(k0:k1, dd), att(:, :, 1, dd), att(:, :, 2, dd), &
+        call dyad_rrr(m, rdy(dd, 1), rdy(dd, 2), mode(1:m), att(:, :, 1, dd), att(:, :, 2, dd), &
                       pose(:, :, idy(dd, 4)), pose(:, :, idy(dd, 5)), ex)
       case (dy_rrp)
-        call dyad_rrp(m, rdy(dd, 1), rdy(dd, 2), modes(k0:k1, dd), att(:, :, 1, dd), att(:, :, 2, dd), &
+        call dyad_rrp(m, rdy(dd, 1), rdy(dd, 2), mode(1:m), att(:, :, 1, dd), att(:, :, 2, dd), &
                       pose(:, :, idy(dd, 4)), pose(:, :, idy(dd, 5)), ex)
       case (dy_rpr)
-        call dyad_rpr(m, rdy(dd, 1), modes(k0:k1, dd), att(:, :, 1, dd), att(:, :, 2, dd), pose(:, :, idy(dd, 4)), &
+        call dyad_rpr(m, rdy(dd, 1), mode(1:m), att(:, :, 1, dd), att(:, :, 2, dd), pose(:, :, idy(dd, 4)), &
                       pose(:, :, idy(dd, 5)), ex)
       case default
         call dyad_prp(m, rdy(dd, 1), rdy(dd, 2), att(:, :, 1, dd), att(:, :, 2, dd), pose(:, :, idy(dd, 4)), &
