@@ -99,7 +99,8 @@ def run(source: DeckSource, *, name: str | None = None, progress: bool = False) 
 
 
 def write(result: Result, outdir: str | os.PathLike, formats: Iterable[str] = (), plot: bool | str = False,
-          json: bool = False, name: str | None = None, report: bool = False) -> list[Path]:
+          json: bool = False, name: str | None = None, report: bool = False,
+          animation: str | None = None) -> list[Path]:
     """Write the files the command line writes for a run's result.
 
     Every file is written atomically; ``outdir`` is created when missing.
@@ -120,6 +121,9 @@ def write(result: Result, outdir: str | os.PathLike, formats: Iterable[str] = ()
         Output stem, a plain file name; default the result's name (the deck's file stem).
     report : bool, default False
         Also write the self-contained report page ``<name>.html`` (as ``--report``).
+    animation : {None, 'gif', 'mp4'}, optional
+        Also write the mechanism's animation ``<name>_animation.gif`` (or ``.mp4``, which needs
+        ffmpeg) from the frames the report page plays (as ``--animation``).
 
     Returns
     -------
@@ -129,7 +133,7 @@ def write(result: Result, outdir: str | os.PathLike, formats: Iterable[str] = ()
     Raises
     ------
     ValueError
-        ``name`` is a path rather than a file stem, or a table or figure format is unknown.
+        ``name`` is a path rather than a file stem, or a table, figure or animation format is unknown.
 
     Examples
     --------
@@ -147,6 +151,12 @@ def write(result: Result, outdir: str | os.PathLike, formats: Iterable[str] = ()
         from driver._outcome import RunOutcome
         page = report_page.page(RunOutcome(result=result))
         written.append(report_page.write_report(Path(outdir) / f"{stem}.html", page))
+    if animation:
+        from driver import _report_page as report_page
+        from driver._outcome import RunOutcome
+        path = report_page.write_animation(Path(outdir) / stem, RunOutcome(result=result), animation)
+        if path is not None:
+            written.append(path)
     return written
 
 

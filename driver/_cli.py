@@ -24,8 +24,8 @@ from driver import __version__
 from driver import _limits as limits
 from driver._export import FORMATS
 from driver._extras import MissingExtra, require
+from driver._formats import ANIMATION_FORMATS, PLOT_FORMATS
 from driver._outcome import ExitCode, Outcome, RunOutcome, SweepOutcome
-from driver._result import PLOT_FORMATS
 from driver._study import study_names
 
 __all__ = ["main", "run_deck", "say", "ExitCode"]
@@ -50,16 +50,25 @@ def _fs_error(exc: OSError) -> str:
     return f"cannot write {where}: {reason}"
 
 
+def _plot_format(text: str) -> str:
+    """``--plot-format``'s value; an animation format is refused naming the option that writes it."""
+    if text.lower() in ANIMATION_FORMATS:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a figure format ({', '.join(PLOT_FORMATS)}): the "
+                                         f"mechanism's animation is written with --animation {text.lower()}")
+    return text
+
+
 def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool | str, progress: bool,
              quiet: bool = False, sweep_options: dict | None = None, summary_json: bool = False,
-             report: bool = False) -> int:
+             report: bool = False, animation: str | None = None) -> int:
     """Run one deck; returns its exit status. Errors are printed, never raised.
 
     ``sweep_options`` (jobs, scheduler, resume) apply when the deck has a &sweep or an
     &optimize group (a sweep's cases always write their summary as JSON); given for any other
     deck, they are reported as ignored.  ``summary_json`` writes a single run's summary as
     ``<stem>.json``.  ``report`` also writes the deck's report page ``<stem>.html``
-    (:mod:`driver._report_page`) once its run has written its outputs.
+    (:mod:`driver._report_page`) once its run has written its outputs; ``animation`` ('gif',
+    'mp4') the mechanism's animation ``<stem>_animation.<fmt>``.
     """
     from driver._atomic import NameTooLong
     from driver._deck import DeckError, read_deck
@@ -70,7 +79,7 @@ def run_deck(path: Path, outdir: Path, formats: list[str], plot: bool | str, pro
         given = [opt for opt, key in (("-j/--jobs", "jobs"), ("--scheduler", "scheduler"), ("--resume", "resume"))
                  if (sweep_options or {}).get(key) and not ({"sweep", "optimize"} & set(deck.groups))]
         outcome = run_by_engine(deck, outdir, formats, plot, progress, summary_json=summary_json, report=report,
-                                notify=_notify, **(sweep_options or {}))
+                                notify=_notify, animation=animation, **(sweep_options or {}))
     except DeckError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return ExitCode.BAD_INPUT
@@ -229,13 +238,17 @@ def build_parser() -> argparse.ArgumentParser:
                              "warnings, a sweep's cases, an optimisation's x, fun, constraints, a synthesis's "
                              "linkage and checks); with --compare, one record per deck on stdout (JSON Lines)")
     parser.add_argument("--plot", action="store_true", help="write figures <stem>_<name>.png (see --plot-format)")
-    parser.add_argument("--plot-format", choices=PLOT_FORMATS, default=None,
+    parser.add_argument("--plot-format", choices=PLOT_FORMATS, default=None, type=_plot_format,
                         help="figure file format (implies --plot; default png); the same inputs give "
                              "byte-identical files")
     parser.add_argument("--report", action="store_true",
                         help="also write a self-contained report page <stem>.html (figures, tables, the deck, "
                              "warnings, the comparison with the published tables, an animation of the mechanism; "
                              "opens offline in any browser and prints)")
+    parser.add_argument("--animation", choices=ANIMATION_FORMATS, default=None,
+                        help="also write the mechanism's animation <stem>_animation.gif (or .mp4, needs ffmpeg) for "
+                             "slides: the frames the report page plays (a sweep's best case, an optimisation's optimum, "
+                             "a synthesised linkage with its targets)")
     parser.add_argument("-q", "--quiet", action="store_true", help="print only warnings and errors")
     parser.add_argument("--keys", metavar="GROUP", help="list the keys of a namelist group and exit")
     parser.add_argument("--examples", action="store_true",
@@ -308,7 +321,8 @@ def _main(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
         parser.error(str(exc))
     formats = list(dict.fromkeys((["csv"] if args.csv else []) + args.formats))
     needs = ([("plot", "--plot")] if (args.plot or args.plot_format) else []) + \
-        ([("plot", "--report")] if args.report else []) + ([("parquet", "--format parquet")]
+        ([("plot", "--report")] if args.report else []) + ([("plot", "--animation")] if args.animation else []) + \
+        ([("parquet", "--format parquet")]
              if "parquet" in formats else []) + ([("dask", "--scheduler")] if args.scheduler else [])
     for extra, option in needs:
         try:
@@ -325,7 +339,8 @@ def _main(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
         for deck in args.decks:
             try:
                 status = max(status, run_deck(deck, outdir, formats, plot, progress, args.quiet,
-                                             sweep_options, summary_json=args.json, report=args.report))
+                                             sweep_options, summary_json=args.json, report=args.report,
+                                             animation=args.animation))
                 sys.stdout.flush()
             except BrokenPipeError:   # stdout closed early (e.g. piped into head): the files are
                 _quiet_stdout()       # written; go on with the other decks without printing

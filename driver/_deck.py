@@ -564,7 +564,7 @@ def _read_legacy(path: Path, text: str) -> Deck:
         for key, tok in zip(keys, tokens):
             f = _as_float(tok)
             if f is None:
-                raise DeckError(path, n, key, f"not a number: {tok!r}")
+                raise DeckError(path, n, key, f"not a number: {shown_value(tok)}")
             values[key] = f
             lines[key] = n
     return Deck(path, {"fourbar": RawGroup("fourbar", values, lines, content[0][0])}, legacy=True)
@@ -766,7 +766,7 @@ def _coerce(kind: str, v: Any) -> tuple[Any, str | None]:
     if kind == "bool":
         if isinstance(v, bool):
             return v, None
-        return None, f"not a logical (.true./.false.): {v!r}"
+        return None, f"not a logical (.true./.false.): {shown_value(v)}"
     if kind == "str":
         if isinstance(v, str):
             bad = next((ch for ch in v if not ch.isprintable()), None)
@@ -796,7 +796,7 @@ def validate(raw: RawGroup, spec: GroupSpec, path: str | Path) -> Params:
             for x in norm:
                 if x not in k.choices:
                     raise DeckError(path, line, key,
-                                    f"{x!r} is not one of {', '.join(map(repr, k.choices))}")
+                                    f"{shown_value(x)} is not one of {', '.join(map(repr, k.choices))}")
             val = norm if isinstance(val, list) else norm[0]
         if k.check is not None:
             try:

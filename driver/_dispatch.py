@@ -36,18 +36,20 @@ def engine_of(deck: Deck) -> str:
 
 def run_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, progress: bool = False, *,
              jobs: int | None = None, scheduler: Any = None, resume: bool = False, summary_json: bool = False,
-             report: bool = False, notify: Callable[[str], None] | None = None) -> Outcome:
+             report: bool = False, notify: Callable[[str], None] | None = None,
+             animation: str | None = None) -> Outcome:
     """Run ``deck`` by its engine and write its outputs to ``outdir``; ``summary_json`` also its
-    ``<stem>.json``, ``report`` its report page ``<stem>.html`` (:mod:`driver._report_page`,
-    once the run has written its outputs).  ``jobs``, ``scheduler`` and ``resume`` apply to
-    sweeps and optimisations; ``notify(line)`` hears what cannot wait for the outcome (a sweep's
-    Ctrl-C: the queued cases are cancelled).  Returns the engine's outcome, with what a library
-    warned while the deck ran as warnings in words (:func:`driver._warnings.caught`); raises DeckError
-    for bad input (nothing written) and :class:`~driver._extras.MissingExtra` for a missing
-    optional package."""
+    ``<stem>.json``, ``report`` its report page ``<stem>.html`` (:mod:`driver._report_page`),
+    both made from the engine's outcome once its run has written its outputs, ``animation``
+    ('gif' or 'mp4') the mechanism's animation ``<stem>_animation.<fmt>`` (the report page's
+    frames).  ``jobs``, ``scheduler`` and ``resume`` apply to sweeps and optimisations;
+    ``notify(line)`` hears what cannot wait for the outcome (a sweep's Ctrl-C: the queued cases
+    are cancelled).  Returns the engine's outcome, with what a library warned while the deck ran
+    as warnings in words (:func:`driver._warnings.caught`); raises DeckError for bad input
+    (nothing written) and :class:`~driver._extras.MissingExtra` for a missing optional package."""
     with caught() as said:
         outcome = _run(deck, outdir, formats, plot, progress, jobs=jobs, scheduler=scheduler, resume=resume,
-                       summary_json=summary_json, report=report, notify=notify)
+                       summary_json=summary_json, report=report, notify=notify, animation=animation)
     for text in dict.fromkeys(said):
         outcome.warn(f"{deck.path}: {text}")
     return outcome
@@ -55,10 +57,12 @@ def run_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, pro
 
 def _run(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, progress: bool = False, *,
          jobs: int | None = None, scheduler: Any = None, resume: bool = False, summary_json: bool = False,
-         report: bool = False, notify: Callable[[str], None] | None = None) -> Outcome:
+         report: bool = False, notify: Callable[[str], None] | None = None,
+         animation: str | None = None) -> Outcome:
     kind = engine_of(deck)
     # the names of what is made from the outcome, known now: refused before the run, not after it
-    after = (*((".html",) if report else ()), *((".json",) if summary_json and kind != "study" else ()))
+    after = (*((".html",) if report else ()), *((".json",) if summary_json and kind != "study" else ()),
+             *((f"_animation.{animation}",) if animation else ()))
     stem = output_stem(outdir, deck.path, after) if after else None
     outcome: Outcome
     if kind in ("synthesis", "optimize"):
@@ -77,13 +81,15 @@ def _run(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, progres
         require("parquet")   # sweeps keep their cases in Parquet: say so before importing them
         from driver import sweep
         outcome = sweep.run_sweep_deck(deck, outdir, formats, plot, progress, jobs=jobs, scheduler=scheduler,
-                                       resume=resume, notify=notify, best=report)
+                                       resume=resume, notify=notify, best=report or bool(animation))
     else:   # a single run writes its record with its other files (as driver.write does)
         outcome = run_study(deck, outdir, formats, plot, progress, summary_json=summary_json)
     if kind == "sweep":
         _record(outcome, stem, summary_json)
     if stem is not None and report:
         _report(deck, stem, outcome)
+    if stem is not None and animation:
+        _animation(deck, stem, outcome, animation)
     return outcome
 
 
@@ -92,6 +98,26 @@ def _record(outcome: Outcome, stem: Path | None, summary_json: bool) -> None:
     if stem is not None and summary_json:
         from driver._record import write_record
         outcome.written.append(write_record(outcome, stem))
+
+
+def _animation(deck: Deck, stem: Path, outcome: Outcome, fmt: str) -> None:
+    """Write the mechanism's animation after the run; one that cannot be written (no ffmpeg for
+    an MP4, a full disk) is an error message and exit status 1, the run's outputs stay."""
+    from driver import _report_page as report_page
+    if outcome.exit_code == ExitCode.BAD_INPUT:
+        return
+    try:
+        path = report_page.write_animation(stem, outcome, fmt)
+    except (KeyboardInterrupt, BrokenPipeError):
+        raise
+    except Exception as exc:
+        outcome.error(f"{deck.path}: the animation could not be written: {exc.__class__.__name__}: {exc}")
+        outcome.late_failure = True
+        return
+    if path is None:
+        outcome.warn(f"{deck.path}: no mechanism to animate (--animation)")
+    else:
+        outcome.written.append(path)
 
 
 def _report(deck: Deck, stem: Path, outcome: Outcome) -> None:

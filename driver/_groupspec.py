@@ -1,18 +1,34 @@
 """What a deck group may hold and what it holds once validated: the declaration of a key
 (:class:`Key`) and of a group (:class:`GroupSpec`), the validated values (:class:`Params`) and
 the bad-input error (:class:`DeckError`).  Plain data with no dependency inside the driver (but the
-exception base of :mod:`driver._errors`), so
+exception base of :mod:`driver._errors` and the rule for names of :mod:`driver._names`), so
 that the deck reader (:mod:`driver._deck`, which re-exports them), the budget
 (:mod:`driver._limits`) and the study contract (:mod:`driver._study`) can use them without
 importing each other."""
 from __future__ import annotations
 
+import re
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from driver._errors import DriverError
+from driver._names import NAME_CHARS, shown
+
+#: a run of more characters than a file name may have (NAME_MAX, 255 bytes) without a blank or a
+#: '/' in a message: not a path's part but a key, group or value echoed from the deck
+_LONG_WORD = re.compile(r"[^\s/]{256,}")
+#: the longest message shown whole (a path may have PATH_MAX, 4 096 bytes)
+_MESSAGE_CHARS = 8192
+
+
+def bounded_words(text: str) -> str:
+    """``text`` with every run of characters longer than a file name may be, without a blank or a
+    '/', cut in the middle to :data:`~driver._names.NAME_CHARS` (:func:`driver._names.shown`), and
+    the whole bounded to 8 192 characters; the path of a deck is shown whole."""
+    text = _LONG_WORD.sub(lambda m: shown(m.group(0), NAME_CHARS), text)
+    return text if len(text) <= _MESSAGE_CHARS else shown(text, _MESSAGE_CHARS)
 
 __all__ = ["KINDS", "DeckError", "Key", "GroupSpec", "Params"]
 
@@ -45,9 +61,12 @@ class DeckError(DriverError, ValueError):
         return (type(self), (self.path, self.line, self.key, self.message))
 
     def __str__(self) -> str:
+        """The message as the command line prints it: the key and every key, group or value the
+        message quotes bounded to :data:`driver._names.NAME_CHARS` characters
+        (:func:`driver._names.shown`: a 75 kB key is not echoed whole); the deck's path whole."""
         where = f"{self.path}:{self.line}" if self.line else self.path
-        what = f"key '{self.key}': " if self.key else ""
-        return f"{where}: {what}{self.message}"
+        what = f"key '{shown(self.key)}': " if self.key else ""
+        return f"{where}: {what}{bounded_words(self.message)}"
 
 
 class Params(Mapping):

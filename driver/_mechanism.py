@@ -15,7 +15,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Link", "Guide", "MechanismFrames"]
+__all__ = ["Link", "Guide", "Mark", "MechanismFrames", "LINK_COLOURS", "PATH_COLOURS", "MARK_COLOUR", "MASS_COLOUR"]
+
+#: colours of the links, in drawing order (cycled): the page's animation, its GIF export and the
+#: studies' linkage drawings use the same, so a crank is the same colour in every view
+LINK_COLOURS = ("#2c3e50", "#2980b9", "#e67e22", "#16a085", "#8e44ad", "#c0392b", "#7f8c8d")
+#: colours of the traced paths, in order (cycled)
+PATH_COLOURS = ("#999999", "#c0392b", "#8e44ad", "#27ae60", "#d35400")
+#: colour of fixed marks (a synthesis's target points) and of counterweights
+MARK_COLOUR = "#000000"
+MASS_COLOUR = "#4d4d4d"
 
 
 @dataclass(frozen=True)
@@ -80,6 +89,30 @@ class Guide:
 
 
 @dataclass(frozen=True)
+class Mark:
+    """Fixed points drawn on top of the moving parts as open squares (the target points a path
+    synthesis passes through).
+
+    Parameters
+    ----------
+    xy : array_like
+        (k, 2) positions, k >= 1, in the frames' length unit.
+    name : str
+        What they are, in words (their tooltip and legend entry).
+    """
+
+    xy: np.ndarray
+    name: str
+
+    def __post_init__(self) -> None:
+        xy = np.array(self.xy, dtype=np.float64).reshape(-1, 2) if np.size(self.xy) else np.zeros((0, 2))
+        if len(xy) < 1 or not np.isfinite(xy).all():
+            raise ValueError(f"mark {self.name!r}: needs (k, 2) finite positions, k >= 1")
+        xy.flags.writeable = False
+        object.__setattr__(self, "xy", xy)
+
+
+@dataclass(frozen=True)
 class MechanismFrames:
     """The motion of a mechanism as frames of named points.
 
@@ -101,8 +134,13 @@ class MechanismFrames:
         Points drawn as pins (open circles).
     markers : tuple of int, optional
         Points drawn as dots (a coupler point).
+    masses : tuple of int, optional
+        Points drawn as masses (filled discs larger than a pin: the counterweights a force
+        balance adds).
     guides : tuple of Guide, optional
         Fixed lines drawn under the parts.
+    marks : tuple of Mark, optional
+        Fixed points drawn on top of the parts (target points).
     paths : tuple of int, optional
         Points whose paths over the frames are drawn (dashed), split where a frame is invalid
         and between :attr:`segments`.
@@ -128,7 +166,9 @@ class MechanismFrames:
     ground: tuple[int, ...] = ()
     joints: tuple[int, ...] = ()
     markers: tuple[int, ...] = ()
+    masses: tuple[int, ...] = ()
     guides: tuple[Guide, ...] = ()
+    marks: tuple[Mark, ...] = ()
     paths: tuple[int, ...] = ()
     segments: tuple[tuple[int, int], ...] = ()
     periodic: bool = True
@@ -150,7 +190,7 @@ class MechanismFrames:
         labels = tuple(str(s) for s in self.labels)
         if len(labels) != n_frames:
             raise ValueError(f"labels: one per frame ({n_frames}), got {len(labels)}")
-        for attr in ("ground", "joints", "markers", "paths"):
+        for attr in ("ground", "joints", "markers", "masses", "paths"):
             idx = tuple(int(i) for i in getattr(self, attr))
             if any(not 0 <= i < n_points for i in idx):
                 raise ValueError(f"{attr}: a point index outside 0..{n_points - 1}")
@@ -170,6 +210,7 @@ class MechanismFrames:
         object.__setattr__(self, "labels", labels)
         object.__setattr__(self, "links", tuple(self.links))
         object.__setattr__(self, "guides", tuple(self.guides))
+        object.__setattr__(self, "marks", tuple(self.marks))
         object.__setattr__(self, "segments", segs)
 
     @property
@@ -201,9 +242,9 @@ class MechanismFrames:
         return self.periodic and not self.segments and bool(self.valid.all())
 
     def extent(self) -> tuple[float, float, float, float]:
-        """(x0, y0, width, height) of every finite point and guide, in the frames' unit."""
+        """(x0, y0, width, height) of every finite point, guide and mark, in the frames' unit."""
         xy = self.points.reshape(-1, 2)
-        xy = np.vstack([xy[np.isfinite(xy).all(axis=1)], *(g.xy for g in self.guides)])
+        xy = np.vstack([xy[np.isfinite(xy).all(axis=1)], *(g.xy for g in self.guides), *(m.xy for m in self.marks)])
         lo, hi = xy.min(axis=0), xy.max(axis=0)
         return float(lo[0]), float(lo[1]), float(hi[0] - lo[0]), float(hi[1] - lo[1])
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import enum
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -61,6 +62,12 @@ class Message:
         return f"{self.level}: {self.text}"
 
 
+#: how an outcome shows itself in a notebook, by its type: each engine registers its outcome's
+#: (the report page stands above the engines, so the outcome cannot import it; see
+#: :meth:`Outcome._repr_html_`)
+HTML: dict[type, Callable[[Any], str]] = {}
+
+
 @dataclass(kw_only=True)
 class Outcome:
     """What an engine did: the base of every outcome.
@@ -92,6 +99,14 @@ class Outcome:
     def ok(self) -> bool:
         """True when the exit status is 0."""
         return self.exit_code == ExitCode.OK
+
+    def _repr_html_(self) -> str | None:
+        """The outcome as its report page shows it, for a notebook's rich display: the renderer
+        its engine registered in :data:`HTML` (the page's own templates), or None (plain repr)."""
+        for kind, render in HTML.items():
+            if isinstance(self, kind):
+                return render(self)
+        return None
 
     def warn(self, text: str) -> None:
         """Record a warning.

@@ -95,6 +95,10 @@ def column_label(study: Study | None, name: str) -> str:
     """The axis label of summary column or deck key ``name`` (``group.key`` or ``key``) of
     ``study``: words and units from its ``labels``, else the key's ``SPEC`` units, else
     units read off the name's suffix (``_deg``, ``_rad_s``, ...).  E.g. ``'crank speed [rad/s]'``."""
+    element = re.fullmatch(r"(([a-z_][a-z0-9_]*\.)?[A-Za-z_][A-Za-z0-9_]*)\(([0-9]+)\)", name)
+    if element:   # one element of a list key (an optimiser's variable 'ujoint.phi(1)'): the key's words, numbered
+        words, _, units = column_label(study, element.group(1)).partition(" [")
+        return f"{words} ({element.group(3)})" + (f" [{units}" if units else "")
     if not re.fullmatch(r"([a-z_][a-z0-9_]*\.)?[A-Za-z_][A-Za-z0-9_]*", name):
         return name   # an expression of columns (driver._expr) is its own label
     group, _, key = name.rpartition(".")

@@ -12,11 +12,13 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+from driver._formats import ANIMATION_FORMATS, PLOT_FORMATS, plot_format
+
 if TYPE_CHECKING:   # annotations only: keeps `python -m driver --help` light
     import matplotlib.figure
     import pandas as pd
 
-__all__ = ["Figure", "PLOT_FORMATS", "Result", "Tidy", "plot_format"]
+__all__ = ["Figure", "PLOT_FORMATS", "ANIMATION_FORMATS", "Result", "Tidy", "plot_format"]
 
 
 class Tidy:
@@ -123,19 +125,6 @@ class _TidyField:
 
 
 
-#: file formats of ``--plot`` figures (``--plot-format``); the first is the default
-PLOT_FORMATS = ("png", "svg", "pdf")
-
-
-def plot_format(plot: bool | str | None) -> str | None:
-    """The figure format a ``plot`` argument asks for: None (no figures), or one of
-    :data:`PLOT_FORMATS` (``True`` means PNG).  Raises ValueError for any other format."""
-    if not plot:
-        return None
-    fmt = PLOT_FORMATS[0] if plot is True else str(plot).lower().lstrip(".")
-    if fmt not in PLOT_FORMATS:
-        raise ValueError(f"figure format {plot!r} is not one of {', '.join(PLOT_FORMATS)}")
-    return fmt
 
 
 @dataclass
@@ -194,6 +183,10 @@ class Result:
         Namelist group of the study (set by the runner).
     params : Params or None
         The validated deck keys the run was made from (set by the runner).
+    data : dict of str to object
+        Arrays of the run that no table holds, for its study's figures and the report page's
+        animation (the slider-crank's nonlinear rod: ``'rod'``, its nodes' lateral deflection
+        over the recorded revolution); never written to a file.
     """
 
     text: str
@@ -208,6 +201,8 @@ class Result:
     #: the validated deck keys the run was made from (set by the runner; the report page's
     #: animation and comparison use them)
     params: Any = field(default=None, repr=False, compare=False)
+    #: arrays no table holds, for the study's figures and the page's animation (not written)
+    data: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
     #: the failure is the design's answer (docs above): a sweep records the case as ok
     design_failure: bool = False
 
@@ -267,6 +262,12 @@ class Result:
             if f.name == name:
                 return f.draw()
         raise LookupError(f"no figure {name!r}; this result draws {', '.join(self.figure_names)}")
+
+    def _repr_html_(self) -> str:
+        """The run as its report page shows it (animation, figures, headline figures, tables),
+        for a notebook's rich display (made by :func:`driver._report_page.fragment`)."""
+        from driver._report_page._fragment import fragment
+        return fragment(self)
 
     def __repr__(self) -> str:
         state = "ok" if self.ok else f"failed: {self.failure}"

@@ -510,19 +510,23 @@ contains
   !> rev_lat(r), rev_eps(r): peak |lateral deflection| and peak |axial strain| in revolution r.
   !> shapes(0:nel, 2): lateral deflection profile at the recorded step of largest lateral
   !> deflection and at the recorded step of largest crank-end compression; shape_step(2).
+  !> frames(0:nel, nframe): the lateral deflection profile [m] at every frame_every-th recorded
+  !> step (recorded steps 1, 1 + frame_every, ...; nframe = (nrec - 1)/frame_every + 1): the
+  !> rod's nodes over the recorded revolution, drawn by the report page's animation.
   !> stats: (total Newton solves, most solves in one step, step cuts, deepest cut level,
   !>         steps completed); fail_step, fail_iter: the step and solves of a failure.
   subroutine simulate_nl(nel, nq, nrec, nrev, r2, rl, rhoa, ea, ei, half_depth, msl, omega, dt, &
                          nsteps, spr, rec_start, alpha, beta, hht, start_mode, tol, maxit, max_cuts, &
-                         want_energy, eps_ax, eps_of, lat_max, mid, elong, slider, energy, rev_lat, &
-                         rev_eps, shapes, shape_step, stats, status, fail_step, fail_iter)
+                         want_energy, frame_every, nframe, eps_ax, eps_of, lat_max, mid, elong, slider, &
+                         energy, rev_lat, rev_eps, shapes, frames, shape_step, stats, status, fail_step, &
+                         fail_iter)
     !f2py threadsafe
     integer, intent(in) :: nel, nq, nrec, nrev, nsteps, spr, rec_start, start_mode, maxit, max_cuts
-    integer, intent(in) :: want_energy
+    integer, intent(in) :: want_energy, frame_every, nframe
     real(dp), intent(in) :: r2, rl, rhoa, ea, ei, half_depth, msl, omega, dt, alpha, beta, hht, tol
     real(dp), intent(out) :: eps_ax(nel, nrec), eps_of(nel, nrec), lat_max(nrec), mid(nrec)
     real(dp), intent(out) :: elong(nrec), slider(nrec), energy(4, nrec), rev_lat(nrev), rev_eps(nrev)
-    real(dp), intent(out) :: shapes(nel + 1, 2)
+    real(dp), intent(out) :: shapes(nel + 1, 2), frames(nel + 1, nframe)
     integer, intent(out) :: shape_step(2), stats(5), status, fail_step, fail_iter
 
     real(dp), allocatable :: q(:), qd(:), qdd(:), qn(:), qdn(:), qddn(:), fint(:), r(:), w1(:), w2(:)
@@ -540,9 +544,10 @@ contains
     fail_step = -1
     fail_iter = 0
     eps_ax = 0; eps_of = 0; lat_max = 0; mid = 0; elong = 0; slider = 0; energy = 0
-    rev_lat = 0; rev_eps = 0; shapes = 0; shape_step = -1; stats = 0
+    rev_lat = 0; rev_eps = 0; shapes = 0; frames = 0; shape_step = -1; stats = 0
     if (nel < 2 .or. nq /= 3*nel .or. nsteps < 0 .or. dt <= 0 .or. spr < 1 .or. maxit < 1 .or. &
-        max_cuts < 0 .or. max_cuts > 30 .or. tol <= 0 .or. hht > 0 .or. hht < -1.0_dp/3) then
+        max_cuts < 0 .or. max_cuts > 30 .or. tol <= 0 .or. hht > 0 .or. hht < -1.0_dp/3 .or. &
+        frame_every < 1 .or. nframe /= (max(nrec, 1) - 1)/frame_every + 1) then
       status = nl_bad_args
       return
     end if
@@ -825,6 +830,7 @@ contains
       lv_ = maxval(abs(lat))
       lat_max(jj) = lv_
       mid(jj) = lat(mid_node)
+      if (mod(jj - 1, frame_every) == 0) frames(:, (jj - 1)/frame_every + 1) = lat
       elong(jj) = cc*qq(nq)
       slider(jj) = kq(4) + qq(nq)
       if (want_energy /= 0) energy(:, jj) = [ekin, estrain, wext, wdamp]

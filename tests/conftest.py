@@ -28,3 +28,27 @@ def write_deck(tmp_path):
         path.write_text(text)
         return path
     return _write
+
+
+@pytest.fixture(scope="session")
+def report_runs(tmp_path_factory):
+    """Decks run with --report in this process, once each per session (tests/report_runs.py)."""
+    from report_runs import ReportRuns
+    return ReportRuns(tmp_path_factory.mktemp("report_runs"))
+
+
+@pytest.fixture(scope="session")
+def browser():
+    """One headless Chromium for the session, driven by Selenium (tests/browser.py).  Without
+    selenium, chromium or chromedriver the browser tests skip on a developer's machine and fail
+    in CI (CI set), where the pages must be tested."""
+    import os
+
+    from browser import Browser, selenium_missing
+    why = selenium_missing()
+    if why:
+        if os.environ.get("CI"):
+            pytest.fail(f"CI must test the report pages in Chromium: {why}", pytrace=False)
+        pytest.skip(why)
+    with Browser(width=1200, height=900) as b:
+        yield b

@@ -58,7 +58,7 @@ def _design_map(keys: int):
         return plotting.design_space_map(frame, names, "mu_min_deg", labels, best=best, best_text="best",
                                          title="one swept key")
     return plotting.sweep_maps(frame, names, ["mu_min_deg"], labels, driver.fourbar.SWEEP_BEST,
-                               title=f"{keys} swept keys")[0]
+                               title=f"{keys} swept keys", searched={f"fourbar.{k}": v for k, v in grid.items()})[0]
 
 
 def _convergence():
@@ -66,8 +66,10 @@ def _convergence():
     history = pd.read_csv(ROOT / "outputs" / "optimize_manipulator_torque_history.csv")
     evals = pd.read_parquet(ROOT / "outputs" / "optimize_manipulator_torque_evals.parquet")
     from driver._output import expression_label  # the label the optimiser gives it (mathtext symbols)
+    best = float(history["objective"].min())
     return plotting.convergence_plot(history, evals, expression_label(driver.manipulator.STUDY, "design_torque_demand_Nm"),
-                                     "minimize", title="convergence")
+                                     "minimize", title="convergence", tolerance=1e-3 * best,
+                                     tolerance_words=f"tol x max(1, |best|) = 0.001 x {best:.6g}")
 
 
 def _manipulator_search():
@@ -110,6 +112,20 @@ def _function_error():
                                     ("error", {"error": 1e-3 * np.sin(9 * x)})], "x", title="line panels")
 
 
+def _nonlinear_strain():
+    deck = ("&slidercrank\n material = 'aluminium'\n speeds = 11.52, 29.32\n n_elements = 8\n"
+            " steps_per_rev = 720, revolutions = 4\n damping_ratio = 0.02\n model = 'nonlinear'\n/\n")
+    return driver.run(deck, name="nonlinear_small").figure("strain_linear_nonlinear")
+
+
+def _phasing_map():
+    """The shipped phasing sweep's map: the ratio over the searched (rho, phi) plane."""
+    from driver.sweep._report import summary_figures
+    s = driver.run_sweep(str(INPUTS / "ujoint_phasing_sweep.dat"), jobs=1)
+    return summary_figures(s.summary, s.sweep, ["ujoint.rho", "ujoint.phi"], driver.ujoint.STUDY,
+                           "ujoint_phasing_sweep")[0]
+
+
 #: figure kind -> how to draw it (real runs of shipped decks where they are quick)
 KINDS = {
     "fourbar_curves": lambda: _fourbar("crank5.dat", "curves"),
@@ -136,6 +152,12 @@ KINDS = {
         " steps_per_rev = 360, revolutions = 2\n/\n", name="convergence_small").figure("convergence"),
     "slidercrank_simeon_history": lambda: _result_figure("slidercrank_simeon1996.dat", "history"),
     "line_panels": _function_error,
+    "fourbar_linkage_balanced": lambda: _fourbar("fourbar_forces_balanced.dat", "linkage"),
+    "fourbar_torque": lambda: _fourbar("fourbar_forces_balanced.dat", "torque"),
+    "fourbar_pin_forces": lambda: _fourbar("fourbar_forces_balanced.dat", "pin_forces"),
+    "fourbar_shaking": lambda: _fourbar("fourbar_forces_balanced.dat", "shaking"),
+    "slidercrank_nonlinear_strain": _nonlinear_strain,
+    "ujoint_phasing_map": _phasing_map,
 }
 
 

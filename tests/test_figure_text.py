@@ -33,6 +33,47 @@ def test_deck_titles_are_never_mathtext(tmp_path):
             assert t._preprocess_math(t.get_text())[0].startswith("cost $x$ per $y$")
 
 
+def _with_title(deck: str, title: str) -> str:
+    """The shipped deck's text with its study group's title set to ``title``."""
+    import re
+    text = (INPUTS / f"{deck}.dat").read_text()
+    if re.search(r"\btitle\s*=", text):
+        return re.sub(r"\btitle\s*=\s*('[^']*'|\"[^\"]*\")", lambda m: f"title = '{title}'", text)
+    return re.sub(r"(&\w+)", lambda m: f"{m.group(1)} title = '{title}',", text, count=1)
+
+
+def test_a_deck_title_is_never_mathtext_in_the_force_figures():
+    """The force analysis's figures (torque, pin forces, shaking) took the deck's title raw: a
+    title 'cost $x$ per $y$' was typeset as mathtext there."""
+    r = driver.run(_with_title("fourbar_forces_balanced", "cost $x$ per $y$"))
+    for name in ("torque", "pin_forces", "shaking"):
+        fig = r.figure(name)
+        fig.canvas.draw()
+        assert fig._suptitle is not None and "cost" in fig._suptitle.get_text(), name
+        assert not _is_math(fig._suptitle)
+        assert fig._suptitle._preprocess_math(fig._suptitle.get_text())[0].startswith("cost $x$ per $y$")
+
+
+@pytest.mark.parametrize("deck", ["crank5", "fourbar_forces_balanced", "manipulator_case1_report", "robust_example"])
+def test_a_75_kB_title_stays_on_the_canvas_bounded(deck):
+    """A deck's 75 000-character title without a blank: every figure shows it cut in the middle
+    to NAME_CHARS characters and wrapped to the figure's width, all its text on the canvas (it
+    ran 158 000 pixels off the canvas and collapsed the force figures' layout)."""
+    import re
+
+    from driver._names import NAME_CHARS
+    from figure_checks import text_outside
+    r = driver.run(_with_title(deck, "t" * 75_000))
+    assert r.figure_names
+    for name in r.figure_names:
+        fig = r.figure(name)
+        assert text_outside(fig) == [], name
+        from matplotlib.text import Text
+        shown = "".join(t.get_text() for t in fig.findobj(Text))
+        assert "characters)" in shown, name
+        assert sum(len(m) for m in re.findall(r"t{50,}", shown)) <= NAME_CHARS, name
+
+
 def test_tool_labels_use_mathtext_symbols():
     r = driver.fourbar.run(fixed_link=12.0, crank=5.0, coupler=15.0, rocker=9.0, step_deg=20)
     fig = r.figure("curves")

@@ -6,6 +6,7 @@ and at the bytes of the files written (PNG, SVG, PDF).
 """
 from __future__ import annotations
 
+import math
 import subprocess
 import sys
 from functools import cache
@@ -23,7 +24,6 @@ from driver._output import column_label
 from driver._result import plot_format
 from driver._runner import compute, study_of
 from driver._study import load_study
-from driver.fourbar import _figures as fourbar_figures
 from driver.ujoint import _figures as ujoint_figures
 
 
@@ -103,7 +103,7 @@ def test_sweep_summary_labels_and_no_trivial_panels():
     assert ylabels == ["peak tensile strain [microstrain]", "peak compression / Euler load [-]"]
     assert fig.axes[-1].get_xlabel() == "crank speed [rad/s]"
     assert all("_" not in y for y in ylabels)
-    legend = fig.axes[0].get_legend()
+    legend = fig.legends[0]   # the figure's legend, under the panels
     assert [t.get_text() for t in legend.get_texts()] == ["material = aluminium", "material = steel"]
     assert _inside_figure(fig, legend)
     assert_no_overlapping_text(fig)
@@ -202,7 +202,7 @@ def test_cli_plot_format_svg_and_repeatable(tmp_path):
 def test_break_wraps_breaks_only_at_the_wrap():
     x = np.arange(6.0)
     y = np.array([350.0, 355.0, 2.0, 8.0, 10.0, 12.0])
-    bx, by = fourbar_figures.break_wraps(x, y)
+    bx, by = plotting.break_wraps(x, y)
     assert np.isnan(by[2]) and np.count_nonzero(np.isnan(by)) == 1
     assert np.allclose(by[~np.isnan(by)], y)
 
@@ -227,10 +227,11 @@ def test_fourbar_wrapped_angle_curves_have_no_vertical_jump():
 
 def test_fourbar_linkage_labelled_with_the_legend_off_the_mechanism():
     fig = figures_of("crank5.dat")["linkage"]
-    (ax,) = fig.axes
+    ax, panel = fig.axes   # the drawing, and the legend's own panel beside it
     assert ax.get_xlabel() == "x [length units]" and ax.get_ylabel() == "y [length units]"
+    assert ax.get_aspect() == 1.0
     r = _renderer(fig)
-    legend = ax.get_legend()
+    legend = panel.get_legend()
     assert not legend.get_window_extent(r).overlaps(ax.get_window_extent(r))
     assert _inside_figure(fig, legend)
     assert_no_overlapping_text(fig)
@@ -287,7 +288,7 @@ def test_slidercrank_linear_model_flags_cases_above_the_euler_load(write_deck):
 def test_manipulator_design_space_draws_the_iso_ri2_ellipses():
     fig = figures_of("manipulator_case1_report.dat")["design_space"]
     left = fig.axes[0]
-    assert "iso-RI2 ellipses" in left.get_title()
+    assert "iso-$RI_2$ ellipses" in left.get_title()
     ellipses = [ln for ln in left.get_lines() if (ln.get_gid() or "").startswith("iso-RI2 ellipse")]
     levels = sorted({float(ln.get_gid().split()[-1]) for ln in ellipses})
     assert len(ellipses) == 2 * len(levels) and len(levels) >= 3 and 2.0 in levels   # the deck's Table 4.1 level
@@ -311,9 +312,10 @@ def test_manipulator_torque_curves_mark_rows_violating_the_reach_conditions():
     result = compute(module, params)
     fig = next(f.draw() for f in result.figures if f.name == "torque_crob")
     (ax,) = fig.axes
-    curves = {ln.get_label(): ln for ln in ax.get_lines() if ln.get_label().startswith("tau")}
-    l1 = np.asarray(curves["tau1"].get_xdata(), dtype=float)
-    drawn = np.isfinite(np.asarray(curves["tau1"].get_ydata(), dtype=float))
+    curves = {ln.get_label(): ln for ln in ax.get_lines() if ln.get_label().startswith("$\\tau")}
+    shoulder = curves["$\\tau_1$ (shoulder)"]
+    l1 = np.asarray(shoulder.get_xdata(), dtype=float)
+    drawn = np.isfinite(np.asarray(shoulder.get_ydata(), dtype=float))
     c = 51.5                                        # C_rob: l1^2 + l2^2 [m^2] of this deck
     l2 = np.sqrt(c - l1 ** 2)
     r, R = result.summary["r_m"], result.summary["R_m"]
@@ -349,4 +351,150 @@ def test_optimisation_convergence_figure_names_its_objective_with_units(tmp_path
     assert designs.get_xlabel().startswith("coupler") and designs.get_ylabel() == "rocker swing [deg]"
     star = next(line for line in designs.get_lines() if line.get_label() == "optimum")
     assert star.get_xdata()[0] == pytest.approx(oc.x["fourbar.coupler"]) and star.get_ydata()[0] == pytest.approx(oc.fun)
-    assert fig.axes[1].get_ylabel() == "|best so far - final best| [deg]"   # the gap in the objective's unit
+    # the gap in units of the stated tolerance (tol x max(1, |best|) for a local method), drawn
+    # until it is within it; the title names the objective in words
+    assert fig.axes[1].get_ylabel() == "|best so far - final best| / tolerance"
+    assert fig.get_suptitle() == "opt: maximize rocker swing [deg]"
+    tol, how = report.stated_tolerance(oc.problem, oc.fun)
+    assert tol == pytest.approx(1e-3 * abs(oc.fun)) and how.startswith("tol x max(1, |best|)")
+    gap = [ln for ln in fig.axes[1].get_lines() if ln.get_label() == "gap of the best so far"]
+    if gap:   # it stops at the first design within the tolerance
+        y = np.asarray(gap[0].get_ydata(), dtype=float)
+        assert y[-1] <= 1.0 and (y[:-1] > 1.0).all()
+
+
+# ----------------------------------------------------------------------------- issue 39: drawings, angles, maps
+
+
+def test_linkage_drawing_one_solid_position_ghosts_counterweights_units():
+    """fourbar_forces_balanced: one position drawn in the link colours (crank, coupler, rocker),
+    the others as light ghosts, the Berkof-Lowen counterweights on the solid position at their
+    deck radii, axes in metres (a deck with masses), equal scales, every text on the canvas."""
+    from driver._mechanism import LINK_COLOURS
+    from figure_checks import text_outside
+    fig = figures_of("fourbar_forces_balanced.dat")["linkage"]
+    ax = fig.axes[0]
+    assert ax.get_xlabel() == "x [m]" and ax.get_ylabel() == "y [m]" and ax.get_aspect() == 1.0
+    solid = [ln for ln in ax.get_lines() if ln.get_color() in LINK_COLOURS[:3] and len(ln.get_xdata()) == 2]
+    assert len(solid) == 3   # one crank, one coupler, one rocker
+    ghosts = [ln for ln in ax.get_lines() if ln.get_color() == "0.8" and len(ln.get_xdata()) == 4]
+    assert len(ghosts) == 5
+    crank = next(ln for ln in solid if ln.get_color() == LINK_COLOURS[0])
+    discs = [ln for ln in ax.get_lines() if "counterweight" in ln.get_label()]
+    assert [ln.get_label().split(" counterweight")[0] for ln in discs] == ["crank", "output link"]
+    x, y = discs[0].get_xdata()[0], discs[0].get_ydata()[0]
+    assert math.hypot(x, y) == pytest.approx(0.06) and "at 0.06 m" in discs[0].get_label()
+    assert math.hypot(discs[1].get_xdata()[0] - 0.30, discs[1].get_ydata()[0]) == pytest.approx(0.10)
+    assert crank.get_zorder() < min(ln.get_zorder() for ln in ax.get_lines() if ln.get_label().startswith("path of"))
+    assert text_outside(fig) == []
+
+
+@pytest.mark.parametrize("links, extra, unit", [
+    (dict(fixed_link=12, crank=5, coupler=150, rocker=9), {}, "length units"),
+    (dict(fixed_link=12, crank=5, coupler=26, rocker=9), {}, "length units"),
+    (dict(fixed_link=0.3, crank=0.05, coupler=3.0, rocker=0.1),
+     dict(mass=[1, 1, 1], inertia=[0.01, 0.01, 0.01], omega=10), "m"),
+])
+def test_the_chain_that_cannot_move_is_drawn_in_the_decks_unit_inside_the_canvas(links, extra, unit):
+    """An impossible (or flat) chain's drawing: its longest link beside the other three laid end to
+    end, short by exactly the longest minus their sum, the axis in the deck's length unit (metres
+    for a deck with masses), every text on the canvas and in words."""
+    import driver
+    from figure_checks import figure_problems
+    r = driver.fourbar.run(step_deg=30, **links, **extra)
+    assert r.failure
+    fig = r.figure("linkage")
+    ax = fig.axes[0]
+    assert ax.get_xlabel() == f"length [{unit}]"
+    longest = max(links.values())
+    bars = [ln for ln in ax.get_lines() if len(ln.get_xdata()) == 2]
+    assert max(ln.get_xdata()[1] for ln in bars) == pytest.approx(longest)
+    laid = [ln for ln in bars if ln.get_ydata()[0] == 0.0]
+    assert laid[-1].get_xdata()[1] == pytest.approx(sum(links.values()) - longest)
+    assert figure_problems(fig, r.summary) == []
+    assert figure_problems(r.figure("curves"), r.summary) == []
+
+
+def test_synthesis_targets_drawn_on_top_of_the_linkage(tmp_path):
+    from driver._deck import read_deck
+    from driver.synthesis import synthesis_figures, synthesise
+    syn = synthesise(read_deck(INPUTS / "synthesis_path.dat"))
+    fig = synthesis_figures(syn, "synthesis_path")[0].draw()
+    ax = fig.axes[0]
+    targets = next(ln for ln in ax.get_lines() if ln.get_label() == "target points")
+    assert len(targets.get_xdata()) == 5
+    assert targets.get_zorder() > max(ln.get_zorder() for ln in ax.get_lines() if ln is not targets)
+
+
+def test_unwrap_angle_and_the_period_of_a_swept_angle():
+    assert np.allclose(plotting.unwrap_angle([90.0, 120.0, 150.0, 0.0], 180.0), [90, 120, 150, 180])
+    assert np.allclose(plotting.unwrap_angle([350.0, 10.0, np.nan, 20.0], 360.0)[[0, 1, 3]], [350, 370, 380])
+    assert plotting.angle_period(np.arange(0.0, 180.0, 1.0)) == 180.0       # a phase over a half turn
+    assert plotting.angle_period(np.arange(0.0, 360.0, 30.0)) == 360.0
+    assert plotting.angle_period([0.0, 30.0, 60.0, 90.0]) is None           # a part of a turn
+    assert plotting.angle_period(np.arange(0.0, 180.0, 1.0), "m") is None   # not an angle
+
+
+def test_kept_designs_of_a_phase_sweep_lie_on_a_straight_line():
+    """A sweep that tabulated only its kept rows (phi = rho + 90 mod 180) draws them as points
+    over the searched grid, phi unwrapped: a straight line, not a dive from 150 to 0 deg."""
+    frame = pd.DataFrame({"case": [91, 301, 511, 541], "ujoint.rho": [0.0, 30.0, 60.0, 90.0],
+                          "ujoint.phi": [90.0, 120.0, 150.0, 0.0], "status": "ok", "kept": True,
+                          "pp_ratio": [0.0] * 4})
+    study = load_study("ujoint")
+    labels = {c: column_label(study, c) for c in frame.columns}
+    searched = {"ujoint.rho": np.array([0.0, 30.0, 60.0, 90.0]), "ujoint.phi": np.arange(0.0, 180.0, 1.0)}
+    fig = plotting.sweep_summary(frame, ["ujoint.rho", "ujoint.phi"], labels=labels, searched=searched, n_cases=720)
+    ax = fig.axes[0]
+    kept = next(ln for ln in ax.get_lines() if ln.get_label().startswith("kept"))
+    assert kept.get_linestyle() == "None"
+    x, y = np.asarray(kept.get_xdata(), float), np.asarray(kept.get_ydata(), float)
+    assert np.allclose(y - x, 90.0)                       # phi = rho + 90, continuous
+    assert "mod 180" in ax.get_ylabel() and "720" in fig.get_suptitle()
+
+
+def test_maps_of_one_sweep_share_their_slices_and_span_the_searched_range():
+    rng = np.random.default_rng(1)
+    crank, coupler, rocker = np.linspace(1, 7, 7), np.linspace(6, 20, 8), np.linspace(4, 16, 9)
+    rows = [(a, b, c) for a in crank for b in coupler for c in rocker]
+    frame = pd.DataFrame(rows, columns=["fourbar.crank", "fourbar.coupler", "fourbar.rocker"])
+    frame["kept"] = (frame["fourbar.crank"] < 4) & (frame["fourbar.rocker"] < 12)
+    frame = frame[frame["kept"]].reset_index(drop=True)   # a kept-only table
+    for col in ("mu_min_deg", "mu_max_deg", "rocker_swing_deg"):
+        frame[col] = rng.uniform(20, 80, len(frame))
+    study = load_study("fourbar")
+    labels = {c: column_label(study, c) for c in frame.columns}
+    searched = {"fourbar.crank": crank, "fourbar.coupler": coupler, "fourbar.rocker": rocker}
+    figs = plotting.sweep_maps(frame, list(searched), ["rocker_swing_deg", "mu_min_deg", "mu_max_deg"], labels,
+                               study.sweep_best, "t", True, searched=searched)
+    titles = [[a.get_title() for a in f.axes if a.get_title().startswith("rocker length")] for f in figs]
+    assert titles[0] and titles[0] == titles[1] == titles[2]   # one shared slice
+    for f in figs:
+        ax = next(a for a in f.axes if a.get_title().startswith("rocker length"))
+        assert ax.get_xlim()[0] < 1.0 and ax.get_xlim()[1] > 7.0     # the searched crank range, not the kept
+        assert ax.get_ylim()[0] < 6.0 and ax.get_ylim()[1] > 20.0
+        assert "of the 9 searched values" in f._supxlabel.get_text()
+
+
+def test_manipulator_design_space_has_one_ri2_scale_with_its_bar():
+    fig = figures_of("manipulator_case1_report.dat")["design_space"]
+    bars = [a for a in fig.axes if "robustness index" in a.get_ylabel()]
+    assert len(bars) == 1
+    legend = fig.legends[0]
+    assert "$RI_2$" in legend.get_title().get_text() and "$C_{rob}$" in legend.get_title().get_text()
+    assert len(legend.get_texts()) <= 9   # one entry for all the ellipses
+
+
+def test_nonlinear_strain_per_speed_with_buckled_speeds_framed():
+    from driver.slidercrank import _figures as sc
+    x = np.linspace(0.0, 360.0, 73)
+    calm = (x, 10 * np.cos(np.radians(x)), 10.5 * np.cos(np.radians(x)))
+    spike = (x, 20 * np.cos(np.radians(x)), 4600 * np.exp(-((x - 350) / 3) ** 2))
+    fig = sc.slidercrank_nl_strain_figure([("11.52 rad/s", *calm), ("29.32 rad/s", *spike)], "t",
+                                          buckled={"29.32 rad/s": "lateral deflection 127 mm > 10.1 mm"})
+    a, b = fig.axes[:2]
+    assert a.get_ylim()[1] < 50 and b.get_ylim()[1] > 4000     # each speed on its own scale
+    assert b.get_title().startswith("29.32 rad/s: buckled") and "buckled" not in a.get_title()
+    assert b.title.get_color() == sc.BUCKLED
+    keys = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert any(k.startswith("nonlinear rod") for k in keys) and any(k.startswith("linear model") for k in keys)

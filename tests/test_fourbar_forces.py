@@ -507,11 +507,18 @@ def test_force_figures_draw_with_units_and_accept_ax():
     assert {"torque", "pin_forces", "shaking"} <= set(figs)
     ax = figs["torque"].axes[0]
     assert "[N m]" in ax.get_ylabel() and "[deg]" in ax.get_xlabel()
-    labels = [t.get_text() for t in ax.get_legend().get_texts()]
-    assert any(l.startswith("mean") for l in labels) and any(l.startswith("dE =") for l in labels)
+    labels = [t.get_text() for t in figs["torque"].legends[0].get_texts()]   # the figure's legend, below
+    assert any(l.startswith("mean") for l in labels) and any(l.startswith("energy fluctuation dE =") for l in labels)
     assert sum(a.name == "polar" for a in figs["pin_forces"].axes) == 4
     sh = figs["shaking"].axes[0]
-    balanced = [l for l in sh.get_lines() if "balanced (" in l.get_label()][0]
+    balanced = [l for l in sh.get_lines() if l.get_label().startswith("with counterweights")][0]
+    # one style per meaning in the three figures: with counterweights solid blue, without dashed red
+    for fig in figs["torque"], figs["pin_forces"], figs["shaking"]:
+        for line in (l for a in fig.axes for l in a.get_lines()):
+            if "without counterweights" in line.get_label():
+                assert (line.get_color(), line.get_linestyle()) == ("C3", "--")
+            elif "with counterweights" in line.get_label():
+                assert (line.get_color(), line.get_linestyle()) == ("C0", "-")
     assert np.nanmax(np.abs(balanced.get_ydata())) < 1e-9 * np.nanmax([l.get_ydata() for l in sh.get_lines()])
     fig = MplFigure()
     own = fig.add_subplot()

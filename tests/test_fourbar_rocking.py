@@ -138,6 +138,6 @@ def test_the_drawing_rocks_between_the_marked_limit_positions(deck):
     # both strokes drawn: B's path out (solid) and back (dashed)
     b_paths = [ln for ln in ax.lines if ln.get_color() == "C3"]
     assert {ln.get_linestyle() for ln in b_paths} == {"-", "--"}
-    title = ax.get_title()
+    title = fig.get_suptitle()   # the figure's title (the legend has its own panel beside the drawing)
     assert "limit positions" in title and ("separate motions" in title) == (len(spans) > 1)
     assert "/" not in title and ".dat" not in title

@@ -340,6 +340,24 @@ def test_shown_escapes_and_bounds_a_name():
     assert len(long) <= 200 and "(74" in long and long.startswith("nnn") and long.endswith("nnn")
 
 
+@pytest.mark.parametrize("where", ["key", "group", "swept key", "choice"])
+def test_a_75_kB_name_in_a_deck_is_bounded_in_the_message(tmp_path, capsys, where):
+    """A deck naming a 75 000-character key, group, swept key or choice value: the one error
+    line shows the name cut in the middle to NAME_CHARS characters (it echoed all 75 kB)."""
+    from driver._names import NAME_CHARS
+    t = "t" * 75_000
+    base = "fixed_link = 12, crank = 5, coupler = 15, rocker = 9, step_deg = 30"
+    text = {"key": f"&fourbar {base}, {t} = 1 /\n", "group": f"&{t} a = 1 /\n",
+            "swept key": f"&sweep key1 = 'fourbar.{t}', values1 = 1, 2 /\n&fourbar {base} /\n",
+            "choice": f"&fourbar {base}, branch = '{t}' /\n"}[where]
+    deck = tmp_path / "d.dat"
+    deck.write_text(text)
+    assert main([str(deck), "-o", str(tmp_path / "out"), "-q", "-j", "1"]) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and len(err) < 1000, len(err)
+    assert max(len(m) for m in re.findall("t+", err)) <= NAME_CHARS
+
+
 # ----------------------------------------------------------------------------- 7. the sweep's part
 
 def test_a_large_sweep_validates_every_case_before_any_runs(tmp_path, capsys):

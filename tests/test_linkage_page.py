@@ -1,4 +1,4 @@
-"""The report page of every shipped ``&linkage`` deck, in headless Chromium (tests/headless.py):
+"""The report page of every shipped ``&linkage`` deck, in headless Chromium (Selenium, tests/browser.py):
 it renders without an error, animates the mechanism, and what it draws at a frame is the
 mechanism of the deck, checked against geometry the page cannot fake:
 
@@ -26,14 +26,8 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
 from conftest import INPUTS, ROOT
-from headless import Browser, chromium_path
 
 pytest.importorskip("matplotlib")
-
-if chromium_path() is None:
-    if os.environ.get("CI"):
-        pytest.fail("CI must test the report page in Chromium: .ci/setup installs Debian's chromium", pytrace=False)
-    pytest.skip("no chromium on PATH (bash .ci/setup installs it)", allow_module_level=True)
 
 from driver._deck import read_deck
 from driver._runner import study_of
@@ -52,12 +46,6 @@ def pages(tmp_path_factory):
                            "-q", "-o", str(out)], capture_output=True, text=True, env=env, timeout=900)
     assert proc.returncode == 0, proc.stderr
     return out
-
-
-@pytest.fixture(scope="module")
-def browser():
-    with Browser(width=1100, height=900) as b:
-        yield b
 
 
 def _links(browser) -> dict[str, np.ndarray]:
@@ -113,7 +101,6 @@ def _drawn_params(deck, summary: Path, browser):
 @pytest.mark.parametrize("stem", DECKS)
 def test_page_animates_the_deck_mechanism(pages, browser, stem):
     path = INPUTS / f"{stem}.dat"
-    browser.events.clear()
     browser.open(pages / f"{stem}.html")
     assert browser.errors() == []
     params = _drawn_params(read_deck(path), pages / f"{stem}_summary.csv", browser)

@@ -96,6 +96,45 @@ def test_a_deck_title_reaches_the_page_as_text(tmp_path):
     assert "<script>alert" not in html and "&lt;script&gt;alert" in html
 
 
+def _longest_run(text: str, ch: str) -> int:
+    return max((len(m) for m in re.findall(f"{re.escape(ch)}+", text)), default=0)
+
+
+def test_a_75_kB_title_and_name_are_bounded_on_the_page(tmp_path):
+    """Issue 36 item 7: a 75 kB design name made a 10 MB page.  A deck's 75 000-character
+    title and a run's 75 000-character name: the page's title, subtitle, captions, figures and
+    notebook display show each at most NAME_CHARS characters (cut in the middle, saying how
+    many were left out), every other line (the deck echo, the .out) at most LINE_CHARS; the page
+    grows by less than 20 kB over the same run with a one-letter title."""
+    import driver
+    from driver._names import NAME_CHARS
+    from driver._outcome import RunOutcome
+    from driver._report_page import page
+    from driver._report_page._render import LINE_CHARS
+    base = dict(fixed_link=12.0, crank=5.0, coupler=15.0, rocker=9.0, step_deg=30)
+    sizes = []
+    for title in ("t", "t" * 75_000):
+        deck = tmp_path / f"d{len(title)}.dat"
+        deck.write_text(f"&fourbar fixed_link = 12, crank = 5, coupler = 15, rocker = 9, step_deg = 30, "
+                        f"title = '{title}' /\n")
+        r = driver.run(str(deck))
+        html = page(RunOutcome(result=r), driver.read_deck(deck))
+        sizes.append(len(html.encode()))
+    head = html[: html.index("<main>")]
+    assert _longest_run(head, "t") <= NAME_CHARS and "characters) ..." in head
+    for svg in re.findall(r"<svg.*?</svg>", html, flags=re.S):
+        assert _longest_run(svg, "t") <= NAME_CHARS
+    assert _longest_run(html, "t") <= LINE_CHARS
+    assert sizes[1] - sizes[0] < 20_000, sizes
+    # a name given in Python: the notebook's display of the run
+    small = driver.run({"fourbar": base}, name="n")._repr_html_()
+    big = driver.run({"fourbar": base}, name="n" * 75_000)._repr_html_()
+    assert _longest_run(big, "n") <= LINE_CHARS and len(big) - len(small) < 20_000
+    heads = re.findall(r"<(?:h[1-6]|figcaption|summary)[^>]*>(.*?)</", big, flags=re.S)
+    assert heads and all(_longest_run(h, "n") <= NAME_CHARS for h in heads)
+    assert all(len(i) <= 60 for i in re.findall(r'id="(anim-[^"]*)"', big))
+
+
 def _code(path: Path) -> str:
     """The code of a Python file without its docstrings and comments."""
     tree = ast.parse(path.read_text())

@@ -22,16 +22,16 @@ from typing import TYPE_CHECKING
 
 from driver._report_page._animation import ANIMATION_FRAMES, animation_view
 from driver._report_page._figures import figure_svg, plain
+from driver._report_page._fragment import fragment
 from driver._report_page._render import render_fragment, render_page, run_metadata
-from driver._report_page._sections import page_of, result_sections
+from driver._report_page._sections import outcome_frames, page_of
 
 if TYPE_CHECKING:
     from driver._deck import Deck
     from driver._outcome import Outcome
-    from driver._result import Result
 
-__all__ = ["MAX_PAGE_BYTES", "ANIMATION_FRAMES", "page", "fragment", "write_report", "figure_svg", "plain",
-           "run_metadata", "animation_view"]
+__all__ = ["MAX_PAGE_BYTES", "ANIMATION_FRAMES", "page", "fragment", "outcome_fragment", "write_report", "figure_svg", "plain",
+           "run_metadata", "animation_view", "outcome_frames", "write_animation"]
 
 #: the page size the browser test holds every shipped report to [bytes] (the SVG figures are most of it)
 MAX_PAGE_BYTES = 6_000_000
@@ -56,11 +56,23 @@ def page(outcome: Outcome, deck: Deck | None = None) -> str:
     return render_page(page_of(outcome, deck))
 
 
-def fragment(result: Result) -> str:
-    """A run's animation, figures, headline figures and tables as an HTML fragment, without the
-    page around them (for a notebook's rich display), made by the page's own templates."""
-    sections, _ = result_sections(result, result.params, None, "")
+def outcome_fragment(outcome: Outcome) -> str:
+    """An engine's outcome as an HTML fragment for a notebook: its page's sections (maps,
+    convergence, the best case or the optimum with its animation, the tables) without the page
+    around them and without the deck, made by the page's own templates."""
+    sections = [s for s in page_of(outcome).sections if s.id not in ("deck", "published")]
     return render_fragment(sections)
+
+
+def write_animation(stem: Path, outcome: Outcome, fmt: str) -> Path | None:
+    """Write the animation the report page plays as ``<stem>_animation.<fmt>`` ('gif' or 'mp4':
+    :func:`driver.plotting.save_animation`, from the same frames); None when the outcome has no
+    mechanism to animate."""
+    frames, whose = outcome_frames(outcome)
+    if frames is None:
+        return None
+    from driver.plotting import save_animation
+    return save_animation(frames, stem.with_name(f"{stem.name}_animation.{fmt}"), fmt, title=whose)
 
 
 def write_report(path: Path, text: str) -> Path:

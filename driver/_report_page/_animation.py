@@ -13,15 +13,12 @@ from typing import Any
 
 import numpy as np
 
-from driver._mechanism import MechanismFrames
+from driver._mechanism import LINK_COLOURS, MARK_COLOUR, MASS_COLOUR, PATH_COLOURS, Mark, MechanismFrames
 
 __all__ = ["ANIMATION_FRAMES", "AnimationView", "LinkView", "animation_view"]
 
 #: frames asked of a study's animation hook (a crank turn in 2 degree steps)
 ANIMATION_FRAMES = 180
-#: colours of the links, in drawing order (cycled), and of the traced paths
-LINK_COLOURS = ("#2c3e50", "#2980b9", "#e67e22", "#16a085", "#8e44ad", "#c0392b", "#7f8c8d")
-PATH_COLOURS = ("#999999", "#c0392b", "#8e44ad", "#27ae60", "#d35400")
 
 
 @dataclass
@@ -47,6 +44,9 @@ class AnimationView:
     links: list[LinkView]
     joints: list[tuple[str, int]]
     markers: list[tuple[str, int]]
+    masses: list[tuple[str, int]]
+    marks: list[dict[str, Any]]
+    mass_colour: str
     ground: list[str]
     guides: list[dict[str, Any]]
     paths: list[dict[str, Any]]
@@ -87,27 +87,43 @@ def animation_view(frames: MechanismFrames, anim_id: str, caption: str = "") -> 
         for a, b in frames.runs():
             paths.append({"points": _coords(pts[a:b, i]), "name": f"path of {frames.names[i]}", "closed": closed,
                           "colour": PATH_COLOURS[j % len(PATH_COLOURS)]})
+    marks = [{"name": m.name, "colour": MARK_COLOUR, "squares": [
+        {"x": f"{x - 1.3 * pin:.5g}", "y": f"{y - 1.3 * pin:.5g}", "size": f"{2.6 * pin:.4g}"} for x, y in m.xy]}
+        for m in frames.marks]
     d = frames.decimals()
     flat = np.round(pts.reshape(frames.n_frames, -1), d)
     data = {"labels": list(frames.labels),
             "points": [[None if np.isnan(v) else float(v) for v in row] for row in flat]}
-    words = " ".join(t for t in (frames.caption, caption) if t)
+    words = " ".join(t for t in (frames.caption, *(f"Squares: {m.name}." for m in frames.marks), caption) if t)
     if frames.units:
         words += f" Lengths in {frames.units}."
     return AnimationView(
         id=anim_id, viewbox=f"{x0:.6g} {y0:.6g} {w:.6g} {h:.6g}", flip=f"translate(0,{2 * y0 + h:.6g}) scale(1,-1)",
         line=line, pin=pin, links=links, joints=[(frames.names[i], i) for i in frames.joints],
-        markers=[(frames.names[i], i) for i in frames.markers], ground=ground, guides=guides, paths=paths,
+        markers=[(frames.names[i], i) for i in frames.markers], masses=[(frames.names[i], i) for i in frames.masses],
+        marks=marks, mass_colour=MASS_COLOUR, ground=ground, guides=guides, paths=paths,
         data=data, note={"x": x0 + 0.02 * w, "y": y0 + 0.06 * h, "size": 0.04 * s},
         invalid_note=frames.invalid_note, frame_name=frames.frame_name, caption=words,
         n_frames=frames.n_frames, first_label=frames.labels[0])
 
 
-def study_animation(params: Any, result: Any, anim_id: str, caption: str = "") -> AnimationView | None:
-    """The animation of a run's mechanism, from its study's hook (``Study.animation``); None for
-    a study without one."""
+def study_frames(params: Any, result: Any, marks: tuple[Mark, ...] = (), n: int = ANIMATION_FRAMES) -> MechanismFrames | None:
+    """The frames of a run's mechanism from its study's hook (``Study.animation``), with ``marks``
+    added (what an engine adds to the drawing: a synthesis's target points); None for a study
+    without one."""
+    import dataclasses
+
     from driver._study import load_study
     study = load_study(params.group) if params is not None else None
     if study is None or study.animation is None:
         return None
-    return animation_view(study.animation(params, result, ANIMATION_FRAMES), anim_id, caption)
+    frames = study.animation(params, result, n)
+    return dataclasses.replace(frames, marks=frames.marks + tuple(marks)) if marks else frames
+
+
+def study_animation(params: Any, result: Any, anim_id: str, caption: str = "",
+                    marks: tuple[Mark, ...] = ()) -> AnimationView | None:
+    """The animation of a run's mechanism, from its study's hook (``Study.animation``), ``marks``
+    added; None for a study without one."""
+    frames = study_frames(params, result, marks)
+    return None if frames is None else animation_view(frames, anim_id, caption)

@@ -9,11 +9,14 @@ and the cells that differ.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
+
+from driver._report_page._numbers import Printed, column_decimals, format_number
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -61,21 +64,34 @@ class KeyValues(Block):
 
 @dataclass
 class Table(Block):
-    """A table with a header row, scrolled on screen, and a note under it (rows left out)."""
+    """A table with a header row (names in words, each column's own name as its tooltip), scrolled
+    on screen, and a note under it (rows left out)."""
 
     kind: ClassVar[str] = "table"
     columns: list[str]
     rows: list[list[str]]
     note: str = ""
+    tips: list[str] = field(default_factory=list)
 
 
 @dataclass
 class FigureBlock(Block):
-    """A figure as inline SVG markup (made by matplotlib, edited as XML) and its caption."""
+    """A figure as inline SVG markup (made by matplotlib, edited as XML) and its caption;
+    ``anchor`` its id on the page (the figure enlarges to the whole window at ``#anchor``)."""
 
     kind: ClassVar[str] = "figure"
     svg: Markup
     caption: str
+    anchor: str = ""
+
+    def __post_init__(self) -> None:
+        if not self.anchor:
+            self.anchor = anchor_of(self.caption.split(":")[0])
+
+
+def anchor_of(name: str) -> str:
+    """A page id from a figure's name (letters, digits and hyphens)."""
+    return "fig-" + (re.sub(r"[^A-Za-z0-9]+", "-", name).strip("-") or "x")
 
 
 @dataclass
@@ -131,21 +147,40 @@ def fmt(v: Any) -> str:
     return str(v)
 
 
-def key_values(rows: Mapping[str, Any] | Iterable[tuple[str, Any]], labels: Mapping[str, str] | None = None) -> KeyValues:
+def key_values(rows: Mapping[str, Any] | Iterable[tuple[str, Any]], labels: Mapping[str, str] | None = None,
+               texts: Mapping[str, str] | None = None) -> KeyValues:
     """A key-value table of ``rows``; ``labels`` gives a name in words for a key (the key is
-    then its tooltip)."""
+    then its tooltip), ``texts`` a value as printed (:func:`driver._report_page._numbers.summary_texts`)."""
     items = rows.items() if isinstance(rows, Mapping) else rows
-    labels = labels or {}
-    return KeyValues([(labels.get(k, k), fmt(v), k if k in labels else "") for k, v in items])
+    labels, texts = labels or {}, texts or {}
+    return KeyValues([(labels.get(k, k), texts.get(k, fmt(v)), k if k in labels else "") for k, v in items])
 
 
-def frame_table(frame: pd.DataFrame, limit: int = MAX_TIDY_ROWS) -> Table:
-    """The first ``limit`` rows of ``frame`` as a table (a note says when rows are left out)."""
+def frame_table(frame: pd.DataFrame, limit: int = MAX_TIDY_ROWS, labels: Mapping[str, str] | None = None,
+                printed: Printed | None = None) -> Table:
+    """The first ``limit`` rows of ``frame`` as a table (a note says when rows are left out).
+
+    ``labels`` names a column in words (its own name becomes the header's tooltip); a float
+    column is printed with the decimals ``printed`` (the run's fixed-format text) prints it
+    with, else to six significant digits of its largest magnitude (round-off reads zero)."""
     shown = frame.head(limit)
-    rows = [[fmt(v) for v in r] for r in shown.itertuples(index=False, name=None)]
+    labels = labels or {}
+    cells = []
+    for name in shown.columns:
+        col = shown[name]
+        if col.dtype.kind == "f":
+            vals = col.to_numpy(dtype=float)
+            fin = vals[np.isfinite(vals)]
+            scale = float(np.max(np.abs(fin))) if fin.size else 0.0
+            dec = column_decimals(vals, printed) if printed is not None else None
+            cells.append([format_number(v, dec, scale) for v in vals])
+        else:
+            cells.append([format_number(v) if not isinstance(v, float) else fmt(v) for v in col.tolist()])
+    rows = [list(r) for r in zip(*cells)] if cells else []
     note = (f"first {limit} of {len(frame)} rows; the whole table is in the CSV/Parquet files "
             "(--csv, --format parquet)") if len(frame) > limit else ""
-    return Table([str(c) for c in shown.columns], rows, note)
+    names = [str(c) for c in shown.columns]
+    return Table([labels.get(c, c) for c in names], rows, note, [c if labels.get(c, c) != c else "" for c in names])
 
 
 def comparison_blocks(frame: pd.DataFrame | None, note: str = "") -> list[Block]:

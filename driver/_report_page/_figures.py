@@ -14,6 +14,7 @@ from typing import Any
 
 from markupsafe import Markup
 
+from driver._names import shown
 from driver._report_page._blocks import FigureBlock
 
 __all__ = ["plain", "figure_svg", "figure_blocks"]
@@ -26,6 +27,13 @@ ET.register_namespace("xlink", _XLINK)
 _GREEK = {"alpha": "α", "beta": "β", "gamma": "γ", "delta": "δ", "theta": "θ", "mu": "μ", "rho": "ρ",
           "sigma": "σ", "tau": "τ", "varphi": "φ", "phi": "φ", "omega": "ω", "psi": "ψ"}
 _SUB = str.maketrans("0123456789", "₀₁₂₃₄₅₆₇₈₉")
+
+
+#: a figure on the page is drawn at most this many pixels per inch of its width (fonts the same
+#: in every figure), and at least this many: 7 pt tick labels stay 9 px tall (legible); a
+#: narrower window scrolls the figure sideways rather than shrinking it
+MAX_PX_PER_INCH = 110
+MIN_PX_PER_INCH = 94
 
 
 def plain(label: str) -> str:
@@ -45,8 +53,9 @@ def plain(label: str) -> str:
 
 def figure_svg(fig: Any, label: str = "") -> Markup:
     """A matplotlib figure as inline SVG: no XML prolog or metadata, no fixed size (it scales to
-    the page, at most its own width at 110 px per inch, so fonts read the same whatever its
-    size), class ``fig``, role ``img`` and ``label`` as its accessible name."""
+    the page, at most its own width at :data:`MAX_PX_PER_INCH`, so fonts read the same whatever
+    its size, and at least at :data:`MIN_PX_PER_INCH`, so they stay legible), class ``fig``,
+    role ``img`` and ``label`` as its accessible name."""
     from driver.plotting import SVG_SALT, style
     buf = io.BytesIO()
     with style(**{"svg.hashsalt": SVG_SALT, "svg.fonttype": "none"}):
@@ -57,7 +66,8 @@ def figure_svg(fig: Any, label: str = "") -> Markup:
     for attr in ("width", "height"):
         root.attrib.pop(attr, None)
     root.set("class", "fig")
-    root.set("style", f"max-width:{round(fig.get_figwidth() * 110)}px")
+    width = fig.get_figwidth()
+    root.set("style", f"max-width:{round(width * MAX_PX_PER_INCH)}px;min-width:{round(width * MIN_PX_PER_INCH)}px")
     root.set("role", "img")
     root.set("aria-label", label)
     return Markup(ET.tostring(root, encoding="unicode"))
@@ -74,6 +84,6 @@ def figure_blocks(figures: Iterable[Any], prefix: str) -> tuple[list[FigureBlock
         except Exception as exc:
             failed.append(f"figure '{f.name}' could not be drawn: {exc.__class__.__name__}: {exc}")
             continue
-        caption = plain(f"{prefix}_{f.name}: {f.name.replace('_', ' ')}")
+        caption = plain(f"{shown(prefix)}_{f.name}: {f.name.replace('_', ' ')}")
         blocks.append(FigureBlock(figure_svg(fig, caption), caption))
     return blocks, failed

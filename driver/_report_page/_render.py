@@ -11,6 +11,7 @@ from pathlib import Path
 
 import jinja2
 import numpy as np
+from markupsafe import Markup
 
 from driver._report_page._blocks import Page, Section
 
@@ -18,14 +19,31 @@ __all__ = ["TEMPLATES", "environment", "render_page", "render_fragment", "run_me
 
 #: the templates' folder (shipped with the package)
 TEMPLATES = Path(__file__).with_name("templates")
+#: the longest line of text the page shows whole: a longer one (a deck's 75 kB title echoed in
+#: the deck and the .out) is cut in the middle, saying how many characters were left out.  The
+#: names the page prints (a run's, a design's, a deck's title) are bounded where they are
+#: composed, to :data:`driver._names.NAME_CHARS`; this bound holds for every text a block
+#: shows (the templates' ``bounded`` filter; not the drawing's coordinates).
+LINE_CHARS = 2000
+
+
+def bounded(value: object) -> object:
+    """A template value as the page prints it: text (not Markup: the figures' SVG) with every
+    line over :data:`LINE_CHARS` characters cut in the middle (:func:`driver._names.shown`)."""
+    if isinstance(value, str) and not isinstance(value, Markup) and len(value) > LINE_CHARS:
+        from driver._names import shown
+        return "\n".join(line if len(line) <= LINE_CHARS else shown(line, LINE_CHARS) for line in value.split("\n"))
+    return value
 
 
 @functools.cache
 def environment() -> jinja2.Environment:
     """The templates' environment: every value escaped unless it is Markup (the figures' SVG),
-    an undefined name an error, not an empty string."""
-    return jinja2.Environment(loader=jinja2.FileSystemLoader(TEMPLATES), autoescape=True,
-                              undefined=jinja2.StrictUndefined, keep_trailing_newline=True)
+    an undefined name an error, not an empty string; the filter ``bounded`` (:func:`bounded`)."""
+    env = jinja2.Environment(loader=jinja2.FileSystemLoader(TEMPLATES), autoescape=True,
+                             undefined=jinja2.StrictUndefined, keep_trailing_newline=True)
+    env.filters["bounded"] = bounded
+    return env
 
 
 def render_page(page: Page) -> str:

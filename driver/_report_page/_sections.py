@@ -8,16 +8,15 @@ run again and no file the engine wrote is read back; the deck is echoed as its f
 """
 from __future__ import annotations
 
-import re
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import f90nml
 
+from driver._mechanism import Mark, MechanismFrames
+from driver._names import shown
 from driver._outcome import OptimizeOutcome, Outcome, RunOutcome, StreamedSummary, SweepOutcome, SynthesisOutcome
-from driver._report_page._animation import study_animation
 from driver._report_page._blocks import (
-    Animation,
     Block,
     Details,
     FigureBlock,
@@ -25,23 +24,18 @@ from driver._report_page._blocks import (
     Pre,
     Section,
     Text,
-    comparison_blocks,
     frame_table,
-    key_values,
     warnings_section,
 )
 from driver._report_page._figures import figure_blocks, figure_svg, plain
+from driver._report_page._fragment import labels_of, result_sections, run_blocks
+from driver._report_page._numbers import Printed
 from driver._report_page._render import run_metadata
 
 if TYPE_CHECKING:
     from driver._deck import Deck, Params
-    from driver._result import Result
 
-__all__ = ["page_of", "result_sections", "deck_text"]
-
-#: what the animation's caption adds to the study's
-HINT = "Drag the slider or press play."
-
+__all__ = ["page_of", "result_sections", "deck_text", "outcome_frames"]
 
 def deck_text(deck: Deck | None, params: Params | None = None) -> str:
     """The deck as its file says it; a deck given in Python (no file) as the namelists of its
@@ -59,62 +53,12 @@ def deck_text(deck: Deck | None, params: Params | None = None) -> str:
     return ""
 
 
-def _labels(study: str, names: Any) -> dict[str, str]:
-    """Each summary column's name in words with its unit (the column name is its tooltip)."""
-    from driver._output import column_label
-    from driver._study import load_study
-    module = load_study(study) if study else None
-    return {n: plain(column_label(module, n)) for n in names} if module is not None else {}
-
-
-def _anim_id(name: str) -> str:
-    return "anim-" + (re.sub(r"[^A-Za-z0-9]", "", name) or "x")
-
-
-def _run_blocks(result: Result, params: Params | None, what: str) -> tuple[list[Block], list[str]]:
-    """A run's animation, figures and headline figures, as blocks (the parts of a design a
-    sweep, an optimisation or a synthesis draws); and the figures that could not be drawn."""
-    blocks: list[Block] = []
-    view = study_animation(params, result, _anim_id(result.name), f"{what} {HINT}")
-    if view is not None:
-        blocks.append(Animation(view))
-    figs, failed = figure_blocks(result.figures, result.name)
-    blocks += figs
-    if result.summary:
-        blocks.append(key_values(result.summary, _labels(result.study, result.summary)))
-    return blocks, failed
-
-
-def result_sections(result: Result, params: Params | None, comparison: Any,
-                    comparison_note: str = "") -> tuple[list[Section], list[str]]:
-    """The sections of one run: animation, figures, headline figures, the comparison with the
-    published cells, the tables (.out and extra files) and the tidy table."""
-    sections = []
-    view = study_animation(params, result, _anim_id(result.name), HINT)
-    if view is not None:
-        sections.append(Section("animation", "animation", [Animation(view)]))
-    figs, failed = figure_blocks(result.figures, result.name)
-    if figs:
-        sections.append(Section("figures", "figures", list(figs)))
-    if result.summary:
-        sections.append(Section("summary", "headline figures",
-                                [key_values(result.summary, _labels(result.study, result.summary))]))
-    sections.append(Section("published", "comparison with the published tables",
-                            comparison_blocks(comparison, comparison_note)))
-    tables: list[Block] = [Pre(result.text)]
-    tables += [Details(result.name + suffix, [Pre(text)]) for suffix, text in result.extra.items()]
-    sections.append(Section("tables", "tables (.out)", tables))
-    if result.tidy is not None and len(result.tidy):
-        sections.append(Section("tidy", "tidy table", [frame_table(result.tidy)]))
-    return sections, failed
-
-
 def _subtitle(study: str, params: Params | None) -> str:
     from driver._study import load_study
     module = load_study(study) if study else None
     doc = module.spec.doc if module is not None else ""
     title = params.get("title", "") if params is not None and hasattr(params, "get") else ""
-    return " \u2014 ".join(x for x in (doc, title) if x)
+    return " \u2014 ".join(x for x in (doc, shown(title)) if x)
 
 
 def _run_page(oc: RunOutcome, deck: Deck | None, compare: bool = True) -> Page:
@@ -134,7 +78,7 @@ def _run_page(oc: RunOutcome, deck: Deck | None, compare: bool = True) -> Page:
         warnings[warnings.index(result.failure)] = f"the run failed: {result.failure}"
     sections.insert(0, warnings_section(warnings))
     sections.append(Section("deck", "deck", [Pre(deck_text(deck, params))]))
-    return Page(f"{result.name}: {result.study}", _subtitle(result.study, params), sections, run_metadata())
+    return Page(f"{shown(result.name)}: {result.study}", _subtitle(result.study, params), sections, run_metadata())
 
 
 def _messages(oc: Outcome) -> list[str]:
@@ -165,7 +109,7 @@ def _sweep_page(oc: SweepOutcome, deck: Deck | None) -> Page:
     if summary is not None and module is not None and oc.sweep is not None and len(summary):
         try:
             for k, fig in enumerate(summary_figures(summary, oc.sweep, keys, module, oc.name)):
-                caption = f"{oc.name}_summary{'' if k == 0 else f'_{k + 1}'}: the summary over the swept keys"
+                caption = f"{shown(oc.name)}_summary{'' if k == 0 else f'_{k + 1}'}: the summary over the swept keys"
                 maps.append(FigureBlock(figure_svg(fig, caption), caption))
         except Exception as exc:
             notes.append(f"the design-space maps could not be drawn: {exc.__class__.__name__}: {exc}")
@@ -174,21 +118,23 @@ def _sweep_page(oc: SweepOutcome, deck: Deck | None) -> Page:
         from driver.sweep._spec import split_key
         best = {k: _swept_value(oc.best.params, *split_key(k)) for k in keys}   # 'key' or 'key(i)'
         values = ", ".join(f"{k} = {v:.6g}" for k, v in best.items() if isinstance(v, (int, float)))
-        blocks, failed = _run_blocks(oc.best, oc.best.params, "The marked design.")
+        blocks, failed = run_blocks(oc.best, oc.best.params, "The marked design.")
         notes += failed
         why = plain(best_words(module, oc.best_metric))
         sections.append(Section("best", "the marked design",
                                 [Text(f"Case {oc.best_case}, {why}" + (f": {values}." if values else "."))] + blocks))
     sections.append(Section("tables", "sweep summary (.out)",
-                            [Pre(oc.text)] if oc.text else [Text(f"See {oc.name}.out.", "note")]))
+                            [Pre(oc.text)] if oc.text else [Text(f"See {shown(oc.name)}.out.", "note")]))
     if summary is not None:
-        sections.append(Section("summary-table", "summary table", [frame_table(summary)]))
+        sections.append(Section("summary-table", "summary table",
+                                [frame_table(summary, labels=labels_of(oc.study, summary.columns),
+                                             printed=Printed(oc.text or ""))]))
     _close(sections, oc, deck, notes, "A sweep runs a study over many cases; the published tables belong to "
                                       "single-case decks.")
     rows = len(summary) if summary is not None else oc.n_cases
     sub = (f"sweep of &{oc.study} over {', '.join(keys)}: {rows} rows in the summary, {oc.n_kept} kept "
            f"of {oc.n_cases} cases")
-    return Page(f"{oc.name}: sweep", sub, sections, run_metadata())
+    return Page(f"{shown(oc.name)}: sweep", sub, sections, run_metadata())
 
 
 def _optimize_page(oc: OptimizeOutcome, deck: Deck | None) -> Page:
@@ -200,18 +146,27 @@ def _optimize_page(oc: OptimizeOutcome, deck: Deck | None) -> Page:
     opt = oc.optimum
     if opt is not None:
         word = "The optimum." if opt.converged else "The best design found (the method did not converge)."
-        blocks, failed = _run_blocks(opt.result, opt.params, word)
+        blocks, failed = run_blocks(opt.result, opt.params, word)
         notes += failed
-        blocks.append(Details(f"{oc.name}.optimum.dat", [Pre(opt.deck)]))
+        blocks.append(Details(f"{shown(oc.name)}.optimum.dat", [Pre(opt.deck)]))
         sections.append(Section("optimum", "the optimum" if opt.converged else "the best design", blocks))
     sections.append(Section("tables", "report (.out)", [Pre(oc.text)]))
     if oc.history_table is not None:
-        sections.append(Section("history", "history", [frame_table(oc.history_table)]))
+        sections.append(Section("history", "history", [frame_table(oc.history_table, printed=Printed(oc.text))]))
     _close(sections, oc, deck, notes, "An optimisation has no published table of its own; compare the optimum "
                                       "deck it writes (--compare).")
     sense = "minimize" if p.sense > 0 else "maximize"
     sub = f"{sense} {p.objective_text} over {', '.join(p.names)}; {oc.nfev} designs evaluated"
-    return Page(f"{oc.name}: optimisation", sub, sections, run_metadata())
+    return Page(f"{shown(oc.name)}: optimisation", sub, sections, run_metadata())
+
+
+def _targets(oc: SynthesisOutcome) -> tuple[Mark, ...]:
+    """A path synthesis's target points, in its linkage's frame, for the animation."""
+    syn = oc.value
+    if syn is None or getattr(syn.params, "task", "") != "path" or syn.design is None:
+        return ()
+    from driver.synthesis import path_targets
+    return (Mark(path_targets(syn), "target points"),)
 
 
 def _synthesis_page(oc: SynthesisOutcome, deck: Deck | None) -> Page:
@@ -220,19 +175,36 @@ def _synthesis_page(oc: SynthesisOutcome, deck: Deck | None) -> Page:
     figs, failed = figure_blocks(oc.figures, oc.name)
     notes += failed
     if oc.result is not None:
-        blocks, failed = _run_blocks(oc.result, oc.params, "The synthesised linkage.")
+        blocks, failed = run_blocks(oc.result, oc.params, "The synthesised linkage.", _targets(oc))
         notes += failed
         if oc.linkage_deck:
-            blocks.append(Details(f"{oc.name}.linkage.dat", [Pre(oc.linkage_deck)]))
+            blocks.append(Details(f"{shown(oc.name)}.linkage.dat", [Pre(oc.linkage_deck)]))
     sections = [Section("linkage", "the synthesised linkage", list(figs) + blocks
                         or [Text("No linkage was found.", "note")])]
     sections.append(Section("tables", "report (.out)", [Pre(oc.text)]))
     if len(oc.table):
-        sections.append(Section("task-table", f"{oc.name}{oc.table_name}.csv", [frame_table(oc.table)]))
+        sections.append(Section("task-table", f"{shown(oc.name)}{oc.table_name}.csv", [frame_table(oc.table)]))
     _close(sections, oc, deck, notes, "A synthesis has no published table of its own; compare the linkage "
                                       "deck it writes (--compare).")
     linkage = f" of a &{oc.result.study} linkage" if oc.result is not None else ""
-    return Page(f"{oc.name}: synthesis", f"synthesis ({oc.task}){linkage}", sections, run_metadata())
+    return Page(f"{shown(oc.name)}: synthesis", f"synthesis ({oc.task}){linkage}", sections, run_metadata())
+
+
+def outcome_frames(outcome: Outcome) -> tuple[MechanismFrames | None, str]:
+    """The mechanism the page of ``outcome`` animates, as frames, and whose it is: a run's, a
+    sweep's best case's, an optimisation's optimum's, the synthesised linkage's (its targets
+    added); (None, '') when there is none (no such run, or a study without an animation)."""
+    from driver._report_page._animation import study_frames
+    if isinstance(outcome, RunOutcome):
+        r = outcome.result
+        return study_frames(r.params, r), shown(r.name)
+    if isinstance(outcome, SweepOutcome) and outcome.best is not None:
+        return study_frames(outcome.best.params, outcome.best), f"{shown(outcome.name)}, case {outcome.best_case}"
+    if isinstance(outcome, OptimizeOutcome) and outcome.optimum is not None:
+        return study_frames(outcome.optimum.params, outcome.optimum.result), f"{shown(outcome.name)}, the optimum"
+    if isinstance(outcome, SynthesisOutcome) and outcome.result is not None:
+        return study_frames(outcome.params, outcome.result, _targets(outcome)), f"{shown(outcome.name)}, the linkage"
+    return None, ""
 
 
 def page_of(outcome: Outcome, deck: Deck | None = None) -> Page:

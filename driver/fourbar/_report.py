@@ -31,9 +31,10 @@ from driver.fourbar._analysis import (
     tidy_frame,
     tidy_part,
 )
+from driver.fourbar._analysis_forces import counterweights as berkof_lowen
 from driver.fourbar._batch import summary_of
 from driver.fourbar._kernel import Listing, Point, State
-from driver.fourbar._spec import SPEC, band_of, forces_active
+from driver.fourbar._spec import SPEC, band_of, force_value, forces_active
 
 if TYPE_CHECKING:   # annotations only: pandas is imported when a table is built
     import pandas as pd
@@ -299,6 +300,22 @@ def output_name(p: Params) -> str:
     return "output crank" if "double-crank" in g.name else "rocker"
 
 
+def length_units(p: Params) -> str:
+    """The deck's length unit in words: metres when it gives masses (the force analysis is in SI
+    units), else '' (any consistent unit)."""
+    return "m" if forces_active(p) else ""
+
+
+def counterweight_view(p: Params) -> dict[str, tuple[float, float]] | None:
+    """The Berkof-Lowen counterweights a ``balance = 'force'`` deck adds, as drawings show them:
+    ``radius`` [m], ``angle_deg`` off the link line and ``mass`` [kg] of (crank, output link);
+    None for a deck that does not balance."""
+    if not forces_active(p) or force_value(p, "balance") != "force":
+        return None
+    cw = berkof_lowen(p)
+    return {"radius": cw.radius, "angle_deg": cw.angle_deg, "mass": cw.mass}
+
+
 def deck_figures(p: Params, stem_title: str, listing_part: dict[str, Any] | pd.DataFrame | None) -> list[Figure]:
     """The figures of a run (drawn on demand): the curves and the linkage at its limit positions;
     for a chain that cannot move, its links laid out beside its longest (the gap seen).
@@ -323,7 +340,8 @@ def deck_figures(p: Params, stem_title: str, listing_part: dict[str, Any] | pd.D
         from driver.fourbar import _figures as figures
         if not g.movable:
             return figures.fourbar_chain({"fixed link": p.fixed_link, "crank": p.crank, "coupler": p.coupler,
-                                          "rocker": p.rocker}, g.name, str(g.reason), stem_title)
+                                          "rocker": p.rocker}, g.name, str(g.reason), stem_title,
+                                          units=length_units(p))
         lo, hi = sorted((p.start_deg, p.stop_deg))
         # the deck's crank range when it is less than a turn (a function generator's design range)
         theta = np.linspace(lo, hi, 721) if hi - lo < 360.0 else np.linspace(0.0, 360.0, 721)
@@ -337,7 +355,8 @@ def deck_figures(p: Params, stem_title: str, listing_part: dict[str, Any] | pd.D
                 drawn.append({"lo": m.lo, "hi": m.hi, "theta": m.theta, "out": m.out, "stroke": m.stroke,
                               "branch": m.branch, "point": None if mp is None else mp[:, :2]})
             return figures.fourbar_linkage(p.fixed_link, theta, out, st == ST["ok"], None, stem_title,
-                                           output=output_name(p), motions=drawn)
+                                           output=output_name(p), motions=drawn, units=length_units(p),
+                                           counterweights=counterweight_view(p))
         limits = []
         for a in limit_angles(p.fixed_link, p.crank, p.coupler, p.rocker):
             if theta[0] - 1e-9 <= a <= theta[-1] + 1e-9 or hi - lo >= 360.0:
@@ -346,7 +365,7 @@ def deck_figures(p: Params, stem_title: str, listing_part: dict[str, Any] | pd.D
                     limits.append((a, row[0]))
         return figures.fourbar_linkage(p.fixed_link, theta, out, st == ST["ok"], listing_frame(), stem_title,
                                        point=None if cp is None else cp[:, :2], output=output_name(p),
-                                       limits=limits)
+                                       limits=limits, units=length_units(p), counterweights=counterweight_view(p))
 
     return [Figure("curves", curves), Figure("linkage", linkage)]
 
@@ -395,12 +414,34 @@ def animation_frames(params: Params, result: Result | None = None, n: int = 180)
     if cp is not None:
         pts[ok, 4] = cp[ok, :2]
     coupler = Link("coupler", (1, 2, 4), body=True) if cp is not None else Link("coupler", (1, 2))
+    links = [Link("crank", (0, 1)), coupler, Link(output_name(params), (3, 2))]
+    masses: tuple[int, ...] = ()
+    cw = counterweight_view(params)
+    if cw is not None:   # the Berkof-Lowen counterweights ride on crank and output link, off their lines
+        crank_dir = np.arctan2(pts[:, 1, 1], pts[:, 1, 0])
+        out_dir = np.arctan2(pts[:, 2, 1], pts[:, 2, 0] - g)
+        extra = []
+        for k, (pivot, direction, name) in enumerate(((0, crank_dir, "crank counterweight"),
+                                                      (3, out_dir, f"{output_name(params)} counterweight"))):
+            radius, off, mass = cw["radius"][k], np.radians(cw["angle_deg"][k]), cw["mass"][k]
+            if mass > 0 and radius > 0:
+                at = pts[:, pivot] + radius * np.column_stack([np.cos(direction + off), np.sin(direction + off)])
+                extra.append((f"{name} {mass:.3g} kg", at, pivot, k))
+        if extra:
+            pts = np.concatenate([pts, np.stack([e[1] for e in extra], axis=1)], axis=1)
+            base = len(names)
+            names = names + tuple(e[0] for e in extra)
+            links += [Link(f"arm of the {e[0].rpartition(' ')[0].rpartition(' ')[0]}", (e[2], base + j),
+                           colour=(0, 2)[e[3]]) for j, e in enumerate(extra)]
+            masses = tuple(range(base, base + len(extra)))
     return MechanismFrames(
-        names=names, points=pts, links=(Link("crank", (0, 1)), coupler, Link(output_name(params), (3, 2))),
+        names=names, points=pts, links=tuple(links), masses=masses,
         labels=tuple(f"{t:.0f}\u00b0" + (phase[k] if phase else "") for k, t in enumerate(np.round(theta, 6))),
+        units=length_units(params),
         ground=(0, 3), joints=(1, 2), markers=(4,) if cp is not None else (), guides=tuple(guides),
         paths=(1, 2, 4) if cp is not None else (1, 2), segments=tuple(segments), frame_name="crank angle",
         caption="The linkage over " + ("its rocking motions between the limit positions (dashed)" if motions
-                                       else "one crank turn") + ", positions from the kernel's closed loop.",
+                                       else "one crank turn") + ", positions from the kernel's closed loop."
+        + (" Discs: the Berkof-Lowen counterweights of the force balance." if masses else ""),
         invalid_note=("the linkage cannot be assembled at this crank angle" if chain.movable
                       else f"{chain.name}: {chain.reason}"))

@@ -245,10 +245,11 @@ def figures(p: Params, title: str, theta_grid: Any) -> list[Figure]:
         from driver import plotting
         from driver.fourbar import _figures as draw  # matplotlib: imported when a figure is drawn
         theta, fa = data()
-        fig, ax = plotting.new_figure(1, 1, figsize=(7.0, 3.4))
+        fig, ax = plotting.new_figure(1, 1, figsize=(8.0, 4.2))
         with plotting.style():
-            draw.plot_torque(theta, fa, p, ax=ax[0])
-            fig.suptitle(f"{title}: input torque")
+            draw.plot_torque(theta, fa, p, ax=ax[0], legend=False)
+            plotting.suptitle(fig, f"{plotting.plain_text(title)}: input torque")
+            fig.legend(*ax[0].get_legend_handles_labels(), loc="outside lower center", ncol=2, frameon=False)
         return fig
 
     def pins() -> Any:
@@ -256,9 +257,11 @@ def figures(p: Params, title: str, theta_grid: Any) -> list[Figure]:
         from driver.fourbar import _figures as draw
         theta, fa = data()
         with plotting.style():
-            fig, axes = plotting.new_figure(2, 2, figsize=(7.0, 7.0), subplot_kw={"projection": "polar"})
-            draw.plot_pin_polars(fa, axes=axes)
-            fig.suptitle(f"{title}: pin forces (force on the pin, polar)")
+            fig, axes = plotting.new_figure(2, 2, figsize=(7.4, 7.8), subplot_kw={"projection": "polar"})
+            draw.plot_pin_polars(fa, axes=axes, theta=theta)
+            plotting.suptitle(fig, f"{plotting.plain_text(title)}: pin forces\n"
+                                   "angle: the force's direction, radius: its magnitude [N]")
+            fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncol=3, frameon=False)
         return fig
 
     def shaking() -> Any:
@@ -266,9 +269,10 @@ def figures(p: Params, title: str, theta_grid: Any) -> list[Figure]:
         from driver.fourbar import _figures as draw
         theta, fa = data()
         with plotting.style():
-            fig, axes = plotting.new_figure(1, 2, figsize=(9.0, 4.0))
+            fig, axes = plotting.new_figure(1, 2, figsize=(9.0, 4.3))
             draw.plot_shaking(theta, fa, ax=axes[0], polar_ax=axes[1])
-            fig.suptitle(f"{title}: shaking force on the frame")
+            plotting.suptitle(fig, f"{plotting.plain_text(title)}: shaking force on the frame")
+            fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncol=2, frameon=False)
         return fig
 
     return [Figure("torque", torque), Figure("pin_forces", pins), Figure("shaking", shaking)]

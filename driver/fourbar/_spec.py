@@ -247,6 +247,9 @@ STRESS_SUMMARY_DOC = {
 #: axis labels of the force summary columns: name -> (words, units)
 FORCE_LABELS = {name: (doc.rsplit(" [", 1)[0], doc.rsplit(" [", 1)[1].rstrip("]"))
                 for name, doc in (FORCE_SUMMARY_DOC | STRESS_SUMMARY_DOC).items()}
+#: ... and of the same columns of the linkage without its counterweights (balance = 'force')
+FORCE_LABELS |= {f"unbalanced_{name}": (f"{words}, without counterweights", unit)
+                 for name, (words, unit) in list(FORCE_LABELS.items())}
 
 
 def sections_of(p: Mapping[str, Any]) -> list[float] | None:

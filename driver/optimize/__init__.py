@@ -37,7 +37,7 @@ from driver._atomic import output_set, write_text
 from driver._deck import Deck, DeckError, Params
 from driver._export import write_tidy
 from driver._extras import require
-from driver._outcome import OptimizeOutcome, Optimum
+from driver._outcome import HTML, OptimizeOutcome, Optimum
 from driver._pydeck import DeckSource, source_deck
 from driver._result import Figure
 from driver._runner import compute, output_stem, write_outputs
@@ -350,3 +350,13 @@ def run_optimize_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool |
 
 def p_obj(oc: OptimizeOutcome) -> str:
     return f"{oc.problem.objective.text} = {oc.fun:.6g}"
+
+
+def _notebook_html(outcome: OptimizeOutcome) -> str:
+    """The outcome in a notebook: its report page's sections (driver._report_page, which stands
+    above this engine: registered here, called when a notebook shows the outcome)."""
+    from driver._report_page import outcome_fragment
+    return outcome_fragment(outcome)
+
+
+HTML[OptimizeOutcome] = _notebook_html

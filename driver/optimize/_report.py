@@ -14,7 +14,7 @@ from driver.optimize._evaluate import Evaluator, Record, rerun_agrees
 from driver.optimize._methods import HistoryRow, MethodResult
 from driver.optimize._problem import Problem
 
-__all__ = ["optimum_deck", "report_text", "history_frame", "convergence_figure", "designs_figure"]
+__all__ = ["optimum_deck", "report_text", "history_frame", "convergence_figure", "designs_figure", "stated_tolerance"]
 
 
 def _g(v: Any) -> str:
@@ -229,15 +229,32 @@ def history_frame(p: Problem, history: list[HistoryRow]) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=["step", "evals", "feasible", "objective"] + p.names)
 
 
+def stated_tolerance(p: Problem, best: float) -> tuple[float, str]:
+    """The objective tolerance the deck states, in the objective's unit, at the final best
+    ``best``, and how: differential evolution stops when the population's spread falls below
+    ``tol x |mean| + atol``; the local methods and a grid judge 'reached the optimum' within
+    ``tol x max(1, |best|)`` (:func:`driver.optimize._methods.objective_tol`)."""
+    o = p.opts
+    if o.method == "differential_evolution":
+        return o.tol * abs(best) + o.atol, f"tol x |best| + atol = {o.tol:g} x {abs(best):.6g} + {o.atol:g}"
+    return o.tol * max(1.0, abs(best)), f"tol x max(1, |best|) = {o.tol:g} x {max(1.0, abs(best)):.6g}"
+
+
 def convergence_figure(p: Problem, history: pd.DataFrame, evals: pd.DataFrame, title: str):
     """How the search converged (driver.plotting.convergence_plot): best feasible objective, its
-    gap to the final best on a log axis, and the constraint violation, against designs evaluated;
-    the objective named in words with its unit."""
+    gap to the final best in units of the stated tolerance (drawn until it is within it), and the
+    constraint violation, against designs evaluated; the objective named in words with its unit,
+    in the axis label and the title."""
     from driver import plotting
     from driver._output import expression_label
-    return plotting.convergence_plot(history, evals, expression_label(p.study, p.objective.text),
-                                     "minimize" if p.sense > 0 else "maximize",
-                                     title=plotting.plain_text(f"{title}: {p.objective_text}"))
+    words = expression_label(p.study, p.objective.text)
+    feas = evals[evals["feasible"].astype(bool)]["objective"].dropna()
+    tol, how = (None, "")
+    if len(feas):
+        tol, how = stated_tolerance(p, float(feas.min() if p.sense > 0 else feas.max()))
+    sense = "minimize" if p.sense > 0 else "maximize"
+    return plotting.convergence_plot(history, evals, words, sense, tolerance=tol, tolerance_words=how,
+                                     title=f"{plotting.plain_text(title)}: {sense} {plotting.wrap(words, 70)}")
 
 
 def designs_figure(p: Problem, evals: pd.DataFrame, title: str, x: dict[str, float] | None = None,
@@ -255,9 +272,10 @@ def designs_figure(p: Problem, evals: pd.DataFrame, title: str, x: dict[str, flo
     feas, bad = evals[ok], evals[~ok]
     with plotting.style():
         fig, (ax,) = plotting.new_figure(1, 1, figsize=(6.4, 4.4))
-        ax.plot(bad[vx], bad[vy], "x", ms=3, color="0.6", label="infeasible designs", rasterized=len(bad) > 2000)
+        ax.plot(bad[vx], bad[vy], "x", ms=3, color="0.6", label="infeasible designs",
+                rasterized=len(bad) > plotting.RASTER_POINTS)
         sc = ax.scatter(feas[vx], feas[vy], c=feas["objective"], s=10, cmap="viridis", label="feasible designs",
-                        rasterized=len(feas) > 2000)
+                        rasterized=len(feas) > plotting.RASTER_POINTS)
         if len(feas):
             cb = fig.colorbar(sc, ax=ax)
             cb.set_label(plotting.wrap(objective, 40))

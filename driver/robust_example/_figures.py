@@ -12,7 +12,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from driver._deck import Params
-from driver.plotting import new_figure, plain_text, styled
+from driver.plotting import new_figure, plain_text, styled, suptitle
 
 
 @styled
@@ -55,7 +55,7 @@ def robust_design_figure(t: np.ndarray, means: dict[str, np.ndarray], spreads: d
     top.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
     bot.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
     if title:
-        fig.suptitle(plain_text(title))
+        suptitle(fig, plain_text(title))
     return fig
 
 

@@ -46,6 +46,8 @@ class NLCase:
     rev_lat: np.ndarray = field(default_factory=no_record)
     rev_eps: np.ndarray = field(default_factory=no_record)
     shapes: np.ndarray = field(default_factory=no_record)
+    frames: np.ndarray = field(default_factory=no_record)
+    frame_deg: np.ndarray = field(default_factory=no_record)
     shape_deg: tuple[float, ...] = (0.0, 0.0)
     solves: int = 0
     max_solves: int = 0
@@ -94,6 +96,9 @@ class NLCase:
 
 
 IRREGULAR = 0.05
+#: about this many of the rod's lateral deflection profiles are kept per recorded revolution
+#: (``NLCase.frames``: the report page's animation of the deflected rod)
+FRAMES_PER_REV = 180
 
 
 def _half(n: int) -> int:
@@ -132,7 +137,8 @@ def run_nl_case(model: Model, params: Params, omega: float, n_el: int, alpha: fl
     res = kernel.slidercrank_nl_simulate(
         n_el, model.r2, model.length, model.rho_a, model.ea, model.ei, model.depth / 2, model.m_s, omega, dt,
         n_steps, spr, rec_start, spr + 1, alpha, beta, hht=params.hht_alpha, start=params.start, tol=params.newton_tolerance,
-        max_iterations=params.newton_max_iterations, max_cuts=params.max_step_cuts, energy=energy)
+        max_iterations=params.newton_max_iterations, max_cuts=params.max_step_cuts, energy=energy,
+        frame_every=max(1, spr // FRAMES_PER_REV))
     status = res["status"].name   # the kernel's status table (NonlinearStatus): 'ok', 'limit', ...
     st = res["stats"]
     case = NLCase(omega, n_el, status, dt, spr, solves=int(st[0]), max_solves=int(st[1]), cuts=int(st[2]),
@@ -145,6 +151,9 @@ def run_nl_case(model: Model, params: Params, omega: float, n_el: int, alpha: fl
     case.eps_ax, case.eps_of = res["eps_ax"], res["eps_of"]
     case.lat_max, case.mid, case.energy = res["lat_max"], res["mid"], res["energy"]
     case.shapes = res["shapes"]
+    case.frames = res["frames"]
+    every = max(1, spr // FRAMES_PER_REV)
+    case.frame_deg = 360.0 * every * np.arange(case.frames.shape[1]) / spr
     case.shape_deg = tuple(float(math.degrees(omega * dt * k) % 360.0) for k in res["shape_step"])
     case.growth = growth_ratio(case.rev_lat)
     case.scatter = scatter(case.rev_lat)

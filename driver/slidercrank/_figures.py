@@ -14,7 +14,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from driver._deck import Params
-from driver.plotting import new_figure, plain_text, styled
+from driver.plotting import new_figure, plain_text, styled, suptitle
 from driver.slidercrank._analysis import Case, history
 from driver.slidercrank._kernel import Shape
 from driver.slidercrank._spec import Model
@@ -52,8 +52,10 @@ def slidercrank_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray
     ax.set_xticks(np.arange(0, 361, 45))
     ax.set_xlabel(r"crank angle $\theta_2$ [deg]")
     ax.set_ylabel(ylabel)
-    fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center",
-               ncol=3 if len(series) + len(missing) > 4 else 2, frameon=False, title="crank speed")
+    handles, labels = ax.get_legend_handles_labels()
+    # a long entry (a speed not drawn and why, the yield strain) gets the legend's whole width
+    ncol = 1 if _longest_line(labels) > 48 else (3 if len(labels) > 4 else 2)
+    fig.legend(handles, labels, loc="outside lower center", ncol=ncol, frameon=False, title="crank speed")
     ax.set_title(plain_text(title))
     return fig
 
@@ -134,7 +136,7 @@ def slidercrank_convergence_figure(series: dict[str, Any], title: str, axes=None
     fig.legend(handles, names, loc="outside lower center", ncol=1 if max(map(len, names)) > 60 else 2,
                frameon=False)
     if title:
-        fig.suptitle(plain_text(title))
+        suptitle(fig, plain_text(title))
     return fig
 
 
@@ -171,7 +173,7 @@ def slidercrank_history_figure(time: np.ndarray, series: dict[str, np.ndarray], 
     handles, names = axes[0].get_legend_handles_labels()
     fig.legend(handles, names, loc="outside lower center", ncol=2, frameon=False)
     if title:
-        fig.suptitle(plain_text(title))
+        suptitle(fig, plain_text(title))
     return fig
 
 
@@ -184,12 +186,17 @@ def _yield_lines(ax, values: Sequence[np.ndarray], yield_strain: tuple[float, st
     from matplotlib.lines import Line2D
     eps, words = yield_strain
     top = max((float(np.nanmax(np.abs(v))) for v in values if np.size(v)), default=0.0)
-    label = f"yield strain $\\pm${eps:.0f} microstrain ({words})"
+    label = f"yield strain $\\pm${eps:.0f} microstrain\n({words})"   # its source on a line of its own
     if top >= 0.25 * eps:
         for sign in (1.0, -1.0):
             ax.axhline(sign * eps, color="C3", lw=0.9, ls=":", label=label if sign > 0 else None)
     else:
         ax.add_line(Line2D([], [], ls="none", label=f"{label}: off the scale"))
+
+
+def _longest_line(labels: Sequence[str]) -> int:
+    """The characters of the longest line of legend entries ``labels`` (an entry may have two)."""
+    return max((len(line) for label in labels for line in label.split("\n")), default=0)
 
 
 def _own_axes(ax, figsize: tuple[float, float]):
@@ -200,24 +207,76 @@ def _own_axes(ax, figsize: tuple[float, float]):
     return fig, axes[0]
 
 
+#: the two models in the nonlinear deck's figures: one style each, a key says which is which
+NONLINEAR: dict[str, Any] = dict(lw=1.3, ls="-")
+LINEAR: dict[str, Any] = dict(lw=1.0, ls="--", color="0.25")
+BUCKLED = "#c0392b"
+#: the rod's yield strain +-sigma_y / E (as :func:`_yield_lines` draws it)
+YIELD: dict[str, Any] = dict(color="C3", lw=0.9, ls=":")
+
+
 @styled
 def slidercrank_nl_strain_figure(series: Sequence[tuple[str, np.ndarray, np.ndarray, np.ndarray]], title: str,
-                                 ax=None, yield_strain: tuple[float, str] | None = None) -> Figure:
-    """Crank-end axial strain [microstrain] against crank angle [deg]: per speed (label, angle,
-    linear, nonlinear), the linear model dashed and the nonlinear rod solid in one colour;
-    ``yield_strain`` (sigma_y / E [microstrain], its words) marked."""
-    fig, ax = _own_axes(ax, (7.4, 4.4))
-    for k, (label, x, lin, nl) in enumerate(series):
-        ax.plot(x, nl, color=f"C{k % 10}", lw=1.2, label=label)
-        ax.plot(x, lin, color=f"C{k % 10}", lw=0.9, ls="--")
-    _yield_lines(ax, [v for _, _, lin, nl in series for v in (lin, nl)], yield_strain)
-    ax.axhline(0.0, color="k", lw=0.6)
-    ax.set_xlim(0, 360)
-    ax.set_xticks(np.arange(0, 361, 45))
-    ax.set_xlabel("crank angle theta2 [deg]")
-    ax.set_ylabel("axial strain [microstrain]")
-    ax.legend(fontsize=7, title="crank speed", title_fontsize=7)
-    ax.set_title(title)
+                                 buckled: dict[str, str] | None = None, axes=None,
+                                 yield_strain: tuple[float, str] | None = None) -> Figure:
+    """Crank-end axial strain [microstrain] against crank angle [deg], one panel per crank speed
+    (label, angle, linear, nonlinear), each on its own scale: the nonlinear rod solid in the
+    speed's colour, the linear model dashed dark grey (a key below says so).  A buckled rod's
+    spike of thousands of microstrain cannot flatten the sub-buckling speeds.  ``buckled`` maps
+    the labels of the speeds at which the nonlinear rod buckled to why (their panels are framed
+    and titled in red).  ``axes``: one axes per speed to draw into.  ``yield_strain``
+    (sigma_y / E [microstrain], its words) marked dotted on the panels whose curves come within a
+    quarter of it, and named in the key (off the scale where no panel reaches it)."""
+    from matplotlib.lines import Line2D
+    buckled = buckled or {}
+    n = len(series)
+    ncols = 1 if n == 1 else 2
+    nrows = int(np.ceil(n / ncols))
+    if axes is None:
+        fig, axes = new_figure(nrows, ncols, sharex=True, figsize=(10.0 if ncols == 2 else 7.4, 2.3 * nrows + 1.3))
+        for extra in list(axes)[n:]:
+            extra.set_visible(False)
+    else:
+        fig = axes[0].figure
+    near_yield = False
+    yield_words = (f"yield strain $\\pm${yield_strain[0]:.0f} microstrain\n({yield_strain[1]})"
+                   if yield_strain is not None else "")
+    for k, (ax, (label, x, lin, nl)) in enumerate(zip(axes, series)):
+        ax.plot(x, nl, color=f"C{k % 10}", **NONLINEAR)
+        ax.plot(x, lin, **LINEAR)
+        if yield_strain is not None and max(float(np.nanmax(np.abs(v))) for v in (lin, nl)) >= 0.25 * yield_strain[0]:
+            near_yield = True
+            for sign in (1.0, -1.0):
+                ax.axhline(sign * yield_strain[0], **YIELD, label=yield_words if sign > 0 else None)
+        ax.axhline(0.0, color="k", lw=0.5)
+        ax.set_xlim(0, 360)
+        ax.set_xticks(np.arange(0, 361, 90))
+        if label in buckled:
+            ax.set_title(f"{label}: buckled ({buckled[label]})", fontsize=8.5, color=BUCKLED)
+            for spine in ax.spines.values():
+                spine.set_visible(True)
+                spine.set_color(BUCKLED)
+                spine.set_linewidth(1.4)
+        else:
+            ax.set_title(label, fontsize=9)
+    shown = list(axes)[:n]
+    for ax in shown:
+        spec = ax.get_subplotspec()
+        if spec is None or spec.is_last_row() or ax is shown[-1] or (ncols == 2 and ax is shown[-2] and n % 2 == 1):
+            ax.set_xlabel("crank angle \u03b8\u2082 [deg]")
+            ax.tick_params(labelbottom=True)
+    fig.supylabel("crank-end axial strain [microstrain]", fontsize=9)
+    key = [Line2D([], [], color="C0", **NONLINEAR), Line2D([], [], **LINEAR)]
+    names = ["nonlinear rod (co-rotational), colour per speed", "linear model (the paper's)"]
+    if buckled:
+        key.append(Line2D([], [], color=BUCKLED, lw=1.4))
+        names.append("frame: the nonlinear rod buckled at this speed")
+    if yield_strain is not None:
+        key.append(Line2D([], [], **YIELD) if near_yield else Line2D([], [], ls="none"))
+        names.append(yield_words + ("" if near_yield else ": off the scale"))
+    # two columns of short entries; a long one (the yield strain and its source) one a line
+    fig.legend(key, names, loc="outside lower center", ncol=1 if _longest_line(names) > 60 else 2, frameon=False)
+    suptitle(fig, plain_text(title))
     return fig
 
 
@@ -227,31 +286,35 @@ def slidercrank_nl_shapes_figure(series: Sequence[tuple[str, tuple[float, float]
     """Lateral deflection [mm] along the rod [m] at the step of largest deflection (solid) and of
     largest crank-end compression (dotted), one colour per speed; true scale in mm (the axis
     is stretched, not the shape)."""
-    fig, ax = _own_axes(ax, (7.4, 4.4))
+    from matplotlib.lines import Line2D
+    fig, ax = _own_axes(ax, (8.6, 4.6))
     for k, (label, (a1, _a2), shapes) in enumerate(series):   # the dotted line's angle is not labelled
         s = np.linspace(0.0, length, shapes.shape[0])
         ax.plot(s, shapes[:, Shape.LARGEST_DEFLECTION] * 1e3, color=f"C{k % 10}", lw=1.2,
-                label=f"{label}, theta2 = {a1:.0f} deg")
+                label=f"{label}, \u03b8\u2082 = {a1:.0f}°")
         ax.plot(s, shapes[:, Shape.LARGEST_COMPRESSION] * 1e3, color=f"C{k % 10}", lw=0.8, ls=":")
     ax.axhline(0.0, color="k", lw=0.6)
     ax.set_xlabel("position along the rod from the crank pin [m]")
     ax.set_ylabel("lateral deflection from the chord [mm]")
-    ax.legend(fontsize=7)
-    ax.set_title(title)
+    handles, labels = ax.get_legend_handles_labels()
+    handles += [Line2D([], [], color="0.3", lw=1.2), Line2D([], [], color="0.3", lw=0.8, ls=":")]
+    labels += ["solid: at the largest deflection", "dotted: at the largest crank-end compression"]
+    ax.legend(handles, labels, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    ax.set_title(plain_text(title))
     return fig
 
 
 @styled
 def slidercrank_nl_revolutions_figure(series: Sequence[tuple[str, np.ndarray]], title: str, ax=None) -> Figure:
     """Peak lateral deflection [mm] in each revolution, one line per speed (log scale)."""
-    fig, ax = _own_axes(ax, (7.0, 4.0))
+    fig, ax = _own_axes(ax, (8.0, 4.2))
     for label, d in series:
         ax.plot(np.arange(1, len(d) + 1), d, "o-", ms=3, label=label)
     ax.set_yscale("log")
     ax.set_xlabel("revolution")
     ax.set_ylabel("peak lateral deflection [mm]")
-    ax.legend(fontsize=7)
-    ax.set_title(title)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False, title="crank speed")
+    ax.set_title(plain_text(title))
     return fig
 
 

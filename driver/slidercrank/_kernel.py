@@ -316,7 +316,7 @@ def slidercrank_nl_simulate(n_elements: int, crank_radius: float, rod_length: fl
                             dt: float, n_steps: int, steps_per_rev: int, rec_start: int, n_rec: int,
                             alpha: float = 0.0, beta: float = 0.0, hht: float = 0.0, start: str = "quasistatic",
                             tol: float = 1e-8, max_iterations: int = 25, max_cuts: int = 6,
-                            energy: bool = False) -> dict:
+                            energy: bool = False, frame_every: int = 1) -> dict:
     """Simulate the geometrically nonlinear (co-rotational) connecting rod: the whole time loop in Fortran.
 
     Parameters
@@ -344,6 +344,9 @@ def slidercrank_nl_simulate(n_elements: int, crank_radius: float, rod_length: fl
         Step halvings allowed.
     energy : bool, default False
         Record the energy balance.
+    frame_every : int, default 1
+        Keep the rod's lateral deflection profile at every ``frame_every``-th recorded step
+        (``frames``), dimensionless.
 
     Returns
     -------
@@ -357,18 +360,22 @@ def slidercrank_nl_simulate(n_elements: int, crank_radius: float, rod_length: fl
     deflection [m], elong rod elongation [m], slider position [m], energy (4, n_rec):
     kinetic, strain energy, work of the loads, damping dissipation since the start [J];
     rev_lat, rev_eps peak |lateral deflection| [m] and |axial strain| per revolution;
+    frames (n_elements + 1, (n_rec - 1) // frame_every + 1) lateral deflection profiles [m] at
+    recorded steps 0, frame_every, ... (the rod's nodes over the recorded steps);
     shapes (n_elements + 1, 2) lateral deflection profiles [m] at the recorded steps
     shape_step (largest deflection, largest crank-end compression); stats (Newton solves,
     most solves in a step, step cuts, deepest cut level, steps completed); status (a
     :class:`NonlinearStatus`), fail_step, fail_iter.
     """
     n_rev = max(1, -(-int(n_steps) // int(steps_per_rev)))
+    every = max(1, int(frame_every))
     out = _kernels.slidercrank_nl.simulate_nl(
         int(n_elements), 3 * int(n_elements), int(n_rec), n_rev, crank_radius, rod_length, rho_a, ea, ei,
         half_depth, slider_mass, omega, dt, int(n_steps), int(steps_per_rev), int(rec_start), alpha, beta, hht,
-        {"rest": 0, "quasistatic": 1}[start], tol, int(max_iterations), int(max_cuts), int(bool(energy)))
+        {"rest": 0, "quasistatic": 1}[start], tol, int(max_iterations), int(max_cuts), int(bool(energy)),
+        every, (max(int(n_rec), 1) - 1) // every + 1)
     names = ("eps_ax", "eps_of", "lat_max", "mid", "elong", "slider", "energy", "rev_lat", "rev_eps", "shapes",
-             "shape_step", "stats", "status", "fail_step", "fail_iter")
+             "frames", "shape_step", "stats", "status", "fail_step", "fail_iter")
     res: dict[str, Any] = dict(zip(names, out))   # arrays and the integer status words
     res["status"] = kernel_status(NonlinearStatus, res["status"], "slidercrank_nl.simulate_nl")
     for key in ("fail_step", "fail_iter"):

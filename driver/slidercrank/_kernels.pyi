@@ -167,8 +167,10 @@ class _slidercrank_nl:
         maxit: int,
         max_cuts: int,
         want_energy: int,
-    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.int32], NDArray[np.int32], int, int, int]:
-        """``eps_ax,eps_of,lat_max,mid,elong,slider,energy,rev_lat,rev_eps,shapes,shape_step,stats,status,fail_step,fail_iter = simulate_nl(nel,nq,nrec,nrev,r2,rl,rhoa,ea,ei,half_depth,msl,omega,dt,nsteps,spr,rec_start,alpha,beta,hht,start_mode,tol,maxit,max_cuts,want_energy)``; shapes eps_ax(nel,nrec), eps_of(nel,nrec), lat_max(nrec), mid(nrec), elong(nrec), slider(nrec), energy(4,nrec), rev_lat(nrev), rev_eps(nrev), shapes(1 + nel,2), shape_step(2), stats(5)"""
+        frame_every: int,
+        nframe: int,
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.int32], NDArray[np.int32], int, int, int]:
+        """``eps_ax,eps_of,lat_max,mid,elong,slider,energy,rev_lat,rev_eps,shapes,frames,shape_step,stats,status,fail_step,fail_iter = simulate_nl(nel,nq,nrec,nrev,r2,rl,rhoa,ea,ei,half_depth,msl,omega,dt,nsteps,spr,rec_start,alpha,beta,hht,start_mode,tol,maxit,max_cuts,want_energy,frame_every,nframe)``; shapes eps_ax(nel,nrec), eps_of(nel,nrec), lat_max(nrec), mid(nrec), elong(nrec), slider(nrec), energy(4,nrec), rev_lat(nrev), rev_eps(nrev), shapes(1 + nel,2), frames(1 + nel,nframe), shape_step(2), stats(5)"""
         ...
 
 

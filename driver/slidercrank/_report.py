@@ -499,18 +499,23 @@ def animation_frames(params: Params, result: Result | None = None, n: int = 180)
     b = np.column_stack([states[:, 3], np.zeros_like(theta)])
     w, h = 0.5 * r, 0.25 * r   # the slider block
     corners = np.array([[-w / 2, -h / 2], [w / 2, -h / 2], [w / 2, h / 2], [-w / 2, h / 2]])
-    bow, note = _rod_bow(result, theta, length)
+    nodes, note = _rod_nodes(result, theta, length)
+    if nodes is None:
+        bow, note = _rod_bow(result, theta, length)
+        if bow is not None:   # the rod's nodes on the parabola through the magnified midpoint deflection
+            t = np.arange(1, ROD_NODES + 1) / (ROD_NODES + 1)
+            nodes = (t, (4.0 * t * (1.0 - t))[:, None] * np.asarray(bow)[None, :])
     names = ["O", "A", "B", "K1", "K2", "K3", "K4"]
     parts = [np.zeros_like(a), a, b, *(b + c for c in corners)]
     rod: tuple[int, ...] = (1, 2)
-    if bow is not None:   # the rod's nodes on the parabola through the magnified midpoint deflection
+    if nodes is not None:   # the rod through its interior nodes, each off the chord by its (magnified) deflection
         chord = b - a
         normal = np.column_stack([-chord[:, 1], chord[:, 0]]) / np.hypot(chord[:, 0], chord[:, 1])[:, None]
-        for j in range(1, ROD_NODES + 1):
-            t = j / (ROD_NODES + 1)
+        where, lateral = nodes
+        for j, (frac, off) in enumerate(zip(where, lateral), start=1):
             names.append(f"R{j}")
-            parts.append(a + t * chord + (4.0 * t * (1.0 - t) * np.asarray(bow))[:, None] * normal)
-        rod = (1, *range(7, 7 + ROD_NODES), 2)
+            parts.append(a + frac * chord + off[:, None] * normal)
+        rod = (1, *range(7, 7 + len(where)), 2)
     x0, x1 = float(b[:, 0].min()) - w, float(b[:, 0].max()) + w
     caption = "The slider-crank over one crank turn, rigid positions from the kernel"
     return MechanismFrames(
@@ -519,6 +524,35 @@ def animation_frames(params: Params, result: Result | None = None, n: int = 180)
         labels=tuple(f"{t:.0f}\u00b0" for t in theta), ground=(0,), joints=(1, 2), paths=(1,), frame_name="crank angle",
         guides=(Guide(np.array([[x0, -h / 2], [x1, -h / 2]]), "slider guide"),),
         units="m", caption=caption + ("; " + note if note else "") + ".")
+
+
+#: interior nodes of the nonlinear rod drawn at most (every k-th node of the mesh)
+MAX_ROD_NODES = 31
+
+
+def _rod_nodes(result: Result | None, theta: np.ndarray, length: float) -> tuple[tuple[np.ndarray, np.ndarray] | None, str]:
+    """The nonlinear rod's interior nodes at the animation's crank angles ``theta`` [deg], from
+    the run's node deflections (``result.data['rod']``, the fastest speed that finished):
+    (positions along the rod as fractions of its length, (nodes, frames) lateral deflection [m],
+    magnified so the largest is 6 % of the rod, or at true scale when it is larger), and the
+    words saying so; (None, '') for a run without them."""
+    rod = getattr(result, "data", {}).get("rod") if result is not None else None
+    if not rod:
+        return None, ""
+    lat = np.asarray(rod["lateral_m"], dtype=float)
+    ang = np.asarray(rod["angle_deg"], dtype=float)
+    n_el = lat.shape[0] - 1
+    if n_el < 2 or lat.shape[1] < 2 or not np.isfinite(lat).all():
+        return None, ""
+    keep = np.unique(np.round(np.linspace(0, n_el, min(n_el, MAX_ROD_NODES + 1) + 1)).astype(int))[1:-1]
+    peak = float(np.max(np.abs(lat)))
+    scale = max(1.0, 0.06 * length / peak) if peak > 0 else 1.0
+    at = np.mod(ang, 360.0)
+    lateral = np.array([np.interp(theta, at, lat[i], period=360.0) for i in keep]) * scale
+    size = "drawn at true scale" if scale == 1.0 else f"magnified {scale:.3g} times"
+    words = (f"the rod through {len(keep)} of its {n_el - 1} interior nodes as the nonlinear run left them at "
+             f"{rod['omega_rad_s']:g} rad/s ({size}; largest lateral deflection {peak * 1e3:.3g} mm)")
+    return (keep / n_el, lateral), words
 
 
 def _rod_bow(result: Result | None, theta: np.ndarray, length: float) -> tuple[np.ndarray | None, str]:

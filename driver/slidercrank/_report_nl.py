@@ -168,6 +168,13 @@ def _tidy(material: str, pairs: list[tuple[Case, NLCase]]) -> Tidy:
     return Tidy(*frames, units={"n_elements": "1"})
 
 
+def _buckled_words(nl: NLCase, tol: float, limit: float) -> str:
+    """Why the nonlinear rod counts as buckled at this speed, in a few words for a figure."""
+    if nl.grows(tol):
+        return f"grows {100 * nl.growth:.0f} % per revolution"
+    return f"lateral deflection {nl.peak_lateral * 1e3:.3g} mm > {limit * 1e3:.3g} mm"
+
+
 def _summary(pairs: list[tuple[Case, NLCase]], tol: float, limit: float,
              onset: dict[str, tuple[float, float] | None] | None, model: Model) -> dict[str, Any]:
     out: dict[str, Any] = {}
@@ -262,10 +269,11 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
     figures = []
     good = [(lin, nl) for lin, nl in pairs if nl.ok and lin.ok]
     if good:
+        buckled = {f"{nl.omega:g} rad/s": _buckled_words(nl, tol, limit) for _, nl in good if nl.buckled(tol, limit)}
         figures.append(Figure("strain_linear_nonlinear", lambda: figures_module().slidercrank_nl_strain_figure(
             [(f"{nl.omega:g} rad/s", lin.angle_deg, lin.eps_1 * 1e6, nl.eps_ax[0] * 1e6) for lin, nl in good],
-            f"{params.material}: crank-end axial strain, linear (dashed) and nonlinear (solid)",
-            yield_strain=yield_strain(model))))
+            f"{params.material}: crank-end axial strain, linear model and nonlinear rod, per crank speed",
+            buckled=buckled, yield_strain=yield_strain(model))))
     okn = [nl for nl in nls if nl.ok]
     if okn:
         figures.append(Figure("shapes", lambda: figures_module().slidercrank_nl_shapes_figure(
@@ -276,7 +284,20 @@ def run_nonlinear(params: Params, progress: bool = False) -> Result:
          for c in nls if c.steps_done], f"{params.material}: peak lateral deflection per revolution")))
     return Result(text="\n".join(text) + "\n", tidy=_tidy(params.material, pairs),
                   summary=_summary(pairs, tol, limit, onset, model), warnings=warnings, failure=failure,
-                  figures=figures)
+                  figures=figures, data=_rod_data(okn))
+
+
+def _rod_data(okn: list[NLCase]) -> dict[str, Any]:
+    """The deflected rod the report page animates: the fastest speed whose nonlinear run
+    finished, its nodes' lateral deflection [m] over the recorded revolution (``lateral``:
+    (nodes, frames) at crank angles ``angle_deg``)."""
+    if not okn:
+        return {}
+    c = max(okn, key=lambda nl: nl.omega)
+    if not c.frames.size:
+        return {}
+    return {"rod": {"omega_rad_s": c.omega, "n_elements": c.n_elements, "angle_deg": np.asarray(c.frame_deg),
+                    "lateral_m": np.asarray(c.frames)}}
 
 
 def _stress_rows(model: Model, pairs: list[tuple[Case, NLCase]]) -> list[tuple[str, float, float | None]]:

@@ -51,7 +51,7 @@ from pathlib import Path
 from typing import Any
 
 from driver._deck import Deck
-from driver._outcome import StreamedSummary, SweepOutcome
+from driver._outcome import HTML, StreamedSummary, SweepOutcome
 from driver.sweep._assemble import assemble
 from driver.sweep._executor import open_workers, run_chunks
 from driver.sweep._plan import chunk_size, plan_sweep
@@ -119,3 +119,13 @@ def run_sweep_deck(deck: Deck, outdir: Path, formats: list[str], plot: bool | st
         tables = CasesTable(plan.layout)
         ran = run_chunks(plan, workers, resume=resume, progress=progress, on_chunk=tables.add_chunk)
         return assemble(plan, ran, tables, workers.where, start_cpu)
+
+
+def _notebook_html(outcome: SweepOutcome) -> str:
+    """The outcome in a notebook: its report page's sections (driver._report_page, which stands
+    above this engine: registered here, called when a notebook shows the outcome)."""
+    from driver._report_page import outcome_fragment
+    return outcome_fragment(outcome)
+
+
+HTML[SweepOutcome] = _notebook_html

@@ -285,10 +285,30 @@ def summary_figures(shown: pd.DataFrame, sw: Params, names: list[str], module: A
     from driver.plotting import is_grid, sweep_maps, sweep_summary
     shown = with_plotted(shown, sw)
     labels = {c: column_label(module, c) for c in shown.columns}
+    searched = searched_values(sw, module)
     if is_grid(shown, names) and not sw.zip:   # a design space: maps over the keys, not strips
         ys = plotted_columns(shown, sw, module)
-        return list(sweep_maps(shown, names, ys[:3], labels, module.sweep_best, stem, sw.summary_rows == "kept"))
-    return [sweep_summary(shown, names, sw.plot_x, sw.plot_y, stem, labels, module.sweep_plot)]
+        return list(sweep_maps(shown, names, ys[:3], labels, module.sweep_best, stem, sw.summary_rows == "kept",
+                               searched=searched))
+    n_cases = math.prod(len(v) for v in searched.values()) if searched and not sw.zip else None
+    return [sweep_summary(shown, names, sw.plot_x, sw.plot_y, stem, labels, module.sweep_plot, searched=searched,
+                          n_cases=n_cases)]
+
+
+def searched_values(sw: Params, module: Any) -> dict[str, np.ndarray]:
+    """The values each numeric key of the sweep was searched over (its grid), for the figures:
+    their axes span the searched space, not only the rows tabulated."""
+    from driver.sweep._spec import grid_of
+    try:
+        grid = grid_of(sw, module.name, module.spec)
+    except Exception:   # the figures draw without (a deck the sweep already checked; never fatal)
+        return {}
+    out = {}
+    for name, values in zip(grid.names, grid.values):
+        arr = np.asarray(values)
+        if arr.dtype.kind in "fiu":
+            out[name] = arr.astype(float)
+    return out
 
 
 def sweep_text(deck: Deck, sw: Params, base: Params, axes: list[tuple[str, list]], n_cases: int,

@@ -580,20 +580,22 @@ def synthesise(deck: DeckSource | Deck, name: str | None = None) -> Synthesis:
 def _path_figure(syn: Synthesis, title: str) -> Any:
     """The linkage, its coupler curve and the target points, in the linkage deck's frame."""
     from driver.fourbar import _figures as fourbar_figures
-    from driver.synthesis import _path as pg
     q = syn.design.parts
     theta = np.linspace(0.0, 360.0, 721)
     out, st = fourbar_kernel.fourbar_exact(np.radians(theta), q["ground"], q["crank"], q["coupler"], q["rocker"], 1.0, 0.0,
                                     1 if syn.params.branch == "open" else -1)
     cp = fourbar_kernel.fourbar_coupler_point(np.radians(theta), out, st, q["crank"], 1.0, 0.0, q["u"], q["v"])
-    fig = fourbar_figures.fourbar_linkage(q["ground"], theta, out, st == ST["ok"], None, title, point=cp[:, :2])
+    return fourbar_figures.fourbar_linkage(q["ground"], theta, out, st == ST["ok"], None, title, point=cp[:, :2],
+                                           targets=path_targets(syn))
+
+
+def path_targets(syn: Synthesis) -> np.ndarray:
+    """The target points of a path synthesis in its linkage deck's frame (crank pivot at the
+    origin, ground along +x): (k, 2), in the targets' length unit."""
+    from driver.synthesis import _path as pg
     targets = np.column_stack([syn.params.target_x, syn.params.target_y]).astype(float)
     pp = pg.PathProblem(targets, None, 1, False, (0.0, 180.0), 1.0, 1.0)
-    tk = pg.to_kernel_frame(pp, syn.design.x)
-    ax = fig.axes[0]
-    ax.plot(tk[:, 0], tk[:, 1], "s", mfc="none", mec="k", ms=7, label="target points")
-    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)   # beside the drawing
-    return fig
+    return pg.to_kernel_frame(pp, syn.design.x)
 
 
 def _error_figure(syn: Synthesis, title: str) -> Any:

@@ -14,7 +14,7 @@ import matplotlib.ticker
 import numpy as np
 from matplotlib.figure import Figure
 
-from driver.plotting import new_figure, plain_text, styled
+from driver.plotting import new_figure, plain_text, styled, suptitle
 from driver.ujoint._analysis import Chain, Design, output_speed, textbook
 
 #: line styles of the Hooke-joint designs, by the label driver.ujoint gives them
@@ -83,7 +83,7 @@ def ujoint_speed_figure(theta_deg: np.ndarray, rpm: float, curves: dict[str, np.
         ax.set_xlim(0.0, 360.0)
         ax.set_xticks(np.arange(0, 361, 45))
         fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncol=2, frameon=False)
-    fig.suptitle(f"{plain_text(title)}: Hooke-joint chain, input and output shaft speed" if title
+    suptitle(fig, f"{plain_text(title)}: Hooke-joint chain, input and output shaft speed" if title
                  else "Hooke-joint chain: input and output shaft speed")
     return fig
 
