@@ -31,7 +31,6 @@ from driver.fourbar._analysis import (
     tidy_frame,
     tidy_part,
 )
-from driver.fourbar._analysis_forces import counterweights as berkof_lowen
 from driver.fourbar._batch import summary_of
 from driver.fourbar._kernel import Listing, Point, State
 from driver.fourbar._spec import SPEC, band_of, force_value, forces_active
@@ -312,6 +311,7 @@ def counterweight_view(p: Params) -> dict[str, tuple[float, float]] | None:
     None for a deck that does not balance."""
     if not forces_active(p) or force_value(p, "balance") != "force":
         return None
+    from driver.fourbar._analysis_forces import counterweights as berkof_lowen  # decks that give masses only
     cw = berkof_lowen(p)
     return {"radius": cw.radius, "angle_deg": cw.angle_deg, "mass": cw.mass}
 
