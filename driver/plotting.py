@@ -93,9 +93,10 @@ def wrap(text: str, width: int) -> str:
 def suptitle(fig: Figure, text: str, **kw: Any) -> Any:
     """Give ``fig`` its title, each line wrapped to the figure's width (a deck's long title
     never runs off the canvas); mathtext spans are kept whole (:func:`wrap`)."""
-    size = matplotlib.font_manager.FontProperties(size=kw.get("fontsize", matplotlib.rcParams["figure.titlesize"]))
-    chars = max(20, int(fig.get_figwidth() * 72.0 / (0.53 * size.get_size_in_points())))
-    return fig.suptitle("\n".join(wrap(line, chars) for line in str(text).split("\n")), **kw)
+    title = fig.suptitle(str(text), **kw)   # its font size as the style in force gives it
+    chars = max(20, int(fig.get_figwidth() * 72.0 / (0.53 * title.get_fontsize())))
+    title.set_text("\n".join(wrap(line, chars) for line in str(text).split("\n")))
+    return title
 
 
 @contextlib.contextmanager

@@ -510,7 +510,8 @@ class Textbook:
     Attributes
     ----------
     ratio_one : numpy.ndarray
-        The input angles where omega_out = omega_in (R = 1), deg.
+        The input angles where omega_out = omega_in (R = 1), deg; none for a chain whose
+        fluctuation is below :data:`PP_SHOWN` (``uniform``).
     accel_peak : float
         The peak magnitude of the output angular acceleration at constant input speed, rad/s^2.
     accel_peak_at : numpy.ndarray
@@ -533,7 +534,15 @@ class Textbook:
     torque_mean: float | None = None
     torque_peak_at: np.ndarray = field(default_factory=lambda: np.empty(0))
     torque_peak_signed: np.ndarray = field(default_factory=lambda: np.empty(0))
+    uniform: bool = False   #: constant velocity to the printed p-p ratio (below :data:`PP_SHOWN`)
 
+
+#: a design whose speed-ratio fluctuation (max R - min R) is below this counts as a constant-velocity
+#: chain for its textbook figures: the .out prints the p-p ratio to six decimals, and an optimum's
+#: residual fluctuation below that (1e-10 after SLSQP) is round-off of its phases, so the angles where
+#: R crosses one moved with the BLAS kernel; it is also the objective's resolution (3.8e-14 ~ pp^2/8)
+PP_SHOWN = 5e-7
+assert PP_SHOWN > UJOINT_CV_TOL
 
 #: extremes within this relative difference of the largest count as the same peak (the mirror and
 #: half-turn images of one peak, equal but for round-off)
@@ -544,7 +553,7 @@ def textbook(chain: Chain, d: Design) -> Textbook:
     """Where design d's speed ratio is one, where and how high its output acceleration peaks,
     and with a load the peak and mean input torque over a turn (:class:`Textbook`)."""
     b, ph = d.beta * DEG, d.phi * DEG
-    uniform = d.pp < UJOINT_CV_TOL   # a constant-velocity chain: R = 1 throughout, no peak (round-off only)
+    uniform = d.pp < PP_SHOWN   # constant velocity to the printed p-p ratio: no crossing or peak resolved
     one = np.empty(0) if uniform else np.sort(chain.deck_deg(ujoint_roots(chain.model, "ratio_one", b, ph,
                                                                           chain.rho, chain.m)))
     ext = np.empty(0) if uniform else ujoint_roots(chain.model, "accel_extreme", b, ph, chain.rho, chain.m)
@@ -553,7 +562,7 @@ def textbook(chain: Chain, d: Design) -> Textbook:
     top = float(np.abs(acc).max()) if acc.size else 0.0
     at = np.abs(acc) >= top * (1.0 - PEAK_RTOL) if top > 0 else np.zeros(acc.size, bool)
     order = np.argsort(chain.deck_deg(ext[at]))
-    tb = Textbook(one, top, chain.deck_deg(ext[at])[order], acc[at][order])
+    tb = Textbook(one, top, chain.deck_deg(ext[at])[order], acc[at][order], uniform=uniform)
     if chain.load is not None:
         inertia, load = chain.load
         coef = (inertia * chain.omega ** 2, load)

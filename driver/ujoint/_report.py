@@ -33,7 +33,7 @@ from driver.ujoint._analysis import (
     textbook,
     yoke_shifts,
 )
-from driver.ujoint._kernel import UJOINT_CV_TOL, UJOINT_MODELS, ujoint_speed
+from driver.ujoint._kernel import UJOINT_MODELS, ujoint_speed
 from driver.ujoint._spec import BAND_TOL, CONVENTIONS, DEG, OPTIONS, ORIGINS, SPEC, joint_geometry, per_joint, phases_deg
 
 if TYPE_CHECKING:
@@ -298,8 +298,13 @@ def _render_textbook(params: Params, chain: Chain, designs: list[Design]) -> lis
             continue
         tb = textbook(chain, d)
         out.append(f"   {d.label}:")
-        out.append("     omega_out = omega_in (ratio one) " + (f"at theta = {_angles(tb.ratio_one)}" if d.pp >= UJOINT_CV_TOL
-                                                             else "throughout: a constant-velocity chain"))
+        if tb.uniform:
+            out.append("     omega_out = omega_in (ratio one) throughout: a constant-velocity chain to the printed "
+                       "p-p ratio (below 5e-7); no crossing of one and no acceleration peak resolved")
+            if tb.torque_mean is not None:
+                out.append(f"     input torque: constant over the turn, {tb.torque_mean:.10f} N m")
+            continue
+        out.append(f"     omega_out = omega_in (ratio one) at theta = {_angles(tb.ratio_one)}")
         out.append(f"     peak output acceleration |alpha_out| = {tb.accel_peak:.10f} rad/s^2 at theta = "
                    f"{_angles(tb.accel_peak_at)}" + ("" if not len(tb.accel_peak_signed) else
                                                     " (signed: " + ", ".join(f"{a:+.10f}" for a in tb.accel_peak_signed)
