@@ -265,10 +265,10 @@ def versus_pylinkage(n: int, repeat: int) -> dict[str, float] | str:
 def batch_summary(nd: int, scan: int, repeat: int) -> dict[str, float]:
     """CPU seconds per design of the Watt II batch summary (kinematics, a ``scan``-point scan):
     the output pass (stroke, time ratio) and every pass."""
-    from driver.linkage._batch import _numbers
+    from driver.linkage._batch import design_numbers
     p = params(SWEEP_DECK.split("&sweep")[0].replace("&linkage", "").replace("/\n", "").format(scan=scan))
     mech = compile_deck(p)
-    rows = _numbers(p, mech, {"driver_length": np.linspace(0.06, 0.12, nd)}, nd)
+    rows = design_numbers(p, mech, {"driver_length": np.linspace(0.06, 0.12, nd)}, nd)
     out = {}
     for name, passes in (("output", Pass.OUTPUT), ("all", Pass.ALL)):
         linkage_kernel.summaries(mech, rows[:10], scan, True, passes=passes)

@@ -191,7 +191,7 @@ def check_finite(result: Result, params: Params) -> Result:
             line = text.count("\n", 0, m.start()) + 1
             found = m.group(0)
             kind = ("a field of asterisks (a number too wide for its column)" if found.startswith("*") else
-                    "a NaN (not a number)" if "nan" in found.lower() else "an infinity")
+                    "a value that is not a number" if "nan" in found.lower() else "an infinity")
             raise numerical_error(params, TableValueError(f"{kind} would be written on line {line} of {what}"))
     pending = result.tidy_pending
     if pending is not None:   # columns not yet a DataFrame (pandas not needed): checked as arrays

@@ -69,7 +69,7 @@ def fortran_f(value: float, w: int | None, d: int, style: str = "modern") -> str
     """
     x = float(value)
     if not math.isfinite(x):   # in words: no 'nan' or 'FNone.3' in a message
-        what = "a NaN (not a number)" if math.isnan(x) else ("+infinity" if x > 0 else "-infinity")
+        what = "a value that is not a number" if math.isnan(x) else ("+infinity" if x > 0 else "-infinity")
         column = f"an F{w}.{d} column" if w is not None else f"a column of {d} decimals"
         raise TableValueError(f"{what} cannot be written in {column}")
     text = _round_half_up(x, d)

@@ -94,7 +94,7 @@ def suptitle(fig: Figure, text: str, **kw: Any) -> Any:
     """Give ``fig`` its title, each line wrapped to the figure's width (a deck's long title
     never runs off the canvas); mathtext spans are kept whole (:func:`wrap`)."""
     title = fig.suptitle(str(text), **kw)   # its font size as the style in force gives it
-    chars = max(20, int(fig.get_figwidth() * 72.0 / (0.53 * title.get_fontsize())))
+    chars = max(20, int(fig.get_figwidth() * 72.0 / (0.53 * title.get_fontproperties().get_size_in_points())))
     title.set_text("\n".join(wrap(line, chars) for line in str(text).split("\n")))
     return title
 

@@ -247,6 +247,8 @@ def grammar_deck(rng: random.Random) -> tuple[str, set[str], bool]:
             must.add("values1")
         if any(not t.strip() for t in toks[:-1]):   # ", ," within the list: a null value, refused
             must.add("values1")
+        if not any(t.strip() for t in toks):   # no value at all: a swept key without values, refused
+            must.add("values1")
         if rng.random() < 0.6:
             lines.append(f"  keep = \"{expression(rng)}\"")
         if rng.random() < 0.3:

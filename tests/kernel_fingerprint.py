@@ -141,7 +141,7 @@ def _batch_and_auxiliary_kernels(rng: np.random.Generator, theta: np.ndarray) ->
     from driver._deck import read_deck, validate
     from driver.linkage import SPEC as LINKAGE_SPEC
     from driver.linkage import compile_deck
-    from driver.linkage._batch import _numbers
+    from driver.linkage._batch import design_numbers
     root = pathlib.Path(__file__).resolve().parents[1] / "inputs"
     decks = [validate(read_deck(root / f"{d}.dat").groups["linkage"], LINKAGE_SPEC, d)
              for d in ("linkage_engine", "linkage_whitworth", "linkage_watt2", "linkage_inverted_slider_crank")]
@@ -156,8 +156,10 @@ def _batch_and_auxiliary_kernels(rng: np.random.Generator, theta: np.ndarray) ->
         mech = compile_deck(p)
         a = linkage_kernel.analyse(mech, xs)
         out[f"linkage_analyse{i}"] = _h(*[np.asarray(v, float) for v in a])
+        b = linkage_kernel.analyse(mech, xs, out=linkage_kernel.buffers(mech, len(xs)))   # into made buffers
+        out[f"linkage_analyse_out{i}"] = _h(*[np.asarray(v, float) for v in b])
         out[f"linkage_reusable_call{i}"] = _h(*linkage_kernel.reusable_call(mech, xs, continuity=False)())
-        rows = np.asfortranarray(np.tile(_numbers(p, mech, {}, 1), (3, 1)))
+        rows = np.asfortranarray(np.tile(design_numbers(p, mech, {}, 1), (3, 1)))
         out[f"linkage_summaries{i}"] = _h(linkage_kernel.summaries(mech, rows, 90, mech.driver == "crank"),
                                           [linkage_kernel.summary_width(mech)])
     out["linkage_table_energy"] = _h(linkage_kernel.table_energy(np.radians([0.0, 90, 135, 180, 360]),

@@ -160,11 +160,15 @@ def test_stale_temporaries_of_a_killed_run_are_removed(tmp_path, capsys):
 def test_sigterm_is_handled_like_ctrl_c(tmp_path):
     out = tmp_path / "o"
     deck = tmp_path / "slow.dat"
-    # 10^7 linkages: minutes even on the batch path, so the run is still going at the signal
-    deck.write_text((INPUTS / "fourbar_design_search.dat").read_text().replace("count1 = 25", "count1 = 2500"))
+    # 10^8 linkages (about a minute on two cores): the signal is sent once the first chunk's part
+    # is in the record, so the run is under way and far from done (no sleep decides it)
+    deck.write_text((INPUTS / "fourbar_design_search.dat").read_text().replace("count1 = 25", "count1 = 25000"))
     p = subprocess.Popen([sys.executable, "-m", "driver", str(deck), "-o", str(out), "-q", "-j", "1"],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT, text=True)
-    time.sleep(8)
+    deadline = time.monotonic() + 300   # a bound for a broken tool only
+    while not any(out.rglob("*.parquet")):
+        assert p.poll() is None and time.monotonic() < deadline, p.communicate()[1] if p.poll() is not None else ""
+        time.sleep(0.05)
     p.send_signal(signal.SIGTERM)
     _, err = p.communicate(timeout=120)
     assert p.returncode == 143, err

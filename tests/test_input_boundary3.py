@@ -399,7 +399,7 @@ def test_a_sweep_record_part_cut_in_half_is_redone_and_said(tmp_path, capsys):
 def test_a_non_finite_table_value_is_said_in_words():
     """The message printed the format 'FNone.3' and the float 'nan'."""
     from driver._table import TableValueError, fortran_f
-    for value, words in ((float("nan"), "a NaN (not a number)"), (float("-inf"), "-infinity")):
+    for value, words in ((float("nan"), "a value that is not a number"), (float("-inf"), "-infinity")):
         with pytest.raises(TableValueError) as info:
             fortran_f(value, None, 3)
         assert str(info.value) == f"{words} cannot be written in a column of 3 decimals"
@@ -422,7 +422,7 @@ def test_a_nan_bound_for_a_table_is_said_in_words(monkeypatch):
     _, params = study_of(read_deck("d.dat", text=FOURBAR))
     with pytest.raises(CaseFailure) as info:
         compute(study, params)
-    assert "a NaN (not a number) would be written on line" in info.value.message
+    assert "a value that is not a number would be written on line" in info.value.message
     assert "'nan'" not in info.value.message
 
 

@@ -56,10 +56,11 @@ from driver.fourbar._report import animation_frames
 from driver.fourbar._spec import LABELS, RENAMED, SPEC, SUMMARY_SETTINGS, SWEEP_BEST, SWEEP_PLOT, estimate
 
 if TYPE_CHECKING:   # run's keys as typed keywords: generated from SPEC (tools/gen_keyword_signatures.py)
-    from driver.fourbar import _forces as forces
     from driver.fourbar._keywords import run
 else:
     from driver.fourbar._report import run
+if TYPE_CHECKING:   # imported on first use (__getattr__ below)
+    from driver.fourbar import _forces as forces
 
 __all__ = ["SPEC", "STUDY", "run", "estimate", "summarise", "summarise_batch", "BATCH_KEYS", "BATCH_PASSES", "grashof",
            "limit_angles", "assembly_intervals", "rocking_motions", "Motion", "crank_angles", "exact_grid", "coupler_point",

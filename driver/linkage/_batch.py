@@ -22,7 +22,8 @@ from driver.linkage._kernel import NSUM_DYAD, NSUM_LINK, NSUM_SLIDE, SummaryCol
 from driver.linkage._kernel_program import Mechanism
 from driver.linkage._spec_model import compile_deck
 
-__all__ = ["BATCH_KEYS", "BATCH_IGNORED", "BATCH_INDEPENDENT", "BATCH_ELEMENTS", "BATCH_PASSES", "ELEMENT_PASSES",
+__all__ = ["design_numbers", "BATCH_KEYS", "BATCH_IGNORED", "BATCH_INDEPENDENT", "BATCH_ELEMENTS", "BATCH_PASSES",
+           "ELEMENT_PASSES",
            "PASS_NAMES", "passes_for", "summarise_batch", "summarise",
            "summary_of", "summary_frame", "scan_of", "refusal"]
 
@@ -99,7 +100,7 @@ def _design(base: Params, key: str, index: int | None, value: Any, b: np.ndarray
     return nq
 
 
-def _numbers(base: Params, mech: Mechanism, columns: Mapping[str, Any], n: int) -> np.ndarray:
+def design_numbers(base: Params, mech: Mechanism, columns: Mapping[str, Any], n: int) -> np.ndarray:
     """(n, numbers + 3) kernel rows: the base design's numbers plus each varied value's change.
 
     A column with few distinct values is compiled once per value (every design checked as a
@@ -191,7 +192,7 @@ def summarise_batch(base: Mapping[str, Any], columns: Mapping[str, Any] | None =
         raise base.error(None, f"batch columns have different lengths {sorted(sizes)}")
     n = sizes.pop() if sizes else 1
     mech = compile_deck(base)
-    rows = kernel.summaries(mech, _numbers(base, mech, columns, n), base["scan_points"], mech.driver == "crank",
+    rows = kernel.summaries(mech, design_numbers(base, mech, columns, n), base["scan_points"], mech.driver == "crank",
                             passes=passes_for(wanted))
     return summary_frame(base, mech, rows, wanted)
 
@@ -308,7 +309,7 @@ def refusal(row: Mapping[str, Any]) -> str | None:
 def summary_rows(p: Params, mech: Mechanism | None = None) -> tuple[Mechanism, np.ndarray]:
     """The kernel's summary row of one deck: (mechanism, (1, width) row)."""
     mech = mech or compile_deck(p)
-    return mech, kernel.summaries(mech, _numbers(p, mech, {}, 1), p.scan_points, mech.driver == "crank")
+    return mech, kernel.summaries(mech, design_numbers(p, mech, {}, 1), p.scan_points, mech.driver == "crank")
 
 
 @contract_doc

@@ -282,9 +282,15 @@ def _render_compare(params: Params, chain: Chain, designs: list[Design]) -> list
     return out
 
 
-def _angles(values: np.ndarray) -> str:
-    """Input angles [deg] for the .out: 9 decimals (the roots are found to 1e-12 rad, 6e-11 deg)."""
-    return ", ".join(f"{v:.9f}" for v in values) if len(values) else "none"
+#: decimals of the textbook angles of a design the deck gives (roots to 1e-12 rad, 6e-11 deg) and of a
+#: design an optimiser found: its variables are known to the optimiser's tolerance, and the angle of
+#: a small fluctuation's peak moved by 1e-7 deg with the BLAS kernel (ujoint_option3's optimum)
+ANGLE_DECIMALS = {"given": 9, "searched": 3}
+
+
+def _angles(values: np.ndarray, decimals: int = ANGLE_DECIMALS["given"]) -> str:
+    """Input angles [deg] for the .out, to ``decimals`` (:data:`ANGLE_DECIMALS`)."""
+    return ", ".join(f"{v:.{decimals}f}" for v in values) if len(values) else "none"
 
 
 def _render_textbook(params: Params, chain: Chain, designs: list[Design]) -> list[str]:
@@ -297,21 +303,23 @@ def _render_textbook(params: Params, chain: Chain, designs: list[Design]) -> lis
         if d.label == "paper printed":
             continue
         tb = textbook(chain, d)
-        out.append(f"   {d.label}:")
+        places = ANGLE_DECIMALS["searched" if d.label in ("optimum", "last iterate") else "given"]
+        out.append(f"   {d.label}:" + ("" if places == ANGLE_DECIMALS["given"] else
+                                      f" (angles to {places} decimals: the design is known to the optimiser's tolerance)"))
         if tb.uniform:
             out.append("     omega_out = omega_in (ratio one) throughout: a constant-velocity chain to the printed "
                        "p-p ratio (below 5e-7); no crossing of one and no acceleration peak resolved")
             if tb.torque_mean is not None:
                 out.append(f"     input torque: constant over the turn, {tb.torque_mean:.10f} N m")
             continue
-        out.append(f"     omega_out = omega_in (ratio one) at theta = {_angles(tb.ratio_one)}")
+        out.append(f"     omega_out = omega_in (ratio one) at theta = {_angles(tb.ratio_one, places)}")
         out.append(f"     peak output acceleration |alpha_out| = {tb.accel_peak:.10f} rad/s^2 at theta = "
-                   f"{_angles(tb.accel_peak_at)}" + ("" if not len(tb.accel_peak_signed) else
+                   f"{_angles(tb.accel_peak_at, places)}" + ("" if not len(tb.accel_peak_signed) else
                                                     " (signed: " + ", ".join(f"{a:+.10f}" for a in tb.accel_peak_signed)
                                                     + ")"))
         if tb.torque_peak is not None:
-            out.append(f"     input torque: peak |T_in| = {tb.torque_peak:.10f} N m at theta = {_angles(tb.torque_peak_at)}"
-                       f"; mean over the turn {tb.torque_mean:.10f} N m")
+            out.append(f"     input torque: peak |T_in| = {tb.torque_peak:.10f} N m at theta = "
+                       f"{_angles(tb.torque_peak_at, places)}; mean over the turn {tb.torque_mean:.10f} N m")
     return out + [""]
 
 
