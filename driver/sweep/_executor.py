@@ -18,6 +18,9 @@ One policy each, whatever the kind of chunk and wherever it runs:
   Dask ("interrupt: cancelling queued ..., finishing the running ones"), cancels the queued
   chunks, lets the running ones finish (their files and parts are complete) and re-raises:
   the command line exits 130.  In this process nothing is queued: the interrupt goes on at once.
+  On the local pool the interrupt is noted and raised at the loop's own points
+  (:func:`_deferred_interrupt`): raised inside ``concurrent.futures.wait`` it could leave a
+  future's lock held, and the pool's shutdown then waited forever.
 * **Small batch sweeps stay here.**  With ``first_here`` the first chunk runs in this process,
   timed, and so do the others when at that rate they would take less than
   :data:`POOL_MIN_SECONDS` of CPU (forking workers would cost more than it saves).
@@ -28,6 +31,7 @@ import concurrent.futures as cf
 import contextlib
 import os
 import secrets
+import signal
 import socket
 import threading
 import time
@@ -239,48 +243,73 @@ def _alone_in_a_process(work: Any) -> Callable[[Span], ChunkResult | None]:
     return alone
 
 
+#: the longest a Ctrl-C on the local pool waits to be raised [s] (a latency, never a result)
+INTERRUPT_POLL_S = 0.1
+
+
+@contextlib.contextmanager
+def _deferred_interrupt() -> Iterator[threading.Event]:
+    """Ctrl-C noted in an event instead of raised wherever the main thread is: ``wait`` of
+    :mod:`concurrent.futures` takes each future's lock in turn, and a KeyboardInterrupt raised
+    between two of them leaves one held, so the pool's result thread and its shutdown wait
+    forever.  Only where Python's own handler is in force, in the main thread."""
+    hit = threading.Event()
+    if (threading.current_thread() is not threading.main_thread()
+            or signal.getsignal(signal.SIGINT) is not signal.default_int_handler):
+        yield hit
+        return
+    old = signal.signal(signal.SIGINT, lambda signum, frame: hit.set())
+    try:
+        yield hit
+    finally:
+        signal.signal(signal.SIGINT, old)
+
+
 def _pool(work: Any, todo: Iterator[Span], on_result: Callable[[ChunkResult], None], workers: Workers,
           limit: int, what: str) -> None:
     """The local worker pool: ``limit`` chunks in flight; a dead worker's chunks isolated."""
     pool = cf.ProcessPoolExecutor(max_workers=workers.jobs, initializer=worker_init)
     pending: dict[cf.Future, Span] = {}
     alone = _alone_in_a_process(work)
-    try:
-        while True:
-            suspects: list[Span] = []
-            while len(pending) < limit and not suspects:
-                span = next(todo, None)
-                if span is None:
-                    break
-                try:
-                    pending[pool.submit(run_chunk, work, span)] = span
-                except cf.process.BrokenProcessPool:   # a worker died since the last wait
-                    suspects.append(span)
-            if not pending and not suspects:   # every chunk sent and returned
-                break
-            if not suspects:
-                done, _ = cf.wait(pending, return_when=cf.FIRST_COMPLETED)
-                for fut in done:
-                    span = pending.pop(fut)
+    with _deferred_interrupt() as interrupted:
+        try:
+            while True:
+                if interrupted.is_set():
+                    raise KeyboardInterrupt
+                suspects: list[Span] = []
+                while len(pending) < limit and not suspects:
+                    span = next(todo, None)
+                    if span is None:
+                        break
                     try:
-                        res = fut.result()
-                    except cf.process.BrokenProcessPool:
+                        pending[pool.submit(run_chunk, work, span)] = span
+                    except cf.process.BrokenProcessPool:   # a worker died since the last wait
                         suspects.append(span)
-                        continue
-                    on_result(res)
-            if suspects:   # every chunk in flight is suspect: each is retried once, alone
-                suspects += list(pending.values())
-                pending.clear()
-                pool.shutdown(wait=False, cancel_futures=True)
-                for span in sorted(suspects, key=lambda s: s.start):
-                    on_result(_isolate(work, span, alone))
-                pool = cf.ProcessPoolExecutor(max_workers=workers.jobs, initializer=worker_init)
-    except KeyboardInterrupt:
-        workers.interrupted(what)
-        pool.shutdown(wait=True, cancel_futures=True)
-        raise
-    finally:
-        pool.shutdown(wait=True)
+                if not pending and not suspects:   # every chunk sent and returned
+                    break
+                if not suspects:
+                    done, _ = cf.wait(pending, timeout=INTERRUPT_POLL_S, return_when=cf.FIRST_COMPLETED)
+                    for fut in done:
+                        span = pending.pop(fut)
+                        try:
+                            res = fut.result()
+                        except cf.process.BrokenProcessPool:
+                            suspects.append(span)
+                            continue
+                        on_result(res)
+                if suspects:   # every chunk in flight is suspect: each is retried once, alone
+                    suspects += list(pending.values())
+                    pending.clear()
+                    pool.shutdown(wait=False, cancel_futures=True)
+                    for span in sorted(suspects, key=lambda s: s.start):
+                        on_result(_isolate(work, span, alone))
+                    pool = cf.ProcessPoolExecutor(max_workers=workers.jobs, initializer=worker_init)
+        except KeyboardInterrupt:
+            workers.interrupted(what)
+            pool.shutdown(wait=True, cancel_futures=True)
+            raise
+        finally:
+            pool.shutdown(wait=True)
 
 
 def _dask(work: Any, todo: Iterator[Span], on_result: Callable[[ChunkResult], None], workers: Workers,
