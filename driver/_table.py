@@ -38,7 +38,7 @@ class _Number(Protocol):
 Cell: TypeAlias = "_Number | str | None"
 
 __all__ = ["TableValueError", "Column", "fortran_f", "fortran_i", "significant", "render_table", "fixed_cells",
-           "render_block"]
+           "render_block", "render_text"]
 
 
 class TableValueError(DriverError, ValueError):
@@ -217,13 +217,23 @@ def fixed_cells(values: Any, decimals: int, style: str = "modern") -> np.ndarray
     neg = (x < 0) & (n > 0)   # no sign on a value that rounds to zero
     if neg.any():
         text = np.where(neg, np.strings.add(b"-", text), text)
-    text = text.astype(str)
+    text = _ascii_text(text)
     if slow.any():
         text = text.astype(object)
         for i in np.flatnonzero(slow).tolist():
             text[i] = fortran_f(float(x[i]), None, decimals, style)
         text = text.astype(str)
     return text
+
+
+def _ascii_text(b: np.ndarray) -> np.ndarray:
+    """``b.astype(str)`` for an array of ASCII bytes (digits, point, sign), widening each byte
+    to its code point in one cast (numpy's decoding goes string by string)."""
+    import numpy as np
+    k = b.dtype.itemsize
+    if not k or not b.size:
+        return b.astype(str)
+    return np.ascontiguousarray(b).view(np.uint8).astype(np.uint32).view(f"<U{k}").reshape(b.shape)
 
 
 def _point_digits(n: np.ndarray, decimals: int, legacy: bool) -> np.ndarray:
@@ -279,3 +289,45 @@ def render_block(columns: Sequence[Column], cells: Sequence[Any], widths: Sequen
             block[:, at:at + w] = field_.view(np.uint32).reshape(-1, w)
         at += w
     return np.strings.rstrip(block.view(f"<U{total}").ravel()).tolist() if total else [""] * len(block)
+
+
+def render_text(columns: Sequence[Column], cells: Sequence[Any], widths: Sequence[int]) -> str:
+    """The lines :func:`render_block` gives, each followed by a newline, as one text: where every
+    cell is ASCII and no line ends in a blank (a table's usual block), laid out as one byte
+    matrix with the newlines in its last column and decoded once (no string per line); else
+    :func:`render_block`'s lines joined.
+
+    Parameters
+    ----------
+    columns : sequence of Column
+        The table's columns (their ``sep``).
+    cells : sequence of array_like of str
+        Per column, the block's cell texts (equal lengths).
+    widths : sequence of int
+        Per column, the field width (at least each of its cells' lengths).
+
+    Returns
+    -------
+    str
+        ``"".join(line + "\\n" for line in render_block(columns, cells, widths))``.
+    """
+    import numpy as np
+    if not cells or not len(cells[0]):
+        return ""
+    total = sum(c.sep + w for c, w in zip(columns, widths))
+    block = np.empty((len(cells[0]), total + 1), dtype=np.uint8)
+    at, ascii_ = 0, total > 0
+    for c, v, w in zip(columns, cells, widths):
+        block[:, at:at + c.sep] = ord(" ")
+        at += c.sep
+        if w:   # (a longer cell would be cut, as in render_block)
+            codes = np.strings.rjust(np.asarray(v, dtype=str), w).astype(f"<U{w}", copy=False).view(np.uint32)
+            if codes.max() > 127:
+                ascii_ = False
+                break
+            block[:, at:at + w] = codes.reshape(-1, w)
+        at += w
+    if not ascii_ or (block[:, total - 1] == ord(" ")).any():   # lines to strip of trailing blanks, or not ASCII
+        return "".join(line + "\n" for line in render_block(columns, cells, widths))
+    block[:, total] = ord("\n")
+    return block.tobytes().decode("ascii")

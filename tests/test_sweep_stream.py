@@ -57,6 +57,18 @@ def test_streamed_tables_equal_the_in_memory_ones(tmp_path, monkeypatch):
     _same(ref, one, "s")
 
 
+@pytest.mark.parametrize("block_rows", [1, 300])
+def test_streamed_tables_a_block_of_parts_at_a_time(tmp_path, monkeypatch, block_rows):
+    """The CSV and the .out are written a block of parts at a time (STREAM_BLOCK_ROWS; the
+    Parquet summary a row group per part): each part its own block, or several parts per block
+    with a block ending inside the .out's second pass, the files are the in-memory path's."""
+    from driver.sweep import _report
+    _, ref = _run(tmp_path, "s", REVERSED, 0, monkeypatch)
+    monkeypatch.setattr(_report, "STREAM_BLOCK_ROWS", block_rows)
+    _, new = _run(tmp_path, "s", REVERSED, 50, monkeypatch)
+    _same(ref, new, "s")
+
+
 def test_streamed_tables_with_every_row(tmp_path, monkeypatch):
     """summary_rows = 'all': the tables hold every case, the .out the kept ones and a count."""
     text = SHIPPED.replace("count1 = 25", "count1 = 3").replace("summary_rows = 'kept'", "summary_rows = 'all'")

@@ -1,5 +1,6 @@
 """The block formatter (issue 37): ``fixed_cells`` and ``render_block`` give, one call per column
-of a block, the text the per-value formatter gives (``fortran_f``, ``render_table``), checked on
+of a block (``render_text``: the block's text at once), the text the per-value formatter gives
+(``fortran_f``, ``render_table``), checked on
 awkward values (exact ties, doubles next to a tie, values that round to zero, signed zeros,
 subnormals, values beyond 2**50 scaled, huge ones), on random values of every magnitude, and
 against an independent oracle: Decimal's half-up rounding of the double's exact value.  The
@@ -12,7 +13,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from driver._table import Column, TableValueError, fixed_cells, fortran_f, render_block, render_table
+from driver._table import Column, TableValueError, fixed_cells, fortran_f, render_block, render_table, render_text
 from driver.sweep._report import _summary_table, table_cells, table_columns
 
 AWKWARD = [0.5, 1.5, 2.5, -0.5, -2.5, 0.00005, -0.00005, 0.00015, 0.00025, 1.00005, 0.125, -0.125, 0.0625,
@@ -123,3 +124,33 @@ def test_sweep_table_equals_the_row_by_row_table():
 
 def test_render_block_of_no_rows():
     assert render_block([Column("a"), Column("b", "i")], [[], []], [10, 5]) == []
+
+
+TEXTS = st.text(st.sampled_from(["a", "Z", "-", ".", " ", "7", "\u00e9", "\u4e2d"]), max_size=6)
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.lists(st.tuples(st.integers(0, 3), st.integers(0, 9)), min_size=1, max_size=5),
+       st.integers(1, 30), st.data())
+def test_render_text_equals_the_row_by_row_table(shape, n, data):
+    """``render_text`` against ``render_table``'s lines (cell by cell, rstrip per line) on drawn
+    text cells: blanks at either end (lines that must be stripped), non-ASCII text, empty cells,
+    zero widths and zero separators."""
+    cols = [Column(f"c{j}", "s", w, 0, sep=sep) for j, (sep, w) in enumerate(shape)]
+    cells = [data.draw(st.lists(TEXTS.filter(lambda t, w=c.width: len(t) <= w), min_size=n, max_size=n))
+             for c in cols]
+    want = render_table(cols, list(zip(*cells)), header=False)
+    assert render_text(cols, cells, [c.width for c in cols]) == "".join(line + "\n" for line in want)
+
+
+def test_render_text_of_a_sweep_block():
+    """The streamed sweep's body: fixed_cells columns and yes/no columns, the block's text equals
+    the row-by-row table's lines, and no rows give no text."""
+    rng = np.random.default_rng(9)
+    frame = pd.DataFrame({"case": np.arange(1, 2001), "x": rng.standard_normal(2000) * 1e3,
+                          "kept": rng.uniform(size=2000) < 0.5, "status": ["ok"] * 2000})
+    cols, keys = table_columns(frame)
+    cells = table_cells(frame, cols, keys)
+    widths = [max(c.width, len(c.header), *(len(v) for v in cj)) for c, cj in zip(cols, cells)]
+    assert render_text(cols, cells, widths) == "".join(line + "\n" for line in row_by_row(frame)[1:])
+    assert render_text(cols, [[] for _ in cols], widths) == ""

@@ -33,7 +33,7 @@ from driver._deck import Deck, Params
 from driver._export import write_tidy
 from driver._outcome import ExitCode
 from driver._output import column_label
-from driver._table import Column, fixed_cells, render_block
+from driver._table import Column, fixed_cells, render_block, render_text
 from driver.sweep._spec import CaseResult
 
 if TYPE_CHECKING:   # annotations only: pyarrow is imported where a table is read or written
@@ -342,6 +342,9 @@ def head_lines(deck: Deck, sw: Params, base: Params, axes: list[tuple[str, list]
     return lines
 
 
+#: a streamed sweep's tables are written this many rows at a time (at least: whole parts)
+STREAM_BLOCK_ROWS = 16_384
+
 #: the .out lists at most this many failed cases (all are in the _summary table's status column)
 FAILED_LISTED = 1000
 
@@ -474,39 +477,52 @@ class _StreamedTable:
         formatting call per column)."""
         cells = table_cells(shown, self.cols, self.keys)
         need = cell_widths(cells)
-        lines = render_block(self.cols, cells, [max(w, n) for w, n in zip(widths, need)])
-        return need, "".join(line + "\n" for line in lines)
+        return need, render_text(self.cols, cells, [max(w, n) for w, n in zip(widths, need)])
 
     def first_pass(self, schema: pa.Schema, csv: Any, pfh: Any, body: Any, result: Streamed) -> None:
-        """Every part once: into the CSV and Parquet summaries, its rows into ``body``, its
-        failed cases and counts into ``result``."""
+        """Every part once: into the Parquet summary (one row group per part), and a block of
+        parts at a time (up to :data:`STREAM_BLOCK_ROWS` rows: what one part costs beyond its
+        rows is paid once per block) into the CSV summary and ``body``, with the block's failed
+        cases and counts into ``result``."""
+        import pyarrow as pa
         import pyarrow.parquet as pq
-
-        from driver._export import write_csv_arrow
         writer = pq.ParquetWriter(pfh, schema)
         try:
+            block: list[pa.Table] = []
+            rows = 0
             for k, path in enumerate(self.paths):
-                table = pq.read_table(path).replace_schema_metadata(schema.metadata)
+                # (ParquetFile: the file alone, none of read_table's dataset layer; one thread for a part)
+                table = pq.ParquetFile(path).read(use_threads=False).replace_schema_metadata(schema.metadata)
                 writer.write_table(table)
-                write_csv_arrow(table, csv, header=k == 0)
-                frame = _frame(table, self.origins)
-                if k == 0:
-                    self._start(frame)
-                bad = frame["status"] != "ok"
-                result.n_rows += len(frame)
-                result.n_kept += int(frame["kept"].sum())
-                shown = self._shown(frame)
-                self.shown += len(shown)
-                need, text = self._lines(shown, self.widths)
-                self.need = [max(w, n) for w, n in zip(self.need, need)]
-                body.write(text)
-                for _, r in frame[bad].iterrows():
-                    result.n_failed += 1
-                    result.bad_input |= r["status"] == "bad input"
-                    if len(result.failed) < FAILED_LISTED:
-                        result.failed.append((int(r["case"]), {k2: r[k2] for k2 in self.names}, r["error"]))
+                if k == 0:   # the columns' kinds and widths from the first part's rows, as ever
+                    self._start(_frame(table, self.origins))
+                block.append(table)
+                rows += table.num_rows
+                if rows >= STREAM_BLOCK_ROWS or k == len(self.paths) - 1:
+                    self._block(pa.concat_tables(block).combine_chunks() if len(block) > 1 else block[0], csv, body,
+                                result)
+                    block, rows = [], 0
         finally:
             writer.close()
+
+    def _block(self, table: pa.Table, csv: Any, body: Any, result: Streamed) -> None:
+        """One block of parts' rows into the CSV summary and ``body``; its counts and failed cases."""
+        from driver._export import write_csv_arrow
+        write_csv_arrow(table, csv, header=result.n_rows == 0)
+        frame = _frame(table, self.origins)
+        bad = frame["status"] != "ok"
+        result.n_rows += len(frame)
+        result.n_kept += int(frame["kept"].sum())
+        shown = self._shown(frame)
+        self.shown += len(shown)
+        need, text = self._lines(shown, self.widths)
+        self.need = [max(w, n) for w, n in zip(self.need, need)]
+        body.write(text)
+        for _, r in frame[bad].iterrows():
+            result.n_failed += 1
+            result.bad_input |= r["status"] == "bad input"
+            if len(result.failed) < FAILED_LISTED:
+                result.failed.append((int(r["case"]), {k2: r[k2] for k2 in self.names}, r["error"]))
 
     def write(self, out: Any, body: Any) -> None:
         """The table's header and rows into the .out: the first pass's body, or every row again
