@@ -108,12 +108,13 @@ module fourbar_summary
   end type plan
 
   integer, parameter :: lbp = 32              ! linkages per batched peak search
-  !> one linkage's peak search (peaks_block): its grid, coarse and refined speeds, brackets
+  !> one linkage's peak search (peaks_block): its grid, coarse and refined speeds (w(:, k): omega3,
+  !> alpha3, omega2, alpha2 at grid point k, together in memory), brackets
   type :: peakplan
     real(dp) :: p, q, r, s, sgn, omega, lo, hie, h
     integer :: branch, row, m, nco, nref, nb
     integer :: ci(maxscan), rj(maxscan), bcol(maxbr), side(maxbr)
-    real(dp) :: w(maxscan, 4), ba(maxbr), bb(maxbr), fa(maxbr), fb(maxbr), tx(maxbr)
+    real(dp) :: w(4, maxscan), ba(maxbr), bb(maxbr), fa(maxbr), fb(maxbr), tx(maxbr)
   end type peakplan
 
 contains
@@ -851,6 +852,30 @@ contains
     smooth = qmin >= 0.5_dp*min(a, b)
   end function smooth
 
+  !> smooth() of ns grid steps at once: sd(j, 1:5) a step's fa, fb, da, db and h; ok(j) 1 where
+  !> smooth(fa, fb, da, db, h), else 0 (the same arithmetic, branch-free so that it vectorises).
+  subroutine smooth_steps(ns, sd, ok)
+    integer, intent(in) :: ns
+    real(dp), intent(in) :: sd(:, :)
+    real(dp), intent(inout) :: ok(:)
+    real(dp) :: da, db, sg, a, b, cc, xs, qmin
+    integer :: j
+    ! hot-loop: fourbar_summary smooth steps
+    do j = 1, ns
+      da = sd(j, 3)
+      db = sd(j, 4)
+      sg = sign(1.0_dp, da)
+      a = sg*da
+      b = sg*db
+      cc = 6.0_dp*(sg*(sd(j, 2) - sd(j, 1))/sd(j, 5) - 0.5_dp*(a + b))
+      qmin = min(a, b)
+      xs = 0.5_dp + (b - a)/merge(2.0_dp*cc, -1.0_dp, cc < 0.0_dp)
+      qmin = merge(min(qmin, a*(1.0_dp - xs) + b*xs + cc*xs*(1.0_dp - xs)), qmin, &
+                   cc < 0.0_dp .and. xs > 0.0_dp .and. xs < 1.0_dp)
+      ok(j) = merge(1.0_dp, 0.0_dp, da*db > 0.0_dp .and. qmin >= 0.5_dp*min(a, b))
+    end do
+  end subroutine smooth_steps
+
   !> Peak |omega3| and |omega2| over [lo, hie] (assembled throughout, no toggle) of the n
   !> linkages of pk (one block): the grid of at most 1 deg, scanned coarsely and refined where
   !> needed (module header), then every sign change of the matching angular acceleration
@@ -862,12 +887,13 @@ contains
     type(peakplan), intent(inout) :: pk(:)
     logical, intent(in) :: dense
     real(dp), intent(inout) :: rows(:, :)
-    real(dp), allocatable :: qs(:, :), qg(:, :)
+    real(dp), allocatable :: qs(:, :), qg(:, :), sd(:, :), okc(:)
     integer, allocatable :: who(:, :)
     real(dp) :: tg(maxscan), g(maxscan, 4)
-    real(dp) :: okc(maxscan), hc, da, db, sg, av, bv, cv, qv, xs, qm, v, best(2), bestat(2), t
-    integer :: l, k, j, c, nq, nco, ka, kb, jr, it, iq, nr
-    allocate (qs(maxscan*n + maxbr*n, 11), qg(maxscan*n, 11), who(maxscan*n + maxbr*n, 2))
+    real(dp) :: hc, da, db, sg, av, bv, cv, qv, xs, qm, v, best(2), bestat(2), t
+    integer :: l, k, j, c, nq, nco, ka, kb, jr, it, iq, nr, ns
+    allocate (qs(maxscan*n + maxbr*n, 11), qg(maxscan*n, 11), who(maxscan*n + maxbr*n, 2), sd(2*maxscan*n, 5), &
+              okc(2*maxscan*n))
 
     ! ---- the coarse scan (first and last grid points included) of every linkage, one call
     nq = 0
@@ -881,8 +907,6 @@ contains
         pk(l)%ci(nco) = k
         nq = nq + 1
         qs(nq, 1) = grid_angle(pk(l), k)
-        who(nq, 1) = l
-        who(nq, 2) = k
         if (k == pk(l)%m) exit
         k = min(k + coarse_every, pk(l)%m)
       end do
@@ -890,8 +914,12 @@ contains
       call fill(pk(l), nq - nco + 1, nq)
     end do
     call batch_speeds(nq, qs)
-    do iq = 1, nq
-      pk(who(iq, 1))%w(who(iq, 2), :) = qs(iq, 7:10)
+    iq = 0
+    do l = 1, n   ! (a linkage's coarse points are consecutive rows of qs)
+      do j = 1, pk(l)%nco
+        pk(l)%w(:, pk(l)%ci(j)) = qs(iq + j, 7:10)
+      end do
+      iq = iq + pk(l)%nco
     end do
 
     ! ---- the smooth test (see smooth) of every coarse interval, both speeds; the grid points
@@ -934,35 +962,60 @@ contains
         do k = ka + 1, kb - 1
           nq = nq + 1
           qg(nq, 1) = grid_angle(pk(l), k)
-          who(nq, 1) = l
-          who(nq, 2) = k
         end do
       end do
       if (nq > nr) call fill_q(qg, pk(l), nr + 1, nq)
     end do
     if (nq > 0) then
       call batch_speeds(nq, qg)
-      do iq = 1, nq
-        pk(who(iq, 1))%w(who(iq, 2), :) = qg(iq, 7:10)
+      iq = 0
+      do l = 1, n   ! (a linkage's refined points are consecutive rows of qg, in the order queued)
+        do jr = 1, pk(l)%nref
+          do k = pk(l)%ci(pk(l)%rj(jr)) + 1, pk(l)%ci(pk(l)%rj(jr) + 1) - 1
+            iq = iq + 1
+            pk(l)%w(:, k) = qg(iq, 7:10)
+          end do
+        end do
       end do
     end if
 
     ! ---- brackets of alpha sign changes on the grid of the refined intervals, both speeds (grid
     ! order, as a full scan); a suspicious interval bisected (hidden), linkage by linkage
+    ! the smooth test of every such grid step first, all linkages and both speeds in one
+    ! vectorised loop (one step at a time, its two divisions would wait on each other)
+    ns = 0
+    if (.not. dense) then
+      do l = 1, n
+        do c = 1, 2
+          do jr = 1, pk(l)%nref
+            do k = pk(l)%ci(pk(l)%rj(jr)), pk(l)%ci(pk(l)%rj(jr) + 1) - 1
+              ns = ns + 1
+              sd(ns, 1) = pk(l)%w(2*c - 1, k)
+              sd(ns, 2) = pk(l)%w(2*c - 1, k + 1)
+              sd(ns, 3) = pk(l)%w(2*c, k)
+              sd(ns, 4) = pk(l)%w(2*c, k + 1)
+              sd(ns, 5) = grid_angle(pk(l), k + 1) - grid_angle(pk(l), k)
+            end do
+          end do
+        end do
+      end do
+      call smooth_steps(ns, sd, okc)
+    end if
+    ns = 0
     do l = 1, n
       pk(l)%nb = 0
       do c = 1, 2
         do jr = 1, pk(l)%nref
           do k = pk(l)%ci(pk(l)%rj(jr)), pk(l)%ci(pk(l)%rj(jr) + 1) - 1
+            ns = ns + 1
             associate (w => pk(l)%w)
-              if (w(k, 2*c)*w(k + 1, 2*c) < 0.0_dp) then
-                call add_bracket(pk(l), grid_angle(pk(l), k), grid_angle(pk(l), k + 1), w(k, 2*c), w(k + 1, 2*c), c)
+              if (w(2*c, k)*w(2*c, k + 1) < 0.0_dp) then
+                call add_bracket(pk(l), grid_angle(pk(l), k), grid_angle(pk(l), k + 1), w(2*c, k), w(2*c, k + 1), c)
               else if (dense) then
                 cycle
-              else if (.not. smooth(w(k, 2*c - 1), w(k + 1, 2*c - 1), w(k, 2*c), w(k + 1, 2*c), &
-                                    grid_angle(pk(l), k + 1) - grid_angle(pk(l), k))) then
-                call hidden(pk(l), grid_angle(pk(l), k), grid_angle(pk(l), k + 1), w(k, 2*c - 1), w(k + 1, 2*c - 1), &
-                            w(k, 2*c), w(k + 1, 2*c), c, 1)
+              else if (okc(ns) == 0.0_dp) then
+                call hidden(pk(l), grid_angle(pk(l), k), grid_angle(pk(l), k + 1), w(2*c - 1, k), w(2*c - 1, k + 1), &
+                            w(2*c, k), w(2*c, k + 1), c, 1)
               end if
             end associate
           end do
@@ -978,10 +1031,10 @@ contains
         nr = nq
         do j = 1, pk(l)%nb
           associate (ba => pk(l)%ba(j), bb => pk(l)%bb(j), fa => pk(l)%fa(j), fb => pk(l)%fb(j))
-            t = (ba*fb - bb*fa)/(fb - fa)
-            t = min(max(t, ba), bb)
-            pk(l)%tx(j) = t
-            if (bb - ba > 1.0e-12_dp) then
+            if (bb - ba > 1.0e-12_dp) then   ! (a converged bracket's tx is set with the final points)
+              t = (ba*fb - bb*fa)/(fb - fa)
+              t = min(max(t, ba), bb)
+              pk(l)%tx(j) = t
               nq = nq + 1
               qs(nq, 1) = t
               who(nq, 1) = l
@@ -1033,10 +1086,10 @@ contains
     do l = 1, n
       associate (w => pk(l)%w, m => pk(l)%m)
         do c = 1, 2
-          best(c) = w(1, 2*c - 1)
+          best(c) = w(2*c - 1, 1)
           bestat(c) = grid_angle(pk(l), 1)
-          if (abs(w(m, 2*c - 1)) > abs(best(c))) then
-            best(c) = w(m, 2*c - 1); bestat(c) = grid_angle(pk(l), m)
+          if (abs(w(2*c - 1, m)) > abs(best(c))) then
+            best(c) = w(2*c - 1, m); bestat(c) = grid_angle(pk(l), m)
           end if
         end do
       end associate
