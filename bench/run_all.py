@@ -158,7 +158,7 @@ def fourbar(n: int, repeat: int) -> list[Row]:
                          lambda: fourbar_kernel.fourbar_exact(theta, *lk, 1), repeat)
     floor = write_floor(lambda: np.empty((n, 12), order="F").fill(0.0), repeat)
     rows.append(Row("four-bar joint forces (baseline: exact states)", "ns/position", tk / n, tb / n, None, 0.5,
-                    "reads 64 B, writes 96 B/position (fresh array); no transcendental function, 6 divisions",
+                    "reads 64 B, writes 96 B/position (fresh array); no transcendental function, 8 divisions",
                     floor / n))
     # issue 37: out= as the kinematics kernel has it; both kernels on reused buffers, the force kernel
     # at most 1.5x the kinematics per position and 1.6x its own store floor (numpy filling its buffer)

@@ -60,10 +60,14 @@ contains
     real(dp), intent(inout) :: fout(n, 12)
     !f2py intent(in,out) :: fout
     integer :: k0, m
+    real(dp) :: com(6)
+    ! com offsets in link axes, d (cos phi, sin phi): once per call, not per block (six libm calls)
+    com = [props(7)*cos(props(10)), props(7)*sin(props(10)), props(8)*cos(props(11)), props(8)*sin(props(11)), &
+           props(9)*cos(props(12)), props(9)*sin(props(12))]
     ! blocks of nb rows, columns passed separately (see fourbar::exact_states)
     do k0 = 1, n, nb
       m = min(nb, n - k0 + 1)
-      call forces_block(m, status(k0:k0 + m - 1), p, q, r, s, omega, alpha1, props, &
+      call forces_block(m, status(k0:k0 + m - 1), p, q, r, s, omega, alpha1, props, com, &
                         states(k0:k0 + m - 1, 4), states(k0:k0 + m - 1, 5), &
                         states(k0:k0 + m - 1, 6), states(k0:k0 + m - 1, 7), &
                         states(k0:k0 + m - 1, 8), states(k0:k0 + m - 1, 9), &
@@ -76,13 +80,14 @@ contains
   end subroutine joint_forces
 
   !> One block of joint_forces (m <= nb): pins A = (xa, ya), B = (xb, yb), coupler and rocker
-  !> angular velocities w2, w3 and accelerations a2, a3 in; the twelve force columns out.
+  !> angular velocities w2, w3 and accelerations a2, a3 in; the twelve force columns out; com the
+  !> centres of mass in link axes (k1x, k1y, k2x, k2y, k3x, k3y: d_i (cos phi_i, sin phi_i)).
   !> The loop body is straight-line arithmetic (no transcendental function: the link
   !> directions are the unit vectors between the pins), so it vectorises.
-  subroutine forces_block(m, status, p, q, r, s, omega, alpha1, props, xa, ya, xb, yb, w2, w3, a2, a3, &
+  subroutine forces_block(m, status, p, q, r, s, omega, alpha1, props, com, xa, ya, xb, yb, w2, w3, a2, a3, &
                           tq, fo2x, fo2y, fax, fay, fbx, fby, fo4x, fo4y, shx, shy, shm)
     integer, intent(in) :: m, status(m)
-    real(dp), intent(in) :: p, q, r, s, omega, alpha1, props(18)
+    real(dp), intent(in) :: p, q, r, s, omega, alpha1, props(18), com(6)
     real(dp), intent(in) :: xa(m), ya(m), xb(m), yb(m), w2(m), w3(m), a2(m), a3(m)
     real(dp), intent(out) :: tq(m), fo2x(m), fo2y(m), fax(m), fay(m), fbx(m), fby(m), fo4x(m), fo4y(m), &
                              shx(m), shy(m), shm(m)
@@ -94,10 +99,7 @@ contains
     integer :: k
     m1 = props(1); m2 = props(2); m3 = props(3)
     i1 = props(4); i2 = props(5); i3 = props(6)
-    ! com offsets in link axes: d (cos phi, sin phi)
-    k1x = props(7)*cos(props(10)); k1y = props(7)*sin(props(10))
-    k2x = props(8)*cos(props(11)); k2y = props(8)*sin(props(11))
-    k3x = props(9)*cos(props(12)); k3y = props(9)*sin(props(12))
+    k1x = com(1); k1y = com(2); k2x = com(3); k2y = com(4); k3x = com(5); k3y = com(6)
     grav = props(13); tl = props(14); flx = props(15); fly = props(16); u = props(17); v = props(18)
     w1s = omega*omega
     ! hot-loop: fourbar_forces status mask
