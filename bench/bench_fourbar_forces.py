@@ -94,7 +94,7 @@ def main(argv: list[str] | None = None) -> dict[str, float]:
     print(f"  numpy, same closed form (reference): {ns['numpy']:8.1f} ns/position   "
           f"({t_np / t_force:.1f} x the force kernel)")
     print("  limits: the force kernel reads 8 state columns and writes 12 (160 bytes per position); "
-          "no transcendental function per position, 6 divisions")
+          "no transcendental function per position, 8 divisions")
     return ns | {"ratio": ratio}
 
 
