@@ -148,12 +148,17 @@ contains
     type(plan), allocatable :: pl(:)
     type(peakplan), allocatable :: pk(:)
     real(dp), allocatable :: rows(:, :), qc(:, :), qm(:, :)
+    ! the peak search's queues and work space (peaks_block), allocated once for lbp linkages
+    real(dp), allocatable :: qs(:, :), qg(:, :), sd(:, :), okc(:)
+    integer, allocatable :: who(:, :)
     real(dp) :: par(npar)
     integer :: i0, m, l, nq, nm, npk
     ! per block: the plans, the rows, and the two queues of states (columns: crank angle [rad],
     ! p, q, r, s, branch sign, then the result and the status): the rocker angle at the
     ! candidates, the rocker speed halfway between them
     allocate (pl(lb), pk(lbp), rows(ncol, lb), qc(lb*maxcl, 8), qm(lb*maxcl + maxcl, 8))   ! qm: room for halfway
+    if (iand(passes, pass_peaks) /= 0) allocate (qs(maxscan*lbp + maxbr*lbp, 11), qg(maxscan*lbp, 11), &
+      who(maxscan*lbp + maxbr*lbp, 2), sd(2*maxscan*lbp, 5), okc(2*maxscan*lbp))
     do i0 = 1, n, lb
       m = min(lb, n - i0 + 1)
       nq = 0
@@ -180,12 +185,12 @@ contains
           pk(npk)%branch = pl(l)%branch
           pk(npk)%row = l
           if (npk == lbp) then
-            call peaks_block(npk, pk, iand(passes, pass_dense_scan) /= 0, rows)
+            call peaks_block(npk, pk, iand(passes, pass_dense_scan) /= 0, rows, qs, qg, who, sd, okc)
             npk = 0
           end if
         end if
       end do
-      if (npk > 0) call peaks_block(npk, pk, iand(passes, pass_dense_scan) /= 0, rows)
+      if (npk > 0) call peaks_block(npk, pk, iand(passes, pass_dense_scan) /= 0, rows, qs, qg, who, sd, okc)
       res(i0:i0 + m - 1, :) = transpose(rows(:, 1:m))
     end do
   end subroutine summaries
@@ -882,18 +887,19 @@ contains
   !> refined to 1e-12 rad.  Each stage evaluates the speeds of every linkage of the block in one
   !> batched call (the coarse scan, the refined grid points, each regula falsi iteration, the
   !> roots); a bracket advances exactly as it would alone, so the figures are the same bits.
-  subroutine peaks_block(n, pk, dense, rows)
+  subroutine peaks_block(n, pk, dense, rows, qs, qg, who, sd, okc)
     integer, intent(in) :: n
     type(peakplan), intent(inout) :: pk(:)
     logical, intent(in) :: dense
     real(dp), intent(inout) :: rows(:, :)
-    real(dp), allocatable :: qs(:, :), qg(:, :), sd(:, :), okc(:)
-    integer, allocatable :: who(:, :)
+    ! queues (rows of batch_speeds) and work space for up to lbp linkages: qs the coarse scan, the
+    ! regula falsi and the roots; qg the refined grid points; who a queued row's linkage and bracket;
+    ! sd, okc the smooth test's steps
+    real(dp), intent(inout), contiguous :: qs(:, :), qg(:, :), sd(:, :), okc(:)
+    integer, intent(inout) :: who(:, :)
     real(dp) :: tg(maxscan), g(maxscan, 4)
     real(dp) :: hc, da, db, sg, av, bv, cv, qv, xs, qm, v, best(2), bestat(2), t
     integer :: l, k, j, c, nq, nco, ka, kb, jr, it, iq, nr, ns
-    allocate (qs(maxscan*n + maxbr*n, 11), qg(maxscan*n, 11), who(maxscan*n + maxbr*n, 2), sd(2*maxscan*n, 5), &
-              okc(2*maxscan*n))
 
     ! ---- the coarse scan (first and last grid points included) of every linkage, one call
     nq = 0
