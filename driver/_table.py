@@ -291,6 +291,10 @@ def render_block(columns: Sequence[Column], cells: Sequence[Any], widths: Sequen
     return np.strings.rstrip(block.view(f"<U{total}").ravel()).tolist() if total else [""] * len(block)
 
 
+#: the ASCII codes str.rstrip (and numpy's) strips: blank, tab, line feeds, form feeds, the separators
+_ASCII_SPACE = tuple(c for c in range(128) if chr(c).isspace())
+
+
 def render_text(columns: Sequence[Column], cells: Sequence[Any], widths: Sequence[int]) -> str:
     """The lines :func:`render_block` gives, each followed by a newline, as one text: where every
     cell is ASCII and no line ends in a blank (a table's usual block), laid out as one byte
@@ -327,7 +331,7 @@ def render_text(columns: Sequence[Column], cells: Sequence[Any], widths: Sequenc
                 break
             block[:, at:at + w] = codes.reshape(-1, w)
         at += w
-    if not ascii_ or (block[:, total - 1] == ord(" ")).any():   # lines to strip of trailing blanks, or not ASCII
+    if not ascii_ or np.isin(block[:, total - 1], _ASCII_SPACE).any():   # lines to strip, or not ASCII
         return "".join(line + "\n" for line in render_block(columns, cells, widths))
     block[:, total] = ord("\n")
     return block.tobytes().decode("ascii")

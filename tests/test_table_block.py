@@ -126,7 +126,7 @@ def test_render_block_of_no_rows():
     assert render_block([Column("a"), Column("b", "i")], [[], []], [10, 5]) == []
 
 
-TEXTS = st.text(st.sampled_from(["a", "Z", "-", ".", " ", "7", "\u00e9", "\u4e2d"]), max_size=6)
+TEXTS = st.text(st.sampled_from(["a", "Z", "-", ".", " ", "7", "\t", "\x1f", "\u00e9", "\u4e2d"]), max_size=6)
 
 
 @settings(max_examples=80, deadline=None)
@@ -134,13 +134,22 @@ TEXTS = st.text(st.sampled_from(["a", "Z", "-", ".", " ", "7", "\u00e9", "\u4e2d
        st.integers(1, 30), st.data())
 def test_render_text_equals_the_row_by_row_table(shape, n, data):
     """``render_text`` against ``render_table``'s lines (cell by cell, rstrip per line) on drawn
-    text cells: blanks at either end (lines that must be stripped), non-ASCII text, empty cells,
-    zero widths and zero separators."""
+    text cells: blanks and other whitespace rstrip removes (tab, unit separator) at either end
+    (lines that must be stripped), non-ASCII text, empty cells, zero widths and zero separators."""
     cols = [Column(f"c{j}", "s", w, 0, sep=sep) for j, (sep, w) in enumerate(shape)]
     cells = [data.draw(st.lists(TEXTS.filter(lambda t, w=c.width: len(t) <= w), min_size=n, max_size=n))
              for c in cols]
     want = render_table(cols, list(zip(*cells)), header=False)
     assert render_text(cols, cells, [c.width for c in cols]) == "".join(line + "\n" for line in want)
+
+
+@pytest.mark.parametrize("end", [" ", "\t", "\n", "\x0b", "\x0c", "\r", "\x1c", "\x1f", "x"])
+def test_render_text_strips_what_rstrip_strips(end):
+    """A line ending in any of the ASCII whitespace rstrip removes is stripped as render_block strips it."""
+    cols = [Column("a", "s", 3, 0), Column("b", "s", 3, 0)]
+    cells = [["1", "22", "333"], ["ab" + end, "c", "d" + end]]
+    want = render_table(cols, list(zip(*cells)), header=False)
+    assert render_text(cols, cells, [3, 3]) == "".join(line + "\n" for line in want)
 
 
 def test_render_text_of_a_sweep_block():
