@@ -21,8 +21,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from driver.linkage import compile_deck
 from driver.linkage import _kernel as kernel
+from driver.linkage import compile_deck
 from driver.linkage._batch import summarise_batch
 from linkage_oracle import params_of
 
