@@ -1700,8 +1700,7 @@ contains
     subroutine peaks_pass()
       do l = 2, nl
         j = nsum_head + nsum_link*(l - 2)
-        call over_input(lk(:, 2, l), lk(:, 3, l), dy)
-        row(j + 1) = rate_peak(n, lk(:, 2, l), dy, okrow, periodic == 1, h)
+        row(j + 1) = rate_peak(n, lk(:, 2, l), lk(:, 3, l), rdrv(2), rdrv(3), okrow, periodic == 1, h)
         row(j + 2) = peak(n, lk(:, 3, l), okrow, periodic == 1)
       end do
       do l = 1, ns
@@ -1710,24 +1709,10 @@ contains
           row(j + 1) = minval(sk(:, 1, l))
           row(j + 2) = maxval(sk(:, 1, l))
         end if
-        call over_input(sk(:, 2, l), sk(:, 3, l), dy)
-        row(j + 3) = rate_peak(n, sk(:, 2, l), dy, okrow, periodic == 1, h)
+        row(j + 3) = rate_peak(n, sk(:, 2, l), sk(:, 3, l), rdrv(2), rdrv(3), okrow, periodic == 1, h)
         row(j + 4) = peak(n, sk(:, 3, l), okrow, periodic == 1)
       end do
     end subroutine peaks_pass
-
-    !> The derivative over the input of a rate v (a link's omega or a slide's rate) from its
-    !> acceleration a: v = g' w and a = g'' w^2 + g' alpha (w, alpha: the driver's), so
-    !> dv/dx = g'' w = (a - v alpha / w) / w; 0 when the driver is at rest (every rate is 0).
-    subroutine over_input(v, a, dv)
-      real(dp), intent(in) :: v(n), a(n)
-      real(dp), intent(out) :: dv(n)
-      if (rdrv(2) /= 0.0_dp) then
-        dv = (a - v*(rdrv(3)/rdrv(2)))/rdrv(2)
-      else
-        dv = 0.0_dp
-      end if
-    end subroutine over_input
 
     !> The driving torque's peak, mean and RMS, the shaking force's and moment's peaks, the
     !> energy fluctuation and the flywheel.
@@ -1917,14 +1902,17 @@ contains
     call peak_at(n, v, okv, per, 1.0_dp, 0.0_dp, peak, at)
   end function peak
 
-  !> The value of a rate v largest in size (signed) over the rows okv, refined on the cubic
-  !> Hermite model (v and its derivative dv over the input at both ends, scan step h) of the
-  !> two scan intervals beside the largest scan value where dv changes sign.
-  real(dp) function rate_peak(n, v, dv, okv, per, h)
+  !> The value of a rate v (a link's omega or a slide's rate) largest in size (signed) over the
+  !> rows okv, refined on the cubic Hermite model of the two scan intervals (step h) beside the
+  !> largest scan value where the rate's derivative over the input changes sign.  That derivative
+  !> comes from the acceleration a: v = g' w and a = g'' w^2 + g' al (w, al: the driver's rate
+  !> and acceleration), so dv/dx = g'' w = (a - v al / w) / w (no refinement when w = 0: every
+  !> rate is 0).
+  real(dp) function rate_peak(n, v, a, w0, al0, okv, per, h)
     integer, intent(in) :: n
-    real(dp), intent(in) :: v(n), dv(n), h
+    real(dp), intent(in) :: v(n), a(n), w0, al0, h
     logical, intent(in) :: okv(n), per
-    real(dp) :: w(n), sgn, e
+    real(dp) :: w(n), sgn, e, d0, d1
     integer :: k, k0, k1, side
     rate_peak = 0.0_dp
     if (.not. any(okv)) return
@@ -1933,6 +1921,7 @@ contains
     k = findloc(okv .and. w >= maxval(w, mask=okv)*(1.0_dp - tie_rel), .true., 1)
     rate_peak = v(k)
     sgn = sign(1.0_dp, v(k))
+    if (w0 == 0.0_dp) return
     do side = -1, 0
       k0 = k + side
       k1 = k0 + 1
@@ -1942,8 +1931,10 @@ contains
       end if
       if (k0 < 1 .or. k1 > n) cycle
       if (.not. (okv(k0) .and. okv(k1))) cycle
-      if (.not. (dv(k0)*dv(k1) < 0.0_dp)) cycle
-      e = cubic_extremum(v(k0), v(k1), dv(k0)*h, dv(k1)*h)
+      d0 = (a(k0) - v(k0)*(al0/w0))/w0
+      d1 = (a(k1) - v(k1)*(al0/w0))/w0
+      if (.not. (d0*d1 < 0.0_dp)) cycle
+      e = cubic_extremum(v(k0), v(k1), d0*h, d1*h)
       if (sgn*e > sgn*rate_peak) rate_peak = e
     end do
   end function rate_peak
