@@ -158,7 +158,7 @@ def test_tolerance_box_worst_corner_on_bound_and_monte_carlo(measure):
     blocks = sensitivity_blocks(th1, th2)
     box = tolerance_box(blocks, eps, measure)
     dl = box["closed"]
-    np.testing.assert_allclose(box["u"], dl, rtol=1e-6)          # SLSQP over all corners
+    np.testing.assert_allclose(box["u"], dl, rtol=1e-12)         # the largest box over all corners
     if measure == "global":
         ri2 = np.linalg.svd(blocks.reshape(-1, 2), compute_uv=False)[0]
         np.testing.assert_allclose(dl, eps / (math.sqrt(2) * ri2), rtol=1e-12)
@@ -191,8 +191,8 @@ def test_study_tolerance_rows(exact_runs):
 @given(st.lists(st.tuples(st.floats(-8, 8), st.floats(-8, 8)), min_size=1, max_size=6),
        st.floats(0.5, 6.0), st.floats(0.5, 6.0), st.sampled_from(["global", "per_point"]))
 def test_tolerance_box_property(points, l1, l2, measure):
-    """Random workspaces and designs: SLSQP over all corners equals the l = 2 closed form, and the
-    worst corner (computed here in numpy) sits on the bound."""
+    """Random workspaces and designs: the largest box equals the l = 2 closed form and SLSQP's (the
+    oracle), and the worst corner (computed here in numpy) sits on the bound."""
     x = np.array([p[0] for p in points])
     y = np.array([p[1] for p in points])
     d = np.hypot(x, y)
@@ -203,11 +203,66 @@ def test_tolerance_box_property(points, l1, l2, measure):
     blocks = sensitivity_blocks(th1, th2)
     box = tolerance_box(blocks, 0.02, measure)
     assert box["converged"]
-    np.testing.assert_allclose(box["u"], box["closed"], rtol=1e-5)
+    np.testing.assert_allclose(box["u"], box["closed"], rtol=1e-12)
+    mats = [blocks.reshape(-1, 2).T @ blocks.reshape(-1, 2)] if measure == "global" else [b.T @ b for b in blocks]
+    np.testing.assert_allclose(box["u"], _slsqp_box(mats, 0.02), rtol=1e-5)   # the oracle
     corners = np.array([[1, 1], [1, -1]]) * box["closed"]
     e = np.einsum("kij,nj->nki", blocks, corners)
     worst = np.sqrt((e ** 2).sum((1, 2))).max() if measure == "global" else np.sqrt((e ** 2).sum(2)).max()
     assert worst == pytest.approx(0.02, rel=1e-10)
+
+
+def _slsqp_box(mats: list[np.ndarray], eps: float) -> np.ndarray:
+    """Test oracle, written apart from the tool's enumeration: the largest two-length box by
+    scipy's SLSQP over every corner pattern, from several starts (the tool's method until 2026-12)."""
+    from scipy.optimize import minimize
+    pats = np.array([[1.0, 1.0], [1.0, -1.0]])
+    scale = eps / math.sqrt(max(m.trace() for m in mats))
+    best = None
+    for start in ([0.5, 0.5], [0.1, 2.0], [2.0, 0.1]):
+        res = minimize(lambda v: -np.sum(np.log(v)), np.array(start), method="SLSQP", jac=lambda v: -1.0 / v,
+                       constraints=[{"type": "ineq", "fun": lambda v: np.array(
+                           [1.0 - (s * v * scale) @ S @ (s * v * scale) / eps ** 2 for S in mats for s in pats])}],
+                       bounds=[(1e-9, None)] * 2, options={"ftol": 1e-14, "maxiter": 1000})
+        if res.success and (best is None or res.fun < best.fun):
+            best = res
+    assert best is not None
+    return best.x * scale
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.tuples(st.floats(0.05, 5.0), st.floats(0.05, 5.0), st.floats(-0.95, 0.95)), min_size=1, max_size=5),
+       st.floats(1e-3, 0.1))
+def test_largest_two_length_box_against_slsqp_and_a_scan(consts, eps):
+    """Per-point constraints with any S11, S22 and correlation (not only a 2R arm's unit columns, where
+    the closed form is already the optimum): the tool's box is on the bound, its volume is SLSQP's
+    (the oracle) to 1e-7 and at least a dense scan of the ratio u2/u1 (so no better box exists)."""
+    blocks = []
+    for s11, s22, rho in consts:   # J = L^T with S = J^T J = [[s11, c], [c, s22]]
+        c = rho * math.sqrt(s11 * s22)
+        L = np.linalg.cholesky(np.array([[s11, c], [c, s22]]))
+        blocks.append(L.T)
+    blocks = np.array(blocks)
+    mats = [b.T @ b for b in blocks]
+    u = tolerance_box(blocks, eps, "per_point")["u"]
+    worst = max((s * u) @ S @ (s * u) for S in mats for s in np.array([[1.0, 1.0], [1.0, -1.0]]))
+    assert math.sqrt(worst) == pytest.approx(eps, rel=1e-12)
+    ref = _slsqp_box(mats, eps)
+    assert u[0] * u[1] >= ref[0] * ref[1] * (1 - 1e-7)
+    r = np.geomspace(1e-4, 1e4, 200_001)
+    q = np.max([S[0, 0] + 2 * abs(S[0, 1]) * r + S[1, 1] * r * r for S in mats], axis=0)
+    assert u[0] * u[1] >= eps ** 2 * (r / q).max() * (1 - 1e-12)
+
+
+def test_crossing_constraints_beat_the_closed_form():
+    """Two constraints whose single optima each break the other: the largest box lies where they
+    cross, above the closed form's scaled-down box (worked by hand: S_a = diag(1, 4), S_b = diag(4, 1);
+    by symmetry r = 1 and u1 = u2 = eps/sqrt(5), volume eps^2/5; the closed form takes S_a's own optimum
+    (eps/sqrt2, eps/sqrt8), which S_b's corner (17/8 eps^2) scales by sqrt(8/17): volume 2 eps^2/17)."""
+    blocks = np.array([np.diag([1.0, 2.0]), np.diag([2.0, 1.0])])
+    box = tolerance_box(blocks, 0.01, "per_point")
+    np.testing.assert_allclose(box["u"], [0.01 / math.sqrt(5)] * 2, rtol=1e-14)
+    assert np.prod(box["closed"]) == pytest.approx(2 * 0.01 ** 2 / 17, rel=1e-12)
 
 
 def test_tolerance_box_three_variables():

@@ -11,7 +11,8 @@ From a workspace given as points P_i (base A at the origin) the study computes
   (Tables 4.5-4.7) and along C_rob (Table 4.8; rows where the target is out of reach blank,
   with a note);
 * tolerance synthesis: the largest box l +- dl whose positioning error stays within a bound
-  (Caro's formulation, closed form and a corner-constrained SLSQP), checked by Monte Carlo.
+  (Caro's formulation, closed form and the exact largest box over every corner constraint),
+  checked by Monte Carlo.
 
 ``mode = 'report'`` applies the report's conventions (docs/manipulator.md sec. 0):
 C_rob radius rounded to 3 dp, C = radius^2 for Table 4.2 and round(radius^2, 2) for Table 4.8,

@@ -12,7 +12,6 @@ from decimal import ROUND_HALF_UP, Decimal
 from typing import Any
 
 import numpy as np
-from scipy.optimize import minimize
 
 from driver._deck import Params
 from driver.manipulator import _kernel as kernel
@@ -171,13 +170,49 @@ def _corner_patterns(l: int) -> np.ndarray:
     return np.array([(1.0,) + s for s in itertools.product((1.0, -1.0), repeat=l - 1)])
 
 
+def _largest_box_two(mats: list[np.ndarray], eps: float) -> np.ndarray:
+    """The largest box (u1, u2) of two half-widths inside every constraint, exactly.
+
+    Each constraint's worst corner is s = (1, sign S12): S11 u1^2 + 2|S12| u1 u2 + S22 u2^2 <= eps^2.
+    With r = u2 / u1 the largest u1^2 is eps^2 / max_S q_S(r), q_S(r) = S11 + 2|S12| r + S22 r^2,
+    and the volume u1 u2 = eps^2 min_S r / q_S(r).  Each r / q_S(r) rises to its peak at
+    r = sqrt(S11 / S22) and falls after it, so their minimum peaks either at one of those points or
+    where two constraints cross (q_a(r) = q_b(r), a quadratic in r): every such r is tried and the
+    largest volume kept.  No iteration, no tolerance, no dependence on the BLAS kernel.
+    """
+    a = np.array([S[0, 0] for S in mats], float)
+    b = np.array([2.0 * abs(S[0, 1]) for S in mats], float)
+    c = np.array([S[1, 1] for S in mats], float)
+    if not ((a > 0).all() and (c > 0).all()):
+        raise ValueError("a link length that moves no point: its tolerance is unbounded")
+    cand = list(np.sqrt(a / c))
+    for i, j in itertools.combinations(range(len(mats)), 2):
+        qa, qb, qc = c[i] - c[j], b[i] - b[j], a[i] - a[j]        # qa r^2 + qb r + qc = 0
+        if qa == 0.0:
+            if qb != 0.0:
+                cand.append(-qc / qb)
+            continue
+        disc = qb * qb - 4.0 * qa * qc
+        if disc < 0.0:
+            continue
+        w = -0.5 * (qb + math.copysign(math.sqrt(disc), qb))    # the two roots without cancellation
+        cand += [w / qa] + ([qc / w] if w != 0.0 else [])
+    r = np.array([x for x in cand if x > 0.0 and math.isfinite(x)])
+    q = (a[:, None] + b[:, None] * r + c[:, None] * r * r).max(axis=0)
+    k = int(np.argmax(r / q))
+    u1 = eps / math.sqrt(float(q[k]))
+    return np.array([u1, float(r[k]) * u1])
+
+
 def tolerance_box(blocks: np.ndarray, eps: float, measure: str = "global") -> dict[str, Any]:
     """Find the largest tolerance box on the link lengths (Caro 2005, eq. 2.45).
 
     Feasible region: ||J_x du||_2 <= eps (``global``, J_x = blocks stacked) or
     max_i ||J_xi du||_2 <= eps (``per_point``), for every corner du = s * u of the box.
-    Maximises prod u_i with SLSQP over all 2^(l-1) corner patterns; for l = 2 the closed form
-    u_i = eps / sqrt(2 S_ii (1 + |rho|)) of the binding corner is returned alongside.
+    Maximises prod u_i over all 2^(l-1) corner patterns: for l = 2 (the 2R arm) exactly, by
+    trying every ratio u2/u1 at which the optimum can lie (`_largest_box_two`), and alongside
+    the closed form u_i = eps / sqrt(2 S_ii (1 + |rho|)) of the binding corner; for l > 2 by
+    SLSQP (scipy, imported only then).
 
     Parameters
     ----------
@@ -192,8 +227,8 @@ def tolerance_box(blocks: np.ndarray, eps: float, measure: str = "global") -> di
     Returns
     -------
     dict
-        ``u`` the SLSQP half-widths of the box (m), ``closed`` the closed form for l = 2 (m;
-        else None), ``converged`` and ``message``.
+        ``u`` the half-widths of the largest box (m), ``closed`` the closed form for l = 2 (m;
+        else None), ``converged`` (True for l = 2) and ``message``.
     """
     k, _, l = blocks.shape
     pats = _corner_patterns(l)
@@ -203,7 +238,6 @@ def tolerance_box(blocks: np.ndarray, eps: float, measure: str = "global") -> di
     def worst(u: np.ndarray) -> np.ndarray:
         return np.array([(s * u) @ S @ (s * u) for S in mats for s in pats])
 
-    closed = None
     if l == 2:
         cand = []
         for S in mats:
@@ -212,6 +246,10 @@ def tolerance_box(blocks: np.ndarray, eps: float, measure: str = "global") -> di
         # with several constraints (per point) the symmetric S_ii = 1 case keeps u1 = u2
         closed = min(cand, key=lambda u: float(np.prod(u)))
         closed = closed * min(1.0, eps / math.sqrt(worst(closed).max()))
+        return {"u": _largest_box_two(mats, eps), "closed": closed, "converged": True,
+                "message": "every ratio at which the largest box can lie was tried"}
+    from scipy.optimize import minimize  # l > 2 only: a 2R arm's run imports no scipy
+
     scale = eps / math.sqrt(max(m.trace() for m in mats))     # work with v = u / scale ~ 1
 
     def neg_log_volume(v: np.ndarray) -> float:
@@ -228,7 +266,7 @@ def tolerance_box(blocks: np.ndarray, eps: float, measure: str = "global") -> di
                    constraints=[{"type": "ineq", "fun": inside}],
                    bounds=[(1e-9, None)] * l, options={"ftol": 1e-13, "maxiter": 500})
     res.x = res.x * scale
-    return {"u": np.asarray(res.x), "closed": closed, "converged": bool(res.success),
+    return {"u": np.asarray(res.x), "closed": None, "converged": bool(res.success),
             "message": str(res.message)}
 
 

@@ -189,8 +189,8 @@ def run(params: Params, progress: bool = False) -> Result:
         if rec["reason"]:
             warnings.append(f"design {rec['name']}: {rec['reason']}")
             continue
-        if not rec["converged"] or abs(rec["slsqp_dl1"] * rec["slsqp_dl2"] / (rec["dl1"] * rec["dl2"]) - 1) > 1e-6:
-            warnings.append(f"design {rec['name']}: SLSQP box ({rec['slsqp_dl1']:.6g}, {rec['slsqp_dl2']:.6g}) "
+        if not rec["converged"] or abs(rec["opt_dl1"] * rec["opt_dl2"] / (rec["dl1"] * rec["dl2"]) - 1) > 1e-6:
+            warnings.append(f"design {rec['name']}: largest box ({rec['opt_dl1']:.6g}, {rec['opt_dl2']:.6g}) "
                             f"does not match the closed form ({rec['dl1']:.6g}, {rec['dl2']:.6g})")
     lines = _header(p, ws, conv)
     for t in tables:
