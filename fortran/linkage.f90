@@ -1554,8 +1554,9 @@ contains
   !>   per slide: minimum, maximum, peak rate, peak acceleration
   !>   per dyad: smallest and largest transmission or pressure angle [rad]
   !> Extremes of the output are refined between scan points on the quintic Hermite model
-  !> (position and its first and second derivatives at both ends); peaks of the other quantities by the parabola
-  !> through three scan points.  Figures that need the whole cycle assembled (stroke, time
+  !> (position and its first and second derivatives at both ends); peak rates (omega, slide rate)
+  !> on the cubic Hermite model (the rate and its derivative, from the acceleration); peaks of the
+  !> other quantities by the parabola through three scan points.  Figures that need the whole cycle assembled (stroke, time
   !> ratio, torque mean, energy) are 0 unless it is.
   subroutine summaries(nds, nr, prm, nl, np, ng, nd, ns, nld, nt, idrv, ipts, igd, idy, ild, ift, nscan, &
                        periodic, iout, want, passes, ncol, res)
@@ -1694,10 +1695,12 @@ contains
     end subroutine quality_pass
 
     !> Each link's peak omega and alpha, each slide's range and peak rate and acceleration.
+    !> The rates' peaks are refined on the cubic Hermite model (each rate and its derivative
+    !> over the input, from the acceleration); the accelerations' by the parabola.
     subroutine peaks_pass()
       do l = 2, nl
         j = nsum_head + nsum_link*(l - 2)
-        row(j + 1) = peak(n, lk(:, 2, l), okrow, periodic == 1)
+        row(j + 1) = rate_peak(n, lk(:, 2, l), lk(:, 3, l), rdrv(2), rdrv(3), okrow, periodic == 1, h)
         row(j + 2) = peak(n, lk(:, 3, l), okrow, periodic == 1)
       end do
       do l = 1, ns
@@ -1706,7 +1709,7 @@ contains
           row(j + 1) = minval(sk(:, 1, l))
           row(j + 2) = maxval(sk(:, 1, l))
         end if
-        row(j + 3) = peak(n, sk(:, 2, l), okrow, periodic == 1)
+        row(j + 3) = rate_peak(n, sk(:, 2, l), sk(:, 3, l), rdrv(2), rdrv(3), okrow, periodic == 1, h)
         row(j + 4) = peak(n, sk(:, 3, l), okrow, periodic == 1)
       end do
     end subroutine peaks_pass
@@ -1898,6 +1901,70 @@ contains
     real(dp) :: at
     call peak_at(n, v, okv, per, 1.0_dp, 0.0_dp, peak, at)
   end function peak
+
+  !> The value of a rate v (a link's omega or a slide's rate) largest in size (signed) over the
+  !> rows okv, refined on the cubic Hermite model of the two scan intervals (step h) beside the
+  !> largest scan value where the rate's derivative over the input changes sign.  That derivative
+  !> comes from the acceleration a: v = g' w and a = g'' w^2 + g' al (w, al: the driver's rate
+  !> and acceleration), so dv/dx = g'' w = (a - v al / w) / w (no refinement when w = 0: every
+  !> rate is 0).
+  real(dp) function rate_peak(n, v, a, w0, al0, okv, per, h)
+    integer, intent(in) :: n
+    real(dp), intent(in) :: v(n), a(n), w0, al0, h
+    logical, intent(in) :: okv(n), per
+    real(dp) :: w(n), sgn, e, d0, d1
+    integer :: k, k0, k1, side
+    rate_peak = 0.0_dp
+    if (.not. any(okv)) return
+    w = abs(v)
+    ! the first of the largest within rounding, as peak_at
+    k = findloc(okv .and. w >= maxval(w, mask=okv)*(1.0_dp - tie_rel), .true., 1)
+    rate_peak = v(k)
+    sgn = sign(1.0_dp, v(k))
+    if (w0 == 0.0_dp) return
+    do side = -1, 0
+      k0 = k + side
+      k1 = k0 + 1
+      if (per) then
+        if (k0 < 1) k0 = n
+        if (k1 > n) k1 = 1
+      end if
+      if (k0 < 1 .or. k1 > n) cycle
+      if (.not. (okv(k0) .and. okv(k1))) cycle
+      d0 = (a(k0) - v(k0)*(al0/w0))/w0
+      d1 = (a(k1) - v(k1)*(al0/w0))/w0
+      if (.not. (d0*d1 < 0.0_dp)) cycle
+      e = cubic_extremum(v(k0), v(k1), d0*h, d1*h)
+      if (sgn*e > sgn*rate_peak) rate_peak = e
+    end do
+  end function rate_peak
+
+  !> The extremum of the cubic Hermite interpolant on [0, 1] with end values y0, y1 and first
+  !> derivatives d0, d1 (per unit of the interval) of opposite signs: its slope, a quadratic,
+  !> has exactly one zero in (0, 1), taken in closed form (the root formula without cancellation).
+  pure real(dp) function cubic_extremum(y0, y1, d0, d1) result(v)
+    real(dp), intent(in) :: y0, y1, d0, d1
+    real(dp) :: c2, c1, q, t, ta, tb
+    ! p'(t) = c2 t^2 + c1 t + d0
+    c2 = 6.0_dp*(y0 - y1) + 3.0_dp*(d0 + d1)
+    c1 = -6.0_dp*(y0 - y1) - 4.0_dp*d0 - 2.0_dp*d1
+    if (c2 == 0.0_dp) then
+      t = -d0/c1
+    else
+      q = -0.5_dp*(c1 + sign(sqrt(max(c1*c1 - 4.0_dp*c2*d0, 0.0_dp)), c1))
+      ta = q/c2
+      tb = d0/q
+      ! the zero inside the interval (the other, if real, lies outside)
+      if (abs(ta - 0.5_dp) <= abs(tb - 0.5_dp)) then
+        t = ta
+      else
+        t = tb
+      end if
+    end if
+    t = min(max(t, 0.0_dp), 1.0_dp)
+    v = (2.0_dp*t**3 - 3.0_dp*t**2 + 1.0_dp)*y0 + (t**3 - 2.0_dp*t**2 + t)*d0 + (3.0_dp*t**2 - 2.0_dp*t**3)*y1 &
+        + (t**3 - t**2)*d1
+  end function cubic_extremum
 
   !> peak with the input at which it occurs (scan step h from x0).
   subroutine peak_at(n, v, okv, per, h, x0, val, at)

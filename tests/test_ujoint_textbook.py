@@ -113,6 +113,32 @@ def test_the_origin_is_where_textbooks_put_it(beta_deg):
             assert words in res.figure(name).axes[0].get_xlabel()
 
 
+def test_input_torque_figure_by_power_balance():
+    """With a load the run draws the input torque over a turn: its curve is the power balance
+    written here (T_in = (J w^2 R' + T_L) R, from the plane: R = c / (1 - s2 cos^2 t)), the load
+    torque is the drawn mean, and the marked peaks reach the curve's largest magnitude; without a
+    load there is no such figure."""
+    pytest.importorskip("matplotlib")
+    beta_deg, inertia, load, rpm = 30.0, 0.5, 20.0, 600.0
+    b, w = beta_deg * D, rpm * 2 * math.pi / 60
+    r = driver.ujoint.run(beta=[beta_deg], rpm=rpm, load_inertia=inertia, load_torque=load, angle_origin="plane")
+    (ax,) = r.figure("torque").axes
+    c, s2 = math.cos(b), math.sin(b) ** 2
+    curve = [ln for ln in ax.get_lines() if ln.get_label().startswith("design:")][0]
+    t = np.radians(curve.get_xdata())
+    d = 1 - s2 * np.cos(t) ** 2
+    oracle = (inertia * w * w * (-c * s2 * np.sin(2 * t) / d ** 2) + load) * c / d
+    assert np.allclose(curve.get_ydata(), oracle, rtol=1e-12, atol=1e-12 * (inertia * w * w + load))
+    assert curve.get_xdata()[0] == 0.0 and curve.get_xdata()[-1] == 360.0
+    mean = [ln for ln in ax.get_lines() if ln.get_label().startswith("load torque")][0]
+    assert set(mean.get_ydata()) == {load} and np.mean(oracle[:-1]) == pytest.approx(load, rel=1e-9)
+    marks = [ln for ln in ax.get_lines() if "peak |T_in|" in ln.get_label()][0]
+    assert np.allclose(np.abs(marks.get_ydata()), np.abs(oracle).max(), rtol=1e-5)   # a 0.5 deg grid's max
+    assert np.all(np.abs(marks.get_ydata()) >= np.abs(oracle).max() * (1 - 1e-12))    # the roots reach above it
+    assert "from joint 1's plane" in ax.get_xlabel()
+    assert "torque" not in {f.name for f in driver.ujoint.run(beta=[beta_deg], rpm=rpm).figures}
+
+
 def test_tidy_grid_chooses_the_tidy_tables_angles():
     r = driver.ujoint.run(beta=[20.0, 10.0], phi=[60.0], n_grid=72, table_step=15.0)
     assert len(r.tidy) == 72 and "at the 72 grid angles (tidy_grid = 'n_grid')" in r.out

@@ -16,8 +16,8 @@ import numpy as np
 from driver._deck import Params
 from driver.manipulator import _kernel as kernel
 
-__all__ = ["STATUS", "SIGNIFICANT", "DESIGN_STATUS", "round_half_up", "Workspace", "Conv", "optima", "tolerance_box",
-           "design_status", "workspace_columns", "sweep_columns", "design_torque_columns"]
+__all__ = ["STATUS", "SIGNIFICANT", "DESIGN_STATUS", "round_half_up", "percentile", "Workspace", "Conv", "optima",
+           "tolerance_box", "design_status", "workspace_columns", "sweep_columns", "design_torque_columns"]
 
 STATUS = kernel.MANIPULATOR_STATUS
 #: significant digits of every number column outside report mode (the report's fixed decimals
@@ -268,6 +268,35 @@ def tolerance_box(blocks: np.ndarray, eps: float, measure: str = "global") -> di
     res.x = res.x * scale
     return {"u": np.asarray(res.x), "closed": None, "converged": bool(res.success),
             "message": str(res.message)}
+
+
+def percentile(values: np.ndarray, q: float) -> float:
+    """The q-th percentile of ``values`` as numpy's default ('linear') method gives it, bit for bit.
+
+    ``np.percentile`` partitions around ``np.unique`` of its indices, whose first call imports
+    ``numpy.ma`` (about 12 ms, 8 % of a manipulator case's start-up); two partition points and
+    numpy's own interpolation formula give the same double.
+
+    Parameters
+    ----------
+    values : numpy.ndarray
+        One-dimensional, finite, at least one value.
+    q : float
+        Percentile, 0 <= q <= 100.
+
+    Returns
+    -------
+    float
+        The percentile, in the units of ``values``.
+    """
+    n = values.size
+    v = (n - 1) * (q / 100.0)                # numpy's virtual index of the 'linear' method
+    i = min(max(int(math.floor(v)), 0), n - 1)
+    j = min(i + 1, n - 1)
+    s = np.partition(values, (i, j)) if j != i else np.partition(values, i)
+    a, b, g = float(s[i]), float(s[j]), v - i
+    diff = b - a                              # numpy's _lerp: from the nearer end
+    return a + diff * g if g < 0.5 else b - diff * (1.0 - g)
 
 
 def sensitivity_blocks(th1: np.ndarray, th2: np.ndarray) -> np.ndarray:

@@ -18,6 +18,7 @@ from driver.manipulator._analysis import (
     design_angles,
     design_list,
     optima,
+    percentile,
     round_half_up,
     sensitivity_blocks,
     sweep_l1_values,
@@ -290,7 +291,7 @@ def tolerance_table(p: Params, ws: Workspace, names: list[str], l1: np.ndarray, 
         rec = {"name": name, "l1": float(l1[i]), "l2": float(l2[i]), "ri2": ri2, "dl1": float(dl[0]),
                "dl2": float(dl[1]), "opt_dl1": float(box["u"][0]), "opt_dl2": float(box["u"][1]),
                "converged": box["converged"], "worst_corner": float(worst), "mc_max": float(err.max()),
-               "mc_p99": float(np.percentile(err, 99.0)), "reason": ""}
+               "mc_p99": percentile(err, 99.0), "reason": ""}
         out.append(rec)
         trailers.append("")
         rows.append([name, rec["l1"], rec["l2"], ri2, rec["dl1"], rec["dl2"], rec["opt_dl1"], rec["opt_dl2"],

@@ -35,7 +35,7 @@ from driver.sweep._chunks import BatchPlan, CaseTask
 from driver.sweep._keep import check_keep, keep_columns
 from driver.sweep._report import summary_settings
 from driver.sweep._resume import Layout, case_signature, layout_for, signature
-from driver.sweep._spec import MAX_CASES, SPEC, Grid, deck_key, grid_of, set_swept, split_key, validate_sweep
+from driver.sweep._spec import MAX_CASES, SPEC, Grid, checked_key, deck_key, grid_of, set_swept, split_key, validate_sweep
 
 __all__ = ["SweepPlan", "plan_sweep", "chunk_size", "batchable", "batch_plan", "batch_signature", "wanted_columns",
            "BATCH_MAX_CASES", "MAX_CHUNKS", "SMALL_SWEEP", "CHUNK", "MIN_CHUNKS"]
@@ -150,7 +150,8 @@ def plan_sweep(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, *
     grid = grid_of(sw, base.group, module.spec)
     may_batch = batchable(module, grid.names, sw.keep, sw.case_outputs)
     _refuse_size(sw, grid, BATCH_MAX_CASES if may_batch else MAX_CASES)
-    estimates = validate_sweep(sw, raw, module, grid)
+    checked: set[tuple] = set()   # the values validate_sweep found good: batch_plan does not check them again
+    estimates = validate_sweep(sw, raw, module, grid, checked)
     plotted = [v for v in [sw.plot_x, *sw.plot_y] if v]
     shown = _check_columns(sw, module, base, grid, plotted)
     # every name the sweep gives its files and folders, known before it runs (the longest counts)
@@ -161,8 +162,8 @@ def plan_sweep(deck: Deck, outdir: Path, formats: list[str], plot: bool | str, *
     cases = CaseTask(str(deck.path), raw, grid, layout, sw.keep, sw.case_outputs, formats, case_plot, _base_hash(raw),
                      case_signature(raw, grid.names, str(deck.path), sw.keep, sw.case_outputs, formats, case_plot,
                                     module))
-    bplan = batch_plan(module, raw, str(deck.path), grid, sw.keep, sw.summary_rows, plotted, shown) if may_batch \
-        else None
+    bplan = batch_plan(module, raw, str(deck.path), grid, sw.keep, sw.summary_rows, plotted, shown,
+                       checked) if may_batch else None
     if bplan is None:
         _refuse_size(sw, grid, MAX_CASES)
     settings = summary_settings(module, base, {name.partition(".")[2] for name in grid.names})
@@ -274,9 +275,15 @@ def _swap(raw: RawGroup, values: dict[str, Any]) -> RawGroup:
 
 
 def batch_plan(module: Any, raw: RawGroup, deck_path: str, grid: Grid, keep: str, rows: str,
-               plotted: list[str] | None = None, shown: list[str] | None = None) -> BatchPlan | None:
+               plotted: list[str] | None = None, shown: list[str] | None = None,
+               checked: set[tuple] | None = None) -> BatchPlan | None:
     """The batch chunk's work for this sweep (see :func:`batchable`), or None when it must run
-    case by case.  ``plotted``: the plot_x/plot_y expressions; ``shown``: summary_columns (None: all)."""
+    case by case.  ``plotted``: the plot_x/plot_y expressions; ``shown``: summary_columns (None: all).
+    Each value of an independent axis and each combination of the coupled axes' values is
+    validated; bad ones become bad-input rows.  ``checked``: the keys
+    (:func:`driver.sweep._spec.checked_key`) of the values validate_sweep already found good,
+    not validated again (each costs a deck validation: 2 000 of them on a 1000 x 1000 sweep)."""
+    done = checked or set()
     applies = module.batch.applies   # e.g. not for a base deck that optimises per case
     if applies is not None and not applies(validate(raw, module.spec, deck_path)):
         return None
@@ -289,6 +296,8 @@ def batch_plan(module: Any, raw: RawGroup, deck_path: str, grid: Grid, keep: str
             continue
         errs = {}
         for j, v in enumerate(vals):
+            if checked_key({name: v}) in done:
+                continue
             try:
                 validate(_swap(raw, {name: v}), module.spec, deck_path)
             except DeckError as exc:
@@ -306,6 +315,8 @@ def batch_plan(module: Any, raw: RawGroup, deck_path: str, grid: Grid, keep: str
             return None
         for combo in dict.fromkeys(combos):
             combo_values = {grid.names[i]: grid.values[i][j] for i, j in zip(coupled, combo)}
+            if checked_key(combo_values) in done:
+                continue
             try:
                 validate(_swap(raw, combo_values), module.spec, deck_path)
             except DeckError as exc:

@@ -20,7 +20,7 @@ from driver._deck import DeckError, GroupSpec, Key, Params, RawGroup, shown_valu
 from driver._outcome import ExitCode
 
 __all__ = ["SPEC", "Case", "CaseResult", "MAX_KEYS", "MAX_CASES", "FULL_VALIDATION", "build_cases", "grid_of", "case_at",
-           "iter_cases", "case_count", "validate_sweep", "split_key", "deck_key", "set_swept"]
+           "iter_cases", "case_count", "validate_sweep", "checked_key", "split_key", "deck_key", "set_swept"]
 
 MAX_KEYS = 9
 #: most cases one per-case sweep deck may have (a batch sweep lists no case: driver.sweep._plan.BATCH_MAX_CASES)
@@ -370,7 +370,8 @@ def _axis_line(sw: Params, name: str) -> tuple[str, int]:
     return "key1", sw.line_of("key1")
 
 
-def validate_sweep(sw: Params, raw: RawGroup, module: Any, grid: Grid) -> dict[int, float]:
+def validate_sweep(sw: Params, raw: RawGroup, module: Any, grid: Grid,
+                   checked: set[tuple] | None = None) -> dict[int, float]:
     """Refuse the whole sweep (DeckError naming the sweep line and key) before anything runs
     when a case would be bad input.
 
@@ -381,10 +382,16 @@ def validate_sweep(sw: Params, raw: RawGroup, module: Any, grid: Grid) -> dict[i
     angle past a stop angle) is found in the inner cases too, not only at the grid's corners.
 
     Returns {case: estimated seconds of work} (driver._limits) when every case was validated
-    and the study estimates its work (the engine runs the longest cases first), else {}."""
+    and the study estimates its work (the engine runs the longest cases first), else {}.
+    ``checked``, when given, receives the :func:`checked_key` of every set of values found
+    good here, so that the batch path's own check (driver.sweep._plan.batch_plan) does not
+    validate them a second time."""
     def check(values: dict[str, Any], case_no: int | None) -> limits.Estimate | None:
         try:
-            return limits.check(module, validate(case_raw(raw, Case(0, values)), module.spec, sw.path), "each case ")
+            est = limits.check(module, validate(case_raw(raw, Case(0, values)), module.spec, sw.path), "each case ")
+            if checked is not None:
+                checked.add(checked_key(values))
+            return est
         except DeckError as exc:
             name = next((n for n in values if deck_key(n) == exc.key), next(iter(values)))
             key, line = _axis_line(sw, name)
@@ -407,6 +414,12 @@ def validate_sweep(sw: Params, raw: RawGroup, module: Any, grid: Grid) -> dict[i
     for combo in _coupled_combinations(sw, module, grid, axis_values):
         check(combo, None)
     return {}
+
+
+def checked_key(values: dict[str, Any]) -> tuple:
+    """The key of a set of swept values (name -> value, in order) that :func:`validate_sweep`
+    found good: the names and the values' reprs (as the sweep tells equal values apart)."""
+    return tuple((n, repr(v)) for n, v in values.items())
 
 
 def _unique(values: Iterable[Any]) -> list[Any]:

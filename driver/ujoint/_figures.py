@@ -1,5 +1,5 @@
 """The Hooke-joint figures: output speed of every design against the input angle (Cartesian or
-polar), the paper's band shaded.
+polar), the paper's band shaded; with a load on the output shaft, the input torque over a turn.
 
 Drawn in the house style (:mod:`driver.plotting`); this module imports matplotlib (the optional
 [plot] extra), so the study imports it only when a figure is drawn.
@@ -15,7 +15,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from driver.plotting import new_figure, plain_text, styled, suptitle
-from driver.ujoint._analysis import Chain, Design, output_speed, textbook
+from driver.ujoint._analysis import Chain, Design, input_torque, output_speed, textbook
 
 #: line styles of the Hooke-joint designs, by the label driver.ujoint gives them
 _UJOINT_STYLES = {"trial": dict(color="C1", lw=1.4), "design": dict(color="C1", lw=1.4),
@@ -99,3 +99,57 @@ def speed_figure(chain: Chain, designs: list[Design], polar: bool, band: list[fl
     ones = {d.label: textbook(chain, d).ratio_one for d in designs if d.label != "paper printed"}
     return ujoint_speed_figure(theta, chain.rpm, curves, polar=polar, band=band, title=title, origin=origin,
                                ratio_one=ones)
+
+
+@styled
+def ujoint_torque_figure(theta_deg: np.ndarray, curves: dict[str, np.ndarray], load_torque: float,
+                         peaks: dict[str, tuple[np.ndarray, np.ndarray]] | None = None, title: str = "",
+                         ax=None, origin: str = "theta from the normal to joint 1's plane",
+                         load_text: str = "") -> Figure:
+    """Input-shaft torque [N m] against the input angle [deg] of every design: what the input
+    must supply to turn the output shaft's inertia and load at constant input speed.
+
+    ``curves`` maps a design's label to its torque at ``theta_deg``; the load torque
+    ``load_torque`` [N m] is drawn as the level the torque averages to over a turn (the input's
+    mean power is the load's); ``peaks`` maps a label to the input angles [deg] and signed values
+    [N m] of its peak magnitude (root-found, marked); ``load_text`` names the load in the title."""
+    if ax is not None:
+        fig = ax.figure
+    else:
+        fig, (ax,) = new_figure(1, 1, figsize=(7.4, 4.0))
+    for k, (label, t) in enumerate(curves.items()):
+        style = _UJOINT_STYLES.get(label, dict(color=f"C{k + 4}", lw=1.4))
+        ax.plot(theta_deg, t, label=f"{label}: {np.min(t):.4g} to {np.max(t):.4g} N m, mean {np.mean(t[:-1]):.4g}",
+                **style)
+        at, value = (peaks or {}).get(label, (np.empty(0), np.empty(0)))
+        if len(at):
+            ax.plot(at, value, "o", ms=5, mfc="none", mec=style.get("color", "k"), zorder=4,
+                    label=f"{label}: peak |T_in| {np.max(np.abs(value)):.4g} N m at {', '.join(f'{a:.1f}' for a in at)} deg")
+    ax.axhline(load_torque, color="k", ls="--", lw=1.1, zorder=5,
+               label=f"load torque {load_torque:g} N m (the mean input torque over a turn)")
+    ax.set_xlim(0.0, 360.0)
+    ax.set_xticks(np.arange(0, 361, 45))
+    ax.set_xlabel(f"input angle [deg, {origin}]")
+    ax.set_ylabel("input torque T_in [N m]")
+    fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncol=1, frameon=False, fontsize=8)
+    what = f"Hooke-joint chain, input torque at constant input speed{': ' + load_text if load_text else ''}"
+    suptitle(fig, f"{plain_text(title)}: {what}" if title else what)
+    return fig
+
+
+def torque_figure(chain: Chain, designs: list[Design], title: str = "",
+                  origin: str = "theta from the normal to joint 1's plane"):
+    """The input-torque figure of a chain with an output load (``chain.load``): every design's
+    input torque over a turn (0.5 deg apart), its root-found peak marked, the load torque drawn."""
+    assert chain.load is not None
+    theta = np.arange(0.0, 360.0 + 1e-9, 0.5)
+    curves = {d.label: input_torque(chain, d, theta) for d in designs}
+    peaks = {}
+    for d in designs:
+        tb = textbook(chain, d)
+        # a torque constant over the turn peaks everywhere: nothing to mark
+        if tb.torque_peak is not None and 0 < len(tb.torque_peak_at) <= 8:
+            peaks[d.label] = (np.asarray(tb.torque_peak_at, float), np.asarray(tb.torque_peak_signed, float))
+    inertia, load = chain.load
+    return ujoint_torque_figure(theta, curves, load, peaks=peaks, title=title, origin=origin,
+                                load_text=f"output inertia {inertia:g} kg m^2, load {load:g} N m, {chain.rpm:g} rpm")

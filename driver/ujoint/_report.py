@@ -490,6 +490,8 @@ def run(params: Params, progress: bool = False) -> Result:
     origin = ORIGINS[params.angle_origin][1]
     figures = [Figure("speed", lambda: _figures().speed_figure(chain, designs, False, params.paper_band, title, origin)),
                Figure("polar", lambda: _figures().speed_figure(chain, designs, True, params.paper_band, title, origin))]
+    if chain.load is not None:
+        figures.append(Figure("torque", lambda: _figures().torque_figure(chain, designs, title, origin)))
     return Result(text=text, tidy=tidy, summary=summary, warnings=warnings, failure=failure,
                   figures=figures, extra=extra)
 
