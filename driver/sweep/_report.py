@@ -494,7 +494,8 @@ class _StreamedTable:
             rows = 0
             for k, path in enumerate(self.paths):
                 # (ParquetFile: the file alone, none of read_table's dataset layer; one thread for a part)
-                table = pq.ParquetFile(path).read(use_threads=False).replace_schema_metadata(schema.metadata)
+                with pq.ParquetFile(path) as part:
+                    table = part.read(use_threads=False).replace_schema_metadata(schema.metadata)
                 writer.write_table(table)
                 if k == 0:   # the columns' kinds and widths from the first part's rows, as ever
                     self._start(_frame(table, self.origins))
