@@ -65,6 +65,7 @@ def test_manipulator_case_without_the_heavy_packages(tmp_path, deck):
     assert (tmp_path / out).read_bytes() == (ROOT / "outputs" / out).read_bytes()
     assert not tops(modules) & {*HEAVY, "tqdm"}
     assert "numpy.ma" not in modules          # np.percentile's np.unique imports it (12 ms)
+    assert "driver._mechanism" not in modules  # the report page's animation only
 
 
 def test_modules_after_a_four_bar_run(tmp_path):

@@ -9,7 +9,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from driver._deck import Params
-from driver._mechanism import Link, MechanismFrames
 from driver._result import Figure, Result, Tidy
 from driver._runner import study_run
 from driver._table import fortran_f
@@ -33,6 +32,8 @@ from driver.manipulator._tables import TIDY_NAMES, Table, mode_differences, repo
 
 if TYPE_CHECKING:   # annotations only: pandas is imported when a table is built
     import pandas as pd
+
+    from driver._mechanism import MechanismFrames
 
 __all__ = ["run", "TIDY_UNITS", "table_frame", "animation_frames"]
 
@@ -287,6 +288,7 @@ def animation_frames(params: Params, result: Result | None = None, n: int = 180)
     kinematics (:func:`~driver.manipulator.kernel.manipulator_ik`, the deck's elbow branch) at
     each point, moving linearly in joint space from one point to the next; a design that cannot
     reach a point is not drawn there.  The designs are the deck's, else the optima on C_rob."""
+    from driver._mechanism import Link, MechanismFrames  # the page's animation only
     ws = Workspace(np.array(params.points_x, float), np.array(params.points_y, float))
     names_d, l1s, l2s = design_list(params, Conv(params.mode == "report", ws))
     m = ws.n
