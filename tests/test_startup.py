@@ -66,6 +66,7 @@ def test_manipulator_case_without_the_heavy_packages(tmp_path, deck):
     assert not tops(modules) & {*HEAVY, "tqdm"}
     assert "numpy.ma" not in modules          # np.percentile's np.unique imports it (12 ms)
     assert "driver._mechanism" not in modules  # the report page's animation only
+    assert "driver._published" not in modules  # the published-record reader: --compare only
 
 
 def test_modules_after_a_four_bar_run(tmp_path):

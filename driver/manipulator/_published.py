@@ -1,18 +1,22 @@
 """The manipulator run beside the published tables of [Ma'arif 2006], chapter 4."""
 from __future__ import annotations
 
-from driver import _published as record
+from typing import TYPE_CHECKING
+
 from driver._deck import Params
-from driver._published import numeric_cell
-from driver._result import Result
 from driver.manipulator._report import table_frame
 from driver.manipulator._tables import NOT_REPRODUCIBLE, REASONS, TEXT_REASONS, TIDY_NAMES
+
+if TYPE_CHECKING:
+    from driver._result import Result
 
 __all__ = ["compare"]
 
 
 def compare(params: Params, result: Result) -> list[dict]:
     """The run beside the report's Tables 4.1-4.8 and text values: one dict per printed cell."""
+    from driver import _published as record  # the comparison's reader: imported when a comparison runs
+    from driver._published import numeric_cell
     exact = params.mode == "exact"
 
     def text_values() -> dict[str, float | None]:
