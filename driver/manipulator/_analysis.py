@@ -180,25 +180,32 @@ def _largest_box_two(mats: list[np.ndarray], eps: float) -> np.ndarray:
     where two constraints cross (q_a(r) = q_b(r), a quadratic in r): every such r is tried and the
     largest volume kept.  No iteration, no tolerance, no dependence on the BLAS kernel.
     """
-    a = np.array([S[0, 0] for S in mats], float)
-    b = np.array([2.0 * abs(S[0, 1]) for S in mats], float)
-    c = np.array([S[1, 1] for S in mats], float)
-    if not ((a > 0).all() and (c > 0).all()):
+    a = [float(S[0, 0]) for S in mats]
+    b = [2.0 * abs(float(S[0, 1])) for S in mats]
+    c = [float(S[1, 1]) for S in mats]
+    if min(a) <= 0.0 or min(c) <= 0.0:
         raise ValueError("a link length that moves no point: its tolerance is unbounded")
-    cand = list(np.sqrt(a / c))
+    peaks = [math.sqrt(ai / ci) for ai, ci in zip(a, c)]
+    # below the smallest peak every bound rises, above the largest every one falls: the optimum
+    # lies between them, and so does every candidate worth trying
+    lo, hi = min(peaks), max(peaks)
+    cand = list(peaks)
     for i, j in itertools.combinations(range(len(mats)), 2):
         qa, qb, qc = c[i] - c[j], b[i] - b[j], a[i] - a[j]        # qa r^2 + qb r + qc = 0
         if qa == 0.0:
-            if qb != 0.0:
+            if qb != 0.0 and abs(qc) <= hi * abs(qb):
                 cand.append(-qc / qb)
             continue
         disc = qb * qb - 4.0 * qa * qc
         if disc < 0.0:
             continue
         w = -0.5 * (qb + math.copysign(math.sqrt(disc), qb))    # the two roots without cancellation
-        cand += [w / qa] + ([qc / w] if w != 0.0 else [])
-    r = np.array([x for x in cand if x > 0.0 and math.isfinite(x)])
-    q = (a[:, None] + b[:, None] * r + c[:, None] * r * r).max(axis=0)
+        if abs(w) <= hi * abs(qa):
+            cand.append(w / qa)
+        if w != 0.0 and abs(qc) <= hi * abs(w):
+            cand.append(qc / w)
+    r = np.array([x for x in cand if lo <= x <= hi])
+    q = (np.array(a)[:, None] + np.array(b)[:, None] * r + np.array(c)[:, None] * r * r).max(axis=0)
     k = int(np.argmax(r / q))
     u1 = eps / math.sqrt(float(q[k]))
     return np.array([u1, float(r[k]) * u1])
