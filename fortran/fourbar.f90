@@ -18,7 +18,7 @@ module fourbar
   private
   public :: listing_table, exact_states, coupler_point
   ! building blocks of the batched summaries (fortran/fourbar_summary.f90); not wrapped by f2py
-  public :: pose_block, rates_block, angles_block
+  public :: pose_block, rates_block, jerks_block, angles_block
 
   !> positions per block of the batched loops (the size of their local arrays)
   integer, parameter, public :: nb = 256
@@ -262,6 +262,35 @@ contains
                    + r(k)*w2*w2 - s(k)*w3*w3*c23(k))/(ok*den3 + (1.0_dp - ok))
     end do
   end subroutine rates_block
+
+  !> Angular jerks j2o, j3o [rad/s^3] of coupler and rocker (the time derivatives of rates_block's
+  !> accelerations; crank speed omega, acceleration alpha1, no crank jerk) from pose_block's and
+  !> rates_block's results; zero unless ok.  The loop closure differentiated once more:
+  !> i r (j2 - w2^3) e2 - i s (j3 - w3^3) e3 = q (i omega^3 + 3 omega alpha1) e1 + 3 r w2 a2 e2
+  !> - 3 s w3 a3 e3 (e1, e2, e3 the unit vectors of crank, coupler, rocker), solved like the
+  !> velocities (the same determinant s23).
+  subroutine jerks_block(m, q, r, s, omega, alpha1, sn, c, e2x, e2y, e3x, e3y, s23, c23, status, &
+                         w2, w3, a2, a3, j2o, j3o)
+    integer, intent(in) :: m
+    real(dp), intent(in) :: q(m), r(m), s(m), omega, alpha1, sn(m), c(m), e2x(m), e2y(m), e3x(m), e3y(m), &
+                            s23(m), c23(m), status(m), w2(m), w3(m), a2(m), a3(m)
+    real(dp), intent(out) :: j2o(m), j3o(m)
+    real(dp) :: ok, sinv, o3, oa, t2, t3
+    integer :: k
+    o3 = omega*omega*omega
+    oa = 3.0_dp*omega*alpha1
+    ! hot-loop: fourbar jerks_block
+    do k = 1, m
+      ok = merge(1.0_dp, 0.0_dp, status(k) == real(st_ok, dp))
+      sinv = ok/(ok*s23(k) + (1.0_dp - ok))
+      t2 = 3.0_dp*r(k)*w2(k)*a2(k)
+      t3 = 3.0_dp*s(k)*w3(k)*a3(k)
+      j2o(k) = ok*((q(k)*(o3*(c(k)*e3y(k) - sn(k)*e3x(k)) + oa*(c(k)*e3x(k) + sn(k)*e3y(k))) + t2*c23(k) - t3) &
+                   /r(k)*sinv + w2(k)*w2(k)*w2(k))
+      j3o(k) = ok*((q(k)*(o3*(c(k)*e2y(k) - sn(k)*e2x(k)) + oa*(c(k)*e2x(k) + sn(k)*e2y(k))) + t2 - t3*c23(k)) &
+                   /s(k)*sinv + w3(k)*w3(k)*w3(k))
+    end do
+  end subroutine jerks_block
 
   !> Rocker angle th3 [rad] from pose_block's results, and with the optional th2, mu the coupler
   !> angle and the transmission angle in [0, pi] (an unplaced row has y = 0 and x = 0 or a unit

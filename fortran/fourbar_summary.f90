@@ -19,15 +19,24 @@
 !> * peak speeds (no toggle in the range): the extremes of omega sit where the angular
 !>   acceleration alpha = d omega / dt vanishes (crank speed constant).  The range is cut into
 !>   a grid of at most 1 deg (as before); a coarse scan evaluates every coarse_every-th grid
-!>   point in one vectorised kernel call, and a coarse interval is refined to the 1 deg grid
-!>   unless, for both speeds, alpha keeps one strict sign at its ends AND the cubic Hermite
-!>   model of omega over it (end values and end slopes alpha) has a slope that stays above
-!>   half the smaller end slope (smooth).  A refined 1 deg interval whose ends agree in sign
-!>   but fail the same test is bisected (to 1/1024 deg) looking for a hidden pair of roots.
-!>   Each sign change of alpha is refined by Illinois regula falsi to 1e-12 rad, all brackets
-!>   of a linkage in one kernel call per iteration.  The coarse test is checked against a
-!>   dense brute-force oracle (tests/test_fourbar_peaks.py); wherever it refines, the
-!>   brackets are those of a plain 1 deg scan, so the figures are bit-identical to it;
+!>   point in one vectorised kernel call.  A coarse interval is taken as it stands when, for
+!>   each speed, either alpha keeps one strict sign at its ends AND the cubic Hermite model of
+!>   omega over it (end values and end slopes alpha) has a slope that stays above half the
+!>   smaller end slope (smooth: no extremum inside), or alpha changes sign at its ends AND the
+!>   model's slope, a quadratic, is monotonic with a margin (|its curvature term| at most half
+!>   the ends' slope difference: one clean crossing, a bracket as it stands).  Any other
+!>   interval is refined to the 1 deg grid; a refined 1 deg interval whose ends agree in sign
+!>   but fail the smooth test is bisected (to 1/1024 deg) looking for a hidden pair of roots.
+!>   Each sign change of alpha is a bracket whose root is found by safeguarded Newton steps
+!>   on alpha (rtsafe: a bisection where a step would leave the bracket or not halve the step
+!>   before last), its derivative the jerk from fourbar::jerks_block, started at the root of
+!>   the Hermite model's slope; a root is taken when the Newton step is at most newton_tol
+!>   (1e-7 rad): the next iterate, within about 1e-14 rad of the root, omega there from the
+!>   Taylor polynomial at the last point.  About two evaluations per root on the shipped search
+!>   (69 per linkage: 61 coarse, 8 Newton), where the previous search (1 deg brackets, Illinois
+!>   regula falsi to 1e-12 rad, a final point) took about 108; the peaks agree with it to
+!>   about 1e-13 relative (tests/test_fourbar_peaks.py: against a dense brute-force oracle, and
+!>   against the 1 deg scan of pass_dense_scan on the shipped grid);
 !> * time ratio (a full turn, assembled throughout, no toggle, rocker oscillating): the crank
 !>   turns a = (crank angle of the upper rocker extreme - that of the lower) mod 360 on one
 !>   stroke and 360 - a on the other; the ratio is the slower over the quicker, >= 1.
@@ -57,7 +66,8 @@
 !> which other passes ran.
 module fourbar_summary
   use kinds, only: dp
-  use fourbar, only: exact_states, pose_block, rates_block, angles_block, nblk => nb, st_ok, st_no_assembly, st_toggle, &
+  use fourbar, only: exact_states, pose_block, rates_block, jerks_block, angles_block, nblk => nb, st_ok, &
+                     st_no_assembly, st_toggle, &
                      st_indeterminate
   implicit none
   private
@@ -78,8 +88,8 @@ module fourbar_summary
                                 gr_no_chain = 9, gr_flat_chain = 10
   !> passes (bits of summaries' passes argument)
   integer, parameter, public :: pass_transmission = 1, pass_rocker = 2, pass_peaks = 4, pass_all = 7
-  !> with pass_peaks: the previous peak search (every 1 deg grid point, no bisection below 1 deg),
-  !> kept as the baseline of bench/bench_sweep.py and of the tests
+  !> with pass_peaks: the previous peak scan (every 1 deg grid point, no bisection below 1 deg; its
+  !> brackets' roots found as above), kept as the baseline of bench/bench_sweep.py and of the tests
   integer, parameter, public :: pass_dense_scan = 8
 
   real(dp), parameter :: pi = 3.14159265358979323846_dp, twopi = 2*pi
@@ -109,13 +119,21 @@ module fourbar_summary
 
   integer, parameter :: lbp = 32              ! linkages per batched peak search
   !> one linkage's peak search (peaks_block): its grid, coarse and refined speeds (w(:, k): omega3,
-  !> alpha3, omega2, alpha2 at grid point k, together in memory), brackets
+  !> alpha3, omega2, alpha2 at grid point k, together in memory), brackets: [ba, bb] with alpha
+  !> fa, fb at its ends, of speed bcol (1 rocker, 2 coupler), the next point (then the root) tx,
+  !> omega at the root wr, state (br_*)
   type :: peakplan
     real(dp) :: p, q, r, s, sgn, omega, lo, hie, h
     integer :: branch, row, m, nco, nref, nb
-    integer :: ci(maxscan), rj(maxscan), bcol(maxbr), side(maxbr)
-    real(dp) :: w(4, maxscan), ba(maxbr), bb(maxbr), fa(maxbr), fb(maxbr), tx(maxbr)
+    integer :: ci(maxscan), rj(maxscan), bcol(maxbr), state(maxbr)
+    real(dp) :: w(4, maxscan), ba(maxbr), bb(maxbr), fa(maxbr), fb(maxbr), tx(maxbr), wr(maxbr), dxo(maxbr)
   end type peakplan
+  !> a bracket's state: its root still sought, found (tx, wr), or lost (a state not ok on the way)
+  integer, parameter :: br_open = 0, br_root = 1, br_lost = 2
+  !> a root is taken when the Newton step from a point is at most newton_tol [rad]: the next
+  !> iterate, within about newton_tol**2 of the root (quadratic convergence), and omega there from
+  !> the point's Taylor polynomial (omega, alpha, jerk), exact to O(newton_tol**3)
+  real(dp), parameter :: newton_tol = 1.0e-7_dp
 
 contains
 
@@ -157,7 +175,7 @@ contains
     ! p, q, r, s, branch sign, then the result and the status): the rocker angle at the
     ! candidates, the rocker speed halfway between them
     allocate (pl(lb), pk(lbp), rows(ncol, lb), qc(lb*maxcl, 8), qm(lb*maxcl + maxcl, 8))   ! qm: room for halfway
-    if (iand(passes, pass_peaks) /= 0) allocate (qs(maxscan*lbp + maxbr*lbp, 11), qg(maxscan*lbp, 11), &
+    if (iand(passes, pass_peaks) /= 0) allocate (qs(maxscan*lbp + maxbr*lbp, 13), qg(maxscan*lbp, 11), &
       who(maxscan*lbp + maxbr*lbp, 2), sd(2*maxscan*lbp, 5), okc(2*maxscan*lbp))
     do i0 = 1, n, lb
       m = min(lb, n - i0 + 1)
@@ -882,23 +900,24 @@ contains
   end subroutine smooth_steps
 
   !> Peak |omega3| and |omega2| over [lo, hie] (assembled throughout, no toggle) of the n
-  !> linkages of pk (one block): the grid of at most 1 deg, scanned coarsely and refined where
-  !> needed (module header), then every sign change of the matching angular acceleration
-  !> refined to 1e-12 rad.  Each stage evaluates the speeds of every linkage of the block in one
-  !> batched call (the coarse scan, the refined grid points, each regula falsi iteration, the
-  !> roots); a bracket advances exactly as it would alone, so the figures are the same bits.
+  !> linkages of pk (one block): the coarse scan, refined to the 1 deg grid where needed (module
+  !> header); every sign change of the matching angular acceleration is a bracket whose root is
+  !> found by safeguarded Newton steps on alpha (its derivative, the jerk, from the kernel),
+  !> started at the root of the cubic Hermite model's slope.  Each stage evaluates the speeds of
+  !> every linkage of the block in one batched call (the coarse scan, the refined grid points,
+  !> each Newton iteration of the brackets not yet converged).
   subroutine peaks_block(n, pk, dense, rows, qs, qg, who, sd, okc)
     integer, intent(in) :: n
     type(peakplan), intent(inout) :: pk(:)
     logical, intent(in) :: dense
     real(dp), intent(inout) :: rows(:, :)
-    ! queues (rows of batch_speeds) and work space for up to lbp linkages: qs the coarse scan, the
-    ! regula falsi and the roots; qg the refined grid points; who a queued row's linkage and bracket;
+    ! queues (rows of batch_speeds) and work space for up to lbp linkages: qs the coarse scan and
+    ! the Newton iterations; qg the refined grid points; who a queued row's linkage and bracket;
     ! sd, okc the smooth test's steps
     real(dp), intent(inout), contiguous :: qs(:, :), qg(:, :), sd(:, :), okc(:)
     integer, intent(inout) :: who(:, :)
     real(dp) :: tg(maxscan), g(maxscan, 4)
-    real(dp) :: hc, da, db, sg, av, bv, cv, qv, xs, qm, v, best(2), bestat(2), t
+    real(dp) :: hc, da, db, sg, av, bv, cv, qv, xs, qm, v, wv, jv, dx, tn, best(2), bestat(2)
     integer :: l, k, j, c, nq, nco, ka, kb, jr, it, iq, nr, ns
 
     ! ---- the coarse scan (first and last grid points included) of every linkage, one call
@@ -917,9 +936,10 @@ contains
         k = min(k + coarse_every, pk(l)%m)
       end do
       pk(l)%nco = nco
+      pk(l)%nb = 0
       call fill(pk(l), nq - nco + 1, nq)
     end do
-    call batch_speeds(nq, qs)
+    call batch_speeds(nq, qs, .false.)
     iq = 0
     do l = 1, n   ! (a linkage's coarse points are consecutive rows of qs)
       do j = 1, pk(l)%nco
@@ -928,8 +948,10 @@ contains
       iq = iq + pk(l)%nco
     end do
 
-    ! ---- the smooth test (see smooth) of every coarse interval, both speeds; the grid points
-    ! inside every coarse interval that is not smooth for both speeds, of every linkage, one call
+    ! ---- the coarse test of every coarse interval, both speeds: smooth (see smooth: no extremum
+    ! inside), or one clean crossing (alpha changes sign at the ends and the Hermite model's
+    ! slope, a quadratic, is monotonic with a margin: one root, a bracket as it stands); any other
+    ! interval is refined: its 1 deg grid points, of every linkage, in one call
     iq = 0
     nq = 0
     do l = 1, n
@@ -954,7 +976,8 @@ contains
           xs = 0.5_dp + (bv - av)/(2.0_dp*min(cv, -tiny(1.0_dp)))
           qm = merge(min(qv, av*(1.0_dp - xs) + bv*xs + cv*xs*(1.0_dp - xs)), qv, &
                      cv < 0.0_dp .and. xs > 0.0_dp .and. xs < 1.0_dp)
-          okc(j) = okc(j)*merge(1.0_dp, 0.0_dp, da*db > 0.0_dp .and. qm >= 0.5_dp*qv)
+          okc(j) = okc(j)*merge(1.0_dp, 0.0_dp, (da*db > 0.0_dp .and. qm >= 0.5_dp*qv) .or. &
+                                (da*db < 0.0_dp .and. abs(cv) <= 0.5_dp*(av - bv)))
         end do
       end do
       pk(l)%nref = 0
@@ -962,7 +985,13 @@ contains
       do j = 1, nco - 1
         ka = pk(l)%ci(j)
         kb = pk(l)%ci(j + 1)
-        if (okc(j) > 0.0_dp .and. kb - ka >= 2 .and. .not. dense) cycle
+        if (okc(j) > 0.0_dp .and. kb - ka >= 2 .and. .not. dense) then
+          do c = 1, 2
+            if (g(j, 2*c)*g(j + 1, 2*c) < 0.0_dp) call add_bracket(pk(l), tg(j), tg(j + 1), g(j, 2*c - 1), &
+                                                                   g(j + 1, 2*c - 1), g(j, 2*c), g(j + 1, 2*c), c)
+          end do
+          cycle
+        end if
         pk(l)%nref = pk(l)%nref + 1
         pk(l)%rj(pk(l)%nref) = j
         do k = ka + 1, kb - 1
@@ -973,7 +1002,7 @@ contains
       if (nq > nr) call fill_q(qg, pk(l), nr + 1, nq)
     end do
     if (nq > 0) then
-      call batch_speeds(nq, qg)
+      call batch_speeds(nq, qg, .false.)
       iq = 0
       do l = 1, n   ! (a linkage's refined points are consecutive rows of qg, in the order queued)
         do jr = 1, pk(l)%nref
@@ -985,10 +1014,10 @@ contains
       end do
     end if
 
-    ! ---- brackets of alpha sign changes on the grid of the refined intervals, both speeds (grid
-    ! order, as a full scan); a suspicious interval bisected (hidden), linkage by linkage
-    ! the smooth test of every such grid step first, all linkages and both speeds in one
-    ! vectorised loop (one step at a time, its two divisions would wait on each other)
+    ! ---- brackets of alpha sign changes on the grid of the refined intervals, both speeds; a
+    ! suspicious step bisected (hidden), linkage by linkage.  The smooth test of every such grid
+    ! step first, all linkages and both speeds in one vectorised loop (one step at a time, its
+    ! two divisions would wait on each other)
     ns = 0
     if (.not. dense) then
       do l = 1, n
@@ -1009,14 +1038,14 @@ contains
     end if
     ns = 0
     do l = 1, n
-      pk(l)%nb = 0
       do c = 1, 2
         do jr = 1, pk(l)%nref
           do k = pk(l)%ci(pk(l)%rj(jr)), pk(l)%ci(pk(l)%rj(jr) + 1) - 1
             ns = ns + 1
             associate (w => pk(l)%w)
               if (w(2*c, k)*w(2*c, k + 1) < 0.0_dp) then
-                call add_bracket(pk(l), grid_angle(pk(l), k), grid_angle(pk(l), k + 1), w(2*c, k), w(2*c, k + 1), c)
+                call add_bracket(pk(l), grid_angle(pk(l), k), grid_angle(pk(l), k + 1), w(2*c - 1, k), &
+                                 w(2*c - 1, k + 1), w(2*c, k), w(2*c, k + 1), c)
               else if (dense) then
                 cycle
               else if (okc(ns) == 0.0_dp) then
@@ -1029,66 +1058,70 @@ contains
       end do
     end do
 
-    ! ---- Illinois regula falsi: every bracket not yet converged, of every linkage, advanced in
-    ! one call per iteration
-    do it = 1, 60
+    ! ---- the roots: safeguarded Newton (rtsafe) on alpha, every open bracket of every linkage
+    ! advanced in one call per iteration.  A Newton step that would leave the bracket, or that
+    ! would not halve the step before last, is a bisection; the bracket shrinks with every point.
+    do it = 1, 100
       nq = 0
       do l = 1, n
         nr = nq
         do j = 1, pk(l)%nb
-          associate (ba => pk(l)%ba(j), bb => pk(l)%bb(j), fa => pk(l)%fa(j), fb => pk(l)%fb(j))
-            if (bb - ba > 1.0e-12_dp) then   ! (a converged bracket's tx is set with the final points)
-              t = (ba*fb - bb*fa)/(fb - fa)
-              t = min(max(t, ba), bb)
-              pk(l)%tx(j) = t
-              nq = nq + 1
-              qs(nq, 1) = t
-              who(nq, 1) = l
-              who(nq, 2) = j
-            end if
-          end associate
+          if (pk(l)%state(j) /= br_open) cycle
+          nq = nq + 1
+          qs(nq, 1) = pk(l)%tx(j)
+          who(nq, 1) = l
+          who(nq, 2) = j
         end do
         if (nq > nr) call fill(pk(l), nr + 1, nq)
       end do
       if (nq == 0) exit
-      call batch_speeds(nq, qs)
+      call batch_speeds(nq, qs, .true.)
       do iq = 1, nq
         l = who(iq, 1)
         j = who(iq, 2)
-        v = qs(iq, 6 + 2*pk(l)%bcol(j))
+        c = pk(l)%bcol(j)
         associate (ba => pk(l)%ba(j), bb => pk(l)%bb(j), fa => pk(l)%fa(j), fb => pk(l)%fb(j), &
-                   tx => pk(l)%tx(j), side => pk(l)%side(j))
+                   tx => pk(l)%tx(j), dxo => pk(l)%dxo(j), state => pk(l)%state(j), wr => pk(l)%wr(j))
+          if (nint(qs(iq, 11)) /= st_ok) then
+            state = br_lost
+            cycle
+          end if
+          wv = qs(iq, 5 + 2*c)
+          v = qs(iq, 6 + 2*c)
+          jv = qs(iq, 11 + c)
           if (v == 0.0_dp) then
-            ba = tx; bb = tx; fa = 0; fb = 0
+            state = br_root
+            wr = wv
             cycle
           end if
           if (sign(1.0_dp, v) == sign(1.0_dp, fa)) then
             ba = tx; fa = v
-            if (side == -1) fb = 0.5_dp*fb
-            side = -1
           else
             bb = tx; fb = v
-            if (side == 1) fa = 0.5_dp*fa
-            side = 1
           end if
+          dx = -v/jv
+          tn = tx + dx
+          if (.not. (tn > ba .and. tn < bb) .or. abs(2.0_dp*dx) > abs(dxo)) then
+            dx = 0.5_dp*(bb - ba)
+            tn = ba + dx
+            if (dx <= 0.5e-12_dp) then   ! (bisected to 1e-12 rad: the point taken)
+              state = br_root
+              wr = wv
+              cycle
+            end if
+          else if (abs(dx) <= newton_tol) then
+            state = br_root
+            tx = tn
+            wr = wv + dx*(v + 0.5_dp*jv*dx)
+            cycle
+          end if
+          dxo = dx
+          tx = tn
         end associate
       end do
     end do
 
-    ! ---- final points: the converged roots, every linkage in one call
-    nq = 0
-    do l = 1, n
-      nr = nq
-      do j = 1, pk(l)%nb
-        pk(l)%tx(j) = 0.5_dp*(pk(l)%ba(j) + pk(l)%bb(j))
-        nq = nq + 1
-        qs(nq, 1) = pk(l)%tx(j)
-      end do
-      if (nq > nr) call fill(pk(l), nr + 1, nq)
-    end do
-    if (nq > 0) call batch_speeds(nq, qs)
-    ! pick the largest |omega| among the range ends and the refined roots (earliest on ties)
-    iq = 0
+    ! pick the largest |omega| among the range ends and the roots (earliest on ties)
     do l = 1, n
       associate (w => pk(l)%w, m => pk(l)%m)
         do c = 1, 2
@@ -1099,12 +1132,10 @@ contains
           end if
         end do
       end associate
-      nr = pk(l)%nb
-      do j = 1, nr
-        iq = iq + 1
+      do j = 1, pk(l)%nb
+        if (pk(l)%state(j) /= br_root) cycle
         c = pk(l)%bcol(j)
-        v = qs(iq, 6 + 2*c - 1)
-        if (nint(qs(iq, 11)) /= st_ok) cycle
+        v = pk(l)%wr(j)
         if (abs(v) > abs(best(c)) .or. (abs(v) == abs(best(c)) .and. pk(l)%tx(j) < bestat(c))) then
           best(c) = v
           bestat(c) = pk(l)%tx(j)
@@ -1151,10 +1182,12 @@ contains
 
   !> The speeds of the n positions queued in q (columns 1-6: crank angle [rad], p, q, r, s,
   !> branch sign) at unit crank speed: columns 7-10 omega3, alpha3, omega2, alpha2 (the order of
-  !> speeds_at), 11 the status code; blocks of nblk positions, each with its own linkage.
-  subroutine batch_speeds(n, q)
+  !> speeds_at), 11 the status code, and with jerk 12-13 d alpha3 / d theta, d alpha2 / d theta;
+  !> blocks of nblk positions, each with its own linkage.
+  subroutine batch_speeds(n, q, jerk)
     integer, intent(in) :: n
     real(dp), intent(inout), contiguous :: q(:, :)
+    logical, intent(in) :: jerk
     real(dp) :: sn(nblk), c(nblk), xa(nblk), ya(nblk), xb(nblk), yb(nblk), e2x(nblk), e2y(nblk), e3x(nblk), &
                 e3y(nblk), s23(nblk), c23(nblk)
     integer :: k0, m
@@ -1166,19 +1199,47 @@ contains
       call rates_block(m, q(k0:k0 + m - 1, 3), q(k0:k0 + m - 1, 4), q(k0:k0 + m - 1, 5), 1.0_dp, 0.0_dp, &
                        sn, c, e2x, e2y, e3x, e3y, s23, c23, q(k0:k0 + m - 1, 11), q(k0:k0 + m - 1, 9), &
                        q(k0:k0 + m - 1, 7), q(k0:k0 + m - 1, 10), q(k0:k0 + m - 1, 8))
+      if (jerk) call jerks_block(m, q(k0:k0 + m - 1, 3), q(k0:k0 + m - 1, 4), q(k0:k0 + m - 1, 5), 1.0_dp, 0.0_dp, &
+                                 sn, c, e2x, e2y, e3x, e3y, s23, c23, q(k0:k0 + m - 1, 11), q(k0:k0 + m - 1, 9), &
+                                 q(k0:k0 + m - 1, 7), q(k0:k0 + m - 1, 10), q(k0:k0 + m - 1, 8), &
+                                 q(k0:k0 + m - 1, 13), q(k0:k0 + m - 1, 12))
     end do
   end subroutine batch_speeds
 
-  subroutine add_bracket(pk, a, b, da, db, col)
+  !> A bracket [a, b] of a sign change of alpha (speed col: 1 rocker, 2 coupler), omega ya, yb and
+  !> alpha da, db at its ends: its first point the root of the slope of omega's cubic Hermite
+  !> model, A (1 - x) + B x + C x (1 - x) with x = (t - a)/(b - a), A = da, B = db and C from the
+  !> mean slope (one root in (0, 1), the ends' slopes having opposite signs); the secant's root
+  !> where that is not found.
+  subroutine add_bracket(pk, a, b, ya, yb, da, db, col)
     type(peakplan), intent(inout) :: pk
-    real(dp), intent(in) :: a, b, da, db
+    real(dp), intent(in) :: a, b, ya, yb, da, db
     integer, intent(in) :: col
+    real(dp) :: h, cc, beta, disc, sq, x
     if (pk%nb >= maxbr) return
     pk%nb = pk%nb + 1
     pk%ba(pk%nb) = a; pk%bb(pk%nb) = b
     pk%fa(pk%nb) = da; pk%fb(pk%nb) = db
     pk%bcol(pk%nb) = col
-    pk%side(pk%nb) = 0
+    pk%state(pk%nb) = br_open
+    pk%dxo(pk%nb) = 2.0_dp*(b - a)
+    h = b - a
+    cc = 6.0_dp*((yb - ya)/h - 0.5_dp*(da + db))
+    ! slope da + beta x - cc x^2 = 0
+    beta = db - da + cc
+    x = da/(da - db)
+    disc = beta*beta + 4.0_dp*da*cc
+    if (cc /= 0.0_dp .and. disc >= 0.0_dp) then
+      sq = beta + sign(sqrt(disc), beta)
+      if (sq /= 0.0_dp) then
+        if (sq/(2.0_dp*cc) > 0.0_dp .and. sq/(2.0_dp*cc) < 1.0_dp) then
+          x = sq/(2.0_dp*cc)
+        else if (-2.0_dp*da/sq > 0.0_dp .and. -2.0_dp*da/sq < 1.0_dp) then
+          x = -2.0_dp*da/sq
+        end if
+      end if
+    end if
+    pk%tx(pk%nb) = a + x*h
   end subroutine add_bracket
 
   !> A grid interval whose ends agree in the sign of alpha but which is not smooth: bisected
@@ -1196,12 +1257,12 @@ contains
     ym = o(1, 2*col - 1)
     dm = o(1, 2*col)
     if (da*dm < 0.0_dp) then
-      call add_bracket(pk, a, tm(1), da, dm, col)
+      call add_bracket(pk, a, tm(1), ya, ym, da, dm, col)
     else if (.not. smooth(ya, ym, da, dm, tm(1) - a)) then
       call hidden(pk, a, tm(1), ya, ym, da, dm, col, depth + 1)
     end if
     if (dm*db < 0.0_dp) then
-      call add_bracket(pk, tm(1), b, dm, db, col)
+      call add_bracket(pk, tm(1), b, ym, yb, dm, db, col)
     else if (.not. smooth(ym, yb, dm, db, b - tm(1))) then
       call hidden(pk, tm(1), b, ym, yb, dm, db, col, depth + 1)
     end if

@@ -486,7 +486,8 @@ def extremes(p: Params, row: np.ndarray | None = None) -> Extremes | None:
 
     One row of the batch kernel (fortran/fourbar_summary.f90, see :func:`summarise_batch`),
     so a single run and a sweep report the same figures: transmission-angle and rocker
-    extremes in closed form, peak speeds from a 1 deg scan refined to 1e-12 rad.
+    extremes in closed form, peak speeds from a 6 deg scan (refined to 1 deg where an extremum
+    may hide) and Newton roots of the angular acceleration.
 
     Parameters
     ----------
