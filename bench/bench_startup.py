@@ -11,9 +11,10 @@ same rounds.  Targets: each small deck at most 2x ``import numpy``; ``--help`` a
 Two ways of running the tool are measured:
 
 * as configured: ``python -m driver`` in this environment.  In a development checkout
-  (``.ci/setup``: meson-python's editable install) every run checks the build with ninja and
-  compiles the tool's Python sources afresh (the editable loader writes no bytecode, and
-  ``PYTHONDONTWRITEBYTECODE`` may be set);
+  (``.ci/setup``: meson-python's editable install) every run checks the build with ninja; the
+  editable loader writes no bytecode (and ``PYTHONDONTWRITEBYTECODE`` may be set) but reads
+  what ``.ci/setup`` compiled (``compileall``), so only sources edited since are compiled
+  afresh;
 * bytecode cached, as an installed package runs: the same processes with their bytecode
   written to and read from a scratch ``PYTHONPYCACHEPREFIX`` (the editable loader's bytecode
   switch turned back on in the measured process only; nothing is written into the checkout).
