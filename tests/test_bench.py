@@ -64,3 +64,16 @@ def test_bench_optimize_times_the_kernels_the_optimiser_calls(capsys):
     assert 0 < kernel == pytest.approx(sum(by_kernel.values())) and kernel < wall
     text = capsys.readouterr().out
     assert "kernel time < 1 s:" in text and "evaluations <= 5 % of the grid's (5120):" in text
+
+
+def test_force_bytes_probe_runs(capsys):
+    """bench/probe_force_bytes.py compiles its Fortran probe with the kernels' flags and prints the
+    force kernel beside loops that only move its bytes (no timing asserted)."""
+    sys.path.insert(0, str(BENCH))
+    try:
+        import probe_force_bytes
+        probe_force_bytes.main(["--n", "20000", "--repeat", "3"])
+    finally:
+        sys.path.remove(str(BENCH))
+    text = capsys.readouterr().out
+    assert "force kernel" in text and "without its arithmetic" in text and "nan" not in text
