@@ -5,8 +5,9 @@ The oracle is written apart from the kernel: the loop closed by intersecting the
 rocker circles, the angular velocities from the two velocity equations (dotted with the rocker
 and the coupler directions), evaluated with numpy on a grid of 0.002 deg over the whole crank
 range.  The kernel scans coarsely (6 deg) and refines to 1 deg (and below) only where its test
-says an extremum may hide, and finds each root of the acceleration by Newton steps; it must never report a peak below the oracle's largest sampled speed
-(a missed extremum), and what it reports must be the oracle's speed at the reported crank angle.
+says an extremum may hide, and finds each root of the acceleration by Newton steps; it must
+never report a peak below the oracle's largest sampled speed (a missed extremum), and what it
+reports must be the oracle's speed at the reported crank angle.
 Linkages are drawn by hypothesis: any proportions, and near-toggle ones (coupler and rocker
 lengths within a relative 1e-10..1e-2 of a toggle), with the transmission angle kept at least
 1e-4 deg from 0 and 180 deg (closer, a toggle hides in the rounding of the closed-form count).
