@@ -31,7 +31,7 @@ FLAGS = ["-O3", "-march=native", "-mprefer-vector-width=512", "-ffp-contract=off
 
 
 def probe(n: int, repeat: int) -> dict[str, float]:
-    """ns/position of the probe's loops (medians inside the Fortran program)."""
+    """ns/position of the probe's loops (medians of the times the Fortran program prints)."""
     gfortran = shutil.which("gfortran")
     if gfortran is None:
         raise SystemExit("gfortran is needed to compile the probe")
@@ -40,8 +40,8 @@ def probe(n: int, repeat: int) -> dict[str, float]:
         subprocess.run([gfortran, *FLAGS, "-J", tmp, str(ROOT / "fortran" / "kinds.f90"),
                         str(ROOT / "bench" / "probes" / "force_bytes.f90"), "-o", str(exe)], check=True)
         out = subprocess.run([str(exe), str(n), str(repeat)], check=True, capture_output=True, text=True).stdout
-    values = [float(v) for v in out.split()[5:9]]
-    return dict(zip(("fill", "move256", "move4096", "copy"), values))
+    runs = np.array([[float(v) for v in line.split()] for line in out.splitlines()[:repeat]])
+    return dict(zip(("fill", "move256", "move4096", "copy"), np.median(runs, axis=0) / n * 1e9))
 
 
 def kernel(n: int, repeat: int) -> dict[str, float]:

@@ -10,7 +10,7 @@
 !>          subtract or multiply each (the kernel's access pattern without its arithmetic);
 !>   copy   8 input columns copied one after another into 8 output columns, the other 4 filled
 !>          (numpy's copyto/fill reference of the bench row).
-!> Each timed `repeat` times, interleaved; medians printed as ns per position.
+!> Each timed `repeat` times, interleaved; every repeat's times printed (the caller takes medians).
 module force_bytes
   use kinds, only: dp
   use iso_fortran_env, only: int32
@@ -134,26 +134,10 @@ program probe_force_bytes
     call system_clock(t1)
     t(r, 4) = real(t1 - t0, dp)/rate
   end do
-  print '(a, 4(1x, f0.3), 1x, es10.3)', 'ns/position fill move256 move4096 copy', &
-    (median(t(:, i))/n*1.0e9_dp, i = 1, 4), sum(fout(1, :))
-
-contains
-
-  real(dp) function median(x)
-    real(dp), intent(in) :: x(:)
-    real(dp) :: y(size(x)), v
-    integer :: a, b
-    y = x
-    do a = 2, size(y)
-      v = y(a)
-      b = a - 1
-      do while (b >= 1)
-        if (y(b) <= v) exit
-        y(b + 1) = y(b)
-        b = b - 1
-      end do
-      y(b + 1) = v
-    end do
-    median = 0.5_dp*(y((size(y) + 1)/2) + y(size(y)/2 + 1))
-  end function median
+  ! every repeat's times [s] of fill, move256, move4096, copy, one line each (the caller takes
+  ! medians), then a checksum that keeps the stores
+  do r = 1, repeat
+    print '(4(es12.5, 1x))', t(r, :)
+  end do
+  print '(es12.5)', sum(fout(1, :))
 end program probe_force_bytes
