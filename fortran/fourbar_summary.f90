@@ -120,13 +120,13 @@ module fourbar_summary
   integer, parameter :: lbp = 32              ! linkages per batched peak search
   !> one linkage's peak search (peaks_block): its grid, coarse and refined speeds (w(:, k): omega3,
   !> alpha3, omega2, alpha2 at grid point k, together in memory), brackets: [ba, bb] with alpha
-  !> fa, fb at its ends, of speed bcol (1 rocker, 2 coupler), the next point (then the root) tx,
+  !> fa at its lower end (its sign tells the ends apart), of speed bcol (1 rocker, 2 coupler), the next point (then the root) tx,
   !> omega at the root wr, state (br_*)
   type :: peakplan
     real(dp) :: p, q, r, s, sgn, omega, lo, hie, h
     integer :: branch, row, m, nco, nref, nb
     integer :: ci(maxscan), rj(maxscan), bcol(maxbr), state(maxbr)
-    real(dp) :: w(4, maxscan), ba(maxbr), bb(maxbr), fa(maxbr), fb(maxbr), tx(maxbr), wr(maxbr), dxo(maxbr)
+    real(dp) :: w(4, maxscan), ba(maxbr), bb(maxbr), fa(maxbr), tx(maxbr), wr(maxbr), dxo(maxbr)
   end type peakplan
   !> a bracket's state: its root still sought, found (tx, wr), or lost (a state not ok on the way)
   integer, parameter :: br_open = 0, br_root = 1, br_lost = 2
@@ -1080,7 +1080,7 @@ contains
         l = who(iq, 1)
         j = who(iq, 2)
         c = pk(l)%bcol(j)
-        associate (ba => pk(l)%ba(j), bb => pk(l)%bb(j), fa => pk(l)%fa(j), fb => pk(l)%fb(j), &
+        associate (ba => pk(l)%ba(j), bb => pk(l)%bb(j), fa => pk(l)%fa(j), &
                    tx => pk(l)%tx(j), dxo => pk(l)%dxo(j), state => pk(l)%state(j), wr => pk(l)%wr(j))
           if (nint(qs(iq, 11)) /= st_ok) then
             state = br_lost
@@ -1094,10 +1094,10 @@ contains
             wr = wv
             cycle
           end if
-          if (sign(1.0_dp, v) == sign(1.0_dp, fa)) then
-            ba = tx; fa = v
+          if (sign(1.0_dp, v) == sign(1.0_dp, fa)) then   ! (alpha keeps its sign at each end)
+            ba = tx
           else
-            bb = tx; fb = v
+            bb = tx
           end if
           dx = -v/jv
           tn = tx + dx
@@ -1219,7 +1219,7 @@ contains
     if (pk%nb >= maxbr) return
     pk%nb = pk%nb + 1
     pk%ba(pk%nb) = a; pk%bb(pk%nb) = b
-    pk%fa(pk%nb) = da; pk%fb(pk%nb) = db
+    pk%fa(pk%nb) = da
     pk%bcol(pk%nb) = col
     pk%state(pk%nb) = br_open
     pk%dxo(pk%nb) = 2.0_dp*(b - a)
